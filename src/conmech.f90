@@ -1,0 +1,12 @@
+!> conmech: mechanical systems with constraints and the stability of their motions.
+!!
+!! `use conmech` gives the public API of every layer.
+module conmech
+    use conmech_kinds
+    use conmech_status
+    use conmech_lapack, only: la_solve, la_eig, la_sym_eig, la_det
+    use conmech_ode_system
+    use conmech_ode_solver
+    implicit none
+    public
+end module conmech

@@ -1,0 +1,269 @@
+!> Explicit interfaces to the LAPACK routines conmech uses, and small safe wrappers.
+!!
+!! All linear algebra of the library goes through LAPACK (system LAPACK/BLAS, linked by
+!! fpm.toml and meson.build). The wrappers allocate their own workspace (after a workspace
+!! query where LAPACK offers one) and return an `info` code from `conmech_status`.
+module conmech_lapack
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_SINGULAR, CM_LAPACK_ERROR, CM_BAD_INPUT, &
+        CM_NO_CONVERGENCE
+    implicit none
+    private
+
+    public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
+        dgelsy, dlange, dpstrf, dgesvd, dgeqp3
+    public :: la_solve, la_eig, la_sym_eig, la_det
+
+    interface
+        subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            integer, intent(in) :: n, nrhs, lda, ldb
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgesv
+        subroutine dgetrf(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetrf
+        subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgetrs
+        subroutine dgecon(norm, n, a, lda, anorm, rcond, work, iwork, info)
+            import :: dp
+            character(len=1), intent(in) :: norm
+            integer, intent(in) :: n, lda
+            real(dp), intent(in) :: a(lda, *), anorm
+            real(dp), intent(out) :: rcond, work(*)
+            integer, intent(out) :: iwork(*), info
+        end subroutine dgecon
+        function dlange(norm, m, n, a, lda, work) result(r)
+            import :: dp
+            character(len=1), intent(in) :: norm
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: work(*)
+            real(dp) :: r
+        end function dlange
+        subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, info)
+            import :: dp
+            character(len=1), intent(in) :: jobvl, jobvr
+            integer, intent(in) :: n, lda, ldvl, ldvr, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            real(dp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
+            integer, intent(out) :: info
+        end subroutine dgeev
+        subroutine dpotrf(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotrf
+        subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, nrhs, lda, ldb
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dpotrs
+        subroutine dpstrf(uplo, n, a, lda, piv, rank, tol, work, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: piv(*), rank, info
+            real(dp), intent(in) :: tol
+            real(dp), intent(out) :: work(*)
+        end subroutine dpstrf
+        subroutine dsysv(uplo, n, nrhs, a, lda, ipiv, b, ldb, work, lwork, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, nrhs, lda, ldb, lwork
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            integer, intent(out) :: ipiv(*), info
+            real(dp), intent(out) :: work(*)
+        end subroutine dsysv
+        subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+            import :: dp
+            character(len=1), intent(in) :: jobz, uplo
+            integer, intent(in) :: n, lda, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            real(dp), intent(out) :: w(*), work(*)
+            integer, intent(out) :: info
+        end subroutine dsyev
+        subroutine dgelsd(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, iwork, info)
+            import :: dp
+            integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            real(dp), intent(out) :: s(*), work(*)
+            real(dp), intent(in) :: rcond
+            integer, intent(out) :: rank, iwork(*), info
+        end subroutine dgelsd
+        subroutine dgelsy(m, n, nrhs, a, lda, b, ldb, jpvt, rcond, rank, work, lwork, info)
+            import :: dp
+            integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            integer, intent(inout) :: jpvt(*)
+            real(dp), intent(in) :: rcond
+            integer, intent(out) :: rank, info
+            real(dp), intent(out) :: work(*)
+        end subroutine dgelsy
+        subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
+            import :: dp
+            character(len=1), intent(in) :: jobu, jobvt
+            integer, intent(in) :: m, n, lda, ldu, ldvt, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            real(dp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
+            integer, intent(out) :: info
+        end subroutine dgesvd
+        subroutine dgeqp3(m, n, a, lda, jpvt, tau, work, lwork, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(inout) :: jpvt(*)
+            real(dp), intent(out) :: tau(*), work(*)
+            integer, intent(out) :: info
+        end subroutine dgeqp3
+    end interface
+
+contains
+
+    !> Solve A X = B for a general square A by LU (dgesv). A and B are not changed.
+    !! info = CM_SINGULAR if A is exactly singular or its reciprocal condition number
+    !! (1-norm, dgecon) is below `rcond_min` (default 1e3*epsilon).
+    subroutine la_solve(a, b, x, info, rcond_min)
+        real(dp), intent(in) :: a(:, :), b(:, :)
+        real(dp), intent(out) :: x(:, :)
+        integer, intent(out) :: info
+        real(dp), intent(in), optional :: rcond_min
+        real(dp), allocatable :: lu(:, :), work(:)
+        integer, allocatable :: ipiv(:), iwork(:)
+        integer :: n, nrhs, lainfo
+        real(dp) :: anorm, rcond, rmin
+        n = size(a, 1)
+        nrhs = size(b, 2)
+        if (size(a, 2) /= n .or. size(b, 1) /= n .or. size(x, 1) /= n .or. &
+            size(x, 2) /= nrhs) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        rmin = 1.0e3_dp*epsilon(1.0_dp)
+        if (present(rcond_min)) rmin = rcond_min
+        allocate (lu(n, n), ipiv(n), work(4*n), iwork(n))
+        lu = a
+        anorm = dlange('1', n, n, lu, n, work)
+        call dgetrf(n, n, lu, n, ipiv, lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+            return
+        else if (lainfo > 0) then
+            info = CM_SINGULAR
+            return
+        end if
+        call dgecon('1', n, lu, n, anorm, rcond, work, iwork, lainfo)
+        if (rcond < rmin) then
+            info = CM_SINGULAR
+            return
+        end if
+        x = b
+        call dgetrs('N', n, nrhs, lu, n, ipiv, x, n, lainfo)
+        info = CM_SUCCESS
+    end subroutine la_solve
+
+    !> Eigenvalues (and optionally right eigenvectors) of a general real matrix (dgeev).
+    subroutine la_eig(a, wr, wi, info, vr)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: wr(:), wi(:)
+        integer, intent(out) :: info
+        real(dp), intent(out), optional :: vr(:, :)
+        real(dp), allocatable :: tmp(:, :), work(:), vl(:, :), v(:, :)
+        real(dp) :: wq(1)
+        integer :: n, lwork, lainfo
+        character(len=1) :: jobvr
+        n = size(a, 1)
+        if (size(a, 2) /= n .or. size(wr) /= n .or. size(wi) /= n) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        jobvr = 'N'
+        if (present(vr)) jobvr = 'V'
+        allocate (tmp(n, n), vl(1, 1), v(n, n))
+        tmp = a
+        call dgeev('N', jobvr, n, tmp, n, wr, wi, vl, 1, v, n, wq, -1, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork))
+        call dgeev('N', jobvr, n, tmp, n, wr, wi, vl, 1, v, n, work, lwork, lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = CM_NO_CONVERGENCE
+        else
+            info = CM_SUCCESS
+            if (present(vr)) vr = v
+        end if
+    end subroutine la_eig
+
+    !> Eigenvalues (ascending) and optionally eigenvectors of a symmetric matrix (dsyev).
+    subroutine la_sym_eig(a, w, info, v)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: w(:)
+        integer, intent(out) :: info
+        real(dp), intent(out), optional :: v(:, :)
+        real(dp), allocatable :: tmp(:, :), work(:)
+        real(dp) :: wq(1)
+        integer :: n, lwork, lainfo
+        character(len=1) :: jobz
+        n = size(a, 1)
+        if (size(a, 2) /= n .or. size(w) /= n) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        jobz = 'N'
+        if (present(v)) jobz = 'V'
+        allocate (tmp(n, n))
+        tmp = a
+        call dsyev(jobz, 'U', n, tmp, n, w, wq, -1, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork))
+        call dsyev(jobz, 'U', n, tmp, n, w, work, lwork, lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = CM_NO_CONVERGENCE
+        else
+            info = CM_SUCCESS
+            if (present(v)) v = tmp
+        end if
+    end subroutine la_sym_eig
+
+    !> Determinant of a general square matrix from its LU factorisation (dgetrf).
+    function la_det(a) result(d)
+        real(dp), intent(in) :: a(:, :)
+        real(dp) :: d
+        real(dp), allocatable :: lu(:, :)
+        integer, allocatable :: ipiv(:)
+        integer :: n, i, lainfo
+        n = size(a, 1)
+        allocate (lu(n, n), ipiv(n))
+        lu = a
+        call dgetrf(n, n, lu, n, ipiv, lainfo)
+        if (lainfo < 0) then
+            d = 0.0_dp
+            return
+        end if
+        d = 1.0_dp
+        do i = 1, n
+            d = d*lu(i, i)
+            if (ipiv(i) /= i) d = -d
+        end do
+    end function la_det
+
+end module conmech_lapack

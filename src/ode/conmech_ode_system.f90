@@ -1,0 +1,140 @@
+!> The system interface of conmech's integrators.
+!!
+!! A first-order system y' = f(t, y) is an extension of the abstract type `ode_system`:
+!! users add their parameters as components and implement `rhs`. The Jacobian df/dy is
+!! optional: the default `jacobian` is a central finite difference (step
+!! h_j = eps^(1/3) * max(|y_j|, 1)), and `has_jacobian` tells whether an analytic one exists.
+!!
+!! For simple use, `ode_function` wraps a plain procedure `f(t, y, dydt)` (and optionally
+!! `jac(t, y, dfdy)`) without a derived type of one's own.
+!!
+!! Events are an extension of `ode_events`: `eval` fills g(1:n_events) at (t, y); the
+!! components `direction` (+1 rising only, -1 falling only, 0 both) and `terminal` say which
+!! zero crossings count and which stop the integration.
+module conmech_ode_system
+    use conmech_kinds, only: dp
+    implicit none
+    private
+
+    public :: ode_system, ode_function, ode_events, rhs_proc, jac_proc
+
+    type, abstract :: ode_system
+    contains
+        procedure(ode_rhs), deferred :: rhs
+        procedure :: jacobian => ode_fd_jacobian
+        procedure :: has_jacobian => ode_no_jacobian
+    end type ode_system
+
+    abstract interface
+        !> dydt = f(t, y).
+        subroutine ode_rhs(self, t, y, dydt)
+            import :: ode_system, dp
+            class(ode_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: y(:)
+            real(dp), intent(out) :: dydt(:)
+        end subroutine ode_rhs
+        !> Plain right-hand side procedure.
+        subroutine rhs_proc(t, y, dydt)
+            import :: dp
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: y(:)
+            real(dp), intent(out) :: dydt(:)
+        end subroutine rhs_proc
+        !> Plain Jacobian procedure: dfdy(i, j) = d f_i / d y_j.
+        subroutine jac_proc(t, y, dfdy)
+            import :: dp
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: y(:)
+            real(dp), intent(out) :: dfdy(:, :)
+        end subroutine jac_proc
+    end interface
+
+    !> A system given by plain procedures.
+    type, extends(ode_system) :: ode_function
+        procedure(rhs_proc), pointer, nopass :: f => null()
+        procedure(jac_proc), pointer, nopass :: jac => null()
+    contains
+        procedure :: rhs => function_rhs
+        procedure :: jacobian => function_jacobian
+        procedure :: has_jacobian => function_has_jacobian
+    end type ode_function
+
+    type, abstract :: ode_events
+        integer, allocatable :: direction(:)   !! +1 rising, -1 falling, 0 both
+        logical, allocatable :: terminal(:)    !! stop the integration at this event
+    contains
+        procedure(event_eval), deferred :: eval
+        procedure :: n_events => events_count
+    end type ode_events
+
+    abstract interface
+        !> g(1:n_events) = event functions at (t, y).
+        subroutine event_eval(self, t, y, g)
+            import :: ode_events, dp
+            class(ode_events), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: y(:)
+            real(dp), intent(out) :: g(:)
+        end subroutine event_eval
+    end interface
+
+contains
+
+    !> Central finite-difference Jacobian, step h_j = eps^(1/3) max(|y_j|, 1).
+    subroutine ode_fd_jacobian(self, t, y, dfdy)
+        class(ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        real(dp) :: yp(size(y)), fp(size(y)), fm(size(y)), h
+        integer :: j
+        yp = y
+        do j = 1, size(y)
+            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(y(j)), 1.0_dp)
+            yp(j) = y(j) + h
+            call self%rhs(t, yp, fp)
+            yp(j) = y(j) - h
+            call self%rhs(t, yp, fm)
+            yp(j) = y(j)
+            dfdy(:, j) = (fp - fm)/(2.0_dp*h)
+        end do
+    end subroutine ode_fd_jacobian
+
+    logical function ode_no_jacobian(self)
+        class(ode_system), intent(in) :: self
+        ode_no_jacobian = .false.
+    end function ode_no_jacobian
+
+    subroutine function_rhs(self, t, y, dydt)
+        class(ode_function), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        call self%f(t, y, dydt)
+    end subroutine function_rhs
+
+    subroutine function_jacobian(self, t, y, dfdy)
+        class(ode_function), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        if (associated(self%jac)) then
+            call self%jac(t, y, dfdy)
+        else
+            call ode_fd_jacobian(self, t, y, dfdy)
+        end if
+    end subroutine function_jacobian
+
+    logical function function_has_jacobian(self)
+        class(ode_function), intent(in) :: self
+        function_has_jacobian = associated(self%jac)
+    end function function_has_jacobian
+
+    integer function events_count(self)
+        class(ode_events), intent(in) :: self
+        events_count = 0
+        if (allocated(self%direction)) events_count = size(self%direction)
+    end function events_count
+
+end module conmech_ode_system
