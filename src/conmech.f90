@@ -7,6 +7,8 @@ module conmech
     use conmech_lapack, only: la_solve, la_eig, la_sym_eig, la_det
     use conmech_ode_system
     use conmech_ode_solver
+    use conmech_systems_basic
+    use conmech_systems
     implicit none
     public
 end module conmech

@@ -1,0 +1,78 @@
+!> Registry of the built-in systems by name, for the apps and the Python layer.
+!!
+!! `make_system(name, params, sys, info, msg)` allocates the built-in first-order system
+!! called `name` with the parameters `params` (in the documented order; missing trailing
+!! parameters keep their defaults). Each layer adds its systems here, one `case` each.
+module conmech_systems
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_ode_system, only: ode_system
+    use conmech_systems_basic
+    implicit none
+    private
+    public :: make_system, system_dimension
+
+contains
+
+    !> Allocate a built-in system by name. Parameters (in order):
+    !! harmonic: omega | pendulum: g, l | kepler: mu | arenstorf: mu | vanderpol: mu
+    subroutine make_system(name, params, sys, info, msg)
+        character(len=*), intent(in) :: name
+        real(dp), intent(in) :: params(:)
+        class(ode_system), allocatable, intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_SUCCESS
+        msg = "success"
+        select case (trim(name))
+        case ("harmonic")
+            block
+                type(harmonic_oscillator) :: s
+                if (size(params) >= 1) s%omega = params(1)
+                allocate (sys, source=s)
+            end block
+        case ("pendulum")
+            block
+                type(pendulum_theta) :: s
+                if (size(params) >= 1) s%g = params(1)
+                if (size(params) >= 2) s%l = params(2)
+                allocate (sys, source=s)
+            end block
+        case ("kepler")
+            block
+                type(kepler_2d) :: s
+                if (size(params) >= 1) s%mu = params(1)
+                allocate (sys, source=s)
+            end block
+        case ("arenstorf")
+            block
+                type(arenstorf) :: s
+                if (size(params) >= 1) s%mu = params(1)
+                allocate (sys, source=s)
+            end block
+        case ("vanderpol")
+            block
+                type(van_der_pol) :: s
+                if (size(params) >= 1) s%mu = params(1)
+                allocate (sys, source=s)
+            end block
+        case default
+            info = CM_BAD_INPUT
+            msg = "bad input: unknown built-in system '"//trim(name)//"'"
+        end select
+    end subroutine make_system
+
+    !> State dimension of a built-in system (0 if unknown).
+    integer function system_dimension(name) result(n)
+        character(len=*), intent(in) :: name
+        select case (trim(name))
+        case ("harmonic", "pendulum", "vanderpol")
+            n = 2
+        case ("kepler", "arenstorf")
+            n = 4
+        case default
+            n = 0
+        end select
+    end function system_dimension
+
+end module conmech_systems

@@ -1,0 +1,174 @@
+!> Basic built-in first-order systems: harmonic oscillator, pendulum (theta), planar
+!! two-body (Kepler) problem, Arenstorf's restricted three-body problem, Van der Pol.
+!! Each has an analytic Jacobian (used by variational equations).
+module conmech_systems_basic
+    use conmech_kinds, only: dp
+    use conmech_ode_system, only: ode_system
+    implicit none
+    private
+    public :: harmonic_oscillator, pendulum_theta, kepler_2d, arenstorf, van_der_pol
+
+    !> x'' = -omega^2 x; y = [x, v].
+    type, extends(ode_system) :: harmonic_oscillator
+        real(dp) :: omega = 1.0_dp
+    contains
+        procedure :: rhs => ho_rhs
+        procedure :: jacobian => ho_jac
+        procedure :: has_jacobian => yes
+    end type harmonic_oscillator
+
+    !> theta'' = -(g/l) sin theta; y = [theta, theta'].
+    type, extends(ode_system) :: pendulum_theta
+        real(dp) :: g = 9.81_dp
+        real(dp) :: l = 1.0_dp
+    contains
+        procedure :: rhs => pend_rhs
+        procedure :: jacobian => pend_jac
+        procedure :: has_jacobian => yes
+        procedure :: energy => pend_energy
+    end type pendulum_theta
+
+    !> r'' = -mu r/|r|^3 in the plane; y = [x, y, vx, vy].
+    type, extends(ode_system) :: kepler_2d
+        real(dp) :: mu = 1.0_dp
+    contains
+        procedure :: rhs => kep_rhs
+        procedure :: jacobian => kep_jac
+        procedure :: has_jacobian => yes
+        procedure :: energy => kep_energy
+    end type kepler_2d
+
+    !> Restricted three-body problem in Arenstorf's rotating frame; y = [x, y, vx, vy].
+    type, extends(ode_system) :: arenstorf
+        real(dp) :: mu = 0.012277471_dp
+    contains
+        procedure :: rhs => are_rhs
+        procedure :: has_jacobian => no
+    end type arenstorf
+
+    !> x'' = mu (1 - x^2) x' - x; y = [x, x'].
+    type, extends(ode_system) :: van_der_pol
+        real(dp) :: mu = 1.0_dp
+    contains
+        procedure :: rhs => vdp_rhs
+        procedure :: jacobian => vdp_jac
+        procedure :: has_jacobian => yes
+    end type van_der_pol
+
+contains
+
+    logical function yes(self)
+        class(ode_system), intent(in) :: self
+        yes = .true.
+    end function yes
+
+    logical function no(self)
+        class(ode_system), intent(in) :: self
+        no = .false.
+    end function no
+
+    subroutine ho_rhs(self, t, y, dydt)
+        class(harmonic_oscillator), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt(1) = y(2)
+        dydt(2) = -self%omega**2*y(1)
+    end subroutine ho_rhs
+
+    subroutine ho_jac(self, t, y, dfdy)
+        class(harmonic_oscillator), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        dfdy = reshape([0.0_dp, -self%omega**2, 1.0_dp, 0.0_dp], [2, 2])
+    end subroutine ho_jac
+
+    subroutine pend_rhs(self, t, y, dydt)
+        class(pendulum_theta), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt(1) = y(2)
+        dydt(2) = -(self%g/self%l)*sin(y(1))
+    end subroutine pend_rhs
+
+    subroutine pend_jac(self, t, y, dfdy)
+        class(pendulum_theta), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        dfdy = reshape([0.0_dp, -(self%g/self%l)*cos(y(1)), 1.0_dp, 0.0_dp], [2, 2])
+    end subroutine pend_jac
+
+    !> Energy per unit mass l^2: theta'^2/2 - (g/l) cos theta.
+    pure real(dp) function pend_energy(self, y)
+        class(pendulum_theta), intent(in) :: self
+        real(dp), intent(in) :: y(:)
+        pend_energy = 0.5_dp*y(2)**2 - (self%g/self%l)*cos(y(1))
+    end function pend_energy
+
+    subroutine kep_rhs(self, t, y, dydt)
+        class(kepler_2d), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp) :: r3
+        r3 = (y(1)**2 + y(2)**2)**1.5_dp
+        dydt(1) = y(3)
+        dydt(2) = y(4)
+        dydt(3) = -self%mu*y(1)/r3
+        dydt(4) = -self%mu*y(2)/r3
+    end subroutine kep_rhs
+
+    subroutine kep_jac(self, t, y, dfdy)
+        class(kepler_2d), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        real(dp) :: r2, r3, r5
+        r2 = y(1)**2 + y(2)**2
+        r3 = r2*sqrt(r2)
+        r5 = r3*r2
+        dfdy = 0.0_dp
+        dfdy(1, 3) = 1.0_dp
+        dfdy(2, 4) = 1.0_dp
+        dfdy(3, 1) = self%mu*(3.0_dp*y(1)**2/r5 - 1.0_dp/r3)
+        dfdy(3, 2) = self%mu*3.0_dp*y(1)*y(2)/r5
+        dfdy(4, 1) = dfdy(3, 2)
+        dfdy(4, 2) = self%mu*(3.0_dp*y(2)**2/r5 - 1.0_dp/r3)
+    end subroutine kep_jac
+
+    pure real(dp) function kep_energy(self, y)
+        class(kepler_2d), intent(in) :: self
+        real(dp), intent(in) :: y(:)
+        kep_energy = 0.5_dp*(y(3)**2 + y(4)**2) - self%mu/sqrt(y(1)**2 + y(2)**2)
+    end function kep_energy
+
+    subroutine are_rhs(self, t, y, dydt)
+        class(arenstorf), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp) :: d1, d2, mp
+        mp = 1.0_dp - self%mu
+        d1 = ((y(1) + self%mu)**2 + y(2)**2)**1.5_dp
+        d2 = ((y(1) - mp)**2 + y(2)**2)**1.5_dp
+        dydt(1) = y(3)
+        dydt(2) = y(4)
+        dydt(3) = y(1) + 2.0_dp*y(4) - mp*(y(1) + self%mu)/d1 - self%mu*(y(1) - mp)/d2
+        dydt(4) = y(2) - 2.0_dp*y(3) - mp*y(2)/d1 - self%mu*y(2)/d2
+    end subroutine are_rhs
+
+    subroutine vdp_rhs(self, t, y, dydt)
+        class(van_der_pol), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt(1) = y(2)
+        dydt(2) = self%mu*(1.0_dp - y(1)**2)*y(2) - y(1)
+    end subroutine vdp_rhs
+
+    subroutine vdp_jac(self, t, y, dfdy)
+        class(van_der_pol), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        dfdy(1, 1) = 0.0_dp
+        dfdy(1, 2) = 1.0_dp
+        dfdy(2, 1) = -2.0_dp*self%mu*y(1)*y(2) - 1.0_dp
+        dfdy(2, 2) = self%mu*(1.0_dp - y(1)**2)
+    end subroutine vdp_jac
+
+end module conmech_systems_basic
