@@ -14,7 +14,7 @@ module conmech_systems_basic
     contains
         procedure :: rhs => ho_rhs
         procedure :: jacobian => ho_jac
-        procedure :: has_jacobian => yes
+        procedure :: has_jacobian => ho_has_jac
     end type harmonic_oscillator
 
     !> theta'' = -(g/l) sin theta; y = [theta, theta'].
@@ -24,7 +24,7 @@ module conmech_systems_basic
     contains
         procedure :: rhs => pend_rhs
         procedure :: jacobian => pend_jac
-        procedure :: has_jacobian => yes
+        procedure :: has_jacobian => pend_has_jac
         procedure :: energy => pend_energy
     end type pendulum_theta
 
@@ -34,7 +34,7 @@ module conmech_systems_basic
     contains
         procedure :: rhs => kep_rhs
         procedure :: jacobian => kep_jac
-        procedure :: has_jacobian => yes
+        procedure :: has_jacobian => kep_has_jac
         procedure :: energy => kep_energy
     end type kepler_2d
 
@@ -43,7 +43,6 @@ module conmech_systems_basic
         real(dp) :: mu = 0.012277471_dp
     contains
         procedure :: rhs => are_rhs
-        procedure :: has_jacobian => no
     end type arenstorf
 
     !> x'' = mu (1 - x^2) x' - x; y = [x, x'].
@@ -52,20 +51,30 @@ module conmech_systems_basic
     contains
         procedure :: rhs => vdp_rhs
         procedure :: jacobian => vdp_jac
-        procedure :: has_jacobian => yes
+        procedure :: has_jacobian => vdp_has_jac
     end type van_der_pol
 
 contains
 
-    logical function yes(self)
-        class(ode_system), intent(in) :: self
-        yes = .true.
-    end function yes
+    logical function ho_has_jac(self)
+        class(harmonic_oscillator), intent(in) :: self
+        ho_has_jac = .true.
+    end function ho_has_jac
 
-    logical function no(self)
-        class(ode_system), intent(in) :: self
-        no = .false.
-    end function no
+    logical function pend_has_jac(self)
+        class(pendulum_theta), intent(in) :: self
+        pend_has_jac = .true.
+    end function pend_has_jac
+
+    logical function kep_has_jac(self)
+        class(kepler_2d), intent(in) :: self
+        kep_has_jac = .true.
+    end function kep_has_jac
+
+    logical function vdp_has_jac(self)
+        class(van_der_pol), intent(in) :: self
+        vdp_has_jac = .true.
+    end function vdp_has_jac
 
     subroutine ho_rhs(self, t, y, dydt)
         class(harmonic_oscillator), intent(in) :: self
