@@ -1,0 +1,184 @@
+!> Mechanical systems in generalized coordinates: M(t, q) q'' = Q(t, q, q').
+!!
+!! A user extends `generalized_system` with the parameters as components and implements
+!! `mass` (the symmetric positive definite mass matrix M(t, q)) and `forces` (the
+!! generalized forces Q(t, q, q'), including the velocity terms of the Euler-Lagrange
+!! equations). `energy` is optional (`has_energy` says whether it is defined).
+!!
+!! `generalized_ode` wraps such a system as a first-order `ode_system` with y = [q, q']:
+!! the accelerations come from a Cholesky factorisation of M (LAPACK dpotrf/dpotrs). The
+!! ODE interface has no status argument, so a mass matrix that is not positive definite
+!! makes the right-hand side NaN (the integrators then stop with CM_NONFINITE);
+!! `generalized_accel` and `generalized_solve` check M first and return CM_SINGULAR with a
+!! message instead.
+module conmech_generalized
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_lapack, only: dpotrf, dpotrs
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: ode_options, ode_result, ode_solve
+    implicit none
+    private
+
+    public :: generalized_system, generalized_ode, generalized_accel, generalized_solve
+    public :: mass_cholesky
+
+    !> A system M(t, q) q'' = Q(t, q, q') with `ndof` generalized coordinates.
+    type, abstract :: generalized_system
+        integer :: ndof = 0   !! number of generalized coordinates
+    contains
+        procedure(gen_mass), deferred :: mass
+        procedure(gen_forces), deferred :: forces
+        procedure :: energy => gen_no_energy
+        procedure :: has_energy => gen_has_no_energy
+    end type generalized_system
+
+    abstract interface
+        !> mm = M(t, q), symmetric positive definite (ndof x ndof).
+        subroutine gen_mass(self, t, q, mm)
+            import :: generalized_system, dp
+            class(generalized_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:)
+            real(dp), intent(out) :: mm(:, :)
+        end subroutine gen_mass
+        !> f = Q(t, q, v): generalized forces including the velocity terms.
+        subroutine gen_forces(self, t, q, v, f)
+            import :: generalized_system, dp
+            class(generalized_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:)
+            real(dp), intent(out) :: f(:)
+        end subroutine gen_forces
+    end interface
+
+    !> First-order form y = [q, v], y' = [v, M^{-1} Q] of a generalized system.
+    type, extends(ode_system) :: generalized_ode
+        class(generalized_system), allocatable :: mech   !! the mechanical system
+    contains
+        procedure :: rhs => genode_rhs
+    end type generalized_ode
+
+contains
+
+    !> Default energy: not defined (returns 0; `has_energy` is false).
+    function gen_no_energy(self, t, q, v) result(e)
+        class(generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp) :: e
+        e = 0.0_dp
+    end function gen_no_energy
+
+    logical function gen_has_no_energy(self)
+        class(generalized_system), intent(in) :: self
+        gen_has_no_energy = .false.
+    end function gen_has_no_energy
+
+    !> Cholesky factor (upper, in place) of an SPD matrix, with a clear status:
+    !! CM_SINGULAR if dpotrf fails or the factor's diagonal ratio squared is below 1e-14
+    !! (numerically singular mass matrix).
+    subroutine mass_cholesky(mm, info, msg)
+        real(dp), intent(inout) :: mm(:, :)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        integer :: n, lainfo, i
+        real(dp) :: dmin, dmax
+        character(len=16) :: buf
+        n = size(mm, 1)
+        info = CM_SUCCESS
+        msg = "success"
+        if (size(mm, 2) /= n) then
+            info = CM_BAD_INPUT
+            msg = "bad input: the mass matrix is not square"
+            return
+        end if
+        call dpotrf('U', n, mm, n, lainfo)
+        if (lainfo /= 0) then
+            info = CM_SINGULAR
+            write (buf, '(i0)') lainfo
+            msg = "singular mass matrix: not symmetric positive definite (dpotrf info=" &
+                  //trim(buf)//")"
+            return
+        end if
+        dmin = huge(1.0_dp)
+        dmax = 0.0_dp
+        do i = 1, n
+            dmin = min(dmin, abs(mm(i, i)))
+            dmax = max(dmax, abs(mm(i, i)))
+        end do
+        if ((dmin/dmax)**2 < 1.0e-14_dp) then
+            info = CM_SINGULAR
+            msg = "singular mass matrix: numerically singular (condition > 1e14)"
+        end if
+    end subroutine mass_cholesky
+
+    !> Accelerations a = M(t, q)^{-1} Q(t, q, v), with a status.
+    subroutine generalized_accel(mech, t, q, v, a, info, msg)
+        class(generalized_system), intent(in) :: mech
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: mm(mech%ndof, mech%ndof)
+        integer :: n, lainfo
+        n = mech%ndof
+        if (n < 1 .or. size(q) /= n .or. size(v) /= n .or. size(a) /= n) then
+            info = CM_BAD_INPUT
+            msg = "bad input: q, v and a must have ndof elements (ndof >= 1)"
+            return
+        end if
+        call mech%mass(t, q, mm)
+        call mech%forces(t, q, v, a)
+        call mass_cholesky(mm, info, msg)
+        if (info /= CM_SUCCESS) return
+        call dpotrs('U', n, 1, mm, n, a, n, lainfo)
+    end subroutine generalized_accel
+
+    subroutine genode_rhs(self, t, y, dydt)
+        class(generalized_ode), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        integer :: n, info
+        character(len=:), allocatable :: msg
+        n = self%mech%ndof
+        dydt(1:n) = y(n + 1:2*n)
+        call generalized_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), info, msg)
+        if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
+    end subroutine genode_rhs
+
+    !> Solve M q'' = Q from (q0, v0) on t_span with `ode_solve`; res%y = [q; v].
+    !! Checks the dimensions and the mass matrix at the initial point first.
+    subroutine generalized_solve(mech, t_span, q0, v0, options, res, t_eval)
+        class(generalized_system), intent(in) :: mech
+        real(dp), intent(in) :: t_span(2)
+        real(dp), intent(in) :: q0(:), v0(:)
+        type(ode_options), intent(in) :: options
+        type(ode_result), intent(out) :: res
+        real(dp), intent(in), optional :: t_eval(:)
+        type(generalized_ode) :: sys
+        real(dp), allocatable :: a(:)
+        integer :: info
+        character(len=:), allocatable :: msg
+        if (mech%ndof < 1 .or. size(q0) /= mech%ndof .or. size(v0) /= mech%ndof) then
+            res%status = CM_BAD_INPUT
+            res%message = "bad input: q0 and v0 must have ndof elements"
+            res%success = .false.
+            return
+        end if
+        allocate (a(mech%ndof))
+        call generalized_accel(mech, t_span(1), q0, v0, a, info, msg)
+        if (info /= CM_SUCCESS) then
+            res%status = info
+            res%message = msg
+            res%success = .false.
+            return
+        end if
+        allocate (sys%mech, source=mech)
+        call ode_solve(sys, t_span, [q0, v0], options, res, t_eval)
+    end subroutine generalized_solve
+
+end module conmech_generalized
