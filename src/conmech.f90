@@ -9,6 +9,12 @@ module conmech
     use conmech_ode_solver
     use conmech_systems_basic
     use conmech_systems
+    use conmech_generalized
+    use conmech_constrained_system
+    use conmech_constrained_solver
+    use conmech_systems_generalized
+    use conmech_systems_constrained
+    use conmech_systems_mech
     implicit none
     public
 end module conmech

@@ -8,6 +8,7 @@ module conmech_systems
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_systems_basic
+    use conmech_systems_mech, only: make_generalized_ode, mech_initial_state
     implicit none
     private
     public :: make_system, system_dimension
@@ -57,8 +58,10 @@ contains
                 allocate (sys, source=s)
             end block
         case default
-            info = CM_BAD_INPUT
-            msg = "bad input: unknown built-in system '"//trim(name)//"'"
+            ! the generalized-coordinate seed systems (conmech_systems_mech), y = [q, q']
+            call make_generalized_ode(name, params, sys, info, msg)
+            if (info /= CM_SUCCESS) msg = "bad input: unknown built-in system '" &
+                                          //trim(name)//"'"
         end select
     end subroutine make_system
 
@@ -72,6 +75,18 @@ contains
             n = 4
         case default
             n = 0
+            block
+                ! the generalized-coordinate seed systems: 2 ndof
+                real(dp), allocatable :: q0(:), v0(:)
+                integer :: info
+                class(ode_system), allocatable :: sys
+                character(len=:), allocatable :: msg
+                call make_generalized_ode(name, [real(dp) ::], sys, info, msg)
+                if (info == CM_SUCCESS) then
+                    call mech_initial_state(name, [real(dp) ::], q0, v0, info)
+                    if (info == CM_SUCCESS) n = 2*size(q0)
+                end if
+            end block
         end select
     end function system_dimension
 
