@@ -25,11 +25,11 @@
 !! - `phi_jac`: central differences, step eps^(1/3) max(|q_j|, 1);
 !! - `phi_t`: zero unless `rheonomic`, then a central difference in t (step eps^(1/3)
 !!   max(|t|, 1));
-!! - `phi_gamma`: scleronomic: gamma_h = -(G(q + s v) v - G(q - s v) v)/(2 s),
-!!   s = eps^(1/3)/max(|v|_inf, 1e-300) scaled by max(|q|_inf, 1) (error ~ 1e-10 relative);
-!!   rheonomic: the second difference -(phi(t+s, q+s v) - 2 phi(t, q) + phi(t-s, q-s v))/s^2
-!!   with s = eps^(1/4) (error ~ 1e-8 relative; supply `phi_gamma` for better);
-!! - `nh_gamma`: -(w(t+s, q+s v) - w(t-s, q-s v))/(2 s), w = A v + b, s = eps^(1/3).
+!! - `phi_gamma`: gamma_h = -d^2/ds^2 phi(t + s, q + s v) (for scleronomic phi the t-shift
+!!   is dropped) by the five-point fourth-order second difference, step
+!!   eps^(1/6) max(|q|, |t|, 1)/max(|v|, 1) (error ~ eps^(2/3), about 1e-10 relative);
+!! - `nh_gamma`: -d/ds [A v + b](t + s, q + s v) by the five-point fourth-order first
+!!   difference, step eps^(1/5) max(|q|, |t|, 1)/max(|v|, 1) (error ~ 1e-12 relative).
 module conmech_constrained_system
     use conmech_kinds, only: dp
     use conmech_status
@@ -128,32 +128,33 @@ contains
         pt = (cp - cm)/(2.0_dp*h)
     end subroutine cs_fd_phi_t
 
-    !> Default gamma_h (see the module notes for the difference formulas).
+    !> Default gamma_h = -d^2/ds^2 phi(t + s, q + s v) at s = 0 (fourth-order five-point
+    !! second difference; step eps^(1/6) times the scale of (t, q) over max(|v|, 1)).
     subroutine cs_fd_phi_gamma(self, t, q, v, gam)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: gam(:)
-        real(dp) :: gp(self%n_hol, size(q)), gm(self%n_hol, size(q))
-        real(dp) :: cp(self%n_hol), c0(self%n_hol), cm(self%n_hol), s, vn
+        real(dp) :: c2p(self%n_hol), cp(self%n_hol), c0(self%n_hol), cm(self%n_hol)
+        real(dp) :: c2m(self%n_hol), s, tdir, scale
         if (self%n_hol == 0) return
-        vn = maxval(abs(v))
+        tdir = 0.0_dp
+        scale = max(maxval(abs(q)), 1.0_dp)
         if (self%rheonomic) then
-            s = epsilon(1.0_dp)**0.25_dp*max(maxval(abs(q)), abs(t), 1.0_dp)/max(vn, 1.0_dp)
-            call self%phi(t + s, q + s*v, cp)
-            call self%phi(t, q, c0)
-            call self%phi(t - s, q - s*v, cm)
-            gam = -(cp - 2.0_dp*c0 + cm)/s**2
-        else
-            if (vn == 0.0_dp) then
-                gam = 0.0_dp
-                return
-            end if
-            s = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(maxval(abs(q)), 1.0_dp)/vn
-            call self%phi_jac(t, q + s*v, gp)
-            call self%phi_jac(t, q - s*v, gm)
-            gam = -matmul(gp - gm, v)/(2.0_dp*s)
+            tdir = 1.0_dp
+            scale = max(scale, abs(t))
         end if
+        if (maxval(abs(v)) == 0.0_dp .and. tdir == 0.0_dp) then
+            gam = 0.0_dp
+            return
+        end if
+        s = epsilon(1.0_dp)**(1.0_dp/6.0_dp)*scale/max(maxval(abs(v)), 1.0_dp)
+        call self%phi(t + 2.0_dp*s*tdir, q + 2.0_dp*s*v, c2p)
+        call self%phi(t + s*tdir, q + s*v, cp)
+        call self%phi(t, q, c0)
+        call self%phi(t - s*tdir, q - s*v, cm)
+        call self%phi(t - 2.0_dp*s*tdir, q - 2.0_dp*s*v, c2m)
+        gam = -(-c2p + 16.0_dp*cp - 30.0_dp*c0 + 16.0_dp*cm - c2m)/(12.0_dp*s**2)
     end subroutine cs_fd_phi_gamma
 
     !> Default: no non-holonomic constraints.
@@ -167,20 +168,26 @@ contains
         b = 0.0_dp
     end subroutine cs_no_nh
 
-    !> Default gamma_n = -d/dt [A v + b] (v fixed) by a central difference along (1, v).
+    !> Default gamma_n = -d/dt [A v + b] (v fixed) along (1, v), by the fourth-order
+    !! five-point first difference with step eps^(1/5) times the scale of (t, q).
     subroutine cs_fd_nh_gamma(self, t, q, v, gam)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: gam(:)
-        real(dp) :: ap(self%n_nh, size(q)), am(self%n_nh, size(q))
-        real(dp) :: bp(self%n_nh), bm(self%n_nh), s
+        real(dp) :: a(self%n_nh, size(q)), b(self%n_nh), w(self%n_nh), s
+        integer :: j
+        real(dp), parameter :: off(4) = [2.0_dp, 1.0_dp, -1.0_dp, -2.0_dp]
+        real(dp), parameter :: wt(4) = [-1.0_dp, 8.0_dp, -8.0_dp, 1.0_dp]
         if (self%n_nh == 0) return
-        s = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(maxval(abs(q)), abs(t), 1.0_dp) &
+        s = epsilon(1.0_dp)**0.2_dp*max(maxval(abs(q)), abs(t), 1.0_dp) &
             /max(maxval(abs(v)), 1.0_dp)
-        call self%nh_matrix(t + s, q + s*v, ap, bp)
-        call self%nh_matrix(t - s, q - s*v, am, bm)
-        gam = -(matmul(ap - am, v) + bp - bm)/(2.0_dp*s)
+        w = 0.0_dp
+        do j = 1, 4
+            call self%nh_matrix(t + off(j)*s, q + off(j)*s*v, a, b)
+            w = w + wt(j)*(matmul(a, v) + b)
+        end do
+        gam = -w/(12.0_dp*s)
     end subroutine cs_fd_nh_gamma
 
     function cs_no_energy(self, t, q, v) result(e)

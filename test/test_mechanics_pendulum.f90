@@ -1,0 +1,232 @@
+!> Pendulum and double pendulum: excessive vs generalized coordinates, the seed's
+!! multiplier, the elliptic-integral period, redundant constraints, FD defaults.
+module test_mech_pendulum_types
+    use conmech
+    implicit none
+
+    !> The pendulum constraint written twice (redundant, rank 1).
+    type, extends(pendulum_xy) :: pendulum_twice
+    contains
+        procedure :: phi => tw_phi
+        procedure :: phi_jac => tw_jac
+        procedure :: phi_gamma => tw_gamma
+    end type pendulum_twice
+
+    !> The pendulum with phi only: Jacobian and acceleration term by the FD defaults.
+    type, extends(constrained_system) :: pendulum_fd
+        real(dp) :: m = 1.0_dp, g = 9.81_dp, l = 1.0_dp
+    contains
+        procedure :: mass => fd_mass
+        procedure :: forces => fd_forces
+        procedure :: phi => fd_phi
+    end type pendulum_fd
+
+contains
+
+    subroutine tw_phi(self, t, q, c)
+        class(pendulum_twice), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: c(:)
+        c(1) = 0.5_dp*(q(1)**2 + q(2)**2 - self%l**2)
+        c(2) = c(1)
+    end subroutine tw_phi
+    subroutine tw_jac(self, t, q, g)
+        class(pendulum_twice), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: g(:, :)
+        g(1, :) = q(1:2)
+        g(2, :) = q(1:2)
+    end subroutine tw_jac
+    subroutine tw_gamma(self, t, q, v, gam)
+        class(pendulum_twice), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: gam(:)
+        gam = -(v(1)**2 + v(2)**2)
+    end subroutine tw_gamma
+
+    subroutine fd_mass(self, t, q, mm)
+        class(pendulum_fd), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: mm(:, :)
+        mm = 0.0_dp
+        mm(1, 1) = self%m
+        mm(2, 2) = self%m
+    end subroutine fd_mass
+    subroutine fd_forces(self, t, q, v, f)
+        class(pendulum_fd), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: f(:)
+        f = [0.0_dp, -self%m*self%g]
+    end subroutine fd_forces
+    subroutine fd_phi(self, t, q, c)
+        class(pendulum_fd), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: c(:)
+        c(1) = 0.5_dp*(q(1)**2 + q(2)**2 - self%l**2)
+    end subroutine fd_phi
+
+    !> Complete elliptic integral of the first kind K(k) by the arithmetic-geometric mean.
+    pure function ellipk_agm(k) result(kk)
+        real(dp), intent(in) :: k
+        real(dp) :: kk, a, b, an
+        integer :: i
+        a = 1.0_dp
+        b = sqrt(1.0_dp - k**2)
+        do i = 1, 60
+            an = 0.5_dp*(a + b)
+            b = sqrt(a*b)
+            a = an
+            if (abs(a - b) <= 4.0_dp*epsilon(1.0_dp)*a) exit
+        end do
+        kk = acos(-1.0_dp)/(2.0_dp*a)
+    end function ellipk_agm
+
+end module test_mech_pendulum_types
+
+program test_mechanics_pendulum
+    use conmech
+    use conmech_testing, only: test_suite
+    use test_mech_pendulum_types
+    implicit none
+    type(test_suite) :: ts
+    real(dp), parameter :: g = 9.81_dp, l = 1.3_dp, m = 0.7_dp, th0 = 1.2_dp
+    real(dp) :: period, kk, lam_seed, err, errl, errp, t_eval(401)
+    class(constrained_system), allocatable :: cs
+    class(generalized_system), allocatable :: gs
+    type(constrained_options) :: copt
+    type(ode_options) :: gopt
+    type(constrained_result) :: cr, cr2
+    type(ode_result) :: gr
+    integer :: info, i
+    character(len=:), allocatable :: msg
+
+    ts%name = "test_mechanics_pendulum"
+
+    ! ---------------------------------------------------------------- period and K by the AGM
+    kk = ellipk_agm(sin(th0/2.0_dp))
+    period = 4.0_dp*sqrt(l/g)*kk
+    do i = 1, size(t_eval)
+        t_eval(i) = (i - 1)*20.0_dp*period/(size(t_eval) - 1)
+    end do
+
+    call make_constrained("pendulum_xy", [m, g, l], cs, info, msg)
+    call ts%check(info == CM_SUCCESS, "make_constrained pendulum_xy")
+    call make_generalized("pendulum_angle", [m, g, l], gs, info, msg)
+    call ts%check(info == CM_SUCCESS, "make_generalized pendulum_angle")
+
+    copt%ode%method = METHOD_DOP853
+    copt%ode%rtol = 1.0e-13_dp
+    copt%ode%atol = 1.0e-13_dp
+    call constrained_solve(cs, [0.0_dp, t_eval(size(t_eval))], &
+                           [l*sin(th0), -l*cos(th0)], [0.0_dp, 0.0_dp], copt, cr, t_eval)
+    call ts%check(cr%success, "projected DOP853 on pendulum_xy succeeds: "//cr%message)
+    gopt%method = METHOD_DOP853
+    gopt%rtol = 1.0e-13_dp
+    gopt%atol = 1.0e-13_dp
+    call generalized_solve(gs, [0.0_dp, t_eval(size(t_eval))], [th0], [0.0_dp], gopt, gr, &
+                           t_eval)
+    call ts%check(gr%success, "DOP853 on pendulum_angle succeeds")
+    call ts%check(cr%nt == size(t_eval) .and. gr%nt == size(t_eval), "outputs at t_eval")
+
+    ! excessive vs generalized over 20 periods
+    err = 0.0_dp
+    errl = 0.0_dp
+    errp = 0.0_dp
+    do i = 1, cr%nt
+        err = max(err, abs(cr%q(1, i) - l*sin(gr%y(1, i))), abs(cr%q(2, i) + l*cos(gr%y(1, i))))
+        lam_seed = m/l**2*(cr%q(2, i)*g - cr%v(1, i)**2 - cr%v(2, i)**2)
+        errl = max(errl, abs(cr%lam(1, i) - lam_seed)/(m*g))
+        errp = max(errp, abs(cr%power(i)))
+    end do
+    call ts%check_less(err, 1.0e-9_dp, "pendulum (x,y) = l (sin th, -cos th) over 20 periods")
+    call ts%check_less(errl, 1.0e-12_dp, "lambda = m/l^2 (y g - xd^2 - yd^2) (seed 000)")
+    call ts%check_less(errp, 1.0e-10_dp, "reaction power is zero (ideal constraint)")
+    call ts%check_less(maxval(abs(cr%reaction(:, 5) - cr%lam(1, 5)*cr%q(:, 5))), 1.0e-14_dp, &
+                       "reaction R = lambda (x, y)")
+    call ts%check_less(maxval(abs(cr%energy - cr%energy(1))), 1.0e-11_dp, "energy conserved")
+    call ts%check_less(maxval(cr%res_pos), 1.0e-13_dp, "position residual")
+    ! the period: th(T/2) = -th0 and th(T) = th0 (the solution at 20 T with 400 samples:
+    ! sample 21 is T, sample 11 is T/2)
+    call ts%check_close(gr%y(1, 11), -th0, 1.0e-10_dp, "theta(T/2) = -theta0, T = 4 sqrt(l/g) K")
+    call ts%check_close(gr%y(1, 21), th0, 1.0e-10_dp, "theta(T) = theta0")
+    call ts%check_close(gr%y(1, 401), th0, 1.0e-9_dp, "theta(20 T) = theta0")
+    call ts%check_close(cr%q(1, 11), -l*sin(th0), 1.0e-10_dp, "x(T/2) = -l sin theta0")
+    ! a wrong K would be seen: a 1e-6 relative change of T moves th(T/2) by > 1e-6
+    call ts%check(abs(gr%y(2, 11)) < 1.0e-9_dp, "velocity zero at T/2 (turning point)")
+
+    ! ---------------------------------------------------------------- redundant constraints
+    block
+        type(pendulum_twice) :: tw
+        tw%m = m; tw%g = g; tw%l = l
+        tw%n = 2; tw%n_hol = 2
+        call constrained_solve(tw, [0.0_dp, t_eval(size(t_eval))], &
+                               [l*sin(th0), -l*cos(th0)], [0.0_dp, 0.0_dp], copt, cr2, t_eval)
+        call ts%check(cr2%success, "redundant constraints solve: "//cr2%message)
+        call ts%check(cr2%rank == 1, "rank of the duplicated constraint is 1")
+        call ts%check_less(maxval(abs(cr2%q - cr%q)), 1.0e-10_dp, &
+                           "redundant constraints: same motion")
+        call ts%check_less(maxval(abs(cr2%reaction - cr%reaction)), 1.0e-9_dp, &
+                           "redundant constraints: same reactions")
+        call ts%check_less(maxval(abs(cr2%lam(1, :) - 0.5_dp*cr%lam(1, :))) + &
+                           maxval(abs(cr2%lam(2, :) - 0.5_dp*cr%lam(1, :))), 1.0e-9_dp, &
+                           "redundant constraints: minimum-norm lambda splits evenly")
+    end block
+
+    ! ---------------------------------------------------------------- FD defaults
+    block
+        type(pendulum_fd) :: pf
+        real(dp) :: a1(2), a2(2), l1(1), l2(1), q(2), v(2)
+        pf%m = m; pf%g = g; pf%l = l
+        pf%n = 2; pf%n_hol = 1
+        q = [l*sin(0.4_dp), -l*cos(0.4_dp)]
+        v = [2.0_dp*cos(0.4_dp), 2.0_dp*sin(0.4_dp)]
+        call constrained_accel(pf, 0.0_dp, q, v, a1, l1, info, msg)
+        call constrained_accel(cs, 0.0_dp, q, v, a2, l2, info, msg)
+        call ts%check_less(maxval(abs(a1 - a2)), 1.0e-8_dp, &
+                           "FD default Jacobian and gamma: accelerations match analytic")
+        call ts%check_less(abs(l1(1) - l2(1)), 1.0e-8_dp, "FD default: multiplier matches")
+        call constrained_solve(pf, [0.0_dp, 5.0_dp*period], [l*sin(th0), -l*cos(th0)], &
+                               [0.0_dp, 0.0_dp], copt, cr2, t_eval(1:101))
+        call ts%check(cr2%success .and. cr2%nt == 101, "FD defaults solve: "//cr2%message)
+        if (cr2%nt == 101) call ts%check_less(maxval(abs(cr2%q - cr%q(:, 1:101))), 1.0e-7_dp, &
+                           "FD defaults: same motion over 5 periods")
+    end block
+
+    ! ---------------------------------------------------------------- double pendulum
+    block
+        real(dp) :: te(201), x1, y1, x2, y2, maxerr
+        real(dp), parameter :: p(5) = [1.0_dp, 0.6_dp, 1.0_dp, 0.8_dp, 9.81_dp]
+        real(dp), parameter :: a1 = 0.3_dp, a2 = -0.2_dp
+        do i = 1, size(te)
+            te(i) = (i - 1)*0.1_dp
+        end do
+        call make_constrained("double_pendulum_xy", p, cs, info, msg)
+        call make_generalized("double_pendulum", p, gs, info, msg)
+        call constrained_solve(cs, [0.0_dp, te(size(te))], &
+                               [p(3)*sin(a1), -p(3)*cos(a1), p(3)*sin(a1) + p(4)*sin(a2), &
+                                -p(3)*cos(a1) - p(4)*cos(a2)], [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], &
+                               copt, cr, te)
+        call generalized_solve(gs, [0.0_dp, te(size(te))], [a1, a2], [0.0_dp, 0.0_dp], gopt, &
+                               gr, te)
+        call ts%check(cr%success .and. gr%success, "double pendulum: both solves succeed")
+        maxerr = 0.0_dp
+        do i = 1, size(te)
+            x1 = p(3)*sin(gr%y(1, i)); y1 = -p(3)*cos(gr%y(1, i))
+            x2 = x1 + p(4)*sin(gr%y(2, i)); y2 = y1 - p(4)*cos(gr%y(2, i))
+            maxerr = max(maxerr, maxval(abs(cr%q(:, i) - [x1, y1, x2, y2])))
+        end do
+        call ts%check_less(maxerr, 1.0e-9_dp, &
+                           "double pendulum: Cartesian vs angles agree over 20 s (~10 periods)")
+        call ts%check_less(maxval(abs(cr%energy - cr%energy(1))), 1.0e-11_dp, &
+                           "double pendulum (x,y): energy conserved")
+        call ts%check_less(maxval(abs(cr%power)), 1.0e-10_dp, "double pendulum: zero power")
+    end block
+
+    call ts%finish()
+end program test_mechanics_pendulum
