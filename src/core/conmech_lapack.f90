@@ -13,6 +13,7 @@ module conmech_lapack
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
         dgelsy, dlange, dpstrf, dgesvd, dgeqp3
     public :: la_solve, la_eig, la_sym_eig, la_det
+    public :: dpotf2, dpstf2   ! unblocked forms: no ilaenv call, fast for tiny matrices
 
     interface
         subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
@@ -132,6 +133,26 @@ module conmech_lapack
             real(dp), intent(out) :: tau(*), work(*)
             integer, intent(out) :: info
         end subroutine dgeqp3
+    end interface
+
+    ! Unblocked Cholesky factorisations (for the small matrices of mechanical systems).
+    interface
+        subroutine dpotf2(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotf2
+        subroutine dpstf2(uplo, n, a, lda, piv, rank, tol, work, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: piv(*), rank, info
+            real(dp), intent(in) :: tol
+            real(dp), intent(out) :: work(*)
+        end subroutine dpstf2
     end interface
 
 contains

@@ -108,15 +108,14 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: lam(self%mech%n_hol + self%mech%n_nh)
         integer :: n, info
-        character(len=:), allocatable :: msg
         n = self%mech%n
         dydt(1:n) = y(n + 1:2*n)
         if (self%baumgarte) then
             call constrained_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), lam, &
-                                   info, msg, alpha=self%alpha, beta=self%beta)
+                                   info, alpha=self%alpha, beta=self%beta)
         else
             call constrained_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), lam, &
-                                   info, msg)
+                                   info)
         end if
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine cons_rhs
@@ -137,7 +136,8 @@ contains
         v_in = v
         dq = 0.0_dp
         dv = 0.0_dp
-        call project_position(sys, t, q, tol, max_iter, iters, info, msg)
+        call project_position(sys, t, q, tol, max_iter, iters, info, msg, &
+                              newton=.true.)
         if (info /= CM_SUCCESS) then
             msg = "inconsistent initial position: "//msg
             return
@@ -371,7 +371,7 @@ contains
                 hnew = h/fac
                 facold = max(err, 1.0e-4_dp)
             else
-                hnew = h
+                hnew = posneg*options%ode%first_step   ! fixed step (a cut step is not kept)
             end if
             t = t + h
             if (hit) t = target

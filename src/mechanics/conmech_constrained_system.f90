@@ -33,7 +33,7 @@
 module conmech_constrained_system
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrs, dpstrf, dgelsd
+    use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd
     use conmech_generalized, only: mass_cholesky
     implicit none
     private
@@ -240,7 +240,11 @@ contains
         if (m == 0) return
         f = s
         tol = 1.0e-11_dp*maxval([(abs(s(i, i)), i=1, m)])
-        call dpstrf('U', m, f, m, piv, rank, tol, work, lainfo)
+        if (m <= 32) then
+            call dpstf2('U', m, f, m, piv, rank, tol, work, lainfo)
+        else
+            call dpstrf('U', m, f, m, piv, rank, tol, work, lainfo)
+        end if
         if (lainfo < 0) then
             info = CM_LAPACK_ERROR
             return
@@ -270,13 +274,14 @@ contains
     !! acceleration-level KKT system. With `alpha`, `beta` (Baumgarte) the acceleration
     !! constraint becomes C a = gamma - 2 alpha (C v + c0) - beta^2 [phi; 0].
     !! `rank` is the rank of the constraint set (< n_hol + n_nh when redundant).
+    !! `msg` (optional: the hot path of the integrators omits it) explains a failure.
     subroutine constrained_accel(sys, t, q, v, a, lam, info, msg, rank, alpha, beta)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: a(:), lam(:)
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=:), allocatable, intent(out), optional :: msg
         integer, intent(out), optional :: rank
         real(dp), intent(in), optional :: alpha, beta
         real(dp) :: mm(sys%n, sys%n), x(sys%n, 1 + sys%n_hol + sys%n_nh)
@@ -290,11 +295,15 @@ contains
         if (n < 1 .or. mh < 0 .or. sys%n_nh < 0 .or. size(q) /= n .or. size(v) /= n &
             .or. size(a) /= n .or. size(lam) /= m) then
             info = CM_BAD_INPUT
-            msg = "bad input: q, v, a need n elements and lambda n_hol + n_nh"
+            if (present(msg)) msg = "bad input: q, v, a need n elements and lambda n_hol + n_nh"
             return
         end if
         call sys%mass(t, q, mm)
-        call mass_cholesky(mm, info, msg)
+        if (present(msg)) then
+            call mass_cholesky(mm, info, msg)
+        else
+            call mass_cholesky(mm, info)
+        end if
         if (info /= CM_SUCCESS) return
         call sys%forces(t, q, v, x(:, 1))
         if (m > 0) then
@@ -318,7 +327,7 @@ contains
             gam(:, 1) = gam(:, 1) - matmul(c, a)
             call schur_solve(s, gam, rk, info)
             if (info /= CM_SUCCESS) then
-                msg = "LAPACK failed in the constraint (Schur complement) solve"
+                if (present(msg)) msg = "LAPACK failed in the constraint (Schur complement) solve"
                 return
             end if
             lam = gam(:, 1)
@@ -326,7 +335,7 @@ contains
         end if
         if (present(rank)) rank = rk
         info = CM_SUCCESS
-        msg = "success"
+        if (present(msg)) msg = "success"
     end subroutine constrained_accel
 
     !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
@@ -351,8 +360,10 @@ contains
     !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
     !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
     !! complement frozen at q~. Converged when max|phi| <= tol; at most max_iter
-    !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged).
-    subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg)
+    !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
+    !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
+    !! convergence from far away; used for the consistent initial values).
+    subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg, newton)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: q(:)
@@ -360,10 +371,12 @@ contains
         integer, intent(in) :: max_iter
         integer, intent(out) :: iters, info
         character(len=:), allocatable, intent(out) :: msg
+        logical, intent(in), optional :: newton   !! refresh G at every iterate (far start)
         real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
         real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n)
         real(dp) :: rnorm
         integer :: n, mh, lainfo, rk
+        logical :: full
         character(len=32) :: buf
         n = sys%n
         mh = sys%n_hol
@@ -381,8 +394,16 @@ contains
         x = transpose(g)
         call dpotrs('U', n, mh, mm, n, x, n, lainfo)
         s = matmul(g, x)
+        full = .false.
+        if (present(newton)) full = newton
         qk = q
         do iters = 1, max_iter
+            if (full .and. iters > 1) then
+                call sys%phi_jac(t, qk, g)
+                x = transpose(g)
+                call dpotrs('U', n, mh, mm, n, x, n, lainfo)
+                s = matmul(g, x)
+            end if
             call schur_solve(s, ph, rk, info)
             if (info /= CM_SUCCESS) then
                 msg = "LAPACK failed in the position projection"

@@ -15,7 +15,7 @@ module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrf, dpotrs
+    use conmech_lapack, only: dpotrf, dpotf2, dpotrs
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     implicit none
@@ -78,28 +78,31 @@ contains
 
     !> Cholesky factor (upper, in place) of an SPD matrix, with a clear status:
     !! CM_SINGULAR if dpotrf fails or the factor's diagonal ratio squared is below 1e-14
-    !! (numerically singular mass matrix).
+    !! (numerically singular mass matrix). `msg` (optional) explains a failure.
     subroutine mass_cholesky(mm, info, msg)
         real(dp), intent(inout) :: mm(:, :)
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=:), allocatable, intent(out), optional :: msg
         integer :: n, lainfo, i
         real(dp) :: dmin, dmax
         character(len=16) :: buf
         n = size(mm, 1)
         info = CM_SUCCESS
-        msg = "success"
         if (size(mm, 2) /= n) then
             info = CM_BAD_INPUT
-            msg = "bad input: the mass matrix is not square"
+            if (present(msg)) msg = "bad input: the mass matrix is not square"
             return
         end if
-        call dpotrf('U', n, mm, n, lainfo)
+        if (n <= 32) then
+            call dpotf2('U', n, mm, n, lainfo)   ! unblocked: no ilaenv overhead
+        else
+            call dpotrf('U', n, mm, n, lainfo)
+        end if
         if (lainfo /= 0) then
             info = CM_SINGULAR
             write (buf, '(i0)') lainfo
-            msg = "singular mass matrix: not symmetric positive definite (dpotrf info=" &
-                  //trim(buf)//")"
+            if (present(msg)) msg = "singular mass matrix: not symmetric positive definite " &
+                                    //"(dpotrf info="//trim(buf)//")"
             return
         end if
         dmin = huge(1.0_dp)
@@ -110,8 +113,10 @@ contains
         end do
         if ((dmin/dmax)**2 < 1.0e-14_dp) then
             info = CM_SINGULAR
-            msg = "singular mass matrix: numerically singular (condition > 1e14)"
+            if (present(msg)) msg = "singular mass matrix: numerically singular (condition > 1e14)"
+            return
         end if
+        if (present(msg)) msg = "success"
     end subroutine mass_cholesky
 
     !> Accelerations a = M(t, q)^{-1} Q(t, q, v), with a status.
@@ -121,18 +126,22 @@ contains
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: a(:)
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=:), allocatable, intent(out), optional :: msg
         real(dp) :: mm(mech%ndof, mech%ndof)
         integer :: n, lainfo
         n = mech%ndof
         if (n < 1 .or. size(q) /= n .or. size(v) /= n .or. size(a) /= n) then
             info = CM_BAD_INPUT
-            msg = "bad input: q, v and a must have ndof elements (ndof >= 1)"
+            if (present(msg)) msg = "bad input: q, v and a must have ndof elements (ndof >= 1)"
             return
         end if
         call mech%mass(t, q, mm)
         call mech%forces(t, q, v, a)
-        call mass_cholesky(mm, info, msg)
+        if (present(msg)) then
+            call mass_cholesky(mm, info, msg)
+        else
+            call mass_cholesky(mm, info)
+        end if
         if (info /= CM_SUCCESS) return
         call dpotrs('U', n, 1, mm, n, a, n, lainfo)
     end subroutine generalized_accel
@@ -143,10 +152,9 @@ contains
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dydt(:)
         integer :: n, info
-        character(len=:), allocatable :: msg
         n = self%mech%ndof
         dydt(1:n) = y(n + 1:2*n)
-        call generalized_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), info, msg)
+        call generalized_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), info)
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine genode_rhs
 
