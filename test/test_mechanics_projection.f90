@@ -42,32 +42,33 @@ program test_mechanics_projection
     call ts%check(r%proj_iter_max >= 1 .and. r%proj_iter_max <= 3, &
                   "simplified Newton converges in at most 3 iterations")
 
+    ! the other stabilisations over 1e5 steps (t = 100) to keep the test short
     opt%projection = PROJ_NONE
-    call constrained_solve(cs, [0.0_dp, 1000.0_dp], q0, v0, opt, rn, te)
-    call ts%check(rn%success .and. rn%nproj == 0, "index-1 RK4, 1e6 steps, no projection")
-    drift_early = rn%res_pos(11)
-    call ts%check(rn%res_pos(rn%nt) > 1.0e-9_dp, "index-1 form drifts: |phi(1000)| > 1e-9")
+    call constrained_solve(cs, [0.0_dp, 100.0_dp], q0, v0, opt, rn, te(1:101))
+    call ts%check(rn%success .and. rn%nproj == 0, "index-1 RK4, 1e5 steps, no projection")
+    drift_early = rn%res_pos(2)
+    call ts%check(rn%res_pos(rn%nt) > 1.0e-10_dp, "index-1 form drifts: |phi(100)| > 1e-10")
     call ts%check(rn%res_pos(rn%nt) > 10.0_dp*drift_early, &
-                  "index-1 drift grows with t (|phi(1000)| > 10 |phi(10)|)")
+                  "index-1 drift grows with t (|phi(100)| > 10 |phi(1)|)")
     call ts%check(rn%res_pos(rn%nt) > 1.0e3_dp*maxval(r%res_pos), &
                   "projection removes the drift (>1000x smaller)")
 
     opt%projection = PROJ_BAUMGARTE
     opt%alpha = 10.0_dp
     opt%beta = 10.0_dp
-    call constrained_solve(cs, [0.0_dp, 1000.0_dp], q0, v0, opt, rb, te)
+    call constrained_solve(cs, [0.0_dp, 100.0_dp], q0, v0, opt, rb, te(1:101))
     call ts%check(rb%success, "Baumgarte RK4 succeeds")
     call ts%check_less(rb%res_pos(rb%nt), 0.1_dp*rn%res_pos(rn%nt), &
                        "Baumgarte keeps |phi| below the plain index-1 drift")
 
     opt%projection = PROJ_VELOCITY
-    call constrained_solve(cs, [0.0_dp, 1000.0_dp], q0, v0, opt, rb, te)
+    call constrained_solve(cs, [0.0_dp, 100.0_dp], q0, v0, opt, rb, te(1:101))
     call ts%check_less(maxval(rb%res_vel), 1.0e-12_dp, "velocity projection: |G v| small")
 
     ! ---------------------------------------------------------------- every k steps
     opt%projection = PROJ_POSITION_VELOCITY
     opt%every = 10
-    call constrained_solve(cs, [0.0_dp, 100.0_dp], q0, v0, opt, rb, te(1:101))
+    call constrained_solve(cs, [0.0_dp, 20.0_dp], q0, v0, opt, rb, te(1:21))
     call ts%check(rb%success .and. rb%nproj == rb%naccept/10, "projection every 10 steps")
     call ts%check_less(maxval(rb%res_pos), 1.0e-12_dp, &
                        "every 10 steps: residual at the (projected) outputs")
