@@ -289,6 +289,7 @@ contains
         real(dp) :: gam(sys%n_hol + sys%n_nh, 1), s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh)
         real(dp) :: ph(sys%n_hol)
         integer :: n, m, mh, lainfo, rk
+        character(len=:), allocatable :: m2
         n = sys%n
         mh = sys%n_hol
         m = sys%n_hol + sys%n_nh
@@ -300,7 +301,10 @@ contains
         end if
         call sys%mass(t, q, mm)
         if (present(msg)) then
-            call mass_cholesky(mm, info, msg)
+            ! (a local string: passing the optional deferred-length msg straight through
+            ! loses its length with gfortran)
+            call mass_cholesky(mm, info, m2)
+            msg = m2
         else
             call mass_cholesky(mm, info)
         end if

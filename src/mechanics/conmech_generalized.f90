@@ -129,6 +129,7 @@ contains
         character(len=:), allocatable, intent(out), optional :: msg
         real(dp) :: mm(mech%ndof, mech%ndof)
         integer :: n, lainfo
+        character(len=:), allocatable :: m2
         n = mech%ndof
         if (n < 1 .or. size(q) /= n .or. size(v) /= n .or. size(a) /= n) then
             info = CM_BAD_INPUT
@@ -138,7 +139,10 @@ contains
         call mech%mass(t, q, mm)
         call mech%forces(t, q, v, a)
         if (present(msg)) then
-            call mass_cholesky(mm, info, msg)
+            ! (a local string: passing the optional deferred-length msg straight through
+            ! loses its length with gfortran)
+            call mass_cholesky(mm, info, m2)
+            msg = m2
         else
             call mass_cholesky(mm, info)
         end if
