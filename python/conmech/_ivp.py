@@ -327,13 +327,20 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         out["hs"] = np.array(hs, dtype=float)
         out["coef"] = np.array(coef, dtype=float)
 
+    # f2py cannot pass empty arrays: t_eval, ev_dir, ev_term get at least one element
+    # and their counts neval, ne say how many are used.
+    pad = np.zeros(1)
     common = dict(t_span=np.array([t0, tf]), y0=y0, method=code, rtol=rtol_v, atol=atol_v,
                   first_step=h0, max_step=hmax, max_steps=int(max_steps),
-                  dense=int(bool(dense_output)), t_eval=t_ev, ev_dir=ev_dir, ev_term=ev_term)
+                  dense=int(bool(dense_output)), neval=t_ev.size,
+                  t_eval=t_ev if t_ev.size else pad, ne=ne,
+                  ev_dir=ev_dir if ne else pad.astype(np.intc),
+                  ev_term=ev_term if ne else pad.astype(np.intc))
     probe_calls = 0
     if builtin:
         nfev, naccept, nreject, info, message = _conmech.flat_solve_builtin(
-            fun.name, fun.params, events_cb, store, **common)
+            fun.name, fun.params.size, fun.params if fun.params.size else pad, events_cb,
+            store, **common)
     else:
         # One probe call checks the shape of fun's output and gives a clear error.
         f0 = np.asarray(fun(t0, y0.copy(), *args))

@@ -46,9 +46,9 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
     real(c_double), intent(in) :: rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
     integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(neval)
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(ne), ev_term(ne)
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: nfev, naccept, nreject, info
     character(len=256), intent(out) :: message
 !f2py external fun, events, store
@@ -90,7 +90,8 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
 end subroutine flat_solve_callback
 
 !> Solve y' = f(t, y) for the built-in system `name` with parameters `params` (see
-!! conmech_systems::make_system): no Python in the loop unless there are events.
+!! conmech_systems::make_system; params has at least one element, np of them are used):
+!! no Python in the loop unless there are events.
 !! Other arguments as in flat_solve_callback.
 subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, method, rtol, &
                               atol, first_step, max_step, max_steps, dense, neval, t_eval, &
@@ -104,7 +105,7 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(np)
+    real(c_double), intent(in) :: params(max(np, 1))
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)
@@ -112,9 +113,9 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     real(c_double), intent(in) :: rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
     integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(neval)
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(ne), ev_term(ne)
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: nfev, naccept, nreject, info
     character(len=256), intent(out) :: message
 !f2py external events, store
@@ -146,7 +147,7 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     nfev = 0
     naccept = 0
     nreject = 0
-    call make_system(name, real(params, dp), sys, info, msg)
+    call make_system(name, real(params(1:np), dp), sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return

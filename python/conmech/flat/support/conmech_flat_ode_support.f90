@@ -68,7 +68,8 @@ contains
 
     !> Solve with `ode_solve` from plain arguments and pass the result to `store`.
     !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
-    !! neval = 0: output at every step. `events` is not called when ne = 0.
+    !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
+    !! t_eval, ev_dir, ev_term have at least one element (f2py cannot pass empty ones).
     subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                          max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
                          nfev, naccept, nreject, info, message)
@@ -80,9 +81,9 @@ contains
         real(c_double), intent(in) :: rtol(n), atol(n)
         real(c_double), intent(in) :: first_step, max_step
         integer(c_int), intent(in) :: max_steps, dense, neval
-        real(c_double), intent(in) :: t_eval(neval)
+        real(c_double), intent(in) :: t_eval(max(neval, 1))
         integer(c_int), intent(in) :: ne
-        integer(c_int), intent(in) :: ev_dir(ne), ev_term(ne)
+        integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
         external :: events, store
         integer(c_int), intent(out) :: nfev, naccept, nreject, info
         character(len=*), intent(out) :: message
@@ -112,16 +113,16 @@ contains
             ev%g => events
             ev%n = n
             ev%ne = ne
-            ev%direction = ev_dir
-            ev%terminal = ev_term /= 0
+            ev%direction = ev_dir(1:ne)
+            ev%terminal = ev_term(1:ne) /= 0
             if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval, events=ev)
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev)
             else
                 call ode_solve(sys, t_span, y0, opt, res, events=ev)
             end if
         else
             if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval)
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval))
             else
                 call ode_solve(sys, t_span, y0, opt, res)
             end if
