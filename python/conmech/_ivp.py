@@ -10,12 +10,20 @@ from .systems import BuiltinSystem
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
 _METHODS = ("RK4", "DOPRI5", "RK45", "DOP853")
+# codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
+# method_from_name by the tests (flat_method_code)
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3}
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
 }
 _CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
+# placeholders for f2py, which cannot pass empty arrays (read only, shared)
+_PAD = np.zeros(1)
+_PADI = np.zeros(1, dtype=np.intc)
+_PAD.flags.writeable = False
+_PADI.flags.writeable = False
 
 
 class OdeResult(dict):
@@ -96,6 +104,8 @@ class DenseOutput:
 
 
 def _real_scalar(value, name):
+    if type(value) is float or type(value) is int:
+        return float(value)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.ndarray)):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
     arr = np.asarray(value, dtype=float)
@@ -105,6 +115,13 @@ def _real_scalar(value, name):
 
 
 def _tolerance(value, name, n):
+    if type(value) is float or type(value) is int:   # fast path for the common case
+        v = float(value)
+        if not v >= 0:
+            raise ValueError(f"{name} must be non-negative")
+        if v == math.inf:
+            raise ValueError(f"{name} must be finite")
+        return np.full(n, v)
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -115,9 +132,9 @@ def _tolerance(value, name, n):
     elif arr.shape != (n,):
         raise ValueError(f"{name} must be a scalar or have shape ({n},) like y0, got shape "
                          f"{arr.shape}")
-    if np.any(np.isnan(arr)) or np.any(arr < 0):
+    if np.isnan(arr).any() or (arr < 0).any():
         raise ValueError(f"{name} must be non-negative")
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ValueError(f"{name} must be finite")
     return np.ascontiguousarray(arr)
 
@@ -225,8 +242,8 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     # ---------------------------------------------------------------- method
     if not isinstance(method, str):
         raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
-    code = int(_conmech.flat_method_code(method.upper()))
-    if code == 0 or method.upper() not in _METHODS:
+    code = _METHOD_CODES.get(method.upper(), 0)
+    if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
 
     # ---------------------------------------------------------------- t_span, y0
@@ -240,7 +257,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
     y0_in = np.asarray(y0)
-    if np.iscomplexobj(y0_in):
+    if y0_in.dtype.kind == "c":
         raise TypeError("y0 must be real: complex states are not supported")
     try:
         y0 = np.array(y0_in, dtype=float)
@@ -251,7 +268,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     n = y0.size
     if n == 0:
         raise ValueError("y0 must not be empty")
-    if not np.all(np.isfinite(y0)):
+    if not np.isfinite(y0).all():
         raise ValueError("y0 contains NaN or Inf")
     if builtin and n != fun.dimension:
         raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
@@ -282,7 +299,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
 
     # ---------------------------------------------------------------- t_eval
     if t_eval is None:
-        t_ev = np.zeros(0)
+        t_ev = _PAD[:0]
     else:
         try:
             t_ev = np.array(t_eval, dtype=float)
@@ -303,8 +320,6 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
     ne = len(settings)
-    ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
-    ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
     ev_funs = [s[0] for s in settings]
 
     if ne > 0:
@@ -318,28 +333,33 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     out = {}
 
     def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
-        out["t"] = np.array(t, dtype=float)
-        out["y"] = np.array(y, dtype=float).reshape(n, -1)
-        out["ev_t"] = np.array(ev_t, dtype=float)
-        out["ev_y"] = np.array(ev_y, dtype=float).reshape(n, -1)
-        out["ev_id"] = np.array(ev_id, dtype=int)
-        out["ts"] = np.array(ts, dtype=float)
-        out["hs"] = np.array(hs, dtype=float)
-        out["coef"] = np.array(coef, dtype=float)
+        # the arrays wrap Fortran memory that is freed on return: copy them
+        out["t"] = t.copy()
+        out["y"] = y.reshape(n, t.size).copy()
+        if ne:
+            out["ev_t"] = ev_t.copy()
+            out["ev_y"] = ev_y.reshape(n, ev_t.size).copy()
+            out["ev_id"] = ev_id.copy()
+        if dense_output:
+            out["ts"] = ts.copy()
+            out["hs"] = hs.copy()
+            out["coef"] = coef.reshape(n, -1, ts.size).copy()
 
     # f2py cannot pass empty arrays: t_eval, ev_dir, ev_term get at least one element
     # and their counts neval, ne say how many are used.
-    pad = np.zeros(1)
+    if ne:
+        ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
+        ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
+    else:
+        ev_dir = ev_term = _PADI
     common = dict(t_span=np.array([t0, tf]), y0=y0, method=code, rtol=rtol_v, atol=atol_v,
                   first_step=h0, max_step=hmax, max_steps=int(max_steps),
                   dense=int(bool(dense_output)), neval=t_ev.size,
-                  t_eval=t_ev if t_ev.size else pad, ne=ne,
-                  ev_dir=ev_dir if ne else pad.astype(np.intc),
-                  ev_term=ev_term if ne else pad.astype(np.intc))
+                  t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir, ev_term=ev_term)
     probe_calls = 0
     if builtin:
         nfev, naccept, nreject, info, message = _conmech.flat_solve_builtin(
-            fun.name, fun.params.size, fun.params if fun.params.size else pad, events_cb,
+            fun.name, fun.params.size, fun.params if fun.params.size else _PAD, events_cb,
             store, **common)
     else:
         # One probe call checks the shape of fun's output and gives a clear error.
@@ -372,14 +392,14 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
                     nfev=int(nfev) + probe_calls, njev=0, nlu=0, status=status,
                     message=message, success=status >= 0, naccept=int(naccept),
                     nreject=int(nreject))
-    if ne > 0 and out:
+    if ne > 0 and "ev_t" in out:
         ids = out["ev_id"]
         res.t_events = [out["ev_t"][ids == i + 1] for i in range(ne)]
         res.y_events = [out["ev_y"][:, ids == i + 1].T.copy() for i in range(ne)]
     elif ne > 0:
         res.t_events = [np.zeros(0) for _ in range(ne)]
         res.y_events = [np.zeros((0, n)) for _ in range(ne)]
-    if dense_output and out and out["ts"].size > 0:
+    if dense_output and "ts" in out and out["ts"].size > 0:
         t_last = float(res.t[-1]) if res.t.size else tf
         if t_eval is not None:
             t_last = float(out["ts"][-1] + out["hs"][-1])

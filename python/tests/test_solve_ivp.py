@@ -382,3 +382,10 @@ def test_nested_solve_inside_fun():
         return -inner.y[0, -1] * math.e * y
     r = conmech.solve_ivp(f, (0, 1.0), [1.0], rtol=1e-8, atol=1e-10)
     assert r.success and abs(r.y[0, -1] - math.exp(-1)) < 1e-7
+
+
+def test_method_codes_match_the_fortran_names():
+    from conmech import _conmech, _ivp
+    for name, code in _ivp._METHOD_CODES.items():
+        assert int(_conmech.flat_method_code(name)) == code
+    assert int(_conmech.flat_method_code("RK23")) == 0
