@@ -61,23 +61,18 @@ PROBLEMS = {
 }
 
 
-def best_time(run, min_total=0.2, repeats=5):
-    """Best time per call over `repeats` batches, each batch at least min_total seconds
-    (or one call if a single call is longer)."""
+def batch_size(run, min_total):
+    """Calls per timed batch so that a batch lasts about min_total seconds."""
     t0 = time.perf_counter()
-    res = run()
+    run()
     one = time.perf_counter() - t0
-    number = max(1, int(min_total / max(one, 1e-7)))
-    best = one
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            run()
-        best = min(best, (time.perf_counter() - t0) / number)
-    return best, res
+    return max(1, int(min_total / max(one, 1e-7)))
 
 
 def measure(problem, tol, repeats, min_total):
+    """Error, nfev and best time per call of the three variants. The variants are timed
+    in turns (one batch each per round) so that a change of machine load affects them
+    alike; the best batch of each counts."""
     p = PROBLEMS[problem]
     runs = {
         "scipy": lambda: scipy_solve_ivp(p["rhs"], p["span"], p["y0"], method="DOP853",
@@ -89,11 +84,19 @@ def measure(problem, tol, repeats, min_total):
     }
     out = {}
     for name, run in runs.items():
-        secs, res = best_time(run, min_total=min_total, repeats=repeats)
+        res = run()
         if not res.success:
             raise RuntimeError(f"{name} failed on {problem} at tol {tol}: {res.message}")
         err = float(np.max(np.abs(res.y[:, -1] - p["ref"])))
-        out[name] = dict(time=secs, err=err, nfev=int(res.nfev))
+        out[name] = dict(time=math.inf, err=err, nfev=int(res.nfev),
+                         number=batch_size(run, min_total))
+    for _ in range(repeats):
+        for name, run in runs.items():
+            number = out[name]["number"]
+            t0 = time.perf_counter()
+            for _ in range(number):
+                run()
+            out[name]["time"] = min(out[name]["time"], (time.perf_counter() - t0) / number)
     return out
 
 
@@ -122,8 +125,8 @@ def main():
     args = ap.parse_args()
     tols = [1e-6, 1e-9, 1e-12] if args.quick else [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11,
                                                      1e-12]
-    repeats = 2 if args.quick else 5
-    min_total = 0.05 if args.quick else 0.2
+    repeats = 3 if args.quick else 9
+    min_total = 0.03 if args.quick else 0.1
 
     results = {}
     for problem in PROBLEMS:

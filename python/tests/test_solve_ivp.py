@@ -389,3 +389,24 @@ def test_method_codes_match_the_fortran_names():
     for name, code in _ivp._METHOD_CODES.items():
         assert int(_conmech.flat_method_code(name)) == code
     assert int(_conmech.flat_method_code("RK23")) == 0
+
+
+def test_concurrent_calls_from_threads_give_the_serial_results():
+    # no saved state in Fortran and thread-local f2py callbacks: calls from several
+    # threads (callbacks and built-ins mixed) must not interfere
+    from concurrent.futures import ThreadPoolExecutor
+
+    def job(i):
+        tol = 10.0 ** -(6 + i % 5)
+        if i % 2:
+            r = conmech.solve_ivp(kepler_rhs, (0, KEPLER_T), KEPLER_Y0, rtol=tol, atol=tol)
+        else:
+            r = conmech.solve_ivp(systems.kepler(), (0, KEPLER_T), KEPLER_Y0, rtol=tol,
+                                  atol=tol)
+        return r.y[:, -1], r.nfev
+    serial = [job(i) for i in range(16)]
+    with ThreadPoolExecutor(max_workers=4) as ex:
+        threaded = list(ex.map(job, range(16)))
+    for (ys, ns), (yt, nt) in zip(serial, threaded):
+        np.testing.assert_array_equal(ys, yt)
+        assert ns == nt
