@@ -7,6 +7,20 @@
 !! A Python exception raised inside a callback makes f2py return to Python at once
 !! (longjmp) with the exception set; Fortran work arrays of that call are then leaked,
 !! never corrupted. Nothing here stops or prints.
+!!
+!! Conventions of every flat file (python/conmech/flat/*.f90, all wrapped into the one
+!! extension conmech._conmech by meson.build):
+!! - plain subroutines only, no modules (Fortran modules of the flat layer go to
+!!   python/conmech/flat/support/, compiled but not wrapped); real(c_double),
+!!   integer(c_int), explicit-shape arrays, `info` + character(len=256) `message` outputs;
+!! - f2py cannot pass empty arrays: an array that may be empty is declared with
+!!   max(count, 1) elements and its count is a separate argument;
+!! - a Python callback is a dummy procedure declared with `!f2py external name` and an
+!!   interface block whose bodies `use, intrinsic :: iso_c_binding` (f2py does not
+!!   understand `import`); intent(in) arguments reach Python, intent(out) ones are what
+!!   the Python function returns. To hand it to a derived type, point a
+!!   `procedure(), pointer, nopass` component at it (see conmech_flat_ode_support);
+!! - results of unknown size go back through a `store` callback, called once at the end.
 
 !> Method code (1 RK4, 2 DOPRI5, 3 DOP853) from a name ("RK4", "DOPRI5"/"RK45",
 !! "DOP853"); 0 if unknown.
