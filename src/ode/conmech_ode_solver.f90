@@ -199,7 +199,7 @@ contains
         real(dp), allocatable :: fc(:, :), g_old(:), g_new(:), ye(:)
         real(dp) :: t, h, hnew, hmax, posneg, err, fac11, fac, facold, safe, facc1, facc2
         real(dp) :: expo1, beta, t_stop, te
-        integer :: n, nf, nsteps, ne, nstiff_nf, ie, iev
+        integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev
         integer :: i_eval, n_eval, nev_step
         logical :: adaptive, need_dense, reject, last, has_events, store_steps, stop_now
         real(dp), allocatable :: ev_times(:)
@@ -260,7 +260,7 @@ contains
         if (opt%fac_min > 0.0_dp) facc1 = 1.0_dp/opt%fac_min
         if (opt%fac_max > 0.0_dp) facc2 = 1.0_dp/opt%fac_max
         hmax = min(abs(opt%max_step), abs(tf - t0))
-        nstiff_nf = 0
+        n_nonfinite = 0
 
         allocate (k(n, 16), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
         t = t0
@@ -322,9 +322,14 @@ contains
                 exit
             end if
             if (0.1_dp*abs(h) <= abs(t)*epsilon(1.0_dp) .or. abs(h) < tiny(1.0_dp)) then
-                info = CM_STEP_TOO_SMALL
                 write (buf, '(es14.6)') t
-                msg = "step size too small at t ="//trim(buf)
+                if (n_nonfinite > 0) then
+                    info = CM_NONFINITE
+                    msg = "non-finite values in the right-hand side near t ="//trim(buf)
+                else
+                    info = CM_STEP_TOO_SMALL
+                    msg = "step size too small at t ="//trim(buf)
+                end if
                 exit
             end if
             if (adaptive) then
@@ -359,8 +364,8 @@ contains
                 end if
                 if (err /= err .or. err > huge(1.0_dp)) then
                     ! non-finite error estimate: cut the step hard
-                    nstiff_nf = nstiff_nf + 1
-                    if (nstiff_nf > 40) then
+                    n_nonfinite = n_nonfinite + 1
+                    if (n_nonfinite > 40) then
                         info = CM_NONFINITE
                         write (buf, '(es14.6)') t
                         msg = "non-finite values in the right-hand side near t ="//trim(buf)
@@ -368,6 +373,7 @@ contains
                     end if
                     h = h*0.1_dp
                 else
+                    n_nonfinite = 0
                     fac11 = err**expo1
                     h = h/min(facc1, fac11/safe)
                 end if
@@ -378,7 +384,7 @@ contains
             end if
 
             ! ---------------------------------------------------- accepted step
-            nstiff_nf = 0
+            n_nonfinite = 0
             st%naccept = st%naccept + 1
             if (adaptive) then
                 fac11 = err**expo1
