@@ -3,7 +3,7 @@
 program test_ode
     use conmech
     use conmech_testing, only: test_suite
-    use ode_test_events, only: radial_events
+    use ode_test_events, only: radial_events, circle_projection
     implicit none
 
     type(test_suite) :: ts
@@ -21,6 +21,7 @@ program test_ode
     call test_backward()
     call test_bad_input()
     call test_failures()
+    call test_hook()
     call ts%finish()
 
 contains
@@ -304,6 +305,30 @@ contains
         call ode_solve(sys, [0.0_dp, 1.0_dp], [1.0_dp], opt, res)
         call ts%check(res%status == CM_NONFINITE, "NaN right-hand side reported: "//res%message)
     end subroutine test_failures
+
+    !> A step hook that projects onto the invariant circle removes the energy drift.
+    subroutine test_hook()
+        type(harmonic_oscillator) :: sys
+        type(ode_options) :: opt
+        type(ode_result) :: res, plain
+        type(circle_projection) :: proj
+        real(dp) :: drift_plain, drift_proj
+        opt%method = METHOD_DOPRI5
+        opt%rtol = 1.0e-6_dp
+        opt%atol = 1.0e-6_dp
+        call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, plain)
+        call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, res, hook=proj)
+        drift_plain = abs(sum(plain%y(:, plain%nt)**2) - 1.0_dp)
+        drift_proj = maxval(abs(sum(res%y**2, dim=1) - 1.0_dp))
+        call ts%check(drift_plain > 1.0e-5_dp, "without the hook the energy drifts")
+        call ts%check_less(drift_proj, 1.0e-14_dp, "with the projecting hook it does not")
+        call ts%check(proj%calls == res%stats%naccept, "the hook runs once per accepted step")
+        proj%calls = 0
+        proj%max_calls = 5
+        call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, res, hook=proj)
+        call ts%check(res%status == CM_EVENT_STOP .and. res%stats%naccept == 5, &
+                      "a hook can stop the run")
+    end subroutine test_hook
 
     subroutine blowup(t, y, dydt)
         real(dp), intent(in) :: t, y(:)

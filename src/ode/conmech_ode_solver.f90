@@ -19,7 +19,7 @@ module conmech_ode_solver
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system, ode_events
+    use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
     use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau
     implicit none
     private
@@ -113,7 +113,7 @@ contains
     !! inside t_span) it holds the solution there, from the dense output. Events are
     !! located on the dense output to near machine precision; a terminal event ends the
     !! integration there (status CM_EVENT_STOP) and is the last output point.
-    subroutine ode_solve(sys, t_span, y0, options, res, t_eval, events)
+    subroutine ode_solve(sys, t_span, y0, options, res, t_eval, events, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: y0(:)
@@ -121,6 +121,7 @@ contains
         type(ode_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        class(ode_step_hook), intent(inout), optional :: hook
         real(dp), allocatable :: y(:)
         integer :: i
         character(len=:), allocatable :: msg
@@ -151,13 +152,13 @@ contains
             end if
         end if
         call drive(sys, t_span(1), t_span(2), y, options, res%stats, res%status, msg, &
-                   res, t_eval, events)
+                   res, t_eval, events, hook)
         res%message = msg
         res%success = res%status >= 0
     end subroutine ode_solve
 
     !> Advance y from t0 to t1 in place, storing nothing. Fast path for shooting.
-    subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message)
+    subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
         real(dp), intent(inout) :: y(:)
@@ -165,9 +166,10 @@ contains
         integer, intent(out) :: info
         type(ode_stats), intent(out), optional :: stats
         character(len=:), allocatable, intent(out), optional :: message
+        class(ode_step_hook), intent(inout), optional :: hook
         type(ode_stats) :: st
         character(len=:), allocatable :: msg
-        call drive(sys, t0, t1, y, options, st, info, msg)
+        call drive(sys, t0, t1, y, options, st, info, msg, hook=hook)
         if (present(stats)) stats = st
         if (present(message)) message = msg
     end subroutine ode_integrate
@@ -182,7 +184,7 @@ contains
     end subroutine fail
 
     !> The common driver of every method.
-    subroutine drive(sys, t0, tf, y, opt, st, info, msg, res, t_eval, events)
+    subroutine drive(sys, t0, tf, y, opt, st, info, msg, res, t_eval, events, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, tf
         real(dp), intent(inout) :: y(:)
@@ -193,6 +195,7 @@ contains
         type(ode_result), intent(inout), optional :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        class(ode_step_hook), intent(inout), optional :: hook
 
         type(rk_tableau) :: tab
         real(dp), allocatable :: k(:, :), ynew(:), ytmp(:), sk(:), rtolv(:), atolv(:)
@@ -202,6 +205,8 @@ contains
         integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev
         integer :: i_eval, n_eval, nev_step
         logical :: adaptive, need_dense, reject, last, has_events, store_steps, stop_now
+        logical :: changed
+        integer :: hinfo
         real(dp), allocatable :: ev_times(:)
         integer, allocatable :: ev_ids(:)
         character(len=32) :: buf
@@ -438,6 +443,26 @@ contains
                 k(:, 1) = k(:, 13)
             else
                 k(:, 1) = k(:, 7)
+            end if
+            if (present(hook)) then
+                call hook%after_step(t, y, changed, hinfo)
+                if (changed) then
+                    call sys%rhs(t, y, k(:, 1))
+                    st%nfev = st%nfev + 1
+                    if (opt%method == METHOD_DOPRI5) k(:, 7) = k(:, 1)
+                end if
+                if (hinfo /= 0) then
+                    if (store_steps) call push_point(res, t, y)
+                    if (hinfo < 0) then
+                        info = hinfo
+                        msg = "stopped by the step hook"
+                        if (allocated(hook%message)) msg = hook%message
+                    else
+                        info = CM_EVENT_STOP
+                        msg = "stopped by the step hook"
+                    end if
+                    exit
+                end if
             end if
             if (.not. all(ieee_is_finite(k(:, 1)))) then
                 info = CM_NONFINITE
