@@ -2,7 +2,7 @@
 !!   fpm run tour
 program tour
     use conmech
-    use tour_events, only: theta_events
+    use app_events, only: theta_events
     implicit none
 
     write (*, '(a)') "conmech tour"
