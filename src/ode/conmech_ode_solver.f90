@@ -517,24 +517,9 @@ contains
                 msg = "success"
             end if
             if (info /= CM_SUCCESS) return
-            if (allocated(opt%rtol_vec)) then
-                if (size(opt%rtol_vec) /= n) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: rtol must be a scalar or have the size of y0"
-                else if (.not. all(opt%rtol_vec >= 0.0_dp)) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: rtol must be non-negative"
-                end if
-            end if
-            if (allocated(opt%atol_vec)) then
-                if (size(opt%atol_vec) /= n) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: atol must be a scalar or have the size of y0"
-                else if (.not. all(opt%atol_vec >= 0.0_dp)) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: atol must be non-negative"
-                end if
-            end if
+            if (allocated(opt%rtol_vec)) call check_tol_vec(opt%rtol_vec, "rtol", info, msg)
+            if (info /= CM_SUCCESS) return
+            if (allocated(opt%atol_vec)) call check_tol_vec(opt%atol_vec, "atol", info, msg)
             if (info == CM_SUCCESS .and. has_events) then
                 if (.not. allocated(events%terminal)) then
                     info = CM_BAD_INPUT
@@ -545,6 +530,20 @@ contains
                 end if
             end if
         end subroutine validate
+
+        subroutine check_tol_vec(v, name, info, msg)
+            real(dp), intent(in) :: v(:)
+            character(len=*), intent(in) :: name
+            integer, intent(inout) :: info
+            character(len=:), allocatable, intent(inout) :: msg
+            if (size(v) /= n) then
+                info = CM_BAD_INPUT
+                msg = "bad input: "//name//" must be a scalar or have the size of y0"
+            else if (.not. all(v >= 0.0_dp)) then
+                info = CM_BAD_INPUT
+                msg = "bad input: "//name//" must be non-negative"
+            end if
+        end subroutine check_tol_vec
 
         !> Hairer's initial step size (hinit of dopri5.f / dop853.f).
         function hinit() result(hh)
