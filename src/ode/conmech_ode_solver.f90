@@ -1,6 +1,9 @@
 !> Explicit Runge-Kutta integrators: fixed-step RK4, and adaptive DOPRI5 and DOP853 with
 !! Hairer's step-size control, dense output and event location.
 !!
+!! Verner's 9(8) pair (METHOD_VERNER98) is the high-order choice for tight tolerances
+!! (rtol below about 1e-10): same control with exponent 1/9, step ratios [1/3, 6].
+!!
 !! Two entry points:
 !! - `ode_solve` stores the solution (every accepted step, or the points of `t_eval`),
 !!   the dense output if asked for, and the events, in an `ode_result`;
@@ -20,13 +23,18 @@ module conmech_ode_solver
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
-    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau
+    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
+        verner98_tableau
     implicit none
     private
 
     integer, parameter, public :: METHOD_RK4 = 1     !! classical RK4, fixed step
     integer, parameter, public :: METHOD_DOPRI5 = 2  !! Dormand-Prince 5(4), dense order 4
     integer, parameter, public :: METHOD_DOP853 = 3  !! Dormand-Prince 8(5,3), dense order 7
+    integer, parameter, public :: METHOD_VERNER98 = 4 !! Verner 9(8), dense order 8
+
+    integer, parameter :: FORM_HAIRER = 1   !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...)))
+    integer, parameter :: FORM_POWER = 2    !! y0 + x F1 + x^2 F2 + ... + x^nf F_nf
 
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name
@@ -63,7 +71,9 @@ module conmech_ode_solver
     type :: dense_solution
         integer :: n = 0            !! dimension
         integer :: nseg = 0         !! number of steps stored
-        integer :: nf = 0           !! number of F coefficients (3 RK4, 4 DOPRI5, 7 DOP853)
+        integer :: nf = 0           !! number of F coefficients (3 RK4, 4 DOPRI5, 7 DOP853,
+                                    !! 8 VERNER98)
+        integer :: form = FORM_HAIRER   !! polynomial form of the coefficients
         real(dp) :: t_first = 0.0_dp, t_last = 0.0_dp
         real(dp), allocatable :: ts(:), hs(:)      !! step start and signed length
         real(dp), allocatable :: coef(:, :, :)     !! (n, 0:nf, nseg); coef(:,0,:) = y0
@@ -90,7 +100,8 @@ module conmech_ode_solver
 
 contains
 
-    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853"; 0 if unknown.
+    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98";
+    !! 0 if unknown.
     pure function method_from_name(name) result(m)
         character(len=*), intent(in) :: name
         integer :: m
@@ -101,6 +112,8 @@ contains
             m = METHOD_DOPRI5
         case ("DOP853", "dop853")
             m = METHOD_DOP853
+        case ("VERNER98", "verner98", "RKV98", "rkv98", "Vern9")
+            m = METHOD_VERNER98
         case default
             m = 0
         end select
@@ -202,7 +215,7 @@ contains
         real(dp), allocatable :: fc(:, :), g_old(:), g_new(:), ye(:)
         real(dp) :: t, h, hnew, hmax, posneg, err, fac11, fac, facold, safe, facc1, facc2
         real(dp) :: expo1, beta, t_stop, te
-        integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev
+        integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev, ifsal, form
         integer :: i_eval, n_eval, nev_step
         logical :: adaptive, need_dense, reject, last, has_events, store_steps, stop_now
         logical :: changed
@@ -241,22 +254,35 @@ contains
         end if
         rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))   ! as SciPy: rtol >= 100 eps
 
+        form = FORM_HAIRER
         select case (opt%method)
         case (METHOD_RK4)
             adaptive = .false.
             nf = 3
             tab%stages = 4
+            ifsal = 13
         case (METHOD_DOPRI5)
             adaptive = .true.
             tab = dopri5_tableau()
             nf = 4
+            ifsal = 7
             safe = 0.9_dp; facc1 = 1.0_dp/0.2_dp; facc2 = 1.0_dp/10.0_dp; beta = 0.04_dp
             if (opt%beta >= 0.0_dp) beta = opt%beta
             expo1 = 0.2_dp - beta*0.75_dp
+        case (METHOD_VERNER98)
+            adaptive = .true.
+            tab = verner98_tableau()
+            nf = 8
+            form = FORM_POWER
+            ifsal = 17
+            safe = 0.9_dp; facc1 = 1.0_dp/0.333_dp; facc2 = 1.0_dp/6.0_dp; beta = 0.0_dp
+            if (opt%beta >= 0.0_dp) beta = opt%beta
+            expo1 = 1.0_dp/9.0_dp - beta*0.2_dp
         case default
             adaptive = .true.
             tab = dop853_tableau()
             nf = 7
+            ifsal = 13
             safe = 0.9_dp; facc1 = 1.0_dp/0.333_dp; facc2 = 1.0_dp/6.0_dp; beta = 0.0_dp
             if (opt%beta >= 0.0_dp) beta = opt%beta
             expo1 = 1.0_dp/8.0_dp - beta*0.2_dp
@@ -267,7 +293,7 @@ contains
         hmax = min(abs(opt%max_step), abs(tf - t0))
         n_nonfinite = 0
 
-        allocate (k(n, 16), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
+        allocate (k(n, 21), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
         t = t0
 
         ! outputs at the start
@@ -275,7 +301,7 @@ contains
         if (present(res)) then
             if (store_steps .or. (.not. opt%save_steps .and. n_eval == 0)) &
                 call push_point(res, t, y)
-            if (opt%dense_output) call dense_init(res%sol, n, nf, t0)
+            if (opt%dense_output) call dense_init(res%sol, n, nf, form, t0)
         end if
         if (n_eval > 0) then
             do while (i_eval <= n_eval)
@@ -355,6 +381,8 @@ contains
                 if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
             case (METHOD_DOPRI5)
                 call dopri5_step()
+            case (METHOD_VERNER98)
+                call verner_step()
             case default
                 call dop853_step()
             end select
@@ -400,9 +428,9 @@ contains
             else
                 hnew = h
             end if
-            ! the new right-hand side (FSAL): RK4 and DOP853 evaluate it here
-            if (opt%method == METHOD_DOP853 .or. opt%method == METHOD_RK4) then
-                call sys%rhs(t + h, ynew, k(:, 13))
+            ! the new right-hand side (FSAL): all but DOPRI5 evaluate it here
+            if (opt%method /= METHOD_DOPRI5) then
+                call sys%rhs(t + h, ynew, k(:, ifsal))
                 st%nfev = st%nfev + 1
             end if
             if (need_dense) call dense_coefs()
@@ -417,7 +445,7 @@ contains
                     if (t_eval(i_eval) == t + h) then
                         call push_point(res, t + h, ynew)
                     else
-                        call interp(fc, (t_eval(i_eval) - t)/h, ytmp)
+                        call interp(fc, form, (t_eval(i_eval) - t)/h, ytmp)
                         call push_point(res, t_eval(i_eval), ytmp)
                     end if
                     i_eval = i_eval + 1
@@ -428,7 +456,7 @@ contains
             end if
 
             if (stop_now) then
-                call interp(fc, (t_stop - t)/h, ytmp)
+                call interp(fc, form, (t_stop - t)/h, ytmp)
                 y = ytmp
                 t = t_stop
                 if (store_steps) call push_point(res, t, y)
@@ -439,17 +467,12 @@ contains
 
             y = ynew
             t = t + h
-            if (opt%method == METHOD_DOP853 .or. opt%method == METHOD_RK4) then
-                k(:, 1) = k(:, 13)
-            else
-                k(:, 1) = k(:, 7)
-            end if
+            k(:, 1) = k(:, ifsal)
             if (present(hook)) then
                 call hook%after_step(t, y, changed, hinfo)
                 if (changed) then
                     call sys%rhs(t, y, k(:, 1))
                     st%nfev = st%nfev + 1
-                    if (opt%method == METHOD_DOPRI5) k(:, 7) = k(:, 1)
                 end if
                 if (hinfo /= 0) then
                     if (store_steps) call push_point(res, t, y)
@@ -495,7 +518,7 @@ contains
                 msg = "bad input: y0 contains NaN or Inf"
             else if (.not. (ieee_is_finite(t0) .and. ieee_is_finite(tf))) then
                 msg = "bad input: t_span must be finite"
-            else if (opt%method < METHOD_RK4 .or. opt%method > METHOD_DOP853) then
+            else if (opt%method < METHOD_RK4 .or. opt%method > METHOD_VERNER98) then
                 msg = "bad input: unknown method"
             else if (.not. allocated(opt%rtol_vec) .and. .not. (opt%rtol >= 0.0_dp)) then
                 msg = "bad input: rtol must be non-negative"
@@ -643,6 +666,23 @@ contains
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dop853_step
 
+        subroutine verner_step()
+            integer :: j
+            call stages(2, 16)
+            ytmp = 0.0_dp
+            do j = 1, 15
+                if (tab%b(j) /= 0.0_dp) ytmp = ytmp + tab%b(j)*k(:, j)
+            end do
+            ynew = y + h*ytmp
+            ytmp = 0.0_dp
+            do j = 1, 16
+                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
+            end do
+            sk = atolv + rtolv*max(abs(y), abs(ynew))
+            err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
+            if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
+        end subroutine verner_step
+
         !> Coefficients of the continuous extension of the accepted step into fc.
         subroutine dense_coefs()
             integer :: s, j, i
@@ -658,6 +698,15 @@ contains
                 fc(:, 4) = 0.0_dp
                 do j = 1, 7
                     if (tab%d(1, j) /= 0.0_dp) fc(:, 4) = fc(:, 4) + (h*tab%d(1, j))*k(:, j)
+                end do
+            case (METHOD_VERNER98)
+                ! stages 18..21 (stage 17 is the FSAL stage), then the power-form weights
+                call stages(18, 21)
+                do j = 1, 8
+                    fc(:, j) = 0.0_dp
+                    do i = 1, 21
+                        if (tab%p(i, j) /= 0.0_dp) fc(:, j) = fc(:, j) + (h*tab%p(i, j))*k(:, i)
+                    end do
                 end do
             case default
                 ! three extra stages 14..16 (they use the FSAL stage 13)
@@ -727,7 +776,7 @@ contains
                 if (te == t + h) then
                     ye = ynew
                 else
-                    call interp(fc, (te - t)/h, ye)
+                    call interp(fc, form, (te - t)/h, ye)
                 end if
                 if (present(res)) call push_event(res, te, ye, ie)
                 if (events%terminal(ie) .and. .not. stop_now) then
@@ -788,7 +837,7 @@ contains
                 else
                     b = b + sign(tol, m)
                 end if
-                call interp(fc, b, ye)
+                call interp(fc, form, b, ye)
                 call events%eval(t + b*h, ye, gv)
                 fb = gv(ie)
                 if ((fb > 0.0_dp .and. fcc > 0.0_dp) .or. (fb < 0.0_dp .and. fcc < 0.0_dp)) then
@@ -809,14 +858,24 @@ contains
 
     end subroutine drive
 
-    !> Hairer's continuous extension: y0 + x (F1 + (1-x)(F2 + x (F3 + ...))).
-    pure subroutine interp(fc, x, yout)
+    !> Continuous extension at x = (t - t0)/h: Hairer's form
+    !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...))) or the power form y0 + sum_j x^j F_j.
+    pure subroutine interp(fc, form, x, yout)
         real(dp), intent(in) :: fc(:, 0:)
+        integer, intent(in) :: form
         real(dp), intent(in) :: x
         real(dp), intent(out) :: yout(:)
         integer :: j, nf
         real(dp) :: x1
         nf = ubound(fc, 2)
+        if (form == FORM_POWER) then
+            yout = fc(:, nf)
+            do j = nf - 1, 1, -1
+                yout = fc(:, j) + x*yout
+            end do
+            yout = fc(:, 0) + x*yout
+            return
+        end if
         x1 = 1.0_dp - x
         yout = fc(:, nf)
         do j = nf - 1, 1, -1
@@ -892,12 +951,13 @@ contains
         end if
     end subroutine shrink_result
 
-    subroutine dense_init(sol, n, nf, t0)
+    subroutine dense_init(sol, n, nf, form, t0)
         type(dense_solution), intent(out) :: sol
-        integer, intent(in) :: n, nf
+        integer, intent(in) :: n, nf, form
         real(dp), intent(in) :: t0
         sol%n = n
         sol%nf = nf
+        sol%form = form
         sol%nseg = 0
         sol%t_first = t0
         sol%t_last = t0
@@ -950,7 +1010,7 @@ contains
                 hi = mid - 1
             end if
         end do
-        call interp(self%coef(:, :, lo), (t - self%ts(lo))/self%hs(lo), y)
+        call interp(self%coef(:, :, lo), self%form, (t - self%ts(lo))/self%hs(lo), y)
     end subroutine dense_eval
 
     !> Evaluate the dense output at many times: y(:, i) at t(i).
