@@ -9,10 +9,10 @@ from .systems import BuiltinSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853")
+_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9")
 # codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
 # method_from_name by the tests (flat_method_code)
-_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3}
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -64,11 +64,19 @@ class DenseOutput:
 
     ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
     (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
-    OdeSolution does. On each step [ts, ts + h] the polynomial is Hairer's form
-    y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))), x = (t - ts) / h.
+    OdeSolution does. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
+    in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
+    RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
+    VERNER98), as in conmech_ode_solver's dense_solution.
     """
 
-    def __init__(self, ts, hs, coef, t_min, t_max):
+    HAIRER = 1
+    POWER = 2
+
+    def __init__(self, ts, hs, coef, t_min, t_max, form=HAIRER):
+        if form not in (self.HAIRER, self.POWER):
+            raise ValueError(f"unknown dense output form {form}")
+        self.form = form
         self.t_start = np.ascontiguousarray(ts, dtype=float)   # step starts
         self.h = np.ascontiguousarray(hs, dtype=float)          # signed step lengths
         self.coef = np.ascontiguousarray(coef, dtype=float)     # (n, nf + 1, nseg)
@@ -96,7 +104,10 @@ class DenseOutput:
         x1 = 1.0 - x
         y = c[:, nf, :].copy()
         for j in range(nf - 1, 0, -1):
-            y *= x1 if j % 2 == 1 else x
+            if self.form == self.POWER:
+                y *= x
+            else:
+                y *= x1 if j % 2 == 1 else x
             y += c[:, j, :]
         y *= x
         y += c[:, 0, :]
@@ -188,9 +199,11 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state.
-    method : {"DOP853", "DOPRI5" (alias "RK45"), "RK4"}
+    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4"}
         DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
-        5(4), dense output of order 4. RK4: classical fixed-step RK4, step ``first_step``.
+        5(4), dense output of order 4. VERNER98: Verner's 9(8) pair, dense output of
+        order 8, for tight tolerances. RK4: classical fixed-step RK4, step ``first_step``.
+        Case-insensitive.
     t_eval : array_like or None
         Times at which to store the solution (sorted in the direction of integration,
         inside t_span), from the dense output. None: every accepted step.
@@ -358,7 +371,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir, ev_term=ev_term)
     probe_calls = 0
     if builtin:
-        nfev, naccept, nreject, info, message = _conmech.flat_solve_builtin(
+        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
             fun.name, fun.params.size, fun.params if fun.params.size else _PAD, events_cb,
             store, **common)
     else:
@@ -374,7 +387,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         else:
             def rhs(t, y):
                 return fun(t, y.copy())
-        nfev, naccept, nreject, info, message = _conmech.flat_solve_callback(
+        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
             rhs, events_cb, store, **common)
 
     message = bytes(message).decode("ascii", "replace").strip() \
@@ -405,5 +418,5 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
             t_last = float(out["ts"][-1] + out["hs"][-1])
             if status == 1 and ne > 0:
                 t_last = float(np.max(out["ev_t"]) if tf > t0 else np.min(out["ev_t"]))
-        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last)
+        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last, form=int(form))
     return res

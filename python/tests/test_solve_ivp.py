@@ -81,6 +81,15 @@ def test_dopri5_agrees_with_scipy_rk45():
     assert 0.7 < res.nfev / ref.nfev < 1.4
 
 
+def test_verner98_is_more_accurate_than_dop853_at_tight_tolerance():
+    kw = dict(rtol=1e-12, atol=1e-12)
+    d = conmech.solve_ivp(systems.kepler(), (0, KEPLER_T), KEPLER_Y0, method="DOP853", **kw)
+    v = conmech.solve_ivp(systems.kepler(), (0, KEPLER_T), KEPLER_Y0, method="Vern9", **kw)
+    err_d = np.max(np.abs(d.y[:, -1] - KEPLER_Y0))
+    err_v = np.max(np.abs(v.y[:, -1] - KEPLER_Y0))
+    assert v.success and err_v < 1e-10 and err_v < err_d
+
+
 def test_rk45_is_an_alias_of_dopri5():
     a = conmech.solve_ivp(kepler_rhs, (0, 1), KEPLER_Y0, method="RK45", rtol=1e-7)
     b = conmech.solve_ivp(kepler_rhs, (0, 1), KEPLER_Y0, method="DOPRI5", rtol=1e-7)
@@ -231,7 +240,7 @@ def test_no_events_found_gives_empty_arrays():
 
 
 # --------------------------------------------------------------------- dense output
-@pytest.mark.parametrize("method", ["DOP853", "DOPRI5", "RK4"])
+@pytest.mark.parametrize("method", ["DOP853", "DOPRI5", "RK4", "VERNER98"])
 def test_dense_output_matches_t_eval(method):
     t_eval = np.linspace(0, 5, 101)
     kw = dict(method=method, rtol=1e-8, atol=1e-10)
@@ -240,9 +249,9 @@ def test_dense_output_matches_t_eval(method):
     r = conmech.solve_ivp(harmonic_rhs, (0, 5), [1.0, 0.0], t_eval=t_eval,
                           dense_output=True, **kw)
     np.testing.assert_array_equal(r.t, t_eval)
-    np.testing.assert_allclose(r.sol(t_eval), r.y, rtol=1e-13, atol=1e-14)
+    np.testing.assert_allclose(r.sol(t_eval), r.y, rtol=1e-12, atol=1e-13)
     # and both are the solution
-    tol = 1e-6 if method != "DOP853" else 1e-8
+    tol = 1e-6 if method in ("DOPRI5", "RK4") else 1e-8
     np.testing.assert_allclose(r.y[0], np.cos(2 * t_eval), atol=tol)
     assert r.sol(2.5).shape == (2,) and r.sol(t_eval).shape == (2, 101)
 
@@ -386,8 +395,11 @@ def test_nested_solve_inside_fun():
 
 def test_method_codes_match_the_fortran_names():
     from conmech import _conmech, _ivp
-    for name, code in _ivp._METHOD_CODES.items():
-        assert int(_conmech.flat_method_code(name)) == code
+    fortran_names = ["RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "Vern9"]
+    for name in fortran_names:
+        code = int(_conmech.flat_method_code(name))
+        assert code > 0 and _ivp._METHOD_CODES[name.upper()] == code
+    assert set(_ivp._METHOD_CODES) == {n.upper() for n in fortran_names}
     assert int(_conmech.flat_method_code("RK23")) == 0
 
 
