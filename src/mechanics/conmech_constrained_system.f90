@@ -40,6 +40,22 @@ module conmech_constrained_system
 
     public :: constrained_system, constrained_accel, constraint_matrix
     public :: project_position, project_velocity, constraint_residuals
+    !> The finite-difference defaults, for extensions that choose at run time (e.g. the
+    !! Python layer) whether an analytic Jacobian / acceleration term exists.
+    public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
+
+    interface fd_phi_jac
+        module procedure cs_fd_phi_jac
+    end interface fd_phi_jac
+    interface fd_phi_t
+        module procedure cs_fd_phi_t
+    end interface fd_phi_t
+    interface fd_phi_gamma
+        module procedure cs_fd_phi_gamma
+    end interface fd_phi_gamma
+    interface fd_nh_gamma
+        module procedure cs_fd_nh_gamma
+    end interface fd_nh_gamma
 
     type, abstract :: constrained_system
         integer :: n = 0             !! number of (excessive) coordinates

@@ -1,0 +1,342 @@
+"""Constrained mechanical systems: multipliers, reaction forces, projected integrators.
+
+The equations are ``M(t, q) q'' = Q(t, q, q') + C^T lambda`` with holonomic constraints
+``phi(t, q) = 0`` (Jacobian ``G``) and non-holonomic ones ``A(t, q) q' + b(t, q) = 0``,
+``C = [G; A]``. The accelerations and multipliers come from the acceleration-level KKT
+system (LAPACK); after each accepted Runge-Kutta step the state is projected back onto the
+constraints (mass-weighted position projection by simplified Newton, then velocity
+projection), or Baumgarte stabilisation is used, or nothing (the plain index-1 form,
+which drifts)::
+
+    from conmech import constrained
+    res = constrained.solve("pendulum_xy", (0, 10), rtol=1e-10, atol=1e-10)
+    res.q, res.lam, res.reaction, res.res_pos
+
+A system is a built-in (:func:`builtin` or its name; see :data:`BUILTIN_NAMES`) or a
+:class:`ConstrainedSystem` made of Python callables. Integrations of built-ins run
+entirely in Fortran.
+"""
+import numpy as np
+
+from . import _conmech
+
+__all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
+           "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS", "plot_trajectory",
+           "plot_drift"]
+
+#: Names of the built-in constrained systems (excessive coordinates).
+BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
+                 "pendulum_moving_xy", "yoyo", "skate", "rolling_disk")
+#: Projection names and their codes in conmech_constrained_solver.
+PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
+_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3}
+_CM_BAD_INPUT = -4
+_PAD = np.zeros(1)
+_PAD.flags.writeable = False
+
+
+class ConstrainedResult(dict):
+    """Result of :func:`solve` (a dict whose keys are also attributes).
+
+    Keys: ``t`` (nt,), ``q`` and ``v`` (n, nt), ``lam`` (m, nt) multipliers,
+    ``reaction`` (n, nt) = C^T lambda, ``res_pos`` (max |phi|) and ``res_vel``
+    (max |C v + c0|) (nt,), ``energy`` (nt,) (zeros if the system defines none),
+    ``power`` (nt,) of the reactions, ``nfev``, ``naccept``, ``nreject``, ``nproj``,
+    ``proj_iter``, ``rank`` (of the constraints; < m when redundant), ``dq0``, ``dv0``
+    (how far the initial state was moved), ``status`` (0 success, -1 failure),
+    ``message``, ``success``.
+    """
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError as exc:
+            raise AttributeError(name) from exc
+
+    __setattr__ = dict.__setitem__
+
+    def __dir__(self):
+        return list(self.keys())
+
+    def __repr__(self):
+        return (f"ConstrainedResult(success={self.success}, message={self.message!r}, "
+                f"nt={self.t.size}, nfev={self.nfev}, max res_pos="
+                f"{np.max(self.res_pos, initial=0.0):.3g})")
+
+
+class BuiltinConstrained:
+    """A built-in constrained system of the Fortran registry, by name and parameters."""
+
+    __slots__ = ("name", "params", "n", "n_hol", "n_nh")
+
+    def __init__(self, name, params=()):
+        if not isinstance(name, str):
+            raise TypeError("system name must be a string")
+        params = np.array(params, dtype=float).ravel()
+        if not np.all(np.isfinite(params)):
+            raise ValueError("params must be finite")
+        kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
+            name, params.size, params if params.size else _PAD)
+        if kind != 1:
+            raise ValueError(f"system: unknown built-in constrained system '{name}' "
+                             f"(known: {', '.join(BUILTIN_NAMES)})")
+        self.name = name
+        self.params = params
+        self.n, self.n_hol, self.n_nh = int(n), int(mh), int(mn)
+
+    def initial_state(self):
+        """Default consistent initial state (q0, v0)."""
+        q0, v0, info = _conmech.flat_mech_initial_state(
+            self.name, self.params.size, self.params if self.params.size else _PAD, self.n)
+        return np.array(q0), np.array(v0)
+
+    def __repr__(self):
+        return f"conmech.constrained.builtin({self.name!r}, {self.params.tolist()})"
+
+
+def builtin(name, params=()):
+    """The built-in constrained system ``name`` with ``params`` (documented order:
+    pendulum_xy m, g, l | rod_two_masses g, l | double_pendulum_xy m1, m2, l1, l2, g |
+    atwood_xy m1, m2, g, L | pendulum_moving_xy m, g, l, a, b, w |
+    yoyo m, r, I, g, ah, vh, h0 | skate m, I, g, alpha | rolling_disk m, R, I_roll, I_turn)."""
+    return BuiltinConstrained(name, params)
+
+
+class ConstrainedSystem:
+    """A constrained system from Python callables.
+
+    Parameters
+    ----------
+    n : int
+        Number of (excessive) coordinates.
+    mass : callable ``mass(t, q) -> (n, n)``
+        Symmetric positive definite mass matrix.
+    forces : callable ``forces(t, q, v) -> (n,)``
+        Applied forces, velocity terms included.
+    phi : callable ``phi(t, q) -> (n_hol,)``, optional
+        Holonomic constraints (then ``n_hol`` > 0).
+    jac : callable ``jac(t, q) -> (n_hol, n)``, optional
+        d phi / d q; default: central differences.
+    gamma : callable ``gamma(t, q, v) -> (n_hol,)``, optional
+        Acceleration term, G q'' = gamma; default: five-point differences of phi.
+    n_hol : int
+    nh : callable ``nh(t, q) -> (A (n_nh, n), b (n_nh,))``, optional
+        Non-holonomic constraints A q' + b = 0.
+    nh_gamma : callable ``nh_gamma(t, q, v) -> (n_nh,)``, optional
+        A q'' = nh_gamma; default: five-point differences of A v + b.
+    n_nh : int
+    rheonomic : bool
+        phi depends explicitly on t.
+    """
+
+    def __init__(self, n, mass, forces, phi=None, jac=None, gamma=None, n_hol=0, nh=None,
+                 nh_gamma=None, n_nh=0, rheonomic=False):
+        self.n, self.n_hol, self.n_nh = int(n), int(n_hol), int(n_nh)
+        if self.n < 1:
+            raise ValueError("n must be at least 1")
+        if self.n_hol < 0 or self.n_nh < 0:
+            raise ValueError("n_hol and n_nh must be non-negative")
+        for label, f in (("mass", mass), ("forces", forces)):
+            if not callable(f):
+                raise TypeError(f"{label} must be callable")
+        if self.n_hol > 0 and not callable(phi):
+            raise TypeError("phi must be callable when n_hol > 0")
+        if self.n_nh > 0 and not callable(nh):
+            raise TypeError("nh must be callable when n_nh > 0")
+        for label, f in (("jac", jac), ("gamma", gamma), ("nh_gamma", nh_gamma)):
+            if f is not None and not callable(f):
+                raise TypeError(f"{label} must be callable or None")
+        self.mass, self.forces, self.phi, self.jac, self.gamma = mass, forces, phi, jac, gamma
+        self.nh, self.nh_gamma, self.rheonomic = nh, nh_gamma, bool(rheonomic)
+
+    def _callbacks(self):
+        n, mh, mn = self.n, self.n_hol, self.n_nh
+
+        def mass(t, q, n_):
+            m = np.asarray(self.mass(t, q.copy()), dtype=float)
+            if m.shape != (n, n):
+                raise ValueError(f"mass must return shape ({n}, {n}), got {m.shape}")
+            return m
+
+        def forces(t, q, v, n_):
+            return np.asarray(self.forces(t, q.copy(), v.copy()), dtype=float).reshape(n)
+
+        def phi(t, q, n_, mh_):
+            return np.asarray(self.phi(t, q.copy()), dtype=float).reshape(mh)
+
+        def jac(t, q, n_, mh_):
+            return np.asarray(self.jac(t, q.copy()), dtype=float).reshape(mh, n)
+
+        def gamma(t, q, v, n_, mh_):
+            return np.asarray(self.gamma(t, q.copy(), v.copy()), dtype=float).reshape(mh)
+
+        def nh(t, q, n_, mn_):
+            a, b = self.nh(t, q.copy())
+            return (np.asarray(a, dtype=float).reshape(mn, n),
+                    np.asarray(b, dtype=float).reshape(mn))
+
+        def nh_gamma(t, q, v, n_, mn_):
+            return np.asarray(self.nh_gamma(t, q.copy(), v.copy()), dtype=float).reshape(mn)
+
+        return mass, forces, phi, jac, gamma, nh, nh_gamma
+
+
+def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="position+velocity",
+          t_eval=None, rtol=1e-8, atol=1e-10, params=(), first_step=None, max_step=np.inf,
+          max_steps=1000000, every=1, alpha=5.0, beta=5.0, proj_tol=1e-14, proj_max_iter=10):
+    """Integrate a constrained mechanical system.
+
+    Parameters
+    ----------
+    system : str, BuiltinConstrained or ConstrainedSystem
+        A built-in (name, with ``params``) or a system of Python callables.
+    t_span : (t0, tf)
+    q0, v0 : array_like, optional
+        Initial coordinates and velocities (built-ins: their default state if omitted).
+        They are projected onto the constraints first; ``dq0``/``dv0`` say how far.
+    method : "RK4" (fixed step ``first_step``), "DOPRI5" or "DOP853"
+    projection : "position+velocity" (default), "velocity", "baumgarte", "none"
+    t_eval : array_like, optional
+        Output times (sorted, inside t_span; the steps hit them exactly). Default: every
+        accepted step.
+    rtol, atol : float
+    every : int
+        Project every ``every`` accepted steps.
+    alpha, beta : float
+        Baumgarte parameters.
+    proj_tol, proj_max_iter :
+        Position projection: target max |phi| and simplified Newton iterations.
+
+    Returns
+    -------
+    ConstrainedResult
+
+    Raises
+    ------
+    ValueError, TypeError
+        On bad input (the message names the argument).
+    """
+    if isinstance(system, str):
+        system = BuiltinConstrained(system, params)
+    elif not isinstance(system, (BuiltinConstrained, ConstrainedSystem)):
+        raise TypeError("system must be a built-in name, conmech.constrained.builtin(...) or "
+                        "a ConstrainedSystem")
+    n = system.n
+    if method not in _METHODS:
+        raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
+    if projection not in PROJECTIONS:
+        raise ValueError(f"projection must be one of {sorted(PROJECTIONS)}, got "
+                         f"{projection!r}")
+    try:
+        t0, tf = (float(x) for x in t_span)
+    except (TypeError, ValueError) as exc:
+        raise ValueError("t_span must be a pair of numbers (t0, tf)") from exc
+    if q0 is None or v0 is None:
+        if not isinstance(system, BuiltinConstrained):
+            raise ValueError("q0 and v0 are required for a user-defined system")
+        dq, dv = system.initial_state()
+        q0 = dq if q0 is None else q0
+        v0 = dv if v0 is None else v0
+    q0 = np.array(q0, dtype=float).ravel()
+    v0 = np.array(v0, dtype=float).ravel()
+    if q0.size != n:
+        raise ValueError(f"q0 must have {n} elements, got {q0.size}")
+    if v0.size != n:
+        raise ValueError(f"v0 must have {n} elements, got {v0.size}")
+    if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
+        raise ValueError("q0 and v0 must be finite")
+    if not (rtol >= 0 and atol >= 0):
+        raise ValueError("rtol and atol must be non-negative")
+    if method == "RK4" and not (first_step and first_step > 0):
+        raise ValueError("first_step (the fixed step) is required for RK4")
+    if int(every) < 1 or int(proj_max_iter) < 1 or not proj_tol > 0:
+        raise ValueError("every, proj_max_iter and proj_tol must be positive")
+    if t_eval is None:
+        t_ev = np.zeros(0)
+    else:
+        t_ev = np.array(t_eval, dtype=float).ravel()
+        lo, hi = min(t0, tf), max(t0, tf)
+        if np.any(t_ev < lo) or np.any(t_ev > hi):
+            raise ValueError("t_eval values must lie in t_span")
+        d = np.diff(t_ev) * np.sign(tf - t0)
+        if np.any(d < 0):
+            raise ValueError("t_eval must be sorted in the direction of integration")
+    iopt = np.array([PROJECTIONS[projection], int(every), int(proj_max_iter), int(max_steps)],
+                    dtype=np.intc)
+    mstep = float(max_step) if np.isfinite(max_step) else np.finfo(float).max
+    ropt = np.array([float(first_step or 0.0), mstep, float(alpha), float(beta),
+                     float(proj_tol)])
+    out = {}
+
+    def store(t, q, v, lam, reac, rp, rv, en, pw, n_, mm, nt):
+        out.update(t=np.array(t), q=np.array(q), v=np.array(v), lam=np.array(lam),
+                   reaction=np.array(reac), res_pos=np.array(rp), res_vel=np.array(rv),
+                   energy=np.array(en), power=np.array(pw))
+
+    common = dict(n=n, t_span=np.array([t0, tf]), q0=q0, v0=v0, method=_METHODS[method],
+                  rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
+                  neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD)
+    if isinstance(system, BuiltinConstrained):
+        p = system.params
+        stats, moved, info, message = _conmech.flat_constrained_builtin(
+            system.name, p.size, p if p.size else _PAD, store, **common)
+    else:
+        cb = system._callbacks()
+        # probe the callables once, for clear shape errors
+        m0 = np.asarray(system.mass(t0, q0.copy()))
+        if m0.shape != (n, n):
+            raise ValueError(f"mass must return shape ({n}, {n}), got {m0.shape}")
+        if np.asarray(system.forces(t0, q0.copy(), v0.copy())).size != n:
+            raise ValueError(f"forces must return {n} values")
+        if system.n_hol and np.asarray(system.phi(t0, q0.copy())).size != system.n_hol:
+            raise ValueError(f"phi must return n_hol = {system.n_hol} values")
+        stats, moved, info, message = _conmech.flat_constrained_callback(
+            cb[0], cb[1], cb[2], cb[3], cb[4], cb[5], cb[6], int(system.jac is not None),
+            int(system.gamma is not None), int(system.nh_gamma is not None),
+            int(system.rheonomic), system.n_hol, system.n_nh, store, **common)
+    message = bytes(message).decode("ascii", "replace").strip() \
+        if not isinstance(message, str) else message.strip()
+    info = int(info)
+    if info == _CM_BAD_INPUT:
+        raise ValueError(message)
+    m = system.n_hol + system.n_nh
+    if not out:
+        out = dict(t=np.zeros(0), q=np.zeros((n, 0)), v=np.zeros((n, 0)),
+                   lam=np.zeros((max(m, 1), 0)), reaction=np.zeros((n, 0)),
+                   res_pos=np.zeros(0), res_vel=np.zeros(0), energy=np.zeros(0),
+                   power=np.zeros(0))
+    out["lam"] = out["lam"][:m]
+    res = ConstrainedResult(out)
+    res.update(nfev=int(stats[0]), naccept=int(stats[1]), nreject=int(stats[2]),
+               nproj=int(stats[3]), proj_iter=int(stats[4]), rank=int(stats[5]),
+               dq0=float(moved[0]), dv0=float(moved[1]), status=0 if info >= 0 else -1,
+               message=message, success=info >= 0, info=info)
+    return res
+
+
+def plot_trajectory(res, coords=(0, 1), ax=None, **kwargs):
+    """Plot q[coords[1]] against q[coords[0]] of a result (matplotlib); returns the axes."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots()
+    i, j = coords
+    ax.plot(res.q[i], res.q[j], **kwargs)
+    ax.set_xlabel(f"q{i + 1}")
+    ax.set_ylabel(f"q{j + 1}")
+    ax.set_aspect("equal", adjustable="datalim")
+    return ax
+
+
+def plot_drift(results, ax=None, velocity=False):
+    """Constraint drift max|phi| (or max|C v + c0| with ``velocity``) against t, on a log
+    scale, for a dict {label: result} (e.g. with and without projection)."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots()
+    key = "res_vel" if velocity else "res_pos"
+    for label, r in results.items():
+        ax.semilogy(r.t, np.maximum(r[key], 1e-17), label=label)
+    ax.set_xlabel("t")
+    ax.set_ylabel("max |C v + c0|" if velocity else "max |phi|")
+    ax.legend()
+    return ax

@@ -1,0 +1,234 @@
+!> Flat f2py layer of the constrained mechanical systems (conventions: see flat_ode.f90).
+!! The Python side is conmech/constrained.py.
+
+!> Kind and dimensions of a built-in mechanical system: kind 1 constrained (excessive
+!! coordinates; n, n_hol, n_nh), 2 generalized coordinates (n = ndof), 0 unknown.
+subroutine flat_mech_info(name, np, params, kind, n, mh, mn, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS
+    use conmech_constrained_system, only: constrained_system
+    use conmech_generalized, only: generalized_system
+    use conmech_systems_mech, only: make_constrained, make_generalized
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np
+    real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(out) :: kind, n, mh, mn, info
+    character(len=256), intent(out) :: message
+    class(constrained_system), allocatable :: cs
+    class(generalized_system), allocatable :: gs
+    character(len=:), allocatable :: msg
+    kind = 0
+    n = 0
+    mh = 0
+    mn = 0
+    call make_constrained(name, real(params(1:np), dp), cs, info, msg)
+    if (info == CM_SUCCESS) then
+        kind = 1
+        n = cs%n
+        mh = cs%n_hol
+        mn = cs%n_nh
+    else
+        call make_generalized(name, real(params(1:np), dp), gs, info, msg)
+        if (info == CM_SUCCESS) then
+            kind = 2
+            n = gs%ndof
+        end if
+    end if
+    call copy_message(msg, message)
+end subroutine flat_mech_info
+
+!> Default initial state (q0, v0) of a built-in mechanical system with n coordinates.
+subroutine flat_mech_initial_state(name, np, params, n, q0, v0, info)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_systems_mech, only: mech_initial_state
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np
+    real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(out) :: q0(n), v0(n)
+    integer(c_int), intent(out) :: info
+    real(dp), allocatable :: q(:), v(:)
+    q0 = 0.0_dp
+    v0 = 0.0_dp
+    call mech_initial_state(name, real(params(1:np), dp), q, v, info)
+    if (info /= CM_SUCCESS) return
+    if (size(q) /= n) then
+        info = CM_BAD_INPUT
+        return
+    end if
+    q0 = q
+    v0 = v
+end subroutine flat_mech_initial_state
+
+!> Solve the built-in constrained system `name` (params as in conmech_systems_mech).
+!! iopt = [projection, every, proj_max_iter, max_steps]; ropt = [first_step, max_step,
+!! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank];
+!! moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
+subroutine flat_constrained_builtin(name, np, params, store, n, t_span, q0, v0, method, &
+                                    rtol, atol, iopt, ropt, neval, t_eval, stats, moved, &
+                                    info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS
+    use conmech_constrained_system, only: constrained_system
+    use conmech_systems_mech, only: make_constrained
+    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_mech_support, only: run_constrained
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np
+    real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
+    integer(c_int), intent(in) :: method
+    real(c_double), intent(in) :: rtol, atol
+    integer(c_int), intent(in) :: iopt(4)
+    real(c_double), intent(in) :: ropt(5)
+    integer(c_int), intent(in) :: neval
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(out) :: stats(6)
+    real(c_double), intent(out) :: moved(2)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external store
+    interface
+        subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mm, nt
+            real(c_double), intent(in) :: t(nt)
+            real(c_double), intent(in) :: q(n, nt), v(n, nt)
+            real(c_double), intent(in) :: lam(mm, nt)
+            real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
+        end subroutine store
+    end interface
+    class(constrained_system), allocatable :: cs
+    character(len=:), allocatable :: msg
+    stats = 0
+    moved = 0.0_dp
+    call make_constrained(name, real(params(1:np), dp), cs, info, msg)
+    if (info /= CM_SUCCESS) then
+        call copy_message(msg, message)
+        return
+    end if
+    call run_constrained(cs, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
+                         t_eval, store, stats, moved, info, message)
+end subroutine flat_constrained_builtin
+
+!> Solve a constrained system given by Python callables (see conmech_flat_mech_support
+!! for their conventions). has_jac, has_gamma, has_nh_gamma, rheonomic: 0 or 1; without
+!! an analytic Jacobian or acceleration term the documented finite differences are used.
+subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma, has_jac, &
+                                     has_gamma, has_nh_gamma, rheonomic, mh, mn, store, n, &
+                                     t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
+                                     t_eval, stats, moved, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_mech_support, only: callback_constrained, run_constrained
+    implicit none
+    integer(c_int), intent(in) :: has_jac, has_gamma, has_nh_gamma, rheonomic, mh, mn
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
+    integer(c_int), intent(in) :: method
+    real(c_double), intent(in) :: rtol, atol
+    integer(c_int), intent(in) :: iopt(4)
+    real(c_double), intent(in) :: ropt(5)
+    integer(c_int), intent(in) :: neval
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(out) :: stats(6)
+    real(c_double), intent(out) :: moved(2)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external mass, forces, phi, jac, gamma, nh, nhgamma, store
+    interface
+        subroutine mass(t, q, mm, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n)
+            real(c_double), intent(out) :: mm(n, n)
+        end subroutine mass
+        subroutine forces(t, q, v, f, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n), v(n)
+            real(c_double), intent(out) :: f(n)
+        end subroutine forces
+        subroutine phi(t, q, c, n, mh)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mh
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n)
+            real(c_double), intent(out) :: c(mh)
+        end subroutine phi
+        subroutine jac(t, q, g, n, mh)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mh
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n)
+            real(c_double), intent(out) :: g(mh, n)
+        end subroutine jac
+        subroutine gamma(t, q, v, gam, n, mh)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mh
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n), v(n)
+            real(c_double), intent(out) :: gam(mh)
+        end subroutine gamma
+        subroutine nh(t, q, a, b, n, mn)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mn
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n)
+            real(c_double), intent(out) :: a(mn, n), b(mn)
+        end subroutine nh
+        subroutine nhgamma(t, q, v, gam, n, mn)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mn
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: q(n), v(n)
+            real(c_double), intent(out) :: gam(mn)
+        end subroutine nhgamma
+        subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, mm, nt
+            real(c_double), intent(in) :: t(nt)
+            real(c_double), intent(in) :: q(n, nt), v(n, nt)
+            real(c_double), intent(in) :: lam(mm, nt)
+            real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
+        end subroutine store
+    end interface
+    type(callback_constrained) :: sys
+    stats = 0
+    moved = 0.0
+    if (n < 1 .or. mh < 0 .or. mn < 0) then
+        info = CM_BAD_INPUT
+        call copy_message("bad input: n must be >= 1, n_hol and n_nh >= 0", message)
+        return
+    end if
+    sys%n = n
+    sys%n_hol = mh
+    sys%n_nh = mn
+    sys%rheonomic = rheonomic /= 0
+    sys%has_jac = has_jac /= 0
+    sys%has_gamma = has_gamma /= 0
+    sys%has_nh_gamma = has_nh_gamma /= 0
+    sys%fmass => mass
+    sys%fforces => forces
+    sys%fphi => phi
+    sys%fjac => jac
+    sys%fgamma => gamma
+    sys%fnh => nh
+    sys%fnhgamma => nhgamma
+    call run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
+                         t_eval, store, stats, moved, info, message)
+end subroutine flat_constrained_callback

@@ -1,0 +1,201 @@
+!> Support of the flat f2py layer for constrained mechanical systems (compiled into the
+!! extension, not wrapped: it holds derived types).
+!!
+!! `callback_constrained` adapts external procedures (f2py callbacks into Python) to
+!! `constrained_system`; `run_constrained` runs `constrained_solve` from plain arguments
+!! and hands the whole result to a `store` procedure. Calling conventions (by reference):
+!!
+!!     mass(t, q, mm, n)            real(c_double) t, q(n), mm(n, n)
+!!     forces(t, q, v, f, n)        real(c_double) t, q(n), v(n), f(n)
+!!     phi(t, q, c, n, mh)          c(mh): holonomic constraints
+!!     jac(t, q, g, n, mh)          g(mh, n): d phi / d q       (if has_jac, else FD)
+!!     gamma(t, q, v, gam, n, mh)   G q'' = gam                 (if has_gamma, else FD)
+!!     nh(t, q, a, b, n, mn)        a(mn, n), b(mn): A q' + b = 0
+!!     nhgamma(t, q, v, gam, n, mn) A q'' = gam                 (if has_nh_gamma, else FD)
+!!     store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)  the result, once, at the end
+!!         (lam is (mm, nt), mm = max(n_hol + n_nh, 1); zero rows when there is no constraint)
+module conmech_flat_mech_support
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_constrained_system
+    use conmech_constrained_solver
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    private
+    public :: callback_constrained, run_constrained
+
+    type, extends(constrained_system) :: callback_constrained
+        procedure(), pointer, nopass :: fmass => null()
+        procedure(), pointer, nopass :: fforces => null()
+        procedure(), pointer, nopass :: fphi => null()
+        procedure(), pointer, nopass :: fjac => null()
+        procedure(), pointer, nopass :: fgamma => null()
+        procedure(), pointer, nopass :: fnh => null()
+        procedure(), pointer, nopass :: fnhgamma => null()
+        logical :: has_jac = .false., has_gamma = .false., has_nh_gamma = .false.
+    contains
+        procedure :: mass => cb_mass
+        procedure :: forces => cb_forces
+        procedure :: phi => cb_phi
+        procedure :: phi_jac => cb_jac
+        procedure :: phi_gamma => cb_gamma
+        procedure :: nh_matrix => cb_nh
+        procedure :: nh_gamma => cb_nh_gamma
+    end type callback_constrained
+
+contains
+
+    subroutine cb_mass(self, t, q, mm)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: mm(:, :)
+        integer(c_int) :: n
+        n = self%n
+        call self%fmass(t, q, mm, n)
+    end subroutine cb_mass
+
+    subroutine cb_forces(self, t, q, v, f)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: f(:)
+        integer(c_int) :: n
+        n = self%n
+        call self%fforces(t, q, v, f, n)
+    end subroutine cb_forces
+
+    subroutine cb_phi(self, t, q, c)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: c(:)
+        integer(c_int) :: n, mh
+        n = self%n
+        mh = self%n_hol
+        call self%fphi(t, q, c, n, mh)
+    end subroutine cb_phi
+
+    subroutine cb_jac(self, t, q, g)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: g(:, :)
+        integer(c_int) :: n, mh
+        if (.not. self%has_jac) then
+            call fd_phi_jac(self, t, q, g)
+            return
+        end if
+        n = self%n
+        mh = self%n_hol
+        call self%fjac(t, q, g, n, mh)
+    end subroutine cb_jac
+
+    subroutine cb_gamma(self, t, q, v, gam)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: gam(:)
+        integer(c_int) :: n, mh
+        if (.not. self%has_gamma) then
+            call fd_phi_gamma(self, t, q, v, gam)
+            return
+        end if
+        n = self%n
+        mh = self%n_hol
+        call self%fgamma(t, q, v, gam, n, mh)
+    end subroutine cb_gamma
+
+    subroutine cb_nh(self, t, q, a, b)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: a(:, :), b(:)
+        integer(c_int) :: n, mn
+        n = self%n
+        mn = self%n_nh
+        call self%fnh(t, q, a, b, n, mn)
+    end subroutine cb_nh
+
+    subroutine cb_nh_gamma(self, t, q, v, gam)
+        class(callback_constrained), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: gam(:)
+        integer(c_int) :: n, mn
+        if (.not. self%has_nh_gamma) then
+            call fd_nh_gamma(self, t, q, v, gam)
+            return
+        end if
+        n = self%n
+        mn = self%n_nh
+        call self%fnhgamma(t, q, v, gam, n, mn)
+    end subroutine cb_nh_gamma
+
+    !> Run `constrained_solve` from plain arguments; the result goes to `store`.
+    !! first_step 0: automatic; neval 0: output at every accepted step. iopt(1:4) =
+    !! [projection, every, proj_max_iter, max_steps]; ropt(1:5) = [first_step, max_step,
+    !! alpha, beta, proj_tol]. stats(1:6) = [nfev, naccept, nreject, nproj, proj_iter, rank];
+    !! moved(1:2) = [dq0, dv0].
+    subroutine run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, &
+                               neval, t_eval, store, stats, moved, info, message)
+        class(constrained_system), intent(in) :: sys
+        integer(c_int), intent(in) :: n
+        real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
+        integer(c_int), intent(in) :: method
+        real(c_double), intent(in) :: rtol, atol
+        integer(c_int), intent(in) :: iopt(4)
+        real(c_double), intent(in) :: ropt(5)
+        integer(c_int), intent(in) :: neval
+        real(c_double), intent(in) :: t_eval(max(neval, 1))
+        external :: store
+        integer(c_int), intent(out) :: stats(6)
+        real(c_double), intent(out) :: moved(2)
+        integer(c_int), intent(out) :: info
+        character(len=*), intent(out) :: message
+        type(constrained_options) :: opt
+        type(constrained_result) :: r
+        real(dp), allocatable :: lam(:, :)
+        integer(c_int) :: m, mm, nt, nn
+
+        stats = 0
+        moved = 0.0_dp
+        if (sys%n /= n) then
+            info = CM_BAD_INPUT
+            call copy_message("bad input: q0 and v0 must have the system's n elements", message)
+            return
+        end if
+        opt%ode%method = method
+        opt%ode%rtol = rtol
+        opt%ode%atol = atol
+        opt%ode%first_step = ropt(1)
+        opt%ode%max_step = ropt(2)
+        opt%ode%max_steps = iopt(4)
+        opt%projection = iopt(1)
+        opt%every = iopt(2)
+        opt%proj_max_iter = iopt(3)
+        opt%alpha = ropt(3)
+        opt%beta = ropt(4)
+        opt%proj_tol = ropt(5)
+        if (neval > 0) then
+            call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
+        else
+            call constrained_solve(sys, t_span, q0, v0, opt, r)
+        end if
+        info = r%status
+        call copy_message(r%message, message)
+        stats = [r%nfev, r%naccept, r%nreject, r%nproj, r%proj_iter, r%rank]
+        moved = [r%dq0, r%dv0]
+        m = sys%n_hol + sys%n_nh
+        mm = max(m, 1)
+        nt = r%nt
+        nn = n
+        allocate (lam(mm, max(nt, 1)))
+        lam = 0.0_dp
+        if (m > 0 .and. nt > 0) lam(1:m, 1:nt) = r%lam
+        if (nt > 0) call store(r%t, r%q, r%v, lam, r%reaction, r%res_pos, r%res_vel, &
+                               r%energy, r%power, nn, mm, nt)
+    end subroutine run_constrained
+
+end module conmech_flat_mech_support
