@@ -83,3 +83,68 @@ def arenstorf(mu=0.012277471):
 def vanderpol(mu=1.0):
     """Van der Pol oscillator x'' = mu (1 - x^2) x' - x; y = [x, x']."""
     return BuiltinSystem("vanderpol", [mu], ("mu",))
+
+
+# --- seed systems in generalized coordinates (conmech_systems_mech), y = [q, q'] -----------
+# (their excessive-coordinate twins with constraints are in conmech.constrained)
+
+def pendulum_angle(m=1.0, g=9.81, l=1.0):
+    """Pendulum m l^2 th'' = -m g l sin th (angle from the downward vertical); y = [th, th']."""
+    return BuiltinSystem("pendulum_angle", [m, g, l], ("m", "g", "l"))
+
+
+def cart_pendulum(M=1.0, m=1.0, l=1.0, g=9.81):
+    """Pendulum on a cart (seed 000; theta from the upright); y = [x, th, x', th']."""
+    return BuiltinSystem("cart_pendulum", [M, m, l, g], ("M", "m", "l", "g"))
+
+
+def double_pendulum(m1=1.0, m2=1.0, l1=1.0, l2=1.0, g=9.81):
+    """Double pendulum in absolute angles; y = [th1, th2, th1', th2']."""
+    return BuiltinSystem("double_pendulum", [m1, m2, l1, l2, g], ("m1", "m2", "l1", "l2", "g"))
+
+
+def atwood(m1=2.0, m2=1.0, g=9.81):
+    """Atwood machine, y1 downward: (m1 + m2) y1'' = (m1 - m2) g; y = [y1, y1']."""
+    return BuiltinSystem("atwood", [m1, m2, g], ("m1", "m2", "g"))
+
+
+def spring_pendulum(m=1.0, k=40.0, l0=1.0, g=9.81):
+    """Spring pendulum in polar coordinates; y = [r, th, r', th']."""
+    return BuiltinSystem("spring_pendulum", [m, k, l0, g], ("m", "k", "l0", "g"))
+
+
+def double_spring_pendulum(m1=1.0, m2=1.0, k1=40.0, k2=40.0, l1=1.0, l2=1.0, g=9.81):
+    """Double spring pendulum in Cartesian coordinates; y = [x1, y1, x2, y2, velocities]."""
+    return BuiltinSystem("double_spring_pendulum", [m1, m2, k1, k2, l1, l2, g],
+                         ("m1", "m2", "k1", "k2", "l1", "l2", "g"))
+
+
+def three_springs(m=1.0, k=10.0, l0=1.0):
+    """Three equal masses joined pairwise by springs; y = [x1, y1, x2, y2, x3, y3, vel.]."""
+    return BuiltinSystem("three_springs", [m, k, l0], ("m", "k", "l0"))
+
+
+def bead_hoop(m=1.0, R=1.0, omega=5.0, g=9.81):
+    """Bead on a hoop spinning at omega: th'' = (omega^2 cos th - g/R) sin th; y = [th, th']."""
+    return BuiltinSystem("bead_hoop", [m, R, omega, g], ("m", "R", "omega", "g"))
+
+
+def polar_particle(m=1.0, mu=1.0):
+    """Particle in polar coordinates, U = -m mu / r; y = [r, th, r', th']."""
+    return BuiltinSystem("polar_particle", [m, mu], ("m", "mu"))
+
+
+def pendulum_moving(m=1.0, g=9.81, l=1.0, a=0.0, b=0.1, w=3.0):
+    """Pendulum with suspension s(t) = a t^2/2 + b sin(w t) (rheonomic); y = [th, th']."""
+    return BuiltinSystem("pendulum_moving", [m, g, l, a, b, w], ("m", "g", "l", "a", "b", "w"))
+
+
+def yoyo_angle(m=1.0, r=0.05, I=1.25e-3, g=9.81, ah=0.0, vh=0.0, h0=0.0):
+    """Yo-yo on a string moving as h0 + vh t + ah t^2/2; y = [y, y']."""
+    return BuiltinSystem("yoyo_angle", [m, r, I, g, ah, vh, h0],
+                         ("m", "r", "I", "g", "ah", "vh", "h0"))
+
+
+__all__ += ["pendulum_angle", "cart_pendulum", "double_pendulum", "atwood", "spring_pendulum",
+            "double_spring_pendulum", "three_springs", "bead_hoop", "polar_particle",
+            "pendulum_moving", "yoyo_angle"]

@@ -186,3 +186,22 @@ def test_plot_helpers(tmp_path):
     ax2.figure.savefig(tmp_path / "drift.png")
     assert (tmp_path / "drift.png").stat().st_size > 0
     assert len(ax.lines) == 1 and len(ax2.lines) == 2
+
+
+def test_generalized_seed_systems_in_solve_ivp():
+    """The generalized seed systems are compiled built-ins of solve_ivp: the cart pendulum
+    conserves P = 2 x' + cos(th) th' and follows x(t) = -sin(th)/2 + C0 + C1 t (seed 000)."""
+    from conmech import systems
+    y0 = [0.3, 2.5, 0.4, 1.0]
+    t = np.linspace(0, 5, 51)
+    s = solve_ivp(systems.cart_pendulum(), (0, 5), y0, t_eval=t, rtol=1e-12, atol=1e-12)
+    assert s.success
+    p0 = 2 * y0[2] + math.cos(y0[1]) * y0[3]
+    assert np.max(np.abs(2 * s.y[2] + np.cos(s.y[1]) * s.y[3] - p0)) < 1e-10
+    x = y0[0] + 0.5 * math.sin(y0[1]) - 0.5 * np.sin(s.y[1]) + 0.5 * p0 * t
+    assert np.max(np.abs(s.y[0] - x)) < 1e-10
+    for f in (systems.double_pendulum, systems.spring_pendulum, systems.bead_hoop,
+              systems.three_springs, systems.polar_particle, systems.atwood,
+              systems.double_spring_pendulum, systems.pendulum_moving, systems.yoyo_angle,
+              systems.pendulum_angle):
+        assert f().dimension >= 2
