@@ -132,5 +132,21 @@ program test_mechanics_defaults
         call ts%check_less(maxval(r2%res_pos), 1.0e-13_dp, "backward: projected residuals")
     end block
 
+    ! ---------------------------------------------------------------- large coordinates
+    block
+        real(dp) :: ll
+        integer :: k
+        do k = 1, 2
+            ll = 10.0_dp**(2*k)
+            call make_constrained("pendulum_xy", [1.0_dp, 9.81_dp, ll], cs, info, msg)
+            q = [ll*sin(1.0_dp), -ll*cos(1.0_dp)]
+            call constrained_solve(cs, [0.0_dp, 10.0_dp], q, [0.0_dp, 0.0_dp], opt, r1)
+            call ts%check(r1%success, "projection converges at round-off for l = 1e"// &
+                          achar(48 + 2*k)//": "//r1%message)
+            call ts%check_less(maxval(r1%res_pos)/ll**2, 1.0e-14_dp, &
+                               "large l: |phi|/l^2 at round-off")
+        end do
+    end block
+
     call ts%finish()
 end program test_mechanics_defaults

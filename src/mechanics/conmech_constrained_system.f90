@@ -379,7 +379,9 @@ contains
 
     !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
     !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
-    !! complement frozen at q~. Converged when max|phi| <= tol; at most max_iter
+    !! complement frozen at q~. Converged when max|phi| <= tol, or when the Newton
+    !! correction is below the round-off of q (4 eps max|q|: large coordinates, where
+    !! phi cannot reach an absolute tol); at most max_iter
     !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
     !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
     !! convergence from far away; used for the consistent initial values).
@@ -393,7 +395,7 @@ contains
         character(len=:), allocatable, intent(out) :: msg
         logical, intent(in), optional :: newton   !! refresh G at every iterate (far start)
         real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
-        real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n)
+        real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
         real(dp) :: rnorm
         integer :: n, mh, lainfo, rk
         logical :: full
@@ -429,7 +431,14 @@ contains
                 msg = "LAPACK failed in the position projection"
                 return
             end if
-            qk = qk - matmul(x, ph(:, 1))
+            dq = matmul(x, ph(:, 1))
+            if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*max(maxval(abs(qk)), tiny(1.0_dp))) &
+                then
+                ! the correction is below the round-off of q: phi is as small as it can get
+                q = qk
+                return
+            end if
+            qk = qk - dq
             call sys%phi(t, qk, ph(:, 1))
             rnorm = maxval(abs(ph(:, 1)))
             if (.not. (rnorm < huge(1.0_dp))) exit
