@@ -148,3 +148,54 @@ def yoyo_angle(m=1.0, r=0.05, I=1.25e-3, g=9.81, ah=0.0, vh=0.0, h0=0.0):
 __all__ += ["pendulum_angle", "cart_pendulum", "double_pendulum", "atwood", "spring_pendulum",
             "double_spring_pendulum", "three_springs", "bead_hoop", "polar_particle",
             "pendulum_moving", "yoyo_angle"]
+
+
+# --- seed systems in excessive coordinates with constraints, for conmech.constrained.solve --
+
+def _constrained(name, params):
+    from .constrained import BuiltinConstrained
+    return BuiltinConstrained(name, params)
+
+
+def pendulum_xy(m=1.0, g=9.81, l=1.0):
+    """Point mass on a circle, q = [x, y], phi = (x^2 + y^2 - l^2)/2 (constrained.solve)."""
+    return _constrained("pendulum_xy", [m, g, l])
+
+
+def rod_two_masses(g=9.81, l=1.0):
+    """Two unit masses on a rod, centre velocity along the rod (holonomic + non-holonomic)."""
+    return _constrained("rod_two_masses", [g, l])
+
+
+def double_pendulum_xy(m1=1.0, m2=1.0, l1=1.0, l2=1.0, g=9.81):
+    """Double pendulum in Cartesian coordinates q = [x1, y1, x2, y2], two constraints."""
+    return _constrained("double_pendulum_xy", [m1, m2, l1, l2, g])
+
+
+def atwood_xy(m1=2.0, m2=1.0, g=9.81, L=2.0):
+    """Atwood machine q = [y1, y2] (downward), y1 + y2 = L; the multiplier is the tension."""
+    return _constrained("atwood_xy", [m1, m2, g, L])
+
+
+def pendulum_moving_xy(m=1.0, g=9.81, l=1.0, a=0.0, b=0.1, w=3.0):
+    """Pendulum with a moving suspension (s(t) = a t^2/2 + b sin w t), rheonomic."""
+    return _constrained("pendulum_moving_xy", [m, g, l, a, b, w])
+
+
+def yoyo(m=1.0, r=0.05, I=1.25e-3, g=9.81, ah=0.0, vh=0.0, h0=0.0):
+    """Yo-yo q = [y, psi] on a string moving as h0 + vh t + ah t^2/2 (rheonomic)."""
+    return _constrained("yoyo", [m, r, I, g, ah, vh, h0])
+
+
+def skate(m=1.0, I=1.0, g=9.81, alpha=0.3):
+    """Ice-skate blade / knife edge on an incline, q = [x, y, theta] (non-holonomic)."""
+    return _constrained("skate", [m, I, g, alpha])
+
+
+def rolling_disk(m=1.0, R=1.0, I_roll=0.5, I_turn=0.25):
+    """Vertical rolling disk q = [x, y, theta, phi] (two non-holonomic constraints)."""
+    return _constrained("rolling_disk", [m, R, I_roll, I_turn])
+
+
+__all__ += ["pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
+            "pendulum_moving_xy", "yoyo", "skate", "rolling_disk"]

@@ -205,3 +205,18 @@ def test_generalized_seed_systems_in_solve_ivp():
               systems.double_spring_pendulum, systems.pendulum_moving, systems.yoyo_angle,
               systems.pendulum_angle):
         assert f().dimension >= 2
+
+
+def test_constrained_factories_in_systems():
+    from conmech import systems
+    r = constrained.solve(systems.atwood_xy(m1=3.0, m2=1.0), (0, 1), [1.0, 1.0], [0.0, 0.0],
+                          rtol=1e-12, atol=1e-12)
+    assert r.success
+    assert np.max(np.abs(r.lam[0] - 2 * 3.0 * 1.0 * G / 4.0)) < 1e-10
+    for f in (systems.pendulum_xy, systems.rod_two_masses, systems.double_pendulum_xy,
+              systems.pendulum_moving_xy, systems.yoyo, systems.skate, systems.rolling_disk):
+        s = f()
+        r = constrained.solve(s, (0, 1), rtol=1e-9, atol=1e-9)
+        assert r.success, (s, r.message)
+        assert r.q.shape[0] == s.n and r.lam.shape[0] == s.n_hol + s.n_nh
+        assert np.max(r.res_pos) < 1e-12 and np.max(r.res_vel) < 1e-12
