@@ -256,6 +256,13 @@ contains
             end if
         end do
         if (orb%info /= CM_SUCCESS) return
+        if (.not. (u(2) > 0.0_dp .and. z(2) > 0.0_dp)) then
+            ! Newton found another symmetric periodic solution (e.g. a retrograde one)
+            orb%info = CM_NO_CONVERGENCE
+            orb%message = "hill_variation_orbit: converged to another periodic orbit, "// &
+                          "not the direct variation orbit (a better guess is needed)"
+            return
+        end if
         orb%y0 = [u(1), 0.0_dp, 0.0_dp, u(2)]
         orb%jacobi = hill_jacobi(m, kappa, orb%y0)
         orb%quarter_stm = a
