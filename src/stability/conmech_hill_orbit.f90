@@ -10,7 +10,7 @@
 !!
 !! Speed: the state and its STM (20 components) are integrated with a fixed-step DOP853
 !! (8th order, the Dormand-Prince coefficients of `conmech_rk_tableaus`) with the Hill
-!! right-hand side written out; the default 24 steps per quarter period give
+!! right-hand side written out; the default 20 steps per quarter period give
 !! |c error| ~ 1e-14 at Hill's m.
 !!
 !! Monodromy by symmetry: with the time-reversing reflections G0 = diag(1, -1, -1, 1)
@@ -50,7 +50,7 @@ module conmech_hill_orbit
 
     !> Options of the variation-orbit solver.
     type :: hill_orbit_options
-        integer :: nsteps = 24           !! DOP853 steps per quarter period
+        integer :: nsteps = 20           !! DOP853 steps per quarter period
         integer :: max_iter = 30         !! Newton iterations
         real(dp) :: tol = 1.0e-13_dp     !! accept when |du| <= tol max(1, |u|)
         logical :: full_period = .false. !! monodromy by direct integration over 2 pi
