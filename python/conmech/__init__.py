@@ -1,0 +1,13 @@
+"""conmech: mechanical systems with constraints and the stability of their motions.
+
+The Python package wraps the same Fortran sources as the fpm package (built by
+numpy.f2py + meson-python). The integrators follow SciPy's names::
+
+    import conmech
+    sol = conmech.solve_ivp(conmech.systems.kepler(), (0, 10), [1, 0, 0, 1], rtol=1e-10)
+"""
+from . import systems
+from ._ivp import DenseOutput, OdeResult, solve_ivp
+
+__all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems"]
+__version__ = "0.1.0"

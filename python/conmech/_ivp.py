@@ -1,0 +1,389 @@
+"""solve_ivp: SciPy's interface on conmech's Fortran Runge-Kutta integrators."""
+import math
+import numbers
+
+import numpy as np
+
+from . import _conmech
+from .systems import BuiltinSystem
+
+__all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
+
+_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853")
+_MESSAGES = {
+    0: "The solver successfully reached the end of the integration interval.",
+    1: "A termination event occurred.",
+}
+_CM_BAD_INPUT = -4
+_HUGE = np.finfo(float).max
+
+
+class OdeResult(dict):
+    """Result of :func:`solve_ivp`: a dict whose keys are also attributes (as SciPy's).
+
+    Keys: t, y, sol, t_events, y_events, nfev, njev, nlu, status, message, success,
+    and conmech's extras naccept, nreject.
+    """
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError as exc:
+            raise AttributeError(name) from exc
+
+    __setattr__ = dict.__setitem__
+    __delattr__ = dict.__delitem__
+
+    def __repr__(self):
+        keys = ("message", "success", "status", "t", "y", "sol", "t_events", "y_events",
+                "nfev", "njev", "nlu")
+        width = max(map(len, keys)) + 1
+        lines = []
+        for k in keys:
+            v = self.get(k)
+            if isinstance(v, np.ndarray) and v.size > 6:
+                v = f"array of shape {v.shape}"
+            lines.append(f"{k.rjust(width)}: {v!r}" if not isinstance(v, str) else
+                         f"{k.rjust(width)}: {v}")
+        return "\n".join(lines)
+
+    def __dir__(self):
+        return list(self.keys())
+
+
+class DenseOutput:
+    """Continuous solution of an integration: piecewise polynomials, one per step.
+
+    ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
+    (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
+    OdeSolution does. On each step [ts, ts + h] the polynomial is Hairer's form
+    y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))), x = (t - ts) / h.
+    """
+
+    def __init__(self, ts, hs, coef, t_min, t_max):
+        self.t_start = np.ascontiguousarray(ts, dtype=float)   # step starts
+        self.h = np.ascontiguousarray(hs, dtype=float)          # signed step lengths
+        self.coef = np.ascontiguousarray(coef, dtype=float)     # (n, nf + 1, nseg)
+        self.t_min = float(min(t_min, t_max))
+        self.t_max = float(max(t_min, t_max))
+        self.n_segments = self.t_start.size
+        self.ts = np.append(self.t_start, self.t_start[-1] + self.h[-1]) \
+            if self.n_segments else np.array([t_min])
+        self._ascending = self.n_segments == 0 or self.h[0] > 0
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        scalar = t.ndim == 0
+        tt = np.atleast_1d(t).ravel()
+        if self.n_segments == 0:
+            raise ValueError("the dense output is empty (no step was taken)")
+        if self._ascending:
+            idx = np.searchsorted(self.t_start, tt, side="right") - 1
+        else:
+            idx = np.searchsorted(-self.t_start, -tt, side="right") - 1
+        np.clip(idx, 0, self.n_segments - 1, out=idx)
+        x = (tt - self.t_start[idx]) / self.h[idx]
+        c = self.coef[:, :, idx]                      # (n, nf + 1, m)
+        nf = c.shape[1] - 1
+        x1 = 1.0 - x
+        y = c[:, nf, :].copy()
+        for j in range(nf - 1, 0, -1):
+            y *= x1 if j % 2 == 1 else x
+            y += c[:, j, :]
+        y *= x
+        y += c[:, 0, :]
+        return y[:, 0] if scalar else y
+
+
+def _real_scalar(value, name):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.ndarray)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim != 0:
+        raise ValueError(f"{name} must be a scalar")
+    return float(arr)
+
+
+def _tolerance(value, name, n):
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a non-negative number or an array of shape "
+                        f"({n},)") from exc
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    elif arr.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have shape ({n},) like y0, got shape "
+                         f"{arr.shape}")
+    if np.any(np.isnan(arr)) or np.any(arr < 0):
+        raise ValueError(f"{name} must be non-negative")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite")
+    return np.ascontiguousarray(arr)
+
+
+def _event_settings(events):
+    if events is None:
+        return []
+    evs = [events] if callable(events) else events
+    try:
+        evs = list(evs)
+    except TypeError:
+        raise TypeError("events must be a callable or a list of callables") from None
+    for i, e in enumerate(evs):
+        if not callable(e):
+            raise TypeError(f"events[{i}] is not callable")
+    settings = []
+    for i, e in enumerate(evs):
+        term = getattr(e, "terminal", False)
+        if isinstance(term, (bool, np.bool_)):
+            term = bool(term)
+        elif isinstance(term, numbers.Integral) and term in (0, 1):
+            term = bool(term)
+        elif isinstance(term, numbers.Integral) and term > 1:
+            raise ValueError(f"events[{i}].terminal: a count of occurrences before "
+                             f"termination ({term}) is not supported; use True or False")
+        else:
+            raise ValueError(f"events[{i}].terminal must be a bool")
+        direction = getattr(e, "direction", 0)
+        try:
+            direction = float(direction)
+        except (TypeError, ValueError):
+            raise ValueError(f"events[{i}].direction must be a number") from None
+        if math.isnan(direction):
+            raise ValueError(f"events[{i}].direction must be a number")
+        settings.append((e, term, int(np.sign(direction))))
+    return settings
+
+
+def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
+              events=None, rtol=1e-3, atol=1e-6, first_step=None, max_step=np.inf,
+              args=None, max_steps=100000):
+    """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
+
+    Parameters
+    ----------
+    fun : callable or conmech.systems.BuiltinSystem
+        ``fun(t, y, *args) -> dydt`` (array of shape (n,)), called from Fortran through
+        an f2py callback; or a compiled built-in system such as
+        ``conmech.systems.kepler(mu=1.0)``, integrated with no Python in the loop.
+    t_span : 2-sequence of float
+        (t0, tf); tf < t0 integrates backwards.
+    y0 : array_like, shape (n,)
+        Initial state.
+    method : {"DOP853", "DOPRI5" (alias "RK45"), "RK4"}
+        DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
+        5(4), dense output of order 4. RK4: classical fixed-step RK4, step ``first_step``.
+    t_eval : array_like or None
+        Times at which to store the solution (sorted in the direction of integration,
+        inside t_span), from the dense output. None: every accepted step.
+    dense_output : bool
+        Return ``sol``, a callable continuous solution.
+    events : callable or list of callables
+        ``event(t, y, *args) -> float``; zero crossings are located on the dense output.
+        Optional attributes ``terminal`` (bool) and ``direction`` (>0 rising, <0 falling,
+        0 both), as in SciPy.
+    rtol, atol : float or array_like of shape (n,)
+        Relative and absolute tolerances (rtol is raised to 100 eps at least, as SciPy).
+    first_step : float or None
+        Initial step (None: Hairer's heuristic). Required by RK4 (its fixed step).
+    max_step : float
+        Largest step size (default no limit).
+    args : tuple or None
+        Extra arguments passed to ``fun`` and to every event function.
+    max_steps : int
+        Attempted steps before giving up (status -1).
+
+    Returns
+    -------
+    OdeResult
+        t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
+        None), nfev, njev = 0, nlu = 0, status (0 reached the end, 1 terminal event, -1
+        failure), message, success, and the step counts naccept, nreject.
+
+    Raises
+    ------
+    TypeError, ValueError
+        On bad input; the message names the argument. An exception raised inside ``fun``
+        or an event function reaches the caller unchanged.
+    """
+    # ---------------------------------------------------------------- fun and args
+    builtin = isinstance(fun, BuiltinSystem)
+    if not builtin and not callable(fun):
+        raise TypeError("fun must be callable or a built-in system from conmech.systems, "
+                        f"got {type(fun).__name__}")
+    if args is not None:
+        if isinstance(args, (str, bytes)) or not hasattr(args, "__iter__"):
+            raise TypeError("args should be a tuple")
+        args = tuple(args)
+        if builtin and args:
+            raise TypeError("args cannot be used with a built-in system: pass its "
+                            "parameters to the factory in conmech.systems")
+    else:
+        args = ()
+
+    # ---------------------------------------------------------------- method
+    if not isinstance(method, str):
+        raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
+    code = int(_conmech.flat_method_code(method.upper()))
+    if code == 0 or method.upper() not in _METHODS:
+        raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+
+    # ---------------------------------------------------------------- t_span, y0
+    try:
+        if len(t_span) != 2:
+            raise ValueError("t_span must have two elements (t0, tf)")
+    except TypeError:
+        raise TypeError("t_span must be a sequence (t0, tf)") from None
+    t0 = _real_scalar(t_span[0], "t_span[0]")
+    tf = _real_scalar(t_span[1], "t_span[1]")
+    if not (math.isfinite(t0) and math.isfinite(tf)):
+        raise ValueError("t_span must be finite")
+    y0_in = np.asarray(y0)
+    if np.iscomplexobj(y0_in):
+        raise TypeError("y0 must be real: complex states are not supported")
+    try:
+        y0 = np.array(y0_in, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("y0 must be an array of real numbers") from None
+    if y0.ndim != 1:
+        raise ValueError(f"y0 must be 1-dimensional, got shape {y0.shape}")
+    n = y0.size
+    if n == 0:
+        raise ValueError("y0 must not be empty")
+    if not np.all(np.isfinite(y0)):
+        raise ValueError("y0 contains NaN or Inf")
+    if builtin and n != fun.dimension:
+        raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
+                         f"'{fun.name}', got {y0.shape}")
+
+    # ---------------------------------------------------------------- tolerances, steps
+    rtol_v = _tolerance(rtol, "rtol", n)
+    atol_v = _tolerance(atol, "atol", n)
+    if first_step is None:
+        h0 = 0.0
+    else:
+        h0 = _real_scalar(first_step, "first_step")
+        if not (h0 > 0 and math.isfinite(h0)):
+            raise ValueError("first_step must be positive")
+        if h0 > abs(tf - t0) and tf != t0:
+            raise ValueError("first_step exceeds the length of t_span")
+    if code == 1 and first_step is None:
+        raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
+                         "step size")
+    hmax = _real_scalar(max_step, "max_step")
+    if not hmax > 0:
+        raise ValueError("max_step must be positive")
+    hmax = min(hmax, _HUGE)
+    if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
+        raise TypeError("max_steps must be an integer")
+    if not 1 <= max_steps <= 2**31 - 1:
+        raise ValueError("max_steps must be positive (and below 2**31)")
+
+    # ---------------------------------------------------------------- t_eval
+    if t_eval is None:
+        t_ev = np.zeros(0)
+    else:
+        try:
+            t_ev = np.array(t_eval, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError("t_eval must be an array of real numbers") from None
+        if t_ev.ndim != 1:
+            raise ValueError("t_eval must be 1-dimensional")
+        if not np.all(np.isfinite(t_ev)):
+            raise ValueError("t_eval contains NaN or Inf")
+        lo, hi = min(t0, tf), max(t0, tf)
+        if np.any(t_ev < lo) or np.any(t_ev > hi):
+            raise ValueError("values in t_eval are not within t_span")
+        d = np.diff(t_ev)
+        if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
+            raise ValueError("values in t_eval are not properly sorted (strictly "
+                             "monotonic in the direction of integration)")
+
+    # ---------------------------------------------------------------- events
+    settings = _event_settings(events)
+    ne = len(settings)
+    ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
+    ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
+    ev_funs = [s[0] for s in settings]
+
+    if ne > 0:
+        def events_cb(t, y):
+            yc = y.copy()
+            return [e(t, yc, *args) for e in ev_funs]
+    else:
+        def events_cb(t, y):  # never called when ne = 0
+            raise RuntimeError("conmech: events callback called without events")
+
+    out = {}
+
+    def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
+        out["t"] = np.array(t, dtype=float)
+        out["y"] = np.array(y, dtype=float).reshape(n, -1)
+        out["ev_t"] = np.array(ev_t, dtype=float)
+        out["ev_y"] = np.array(ev_y, dtype=float).reshape(n, -1)
+        out["ev_id"] = np.array(ev_id, dtype=int)
+        out["ts"] = np.array(ts, dtype=float)
+        out["hs"] = np.array(hs, dtype=float)
+        out["coef"] = np.array(coef, dtype=float)
+
+    # f2py cannot pass empty arrays: t_eval, ev_dir, ev_term get at least one element
+    # and their counts neval, ne say how many are used.
+    pad = np.zeros(1)
+    common = dict(t_span=np.array([t0, tf]), y0=y0, method=code, rtol=rtol_v, atol=atol_v,
+                  first_step=h0, max_step=hmax, max_steps=int(max_steps),
+                  dense=int(bool(dense_output)), neval=t_ev.size,
+                  t_eval=t_ev if t_ev.size else pad, ne=ne,
+                  ev_dir=ev_dir if ne else pad.astype(np.intc),
+                  ev_term=ev_term if ne else pad.astype(np.intc))
+    probe_calls = 0
+    if builtin:
+        nfev, naccept, nreject, info, message = _conmech.flat_solve_builtin(
+            fun.name, fun.params.size, fun.params if fun.params.size else pad, events_cb,
+            store, **common)
+    else:
+        # One probe call checks the shape of fun's output and gives a clear error.
+        f0 = np.asarray(fun(t0, y0.copy(), *args))
+        probe_calls = 1
+        if f0.size != n or f0.ndim > 1:
+            raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
+                             f"shape {f0.shape}")
+        if args:
+            def rhs(t, y):
+                return fun(t, y.copy(), *args)
+        else:
+            def rhs(t, y):
+                return fun(t, y.copy())
+        nfev, naccept, nreject, info, message = _conmech.flat_solve_callback(
+            rhs, events_cb, store, **common)
+
+    message = bytes(message).decode("ascii", "replace").strip() \
+        if not isinstance(message, str) else message.strip()
+    info = int(info)
+    if info == _CM_BAD_INPUT:
+        raise ValueError(message)
+    if info >= 0:
+        status = int(info)
+        message = _MESSAGES.get(status, message)
+    else:
+        status = -1
+    res = OdeResult(t=out.get("t", np.array([t0])), y=out.get("y", y0[:, None].copy()),
+                    sol=None, t_events=None, y_events=None,
+                    nfev=int(nfev) + probe_calls, njev=0, nlu=0, status=status,
+                    message=message, success=status >= 0, naccept=int(naccept),
+                    nreject=int(nreject))
+    if ne > 0 and out:
+        ids = out["ev_id"]
+        res.t_events = [out["ev_t"][ids == i + 1] for i in range(ne)]
+        res.y_events = [out["ev_y"][:, ids == i + 1].T.copy() for i in range(ne)]
+    elif ne > 0:
+        res.t_events = [np.zeros(0) for _ in range(ne)]
+        res.y_events = [np.zeros((0, n)) for _ in range(ne)]
+    if dense_output and out and out["ts"].size > 0:
+        t_last = float(res.t[-1]) if res.t.size else tf
+        if t_eval is not None:
+            t_last = float(out["ts"][-1] + out["hs"][-1])
+            if status == 1 and ne > 0:
+                t_last = float(np.max(out["ev_t"]) if tf > t0 else np.min(out["ev_t"]))
+        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last)
+    return res

@@ -1,0 +1,165 @@
+!> Flat f2py layer of the integrators: plain subroutines with c_double/c_int arguments,
+!! explicit-shape arrays, an `info` code and a fixed-length message (wrapped by numpy.f2py
+!! into conmech._conmech; the Python API in conmech/_ivp.py is the user-facing side).
+!!
+!! Results are handed to the `store` callback once, at the end, with their actual sizes:
+!! no capacities to guess, no re-runs, nothing saved between calls (thread-safe).
+!! A Python exception raised inside a callback makes f2py return to Python at once
+!! (longjmp) with the exception set; Fortran work arrays of that call are then leaked,
+!! never corrupted. Nothing here stops or prints.
+
+!> Method code (1 RK4, 2 DOPRI5, 3 DOP853) from a name ("RK4", "DOPRI5"/"RK45",
+!! "DOP853"); 0 if unknown.
+subroutine flat_method_code(name, code)
+    use, intrinsic :: iso_c_binding, only: c_int
+    use conmech_ode_solver, only: method_from_name
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(out) :: code
+    code = method_from_name(name)
+end subroutine flat_method_code
+
+!> State dimension of a built-in system (0 if the name is unknown).
+subroutine flat_system_dimension(name, n)
+    use, intrinsic :: iso_c_binding, only: c_int
+    use conmech_systems, only: system_dimension
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(out) :: n
+    n = system_dimension(name)
+end subroutine flat_system_dimension
+
+!> Solve y' = fun(t, y) for a Python right-hand side (f2py callback).
+!! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
+!! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
+!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal.
+subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, atol, &
+                               first_step, max_step, max_steps, dense, neval, t_eval, ne, &
+                               ev_dir, ev_term, nfev, naccept, nreject, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system, run_solve
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t_span(2)
+    real(c_double), intent(in) :: y0(n)
+    integer(c_int), intent(in) :: method
+    real(c_double), intent(in) :: rtol(n), atol(n)
+    real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: max_steps, dense, neval
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(in) :: ne
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+    integer(c_int), intent(out) :: nfev, naccept, nreject, info
+    character(len=256), intent(out) :: message
+!f2py external fun, events, store
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+        subroutine events(t, y, g, n, ne)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, ne
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: g(ne)
+        end subroutine events
+        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
+            real(c_double), intent(in) :: t(nt)
+            real(c_double), intent(in) :: y(n, nt)
+            real(c_double), intent(in) :: ev_t(nev)
+            real(c_double), intent(in) :: ev_y(n, nev)
+            integer(c_int), intent(in) :: ev_id(nev)
+            real(c_double), intent(in) :: ts(nseg)
+            real(c_double), intent(in) :: hs(nseg)
+            real(c_double), intent(in) :: coef(n, nf1, nseg)
+        end subroutine store
+    end interface
+    type(callback_system) :: sys
+
+    sys%f => fun
+    sys%n = n
+    call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
+                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
+                   nreject, info, message)
+end subroutine flat_solve_callback
+
+!> Solve y' = f(t, y) for the built-in system `name` with parameters `params` (see
+!! conmech_systems::make_system; params has at least one element, np of them are used):
+!! no Python in the loop unless there are events.
+!! Other arguments as in flat_solve_callback.
+subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, method, rtol, &
+                              atol, first_step, max_step, max_steps, dense, neval, t_eval, &
+                              ne, ev_dir, ev_term, nfev, naccept, nreject, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_ode_system, only: ode_system
+    use conmech_systems, only: make_system, system_dimension
+    use conmech_flat_ode_support, only: run_solve, copy_message
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np
+    real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t_span(2)
+    real(c_double), intent(in) :: y0(n)
+    integer(c_int), intent(in) :: method
+    real(c_double), intent(in) :: rtol(n), atol(n)
+    real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: max_steps, dense, neval
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(in) :: ne
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+    integer(c_int), intent(out) :: nfev, naccept, nreject, info
+    character(len=256), intent(out) :: message
+!f2py external events, store
+    interface
+        subroutine events(t, y, g, n, ne)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, ne
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: g(ne)
+        end subroutine events
+        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
+            real(c_double), intent(in) :: t(nt)
+            real(c_double), intent(in) :: y(n, nt)
+            real(c_double), intent(in) :: ev_t(nev)
+            real(c_double), intent(in) :: ev_y(n, nev)
+            integer(c_int), intent(in) :: ev_id(nev)
+            real(c_double), intent(in) :: ts(nseg)
+            real(c_double), intent(in) :: hs(nseg)
+            real(c_double), intent(in) :: coef(n, nf1, nseg)
+        end subroutine store
+    end interface
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    character(len=24) :: buf
+
+    nfev = 0
+    naccept = 0
+    nreject = 0
+    call make_system(name, real(params(1:np), dp), sys, info, msg)
+    if (info /= CM_SUCCESS) then
+        call copy_message(msg, message)
+        return
+    end if
+    if (system_dimension(name) /= n) then
+        info = CM_BAD_INPUT
+        write (buf, '(i0)') system_dimension(name)
+        call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
+                          //trim(name)//"'", message)
+        return
+    end if
+    call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
+                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
+                   nreject, info, message)
+end subroutine flat_solve_builtin

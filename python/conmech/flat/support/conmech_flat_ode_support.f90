@@ -1,0 +1,155 @@
+!> Support of the flat f2py layer for the integrators (compiled into the extension, not
+!! wrapped by f2py: it holds derived types).
+!!
+!! `callback_system` and `callback_events` adapt external procedures with an implicit
+!! interface (in practice f2py callbacks into Python) to conmech's `ode_system` and
+!! `ode_events`; `run_solve` runs `ode_solve` from plain arguments and hands the whole
+!! result to a `store` procedure, so that output sizes need not be known in advance and
+!! nothing is saved between calls (thread-safe).
+!!
+!! Calling conventions of the external procedures (all arguments by reference):
+!!
+!!     fun(t, y, dydt, n)                real(c_double) t, y(n), dydt(n); integer(c_int) n
+!!     events(t, y, g, n, ne)            real(c_double) t, y(n), g(ne); integer(c_int) n, ne
+!!     store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
+!!         real(c_double) t(nt), y(n,nt), ev_t(nev), ev_y(n,nev), ts(nseg), hs(nseg),
+!!         coef(n,nf1,nseg); integer(c_int) ev_id(nev), n, nt, nev, nseg, nf1
+module conmech_flat_ode_support
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_ode_system, only: ode_system, ode_events
+    use conmech_ode_solver, only: ode_options, ode_result, ode_solve
+    implicit none
+    private
+    public :: callback_system, callback_events, run_solve, copy_message
+
+    !> A system whose right-hand side is an external procedure fun(t, y, dydt, n).
+    type, extends(ode_system) :: callback_system
+        procedure(), pointer, nopass :: f => null()
+        integer(c_int) :: n = 0
+    contains
+        procedure :: rhs => callback_rhs
+    end type callback_system
+
+    !> Event functions given by one external procedure events(t, y, g, n, ne).
+    type, extends(ode_events) :: callback_events
+        procedure(), pointer, nopass :: g => null()
+        integer(c_int) :: n = 0
+        integer(c_int) :: ne = 0
+    contains
+        procedure :: eval => callback_eval
+    end type callback_events
+
+contains
+
+    subroutine callback_rhs(self, t, y, dydt)
+        class(callback_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        call self%f(t, y, dydt, self%n)
+    end subroutine callback_rhs
+
+    subroutine callback_eval(self, t, y, g)
+        class(callback_events), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: g(:)
+        call self%g(t, y, g, self%n, self%ne)
+    end subroutine callback_eval
+
+    !> Copy a message into a fixed-length output (truncated, blank padded).
+    subroutine copy_message(src, dst)
+        character(len=*), intent(in) :: src
+        character(len=*), intent(out) :: dst
+        dst = src
+    end subroutine copy_message
+
+    !> Solve with `ode_solve` from plain arguments and pass the result to `store`.
+    !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
+    !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
+    !! t_eval, ev_dir, ev_term have at least one element (f2py cannot pass empty ones).
+    subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
+                         max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
+                         nfev, naccept, nreject, info, message)
+        class(ode_system), intent(in) :: sys
+        integer(c_int), intent(in) :: n
+        real(c_double), intent(in) :: t_span(2)
+        real(c_double), intent(in) :: y0(n)
+        integer(c_int), intent(in) :: method
+        real(c_double), intent(in) :: rtol(n), atol(n)
+        real(c_double), intent(in) :: first_step, max_step
+        integer(c_int), intent(in) :: max_steps, dense, neval
+        real(c_double), intent(in) :: t_eval(max(neval, 1))
+        integer(c_int), intent(in) :: ne
+        integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+        external :: events, store
+        integer(c_int), intent(out) :: nfev, naccept, nreject, info
+        character(len=*), intent(out) :: message
+
+        type(ode_options) :: opt
+        type(ode_result) :: res
+        type(callback_events) :: ev
+        real(c_double) :: empty1(0), empty3(n, 1, 0)
+        integer :: nseg, nf1
+
+        nfev = 0
+        naccept = 0
+        nreject = 0
+        if (n < 1 .or. neval < 0 .or. ne < 0) then
+            info = CM_BAD_INPUT
+            call copy_message("bad input: array sizes must be positive", message)
+            return
+        end if
+        opt%method = method
+        opt%rtol_vec = rtol
+        opt%atol_vec = atol
+        opt%first_step = first_step
+        opt%max_step = max_step
+        opt%max_steps = max_steps
+        opt%dense_output = dense /= 0
+        if (ne > 0) then
+            ev%g => events
+            ev%n = n
+            ev%ne = ne
+            ev%direction = ev_dir(1:ne)
+            ev%terminal = ev_term(1:ne) /= 0
+            if (neval > 0) then
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev)
+            else
+                call ode_solve(sys, t_span, y0, opt, res, events=ev)
+            end if
+        else
+            if (neval > 0) then
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval))
+            else
+                call ode_solve(sys, t_span, y0, opt, res)
+            end if
+        end if
+
+        nfev = res%stats%nfev
+        naccept = res%stats%naccept
+        nreject = res%stats%nreject
+        info = res%status
+        call copy_message(res%message, message)
+
+        nseg = 0
+        nf1 = 1
+        if (opt%dense_output .and. allocated(res%sol%ts)) then
+            nseg = res%sol%nseg
+            nf1 = res%sol%nf + 1
+        end if
+        if (nseg > 0) then
+            call store(res%t(1:res%nt), res%y(:, 1:res%nt), res%ev_t(1:res%nev), &
+                       res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), res%sol%ts(1:nseg), &
+                       res%sol%hs(1:nseg), res%sol%coef(:, :, 1:nseg), &
+                       n, res%nt, res%nev, nseg, nf1)
+        else
+            call store(res%t(1:res%nt), res%y(:, 1:res%nt), res%ev_t(1:res%nev), &
+                       res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), empty1, empty1, &
+                       empty3, n, res%nt, res%nev, 0, 1)
+        end if
+    end subroutine run_solve
+
+end module conmech_flat_ode_support
