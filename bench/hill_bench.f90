@@ -86,12 +86,16 @@ program hill_bench
     write (*, '(a, i0, a)') "# family of ", nfam, " orbits, m in [0.01, 0.15]"
     nthr = 1
     !$ nthr = omp_get_max_threads()
+    ! best of 3 (the machine is shared), threads alternating
     do k = 1, max(1, min(2, nthr))
-        !$ call omp_set_num_threads(k)
-        call system_clock(c0)
-        call hill_family(ms, 1.0_dp, fam, opt)
-        call system_clock(c1)
-        t1 = real(c1 - c0, dp)/rate
+        t1 = huge(1.0_dp)
+        do i = 1, 3
+            !$ call omp_set_num_threads(k)
+            call system_clock(c0)
+            call hill_family(ms, 1.0_dp, fam, opt)
+            call system_clock(c1)
+            t1 = min(t1, real(c1 - c0, dp)/rate)
+        end do
         nfail = count(fam%info /= CM_SUCCESS)
         write (*, '(a, i0, a, f12.0, a, f8.2, a, i0)') "threads ", k, ": orbits/s ", &
             nfam/t1, "  us/orbit ", 1.0e6_dp*t1/nfam, "  failures ", nfail
