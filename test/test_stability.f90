@@ -245,7 +245,41 @@ contains
         call ts%check_close(o%floquet%det, mu1*maxval(o%floquet%abs_mult), 1.0e-12_dp, &
                             "det M = product of the multipliers")
         i = 0
+        call test_vdp_continuation()
     end subroutine test_vdp_limit_cycle
+
+    !> Continuation of the limit cycle in mu (general shooting, free period).
+    subroutine test_vdp_continuation()
+        type(van_der_pol) :: v
+        type(periodic_orbit) :: fam(6), o
+        real(dp) :: mus(6)
+        integer :: i
+        logical :: ok
+        mus = [0.5_dp, 0.6_dp, 0.7_dp, 0.8_dp, 0.9_dp, 1.0_dp]
+        v%mu = mus(1)
+        call continue_periodic_family(v, set_mu, mus, [2.0_dp, 0.0_dp], 6.4_dp, fam)
+        ok = all(fam%info == CM_SUCCESS)
+        call ts%check(ok, "Van der Pol continuation in mu converges")
+        call ts%check_close(fam(6)%period, 6.663286859323130_dp, 1.0e-9_dp, &
+                            "continued period at mu = 1")
+        ok = .true.
+        do i = 2, 6
+            ok = ok .and. fam(i)%period > fam(i - 1)%period
+        end do
+        call ts%check(ok, "the period grows with mu")
+        v%mu = 0.7_dp
+        call find_periodic_orbit(v, [2.0_dp, 0.0_dp], 6.4_dp, o)
+        call ts%check_close(fam(3)%period, o%period, 1.0e-9_dp, "continued = cold start")
+    end subroutine test_vdp_continuation
+
+    subroutine set_mu(sys, p)
+        class(ode_system), intent(inout) :: sys
+        real(dp), intent(in) :: p
+        select type (sys)
+        type is (van_der_pol)
+            sys%mu = p
+        end select
+    end subroutine set_mu
 
     subroutine test_hill_generic_shooting()
         type(hill_problem) :: hp

@@ -85,6 +85,11 @@ class HillOrbit:
             setattr(self, k, kw.get(k))
 
     @property
+    def initial_state(self):
+        """Alias of y0."""
+        return self.y0
+
+    @property
     def stable(self):
         """True when |stability_index| < 1."""
         return bool(abs(self.stability_index) < 1.0)
