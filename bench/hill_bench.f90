@@ -1,6 +1,6 @@
 !> Benchmark of Hill's variation orbit + monodromy (fast symmetric path against the generic
 !! DOP853 shooting of the library, measured in the same run), and family throughput.
-!! Run: fpm run hill_bench --profile release [--flag -fopenmp] -- [n_family]
+!! Run: fpm run --example hill_bench --profile release [--flag -fopenmp] -- [n_family]
 program hill_bench
     use conmech
     !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads

@@ -1,6 +1,9 @@
 !> Explicit Runge-Kutta integrators: fixed-step RK4, and adaptive DOPRI5 and DOP853 with
 !! Hairer's step-size control, dense output and event location.
 !!
+!! Verner's 9(8) pair (METHOD_VERNER98) is the high-order choice for tight tolerances
+!! (rtol below about 1e-10): same control with exponent 1/9, step ratios [1/3, 6].
+!!
 !! Two entry points:
 !! - `ode_solve` stores the solution (every accepted step, or the points of `t_eval`),
 !!   the dense output if asked for, and the events, in an `ode_result`;
@@ -19,14 +22,19 @@ module conmech_ode_solver
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system, ode_events
-    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau
+    use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
+    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
+        verner98_tableau
     implicit none
     private
 
     integer, parameter, public :: METHOD_RK4 = 1     !! classical RK4, fixed step
     integer, parameter, public :: METHOD_DOPRI5 = 2  !! Dormand-Prince 5(4), dense order 4
     integer, parameter, public :: METHOD_DOP853 = 3  !! Dormand-Prince 8(5,3), dense order 7
+    integer, parameter, public :: METHOD_VERNER98 = 4 !! Verner 9(8), dense order 8
+
+    integer, parameter :: FORM_HAIRER = 1   !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...)))
+    integer, parameter :: FORM_POWER = 2    !! y0 + x F1 + x^2 F2 + ... + x^nf F_nf
 
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name
@@ -63,7 +71,9 @@ module conmech_ode_solver
     type :: dense_solution
         integer :: n = 0            !! dimension
         integer :: nseg = 0         !! number of steps stored
-        integer :: nf = 0           !! number of F coefficients (3 RK4, 4 DOPRI5, 7 DOP853)
+        integer :: nf = 0           !! number of F coefficients (3 RK4, 4 DOPRI5, 7 DOP853,
+                                    !! 8 VERNER98)
+        integer :: form = FORM_HAIRER   !! polynomial form of the coefficients
         real(dp) :: t_first = 0.0_dp, t_last = 0.0_dp
         real(dp), allocatable :: ts(:), hs(:)      !! step start and signed length
         real(dp), allocatable :: coef(:, :, :)     !! (n, 0:nf, nseg); coef(:,0,:) = y0
@@ -90,7 +100,8 @@ module conmech_ode_solver
 
 contains
 
-    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853"; 0 if unknown.
+    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98";
+    !! 0 if unknown.
     pure function method_from_name(name) result(m)
         character(len=*), intent(in) :: name
         integer :: m
@@ -101,6 +112,8 @@ contains
             m = METHOD_DOPRI5
         case ("DOP853", "dop853")
             m = METHOD_DOP853
+        case ("VERNER98", "verner98", "RKV98", "rkv98", "Vern9")
+            m = METHOD_VERNER98
         case default
             m = 0
         end select
@@ -113,7 +126,7 @@ contains
     !! inside t_span) it holds the solution there, from the dense output. Events are
     !! located on the dense output to near machine precision; a terminal event ends the
     !! integration there (status CM_EVENT_STOP) and is the last output point.
-    subroutine ode_solve(sys, t_span, y0, options, res, t_eval, events)
+    subroutine ode_solve(sys, t_span, y0, options, res, t_eval, events, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: y0(:)
@@ -121,6 +134,7 @@ contains
         type(ode_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        class(ode_step_hook), intent(inout), optional :: hook
         real(dp), allocatable :: y(:)
         integer :: i
         character(len=:), allocatable :: msg
@@ -151,13 +165,13 @@ contains
             end if
         end if
         call drive(sys, t_span(1), t_span(2), y, options, res%stats, res%status, msg, &
-                   res, t_eval, events)
+                   res, t_eval, events, hook)
         res%message = msg
         res%success = res%status >= 0
     end subroutine ode_solve
 
     !> Advance y from t0 to t1 in place, storing nothing. Fast path for shooting.
-    subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message)
+    subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
         real(dp), intent(inout) :: y(:)
@@ -165,9 +179,10 @@ contains
         integer, intent(out) :: info
         type(ode_stats), intent(out), optional :: stats
         character(len=:), allocatable, intent(out), optional :: message
+        class(ode_step_hook), intent(inout), optional :: hook
         type(ode_stats) :: st
         character(len=:), allocatable :: msg
-        call drive(sys, t0, t1, y, options, st, info, msg)
+        call drive(sys, t0, t1, y, options, st, info, msg, hook=hook)
         if (present(stats)) stats = st
         if (present(message)) message = msg
     end subroutine ode_integrate
@@ -182,7 +197,7 @@ contains
     end subroutine fail
 
     !> The common driver of every method.
-    subroutine drive(sys, t0, tf, y, opt, st, info, msg, res, t_eval, events)
+    subroutine drive(sys, t0, tf, y, opt, st, info, msg, res, t_eval, events, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, tf
         real(dp), intent(inout) :: y(:)
@@ -193,15 +208,18 @@ contains
         type(ode_result), intent(inout), optional :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        class(ode_step_hook), intent(inout), optional :: hook
 
         type(rk_tableau) :: tab
         real(dp), allocatable :: k(:, :), ynew(:), ytmp(:), sk(:), rtolv(:), atolv(:)
         real(dp), allocatable :: fc(:, :), g_old(:), g_new(:), ye(:)
         real(dp) :: t, h, hnew, hmax, posneg, err, fac11, fac, facold, safe, facc1, facc2
         real(dp) :: expo1, beta, t_stop, te
-        integer :: n, nf, nsteps, ne, nstiff_nf, ie, iev
+        integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev, ifsal, form
         integer :: i_eval, n_eval, nev_step
         logical :: adaptive, need_dense, reject, last, has_events, store_steps, stop_now
+        logical :: changed
+        integer :: hinfo
         real(dp), allocatable :: ev_times(:)
         integer, allocatable :: ev_ids(:)
         character(len=32) :: buf
@@ -236,22 +254,35 @@ contains
         end if
         rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))   ! as SciPy: rtol >= 100 eps
 
+        form = FORM_HAIRER
         select case (opt%method)
         case (METHOD_RK4)
             adaptive = .false.
             nf = 3
             tab%stages = 4
+            ifsal = 13
         case (METHOD_DOPRI5)
             adaptive = .true.
             tab = dopri5_tableau()
             nf = 4
+            ifsal = 7
             safe = 0.9_dp; facc1 = 1.0_dp/0.2_dp; facc2 = 1.0_dp/10.0_dp; beta = 0.04_dp
             if (opt%beta >= 0.0_dp) beta = opt%beta
             expo1 = 0.2_dp - beta*0.75_dp
+        case (METHOD_VERNER98)
+            adaptive = .true.
+            tab = verner98_tableau()
+            nf = 8
+            form = FORM_POWER
+            ifsal = 17
+            safe = 0.9_dp; facc1 = 1.0_dp/0.333_dp; facc2 = 1.0_dp/6.0_dp; beta = 0.0_dp
+            if (opt%beta >= 0.0_dp) beta = opt%beta
+            expo1 = 1.0_dp/9.0_dp - beta*0.2_dp
         case default
             adaptive = .true.
             tab = dop853_tableau()
             nf = 7
+            ifsal = 13
             safe = 0.9_dp; facc1 = 1.0_dp/0.333_dp; facc2 = 1.0_dp/6.0_dp; beta = 0.0_dp
             if (opt%beta >= 0.0_dp) beta = opt%beta
             expo1 = 1.0_dp/8.0_dp - beta*0.2_dp
@@ -260,9 +291,9 @@ contains
         if (opt%fac_min > 0.0_dp) facc1 = 1.0_dp/opt%fac_min
         if (opt%fac_max > 0.0_dp) facc2 = 1.0_dp/opt%fac_max
         hmax = min(abs(opt%max_step), abs(tf - t0))
-        nstiff_nf = 0
+        n_nonfinite = 0
 
-        allocate (k(n, 16), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
+        allocate (k(n, 21), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
         t = t0
 
         ! outputs at the start
@@ -270,7 +301,7 @@ contains
         if (present(res)) then
             if (store_steps .or. (.not. opt%save_steps .and. n_eval == 0)) &
                 call push_point(res, t, y)
-            if (opt%dense_output) call dense_init(res%sol, n, nf, t0)
+            if (opt%dense_output) call dense_init(res%sol, n, nf, form, t0)
         end if
         if (n_eval > 0) then
             do while (i_eval <= n_eval)
@@ -322,9 +353,14 @@ contains
                 exit
             end if
             if (0.1_dp*abs(h) <= abs(t)*epsilon(1.0_dp) .or. abs(h) < tiny(1.0_dp)) then
-                info = CM_STEP_TOO_SMALL
                 write (buf, '(es14.6)') t
-                msg = "step size too small at t ="//trim(buf)
+                if (n_nonfinite > 0) then
+                    info = CM_NONFINITE
+                    msg = "non-finite values in the right-hand side near t ="//trim(buf)
+                else
+                    info = CM_STEP_TOO_SMALL
+                    msg = "step size too small at t ="//trim(buf)
+                end if
                 exit
             end if
             if (adaptive) then
@@ -345,6 +381,8 @@ contains
                 if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
             case (METHOD_DOPRI5)
                 call dopri5_step()
+            case (METHOD_VERNER98)
+                call verner_step()
             case default
                 call dop853_step()
             end select
@@ -359,8 +397,8 @@ contains
                 end if
                 if (err /= err .or. err > huge(1.0_dp)) then
                     ! non-finite error estimate: cut the step hard
-                    nstiff_nf = nstiff_nf + 1
-                    if (nstiff_nf > 40) then
+                    n_nonfinite = n_nonfinite + 1
+                    if (n_nonfinite > 40) then
                         info = CM_NONFINITE
                         write (buf, '(es14.6)') t
                         msg = "non-finite values in the right-hand side near t ="//trim(buf)
@@ -368,6 +406,7 @@ contains
                     end if
                     h = h*0.1_dp
                 else
+                    n_nonfinite = 0
                     fac11 = err**expo1
                     h = h/min(facc1, fac11/safe)
                 end if
@@ -378,7 +417,7 @@ contains
             end if
 
             ! ---------------------------------------------------- accepted step
-            nstiff_nf = 0
+            n_nonfinite = 0
             st%naccept = st%naccept + 1
             if (adaptive) then
                 fac11 = err**expo1
@@ -389,9 +428,9 @@ contains
             else
                 hnew = h
             end if
-            ! the new right-hand side (FSAL): RK4 and DOP853 evaluate it here
-            if (opt%method == METHOD_DOP853 .or. opt%method == METHOD_RK4) then
-                call sys%rhs(t + h, ynew, k(:, 13))
+            ! the new right-hand side (FSAL): all but DOPRI5 evaluate it here
+            if (opt%method /= METHOD_DOPRI5) then
+                call sys%rhs(t + h, ynew, k(:, ifsal))
                 st%nfev = st%nfev + 1
             end if
             if (need_dense) call dense_coefs()
@@ -406,7 +445,7 @@ contains
                     if (t_eval(i_eval) == t + h) then
                         call push_point(res, t + h, ynew)
                     else
-                        call interp(fc, (t_eval(i_eval) - t)/h, ytmp)
+                        call interp(fc, form, (t_eval(i_eval) - t)/h, ytmp)
                         call push_point(res, t_eval(i_eval), ytmp)
                     end if
                     i_eval = i_eval + 1
@@ -417,7 +456,7 @@ contains
             end if
 
             if (stop_now) then
-                call interp(fc, (t_stop - t)/h, ytmp)
+                call interp(fc, form, (t_stop - t)/h, ytmp)
                 y = ytmp
                 t = t_stop
                 if (store_steps) call push_point(res, t, y)
@@ -428,10 +467,25 @@ contains
 
             y = ynew
             t = t + h
-            if (opt%method == METHOD_DOP853 .or. opt%method == METHOD_RK4) then
-                k(:, 1) = k(:, 13)
-            else
-                k(:, 1) = k(:, 7)
+            k(:, 1) = k(:, ifsal)
+            if (present(hook)) then
+                call hook%after_step(t, y, changed, hinfo)
+                if (changed) then
+                    call sys%rhs(t, y, k(:, 1))
+                    st%nfev = st%nfev + 1
+                end if
+                if (hinfo /= 0) then
+                    if (store_steps) call push_point(res, t, y)
+                    if (hinfo < 0) then
+                        info = hinfo
+                        msg = "stopped by the step hook"
+                        if (allocated(hook%message)) msg = hook%message
+                    else
+                        info = CM_EVENT_STOP
+                        msg = "stopped by the step hook"
+                    end if
+                    exit
+                end if
             end if
             if (.not. all(ieee_is_finite(k(:, 1)))) then
                 info = CM_NONFINITE
@@ -464,7 +518,7 @@ contains
                 msg = "bad input: y0 contains NaN or Inf"
             else if (.not. (ieee_is_finite(t0) .and. ieee_is_finite(tf))) then
                 msg = "bad input: t_span must be finite"
-            else if (opt%method < METHOD_RK4 .or. opt%method > METHOD_DOP853) then
+            else if (opt%method < METHOD_RK4 .or. opt%method > METHOD_VERNER98) then
                 msg = "bad input: unknown method"
             else if (.not. allocated(opt%rtol_vec) .and. .not. (opt%rtol >= 0.0_dp)) then
                 msg = "bad input: rtol must be non-negative"
@@ -486,24 +540,9 @@ contains
                 msg = "success"
             end if
             if (info /= CM_SUCCESS) return
-            if (allocated(opt%rtol_vec)) then
-                if (size(opt%rtol_vec) /= n) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: rtol must be a scalar or have the size of y0"
-                else if (.not. all(opt%rtol_vec >= 0.0_dp)) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: rtol must be non-negative"
-                end if
-            end if
-            if (allocated(opt%atol_vec)) then
-                if (size(opt%atol_vec) /= n) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: atol must be a scalar or have the size of y0"
-                else if (.not. all(opt%atol_vec >= 0.0_dp)) then
-                    info = CM_BAD_INPUT
-                    msg = "bad input: atol must be non-negative"
-                end if
-            end if
+            if (allocated(opt%rtol_vec)) call check_tol_vec(opt%rtol_vec, "rtol", info, msg)
+            if (info /= CM_SUCCESS) return
+            if (allocated(opt%atol_vec)) call check_tol_vec(opt%atol_vec, "atol", info, msg)
             if (info == CM_SUCCESS .and. has_events) then
                 if (.not. allocated(events%terminal)) then
                     info = CM_BAD_INPUT
@@ -514,6 +553,20 @@ contains
                 end if
             end if
         end subroutine validate
+
+        subroutine check_tol_vec(v, name, info, msg)
+            real(dp), intent(in) :: v(:)
+            character(len=*), intent(in) :: name
+            integer, intent(inout) :: info
+            character(len=:), allocatable, intent(inout) :: msg
+            if (size(v) /= n) then
+                info = CM_BAD_INPUT
+                msg = "bad input: "//name//" must be a scalar or have the size of y0"
+            else if (.not. all(v >= 0.0_dp)) then
+                info = CM_BAD_INPUT
+                msg = "bad input: "//name//" must be non-negative"
+            end if
+        end subroutine check_tol_vec
 
         !> Hairer's initial step size (hinit of dopri5.f / dop853.f).
         function hinit() result(hh)
@@ -613,6 +666,23 @@ contains
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dop853_step
 
+        subroutine verner_step()
+            integer :: j
+            call stages(2, 16)
+            ytmp = 0.0_dp
+            do j = 1, 15
+                if (tab%b(j) /= 0.0_dp) ytmp = ytmp + tab%b(j)*k(:, j)
+            end do
+            ynew = y + h*ytmp
+            ytmp = 0.0_dp
+            do j = 1, 16
+                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
+            end do
+            sk = atolv + rtolv*max(abs(y), abs(ynew))
+            err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
+            if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
+        end subroutine verner_step
+
         !> Coefficients of the continuous extension of the accepted step into fc.
         subroutine dense_coefs()
             integer :: s, j, i
@@ -628,6 +698,15 @@ contains
                 fc(:, 4) = 0.0_dp
                 do j = 1, 7
                     if (tab%d(1, j) /= 0.0_dp) fc(:, 4) = fc(:, 4) + (h*tab%d(1, j))*k(:, j)
+                end do
+            case (METHOD_VERNER98)
+                ! stages 18..21 (stage 17 is the FSAL stage), then the power-form weights
+                call stages(18, 21)
+                do j = 1, 8
+                    fc(:, j) = 0.0_dp
+                    do i = 1, 21
+                        if (tab%p(i, j) /= 0.0_dp) fc(:, j) = fc(:, j) + (h*tab%p(i, j))*k(:, i)
+                    end do
                 end do
             case default
                 ! three extra stages 14..16 (they use the FSAL stage 13)
@@ -697,7 +776,7 @@ contains
                 if (te == t + h) then
                     ye = ynew
                 else
-                    call interp(fc, (te - t)/h, ye)
+                    call interp(fc, form, (te - t)/h, ye)
                 end if
                 if (present(res)) call push_event(res, te, ye, ie)
                 if (events%terminal(ie) .and. .not. stop_now) then
@@ -758,7 +837,7 @@ contains
                 else
                     b = b + sign(tol, m)
                 end if
-                call interp(fc, b, ye)
+                call interp(fc, form, b, ye)
                 call events%eval(t + b*h, ye, gv)
                 fb = gv(ie)
                 if ((fb > 0.0_dp .and. fcc > 0.0_dp) .or. (fb < 0.0_dp .and. fcc < 0.0_dp)) then
@@ -779,14 +858,24 @@ contains
 
     end subroutine drive
 
-    !> Hairer's continuous extension: y0 + x (F1 + (1-x)(F2 + x (F3 + ...))).
-    pure subroutine interp(fc, x, yout)
+    !> Continuous extension at x = (t - t0)/h: Hairer's form
+    !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...))) or the power form y0 + sum_j x^j F_j.
+    pure subroutine interp(fc, form, x, yout)
         real(dp), intent(in) :: fc(:, 0:)
+        integer, intent(in) :: form
         real(dp), intent(in) :: x
         real(dp), intent(out) :: yout(:)
         integer :: j, nf
         real(dp) :: x1
         nf = ubound(fc, 2)
+        if (form == FORM_POWER) then
+            yout = fc(:, nf)
+            do j = nf - 1, 1, -1
+                yout = fc(:, j) + x*yout
+            end do
+            yout = fc(:, 0) + x*yout
+            return
+        end if
         x1 = 1.0_dp - x
         yout = fc(:, nf)
         do j = nf - 1, 1, -1
@@ -862,12 +951,13 @@ contains
         end if
     end subroutine shrink_result
 
-    subroutine dense_init(sol, n, nf, t0)
+    subroutine dense_init(sol, n, nf, form, t0)
         type(dense_solution), intent(out) :: sol
-        integer, intent(in) :: n, nf
+        integer, intent(in) :: n, nf, form
         real(dp), intent(in) :: t0
         sol%n = n
         sol%nf = nf
+        sol%form = form
         sol%nseg = 0
         sol%t_first = t0
         sol%t_last = t0
@@ -920,7 +1010,7 @@ contains
                 hi = mid - 1
             end if
         end do
-        call interp(self%coef(:, :, lo), (t - self%ts(lo))/self%hs(lo), y)
+        call interp(self%coef(:, :, lo), self%form, (t - self%ts(lo))/self%hs(lo), y)
     end subroutine dense_eval
 
     !> Evaluate the dense output at many times: y(:, i) at t(i).

@@ -16,7 +16,7 @@ module conmech_ode_system
     implicit none
     private
 
-    public :: ode_system, ode_function, ode_events, rhs_proc, jac_proc
+    public :: ode_system, ode_function, ode_events, ode_step_hook, rhs_proc, jac_proc
 
     type, abstract :: ode_system
     contains
@@ -77,6 +77,29 @@ module conmech_ode_system
             real(dp), intent(in) :: y(:)
             real(dp), intent(out) :: g(:)
         end subroutine event_eval
+    end interface
+
+    !> A procedure called after every accepted step (Hairer's `solout`, generalised): it may
+    !! change the state (projection onto a manifold, a reset), count, or stop the run.
+    !! If it sets `changed`, the integrator re-evaluates f at the new state (one more
+    !! evaluation) before the next step. `info` < 0 stops the integration with that
+    !! status and the hook's `message`; `info` > 0 stops it as a success (like a terminal
+    !! event, status CM_EVENT_STOP).
+    type, abstract :: ode_step_hook
+        character(len=:), allocatable :: message   !! set by the hook when it fails
+    contains
+        procedure(hook_after_step), deferred :: after_step
+    end type ode_step_hook
+
+    abstract interface
+        subroutine hook_after_step(self, t, y, changed, info)
+            import :: ode_step_hook, dp
+            class(ode_step_hook), intent(inout) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(inout) :: y(:)
+            logical, intent(out) :: changed
+            integer, intent(out) :: info
+        end subroutine hook_after_step
     end interface
 
 contains

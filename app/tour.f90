@@ -1,0 +1,79 @@
+!> The main job: a short tour of conmech printed to the terminal.
+!!   fpm run tour
+program tour
+    use conmech
+    use app_events, only: theta_events
+    implicit none
+
+    write (*, '(a)') "conmech tour"
+    write (*, '(a)') "============"
+    call pendulum_part()
+    call kepler_part()
+
+contains
+
+    !> Complete elliptic integral of the first kind K(k) by the arithmetic-geometric mean.
+    pure real(dp) function ellipk(k)
+        real(dp), intent(in) :: k
+        real(dp) :: a, b, c
+        a = 1.0_dp
+        b = sqrt(1.0_dp - k**2)
+        do
+            c = 0.5_dp*(a + b)
+            b = sqrt(a*b)
+            a = c
+            if (abs(a - b) <= 4.0_dp*epsilon(1.0_dp)*a) exit
+        end do
+        ellipk = pi/(2.0_dp*a)
+    end function ellipk
+
+    subroutine pendulum_part()
+        type(pendulum_theta) :: sys
+        type(ode_options) :: opt
+        type(ode_result) :: res
+        type(theta_events) :: ev
+        real(dp) :: th0, t_exact, t_num, e0, edrift
+        th0 = 2.0_dp
+        opt%rtol = 1.0e-12_dp
+        opt%atol = 1.0e-12_dp
+        ev%direction = [1]
+        ev%terminal = [.false.]
+        call ode_solve(sys, [0.0_dp, 20.0_dp], [th0, 0.0_dp], opt, res, events=ev)
+        e0 = sys%energy([th0, 0.0_dp])
+        edrift = abs(sys%energy(res%y(:, res%nt)) - e0)/abs(e0)
+        t_exact = 4.0_dp*sqrt(sys%l/sys%g)*ellipk(sin(th0/2.0_dp))
+        t_num = res%ev_t(res%nev) - res%ev_t(res%nev - 1)
+        write (*, '(/,a)') "Pendulum theta'' = -(g/l) sin(theta), theta(0) = 2 rad, DOP853, tol 1e-12"
+        write (*, '(a,f18.14)') "  period from events     ", t_num
+        write (*, '(a,f18.14)') "  4 sqrt(l/g) K(sin 1)   ", t_exact
+        write (*, '(a,es10.2)') "  relative energy drift over t = 20:", edrift
+        write (*, '(a,i0,a,i0,a,i0)') "  nfev ", res%stats%nfev, ", accepted ", &
+            res%stats%naccept, ", rejected ", res%stats%nreject
+    end subroutine pendulum_part
+
+    subroutine kepler_part()
+        type(kepler_2d) :: sys
+        type(ode_options) :: opt
+        type(ode_result) :: res
+        real(dp) :: y0(4), e, period
+        integer :: m
+        e = 0.6_dp
+        y0 = [1.0_dp - e, 0.0_dp, 0.0_dp, sqrt((1.0_dp + e)/(1.0_dp - e))]
+        period = 2.0_dp*pi
+        write (*, '(/,a)') "Kepler orbit, eccentricity 0.6, one period, tol 1e-10"
+        write (*, '(a)') "  method   closure error   energy error   angular-momentum error   nfev"
+        do m = METHOD_DOPRI5, METHOD_DOP853
+            opt%method = m
+            opt%rtol = 1.0e-10_dp
+            opt%atol = 1.0e-10_dp
+            call ode_solve(sys, [0.0_dp, period], y0, opt, res)
+            associate (y => res%y(:, res%nt))
+                write (*, '(2x,a8,es13.2,es15.2,es22.2,i10)') merge("DOPRI5", "DOP853", &
+                    m == METHOD_DOPRI5), maxval(abs(y - y0)), &
+                    abs(sys%energy(y) - sys%energy(y0)), &
+                    abs(y(1)*y(4) - y(2)*y(3) - (y0(1)*y0(4) - y0(2)*y0(3))), res%stats%nfev
+            end associate
+        end do
+    end subroutine kepler_part
+
+end program tour
