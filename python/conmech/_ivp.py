@@ -9,13 +9,21 @@ from .systems import BuiltinSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853")
+_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9")
+# codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
+# method_from_name by the tests (flat_method_code)
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
 }
 _CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
+# placeholders for f2py, which cannot pass empty arrays (read only, shared)
+_PAD = np.zeros(1)
+_PADI = np.zeros(1, dtype=np.intc)
+_PAD.flags.writeable = False
+_PADI.flags.writeable = False
 
 
 class OdeResult(dict):
@@ -56,11 +64,19 @@ class DenseOutput:
 
     ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
     (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
-    OdeSolution does. On each step [ts, ts + h] the polynomial is Hairer's form
-    y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))), x = (t - ts) / h.
+    OdeSolution does. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
+    in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
+    RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
+    VERNER98), as in conmech_ode_solver's dense_solution.
     """
 
-    def __init__(self, ts, hs, coef, t_min, t_max):
+    HAIRER = 1
+    POWER = 2
+
+    def __init__(self, ts, hs, coef, t_min, t_max, form=HAIRER):
+        if form not in (self.HAIRER, self.POWER):
+            raise ValueError(f"unknown dense output form {form}")
+        self.form = form
         self.t_start = np.ascontiguousarray(ts, dtype=float)   # step starts
         self.h = np.ascontiguousarray(hs, dtype=float)          # signed step lengths
         self.coef = np.ascontiguousarray(coef, dtype=float)     # (n, nf + 1, nseg)
@@ -88,7 +104,10 @@ class DenseOutput:
         x1 = 1.0 - x
         y = c[:, nf, :].copy()
         for j in range(nf - 1, 0, -1):
-            y *= x1 if j % 2 == 1 else x
+            if self.form == self.POWER:
+                y *= x
+            else:
+                y *= x1 if j % 2 == 1 else x
             y += c[:, j, :]
         y *= x
         y += c[:, 0, :]
@@ -96,6 +115,8 @@ class DenseOutput:
 
 
 def _real_scalar(value, name):
+    if type(value) is float or type(value) is int:
+        return float(value)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.ndarray)):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
     arr = np.asarray(value, dtype=float)
@@ -105,6 +126,13 @@ def _real_scalar(value, name):
 
 
 def _tolerance(value, name, n):
+    if type(value) is float or type(value) is int:   # fast path for the common case
+        v = float(value)
+        if not v >= 0:
+            raise ValueError(f"{name} must be non-negative")
+        if v == math.inf:
+            raise ValueError(f"{name} must be finite")
+        return np.full(n, v)
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -115,9 +143,9 @@ def _tolerance(value, name, n):
     elif arr.shape != (n,):
         raise ValueError(f"{name} must be a scalar or have shape ({n},) like y0, got shape "
                          f"{arr.shape}")
-    if np.any(np.isnan(arr)) or np.any(arr < 0):
+    if np.isnan(arr).any() or (arr < 0).any():
         raise ValueError(f"{name} must be non-negative")
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ValueError(f"{name} must be finite")
     return np.ascontiguousarray(arr)
 
@@ -171,9 +199,11 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state.
-    method : {"DOP853", "DOPRI5" (alias "RK45"), "RK4"}
+    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4"}
         DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
-        5(4), dense output of order 4. RK4: classical fixed-step RK4, step ``first_step``.
+        5(4), dense output of order 4. VERNER98: Verner's 9(8) pair, dense output of
+        order 8, for tight tolerances. RK4: classical fixed-step RK4, step ``first_step``.
+        Case-insensitive.
     t_eval : array_like or None
         Times at which to store the solution (sorted in the direction of integration,
         inside t_span), from the dense output. None: every accepted step.
@@ -225,8 +255,8 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     # ---------------------------------------------------------------- method
     if not isinstance(method, str):
         raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
-    code = int(_conmech.flat_method_code(method.upper()))
-    if code == 0 or method.upper() not in _METHODS:
+    code = _METHOD_CODES.get(method.upper(), 0)
+    if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
 
     # ---------------------------------------------------------------- t_span, y0
@@ -240,7 +270,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
     y0_in = np.asarray(y0)
-    if np.iscomplexobj(y0_in):
+    if y0_in.dtype.kind == "c":
         raise TypeError("y0 must be real: complex states are not supported")
     try:
         y0 = np.array(y0_in, dtype=float)
@@ -251,7 +281,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     n = y0.size
     if n == 0:
         raise ValueError("y0 must not be empty")
-    if not np.all(np.isfinite(y0)):
+    if not np.isfinite(y0).all():
         raise ValueError("y0 contains NaN or Inf")
     if builtin and n != fun.dimension:
         raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
@@ -282,7 +312,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
 
     # ---------------------------------------------------------------- t_eval
     if t_eval is None:
-        t_ev = np.zeros(0)
+        t_ev = _PAD[:0]
     else:
         try:
             t_ev = np.array(t_eval, dtype=float)
@@ -303,8 +333,6 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
     ne = len(settings)
-    ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
-    ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
     ev_funs = [s[0] for s in settings]
 
     if ne > 0:
@@ -318,28 +346,33 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     out = {}
 
     def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
-        out["t"] = np.array(t, dtype=float)
-        out["y"] = np.array(y, dtype=float).reshape(n, -1)
-        out["ev_t"] = np.array(ev_t, dtype=float)
-        out["ev_y"] = np.array(ev_y, dtype=float).reshape(n, -1)
-        out["ev_id"] = np.array(ev_id, dtype=int)
-        out["ts"] = np.array(ts, dtype=float)
-        out["hs"] = np.array(hs, dtype=float)
-        out["coef"] = np.array(coef, dtype=float)
+        # the arrays wrap Fortran memory that is freed on return: copy them
+        out["t"] = t.copy()
+        out["y"] = y.reshape(n, t.size).copy()
+        if ne:
+            out["ev_t"] = ev_t.copy()
+            out["ev_y"] = ev_y.reshape(n, ev_t.size).copy()
+            out["ev_id"] = ev_id.copy()
+        if dense_output:
+            out["ts"] = ts.copy()
+            out["hs"] = hs.copy()
+            out["coef"] = coef.reshape(n, -1, ts.size).copy()
 
     # f2py cannot pass empty arrays: t_eval, ev_dir, ev_term get at least one element
     # and their counts neval, ne say how many are used.
-    pad = np.zeros(1)
+    if ne:
+        ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
+        ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
+    else:
+        ev_dir = ev_term = _PADI
     common = dict(t_span=np.array([t0, tf]), y0=y0, method=code, rtol=rtol_v, atol=atol_v,
                   first_step=h0, max_step=hmax, max_steps=int(max_steps),
                   dense=int(bool(dense_output)), neval=t_ev.size,
-                  t_eval=t_ev if t_ev.size else pad, ne=ne,
-                  ev_dir=ev_dir if ne else pad.astype(np.intc),
-                  ev_term=ev_term if ne else pad.astype(np.intc))
+                  t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir, ev_term=ev_term)
     probe_calls = 0
     if builtin:
-        nfev, naccept, nreject, info, message = _conmech.flat_solve_builtin(
-            fun.name, fun.params.size, fun.params if fun.params.size else pad, events_cb,
+        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
+            fun.name, fun.params.size, fun.params if fun.params.size else _PAD, events_cb,
             store, **common)
     else:
         # One probe call checks the shape of fun's output and gives a clear error.
@@ -354,7 +387,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         else:
             def rhs(t, y):
                 return fun(t, y.copy())
-        nfev, naccept, nreject, info, message = _conmech.flat_solve_callback(
+        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
             rhs, events_cb, store, **common)
 
     message = bytes(message).decode("ascii", "replace").strip() \
@@ -372,18 +405,18 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
                     nfev=int(nfev) + probe_calls, njev=0, nlu=0, status=status,
                     message=message, success=status >= 0, naccept=int(naccept),
                     nreject=int(nreject))
-    if ne > 0 and out:
+    if ne > 0 and "ev_t" in out:
         ids = out["ev_id"]
         res.t_events = [out["ev_t"][ids == i + 1] for i in range(ne)]
         res.y_events = [out["ev_y"][:, ids == i + 1].T.copy() for i in range(ne)]
     elif ne > 0:
         res.t_events = [np.zeros(0) for _ in range(ne)]
         res.y_events = [np.zeros((0, n)) for _ in range(ne)]
-    if dense_output and out and out["ts"].size > 0:
+    if dense_output and "ts" in out and out["ts"].size > 0:
         t_last = float(res.t[-1]) if res.t.size else tf
         if t_eval is not None:
             t_last = float(out["ts"][-1] + out["hs"][-1])
             if status == 1 and ne > 0:
                 t_last = float(np.max(out["ev_t"]) if tf > t0 else np.min(out["ev_t"]))
-        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last)
+        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last, form=int(form))
     return res

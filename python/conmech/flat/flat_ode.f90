@@ -7,6 +7,20 @@
 !! A Python exception raised inside a callback makes f2py return to Python at once
 !! (longjmp) with the exception set; Fortran work arrays of that call are then leaked,
 !! never corrupted. Nothing here stops or prints.
+!!
+!! Conventions of every flat file (python/conmech/flat/*.f90, all wrapped into the one
+!! extension conmech._conmech by meson.build):
+!! - plain subroutines only, no modules (Fortran modules of the flat layer go to
+!!   python/conmech/flat/support/, compiled but not wrapped); real(c_double),
+!!   integer(c_int), explicit-shape arrays, `info` + character(len=256) `message` outputs;
+!! - f2py cannot pass empty arrays: an array that may be empty is declared with
+!!   max(count, 1) elements and its count is a separate argument;
+!! - a Python callback is a dummy procedure declared with `!f2py external name` and an
+!!   interface block whose bodies `use, intrinsic :: iso_c_binding` (f2py does not
+!!   understand `import`); intent(in) arguments reach Python, intent(out) ones are what
+!!   the Python function returns. To hand it to a derived type, point a
+!!   `procedure(), pointer, nopass` component at it (see conmech_flat_ode_support);
+!! - results of unknown size go back through a `store` callback, called once at the end.
 
 !> Method code (1 RK4, 2 DOPRI5, 3 DOP853) from a name ("RK4", "DOPRI5"/"RK45",
 !! "DOP853"); 0 if unknown.
@@ -32,10 +46,12 @@ end subroutine flat_system_dimension
 !> Solve y' = fun(t, y) for a Python right-hand side (f2py callback).
 !! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
 !! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
-!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal.
+!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal. dense_form: form of the
+!! dense coefficients handed to `store` (1 Hairer's, 2 power basis, 0 none).
 subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, atol, &
                                first_step, max_step, max_steps, dense, neval, t_eval, ne, &
-                               ev_dir, ev_term, nfev, naccept, nreject, info, message)
+                               ev_dir, ev_term, nfev, naccept, nreject, dense_form, info, &
+                               message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_flat_ode_support, only: callback_system, run_solve
     implicit none
@@ -49,7 +65,7 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: nfev, naccept, nreject, info
+    integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
     character(len=256), intent(out) :: message
 !f2py external fun, events, store
     interface
@@ -86,7 +102,7 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
     sys%n = n
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
-                   nreject, info, message)
+                   nreject, dense_form, info, message)
 end subroutine flat_solve_callback
 
 !> Solve y' = f(t, y) for the built-in system `name` with parameters `params` (see
@@ -95,7 +111,8 @@ end subroutine flat_solve_callback
 !! Other arguments as in flat_solve_callback.
 subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, method, rtol, &
                               atol, first_step, max_step, max_steps, dense, neval, t_eval, &
-                              ne, ev_dir, ev_term, nfev, naccept, nreject, info, message)
+                              ne, ev_dir, ev_term, nfev, naccept, nreject, dense_form, &
+                              info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -116,7 +133,7 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: nfev, naccept, nreject, info
+    integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
     character(len=256), intent(out) :: message
 !f2py external events, store
     interface
@@ -147,6 +164,7 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     nfev = 0
     naccept = 0
     nreject = 0
+    dense_form = 0
     call make_system(name, real(params(1:np), dp), sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
@@ -161,5 +179,5 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     end if
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
-                   nreject, info, message)
+                   nreject, dense_form, info, message)
 end subroutine flat_solve_builtin

@@ -70,9 +70,11 @@ contains
     !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
     !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
     !! t_eval, ev_dir, ev_term have at least one element (f2py cannot pass empty ones).
+    !! dense_form: the polynomial form of the dense coefficients (dense_solution%form of
+    !! conmech_ode_solver: 1 Hairer's, 2 power basis; 0 without dense output).
     subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                          max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
-                         nfev, naccept, nreject, info, message)
+                         nfev, naccept, nreject, dense_form, info, message)
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: n
         real(c_double), intent(in) :: t_span(2)
@@ -85,7 +87,7 @@ contains
         integer(c_int), intent(in) :: ne
         integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
         external :: events, store
-        integer(c_int), intent(out) :: nfev, naccept, nreject, info
+        integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
         character(len=*), intent(out) :: message
 
         type(ode_options) :: opt
@@ -97,6 +99,7 @@ contains
         nfev = 0
         naccept = 0
         nreject = 0
+        dense_form = 0
         if (n < 1 .or. neval < 0 .or. ne < 0) then
             info = CM_BAD_INPUT
             call copy_message("bad input: array sizes must be positive", message)
@@ -139,6 +142,7 @@ contains
         if (opt%dense_output .and. allocated(res%sol%ts)) then
             nseg = res%sol%nseg
             nf1 = res%sol%nf + 1
+            dense_form = res%sol%form
         end if
         if (nseg > 0) then
             call store(res%t(1:res%nt), res%y(:, 1:res%nt), res%ev_t(1:res%nev), &
