@@ -66,6 +66,16 @@ program hill_bench
     s = 0.5_dp*(po%floquet%trace - 2.0_dp)
     write (*, '(a, f10.1, a, es9.2)') "generic shooting (adaptive DOP853, rtol 1e-13): us/orbit", &
         1.0e6_dp*tgen, "  |c err|", abs(hill_perigee_c(s) - c_hill)
+    so%method = METHOD_VERNER98
+    call system_clock(c0)
+    do i = 1, nrep
+        call find_symmetric_orbit(hp, [0.95_dp, 0.0_dp, 0.0_dp, 0.95_dp], [1, 4], 0.5_dp*pi, &
+                                  [1, 4], po, so, period_factor=4.0_dp)
+    end do
+    call system_clock(c1)
+    s = 0.5_dp*(po%floquet%trace - 2.0_dp)
+    write (*, '(a, f8.1, a, es9.2)') &
+        "generic shooting (adaptive Verner 9(8), rtol 1e-13): us/orbit", 1.0e6_dp*real(c1 - c0, dp)/rate/nrep, "  |c err|", abs(hill_perigee_c(s) - c_hill)
 
     opt = hill_orbit_options()
     call hill_variation_orbit(m_hill, 1.0_dp, orb, opt)
