@@ -75,7 +75,8 @@ program hill_bench
     call system_clock(c1)
     s = 0.5_dp*(po%floquet%trace - 2.0_dp)
     write (*, '(a, f8.1, a, es9.2)') &
-        "generic shooting (adaptive Verner 9(8), rtol 1e-13): us/orbit", 1.0e6_dp*real(c1 - c0, dp)/rate/nrep, "  |c err|", abs(hill_perigee_c(s) - c_hill)
+        "generic shooting (adaptive Verner 9(8), rtol 1e-13): us/orbit", &
+        1.0e6_dp*real(c1 - c0, dp)/rate/nrep, "  |c err|", abs(hill_perigee_c(s) - c_hill)
 
     opt = hill_orbit_options()
     call hill_variation_orbit(m_hill, 1.0_dp, orb, opt)
