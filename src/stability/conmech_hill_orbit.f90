@@ -21,7 +21,9 @@
 !! Perigee constant: the non-trivial multipliers are exp(+-2 pi i c). From the trace,
 !! S = (trace M - 2)/2 = cos(2 pi c); the branch is c = 1 + acos(S)/(2 pi), the
 !! continuation of c = 1 at m = 0 (c > 1 along the direct family, valid while
-!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit).
+!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit). Conditioning: an error e in S
+!! gives e/(2 pi sin(2 pi (c - 1))) in c, about e/2.7 at Hill's m, but it grows as m -> 0
+!! (c -> 1, S -> 1: at m = 1e-6, |c error| ~ 3e-9; at m = 0 c = 1 only to ~2e-7).
 !!
 !! Transverse linearisation (seed 000): with tangent tau = v/|v|, normal n = (-tau_y, tau_x),
 !! V = |v|, H the Hessian of F and omega = n.grad F / V - 2 m (the turning rate of the
