@@ -15,6 +15,12 @@ module conmech
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_mech
+    use conmech_hill
+    use conmech_equilibria
+    use conmech_variational
+    use conmech_floquet
+    use conmech_shooting
+    use conmech_hill_orbit
     implicit none
     public
 end module conmech

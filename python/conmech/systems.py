@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _conmech
 
-__all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol"]
+__all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill"]
 
 
 class BuiltinSystem:
@@ -199,3 +199,9 @@ def rolling_disk(m=1.0, R=1.0, I_roll=0.5, I_turn=0.25):
 
 __all__ += ["pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
             "pendulum_moving_xy", "yoyo", "skate", "rolling_disk"]
+
+
+def hill(m=0.080848933808312, kappa=1.0):
+    """Hill's lunar problem x'' - 2 m y' = F_x, y'' + 2 m x' = F_y,
+    F = kappa/r + (3/2) m^2 x^2; y = [x, y, x', y'] (analytic Jacobian)."""
+    return BuiltinSystem("hill", [m, kappa], ("m", "kappa"))

@@ -9,6 +9,7 @@ module conmech_systems
     use conmech_ode_system, only: ode_system
     use conmech_systems_basic
     use conmech_systems_mech, only: make_generalized_ode, mech_initial_state
+    use conmech_hill, only: hill_problem
     implicit none
     private
     public :: make_system, system_dimension
@@ -17,6 +18,7 @@ contains
 
     !> Allocate a built-in system by name. Parameters (in order):
     !! harmonic: omega | pendulum: g, l | kepler: mu | arenstorf: mu | vanderpol: mu
+    !! | hill: m, kappa
     subroutine make_system(name, params, sys, info, msg)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
@@ -57,6 +59,13 @@ contains
                 if (size(params) >= 1) s%mu = params(1)
                 allocate (sys, source=s)
             end block
+        case ("hill")
+            block
+                type(hill_problem) :: s
+                if (size(params) >= 1) s%m = params(1)
+                if (size(params) >= 2) s%kappa = params(2)
+                allocate (sys, source=s)
+            end block
         case default
             ! the generalized-coordinate seed systems (conmech_systems_mech), y = [q, q']
             call make_generalized_ode(name, params, sys, info, msg)
@@ -71,7 +80,7 @@ contains
         select case (trim(name))
         case ("harmonic", "pendulum", "vanderpol")
             n = 2
-        case ("kepler", "arenstorf")
+        case ("kepler", "arenstorf", "hill")
             n = 4
         case default
             n = 0
