@@ -465,3 +465,14 @@ def test_observed_orders_of_the_methods_and_dense_outputs(method, hs, order, den
     # the global order is checked as "at least the order, below the next one"
     assert order - 0.35 < p < order + 0.9, (glob, p)
     assert abs(q - dense_order) < 0.35, (dense, q)
+
+
+def test_exception_in_fun_prints_nothing(capfd):
+    def f(t, y):
+        if t > 0.1:
+            raise RuntimeError("stop here")
+        return -y
+    with pytest.raises(RuntimeError, match="^stop here$"):
+        conmech.solve_ivp(f, (0, 1.0), [1.0])
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
