@@ -128,6 +128,7 @@ def main():
     repeats = 3 if args.quick else 9
     min_total = 0.03 if args.quick else 0.1
 
+    load_start = os.getloadavg()[0]
     results = {}
     for problem in PROBLEMS:
         results[problem] = {}
@@ -145,7 +146,9 @@ def main():
                  f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; "
                  f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
                  f"Python {platform.python_version()}, numpy {np.__version__}, "
-                 f"SciPy {scipy.__version__}, conmech {conmech.__version__}.")
+                 f"SciPy {scipy.__version__}, conmech {conmech.__version__}; load average "
+                 f"{load_start:.2f} at the start, {os.getloadavg()[0]:.2f} at the end (other "
+                 f"processes on the machine make the times noisy: compare within a row).")
     lines.append("")
     lines.append("rtol = atol = tol. err: max-norm error of the final state against the exact "
                  "one. Times: best of several repeats, whole `solve_ivp` call (all steps "
