@@ -10,6 +10,8 @@ time (best of several repeats) of
   * scipy     scipy.integrate.solve_ivp(method="DOP853") with a Python right-hand side,
   * callback  conmech.solve_ivp(method="DOP853") with the same Python right-hand side,
   * builtin   conmech.solve_ivp(method="DOP853") with the compiled built-in system,
+  * vern9     conmech.solve_ivp(method="VERNER98"), built-in system (conmech's pair for
+              tight tolerances; only compared at equal accuracy),
 and the speed-ups scipy time / conmech time at equal tolerance, and at equal accuracy
 (SciPy's time interpolated, log-log in its error, at conmech's error).
 
@@ -81,6 +83,8 @@ def measure(problem, tol, repeats, min_total):
                                               rtol=tol, atol=tol),
         "builtin": lambda: conmech.solve_ivp(p["builtin"], p["span"], p["y0"],
                                              method="DOP853", rtol=tol, atol=tol),
+        "vern9": lambda: conmech.solve_ivp(p["builtin"], p["span"], p["y0"],
+                                           method="VERNER98", rtol=tol, atol=tol),
     }
     out = {}
     for name, run in runs.items():
@@ -162,27 +166,36 @@ def main():
         lines.append("")
         lines.append("| tol | err SciPy | err conmech | nfev SciPy | nfev conmech | "
                      "t SciPy (ms) | t callback (ms) | t built-in (ms) | "
-                     "speed-up callback | speed-up built-in | built-in, equal acc. |")
-        lines.append("|---|---|---|---|---|---|---|---|---|---|---|")
+                     "speed-up callback | speed-up built-in | built-in, equal acc. | "
+                     "err Vern9 | t Vern9 (ms) | Vern9, equal acc. |")
+        lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         scipy_rows = [rows[t]["scipy"] for t in tols]
         for tol in tols:
             r = rows[tol]
-            s, c, b = r["scipy"], r["callback"], r["builtin"]
+            s, c, b, v = r["scipy"], r["callback"], r["builtin"], r["vern9"]
             eq = equal_accuracy_ratio(scipy_rows, b["err"], b["time"])
+            eqv = equal_accuracy_ratio(scipy_rows, v["err"], v["time"])
             sc, sb = s["time"] / c["time"], s["time"] / b["time"]
-            summary.setdefault(problem, []).append((tol, sc, sb))
+            summary.setdefault(problem, []).append((tol, sc, sb, eq, eqv))
             lines.append(f"| {tol:.0e} | {s['err']:.1e} | {b['err']:.1e} | {s['nfev']} | "
                          f"{b['nfev']} | {s['time']*1e3:.2f} | {c['time']*1e3:.2f} | "
                          f"{b['time']*1e3:.3f} | {fmt_ratio(sc)} | {fmt_ratio(sb)} | "
-                         f"{fmt_ratio(eq)} |")
+                         f"{fmt_ratio(eq)} | {v['err']:.1e} | {v['time']*1e3:.3f} | "
+                         f"{fmt_ratio(eqv)} |")
     lines.append("")
     lines.append("Summary (speed-up over SciPy at equal tolerance, min .. max over tol):")
     lines.append("")
+    def span(values, digits):
+        values = [x for x in values if x is not None]
+        if not values:
+            return "n/a"
+        return f"{min(values):.{digits}f}x .. {max(values):.{digits}f}x"
+
     for problem, rows in summary.items():
-        sc = [r[1] for r in rows]
-        sb = [r[2] for r in rows]
-        lines.append(f"- {problem}: Python callback {min(sc):.1f}x .. {max(sc):.1f}x, "
-                     f"built-in {min(sb):.0f}x .. {max(sb):.0f}x")
+        lines.append(f"- {problem}: Python callback {span([r[1] for r in rows], 1)}, "
+                     f"built-in DOP853 {span([r[2] for r in rows], 0)}; at equal accuracy: "
+                     f"built-in DOP853 {span([r[3] for r in rows], 0)}, built-in VERNER98 "
+                     f"{span([r[4] for r in rows], 0)}")
     text = "\n".join(lines) + "\n"
     print()
     print(text)
