@@ -185,8 +185,8 @@ def _event_settings(events):
 
 
 def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
-              events=None, rtol=1e-3, atol=1e-6, first_step=None, max_step=np.inf,
-              args=None, max_steps=100000):
+              events=None, vectorized=False, args=None, *, rtol=1e-3, atol=1e-6,
+              first_step=None, max_step=np.inf, max_steps=100000):
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
 
     Parameters
@@ -213,14 +213,17 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         ``event(t, y, *args) -> float``; zero crossings are located on the dense output.
         Optional attributes ``terminal`` (bool) and ``direction`` (>0 rising, <0 falling,
         0 both), as in SciPy.
+    vectorized : bool
+        Accepted for SciPy compatibility and without effect: explicit Runge-Kutta methods
+        call ``fun`` with one state of shape (n,) at a time, as SciPy's do.
+    args : tuple or None
+        Extra arguments passed to ``fun`` and to every event function.
     rtol, atol : float or array_like of shape (n,)
         Relative and absolute tolerances (rtol is raised to 100 eps at least, as SciPy).
     first_step : float or None
         Initial step (None: Hairer's heuristic). Required by RK4 (its fixed step).
     max_step : float
         Largest step size (default no limit).
-    args : tuple or None
-        Extra arguments passed to ``fun`` and to every event function.
     max_steps : int
         Attempted steps before giving up (status -1).
 
@@ -230,6 +233,9 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
         None), nfev, njev = 0, nlu = 0, status (0 reached the end, 1 terminal event, -1
         failure), message, success, and the step counts naccept, nreject.
+
+    The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step and
+    max_steps (SciPy's ``**options``) are keyword-only.
 
     Raises
     ------

@@ -169,6 +169,18 @@ def test_args_are_passed_to_fun_and_events():
                                atol=1e-10)
 
 
+def test_scipy_call_is_accepted_unchanged():
+    # the same call, positional arguments in SciPy's order, works with both
+    call = (harmonic_rhs, (0.0, 2.0), [1.0, 0.0], "DOP853", np.linspace(0, 2, 5), True,
+            None, False, (2.0,))
+    a = scipy_solve_ivp(*call, rtol=1e-10, atol=1e-12)
+    b = conmech.solve_ivp(*call, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(a.t, b.t)
+    np.testing.assert_allclose(a.y, b.y, atol=1e-9)
+    np.testing.assert_allclose(a.sol(1.3), b.sol(1.3), atol=1e-9)
+    assert set(a.keys()) <= set(b.keys())
+
+
 def test_fun_gets_a_fresh_copy_of_y():
     seen = []
 
