@@ -341,10 +341,25 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     ne = len(settings)
     ev_funs = [s[0] for s in settings]
 
+    # A Python exception raised in a callback is kept and the callback returns NaN from
+    # then on without calling the user's function again: the Fortran solver stops at once
+    # on the non-finite values (status "non-finite") and returns normally, freeing its
+    # memory, and the exception is raised again here, unchanged. (Letting it go through
+    # f2py instead would longjmp over the Fortran frames and leak their arrays.)
+    failure = []
+
     if ne > 0:
+        nan_g = [math.nan] * ne
+
         def events_cb(t, y):
+            if failure:
+                return nan_g
             yc = y.copy()
-            return [e(t, yc, *args) for e in ev_funs]
+            try:
+                return [e(t, yc, *args) for e in ev_funs]
+            except BaseException as exc:
+                failure.append(exc)
+                return nan_g
     else:
         def events_cb(t, y):  # never called when ne = 0
             raise RuntimeError("conmech: events callback called without events")
@@ -387,14 +402,21 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         if f0.size != n or f0.ndim > 1:
             raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
                              f"shape {f0.shape}")
-        if args:
-            def rhs(t, y):
+        nan_y = np.full(n, math.nan)
+        nan_y.flags.writeable = False
+
+        def rhs(t, y):
+            if failure:
+                return nan_y
+            try:
                 return fun(t, y.copy(), *args)
-        else:
-            def rhs(t, y):
-                return fun(t, y.copy())
+            except BaseException as exc:
+                failure.append(exc)
+                return nan_y
         nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
             rhs, events_cb, store, **common)
+    if failure:
+        raise failure[0]
 
     message = bytes(message).decode("ascii", "replace").strip() \
         if not isinstance(message, str) else message.strip()

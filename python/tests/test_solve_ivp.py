@@ -371,6 +371,9 @@ def test_exception_in_fun_propagates_unchanged():
     with pytest.raises(CallbackError, match="^boom at call 50$") as info:
         conmech.solve_ivp(f, (0, 100.0), [1.0, 2.0], rtol=1e-10)
     assert info.value is raised[0]
+    assert calls[0] == 50   # fun is not called again after it raised
+    # the traceback reaches into fun
+    assert any(tb.name == "f" for tb in info.traceback)
     # the interpreter survived and the next integration is fine
     r = conmech.solve_ivp(_ok, (0, 1.0), [1.0], rtol=1e-10, atol=1e-12)
     assert r.success and abs(r.y[0, -1] - math.exp(-1)) < 1e-9
@@ -488,3 +491,25 @@ def test_exception_in_fun_prints_nothing(capfd):
         conmech.solve_ivp(f, (0, 1.0), [1.0])
     out, err = capfd.readouterr()
     assert out == "" and err == ""
+
+
+def test_exceptions_do_not_leak_memory():
+    import resource
+
+    def f(t, y):
+        if t > 0.5:
+            raise KeyError("k")
+        return -y
+    y0 = np.ones(200)
+
+    def burst():
+        for _ in range(300):
+            with pytest.raises(KeyError):
+                conmech.solve_ivp(f, (0, 1.0), y0, rtol=1e-8)
+    burst()
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    for _ in range(5):
+        burst()
+    grown_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    # a leak of the Fortran arrays (about 50 KB per call here) would add > 70 MB
+    assert grown_kb < 10_000
