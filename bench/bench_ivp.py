@@ -129,8 +129,8 @@ def main():
     args = ap.parse_args()
     tols = [1e-6, 1e-9, 1e-12] if args.quick else [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11,
                                                      1e-12]
-    repeats = 3 if args.quick else 9
-    min_total = 0.03 if args.quick else 0.1
+    repeats = 3 if args.quick else 15
+    min_total = 0.03 if args.quick else 0.05
 
     load_start = os.getloadavg()[0]
     results = {}
