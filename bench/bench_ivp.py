@@ -10,6 +10,8 @@ time (best of several repeats) of
   * scipy     scipy.integrate.solve_ivp(method="DOP853") with a Python right-hand side,
   * callback  conmech.solve_ivp(method="DOP853") with the same Python right-hand side,
   * builtin   conmech.solve_ivp(method="DOP853") with the compiled built-in system,
+  * vern9     conmech.solve_ivp(method="VERNER98"), built-in system (conmech's pair for
+              tight tolerances; only compared at equal accuracy),
 and the speed-ups scipy time / conmech time at equal tolerance, and at equal accuracy
 (SciPy's time interpolated, log-log in its error, at conmech's error).
 
@@ -81,6 +83,8 @@ def measure(problem, tol, repeats, min_total):
                                               rtol=tol, atol=tol),
         "builtin": lambda: conmech.solve_ivp(p["builtin"], p["span"], p["y0"],
                                              method="DOP853", rtol=tol, atol=tol),
+        "vern9": lambda: conmech.solve_ivp(p["builtin"], p["span"], p["y0"],
+                                           method="VERNER98", rtol=tol, atol=tol),
     }
     out = {}
     for name, run in runs.items():
@@ -125,9 +129,10 @@ def main():
     args = ap.parse_args()
     tols = [1e-6, 1e-9, 1e-12] if args.quick else [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11,
                                                      1e-12]
-    repeats = 3 if args.quick else 9
-    min_total = 0.03 if args.quick else 0.1
+    repeats = 3 if args.quick else 15
+    min_total = 0.03 if args.quick else 0.05
 
+    load_start = os.getloadavg()[0]
     results = {}
     for problem in PROBLEMS:
         results[problem] = {}
@@ -145,7 +150,9 @@ def main():
                  f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; "
                  f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
                  f"Python {platform.python_version()}, numpy {np.__version__}, "
-                 f"SciPy {scipy.__version__}, conmech {conmech.__version__}.")
+                 f"SciPy {scipy.__version__}, conmech {conmech.__version__}; load average "
+                 f"{load_start:.2f} at the start, {os.getloadavg()[0]:.2f} at the end (other "
+                 f"processes on the machine make the times noisy: compare within a row).")
     lines.append("")
     lines.append("rtol = atol = tol. err: max-norm error of the final state against the exact "
                  "one. Times: best of several repeats, whole `solve_ivp` call (all steps "
@@ -159,27 +166,36 @@ def main():
         lines.append("")
         lines.append("| tol | err SciPy | err conmech | nfev SciPy | nfev conmech | "
                      "t SciPy (ms) | t callback (ms) | t built-in (ms) | "
-                     "speed-up callback | speed-up built-in | built-in, equal acc. |")
-        lines.append("|---|---|---|---|---|---|---|---|---|---|---|")
+                     "speed-up callback | speed-up built-in | built-in, equal acc. | "
+                     "err Vern9 | t Vern9 (ms) | Vern9, equal acc. |")
+        lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         scipy_rows = [rows[t]["scipy"] for t in tols]
         for tol in tols:
             r = rows[tol]
-            s, c, b = r["scipy"], r["callback"], r["builtin"]
+            s, c, b, v = r["scipy"], r["callback"], r["builtin"], r["vern9"]
             eq = equal_accuracy_ratio(scipy_rows, b["err"], b["time"])
+            eqv = equal_accuracy_ratio(scipy_rows, v["err"], v["time"])
             sc, sb = s["time"] / c["time"], s["time"] / b["time"]
-            summary.setdefault(problem, []).append((tol, sc, sb))
+            summary.setdefault(problem, []).append((tol, sc, sb, eq, eqv))
             lines.append(f"| {tol:.0e} | {s['err']:.1e} | {b['err']:.1e} | {s['nfev']} | "
                          f"{b['nfev']} | {s['time']*1e3:.2f} | {c['time']*1e3:.2f} | "
                          f"{b['time']*1e3:.3f} | {fmt_ratio(sc)} | {fmt_ratio(sb)} | "
-                         f"{fmt_ratio(eq)} |")
+                         f"{fmt_ratio(eq)} | {v['err']:.1e} | {v['time']*1e3:.3f} | "
+                         f"{fmt_ratio(eqv)} |")
     lines.append("")
     lines.append("Summary (speed-up over SciPy at equal tolerance, min .. max over tol):")
     lines.append("")
+    def span(values, digits):
+        values = [x for x in values if x is not None]
+        if not values:
+            return "n/a"
+        return f"{min(values):.{digits}f}x .. {max(values):.{digits}f}x"
+
     for problem, rows in summary.items():
-        sc = [r[1] for r in rows]
-        sb = [r[2] for r in rows]
-        lines.append(f"- {problem}: Python callback {min(sc):.1f}x .. {max(sc):.1f}x, "
-                     f"built-in {min(sb):.0f}x .. {max(sb):.0f}x")
+        lines.append(f"- {problem}: Python callback {span([r[1] for r in rows], 1)}, "
+                     f"built-in DOP853 {span([r[2] for r in rows], 0)}; at equal accuracy: "
+                     f"built-in DOP853 {span([r[3] for r in rows], 0)}, built-in VERNER98 "
+                     f"{span([r[4] for r in rows], 0)}")
     text = "\n".join(lines) + "\n"
     print()
     print(text)

@@ -185,8 +185,8 @@ def _event_settings(events):
 
 
 def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
-              events=None, rtol=1e-3, atol=1e-6, first_step=None, max_step=np.inf,
-              args=None, max_steps=100000):
+              events=None, vectorized=False, args=None, *, rtol=1e-3, atol=1e-6,
+              first_step=None, max_step=np.inf, max_steps=100000):
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
 
     Parameters
@@ -213,14 +213,17 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         ``event(t, y, *args) -> float``; zero crossings are located on the dense output.
         Optional attributes ``terminal`` (bool) and ``direction`` (>0 rising, <0 falling,
         0 both), as in SciPy.
+    vectorized : bool
+        Accepted for SciPy compatibility and without effect: explicit Runge-Kutta methods
+        call ``fun`` with one state of shape (n,) at a time, as SciPy's do.
+    args : tuple or None
+        Extra arguments passed to ``fun`` and to every event function.
     rtol, atol : float or array_like of shape (n,)
         Relative and absolute tolerances (rtol is raised to 100 eps at least, as SciPy).
     first_step : float or None
         Initial step (None: Hairer's heuristic). Required by RK4 (its fixed step).
     max_step : float
         Largest step size (default no limit).
-    args : tuple or None
-        Extra arguments passed to ``fun`` and to every event function.
     max_steps : int
         Attempted steps before giving up (status -1).
 
@@ -230,6 +233,9 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
         None), nfev, njev = 0, nlu = 0, status (0 reached the end, 1 terminal event, -1
         failure), message, success, and the step counts naccept, nreject.
+
+    The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step and
+    max_steps (SciPy's ``**options``) are keyword-only.
 
     Raises
     ------
@@ -335,10 +341,25 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     ne = len(settings)
     ev_funs = [s[0] for s in settings]
 
+    # A Python exception raised in a callback is kept and the callback returns NaN from
+    # then on without calling the user's function again: the Fortran solver stops at once
+    # on the non-finite values (status "non-finite") and returns normally, freeing its
+    # memory, and the exception is raised again here, unchanged. (Letting it go through
+    # f2py instead would longjmp over the Fortran frames and leak their arrays.)
+    failure = []
+
     if ne > 0:
+        nan_g = [math.nan] * ne
+
         def events_cb(t, y):
+            if failure:
+                return nan_g
             yc = y.copy()
-            return [e(t, yc, *args) for e in ev_funs]
+            try:
+                return [e(t, yc, *args) for e in ev_funs]
+            except BaseException as exc:
+                failure.append(exc)
+                return nan_g
     else:
         def events_cb(t, y):  # never called when ne = 0
             raise RuntimeError("conmech: events callback called without events")
@@ -381,14 +402,21 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         if f0.size != n or f0.ndim > 1:
             raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
                              f"shape {f0.shape}")
-        if args:
-            def rhs(t, y):
+        nan_y = np.full(n, math.nan)
+        nan_y.flags.writeable = False
+
+        def rhs(t, y):
+            if failure:
+                return nan_y
+            try:
                 return fun(t, y.copy(), *args)
-        else:
-            def rhs(t, y):
-                return fun(t, y.copy())
+            except BaseException as exc:
+                failure.append(exc)
+                return nan_y
         nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
             rhs, events_cb, store, **common)
+    if failure:
+        raise failure[0]
 
     message = bytes(message).decode("ascii", "replace").strip() \
         if not isinstance(message, str) else message.strip()

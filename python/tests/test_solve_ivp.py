@@ -169,6 +169,18 @@ def test_args_are_passed_to_fun_and_events():
                                atol=1e-10)
 
 
+def test_scipy_call_is_accepted_unchanged():
+    # the same call, positional arguments in SciPy's order, works with both
+    call = (harmonic_rhs, (0.0, 2.0), [1.0, 0.0], "DOP853", np.linspace(0, 2, 5), True,
+            None, False, (2.0,))
+    a = scipy_solve_ivp(*call, rtol=1e-10, atol=1e-12)
+    b = conmech.solve_ivp(*call, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(a.t, b.t)
+    np.testing.assert_allclose(a.y, b.y, atol=1e-9)
+    np.testing.assert_allclose(a.sol(1.3), b.sol(1.3), atol=1e-9)
+    assert set(a.keys()) <= set(b.keys())
+
+
 def test_fun_gets_a_fresh_copy_of_y():
     seen = []
 
@@ -359,6 +371,9 @@ def test_exception_in_fun_propagates_unchanged():
     with pytest.raises(CallbackError, match="^boom at call 50$") as info:
         conmech.solve_ivp(f, (0, 100.0), [1.0, 2.0], rtol=1e-10)
     assert info.value is raised[0]
+    assert calls[0] == 50   # fun is not called again after it raised
+    # the traceback reaches into fun
+    assert any(tb.name == "f" for tb in info.traceback)
     # the interpreter survived and the next integration is fine
     r = conmech.solve_ivp(_ok, (0, 1.0), [1.0], rtol=1e-10, atol=1e-12)
     assert r.success and abs(r.y[0, -1] - math.exp(-1)) < 1e-9
@@ -465,3 +480,36 @@ def test_observed_orders_of_the_methods_and_dense_outputs(method, hs, order, den
     # the global order is checked as "at least the order, below the next one"
     assert order - 0.35 < p < order + 0.9, (glob, p)
     assert abs(q - dense_order) < 0.35, (dense, q)
+
+
+def test_exception_in_fun_prints_nothing(capfd):
+    def f(t, y):
+        if t > 0.1:
+            raise RuntimeError("stop here")
+        return -y
+    with pytest.raises(RuntimeError, match="^stop here$"):
+        conmech.solve_ivp(f, (0, 1.0), [1.0])
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_exceptions_do_not_leak_memory():
+    import resource
+
+    def f(t, y):
+        if t > 0.5:
+            raise KeyError("k")
+        return -y
+    y0 = np.ones(200)
+
+    def burst():
+        for _ in range(300):
+            with pytest.raises(KeyError):
+                conmech.solve_ivp(f, (0, 1.0), y0, rtol=1e-8)
+    burst()
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    for _ in range(5):
+        burst()
+    grown_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    # a leak of the Fortran arrays (about 50 KB per call here) would add > 70 MB
+    assert grown_kb < 10_000

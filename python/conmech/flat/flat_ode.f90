@@ -4,9 +4,12 @@
 !!
 !! Results are handed to the `store` callback once, at the end, with their actual sizes:
 !! no capacities to guess, no re-runs, nothing saved between calls (thread-safe).
-!! A Python exception raised inside a callback makes f2py return to Python at once
-!! (longjmp) with the exception set; Fortran work arrays of that call are then leaked,
-!! never corrupted. Nothing here stops or prints.
+!! The Python layer catches an exception raised in a user's callback, returns NaN from
+!! then on (the solver stops on the non-finite values and returns normally) and raises it
+!! again after the call. Should an exception still cross a callback (e.g. f2py failing
+!! to convert a returned value), f2py returns to Python at once (longjmp) with the
+!! exception set: the Fortran arrays of that call leak, nothing is corrupted.
+!! Nothing here stops or prints.
 !!
 !! Conventions of every flat file (python/conmech/flat/*.f90, all wrapped into the one
 !! extension conmech._conmech by meson.build):
