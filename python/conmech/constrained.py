@@ -149,34 +149,92 @@ class ConstrainedSystem:
         self.mass, self.forces, self.phi, self.jac, self.gamma = mass, forces, phi, jac, gamma
         self.nh, self.nh_gamma, self.rheonomic = nh, nh_gamma, bool(rheonomic)
 
-    def _callbacks(self):
+    def _callbacks(self, failure):
+        """The f2py callbacks. An exception raised by a user function is kept in
+        ``failure`` and the callbacks return NaN from then on (the Fortran solver stops on
+        the non-finite values and returns normally); :func:`solve` re-raises it."""
         n, mh, mn = self.n, self.n_hol, self.n_nh
 
+        # (f2py reads the number of arguments of a callback from its signature: every
+        # guarded callback spells its arguments out)
+        def failed(exc):
+            failure.append(exc)
+
+        nan_m = np.full((n, n), np.nan)
+        nan_n = np.full(n, np.nan)
+        nan_h = np.full(max(mh, 1), np.nan)
+        nan_g = np.full((max(mh, 1), n), np.nan)
+        nan_a = np.full((max(mn, 1), n), np.nan)
+        nan_b = np.full(max(mn, 1), np.nan)
+
         def mass(t, q, n_):
-            m = np.asarray(self.mass(t, q.copy()), dtype=float)
-            if m.shape != (n, n):
-                raise ValueError(f"mass must return shape ({n}, {n}), got {m.shape}")
-            return m
+            if failure:
+                return nan_m
+            try:
+                m = np.asarray(self.mass(t, q.copy()), dtype=float)
+                if m.shape != (n, n):
+                    raise ValueError(f"mass must return shape ({n}, {n}), got {m.shape}")
+                return m
+            except BaseException as exc:
+                failed(exc)
+                return nan_m
 
         def forces(t, q, v, n_):
-            return np.asarray(self.forces(t, q.copy(), v.copy()), dtype=float).reshape(n)
+            if failure:
+                return nan_n
+            try:
+                return np.asarray(self.forces(t, q.copy(), v.copy()), dtype=float).reshape(n)
+            except BaseException as exc:
+                failed(exc)
+                return nan_n
 
         def phi(t, q, n_, mh_):
-            return np.asarray(self.phi(t, q.copy()), dtype=float).reshape(mh)
+            if failure:
+                return nan_h
+            try:
+                return np.asarray(self.phi(t, q.copy()), dtype=float).reshape(mh)
+            except BaseException as exc:
+                failed(exc)
+                return nan_h
 
         def jac(t, q, n_, mh_):
-            return np.asarray(self.jac(t, q.copy()), dtype=float).reshape(mh, n)
+            if failure:
+                return nan_g
+            try:
+                return np.asarray(self.jac(t, q.copy()), dtype=float).reshape(mh, n)
+            except BaseException as exc:
+                failed(exc)
+                return nan_g
 
         def gamma(t, q, v, n_, mh_):
-            return np.asarray(self.gamma(t, q.copy(), v.copy()), dtype=float).reshape(mh)
+            if failure:
+                return nan_h
+            try:
+                return np.asarray(self.gamma(t, q.copy(), v.copy()), dtype=float).reshape(mh)
+            except BaseException as exc:
+                failed(exc)
+                return nan_h
 
         def nh(t, q, n_, mn_):
-            a, b = self.nh(t, q.copy())
-            return (np.asarray(a, dtype=float).reshape(mn, n),
-                    np.asarray(b, dtype=float).reshape(mn))
+            if failure:
+                return nan_a, nan_b
+            try:
+                a, b = self.nh(t, q.copy())
+                return (np.asarray(a, dtype=float).reshape(mn, n),
+                        np.asarray(b, dtype=float).reshape(mn))
+            except BaseException as exc:
+                failed(exc)
+                return nan_a, nan_b
 
         def nh_gamma(t, q, v, n_, mn_):
-            return np.asarray(self.nh_gamma(t, q.copy(), v.copy()), dtype=float).reshape(mn)
+            if failure:
+                return nan_b
+            try:
+                return np.asarray(self.nh_gamma(t, q.copy(), v.copy()),
+                                  dtype=float).reshape(mn)
+            except BaseException as exc:
+                failed(exc)
+                return nan_b
 
         return mass, forces, phi, jac, gamma, nh, nh_gamma
 
@@ -281,7 +339,8 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         stats, moved, info, message = _conmech.flat_constrained_builtin(
             system.name, p.size, p if p.size else _PAD, store, **common)
     else:
-        cb = system._callbacks()
+        failure = []
+        cb = system._callbacks(failure)
         # probe the callables once, for clear shape errors
         m0 = np.asarray(system.mass(t0, q0.copy()))
         if m0.shape != (n, n):
@@ -294,6 +353,8 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
             cb[0], cb[1], cb[2], cb[3], cb[4], cb[5], cb[6], int(system.jac is not None),
             int(system.gamma is not None), int(system.nh_gamma is not None),
             int(system.rheonomic), system.n_hol, system.n_nh, store, **common)
+        if failure:
+            raise failure[0]
     message = bytes(message).decode("ascii", "replace").strip() \
         if not isinstance(message, str) else message.strip()
     info = int(info)

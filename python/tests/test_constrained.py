@@ -220,3 +220,24 @@ def test_constrained_factories_in_systems():
         assert r.success, (s, r.message)
         assert r.q.shape[0] == s.n and r.lam.shape[0] == s.n_hol + s.n_nh
         assert np.max(r.res_pos) < 1e-12 and np.max(r.res_vel) < 1e-12
+
+
+def test_callback_exception_in_constraints_is_reraised_unchanged():
+    calls = []
+
+    class Boom(Exception):
+        pass
+
+    def phi(t, q):
+        calls.append(t)
+        if len(calls) > 50:
+            raise Boom("phi failed")
+        return [0.5 * (q @ q - 1.0)]
+
+    sys = constrained.ConstrainedSystem(2, lambda t, q: np.eye(2),
+                                        lambda t, q, v: np.array([0.0, -G]), phi=phi,
+                                        n_hol=1)
+    with pytest.raises(Boom, match="phi failed"):
+        constrained.solve(sys, (0, 10), [1.0, 0.0], [0.0, 0.0])
+    n_calls = len(calls)
+    assert n_calls == 51      # not called again after the exception
