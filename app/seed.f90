@@ -1,7 +1,7 @@
 !> Run a named seed system and write its motion as CSV.
 !!
 !!     fpm run seed -- --system NAME [--t-end T] [--projection P] [--method M]
-!!                     [--rtol R] [--atol A] [--n-out N] [--every K]
+!!                     [--rtol R] [--atol A] [--step H (RK4)] [--n-out N] [--every K]
 !!                     [--params p1,p2,...] [--q0 ...] [--v0 ...] [--out file.csv]
 !!     fpm run seed -- --list
 !!
@@ -14,7 +14,7 @@ program seed
     implicit none
     character(len=:), allocatable :: name, proj_name, method_name, out, arg, val, msg
     real(dp), allocatable :: params(:), q0(:), v0(:), t_eval(:)
-    real(dp) :: t_end, rtol, atol
+    real(dp) :: t_end, rtol, atol, step
     integer :: n_out, every, i, info, nargs, unit
     logical :: have_q0, have_v0, is_constrained
     class(constrained_system), allocatable :: cs
@@ -25,6 +25,7 @@ program seed
     method_name = "DOP853"
     out = ""
     t_end = 10.0_dp
+    step = 1.0e-3_dp
     rtol = 1.0e-10_dp
     atol = 1.0e-10_dp
     n_out = 201
@@ -56,6 +57,8 @@ program seed
             proj_name = val
         case ("--method")
             method_name = val
+        case ("--step")
+            step = to_real(val, arg)
         case ("--rtol")
             rtol = to_real(val, arg)
         case ("--atol")
@@ -119,7 +122,7 @@ contains
         opt%ode%rtol = rtol
         opt%ode%atol = atol
         opt%ode%max_steps = 10000000
-        if (opt%ode%method == METHOD_RK4) opt%ode%first_step = 1.0e-3_dp
+        if (opt%ode%method == METHOD_RK4) opt%ode%first_step = step
         opt%projection = projection_from_name(proj_name)
         opt%every = every
         call constrained_solve(cs, [0.0_dp, t_end], q0, v0, opt, r, t_eval)
@@ -168,7 +171,7 @@ contains
         opt%rtol = rtol
         opt%atol = atol
         opt%max_steps = 10000000
-        if (opt%method == METHOD_RK4) opt%first_step = 1.0e-3_dp
+        if (opt%method == METHOD_RK4) opt%first_step = step
         call generalized_solve(gs, [0.0_dp, t_end], q0, v0, opt, r, t_eval)
         n = gs%ndof
         allocate (e(r%nt))
@@ -242,7 +245,7 @@ contains
         write (*, '(a)') "usage: seed --system NAME [--t-end T] [--projection none|velocity|"// &
             "position+velocity|baumgarte]"
         write (*, '(a)') "            [--method RK4|DOPRI5|DOP853] [--rtol R] [--atol A] "// &
-            "[--n-out N] [--every K]"
+            "[--step H] [--n-out N] [--every K]"
         write (*, '(a)') "            [--params p1,p2,..] [--q0 ..] [--v0 ..] [--out file.csv]"
         write (*, '(a)') "       seed --list"
     end subroutine usage

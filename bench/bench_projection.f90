@@ -35,8 +35,9 @@ program bench_projection
 
     write (*, '(a)') "# Cost of projection (DOP853)"
     write (*, '(a)') ""
-    write (*, '(a,f0.0,a,i0,a)') "t in [0, ", tend, "], gfortran (fpm --profile release), one "// &
-        "core; CPU time per step = best of ", 2*nrep + 1, " interleaved rounds (each round runs "// &
+    write (*, '(a,f0.0,a,i0,a)') "t in [0, ", tend, "], gfortran (fpm --profile release), "// &
+        "one core; CPU time per step = best of ", 2*nrep + 1, " interleaved rounds (each "// &
+        "round runs "// &
         "every stabilisation once). Ratios are to the unprojected DOP853 of the core "// &
         "integrator (ode_solve on the index-1 form), measured in the same process; 'none' "// &
         "is the constrained integrator's own loop without projection."
