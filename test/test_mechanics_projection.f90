@@ -85,6 +85,12 @@ program test_mechanics_projection
     ord = order_of(METHOD_DOP853, 0.2_dp, PROJ_POSITION_VELOCITY)
     call ts%check(ord > 7.4_dp .and. ord < 8.8_dp, "projected DOP853 has order 8 ("// &
                   fmt(ord)//")")
+    ! Verner 9(8) is not yet asymptotic at these steps on this problem (the core integrator
+    ! on the generalized pendulum shows ratios of 2^10.5 too): assert that projection does
+    ! not lower the order below 9.
+    ord = order_of(METHOD_VERNER98, 0.2_dp, PROJ_POSITION_VELOCITY)
+    call ts%check(ord > 8.5_dp .and. ord < 12.0_dp, "projected VERNER98: order >= 9 ("// &
+                  fmt(ord)//")")
     ord = order_of(METHOD_RK4, 0.04_dp, PROJ_NONE)
     call ts%check(ord > 3.7_dp .and. ord < 4.4_dp, "unprojected RK4 has order 4 ("// &
                   fmt(ord)//")")

@@ -29,7 +29,7 @@ BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_
                  "pendulum_moving_xy", "yoyo", "skate", "rolling_disk")
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
-_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3}
+_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
@@ -252,7 +252,7 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
     q0, v0 : array_like, optional
         Initial coordinates and velocities (built-ins: their default state if omitted).
         They are projected onto the constraints first; ``dq0``/``dv0`` say how far.
-    method : "RK4" (fixed step ``first_step``), "DOPRI5" or "DOP853"
+    method : "RK4" (fixed step ``first_step``), "DOPRI5", "DOP853" or "VERNER98"
     projection : "position+velocity" (default), "velocity", "baumgarte", "none"
     t_eval : array_like, optional
         Output times (sorted, inside t_span; the steps hit them exactly). Default: every

@@ -1,5 +1,5 @@
 !> Integrators for constrained mechanical systems: the index-1 form (accelerations from the
-!! KKT system) advanced by RK4 / DOPRI5 / DOP853, with
+!! KKT system) advanced by RK4 / DOPRI5 / DOP853 / Verner 9(8), with
 !! - no stabilisation (PROJ_NONE: the constraints drift, |phi| ~ h^p (A t + B t^2)),
 !! - velocity projection after each accepted step (PROJ_VELOCITY),
 !! - mass-weighted position projection (simplified Newton) then velocity projection
@@ -19,8 +19,9 @@ module conmech_constrained_solver
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
-    use conmech_ode_solver, only: ode_options, METHOD_RK4, METHOD_DOPRI5, METHOD_DOP853
-    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau
+    use conmech_ode_solver, only: ode_options, METHOD_RK4, METHOD_DOPRI5, METHOD_DOP853, &
+                                  METHOD_VERNER98
+    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, verner98_tableau
     use conmech_constrained_system
     implicit none
     private
@@ -199,7 +200,7 @@ contains
             res%message = "bad input: unknown projection"
             return
         end if
-        if (options%ode%method < METHOD_RK4 .or. options%ode%method > METHOD_DOP853) then
+        if (options%ode%method < METHOD_RK4 .or. options%ode%method > METHOD_VERNER98) then
             res%message = "bad input: unknown method"
             return
         end if
@@ -281,6 +282,11 @@ contains
             tab = dopri5_tableau()
             safe = 0.9_dp; facc1 = 1.0_dp/0.2_dp; facc2 = 1.0_dp/10.0_dp
             expo1 = 0.2_dp
+        case (METHOD_VERNER98)
+            adaptive = .true.
+            tab = verner98_tableau()
+            safe = 0.9_dp; facc1 = 1.0_dp/0.333_dp; facc2 = 1.0_dp/6.0_dp
+            expo1 = 1.0_dp/9.0_dp
         case default
             adaptive = .true.
             tab = dop853_tableau()
@@ -343,6 +349,8 @@ contains
                 call rk4_step()
             case (METHOD_DOPRI5)
                 call dopri5_step()
+            case (METHOD_VERNER98)
+                call verner_step()
             case default
                 call dop853_step()
             end select
@@ -385,7 +393,7 @@ contains
                 if (info /= CM_SUCCESS) exit
                 nf_new = 1
             end if
-            if (nf_new == 1 .or. .not. adaptive .or. options%ode%method == METHOD_DOP853) then
+            if (nf_new == 1 .or. options%ode%method /= METHOD_DOPRI5) then
                 call f%rhs(t, y, k(:, 1))
                 res%nfev = res%nfev + 1
             else
@@ -645,6 +653,23 @@ contains
             err = abs(h)*err5*sqrt(1.0_dp/(real(2*n, dp)*deno))
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dop853_step
+
+        subroutine verner_step()
+            integer :: j
+            call stages(2, 16)
+            ytmp = 0.0_dp
+            do j = 1, 15
+                if (tab%b(j) /= 0.0_dp) ytmp = ytmp + tab%b(j)*k(:, j)
+            end do
+            ynew = y + h*ytmp
+            ytmp = 0.0_dp
+            do j = 1, 16
+                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
+            end do
+            sk = atolv + rtolv*max(abs(y), abs(ynew))
+            err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(2*n, dp))
+            if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
+        end subroutine verner_step
 
     end subroutine constrained_solve
 
