@@ -241,3 +241,16 @@ def test_callback_exception_in_constraints_is_reraised_unchanged():
         constrained.solve(sys, (0, 10), [1.0, 0.0], [0.0, 0.0])
     n_calls = len(calls)
     assert n_calls == 51      # not called again after the exception
+
+
+@pytest.mark.parametrize("method", ["DOPRI5", "DOP853", "VERNER98"])
+def test_methods_agree(method):
+    t = np.linspace(0, 5, 11)
+    ref = constrained.solve("double_pendulum_xy", (0, 5), t_eval=t, rtol=1e-12, atol=1e-12)
+    r = constrained.solve("double_pendulum_xy", (0, 5), t_eval=t, method=method, rtol=1e-11,
+                          atol=1e-11)
+    assert r.success and np.max(np.abs(r.q - ref.q)) < 1e-7
+    assert np.max(r.res_pos) < 1e-13
+    rk = constrained.solve("double_pendulum_xy", (0, 5), t_eval=t, method="RK4",
+                           first_step=1e-3)
+    assert rk.success and np.max(np.abs(rk.q - ref.q)) < 1e-6
