@@ -209,6 +209,33 @@ program test_mechanics_systems
             e = max(e, abs((d(1)*cv(2) - d(2)*cv(1)) - 0.6_dp))
         end do
         call ts%check_less(e, 1.0e-10_dp, "rod: constant angular velocity (integrable motion)")
+        ! the centre speed along the rod: u' = -g sin(psi), psi = psi0 + w t, so
+        ! u(t) = u0 + (g/w)(cos psi - cos psi0)
+        e = 0.0_dp
+        do i = 1, cr%nt
+            d = cr%q(3:4, i) - cr%q(1:2, i)
+            cv = 0.5_dp*(cr%v(1:2, i) + cr%v(3:4, i))
+            ref = 1.0_dp + 9.81_dp/0.6_dp*(cos(0.5_dp + 0.6_dp*te(i)) - cos(0.5_dp))
+            e = max(e, abs(dot_product(cv, d) - ref))
+        end do
+        call ts%check_less(e, 1.0e-9_dp, "rod: centre speed u = u0 + (g/w)(cos psi - cos psi0)")
+    end block
+
+    ! ---------------------------------------------------------------- cart pendulum equilibria
+    block
+        class(ode_system), allocatable :: os
+        real(dp) :: jac(4, 4), wr(4), wi(4), g
+        g = 9.81_dp
+        call make_system("cart_pendulum", [1.0_dp, 1.0_dp, 1.0_dp, g], os, info, msg)
+        call os%jacobian(0.0_dp, [0.3_dp, 0.0_dp, 0.0_dp, 0.0_dp], jac)
+        call la_eig(jac, wr, wi, info)
+        call ts%check_close(maxval(wr), sqrt(2.0_dp*g), 1.0e-6_dp, &
+                            "cart pendulum upright: z'' = 2 g z (saddle, rate sqrt(2 g))")
+        call os%jacobian(0.0_dp, [0.3_dp, acos(-1.0_dp), 0.0_dp, 0.0_dp], jac)
+        call la_eig(jac, wr, wi, info)
+        call ts%check_close(maxval(wi), sqrt(2.0_dp*g), 1.0e-6_dp, &
+                            "cart pendulum hanging: z'' = -2 g z (centre, frequency sqrt(2 g))")
+        call ts%check_less(maxval(abs(wr)), 1.0e-6_dp, "cart pendulum hanging: no growth")
     end block
 
     ! ---------------------------------------------------------------- bead on a spinning hoop
