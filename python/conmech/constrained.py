@@ -42,8 +42,9 @@ class ConstrainedResult(dict):
     ``reaction`` (n, nt) = C^T lambda, ``res_pos`` (max |phi|) and ``res_vel``
     (max |C v + c0|) (nt,), ``energy`` (nt,) (zeros if the system defines none),
     ``power`` (nt,) of the reactions, ``nfev``, ``naccept``, ``nreject``, ``nproj``,
-    ``proj_iter``, ``rank`` (of the constraints; < m when redundant), ``dq0``, ``dv0``
-    (how far the initial state was moved), ``status`` (0 success, -1 failure),
+    ``proj_iter`` (total simplified Newton iterations), ``proj_iter_max``, ``rank`` (of
+    the constraints; < m when redundant), ``dq0``, ``dv0`` (how far the initial state was
+    moved), ``status`` (0 success, -1 failure),
     ``message``, ``success``.
     """
 
@@ -127,10 +128,12 @@ class ConstrainedSystem:
     n_nh : int
     rheonomic : bool
         phi depends explicitly on t.
+    energy : callable ``energy(t, q, v) -> float``, optional
+        Evaluated at the output points into ``result.energy``.
     """
 
     def __init__(self, n, mass, forces, phi=None, jac=None, gamma=None, n_hol=0, nh=None,
-                 nh_gamma=None, n_nh=0, rheonomic=False):
+                 nh_gamma=None, n_nh=0, rheonomic=False, energy=None):
         self.n, self.n_hol, self.n_nh = int(n), int(n_hol), int(n_nh)
         if self.n < 1:
             raise ValueError("n must be at least 1")
@@ -143,11 +146,13 @@ class ConstrainedSystem:
             raise TypeError("phi must be callable when n_hol > 0")
         if self.n_nh > 0 and not callable(nh):
             raise TypeError("nh must be callable when n_nh > 0")
-        for label, f in (("jac", jac), ("gamma", gamma), ("nh_gamma", nh_gamma)):
+        for label, f in (("jac", jac), ("gamma", gamma), ("nh_gamma", nh_gamma),
+                         ("energy", energy)):
             if f is not None and not callable(f):
                 raise TypeError(f"{label} must be callable or None")
         self.mass, self.forces, self.phi, self.jac, self.gamma = mass, forces, phi, jac, gamma
         self.nh, self.nh_gamma, self.rheonomic = nh, nh_gamma, bool(rheonomic)
+        self.energy = energy
 
     def _callbacks(self, failure):
         """The f2py callbacks. An exception raised by a user function is kept in
@@ -367,9 +372,13 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
                    res_pos=np.zeros(0), res_vel=np.zeros(0), energy=np.zeros(0),
                    power=np.zeros(0))
     out["lam"] = out["lam"][:m]
+    if isinstance(system, ConstrainedSystem) and system.energy is not None:
+        out["energy"] = np.array([float(system.energy(t, q.copy(), v.copy()))
+                                  for t, q, v in zip(out["t"], out["q"].T, out["v"].T)])
     res = ConstrainedResult(out)
     res.update(nfev=int(stats[0]), naccept=int(stats[1]), nreject=int(stats[2]),
                nproj=int(stats[3]), proj_iter=int(stats[4]), rank=int(stats[5]),
+               proj_iter_max=int(stats[6]),
                dq0=float(moved[0]), dv0=float(moved[1]), status=0 if info >= 0 else -1,
                message=message, success=info >= 0, info=info)
     return res

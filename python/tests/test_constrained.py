@@ -20,7 +20,7 @@ def ellipk_agm(k):
 
 
 def pendulum_callables(m=1.0, l=1.0, with_jac=True):
-    kw = dict(n=2, n_hol=1,
+    kw = dict(n=2, n_hol=1, energy=lambda t, q, v: 0.5 * m * (v @ v) + m * G * q[1],
               mass=lambda t, q: m * np.eye(2),
               forces=lambda t, q, v: np.array([0.0, -m * G]),
               phi=lambda t, q: [0.5 * (q @ q - l * l)])
@@ -68,6 +68,8 @@ def test_user_callables_match_builtin():
         ru = constrained.solve(pendulum_callables(with_jac=with_jac), (0, 5), q0, v0,
                                t_eval=t_eval, rtol=1e-11, atol=1e-11)
         assert ru.success
+        assert np.max(np.abs(ru.energy - rb.energy)) < 1e-8     # the callable energy
+        assert 1 <= ru.proj_iter_max <= 3
         assert np.max(np.abs(ru.q - rb.q)) < 1e-8
         assert np.max(np.abs(ru.lam - rb.lam)) < 1e-7
 

@@ -68,8 +68,8 @@ end subroutine flat_mech_initial_state
 
 !> Solve the built-in constrained system `name` (params as in conmech_systems_mech).
 !! iopt = [projection, every, proj_max_iter, max_steps]; ropt = [first_step, max_step,
-!! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank];
-!! moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
+!! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank,
+!! proj_iter_max]; moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
 subroutine flat_constrained_builtin(name, np, params, store, n, t_span, q0, v0, method, &
                                     rtol, atol, iopt, ropt, neval, t_eval, stats, moved, &
                                     info, message)
@@ -92,7 +92,7 @@ subroutine flat_constrained_builtin(name, np, params, store, n, t_span, q0, v0, 
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(out) :: stats(6)
+    integer(c_int), intent(out) :: stats(7)
     real(c_double), intent(out) :: moved(2)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
@@ -142,7 +142,7 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(out) :: stats(6)
+    integer(c_int), intent(out) :: stats(7)
     real(c_double), intent(out) :: moved(2)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message

@@ -136,7 +136,8 @@ contains
     !> Run `constrained_solve` from plain arguments; the result goes to `store`.
     !! first_step 0: automatic; neval 0: output at every accepted step. iopt(1:4) =
     !! [projection, every, proj_max_iter, max_steps]; ropt(1:5) = [first_step, max_step,
-    !! alpha, beta, proj_tol]. stats(1:6) = [nfev, naccept, nreject, nproj, proj_iter, rank];
+    !! alpha, beta, proj_tol]. stats(1:7) = [nfev, naccept, nreject, nproj, proj_iter, rank,
+    !! proj_iter_max];
     !! moved(1:2) = [dq0, dv0].
     subroutine run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, &
                                neval, t_eval, store, stats, moved, info, message)
@@ -150,7 +151,7 @@ contains
         integer(c_int), intent(in) :: neval
         real(c_double), intent(in) :: t_eval(max(neval, 1))
         external :: store
-        integer(c_int), intent(out) :: stats(6)
+        integer(c_int), intent(out) :: stats(7)
         real(c_double), intent(out) :: moved(2)
         integer(c_int), intent(out) :: info
         character(len=*), intent(out) :: message
@@ -185,7 +186,7 @@ contains
         end if
         info = r%status
         call copy_message(r%message, message)
-        stats = [r%nfev, r%naccept, r%nreject, r%nproj, r%proj_iter, r%rank]
+        stats = [r%nfev, r%naccept, r%nreject, r%nproj, r%proj_iter, r%rank, r%proj_iter_max]
         moved = [r%dq0, r%dv0]
         m = sys%n_hol + sys%n_nh
         mm = max(m, 1)
