@@ -256,6 +256,15 @@ program test_mechanics_systems
                            "bead: oscillation about th* at W sin th* (full period)")
         call generalized_accel(gs, 0.0_dp, [0.1_dp], [0.0_dp], a, info, msg)
         call ts%check(a(1) > 0.0_dp, "bead: th = 0 unstable when W^2 > g/R (pushed away)")
+        call make_generalized("bead_hoop", [1.0_dp, rr, 0.5_dp*sqrt(g/rr), g], gs, info, msg)
+        call generalized_accel(gs, 0.0_dp, [0.1_dp], [0.0_dp], a, info, msg)
+        call ts%check(a(1) < 0.0_dp, "bead: th = 0 restoring when W^2 < g/R")
+        ! and then th = 0 oscillates at sqrt(g/R - W^2)
+        wsmall = sqrt(g/rr - 0.25_dp*g/rr)
+        tt = [0.0_dp, acos(-1.0_dp)/wsmall, 2.0_dp*acos(-1.0_dp)/wsmall]
+        call generalized_solve(gs, [0.0_dp, tt(3)], [eps], [0.0_dp], gopt, r, tt)
+        call ts%check_less(abs(r%y(1, 2) + eps), 1.0e-3_dp*eps, &
+                           "bead: small oscillation about 0 at sqrt(g/R - W^2)")
     end block
 
     ! ---------------------------------------------------------------- energies and momenta
