@@ -21,7 +21,21 @@ module test_mech_pendulum_types
         procedure :: phi => fd_phi
     end type pendulum_fd
 
+    !> theta = 0 crossings of the generalized pendulum (y = [theta, theta']).
+    type, extends(ode_events) :: bottom_crossing
+    contains
+        procedure :: eval => bottom_eval
+    end type bottom_crossing
+
 contains
+
+    subroutine bottom_eval(self, t, y, g)
+        class(bottom_crossing), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: g(:)
+        g(1) = y(1)
+    end subroutine bottom_eval
 
     subroutine tw_phi(self, t, q, c)
         class(pendulum_twice), intent(in) :: self
@@ -159,6 +173,20 @@ program test_mechanics_pendulum
     call ts%check_close(cr%q(1, 11), -l*sin(th0), 1.0e-10_dp, "x(T/2) = -l sin theta0")
     ! a wrong K would be seen: a 1e-6 relative change of T moves th(T/2) by > 1e-6
     call ts%check(abs(gr%y(2, 11)) < 1.0e-9_dp, "velocity zero at T/2 (turning point)")
+
+    ! events through generalized_solve: the bob passes the bottom at T/4 and 3T/4
+    block
+        type(bottom_crossing) :: ev
+        type(ode_result) :: er
+        ev%direction = [0]
+        ev%terminal = [.false.]
+        call generalized_solve(gs, [0.0_dp, period], [th0], [0.0_dp], gopt, er, events=ev)
+        call ts%check(er%nev == 2, "events: two bottom passages per period")
+        if (er%nev == 2) then
+            call ts%check_close(er%ev_t(1), 0.25_dp*period, 1.0e-9_dp, "event at T/4")
+            call ts%check_close(er%ev_t(2), 0.75_dp*period, 1.0e-9_dp, "event at 3T/4")
+        end if
+    end block
 
     ! ---------------------------------------------------------------- redundant constraints
     block

@@ -16,7 +16,7 @@ module conmech_generalized
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_lapack, only: dpotrf, dpotf2, dpotrs
-    use conmech_ode_system, only: ode_system
+    use conmech_ode_system, only: ode_system, ode_events
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     implicit none
     private
@@ -162,15 +162,16 @@ contains
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine genode_rhs
 
-    !> Solve M q'' = Q from (q0, v0) on t_span with `ode_solve`; res%y = [q; v].
-    !! Checks the dimensions and the mass matrix at the initial point first.
-    subroutine generalized_solve(mech, t_span, q0, v0, options, res, t_eval)
+    !> Solve M q'' = Q from (q0, v0) on t_span with `ode_solve`; res%y = [q; v] (events
+    !! see y = [q; v] too). Checks the dimensions and the mass matrix at the start first.
+    subroutine generalized_solve(mech, t_span, q0, v0, options, res, t_eval, events)
         class(generalized_system), intent(in) :: mech
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: q0(:), v0(:)
         type(ode_options), intent(in) :: options
         type(ode_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
+        class(ode_events), intent(in), optional :: events
         type(generalized_ode) :: sys
         real(dp), allocatable :: a(:)
         integer :: info
@@ -190,7 +191,7 @@ contains
             return
         end if
         allocate (sys%mech, source=mech)
-        call ode_solve(sys, t_span, [q0, v0], options, res, t_eval)
+        call ode_solve(sys, t_span, [q0, v0], options, res, t_eval, events)
     end subroutine generalized_solve
 
 end module conmech_generalized
