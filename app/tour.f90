@@ -9,6 +9,7 @@ program tour
     write (*, '(a)') "============"
     call pendulum_part()
     call kepler_part()
+    call hill_part()
 
 contains
 
@@ -75,5 +76,30 @@ contains
             end associate
         end do
     end subroutine kepler_part
+
+    subroutine hill_part()
+        type(hill_orbit) :: orb
+        real(dp), parameter :: m_hill = 0.080848933808312_dp
+        real(dp), parameter :: c_hill = 1.0715832774160_dp
+        integer :: i
+        call hill_variation_orbit(m_hill, 1.0_dp, orb)
+        write (*, '(/,a)') "Hill's lunar problem, variation orbit at Hill's m = 0.080848933808312"
+        if (orb%info /= CM_SUCCESS) then
+            write (*, '(a)') "  failed: "//orb%message
+            return
+        end if
+        write (*, '(a,2f20.16)') "  x0, y'0                  ", orb%y0(1), orb%y0(4)
+        write (*, '(a,f20.16)') "  Jacobi constant          ", orb%jacobi
+        write (*, '(a)') "  Floquet multipliers of the monodromy matrix (the pair at 1 is the trivial"
+        write (*, '(a)') "  Jordan block, accurate only to ~sqrt(eps); stability is read from the trace):"
+        do i = 1, 4
+            write (*, '(4x,f19.15,sp,f19.15,"i")') orb%mr(i), orb%mi(i)
+        end do
+        write (*, '(a,f20.16)') "  stability index S        ", orb%stability_index
+        write (*, '(a,f20.16)') "  perigee constant c       ", orb%c
+        write (*, '(a,f20.16,a,es9.2)') "  Hill (1877)              ", c_hill, &
+            "   difference", abs(orb%c - c_hill)
+        write (*, '(a,i0,a,i0)') "  Newton iterations ", orb%iterations, ", nfev ", orb%nfev
+    end subroutine hill_part
 
 end program tour

@@ -9,6 +9,12 @@ module conmech
     use conmech_ode_solver
     use conmech_systems_basic
     use conmech_systems
+    use conmech_hill
+    use conmech_equilibria
+    use conmech_variational
+    use conmech_floquet
+    use conmech_shooting
+    use conmech_hill_orbit
     implicit none
     public
 end module conmech

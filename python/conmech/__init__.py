@@ -7,7 +7,8 @@ numpy.f2py + meson-python). The integrators follow SciPy's names::
     sol = conmech.solve_ivp(conmech.systems.kepler(), (0, 10), [1, 0, 0, 1], rtol=1e-10)
 """
 from . import systems
+from . import hill, stability
 from ._ivp import DenseOutput, OdeResult, solve_ivp
 
-__all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems"]
+__all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability"]
 __version__ = "0.1.0"

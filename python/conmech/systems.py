@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _conmech
 
-__all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol"]
+__all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill"]
 
 
 class BuiltinSystem:
@@ -83,3 +83,9 @@ def arenstorf(mu=0.012277471):
 def vanderpol(mu=1.0):
     """Van der Pol oscillator x'' = mu (1 - x^2) x' - x; y = [x, x']."""
     return BuiltinSystem("vanderpol", [mu], ("mu",))
+
+
+def hill(m=0.080848933808312, kappa=1.0):
+    """Hill's lunar problem x'' - 2 m y' = F_x, y'' + 2 m x' = F_y,
+    F = kappa/r + (3/2) m^2 x^2; y = [x, y, x', y'] (analytic Jacobian)."""
+    return BuiltinSystem("hill", [m, kappa], ("m", "kappa"))

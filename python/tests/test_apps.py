@@ -50,6 +50,8 @@ def test_tour_runs_and_shows_the_pendulum_period():
     num = float(next(l for l in lines if "period from events" in l).split()[-1])
     exact = float(next(l for l in lines if "K(sin 1)" in l).split()[-1])
     assert abs(num - exact) < 1e-9
+    c = float(next(l for l in lines if "perigee constant c" in l).split()[-1])
+    assert abs(c - 1.0715832774160) < 1e-12
 
 
 def test_sweep_return_times_are_pendulum_periods(serial_sweep):

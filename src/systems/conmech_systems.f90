@@ -8,6 +8,7 @@ module conmech_systems
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_systems_basic
+    use conmech_hill, only: hill_problem
     implicit none
     private
     public :: make_system, system_dimension
@@ -16,6 +17,7 @@ contains
 
     !> Allocate a built-in system by name. Parameters (in order):
     !! harmonic: omega | pendulum: g, l | kepler: mu | arenstorf: mu | vanderpol: mu
+    !! | hill: m, kappa
     subroutine make_system(name, params, sys, info, msg)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
@@ -56,6 +58,13 @@ contains
                 if (size(params) >= 1) s%mu = params(1)
                 allocate (sys, source=s)
             end block
+        case ("hill")
+            block
+                type(hill_problem) :: s
+                if (size(params) >= 1) s%m = params(1)
+                if (size(params) >= 2) s%kappa = params(2)
+                allocate (sys, source=s)
+            end block
         case default
             info = CM_BAD_INPUT
             msg = "bad input: unknown built-in system '"//trim(name)//"'"
@@ -68,7 +77,7 @@ contains
         select case (trim(name))
         case ("harmonic", "pendulum", "vanderpol")
             n = 2
-        case ("kepler", "arenstorf")
+        case ("kepler", "arenstorf", "hill")
             n = 4
         case default
             n = 0

@@ -1,0 +1,367 @@
+!> Flat f2py layer of the stability layer: Hill's variation orbit and family, transverse
+!! linearisation, equilibria, state transition matrices, periodic orbits (general and
+!! symmetric shooting) for built-in systems (by name) and Python callbacks, Hill's equation.
+!! Plain subroutines, c_double/c_int explicit-shape arrays, an `info` code and a message.
+!! Nothing is saved between calls; nothing stops or prints.
+!!
+!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n); phi(t, p) for Hill's
+!! equation.
+
+!> Hill's variation orbit with its monodromy (see conmech_hill_orbit).
+!! use_guess /= 0: Newton starts from guess = (x0, v0). full_period /= 0: monodromy by
+!! direct integration over 2 pi instead of the symmetry.
+subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, y0, period, &
+                           jacobi, mono, mr, mi, s, c, residual, iterations, nfev, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
+    implicit none
+    real(c_double), intent(in) :: m, kappa
+    integer(c_int), intent(in) :: nsteps, full_period, use_guess
+    real(c_double), intent(in) :: guess(2)
+    real(c_double), intent(out) :: y0(4), period, jacobi, mono(4, 4), mr(4), mi(4), s, c
+    real(c_double), intent(out) :: residual
+    integer(c_int), intent(out) :: iterations, nfev, info
+    character(len=256), intent(out) :: message
+    type(hill_orbit) :: orb
+    type(hill_orbit_options) :: opt
+    if (nsteps > 0) opt%nsteps = nsteps
+    opt%full_period = full_period /= 0
+    if (use_guess /= 0) then
+        call hill_variation_orbit(m, kappa, orb, opt, guess)
+    else
+        call hill_variation_orbit(m, kappa, orb, opt)
+    end if
+    y0 = orb%y0
+    period = orb%period
+    jacobi = orb%jacobi
+    mono = orb%monodromy
+    mr = orb%mr
+    mi = orb%mi
+    s = orb%stability_index
+    c = orb%c
+    residual = orb%residual
+    iterations = orb%iterations
+    nfev = orb%nfev
+    info = orb%info
+    message = orb%message
+end subroutine flat_hill_orbit
+
+!> The family of variation orbits over ms(nm) by continuation (see hill_family).
+subroutine flat_hill_family(nm, ms, kappa, nsteps, y0s, jacobis, monos, ss, cs, infos, iters)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_family
+    implicit none
+    integer(c_int), intent(in) :: nm
+    real(c_double), intent(in) :: ms(nm), kappa
+    integer(c_int), intent(in) :: nsteps
+    real(c_double), intent(out) :: y0s(4, nm), jacobis(nm), monos(4, 4, nm), ss(nm), cs(nm)
+    integer(c_int), intent(out) :: infos(nm), iters(nm)
+    type(hill_orbit), allocatable :: orbs(:)
+    type(hill_orbit_options) :: opt
+    integer :: i
+    if (nsteps > 0) opt%nsteps = nsteps
+    opt%eigenvalues = .false.
+    allocate (orbs(nm))
+    call hill_family(ms, kappa, orbs, opt)
+    do i = 1, nm
+        y0s(:, i) = orbs(i)%y0
+        jacobis(i) = orbs(i)%jacobi
+        monos(:, :, i) = orbs(i)%monodromy
+        ss(i) = orbs(i)%stability_index
+        cs(i) = orbs(i)%c
+        infos(i) = orbs(i)%info
+        iters(i) = orbs(i)%iterations
+    end do
+end subroutine flat_hill_family
+
+!> Transverse linearisation along the variation orbit starting at y0: 2x2 monodromy of
+!! N'' + Phi N = 0 over 2 pi, its half trace and c; Phi and the orbit at the times t(nt).
+subroutine flat_hill_transverse(m, kappa, y0, rtol, nt, t, states, phi, mono2, half_trace, &
+                                c, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: pi
+    use conmech_status, only: CM_SUCCESS
+    use conmech_hill_orbit, only: hill_orbit, hill_transverse, hill_transverse_result, &
+                                  hill_orbit_sample
+    implicit none
+    real(c_double), intent(in) :: m, kappa, y0(4), rtol
+    integer(c_int), intent(in) :: nt
+    real(c_double), intent(in) :: t(nt)
+    real(c_double), intent(out) :: states(4, nt), phi(nt), mono2(2, 2), half_trace, c
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    type(hill_orbit) :: orb
+    type(hill_transverse_result) :: tr
+    integer :: inf
+    orb%m = m
+    orb%kappa = kappa
+    orb%y0 = y0
+    orb%period = 2.0_c_double*pi
+    orb%info = CM_SUCCESS
+    call hill_transverse(orb, tr, rtol)
+    info = tr%info
+    message = tr%message
+    mono2 = tr%monodromy
+    half_trace = tr%half_trace
+    c = tr%c
+    states = 0.0_c_double
+    phi = 0.0_c_double
+    if (info /= CM_SUCCESS .or. nt < 1) return
+    call hill_orbit_sample(orb, t, states, phi, inf)
+    if (inf /= CM_SUCCESS) then
+        info = inf
+        message = "sampling the orbit failed"
+    end if
+end subroutine flat_hill_transverse
+
+!> Equilibrium analysis of a built-in system at y.
+subroutine flat_equilibrium_builtin(name, np, params, n, y, t, tol, jac, wr, wi, kind, saddle, &
+                                    residual, analytic, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_systems, only: make_system
+    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
+    use conmech_support_stab, only: unpack_eq
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n
+    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual
+    integer(c_int), intent(out) :: kind, saddle, analytic, info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    type(equilibrium_result) :: e
+    character(len=:), allocatable :: msg
+    call make_system(name, params(1:np), sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call analyze_equilibrium(sys, y, e, t, tol)
+    call unpack_eq(e, n, jac, wr, wi, kind, saddle, residual, analytic, info, message)
+end subroutine flat_equilibrium_builtin
+
+!> Equilibrium analysis of a Python right-hand side fun(t, y, dydt, n) (FD Jacobian).
+subroutine flat_equilibrium_callback(fun, n, y, t, tol, jac, wr, wi, kind, saddle, residual, &
+                                     analytic, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
+    use conmech_support_stab, only: unpack_eq
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y(n), t, tol
+    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual
+    integer(c_int), intent(out) :: kind, saddle, analytic, info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    type(equilibrium_result) :: e
+    sys%f => fun
+    sys%n = n
+    call analyze_equilibrium(sys, y, e, t, tol)
+    call unpack_eq(e, n, jac, wr, wi, kind, saddle, residual, analytic, info, message)
+end subroutine flat_equilibrium_callback
+
+!> Lagrange-Dirichlet test on a symmetric Hessian (dsyev).
+subroutine flat_lagrange_dirichlet(n, hess, tol, stable, w, info)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_equilibria, only: lagrange_dirichlet
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: hess(n, n), tol
+    integer(c_int), intent(out) :: stable, info
+    real(c_double), intent(out) :: w(n)
+    logical :: st
+    call lagrange_dirichlet(hess, st, w, info, tol)
+    stable = merge(1, 0, st)
+end subroutine flat_lagrange_dirichlet
+
+!> Periodic orbit of a built-in system: general shooting (kind 1; mode 1 free period, 2 fixed
+!! period) or symmetric shooting (kind 2; free_idx(nfree), targets(ntg) one-based, tau = period
+!! guess / period_factor, free_time /= 0). Returns y0, period, monodromy and multipliers.
+subroutine flat_orbit_builtin(name, np, params, n, y0, period, kind, mode, nfree, free_idx, ntg, &
+                              targets, free_time, period_factor, rtol, atol, max_iter, y0_out, &
+                              period_out, mono, mr, mi, residual, iterations, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_systems, only: make_system
+    use conmech_support_stab, only: run_orbit
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n, kind, mode, nfree, ntg, free_time, max_iter
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, period_factor, rtol, atol
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), residual
+    integer(c_int), intent(out) :: iterations, info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    call make_system(name, params(1:np), sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call run_orbit(sys, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, free_time, &
+                   period_factor, rtol, atol, max_iter, y0_out, period_out, mono, mr, mi, &
+                   residual, iterations, info, message)
+end subroutine flat_orbit_builtin
+
+!> As flat_orbit_builtin for a Python right-hand side fun(t, y, dydt, n) (FD Jacobian).
+subroutine flat_orbit_callback(fun, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, &
+                               free_time, period_factor, rtol, atol, max_iter, y0_out, &
+                               period_out, mono, mr, mi, residual, iterations, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_support_stab, only: run_orbit
+    implicit none
+    integer(c_int), intent(in) :: n, kind, mode, nfree, ntg, free_time, max_iter
+    real(c_double), intent(in) :: y0(n), period, period_factor, rtol, atol
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), residual
+    integer(c_int), intent(out) :: iterations, info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    sys%f => fun
+    sys%n = n
+    call run_orbit(sys, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, free_time, &
+                   period_factor, rtol, atol, max_iter, y0_out, period_out, mono, mr, mi, &
+                   residual, iterations, info, message)
+end subroutine flat_orbit_callback
+
+!> State and state transition matrix of a built-in system from t0 to t1 (DOP853).
+subroutine flat_stm_builtin(name, np, params, n, y0, t0, t1, rtol, atol, y1, phi, nfev, info, &
+                            message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: ode_options, ode_stats
+    use conmech_systems, only: make_system
+    use conmech_variational, only: integrate_stm
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), t0, t1, rtol, atol
+    real(c_double), intent(out) :: y1(n), phi(n, n)
+    integer(c_int), intent(out) :: nfev, info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    type(ode_options) :: opt
+    type(ode_stats) :: st
+    integer :: i
+    nfev = 0
+    y1 = y0
+    phi = 0.0_c_double
+    do i = 1, n
+        phi(i, i) = 1.0_c_double
+    end do
+    call make_system(name, params(1:np), sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    opt%rtol = rtol
+    opt%atol = atol
+    call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
+    nfev = st%nfev
+    message = msg
+end subroutine flat_stm_builtin
+
+!> State and STM for a Python right-hand side (FD Jacobian).
+subroutine flat_stm_callback(fun, n, y0, t0, t1, rtol, atol, y1, phi, nfev, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_solver, only: ode_options, ode_stats
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_variational, only: integrate_stm
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y0(n), t0, t1, rtol, atol
+    real(c_double), intent(out) :: y1(n), phi(n, n)
+    integer(c_int), intent(out) :: nfev, info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    type(ode_options) :: opt
+    type(ode_stats) :: st
+    character(len=:), allocatable :: msg
+    integer :: i
+    sys%f => fun
+    sys%n = n
+    y1 = y0
+    phi = 0.0_c_double
+    do i = 1, n
+        phi(i, i) = 1.0_c_double
+    end do
+    opt%rtol = rtol
+    opt%atol = atol
+    call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
+    nfev = st%nfev
+    message = msg
+end subroutine flat_stm_callback
+
+!> Hill's equation N'' + Phi(t) N = 0 with Phi given by ns samples over one period.
+subroutine flat_hill_equation_samples(ns, p, period, rtol, mono, half_trace, det, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_floquet, only: hill_result, hill_solve_samples
+    implicit none
+    integer(c_int), intent(in) :: ns
+    real(c_double), intent(in) :: p(ns), period, rtol
+    real(c_double), intent(out) :: mono(2, 2), half_trace, det
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    type(hill_result) :: r
+    call hill_solve_samples(p, period, r, rtol)
+    mono = r%monodromy
+    half_trace = r%half_trace
+    det = r%det
+    info = r%info
+    message = r%message
+end subroutine flat_hill_equation_samples
+
+!> Hill's equation with Phi(t) a Python callback phi(t, p).
+subroutine flat_hill_equation_callback(phi, period, rtol, mono, half_trace, det, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_support_stab, only: callback_hill_solve
+    implicit none
+    real(c_double), intent(in) :: period, rtol
+    real(c_double), intent(out) :: mono(2, 2), half_trace, det
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external phi
+    interface
+        subroutine phi(t, p)
+            use, intrinsic :: iso_c_binding, only: c_double
+            real(c_double), intent(in) :: t
+            real(c_double), intent(out) :: p
+        end subroutine phi
+    end interface
+    call callback_hill_solve(phi, period, rtol, mono, half_trace, det, info, message)
+end subroutine flat_hill_equation_callback

@@ -1,0 +1,226 @@
+"""Hill's lunar problem and the stability layer through the Python API."""
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import fsolve
+from scipy.special import mathieu_a, mathieu_b
+
+import conmech
+from conmech import hill, stability, systems
+
+
+# ----------------------------------------------------------------------------- Hill
+
+def test_perigee_constant_at_hills_m():
+    orb = hill.variation_orbit(hill.M_HILL)
+    assert abs(orb.c - hill.C_HILL) <= 1e-12
+    assert orb.period == pytest.approx(2*np.pi, abs=0)
+    assert orb.monodromy.shape == (4, 4)
+    assert np.linalg.det(orb.monodromy) == pytest.approx(1.0, abs=1e-12)
+    assert orb.stable and abs(orb.stability_index) < 1
+    # non-trivial multipliers exp(+-2 pi i c), on the unit circle
+    mu = orb.multipliers[np.argsort(-np.abs(orb.multipliers.imag))][:2]
+    assert np.allclose(np.abs(mu), 1.0, atol=1e-12)
+    assert np.allclose(np.sort(mu.imag), [-np.sin(2*np.pi*orb.c), np.sin(2*np.pi*orb.c)],
+                       atol=1e-11)
+
+
+def test_direct_full_period_agrees():
+    a = hill.variation_orbit(hill.M_HILL)
+    b = hill.variation_orbit(hill.M_HILL, full_period=True)
+    assert abs(b.c - hill.C_HILL) <= 1e-12
+    assert np.max(np.abs(a.monodromy - b.monodromy)) < 1e-10
+
+
+def test_against_scipy_shooting():
+    """An independent reference: SciPy's DOP853 on the variational equations + fsolve."""
+    m = hill.M_HILL
+    ref = _scipy_orbit(m)
+    orb = hill.variation_orbit(m)
+    assert np.allclose(orb.y0[[0, 3]], ref["u"], atol=1e-10)
+    assert abs(orb.c - ref["c"]) < 1e-9
+
+
+def test_transverse_hill_equation():
+    orb = hill.variation_orbit(hill.M_HILL)
+    tr = hill.transverse(orb, t=np.linspace(0, np.pi, 64, endpoint=False))
+    assert abs(tr["c"] - hill.C_HILL) < 1e-11
+    assert tr["half_trace"] == pytest.approx(orb.stability_index, abs=1e-11)
+    assert np.linalg.det(tr["monodromy"]) == pytest.approx(1.0, abs=1e-11)
+    # Phi has period pi: its samples into the general Hill's-equation solver
+    res = stability.hill_equation(tr["phi"], np.pi)
+    half_trace_2pi = 2*res.half_trace**2 - 1
+    assert 1 + np.arccos(half_trace_2pi)/(2*np.pi) == pytest.approx(hill.C_HILL, abs=1e-9)
+
+
+def test_family_continuation():
+    ms = np.linspace(0.02, 0.13, 300)
+    fam = hill.family(ms)
+    assert np.all(fam.success)
+    assert np.all(np.diff(fam.c) > 0)
+    assert np.all(np.abs(fam.stability_index) < 1)
+    one = hill.variation_orbit(ms[123])
+    assert fam.c[123] == pytest.approx(one.c, abs=1e-13)
+    assert np.max(fam.iterations[3:]) <= 2
+
+
+def test_hill_bad_input():
+    with pytest.raises(ValueError, match="m"):
+        hill.variation_orbit(-0.1)
+    with pytest.raises(ValueError, match="kappa"):
+        hill.variation_orbit(0.08, kappa=0.0)
+    with pytest.raises(TypeError):
+        hill.variation_orbit("x")
+    with pytest.raises(RuntimeError, match="converge"):
+        hill.variation_orbit(hill.M_HILL, guess=(5.0, 5.0))
+    with pytest.raises(RuntimeError, match="another periodic orbit"):
+        hill.variation_orbit(hill.M_HILL, guess=(0.95, -0.95))
+    with pytest.raises(ValueError):
+        hill.family([])
+
+
+def test_plots(tmp_path):
+    mpl = pytest.importorskip("matplotlib")
+    mpl.use("Agg")
+    import matplotlib.pyplot as plt
+    orb = hill.variation_orbit(hill.M_HILL)
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
+    hill.plot_orbit(orb, axes[0])
+    hill.plot_multipliers(orb, axes[1])
+    hill.plot_family(hill.family(np.linspace(0.01, 0.15, 50)), axes[2])
+    fig.savefig(tmp_path / "hill.png")
+    plt.close(fig)
+    assert (tmp_path / "hill.png").stat().st_size > 1000
+
+
+# ------------------------------------------------------------------- Mathieu vs SciPy
+
+@pytest.mark.parametrize("q", [0.5, 1.0, 3.0])
+def test_mathieu_boundaries(q):
+    """y'' + (a - 2 q cos 2t) y = 0: stable/unstable on either side of SciPy's
+    characteristic values a_r(q), b_r(q); half trace +-1 on them."""
+    def solve(a):
+        return stability.hill_equation(lambda t: a - 2*q*np.cos(2*t), np.pi, rtol=1e-13)
+    d = 1e-5
+    cases = [(mathieu_a(0, q), 1, False, True), (mathieu_b(1, q), -1, True, False),
+             (mathieu_a(1, q), -1, False, True), (mathieu_b(2, q), 1, True, False),
+             (mathieu_a(2, q), 1, False, True)]
+    for a, edge, below, above in cases:
+        assert solve(a).half_trace == pytest.approx(edge, abs=1e-8)
+        assert solve(a - d).stable is below
+        assert solve(a + d).stable is above
+
+
+def test_hill_equation_samples_and_bad_input():
+    q, a = 2.0, 3.0
+    f = stability.hill_equation(lambda t: a - 2*q*np.cos(2*t), np.pi)
+    t = np.arange(32)*np.pi/32
+    s = stability.hill_equation(a - 2*q*np.cos(2*t), np.pi)
+    assert np.allclose(f.monodromy, s.monodromy, atol=1e-9)
+    with pytest.raises(ValueError):
+        stability.hill_equation([1.0, 2.0], np.pi)
+    with pytest.raises(ValueError):
+        stability.hill_equation(lambda t: 1.0, -1.0)
+
+
+# ------------------------------------------------------------------------- stability
+
+def test_equilibria():
+    g = 9.81
+    e = stability.equilibrium(systems.pendulum(g=g), [0, 0])
+    assert e.kind == "centre" and e.analytic
+    assert np.max(e.eigenvalues.imag) == pytest.approx(np.sqrt(g), abs=1e-12)
+    e = stability.equilibrium(systems.pendulum(g=g), [np.pi, 0])
+    assert e.kind == "unstable" and e.saddle
+
+    def cart(t, y):   # reduced cart-pendulum dynamics (seed 000)
+        th, w = y
+        return [w, (g*np.sin(th) - 0.5*np.cos(th)*np.sin(th)*w**2)/(1 - 0.5*np.cos(th)**2)]
+    up = stability.equilibrium(cart, [0, 0])
+    down = stability.equilibrium(cart, [np.pi, 0])
+    assert up.kind == "unstable" and not up.analytic
+    assert np.max(up.eigenvalues.real) == pytest.approx(np.sqrt(2*g), rel=1e-8)
+    assert down.kind == "centre"
+    assert np.max(down.eigenvalues.imag) == pytest.approx(np.sqrt(2*g), rel=1e-8)
+    xe = (1/(3*hill.M_HILL**2))**(1/3)
+    e = stability.equilibrium(systems.hill(), [xe, 0, 0, 0])
+    assert e.kind == "unstable" and e.saddle and e.residual < 1e-12
+
+
+def test_lagrange_dirichlet():
+    ok, w = stability.lagrange_dirichlet([[2.0, 0.5], [0.5, 1.0]])
+    assert ok and np.all(w > 0)
+    ok, w = stability.lagrange_dirichlet([[-2.0, 0.5], [0.5, 1.0]])
+    assert not ok
+    with pytest.raises(ValueError):
+        stability.lagrange_dirichlet([[1.0, 1.0], [0.0, 1.0]])
+
+
+def test_periodic_orbits_builtin_and_callback():
+    vdp = stability.periodic_orbit(systems.vanderpol(1.0), [2, 0], 6.5)
+    assert vdp.period == pytest.approx(6.663286859323130, abs=1e-9)
+    cb = stability.periodic_orbit(lambda t, y: [y[1], (1 - y[0]**2)*y[1] - y[0]], [2, 0], 6.5)
+    assert cb.period == pytest.approx(vdp.period, abs=1e-8)
+    assert np.min(np.abs(vdp.multipliers)) < 0.01
+    sym = stability.symmetric_orbit(systems.hill(), [0.95, 0, 0, 0.95], [0, 3], [0, 3],
+                                    2*np.pi, period_factor=4)
+    assert 1 + np.arccos(sym.stability_index)/(2*np.pi) == pytest.approx(hill.C_HILL,
+                                                                         abs=1e-10)
+    with pytest.raises(RuntimeError, match="singular"):
+        stability.periodic_orbit(systems.harmonic(), [1, 0], 2*np.pi, fixed_period=True)
+    with pytest.raises(ValueError):
+        stability.periodic_orbit(systems.harmonic(), [1, 0, 0], 2*np.pi)
+    with pytest.raises(ValueError):
+        stability.symmetric_orbit(systems.hill(), [1, 0, 0, 1], [7], [0], 1.0)
+
+
+def test_stm_and_floquet():
+    y1, phi = stability.stm(systems.harmonic(2.0), (0, 1.3), [1, 0])
+    assert phi[0, 1] == pytest.approx(np.sin(2.6)/2, abs=1e-10)
+    _, phi2 = stability.stm(lambda t, y: [y[1], -4*y[0]], (0, 1.3), [1, 0])
+    assert np.allclose(phi, phi2, atol=1e-8)
+    orb = hill.variation_orbit(hill.M_HILL)
+    m = stability.monodromy(systems.hill(), orb.y0, 2*np.pi, rtol=1e-13, atol=1e-13)
+    fl = stability.floquet(m, 2*np.pi)
+    assert fl["stability_index"] == pytest.approx(orb.stability_index, abs=1e-10)
+
+
+def test_package_exports():
+    assert conmech.hill is hill and conmech.stability is stability
+
+
+# -------------------------------------------------------------------- SciPy reference
+
+def _scipy_orbit(m, kappa=1.0, rtol=1e-13, atol=1e-13, u0=None):
+    """Variation orbit and c with SciPy only: DOP853 on state + STM, fsolve."""
+    def rhs(t, z):
+        x, y, vx, vy = z[:4]
+        r2 = x*x + y*y
+        r3 = r2*np.sqrt(r2)
+        r5 = r3*r2
+        fxx = kappa*(3*x*x/r5 - 1/r3) + 3*m*m
+        fxy = 3*kappa*x*y/r5
+        fyy = kappa*(3*y*y/r5 - 1/r3)
+        a = np.array([[0, 0, 1, 0], [0, 0, 0, 1], [fxx, fxy, 0, 2*m], [fxy, fyy, -2*m, 0]])
+        p = z[4:].reshape(4, 4)
+        return np.concatenate([[vx, vy, 2*m*vy - kappa*x/r3 + 3*m*m*x,
+                                -2*m*vx - kappa*y/r3], (a @ p).ravel()])
+
+    def flow(u, t1):
+        z0 = np.concatenate([[u[0], 0, 0, u[1]], np.eye(4).ravel()])
+        return solve_ivp(rhs, (0, t1), z0, method="DOP853", rtol=rtol, atol=atol).y[:, -1]
+
+    def resid(u):
+        z = flow(u, np.pi/2)
+        return [z[0], z[3]]
+
+    def jac(u):
+        p = flow(u, np.pi/2)[4:].reshape(4, 4)
+        return [[p[0, 0], p[0, 3]], [p[3, 0], p[3, 3]]]
+
+    if u0 is None:
+        u0 = [(1 + m)**(-2/3), (1 + m)**(-2/3)]
+    u = fsolve(resid, u0, fprime=jac, xtol=1e-14)
+    mono = flow(u, 2*np.pi)[4:].reshape(4, 4)
+    s = 0.5*(np.trace(mono) - 2)
+    return {"u": u, "c": 1 + np.arccos(s)/(2*np.pi), "monodromy": mono}

@@ -1,0 +1,458 @@
+!> Periodic orbits by Newton shooting, their monodromy matrices and natural-parameter
+!! continuation of families.
+!!
+!! General shooting (`find_periodic_orbit`) solves for the initial state y0 (and the period
+!! T) of y(T; y0) = y0 with the phase condition f(y_g) . (y0 - y_g) = 0 (the orbit starts on
+!! the hyperplane through the guess y_g normal to the flow), in one of three modes:
+!! - PO_FREE_PERIOD: unknowns (y0, T), n + 1 equations (isolated orbits: limit cycles,
+!!   forced oscillations with T given is PO_FIXED_PERIOD);
+!! - PO_FIXED_PERIOD: unknowns y0, n + 1 equations;
+!! - PO_FIXED_ENERGY: unknowns (y0, T), n + 2 equations (the extra one E(y0) = E given):
+!!   the choice for conservative systems, whose orbits come in one-parameter families.
+!! Symmetric shooting (`find_symmetric_orbit`) is for an orbit that crosses a symmetry line
+!! at right angles: the user fixes the components of y0 that the symmetry line fixes,
+!! names the free ones, and the components of y(tau) that must vanish at tau (half or
+!! quarter period, `period_factor` 2 or 4), tau optionally free.
+!!
+!! Both iterate Gauss-Newton steps solved in the least-squares sense by LAPACK dgelsd; the
+!! Jacobian comes from the state transition matrix of the variational equations
+!! (`integrate_stm`, analytic Jacobians where the system has them). A rank-deficient
+!! Newton matrix (rcond 1e-10) is reported as CM_SINGULAR (e.g. a fixed period in an
+!! isochronous system, or a free period in a conservative one), a failed iteration as
+!! CM_NO_CONVERGENCE. On success the monodromy over the full period is integrated and its
+!! Floquet multipliers computed.
+module conmech_shooting
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: ode_options, METHOD_DOP853
+    use conmech_variational, only: integrate_stm
+    use conmech_floquet, only: floquet_result, floquet_analysis
+    use conmech_lapack, only: dgelsd
+    implicit none
+    private
+
+    integer, parameter, public :: PO_FREE_PERIOD = 1
+    integer, parameter, public :: PO_FIXED_PERIOD = 2
+    integer, parameter, public :: PO_FIXED_ENERGY = 3
+
+    public :: shooting_options, periodic_orbit, energy_fun, set_parameter_proc
+    public :: find_periodic_orbit, find_symmetric_orbit, orbit_monodromy
+    public :: continue_symmetric_family, continue_periodic_family, lstsq_solve
+
+    !> Options of the shooting methods.
+    type :: shooting_options
+        integer :: method = METHOD_DOP853     !! integrator of the variational equations
+        real(dp) :: rtol = 1.0e-12_dp         !! its relative tolerance
+        real(dp) :: atol = 1.0e-12_dp         !! its absolute tolerance
+        integer :: max_steps = 100000         !! its step limit per integration
+        integer :: max_iter = 30              !! Newton iterations
+        real(dp) :: tol = 1.0e-10_dp          !! converged when |residual| and |step| <= tol
+        real(dp) :: rcond = 1.0e-10_dp        !! rank threshold of the Newton matrix
+        logical :: monodromy = .true.         !! integrate the monodromy on success
+    end type shooting_options
+
+    !> A periodic orbit.
+    type :: periodic_orbit
+        integer :: info = CM_BAD_INPUT
+        character(len=:), allocatable :: message
+        real(dp), allocatable :: y0(:)          !! initial state
+        real(dp) :: period = 0.0_dp
+        real(dp), allocatable :: monodromy(:, :)
+        type(floquet_result) :: floquet         !! multipliers of the monodromy
+        real(dp) :: residual = 0.0_dp           !! max |residual| at the solution
+        integer :: iterations = 0
+    end type periodic_orbit
+
+    abstract interface
+        !> Energy (or any first integral) E(y).
+        function energy_fun(y) result(e)
+            import :: dp
+            real(dp), intent(in) :: y(:)
+            real(dp) :: e
+        end function energy_fun
+        !> Set the continuation parameter of a system.
+        subroutine set_parameter_proc(sys, p)
+            import :: ode_system, dp
+            class(ode_system), intent(inout) :: sys
+            real(dp), intent(in) :: p
+        end subroutine set_parameter_proc
+    end interface
+
+contains
+
+    function ode_opts(o) result(oo)
+        type(shooting_options), intent(in) :: o
+        type(ode_options) :: oo
+        oo%method = o%method
+        oo%rtol = o%rtol
+        oo%atol = o%atol
+        oo%max_steps = o%max_steps
+    end function ode_opts
+
+    !> Minimum-norm least-squares solution of a x = b (dgelsd); rank returned.
+    subroutine lstsq_solve(a, b, x, rank, info, rcond)
+        real(dp), intent(in) :: a(:, :), b(:)
+        real(dp), intent(out) :: x(:)
+        integer, intent(out) :: rank, info
+        real(dp), intent(in) :: rcond
+        real(dp), allocatable :: aa(:, :), bb(:, :), s(:), work(:)
+        integer, allocatable :: iwork(:)
+        real(dp) :: wq(1)
+        integer :: m, n, ldb, lwork
+        m = size(a, 1)
+        n = size(a, 2)
+        ldb = max(m, n)
+        allocate (aa(m, n), bb(ldb, 1), s(min(m, n)), iwork(64*max(m, n) + 64))
+        aa = a
+        bb = 0.0_dp
+        bb(1:m, 1) = b
+        call dgelsd(m, n, 1, aa, m, bb, ldb, s, rcond, rank, wq, -1, iwork, info)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork))
+        call dgelsd(m, n, 1, aa, m, bb, ldb, s, rcond, rank, work, lwork, iwork, info)
+        if (info /= 0) then
+            info = CM_NO_CONVERGENCE
+            return
+        end if
+        x = bb(1:n, 1)
+        info = CM_SUCCESS
+    end subroutine lstsq_solve
+
+    !> General Newton shooting for a periodic orbit from the guess (y0, period).
+    !! `energy` and `energy_value` are required for PO_FIXED_ENERGY (its gradient is
+    !! taken by central differences).
+    subroutine find_periodic_orbit(sys, y0, period, orbit, mode, options, energy, &
+                                   energy_value)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: y0(:)
+        real(dp), intent(in) :: period
+        type(periodic_orbit), intent(out) :: orbit
+        integer, intent(in), optional :: mode
+        type(shooting_options), intent(in), optional :: options
+        procedure(energy_fun), optional :: energy
+        real(dp), intent(in), optional :: energy_value
+        type(shooting_options) :: opt
+        integer :: md, n, neq, nun, it, rank, info, j
+        real(dp), allocatable :: y(:), yt(:), phi(:, :), f0(:), ft(:), jac(:, :), r(:), dx(:)
+        real(dp), allocatable :: yg(:), yp(:)
+        real(dp) :: t, h, scale
+        character(len=:), allocatable :: msg
+        if (present(options)) opt = options
+        md = PO_FREE_PERIOD
+        if (present(mode)) md = mode
+        n = size(y0)
+        orbit%iterations = 0
+        if (n < 1 .or. .not. (period > 0.0_dp) .or. md < 1 .or. md > 3 .or. &
+            .not. all(ieee_is_finite(y0))) then
+            orbit%info = CM_BAD_INPUT
+            orbit%message = "find_periodic_orbit: bad input (empty y0, period <= 0 or mode)"
+            return
+        end if
+        if (md == PO_FIXED_ENERGY .and. .not. (present(energy) .and. present(energy_value))) &
+            then
+            orbit%info = CM_BAD_INPUT
+            orbit%message = "find_periodic_orbit: PO_FIXED_ENERGY needs energy and energy_value"
+            return
+        end if
+        neq = n + 1
+        nun = n + 1
+        if (md == PO_FIXED_PERIOD) nun = n
+        if (md == PO_FIXED_ENERGY) neq = n + 2
+        allocate (y(n), yt(n), phi(n, n), f0(n), ft(n), jac(neq, nun), r(neq), dx(nun))
+        allocate (yg(n), yp(n))
+        yg = y0
+        call sys%rhs(0.0_dp, yg, f0)
+        y = y0
+        t = period
+        orbit%info = CM_NO_CONVERGENCE
+        orbit%message = "find_periodic_orbit: Newton did not converge"
+        do it = 1, opt%max_iter
+            orbit%iterations = it
+            yt = y
+            call identity(phi)
+            call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
+            if (info < 0) then
+                orbit%info = info
+                orbit%message = "find_periodic_orbit: integration failed: "//msg
+                return
+            end if
+            call sys%rhs(t, yt, ft)
+            r(1:n) = yt - y
+            r(n + 1) = dot_product(f0, y - yg)
+            jac = 0.0_dp
+            jac(1:n, 1:n) = phi
+            do j = 1, n
+                jac(j, j) = jac(j, j) - 1.0_dp
+            end do
+            jac(n + 1, 1:n) = f0
+            if (md /= PO_FIXED_PERIOD) jac(1:n, n + 1) = ft
+            if (md == PO_FIXED_ENERGY) then
+                r(n + 2) = energy(y) - energy_value
+                do j = 1, n
+                    h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(y(j)), 1.0_dp)
+                    yp = y
+                    yp(j) = y(j) + h
+                    jac(n + 2, j) = energy(yp)
+                    yp(j) = y(j) - h
+                    jac(n + 2, j) = (jac(n + 2, j) - energy(yp))/(2.0_dp*h)
+                end do
+            end if
+            orbit%residual = maxval(abs(r))
+            if (.not. all(ieee_is_finite(jac)) .or. .not. all(ieee_is_finite(r))) then
+                orbit%info = CM_NO_CONVERGENCE
+                orbit%message = "find_periodic_orbit: non-finite values (a bad guess?)"
+                return
+            end if
+            call lstsq_solve(jac, -r, dx, rank, info, opt%rcond)
+            if (info /= CM_SUCCESS .or. rank < nun) then
+                orbit%info = CM_SINGULAR
+                orbit%message = "find_periodic_orbit: singular Newton matrix (the orbit is "// &
+                                "not isolated: fix the energy or the period?)"
+                return
+            end if
+            y = y + dx(1:n)
+            if (md /= PO_FIXED_PERIOD) t = t + dx(n + 1)
+            scale = max(1.0_dp, maxval(abs(y)), t)
+            if (.not. (t > 0.0_dp)) then
+                orbit%info = CM_NO_CONVERGENCE
+                orbit%message = "find_periodic_orbit: the period became non-positive"
+                return
+            end if
+            if (maxval(abs(dx)) <= opt%tol*scale .and. orbit%residual <= sqrt(opt%tol)) then
+                orbit%info = CM_SUCCESS
+                orbit%message = "success"
+                exit
+            end if
+        end do
+        if (orbit%info /= CM_SUCCESS) return
+        orbit%y0 = y
+        orbit%period = t
+        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt))
+    end subroutine find_periodic_orbit
+
+    !> Symmetric shooting. y0 holds the fixed components (on the symmetry line); the
+    !! components `free` of y0 are unknowns, and so is tau if `free_time`; the components
+    !! `targets` of y(tau) must vanish. The period is `period_factor` * tau (default 2:
+    !! half-period shooting; 4 for an orbit with two perpendicular symmetry lines).
+    subroutine find_symmetric_orbit(sys, y0, free, tau, targets, orbit, options, free_time, &
+                                    period_factor)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: y0(:)
+        integer, intent(in) :: free(:)
+        real(dp), intent(in) :: tau
+        integer, intent(in) :: targets(:)
+        type(periodic_orbit), intent(out) :: orbit
+        type(shooting_options), intent(in), optional :: options
+        logical, intent(in), optional :: free_time
+        real(dp), intent(in), optional :: period_factor
+        type(shooting_options) :: opt
+        logical :: ft_free
+        real(dp) :: pf, t, scale
+        integer :: n, nf, ntg, nun, it, info, rank, j
+        real(dp), allocatable :: y(:), yt(:), phi(:, :), f(:), jac(:, :), r(:), dx(:)
+        character(len=:), allocatable :: msg
+        if (present(options)) opt = options
+        ft_free = .false.
+        if (present(free_time)) ft_free = free_time
+        pf = 2.0_dp
+        if (present(period_factor)) pf = period_factor
+        n = size(y0)
+        nf = size(free)
+        ntg = size(targets)
+        nun = nf
+        if (ft_free) nun = nf + 1
+        if (n < 1 .or. nun < 1 .or. ntg < 1 .or. .not. (tau > 0.0_dp) .or. &
+            any(free < 1) .or. any(free > n) .or. any(targets < 1) .or. any(targets > n) &
+            .or. .not. all(ieee_is_finite(y0))) then
+            orbit%info = CM_BAD_INPUT
+            orbit%message = "find_symmetric_orbit: bad input (indices, tau > 0, finite y0)"
+            return
+        end if
+        allocate (y(n), yt(n), phi(n, n), f(n), jac(ntg, nun), r(ntg), dx(nun))
+        y = y0
+        t = tau
+        orbit%info = CM_NO_CONVERGENCE
+        orbit%message = "find_symmetric_orbit: Newton did not converge"
+        do it = 1, opt%max_iter
+            orbit%iterations = it
+            yt = y
+            call identity(phi)
+            call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
+            if (info < 0) then
+                orbit%info = info
+                orbit%message = "find_symmetric_orbit: integration failed: "//msg
+                return
+            end if
+            r = yt(targets)
+            do j = 1, nf
+                jac(:, j) = phi(targets, free(j))
+            end do
+            if (ft_free) then
+                call sys%rhs(t, yt, f)
+                jac(:, nun) = f(targets)
+            end if
+            orbit%residual = maxval(abs(r))
+            if (.not. all(ieee_is_finite(jac)) .or. .not. all(ieee_is_finite(r))) then
+                orbit%info = CM_NO_CONVERGENCE
+                orbit%message = "find_symmetric_orbit: non-finite values (a bad guess?)"
+                return
+            end if
+            call lstsq_solve(jac, -r, dx, rank, info, opt%rcond)
+            if (info /= CM_SUCCESS .or. rank < min(nun, ntg)) then
+                orbit%info = CM_SINGULAR
+                orbit%message = "find_symmetric_orbit: singular Newton matrix"
+                return
+            end if
+            y(free) = y(free) + dx(1:nf)
+            if (ft_free) t = t + dx(nun)
+            if (.not. (t > 0.0_dp)) then
+                orbit%info = CM_NO_CONVERGENCE
+                orbit%message = "find_symmetric_orbit: the time became non-positive"
+                return
+            end if
+            scale = max(1.0_dp, maxval(abs(y)), t)
+            if (maxval(abs(dx)) <= opt%tol*scale .and. orbit%residual <= sqrt(opt%tol)) then
+                orbit%info = CM_SUCCESS
+                orbit%message = "success"
+                exit
+            end if
+        end do
+        if (orbit%info /= CM_SUCCESS) return
+        orbit%y0 = y
+        orbit%period = pf*t
+        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt))
+    end subroutine find_symmetric_orbit
+
+    !> Integrate the monodromy of orbit (y0, period) and its Floquet multipliers.
+    subroutine orbit_monodromy(sys, orbit, ode)
+        class(ode_system), intent(in) :: sys
+        type(periodic_orbit), intent(inout) :: orbit
+        type(ode_options), intent(in) :: ode
+        real(dp), allocatable :: y(:), phi(:, :)
+        character(len=:), allocatable :: msg
+        integer :: n, info
+        n = size(orbit%y0)
+        allocate (y(n), phi(n, n))
+        y = orbit%y0
+        call identity(phi)
+        call integrate_stm(sys, 0.0_dp, orbit%period, y, phi, ode, info, msg)
+        if (info < 0) then
+            orbit%info = info
+            orbit%message = "monodromy: integration failed: "//msg
+            return
+        end if
+        orbit%monodromy = phi
+        call floquet_analysis(phi, orbit%period, orbit%floquet)
+        if (orbit%floquet%info /= CM_SUCCESS) then
+            orbit%info = orbit%floquet%info
+            orbit%message = "monodromy: eigenvalues failed"
+        end if
+    end subroutine orbit_monodromy
+
+    !> Natural-parameter continuation of a symmetric family over the parameters ps: the
+    !! parameter is set by `set_param`, each orbit starts from the (linear, then quadratic)
+    !! extrapolation of the previous ones. (y0, tau) is the guess for ps(1). A failure
+    !! restarts the extrapolation from the last success.
+    subroutine continue_symmetric_family(sys, set_param, ps, y0, free, tau, targets, orbits, &
+                                         options, free_time, period_factor)
+        class(ode_system), intent(inout) :: sys
+        procedure(set_parameter_proc) :: set_param
+        real(dp), intent(in) :: ps(:)
+        real(dp), intent(in) :: y0(:)
+        integer, intent(in) :: free(:)
+        real(dp), intent(in) :: tau
+        integer, intent(in) :: targets(:)
+        type(periodic_orbit), intent(out) :: orbits(:)
+        type(shooting_options), intent(in), optional :: options
+        logical, intent(in), optional :: free_time
+        real(dp), intent(in), optional :: period_factor
+        real(dp) :: hist(size(y0) + 1, 3), pp(3), g(size(y0) + 1), pf
+        integer :: i, nh, n
+        n = size(y0)
+        pf = 2.0_dp
+        if (present(period_factor)) pf = period_factor
+        nh = 0
+        do i = 1, size(ps)
+            call set_param(sys, ps(i))
+            if (nh == 0) then
+                g(1:n) = y0
+                g(n + 1) = tau
+            else
+                call extrapolate(ps(i), pp, hist, nh, g)
+            end if
+            call find_symmetric_orbit(sys, g(1:n), free, g(n + 1), targets, orbits(i), &
+                                      options, free_time, pf)
+            if (orbits(i)%info == CM_SUCCESS) then
+                call push(ps(i), [orbits(i)%y0, orbits(i)%period/pf], pp, hist, nh)
+            end if
+        end do
+    end subroutine continue_symmetric_family
+
+    !> Natural-parameter continuation with general shooting (see find_periodic_orbit).
+    subroutine continue_periodic_family(sys, set_param, ps, y0, period, orbits, mode, options)
+        class(ode_system), intent(inout) :: sys
+        procedure(set_parameter_proc) :: set_param
+        real(dp), intent(in) :: ps(:)
+        real(dp), intent(in) :: y0(:)
+        real(dp), intent(in) :: period
+        type(periodic_orbit), intent(out) :: orbits(:)
+        integer, intent(in), optional :: mode
+        type(shooting_options), intent(in), optional :: options
+        real(dp) :: hist(size(y0) + 1, 3), pp(3), g(size(y0) + 1)
+        integer :: i, nh, n
+        n = size(y0)
+        nh = 0
+        do i = 1, size(ps)
+            call set_param(sys, ps(i))
+            if (nh == 0) then
+                g(1:n) = y0
+                g(n + 1) = period
+            else
+                call extrapolate(ps(i), pp, hist, nh, g)
+            end if
+            call find_periodic_orbit(sys, g(1:n), g(n + 1), orbits(i), mode, options)
+            if (orbits(i)%info == CM_SUCCESS) then
+                call push(ps(i), [orbits(i)%y0, orbits(i)%period], pp, hist, nh)
+            end if
+        end do
+    end subroutine continue_periodic_family
+
+    pure subroutine push(p, v, pp, hist, nh)
+        real(dp), intent(in) :: p, v(:)
+        real(dp), intent(inout) :: pp(3), hist(:, :)
+        integer, intent(inout) :: nh
+        pp(2:3) = pp(1:2)
+        hist(:, 2:3) = hist(:, 1:2)
+        pp(1) = p
+        hist(:, 1) = v
+        nh = min(nh + 1, 3)
+    end subroutine push
+
+    pure subroutine extrapolate(p, pp, hist, nh, g)
+        real(dp), intent(in) :: p, pp(3), hist(:, :)
+        integer, intent(in) :: nh
+        real(dp), intent(out) :: g(:)
+        integer :: j, k
+        real(dp) :: w
+        g = 0.0_dp
+        do j = 1, nh
+            w = 1.0_dp
+            do k = 1, nh
+                if (k /= j) w = w*(p - pp(k))/(pp(j) - pp(k))
+            end do
+            g = g + w*hist(:, j)
+        end do
+    end subroutine extrapolate
+
+    pure subroutine identity(a)
+        real(dp), intent(out) :: a(:, :)
+        integer :: i
+        a = 0.0_dp
+        do i = 1, size(a, 1)
+            a(i, i) = 1.0_dp
+        end do
+    end subroutine identity
+
+end module conmech_shooting

@@ -1,0 +1,115 @@
+!> Variational equations: the state together with its state transition matrix (STM).
+!!
+!! For y' = f(t, y) the STM Phi(t) = dy(t)/dy(t0) solves Phi' = J(t, y(t)) Phi, Phi(t0) = I,
+!! with J = df/dy the system's Jacobian (analytic when the system has one, else its
+!! finite-difference default). `variational_system` is the ode_system of the extended
+!! state z = [y; vec(Phi)] (n + n^2 components, Phi stored column by column), so every
+!! conmech integrator (and its step control) applies to it.
+!!
+!! `integrate_stm` advances (y, Phi) from t0 to t1. By default the error of every component
+!! of z is controlled (same step control on the state and on the STM). With
+!! `state_only = .true.` the STM components get an infinite tolerance and the state's
+!! tolerances are scaled by sqrt(n/(n + n^2)), so that the RMS error norm over z equals the
+!! RMS norm over the state alone: the steps are those of the state's integration.
+module conmech_variational
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate
+    implicit none
+    private
+
+    public :: variational_system, integrate_stm
+
+    !> z = [y; vec(Phi)], z' = [f(t, y); vec(J(t, y) Phi)].
+    type, extends(ode_system) :: variational_system
+        class(ode_system), allocatable :: base   !! the underlying system
+        integer :: n = 0                         !! its dimension
+    contains
+        procedure :: rhs => var_rhs
+    end type variational_system
+
+contains
+
+    subroutine var_rhs(self, t, y, dydt)
+        class(variational_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp) :: jac(self%n, self%n)
+        integer :: n, j
+        n = self%n
+        call self%base%rhs(t, y(1:n), dydt(1:n))
+        call self%base%jacobian(t, y(1:n), jac)
+        do j = 1, n
+            dydt(n*j + 1:n*j + n) = matmul(jac, y(n*j + 1:n*j + n))
+        end do
+    end subroutine var_rhs
+
+    !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
+    !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.
+    subroutine integrate_stm(sys, t0, t1, y, phi, options, info, message, stats, state_only)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t0, t1
+        real(dp), intent(inout) :: y(:)
+        real(dp), intent(inout) :: phi(:, :)
+        type(ode_options), intent(in) :: options
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out), optional :: message
+        type(ode_stats), intent(out), optional :: stats
+        logical, intent(in), optional :: state_only
+        type(variational_system) :: vs
+        type(ode_options) :: opt
+        real(dp), allocatable :: z(:)
+        character(len=:), allocatable :: msg
+        real(dp) :: scl
+        integer :: n, nz
+        logical :: only
+        n = size(y)
+        nz = n + n*n
+        if (size(phi, 1) /= n .or. size(phi, 2) /= n) then
+            info = CM_BAD_INPUT
+            if (present(message)) message = "integrate_stm: phi must be n x n"
+            return
+        end if
+        only = .false.
+        if (present(state_only)) only = state_only
+        allocate (vs%base, source=sys)
+        vs%n = n
+        opt = options
+        if (only .or. allocated(options%atol_vec) .or. allocated(options%rtol_vec)) then
+            allocate (opt%atol_vec(nz), opt%rtol_vec(nz))
+            opt%atol_vec = options%atol
+            opt%rtol_vec = options%rtol
+            if (allocated(options%atol_vec)) then
+                if (size(options%atol_vec) == n) then
+                    opt%atol_vec(1:n) = options%atol_vec
+                else if (size(options%atol_vec) == nz) then
+                    opt%atol_vec = options%atol_vec
+                end if
+            end if
+            if (allocated(options%rtol_vec)) then
+                if (size(options%rtol_vec) == n) then
+                    opt%rtol_vec(1:n) = options%rtol_vec
+                else if (size(options%rtol_vec) == nz) then
+                    opt%rtol_vec = options%rtol_vec
+                end if
+            end if
+            if (only) then
+                scl = sqrt(real(n, dp)/real(nz, dp))
+                opt%atol_vec(1:n) = opt%atol_vec(1:n)*scl
+                opt%rtol_vec(1:n) = opt%rtol_vec(1:n)*scl
+                opt%atol_vec(n + 1:) = huge(1.0_dp)*1.0e-10_dp
+                opt%rtol_vec(n + 1:) = 0.0_dp
+            end if
+        end if
+        allocate (z(nz))
+        z(1:n) = y
+        z(n + 1:) = reshape(phi, [n*n])
+        call ode_integrate(vs, t0, t1, z, opt, info, stats, msg)
+        y = z(1:n)
+        phi = reshape(z(n + 1:), [n, n])
+        if (present(message)) message = msg
+    end subroutine integrate_stm
+
+end module conmech_variational
