@@ -4,7 +4,7 @@
 Meson cannot glob, so meson.build runs this script at configure time; a file added under
 src/ (or python/conmech/flat/) is picked up at the next configure without editing meson.build.
 
-    python3 tools/list_sources.py src                      # src/**/*.f90 (what fpm compiles)
+    python3 tools/list_sources.py src                      # src/**/*.f90 and *.F90 (fpm's)
     python3 tools/list_sources.py python/conmech/flat --flat           # flat/*.f90 only
     python3 tools/list_sources.py python/conmech --flat --ext py       # conmech/*.py only
 
@@ -19,14 +19,18 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("directory")
     parser.add_argument("--flat", action="store_true", help="do not descend into subfolders")
-    parser.add_argument("--ext", default="f90", help="file extension without the dot")
+    parser.add_argument("--ext", action="append",
+                        help="file extension without the dot (repeatable; default: f90 and "
+                             "F90, the free-form Fortran sources fpm compiles)")
     args = parser.parse_args(argv)
     root = Path(args.directory)
     if not root.is_dir():
         sys.stderr.write(f"list_sources.py: no directory {root}\n")
         return 1
-    pattern = ("" if args.flat else "**/") + "*." + args.ext
-    files = sorted(p.as_posix() for p in root.glob(pattern) if p.is_file())
+    exts = args.ext or ["f90", "F90"]
+    prefix = "" if args.flat else "**/"
+    files = sorted({p.as_posix() for ext in exts for p in root.glob(prefix + "*." + ext)
+                    if p.is_file()})
     sys.stdout.write("".join(f + "\n" for f in files))
     return 0
 

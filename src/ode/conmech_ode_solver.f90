@@ -212,7 +212,7 @@ contains
 
         type(rk_tableau) :: tab
         real(dp), allocatable :: k(:, :), ynew(:), ytmp(:), sk(:), rtolv(:), atolv(:)
-        real(dp), allocatable :: fc(:, :), g_old(:), g_new(:), ye(:)
+        real(dp), allocatable :: fc(:, :), g_old(:), g_new(:), ye(:), zero(:)
         real(dp) :: t, h, hnew, hmax, posneg, err, fac11, fac, facold, safe, facc1, facc2
         real(dp) :: expo1, beta, t_stop, te
         integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev, ifsal, form
@@ -293,7 +293,8 @@ contains
         hmax = min(abs(opt%max_step), abs(tf - t0))
         n_nonfinite = 0
 
-        allocate (k(n, 21), ynew(n), ytmp(n), sk(n), fc(n, 0:nf))
+        allocate (k(n, 21), ynew(n), ytmp(n), sk(n), fc(n, 0:nf), zero(n))
+        zero = 0.0_dp
         t = t0
 
         ! outputs at the start
@@ -596,15 +597,40 @@ contains
             hh = min(100.0_dp*abs(hh), h1, hmax)*posneg
         end function hinit
 
+        !> out = base + sum_{j <= m} w(j) k(:, j). Small systems loop over the components
+        !! outside (one pass, the sum in a register; multiplying the tableau's zeros is
+        !! cheaper than skipping them), large ones over the stages (contiguous columns of k,
+        !! zero weights skipped).
+        subroutine lincomb(base, w, m, out)
+            real(dp), intent(in) :: base(:), w(:)
+            integer, intent(in) :: m
+            real(dp), intent(out) :: out(:)
+            integer :: i, j
+            real(dp) :: acc
+            if (n <= 32) then
+                do i = 1, n
+                    acc = base(i)
+                    do j = 1, m
+                        acc = acc + w(j)*k(i, j)
+                    end do
+                    out(i) = acc
+                end do
+            else
+                out = base
+                do j = 1, m
+                    if (w(j) /= 0.0_dp) out = out + w(j)*k(:, j)
+                end do
+            end if
+        end subroutine lincomb
+
         !> Stages s1..s2 of the tableau; stage s uses a(s, 1:s-1).
         subroutine stages(s1, s2)
             integer, intent(in) :: s1, s2
-            integer :: s, j
+            integer :: s
+            real(dp) :: ha(21)
             do s = s1, s2
-                ytmp = y
-                do j = 1, s - 1
-                    if (tab%a(s, j) /= 0.0_dp) ytmp = ytmp + (h*tab%a(s, j))*k(:, j)
-                end do
+                ha(1:s - 1) = h*tab%a(s, 1:s - 1)
+                call lincomb(y, ha, s - 1, ytmp)
                 call sys%rhs(t + tab%c(s)*h, ytmp, k(:, s))
             end do
             st%nfev = st%nfev + (s2 - s1 + 1)
@@ -624,41 +650,27 @@ contains
         end subroutine rk4_step
 
         subroutine dopri5_step()
-            integer :: j
             call stages(2, 6)
-            ynew = y
-            do j = 1, 6
-                if (tab%b(j) /= 0.0_dp) ynew = ynew + (h*tab%b(j))*k(:, j)
-            end do
+            call lincomb(y, h*tab%b(1:6), 6, ynew)
             call sys%rhs(t + h, ynew, k(:, 7))
             st%nfev = st%nfev + 1
-            ytmp = 0.0_dp
-            do j = 1, 7
-                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
-            end do
+            call lincomb(zero, tab%e, 7, ytmp)
             sk = atolv + rtolv*max(abs(y), abs(ynew))
             err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dopri5_step
 
         subroutine dop853_step()
-            integer :: j
             real(dp) :: err5, err3, deno
             call stages(2, 12)
             ! ytmp = sum b_j k_j (8th-order increment / h)
-            ytmp = 0.0_dp
-            do j = 1, 12
-                if (tab%b(j) /= 0.0_dp) ytmp = ytmp + tab%b(j)*k(:, j)
-            end do
+            call lincomb(zero, tab%b, 12, ytmp)
             ynew = y + h*ytmp
             sk = atolv + rtolv*max(abs(y), abs(ynew))
             ! 3rd-order estimator: b.k - bhh.k
             err3 = sum(((ytmp - tab%bhh(1)*k(:, 1) - tab%bhh(9)*k(:, 9) &
                          - tab%bhh(12)*k(:, 12))/sk)**2)
-            ytmp = 0.0_dp
-            do j = 1, 12
-                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
-            end do
+            call lincomb(zero, tab%e, 12, ytmp)
             err5 = sum((ytmp/sk)**2)
             deno = err5 + 0.01_dp*err3
             if (deno <= 0.0_dp) deno = 1.0_dp
@@ -667,17 +679,9 @@ contains
         end subroutine dop853_step
 
         subroutine verner_step()
-            integer :: j
             call stages(2, 16)
-            ytmp = 0.0_dp
-            do j = 1, 15
-                if (tab%b(j) /= 0.0_dp) ytmp = ytmp + tab%b(j)*k(:, j)
-            end do
-            ynew = y + h*ytmp
-            ytmp = 0.0_dp
-            do j = 1, 16
-                if (tab%e(j) /= 0.0_dp) ytmp = ytmp + tab%e(j)*k(:, j)
-            end do
+            call lincomb(y, h*tab%b(1:15), 15, ynew)
+            call lincomb(zero, tab%e, 16, ytmp)
             sk = atolv + rtolv*max(abs(y), abs(ynew))
             err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)

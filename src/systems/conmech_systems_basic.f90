@@ -118,7 +118,8 @@ contains
         real(dp), intent(in) :: t, y(:)
         real(dp), intent(out) :: dydt(:)
         real(dp) :: r3
-        r3 = (y(1)**2 + y(2)**2)**1.5_dp
+        r3 = y(1)**2 + y(2)**2
+        r3 = r3*sqrt(r3)
         dydt(1) = y(3)
         dydt(2) = y(4)
         dydt(3) = -self%mu*y(1)/r3
@@ -154,8 +155,10 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: d1, d2, mp
         mp = 1.0_dp - self%mu
-        d1 = ((y(1) + self%mu)**2 + y(2)**2)**1.5_dp
-        d2 = ((y(1) - mp)**2 + y(2)**2)**1.5_dp
+        d1 = (y(1) + self%mu)**2 + y(2)**2
+        d1 = d1*sqrt(d1)
+        d2 = (y(1) - mp)**2 + y(2)**2
+        d2 = d2*sqrt(d2)
         dydt(1) = y(3)
         dydt(2) = y(4)
         dydt(3) = y(1) + 2.0_dp*y(4) - mp*(y(1) + self%mu)/d1 - self%mu*(y(1) - mp)/d2
