@@ -132,10 +132,41 @@ program test_mechanics_defaults
         call ts%check_less(maxval(r2%res_pos), 1.0e-13_dp, "backward: projected residuals")
     end block
 
+    ! ---------------------------------------------------------------- same step control as core
+    block
+        type(constrained_ode) :: f
+        type(ode_options) :: oo
+        type(ode_result) :: orr
+        integer :: meth
+        real(dp), allocatable :: q0(:), v0(:)
+        call make_constrained("double_pendulum_xy", [real(dp) ::], f%mech, info, msg)
+        call mech_initial_state("double_pendulum_xy", [real(dp) ::], q0, v0, info)
+        do meth = METHOD_DOPRI5, METHOD_DOP853
+            oo%method = meth
+            oo%rtol = 1.0e-8_dp
+            oo%atol = 1.0e-8_dp
+            oo%save_steps = .false.
+            call ode_solve(f, [0.0_dp, 10.0_dp], [q0, v0], oo, orr)
+            opt = constrained_options()
+            opt%ode = oo
+            opt%projection = PROJ_NONE
+            opt%save_steps = .false.
+            call constrained_solve(f%mech, [0.0_dp, 10.0_dp], q0, v0, opt, r1)
+            call ts%check(r1%naccept == orr%stats%naccept .and. &
+                          r1%nreject == orr%stats%nreject .and. r1%nfev == orr%stats%nfev, &
+                          "no projection: the same steps and nfev as the core ode_solve")
+            call ts%check_less(maxval(abs(r1%q(:, r1%nt) - orr%y(1:4, orr%nt))), 1.0e-12_dp, &
+                               "no projection: the same end state as the core ode_solve")
+        end do
+    end block
+
     ! ---------------------------------------------------------------- large coordinates
     block
         real(dp) :: ll
         integer :: k
+        opt = constrained_options()
+        opt%ode%rtol = 1.0e-11_dp
+        opt%ode%atol = 1.0e-11_dp
         do k = 1, 2
             ll = 10.0_dp**(2*k)
             call make_constrained("pendulum_xy", [1.0_dp, 9.81_dp, ll], cs, info, msg)

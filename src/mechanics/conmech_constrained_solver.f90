@@ -166,7 +166,7 @@ contains
         real(dp), allocatable :: y(:), ynew(:), k(:, :), ytmp(:), sk(:), rtolv(:), atolv(:)
         real(dp), allocatable :: q(:), v(:), acc(:), lam(:)
         real(dp) :: t, tf, h, hnew, hmax, posneg, err, facold, safe, facc1, facc2, expo1
-        real(dp) :: fac, target
+        real(dp) :: fac, target, beta
         integer :: n, m, nsteps, i_eval, n_eval, info, iters, cap, nf_new, since_proj
         logical :: adaptive, reject, hit
         character(len=:), allocatable :: msg
@@ -274,6 +274,7 @@ contains
                                                           100.0_dp*epsilon(1.0_dp))
         if (allocated(options%ode%atol_vec)) atolv = options%ode%atol_vec
 
+        beta = 0.0_dp
         select case (options%ode%method)
         case (METHOD_RK4)
             adaptive = .false.
@@ -281,7 +282,9 @@ contains
             adaptive = .true.
             tab = dopri5_tableau()
             safe = 0.9_dp; facc1 = 1.0_dp/0.2_dp; facc2 = 1.0_dp/10.0_dp
-            expo1 = 0.2_dp
+            beta = 0.04_dp                       ! Lund stabilisation, as dopri5.f
+            if (options%ode%beta >= 0.0_dp) beta = options%ode%beta
+            expo1 = 0.2_dp - 0.75_dp*beta
         case (METHOD_VERNER98)
             adaptive = .true.
             tab = verner98_tableau()
@@ -375,7 +378,7 @@ contains
             ! ---------------------------------------------------------- accepted
             res%naccept = res%naccept + 1
             if (adaptive) then
-                fac = max(facc2, min(facc1, err**expo1/safe))
+                fac = max(facc2, min(facc1, err**expo1/facold**beta/safe))
                 hnew = h/fac
                 facold = max(err, 1.0e-4_dp)
             else
