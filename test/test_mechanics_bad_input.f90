@@ -99,6 +99,24 @@ program test_mechanics_bad_input
     call ts%check(r%status == CM_NO_CONVERGENCE .and. index(r%message, " at t =") > 0, &
                   "projection failing during the run -> CM_NO_CONVERGENCE: "//r%message)
 
+    ! the same through the step hook of the core ode_solve
+    block
+        type(constrained_ode) :: f
+        type(projection_hook) :: hk
+        type(ode_options) :: oo
+        allocate (f%mech, source=cs)
+        allocate (hk%mech, source=cs)
+        hk%proj_max_iter = 1
+        hk%proj_tol = 1.0e-15_dp
+        oo%method = METHOD_RK4
+        oo%first_step = 0.3_dp
+        call ode_solve(f, [0.0_dp, 3.0_dp], [sin(1.0_dp), -cos(1.0_dp), 0.0_dp, 0.0_dp], oo, &
+                       gr, hook=hk)
+        call ts%check(gr%status == CM_NO_CONVERGENCE .and. &
+                      index(gr%message, "did not converge") > 0, &
+                      "hook: non-converging projection stops ode_solve: "//gr%message)
+    end block
+
     ! ---------------------------------------------------------------- wrong dimensions
     opt = constrained_options()
     call constrained_solve(cs, [0.0_dp, 1.0_dp], [1.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], &

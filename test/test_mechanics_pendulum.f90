@@ -188,6 +188,33 @@ program test_mechanics_pendulum
         end if
     end block
 
+    ! the projection as a step hook of the core ode_solve, with events (x = 0 at T/4, 3T/4)
+    block
+        type(bottom_crossing) :: ev
+        type(ode_result) :: er
+        type(constrained_ode) :: f
+        type(projection_hook) :: hk
+        real(dp) :: rp, rv, worst
+        ev%direction = [0]
+        ev%terminal = [.false.]
+        allocate (f%mech, source=cs)
+        allocate (hk%mech, source=cs)
+        call ode_solve(f, [0.0_dp, period], [l*sin(th0), -l*cos(th0), 0.0_dp, 0.0_dp], gopt, &
+                       er, events=ev, hook=hk)
+        call ts%check(er%success .and. er%nev == 2, "hook: projected ode_solve with events")
+        call ts%check(hk%nproj == er%stats%naccept, "hook: every accepted step projected")
+        if (er%nev == 2) then
+            call ts%check_close(er%ev_t(1), 0.25_dp*period, 1.0e-9_dp, "hook: event at T/4")
+            call ts%check_close(er%ev_t(2), 0.75_dp*period, 1.0e-9_dp, "hook: event at 3T/4")
+        end if
+        worst = 0.0_dp
+        do i = 1, er%nt
+            call constraint_residuals(cs, er%t(i), er%y(1:2, i), er%y(3:4, i), rp, rv)
+            worst = max(worst, rp, rv)
+        end do
+        call ts%check_less(worst, 1.0e-13_dp, "hook: residuals at the steps")
+    end block
+
     ! ---------------------------------------------------------------- redundant constraints
     block
         type(pendulum_twice) :: tw

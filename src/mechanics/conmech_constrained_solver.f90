@@ -18,7 +18,7 @@ module conmech_constrained_solver
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system
+    use conmech_ode_system, only: ode_system, ode_step_hook
     use conmech_ode_solver, only: ode_options, METHOD_RK4, METHOD_DOPRI5, METHOD_DOP853, &
                                   METHOD_VERNER98
     use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, verner98_tableau
@@ -31,7 +31,7 @@ module conmech_constrained_solver
     integer, parameter, public :: PROJ_POSITION_VELOCITY = 2  !! position, then velocity
     integer, parameter, public :: PROJ_BAUMGARTE = 3          !! Baumgarte stabilisation
 
-    public :: constrained_ode, constrained_options, constrained_result
+    public :: constrained_ode, constrained_options, constrained_result, projection_hook
     public :: constrained_solve, consistent_initial, projection_from_name
 
     !> First-order form y = [q, v] of a constrained system (index-1 / Baumgarte).
@@ -44,6 +44,25 @@ module conmech_constrained_solver
     contains
         procedure :: rhs => cons_rhs
     end type constrained_ode
+
+    !> The projection as a step hook of the core integrators: `ode_solve(f, ..., hook=h)`
+    !! with f a `constrained_ode` and h a `projection_hook` holding the same system gives
+    !! projected integration with everything `ode_solve` offers (events, dense output,
+    !! t_eval by interpolation). Differences to `constrained_solve`: one more right-hand
+    !! side per projected step (the core evaluates the FSAL stage before the hook), and
+    !! t_eval/dense/event points are interpolated between projected steps, so they are on
+    !! the manifold only to the local error. Counters: nproj, proj_iter, proj_iter_max.
+    type, extends(ode_step_hook) :: projection_hook
+        class(constrained_system), allocatable :: mech
+        integer :: projection = PROJ_POSITION_VELOCITY   !! or PROJ_VELOCITY
+        integer :: every = 1
+        real(dp) :: proj_tol = 1.0e-14_dp
+        integer :: proj_max_iter = 10
+        integer :: nproj = 0, proj_iter = 0, proj_iter_max = 0
+        integer :: since = 0
+    contains
+        procedure :: after_step => hook_project
+    end type projection_hook
 
     !> Options of `constrained_solve`.
     type :: constrained_options
@@ -120,6 +139,45 @@ contains
         end if
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine cons_rhs
+
+    !> Project y = [q, v] after an accepted step of the core integrator.
+    subroutine hook_project(self, t, y, changed, info)
+        class(projection_hook), intent(inout) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: y(:)
+        logical, intent(out) :: changed
+        integer, intent(out) :: info
+        real(dp) :: q(self%mech%n), v(self%mech%n)
+        integer :: n, it
+        character(len=:), allocatable :: msg
+        character(len=32) :: buf
+        changed = .false.
+        info = CM_SUCCESS
+        self%since = self%since + 1
+        if (self%since < self%every) return
+        if (self%projection /= PROJ_VELOCITY .and. &
+            self%projection /= PROJ_POSITION_VELOCITY) return
+        self%since = 0
+        n = self%mech%n
+        q = y(1:n)
+        v = y(n + 1:2*n)
+        if (self%projection == PROJ_POSITION_VELOCITY) then
+            call project_position(self%mech, t, q, self%proj_tol, self%proj_max_iter, it, &
+                                  info, msg)
+            self%proj_iter = self%proj_iter + it
+            self%proj_iter_max = max(self%proj_iter_max, it)
+        end if
+        if (info == CM_SUCCESS) call project_velocity(self%mech, t, q, v, info, msg)
+        if (info /= CM_SUCCESS) then
+            write (buf, '(es14.6)') t
+            self%message = msg//" at t ="//trim(buf)
+            return
+        end if
+        self%nproj = self%nproj + 1
+        y(1:n) = q
+        y(n + 1:2*n) = v
+        changed = .true.
+    end subroutine hook_project
 
     !> Make (q, v) consistent at t: position projection (if holonomic constraints) then
     !! velocity projection. dq, dv: Euclidean distances moved.
