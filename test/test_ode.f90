@@ -337,6 +337,29 @@ contains
         call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, res, hook=proj)
         call ts%check(res%status == CM_EVENT_STOP .and. res%stats%naccept == 5, &
                       "a hook can stop the run")
+        ! hit_t_eval: the outputs are projected step ends, exactly on the circle
+        block
+            real(dp) :: te(50)
+            integer :: i
+            te = [(10.0_dp*i, i=1, 50)]
+            proj%calls = 0
+            proj%max_calls = huge(1)
+            opt%method = METHOD_DOP853
+            call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, res, t_eval=te, &
+                           hook=proj)
+            call ts%check(res%nt == 50, "t_eval by interpolation between projected steps")
+            drift_plain = maxval(abs(sum(res%y**2, dim=1) - 1.0_dp))
+            opt%hit_t_eval = .true.
+            call ode_solve(sys, [0.0_dp, 500.0_dp], [1.0_dp, 0.0_dp], opt, res, t_eval=te, &
+                           hook=proj)
+            drift_proj = maxval(abs(sum(res%y**2, dim=1) - 1.0_dp))
+            call ts%check(res%nt == 50 .and. all(res%t == te), "hit_t_eval returns t_eval")
+            call ts%check(drift_plain > 1.0e-10_dp .and. drift_proj < 1.0e-15_dp, &
+                          "hit_t_eval outputs are projected points, interpolated ones are not")
+            ! DOP853 with a hook and no dense output: f once per accepted step, after the hook
+            call ts%check(res%stats%nfev == 11*(res%stats%naccept + res%stats%nreject) + &
+                          res%stats%naccept + 2, "one evaluation per projected step (FSAL deferred)")
+        end block
     end subroutine test_hook
 
     !> At tol 1e-13 the Verner pair is more accurate than DOP853 for no more evaluations.

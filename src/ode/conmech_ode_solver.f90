@@ -56,6 +56,8 @@ module conmech_ode_solver
         real(dp) :: beta = -1.0_dp                 !! Lund stabilisation exponent
         logical :: dense_output = .false.          !! keep a dense_solution in the result
         logical :: save_steps = .true.             !! without t_eval: store every step
+        logical :: hit_t_eval = .false.            !! shorten steps to land on t_eval points
+                                                   !! (outputs are step ends, not interpolated)
     end type ode_options
 
     !> Counters of one integration.
@@ -218,8 +220,9 @@ contains
         integer :: n, nf, nsteps, ne, n_nonfinite, ie, iev, ifsal, form
         integer :: i_eval, n_eval, nev_step
         logical :: adaptive, need_dense, reject, last, has_events, store_steps, stop_now
-        logical :: changed
+        logical :: changed, hit, hit_mode, defer_fsal
         integer :: hinfo
+        real(dp) :: target, t_new, h_fixed, h_unclipped
         real(dp), allocatable :: ev_times(:)
         integer, allocatable :: ev_ids(:)
         character(len=32) :: buf
@@ -234,7 +237,8 @@ contains
         if (present(t_eval)) n_eval = size(t_eval)
         store_steps = present(res) .and. n_eval == 0
         if (store_steps) store_steps = opt%save_steps
-        need_dense = has_events .or. n_eval > 0
+        hit_mode = opt%hit_t_eval .and. n_eval > 0
+        need_dense = has_events .or. (n_eval > 0 .and. .not. hit_mode)
         if (present(res)) need_dense = need_dense .or. opt%dense_output
 
         ! ---------------------------------------------------------------- validation
@@ -340,6 +344,9 @@ contains
             nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step*(1.0_dp - 1.0e-12_dp)))
             h = (tf - t0)/real(nsteps, dp)
         end if
+        h_fixed = h
+        ! without dense output, a step hook that may change y gets f evaluated once, after it
+        defer_fsal = present(hook) .and. .not. need_dense .and. opt%method /= METHOD_DOPRI5
 
         facold = 1.0e-4_dp
         reject = .false.
@@ -364,15 +371,25 @@ contains
                 end if
                 exit
             end if
+            ! the point the step must land on if it reaches it: tf, or in hit mode the next
+            ! t_eval point (Hairer's rule: stretch the step by up to 1 % to reach it)
+            target = tf
+            if (hit_mode .and. i_eval <= n_eval) target = t_eval(i_eval)
+            hit = .false.
+            h_unclipped = h
             if (adaptive) then
-                if ((t + 1.01_dp*h - tf)*posneg > 0.0_dp) then
-                    h = tf - t
-                    last = .true.
+                if ((t + 1.01_dp*h - target)*posneg > 0.0_dp) then
+                    h = target - t
+                    hit = .true.
                 end if
             else
-                last = abs(tf - (t + h)) <= 0.5_dp*abs(h)
-                if (last) h = tf - t
+                h = h_fixed
+                if ((target - t)*posneg <= abs(h)*(1.0_dp + 1.0e-8_dp)) then
+                    h = target - t
+                    hit = .true.
+                end if
             end if
+            last = hit .and. target == tf
             nsteps = nsteps + 1
 
             select case (opt%method)
@@ -412,7 +429,6 @@ contains
                     h = h/min(facc1, fac11/safe)
                 end if
                 reject = .true.
-                last = .false.
                 if (st%naccept >= 1) st%nreject = st%nreject + 1
                 cycle
             end if
@@ -426,29 +442,35 @@ contains
                 fac = max(facc2, min(facc1, fac/safe))
                 hnew = h/fac
                 facold = max(err, 1.0e-4_dp)
+                ! a step shortened to land on a point does not shrink the next one
+                if (hit) hnew = posneg*max(abs(hnew), abs(h_unclipped))
             else
-                hnew = h
+                hnew = h_fixed
             end if
+            t_new = t + h
+            if (hit) t_new = target
             ! the new right-hand side (FSAL): all but DOPRI5 evaluate it here
-            if (opt%method /= METHOD_DOPRI5) then
-                call sys%rhs(t + h, ynew, k(:, ifsal))
+            if (opt%method /= METHOD_DOPRI5 .and. .not. defer_fsal) then
+                call sys%rhs(t_new, ynew, k(:, ifsal))
                 st%nfev = st%nfev + 1
             end if
             if (need_dense) call dense_coefs()
 
             stop_now = .false.
-            t_stop = t + h
+            t_stop = t_new
             if (has_events) call find_events()
 
+            ! outputs inside the step from the dense output; a point at the step's end is
+            ! written after the step hook, with the final state
             if (n_eval > 0) then
                 do while (i_eval <= n_eval)
-                    if ((t_eval(i_eval) - t_stop)*posneg > 0.0_dp) exit
-                    if (t_eval(i_eval) == t + h) then
-                        call push_point(res, t + h, ynew)
+                    if (stop_now) then
+                        if ((t_eval(i_eval) - t_stop)*posneg > 0.0_dp) exit
                     else
-                        call interp(fc, form, (t_eval(i_eval) - t)/h, ytmp)
-                        call push_point(res, t_eval(i_eval), ytmp)
+                        if ((t_eval(i_eval) - t_new)*posneg >= 0.0_dp) exit
                     end if
+                    call interp(fc, form, (t_eval(i_eval) - t)/h, ytmp)
+                    call push_point(res, t_eval(i_eval), ytmp)
                     i_eval = i_eval + 1
                 end do
             end if
@@ -467,11 +489,11 @@ contains
             end if
 
             y = ynew
-            t = t + h
-            k(:, 1) = k(:, ifsal)
+            t = t_new
+            if (.not. defer_fsal) k(:, 1) = k(:, ifsal)
             if (present(hook)) then
                 call hook%after_step(t, y, changed, hinfo)
-                if (changed) then
+                if (changed .or. defer_fsal) then
                     call sys%rhs(t, y, k(:, 1))
                     st%nfev = st%nfev + 1
                 end if
@@ -495,6 +517,11 @@ contains
                 exit
             end if
             if (store_steps) call push_point(res, t, y)
+            do while (i_eval <= n_eval)
+                if (t_eval(i_eval) /= t) exit
+                call push_point(res, t, y)
+                i_eval = i_eval + 1
+            end do
             if (last) exit
             if (adaptive) then
                 if (abs(hnew) > hmax) hnew = posneg*hmax
