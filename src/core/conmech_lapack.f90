@@ -4,15 +4,23 @@
 !! fpm.toml and meson.build). The wrappers allocate their own workspace (after a workspace
 !! query where LAPACK offers one) and return an `info` code from `conmech_status`.
 module conmech_lapack
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_SINGULAR, CM_LAPACK_ERROR, CM_BAD_INPUT, &
-        CM_NO_CONVERGENCE
+        CM_NO_CONVERGENCE, CM_NONFINITE
     implicit none
     private
 
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
         dgelsy, dlange, dpstrf, dgesvd, dgeqp3
-    public :: la_solve, la_eig, la_sym_eig, la_det
+    public :: la_solve, la_eig, la_sym_eig, la_det, la_finite
+
+    !> True if every entry is finite (call it before handing data to LAPACK: NaN input
+    !! makes some routines report an illegal argument).
+    interface la_finite
+        module procedure la_finite_1, la_finite_2
+    end interface la_finite
     public :: dpotf2, dpstf2   ! unblocked forms: no ilaenv call, fast for tiny matrices
 
     interface
@@ -157,6 +165,30 @@ module conmech_lapack
 
 contains
 
+    !> conmech's replacement for LAPACK's error handler XERBLA (Fortran name `xerbla`).
+    !!
+    !! Reference LAPACK's XERBLA prints a line and executes STOP, which would end the
+    !! program, and the Python interpreter that imported conmech, with exit status 0. LAPACK
+    !! documents that users may supply their own XERBLA: this one does nothing, so the
+    !! routine returns with its negative INFO, which the callers turn into a status
+    !! (CM_LAPACK_ERROR) with a message. It lives in this module so that every program that
+    !! uses conmech's LAPACK layer (la_* or la_finite) links it.
+    subroutine conmech_xerbla(srname, info, srname_len) bind(c, name="xerbla_")
+        character(kind=c_char), intent(in) :: srname(*)   !! routine name (not used)
+        integer(c_int), intent(in) :: info                 !! bad argument (not used)
+        integer(c_size_t), value :: srname_len             !! hidden length (not used)
+    end subroutine conmech_xerbla
+
+    pure logical function la_finite_1(a) result(ok)
+        real(dp), intent(in) :: a(:)
+        ok = all(ieee_is_finite(a))
+    end function la_finite_1
+
+    pure logical function la_finite_2(a) result(ok)
+        real(dp), intent(in) :: a(:, :)
+        ok = all(ieee_is_finite(a))
+    end function la_finite_2
+
     !> Solve A X = B for a general square A by LU (dgesv). A and B are not changed.
     !! info = CM_SINGULAR if A is exactly singular or its reciprocal condition number
     !! (1-norm, dgecon) is below `rcond_min` (default 1e3*epsilon).
@@ -174,6 +206,10 @@ contains
         if (size(a, 2) /= n .or. size(b, 1) /= n .or. size(x, 1) /= n .or. &
             size(x, 2) /= nrhs) then
             info = CM_BAD_INPUT
+            return
+        end if
+        if (.not. (la_finite(a) .and. la_finite(b))) then
+            info = CM_NONFINITE
             return
         end if
         rmin = 1.0e3_dp*epsilon(1.0_dp)
@@ -214,6 +250,10 @@ contains
             info = CM_BAD_INPUT
             return
         end if
+        if (.not. la_finite(a)) then
+            info = CM_NONFINITE
+            return
+        end if
         jobvr = 'N'
         if (present(vr)) jobvr = 'V'
         allocate (tmp(n, n), vl(1, 1), v(n, n))
@@ -245,6 +285,10 @@ contains
         n = size(a, 1)
         if (size(a, 2) /= n .or. size(w) /= n) then
             info = CM_BAD_INPUT
+            return
+        end if
+        if (.not. la_finite(a)) then
+            info = CM_NONFINITE
             return
         end if
         jobz = 'N'

@@ -33,7 +33,7 @@
 module conmech_constrained_system
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd
+    use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd, la_finite
     use conmech_generalized, only: mass_cholesky
     implicit none
     private
@@ -254,6 +254,10 @@ contains
         info = CM_SUCCESS
         rank = 0
         if (m == 0) return
+        if (.not. (la_finite(s) .and. la_finite(r))) then
+            info = CM_NONFINITE
+            return
+        end if
         f = s
         tol = 1.0e-11_dp*maxval([(abs(s(i, i)), i=1, m)])
         if (m <= 32) then

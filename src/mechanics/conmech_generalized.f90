@@ -15,7 +15,7 @@ module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrf, dpotf2, dpotrs
+    use conmech_lapack, only: dpotrf, dpotf2, dpotrs, la_finite
     use conmech_ode_system, only: ode_system, ode_events
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     implicit none
@@ -91,6 +91,11 @@ contains
         if (size(mm, 2) /= n) then
             info = CM_BAD_INPUT
             if (present(msg)) msg = "bad input: the mass matrix is not square"
+            return
+        end if
+        if (.not. la_finite(mm)) then
+            info = CM_NONFINITE
+            if (present(msg)) msg = "non-finite entries (NaN or Inf) in the mass matrix"
             return
         end if
         if (n <= 32) then

@@ -37,7 +37,7 @@ module conmech_hill_orbit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp, pi
     use conmech_status
-    use conmech_lapack, only: dgesv, la_eig
+    use conmech_lapack, only: dgesv, la_eig, la_finite
     use conmech_rk_tableaus, only: rk_tableau, dop853_tableau
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate, ode_solve, ode_result
@@ -299,6 +299,11 @@ contains
         real(dp) :: lu(4, 4), x(4, 4), b(4, 4), g1(4)
         integer :: ipiv(4), i, j
         g1 = [-1.0_dp, 1.0_dp, 1.0_dp, -1.0_dp]
+        if (.not. la_finite(a)) then
+            mono = 0.0_dp
+            info = CM_NONFINITE
+            return
+        end if
         lu = a
         ! x = A^-1 (G1 A): solve A x = G1 A
         do j = 1, 4

@@ -29,7 +29,7 @@ module conmech_shooting
     use conmech_ode_solver, only: ode_options, METHOD_DOP853
     use conmech_variational, only: integrate_stm
     use conmech_floquet, only: floquet_result, floquet_analysis
-    use conmech_lapack, only: dgelsd
+    use conmech_lapack, only: dgelsd, la_finite
     implicit none
     private
 
@@ -104,6 +104,12 @@ contains
         m = size(a, 1)
         n = size(a, 2)
         ldb = max(m, n)
+        if (.not. (la_finite(a) .and. la_finite(b))) then
+            rank = 0
+            x = 0.0_dp
+            info = CM_NONFINITE
+            return
+        end if
         allocate (aa(m, n), bb(ldb, 1), s(min(m, n)), iwork(64*max(m, n) + 64))
         aa = a
         bb = 0.0_dp
