@@ -40,7 +40,8 @@ program bench_projection
         "round runs "// &
         "every stabilisation once). Ratios are to the unprojected DOP853 of the core "// &
         "integrator (ode_solve on the index-1 form), measured in the same process; 'none' "// &
-        "is the constrained integrator's own loop without projection."
+        "is constrained_solve without projection (ode_solve with the diagnostics at the "// &
+        "outputs)."
     do isys = 1, 2
         write (*, '(a)') ""
         write (*, '(a)') "## "//trim(systems(isys))//": time per step at rtol = atol = 1e-10"
