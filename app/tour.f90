@@ -97,7 +97,7 @@ contains
         end do
         write (*, '(a,f20.16)') "  stability index S        ", orb%stability_index
         write (*, '(a,f20.16)') "  perigee constant c       ", orb%c
-        write (*, '(a,f20.16,a,es9.2)') "  Hill (1877)              ", c_hill, &
+        write (*, '(a,f17.13,a,es9.2)') "  Hill (1877)              ", c_hill, &
             "   difference", abs(orb%c - c_hill)
         write (*, '(a,i0,a,i0)') "  Newton iterations ", orb%iterations, ", nfev ", orb%nfev
     end subroutine hill_part
