@@ -44,7 +44,8 @@ contains
         edrift = abs(sys%energy(res%y(:, res%nt)) - e0)/abs(e0)
         t_exact = 4.0_dp*sqrt(sys%l/sys%g)*ellipk(sin(th0/2.0_dp))
         t_num = res%ev_t(res%nev) - res%ev_t(res%nev - 1)
-        write (*, '(/,a)') "Pendulum theta'' = -(g/l) sin(theta), theta(0) = 2 rad, DOP853, tol 1e-12"
+        write (*, '(/,a)') "Pendulum theta'' = -(g/l) sin(theta), theta(0) = 2 rad, " // &
+            "DOP853, tol 1e-12"
         write (*, '(a,f18.14)') "  period from events     ", t_num
         write (*, '(a,f18.14)') "  4 sqrt(l/g) K(sin 1)   ", t_exact
         write (*, '(a,es10.2)') "  relative energy drift over t = 20:", edrift
@@ -90,8 +91,10 @@ contains
         end if
         write (*, '(a,2f20.16)') "  x0, y'0                  ", orb%y0(1), orb%y0(4)
         write (*, '(a,f20.16)') "  Jacobi constant          ", orb%jacobi
-        write (*, '(a)') "  Floquet multipliers of the monodromy matrix (the pair at 1 is the trivial"
-        write (*, '(a)') "  Jordan block, accurate only to ~sqrt(eps); stability is read from the trace):"
+        write (*, '(a)') "  Floquet multipliers of the monodromy matrix (the pair at 1 is " // &
+            "the trivial"
+        write (*, '(a)') "  Jordan block, accurate only to ~sqrt(eps); stability is read " // &
+            "from the trace):"
         do i = 1, 4
             write (*, '(4x,f19.15,sp,f19.15,"i")') orb%mr(i), orb%mi(i)
         end do

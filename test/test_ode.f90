@@ -358,7 +358,8 @@ contains
                           "hit_t_eval outputs are projected points, interpolated ones are not")
             ! DOP853 with a hook and no dense output: f once per accepted step, after the hook
             call ts%check(res%stats%nfev == 11*(res%stats%naccept + res%stats%nreject) + &
-                          res%stats%naccept + 2, "one evaluation per projected step (FSAL deferred)")
+                          res%stats%naccept + 2, &
+                          "one evaluation per projected step (FSAL deferred)")
         end block
     end subroutine test_hook
 

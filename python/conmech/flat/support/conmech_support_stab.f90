@@ -105,7 +105,8 @@ contains
     end subroutine unpack_eq
 
     subroutine run_orbit(sys, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, &
-                         free_time, period_factor, rtol, atol, max_iter, y0_out, period_out, mono, mr, mi, &
+                         free_time, period_factor, rtol, atol, max_iter, y0_out, period_out, &
+                         mono, mr, mi, &
                          residual, iterations, info, message)
         use, intrinsic :: iso_c_binding, only: c_double, c_int
         use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
