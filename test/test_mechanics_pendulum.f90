@@ -12,13 +12,12 @@ module test_mech_pendulum_types
         procedure :: phi_gamma => tw_gamma
     end type pendulum_twice
 
-    !> The pendulum with phi only: Jacobian and acceleration term by the FD defaults.
-    type, extends(constrained_system) :: pendulum_fd
-        real(dp) :: m = 1.0_dp, g = 9.81_dp, l = 1.0_dp
+    !> The built-in pendulum with its analytic Jacobian and acceleration term replaced by
+    !! the library's finite-difference defaults (fd_phi_jac, fd_phi_gamma).
+    type, extends(pendulum_xy) :: pendulum_fd
     contains
-        procedure :: mass => fd_mass
-        procedure :: forces => fd_forces
-        procedure :: phi => fd_phi
+        procedure :: phi_jac => fdp_jac
+        procedure :: phi_gamma => fdp_gamma
     end type pendulum_fd
 
     !> theta = 0 crossings of the generalized pendulum (y = [theta, theta']).
@@ -61,29 +60,20 @@ contains
         gam = -(v(1)**2 + v(2)**2)
     end subroutine tw_gamma
 
-    subroutine fd_mass(self, t, q, mm)
+    subroutine fdp_jac(self, t, q, g)
         class(pendulum_fd), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: mm(:, :)
-        mm = 0.0_dp
-        mm(1, 1) = self%m
-        mm(2, 2) = self%m
-    end subroutine fd_mass
-    subroutine fd_forces(self, t, q, v, f)
+        real(dp), intent(out) :: g(:, :)
+        call fd_phi_jac(self, t, q, g)
+    end subroutine fdp_jac
+    subroutine fdp_gamma(self, t, q, v, gam)
         class(pendulum_fd), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: f(:)
-        f = [0.0_dp, -self%m*self%g]
-    end subroutine fd_forces
-    subroutine fd_phi(self, t, q, c)
-        class(pendulum_fd), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: c(:)
-        c(1) = 0.5_dp*(q(1)**2 + q(2)**2 - self%l**2)
-    end subroutine fd_phi
+        real(dp), intent(out) :: gam(:)
+        call fd_phi_gamma(self, t, q, v, gam)
+    end subroutine fdp_gamma
 
     !> Complete elliptic integral of the first kind K(k) by the arithmetic-geometric mean.
     pure function ellipk_agm(k) result(kk)
