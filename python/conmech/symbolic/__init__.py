@@ -1,0 +1,1 @@
+"""conmech.symbolic (in progress)."""

@@ -1,0 +1,462 @@
+"""Derivation of the equations of motion with sympy (pure sympy, no code generation).
+
+Three entry points build a :class:`Derived` object, a plain record of sympy expressions in
+*plain symbols* (no functions of t), ready for a code generator:
+
+- :func:`derive_ode`: y' = f(t, y, p) and its Jacobian df/dy;
+- :func:`derive_lagrangian`: generalized coordinates, L = T - U, optional generalized forces:
+  M(t, q), Q(t, q, v), R = [dQ/dq - d(M a)/dq |a fixed, dQ/dv], the energy (Jacobi integral
+  h = v . dL/dv - L, i.e. T + U for a natural scleronomic system);
+- :func:`derive_constrained`: excessive coordinates, T and U, holonomic phi(t, q) = 0 and
+  Pfaffian A(t, q) v + b(t, q) = 0 constraints: M, Q, energy, phi, G, phi_t, gamma_h, A, b,
+  gamma_n (conventions of src/mechanics/conmech_constrained_system.f90:
+  gamma_h = -d/dt[G v + phi_t], gamma_n = -d/dt[A v + b], v held fixed).
+
+Coordinates are either sympy ``dynamicsymbols`` (functions of t; their first derivatives are
+the velocities, second derivatives the accelerations) or plain Symbols, then with
+``velocities=[...]`` plain Symbols standing for their time derivatives. Time is the symbol
+``t`` (``dynamicsymbols._t``; any free symbol named "t").
+
+``params`` maps sympy Symbols, or their names as strings, to float values. Every free symbol
+of the expressions that is not t, a coordinate or a velocity must be a parameter (else
+ValueError naming it); a parameter without a value is a ValueError naming it. Parameters are
+identified by name (Symbol("m", positive=True) and Symbol("m") are the same parameter).
+
+The :class:`Derived` record (attributes; absent items are None):
+
+=============  ==============================================================================
+kind           "ode", "generalized" or "constrained"
+t              the time Symbol
+coords         list of Symbols: y (ode) or q (generalized, constrained)
+speeds         list of Symbols v (velocities; [] for ode)
+accels         list of Symbols a (accelerations, used in R; [] for ode)
+params         list of parameter Symbols, in the order of the run-time array p
+param_names    list of their names; ``param_values``: list of floats
+f, jac         ode: Matrix n x 1, Matrix n x n (df/dy)
+M, Q           mass matrix (nd x nd, depends on t, q, p), forces (nd x 1, t, q, v, p)
+R              generalized only: nd x 2nd, [dQ/dq - d(M a)/dq, dQ/dv] (t, q, v, a, p)
+energy         scalar expression (t, q, v, p) or None
+phi, G, phi_t  constrained: n_hol x 1, n_hol x n, n_hol x 1
+gamma_h        n_hol x 1 (t, q, v, p)
+A, b, gamma_n  n_nh x n, n_nh x 1, n_nh x 1
+n_hol, n_nh    numbers of constraints; ``rheonomic``: phi depends explicitly on t
+=============  ==============================================================================
+
+``Derived.values(**kw)`` returns the parameter vector with some values replaced by name.
+"""
+import random
+
+import numpy as np
+import sympy as sp
+from sympy.core.function import AppliedUndef
+
+__all__ = ["Derived", "derive_ode", "derive_lagrangian", "derive_constrained"]
+
+
+class Derived:
+    """Plain record of the derived expressions (see the module docstring)."""
+
+    def __init__(self, kind, **kw):
+        self.kind = kind
+        self.t = sp.Symbol("t")
+        self.coords, self.speeds, self.accels = [], [], []
+        self.params, self.param_names, self.param_values = [], [], []
+        for name in ("f", "jac", "M", "Q", "R", "energy", "phi", "G", "phi_t", "gamma_h",
+                     "A", "b", "gamma_n"):
+            setattr(self, name, None)
+        self.n_hol = 0
+        self.n_nh = 0
+        self.rheonomic = False
+        for k, v in kw.items():
+            setattr(self, k, v)
+
+    @property
+    def n(self):
+        """Number of coordinates (state dimension for an ode)."""
+        return len(self.coords)
+
+    def values(self, **kw):
+        """The parameter values as a list, with the named ones replaced."""
+        vals = list(self.param_values)
+        for k, v in kw.items():
+            if k not in self.param_names:
+                raise ValueError(f"unknown parameter '{k}' (parameters: "
+                                 f"{', '.join(self.param_names) or 'none'})")
+            vals[self.param_names.index(k)] = _as_value(k, v)
+        return vals
+
+    def __repr__(self):
+        return (f"Derived(kind={self.kind!r}, coords={self.coords}, "
+                f"params={dict(zip(self.param_names, self.param_values))})")
+
+
+# ------------------------------------------------------------------------------ helpers
+
+def _as_value(name, v):
+    if v is None:
+        raise ValueError(f"parameter '{name}' has no value")
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"parameter '{name}' has no numeric value (got {v!r})") from None
+    if not np.isfinite(x):
+        raise ValueError(f"parameter '{name}' must be finite (got {x})")
+    return x
+
+
+def _sympify_list(exprs, what):
+    if isinstance(exprs, sp.MatrixBase):
+        exprs = list(exprs)
+    elif not isinstance(exprs, (list, tuple)):
+        exprs = [exprs]
+    out = []
+    for e in exprs:
+        try:
+            out.append(sp.sympify(e))
+        except (sp.SympifyError, TypeError) as exc:
+            raise TypeError(f"{what}: cannot read {e!r} as a sympy expression") from exc
+    return out
+
+
+class _Coords:
+    """Coordinates q (dynamicsymbols or Symbols), their plain symbols, speeds, accels."""
+
+    def __init__(self, q, velocities, t, need_speeds):
+        if isinstance(q, (sp.Basic,)) and not isinstance(q, sp.MatrixBase):
+            q = [q]
+        q = list(q)
+        if not q:
+            raise ValueError("no coordinates given")
+        self.t = t
+        self.kind = None
+        self.plain, self.speeds, self.accels = [], [], []
+        self.fmap = {}       # functions of t and their derivatives -> plain symbols
+        self.names = []
+        for i, qi in enumerate(q):
+            if isinstance(qi, AppliedUndef):
+                if qi.args != (t,):
+                    raise ValueError(f"coordinate {qi} must be a function of t only")
+                kind = "function"
+                name = str(qi.func)
+            elif isinstance(qi, sp.Symbol):
+                kind = "symbol"
+                name = qi.name
+            else:
+                raise TypeError(f"coordinate {i} ({qi!r}) is neither a sympy Symbol nor a "
+                                "dynamicsymbol (function of t)")
+            if self.kind is None:
+                self.kind = kind
+            elif kind != self.kind:
+                raise ValueError("coordinates must be all dynamicsymbols or all Symbols")
+            if name in self.names:
+                raise ValueError(f"coordinate '{name}' given twice")
+            if name == t.name:
+                raise ValueError(f"the time symbol '{t.name}' cannot be a coordinate")
+            self.names.append(name)
+        if self.kind == "function":
+            if velocities is not None:
+                raise ValueError("velocities= is only for coordinates given as plain Symbols "
+                                 "(dynamicsymbols carry their own derivatives)")
+            for qi, name in zip(q, self.names):
+                qs = sp.Dummy(name)
+                vs = sp.Dummy(name + "_d")
+                as_ = sp.Dummy(name + "_dd")
+                self.plain.append(qs)
+                self.speeds.append(vs)
+                self.accels.append(as_)
+                self.fmap[sp.Derivative(qi, (t, 2))] = as_
+                self.fmap[sp.Derivative(qi, t)] = vs
+                self.fmap[qi] = qs
+        else:
+            self.plain = list(q)
+            if need_speeds:
+                if velocities is None:
+                    raise ValueError("coordinates given as plain Symbols need velocities=[...] "
+                                     "(the Symbols standing for their time derivatives), or "
+                                     "use sympy.physics.mechanics.dynamicsymbols")
+                velocities = list(velocities)
+                if len(velocities) != len(q):
+                    raise ValueError(f"velocities has {len(velocities)} entries for "
+                                     f"{len(q)} coordinates")
+                for v in velocities:
+                    if not isinstance(v, sp.Symbol):
+                        raise TypeError(f"velocity {v!r} is not a sympy Symbol")
+                    if v in self.plain:
+                        raise ValueError(f"'{v}' is both a coordinate and a velocity")
+                self.speeds = velocities
+                self.accels = [sp.Dummy(n + "_dd") for n in self.names]
+            elif velocities is not None:
+                raise ValueError("velocities= has no meaning for a first-order system")
+
+    def convert(self, exprs, what):
+        """Replace the functions of t by plain symbols; reject foreign functions of t."""
+        out = []
+        for e in exprs:
+            e = e.xreplace(self.fmap) if self.fmap else e
+            for d in e.atoms(sp.Derivative):
+                raise ValueError(f"{what} contains the derivative {d} of something that is "
+                                 "not a coordinate (coordinates: " + ", ".join(self.names) + ")")
+            for f in e.atoms(AppliedUndef):
+                raise ValueError(f"{what} depends on {f}, which is not one of the "
+                                 "coordinates " + ", ".join(self.names))
+            out.append(e)
+        return out
+
+
+def _time_symbol(exprs):
+    """The time symbol: the free symbol named 't' (the same as dynamicsymbols._t)."""
+    return sp.Symbol("t")
+
+
+def _unify_time(exprs, t):
+    """Replace every free symbol named 't' (whatever its assumptions) by t."""
+    out = []
+    for e in exprs:
+        subs = {s: t for s in e.free_symbols if s.name == t.name and s != t}
+        out.append(e.xreplace(subs) if subs else e)
+    return out
+
+
+def _resolve_params(params, exprs, known, t):
+    """Parameter symbols (in order), names and values; checks every free symbol."""
+    if params is None:
+        params = {}
+    if isinstance(params, (list, tuple, set)):
+        # symbols without values
+        for p in params:
+            raise ValueError(f"parameter '{p}' has no value (give params as a dict "
+                             "{symbol or name: value})")
+    if not isinstance(params, dict):
+        raise TypeError("params must be a dict {sympy Symbol or name: value}")
+    known_names = {s.name for s in known} | {t.name}
+    free = set()
+    for e in exprs:
+        free |= e.free_symbols
+    by_name = {}
+    for s in free:
+        if s.name in known_names:
+            continue
+        by_name.setdefault(s.name, []).append(s)
+    names, values = [], []
+    for k, v in params.items():
+        if isinstance(k, sp.Symbol):
+            name = k.name
+        elif isinstance(k, str):
+            name = k
+        else:
+            raise TypeError(f"params key {k!r} must be a sympy Symbol or a string")
+        if not name.isidentifier():
+            raise ValueError(f"parameter name '{name}' is not an identifier")
+        if name in known_names:
+            raise ValueError(f"'{name}' is a coordinate, a velocity or the time, not a "
+                             "parameter")
+        if name in names:
+            raise ValueError(f"parameter '{name}' given twice")
+        names.append(name)
+        values.append(_as_value(name, v))
+    unknown = sorted(set(by_name) - set(names))
+    if unknown:
+        raise ValueError("unknown symbol(s) " + ", ".join(f"'{u}'" for u in unknown)
+                         + ": neither a coordinate, a velocity, t nor a parameter with a "
+                         "value (add it to params=)")
+    psyms = [sp.Symbol(n) for n in names]
+    # map every free symbol of the same name onto one canonical parameter symbol
+    sub = {}
+    for n, ps in zip(names, psyms):
+        for s in by_name.get(n, []):
+            if s != ps:
+                sub[s] = ps
+    return psyms, names, values, sub
+
+
+def _subs_all(exprs, sub):
+    return [e.xreplace(sub) if sub else e for e in exprs]
+
+
+def _check_mass(M, coords, speeds, params, values, t):
+    """ValueError if M depends on the velocities or is singular identically (seen at random
+    states and random parameter values)."""
+    bad = M.free_symbols & set(speeds)
+    if bad:
+        raise ValueError("the mass matrix depends on the velocities "
+                         f"({', '.join(map(str, bad))}): the Lagrangian must be quadratic "
+                         "in the velocities")
+    n = M.shape[0]
+    if M.shape[0] != M.shape[1]:
+        raise ValueError(f"mass matrix is not square ({M.shape[0]} x {M.shape[1]})")
+    args = [t] + list(coords) + list(params)
+    fM = sp.lambdify(args, M, modules="numpy")
+    rng = random.Random(12345)
+    singular_everywhere = True
+    for trial in range(3):
+        vals = [rng.uniform(0.3, 1.3)] + [rng.uniform(-1.0, 1.0) for _ in coords]
+        if trial == 0:
+            vals += list(values)
+        else:
+            vals += [v * rng.uniform(0.7, 1.3) if v != 0 else rng.uniform(0.5, 1.5)
+                     for v in values]
+        try:
+            with np.errstate(all="ignore"):
+                A = np.array(fM(*vals), dtype=float).reshape(n, n)
+        except (ZeroDivisionError, ValueError, TypeError):
+            singular_everywhere = False
+            continue
+        if not np.all(np.isfinite(A)):
+            singular_everywhere = False
+            continue
+        s = np.linalg.svd(A, compute_uv=False)
+        if s[0] > 0 and s[-1] > 1e-12 * s[0]:
+            singular_everywhere = False
+            break
+    if singular_everywhere:
+        det = sp.simplify(M.det()) if n <= 4 else 0
+        if det == 0:
+            raise ValueError("the mass matrix is singular identically (det M = 0): a "
+                             "coordinate has no kinetic energy, or the coordinates are "
+                             "dependent")
+
+
+# ------------------------------------------------------------------------------ ode
+
+def derive_ode(f, y, params=None):
+    """y' = f(t, y, p): f (list of expressions), y (Symbols or dynamicsymbols)."""
+    t = sp.Symbol("t")
+    f = _unify_time(_sympify_list(f, "f"), t)
+    c = _Coords(y, None, t, need_speeds=False)
+    if len(f) != len(c.plain):
+        raise ValueError(f"f has {len(f)} components for {len(c.plain)} state variables")
+    # for dynamicsymbols: y_i(t) -> plain; derivatives of y in f are an error
+    f = c.convert(f, "f")
+    psyms, names, values, sub = _resolve_params(params, f, c.plain, t)
+    f = _subs_all(f, sub)
+    F = sp.Matrix(f)
+    J = F.jacobian(c.plain)
+    return Derived("ode", t=t, coords=c.plain, coord_names=c.names, params=psyms,
+                   param_names=names, param_values=values, f=F, jac=J)
+
+
+# ------------------------------------------------------------------------------ Lagrange
+
+def _euler_lagrange(L, q, v, t):
+    """M (Hessian of L in v) and the velocity/potential part of Q (without q'')."""
+    p = [sp.diff(L, vi) for vi in v]
+    n = len(q)
+    M = sp.Matrix(n, n, lambda i, j: sp.diff(p[i], v[j]))
+    Q = []
+    for i in range(n):
+        dpdt = sum((sp.diff(p[i], q[j]) * v[j] for j in range(n)), sp.Integer(0)) \
+            + sp.diff(p[i], t)
+        Q.append(sp.diff(L, q[i]) - dpdt)
+    return M, sp.Matrix(Q), p
+
+
+def _energy(L, M, v):
+    """Jacobi integral h = v . dL/dv - L = v^T M v / 2 - L(v = 0) for L quadratic in v
+    (T + U for a natural scleronomic system)."""
+    vv = sp.Matrix(v)
+    return sp.expand((vv.T * M * vv)[0, 0] / 2) - L.xreplace({vi: 0 for vi in v})
+
+
+def _forces_list(forces, n, what="forces"):
+    if forces is None:
+        return [sp.Integer(0)] * n
+    fl = _sympify_list(forces, what)
+    if len(fl) != n:
+        raise ValueError(f"{what} has {len(fl)} components for {n} coordinates")
+    return fl
+
+
+def derive_lagrangian(L, q, params=None, forces=None, velocities=None):
+    """M q'' = Q from the Lagrangian L(t, q, q'); optional generalized forces."""
+    t = sp.Symbol("t")
+    c = _Coords(q, velocities, t, need_speeds=True)
+    n = len(c.plain)
+    exprs = _unify_time(_sympify_list(L, "L") + _forces_list(forces, n), t)
+    if len(exprs) != n + 1:
+        raise ValueError("L must be a single expression")
+    exprs = c.convert(exprs, "L")
+    _check_no_accel(exprs, c)
+    known = list(c.plain) + list(c.speeds)
+    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
+    exprs = _subs_all(exprs, sub)
+    Lp, fq = exprs[0], exprs[1:]
+    M, Q, mom = _euler_lagrange(Lp, c.plain, c.speeds, t)
+    _check_mass(M, c.plain, c.speeds, psyms, values, t)
+    Q = Q + sp.Matrix(fq)
+    Ma = M * sp.Matrix(c.accels)
+    R = (Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds))
+    energy = _energy(Lp, M, c.speeds)
+    return Derived("generalized", t=t, coords=c.plain, coord_names=c.names,
+                   speeds=c.speeds, accels=c.accels, params=psyms, param_names=names,
+                   param_values=values, M=M, Q=Q, R=R, energy=energy, lagrangian=Lp)
+
+
+def _check_no_accel(exprs, c):
+    acc = set(c.accels)
+    for e in exprs:
+        if e.free_symbols & acc:
+            raise ValueError("the expressions must not contain accelerations (second "
+                             "derivatives of the coordinates)")
+
+
+# ------------------------------------------------------------------------------ constrained
+
+def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None,
+                       velocities=None):
+    """Excessive coordinates q with L = T - U, holonomic phi(t, q) = 0 and Pfaffian
+    constraints given as expressions linear in the velocities (A q' + b = 0)."""
+    t = sp.Symbol("t")
+    c = _Coords(q, velocities, t, need_speeds=True)
+    n = len(c.plain)
+    hol = _sympify_list(list(holonomic) if not isinstance(holonomic, sp.Basic)
+                        else [holonomic], "holonomic")
+    nh = _sympify_list(list(nonholonomic) if not isinstance(nonholonomic, sp.Basic)
+                       else [nonholonomic], "nonholonomic")
+    base = _sympify_list(T, "T") + _sympify_list(U, "U") + _forces_list(forces, n)
+    if len(base) != n + 2:
+        raise ValueError("T and U must be single expressions")
+    exprs = _unify_time(base + hol + nh, t)
+    exprs = c.convert(exprs, "the expressions")
+    _check_no_accel(exprs, c)
+    known = list(c.plain) + list(c.speeds)
+    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
+    exprs = _subs_all(exprs, sub)
+    Tp, Up, fq = exprs[0], exprs[1], exprs[2:2 + n]
+    hol = exprs[2 + n:2 + n + len(hol)]
+    nh = exprs[2 + n + len(hol):]
+    if Up.free_symbols & set(c.speeds):
+        raise ValueError("U must not depend on the velocities")
+    L = Tp - Up
+    M, Q, mom = _euler_lagrange(L, c.plain, c.speeds, t)
+    _check_mass(M, c.plain, c.speeds, psyms, values, t)
+    Q = Q + sp.Matrix(fq)
+    energy = _energy(L, M, c.speeds)
+    q_, v_ = c.plain, c.speeds
+    vv = sp.Matrix(v_)
+    d = Derived("constrained", t=t, coords=q_, coord_names=c.names, speeds=v_,
+                accels=c.accels, params=psyms, param_names=names, param_values=values,
+                M=M, Q=Q, energy=energy, lagrangian=L, n_hol=len(hol), n_nh=len(nh))
+    if hol:
+        for i, h in enumerate(hol):
+            if h.free_symbols & set(v_):
+                raise ValueError(f"holonomic constraint {i} depends on the velocities "
+                                 "(give it as nonholonomic)")
+        phi = sp.Matrix(hol)
+        G = phi.jacobian(q_)
+        phi_t = sp.diff(phi, t)
+        w = G * vv + phi_t                       # d phi/dt
+        gamma_h = -(w.jacobian(q_) * vv + sp.diff(w, t))
+        d.phi, d.G, d.phi_t, d.gamma_h = phi, G, phi_t, gamma_h
+        d.rheonomic = any(sp.simplify(e) != 0 for e in phi_t) if len(hol) < 8 \
+            else any(e != 0 for e in phi_t)
+    if nh:
+        E = sp.Matrix(nh)
+        A = E.jacobian(v_)
+        if A.free_symbols & set(v_):
+            raise ValueError("a non-holonomic constraint is not linear in the velocities "
+                             "(Pfaffian form A(t, q) q' + b(t, q) = 0 required)")
+        b = E.xreplace({vi: 0 for vi in v_})
+        w = A * vv + b
+        gamma_n = -(w.jacobian(q_) * vv + sp.diff(w, t))
+        d.A, d.b, d.gamma_n = A, b, gamma_n
+    return d
