@@ -167,8 +167,8 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
     return _finish(d, time.perf_counter() - t0, flags, model_only)
 
 
-def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, flags=None,
-                      model_only=False):
+def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
+                      flags=None, model_only=False):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -177,14 +177,16 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, flags=
     forces : optional generalized non-conservative forces, one expression per coordinate
              (in t, q, q' and the parameters).
     params : dict {Symbol or name: value}.
+    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, when L is
+               small enough: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
     """
     t0 = time.perf_counter()
-    d = derive_lagrangian(L, q, params, forces, velocities)
+    d = derive_lagrangian(L, q, params, forces, velocities, simplify)
     return _finish(d, time.perf_counter() - t0, flags, model_only)
 
 
 def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
-                       velocities=None, flags=None, model_only=False):
+                       velocities=None, simplify="auto", flags=None, model_only=False):
     """A compiled system in excessive coordinates for ``conmech.constrained.solve``:
     kinetic energy T, potential U, holonomic constraints phi(t, q) = 0 and non-holonomic
     constraints given as expressions linear in the velocities (A(t, q) q' + b(t, q) = 0).
@@ -192,5 +194,6 @@ def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     integral); rheonomic constraints (explicit t) are detected.
     """
     t0 = time.perf_counter()
-    d = derive_constrained(T, U, q, holonomic, nonholonomic, params, forces, velocities)
+    d = derive_constrained(T, U, q, holonomic, nonholonomic, params, forces, velocities,
+                           simplify)
     return _finish(d, time.perf_counter() - t0, flags, model_only)
