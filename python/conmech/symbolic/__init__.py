@@ -38,7 +38,7 @@ from .codegen import generate
 from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
-           "CompileError", "cache_dir", "Derived", "compile_model"]
+           "CompileError", "cache_dir", "Derived", "compile_model", "model_of"]
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
@@ -118,6 +118,17 @@ def compile_model(derived, flags=None):
     return CompiledModel(derived, src, path, lib, addr, hit, times)
 
 
+def model_of(system):
+    """The :class:`CompiledModel` (derived expressions, source, library) behind a system
+    made by this module (also after ``with_params``)."""
+    keep = getattr(system, "_keep", None)
+    if isinstance(system, CompiledModel):
+        return system
+    if isinstance(keep, tuple) and keep and isinstance(keep[0], CompiledModel):
+        return keep[0]
+    raise TypeError("not a system made by conmech.symbolic")
+
+
 def _compiled_module():
     try:
         from .. import compiled
@@ -134,7 +145,8 @@ def _system(model):
     if compiled is None:
         return model
     a = model.addresses
-    common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model)
+    common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model,
+                  name="symbolic")
     if d.kind == "ode":
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], **common)
     if d.kind == "generalized":
