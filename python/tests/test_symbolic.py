@@ -187,6 +187,20 @@ def test_cache_hit_loads_without_compiling(symbolic_cache):
     a = symbolic.ode_system(f, y, params={mu: 0.1}, model_only=True)
     b = symbolic.ode_system(f, y, params={mu: 0.1}, model_only=True)
     assert b.cache_hit and b.path == a.path
+    # the derivation is cached too: the second construction runs no sympy derivation
+    assert b.times["derive"] == 0.0 and "derived_cache" in b.times
+    assert b.derived.param_values == [0.1]
+    c = symbolic.ode_system(f, y, params={"mu": 0.2}, model_only=True)
+    assert c.path == a.path and c.derived.param_values == [0.2]
+    # a corrupt derivation-cache entry is ignored (derived again, then rewritten)
+    entries = [e for e in os.listdir(symbolic_cache) if e.endswith(".derived.pickle")]
+    for e in entries:
+        with open(os.path.join(symbolic_cache, e), "wb") as fh:
+            fh.write(b"not a pickle")
+    d = symbolic.ode_system(f, y, params={mu: 0.1}, model_only=True)
+    assert d.times["derive"] > 0 and d.path == a.path
+    e = symbolic.ode_system(f, y, params={mu: 0.1}, model_only=True)
+    assert e.times["derive"] == 0.0
     assert os.path.dirname(b.path) == symbolic_cache
     assert os.path.basename(b.path) == f"conmech_{build.library_path(b.source)[1]}.so"
     # the key changes with the flags

@@ -29,12 +29,16 @@ Layout: ``derive.py`` (pure sympy, the :class:`~conmech.symbolic.derive.Derived`
 public constructors).
 """
 import ctypes
+import hashlib
+import os
+import pickle
 import time
 
 import numpy as np
+import sympy as sp
 
-from .build import CompileError, cache_dir, compile_source, load
-from .codegen import generate
+from .build import CompileError, _conmech_version, cache_dir, compile_source, load
+from .codegen import CODEGEN_VERSION, generate
 from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
@@ -160,9 +164,90 @@ def _system(model):
         rheonomic=bool(d.rheonomic), **common)
 
 
-def _finish(derived, t_derive, flags, model_only):
-    model = compile_model(derived, flags)
-    model.times["derive"] = t_derive
+def _input_key(kind, inputs, params, options):
+    """Key of a construction's inputs (expressions, parameter names, options), or None when
+    the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
+    if not isinstance(params, dict):
+        return None
+    names = []
+    for k, v in params.items():
+        if isinstance(k, sp.Symbol):
+            names.append(k.name)
+        elif isinstance(k, str):
+            names.append(k)
+        else:
+            return None
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+            return None
+    try:
+        text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
+                            for x in inputs], names, options, CODEGEN_VERSION,
+                     _conmech_version()))
+    except (sp.SympifyError, TypeError, AttributeError):
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _entry_path(key):
+    return os.path.join(cache_dir(), f"conmech_{key}.derived.pickle")
+
+
+def _from_cache(key, params, flags):
+    """The model from the derivation cache (derived record + source), or None."""
+    path = _entry_path(key)
+    if not os.path.isfile(path):
+        return None
+    t0 = time.perf_counter()
+    try:
+        with open(path, "rb") as fh:
+            d, src, entries, fl = pickle.load(fh)
+    except Exception:        # a stale or foreign entry: derive again
+        return None
+    if fl != (list(flags) if flags is not None else None):
+        return None
+    d.param_values = [float(v) for v in params.values()]
+    if len(d.param_values) != len(d.param_names) or not np.all(np.isfinite(d.param_values)):
+        return None
+    t1 = time.perf_counter()
+    lib_path, hit = compile_source(src, flags)
+    t2 = time.perf_counter()
+    lib, addr = load(lib_path, entries)
+    t3 = time.perf_counter()
+    times = {"derive": 0.0, "derived_cache": t1 - t0, "generate": 0.0,
+             "compile_or_load": t2 - t1, "load": t3 - t2}
+    return CompiledModel(d, src, lib_path, lib, addr, hit, times)
+
+
+def _store(key, model, flags):
+    path = _entry_path(key)
+    d = model.derived
+    tmp = f"{path}.{os.getpid()}.tmp"
+    try:
+        with open(tmp, "wb") as fh:
+            pickle.dump((d, model.source, list(model.addresses),
+                         list(flags) if flags is not None else None), fh)
+        os.replace(tmp, path)
+    except Exception:        # the derivation cache is an optimisation only
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
+def _construct(kind, inputs, params, options, derive, flags, model_only):
+    """Derive (or take the derivation from the cache), compile (or load), wrap."""
+    t0 = time.perf_counter()
+    params = {} if params is None else params
+    key = _input_key(kind, inputs, params, options)
+    model = _from_cache(key, params, flags) if key else None
+    if model is None:
+        d = derive()
+        t1 = time.perf_counter()
+        model = compile_model(d, flags)
+        model.times["derive"] = t1 - t0
+        if key:
+            _store(key, model, flags)
+    model.times["total"] = time.perf_counter() - t0
     return model if model_only else _system(model)
 
 
@@ -174,9 +259,8 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
     params : dict {Symbol or name: value}; every other free symbol is an error.
     Returns a ``conmech.compiled`` system (``model_only=True``: the :class:`CompiledModel`).
     """
-    t0 = time.perf_counter()
-    d = derive_ode(f, y, params)
-    return _finish(d, time.perf_counter() - t0, flags, model_only)
+    return _construct("ode", [_tup(f), _tup(y)], params, (), lambda: derive_ode(f, y, params),
+                      flags, model_only)
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
@@ -192,9 +276,10 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     simplify : True, False or "auto" (a fast trigonometric clean-up of L first, when L is
                small enough: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
     """
-    t0 = time.perf_counter()
-    d = derive_lagrangian(L, q, params, forces, velocities, simplify)
-    return _finish(d, time.perf_counter() - t0, flags, model_only)
+    return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
+                      (simplify,),
+                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify),
+                      flags, model_only)
 
 
 def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
@@ -205,7 +290,19 @@ def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     Derives M, Q, G = d phi/dq, phi_t, gamma_h, A, b, gamma_n and the energy T + U (Jacobi
     integral); rheonomic constraints (explicit t) are detected.
     """
-    t0 = time.perf_counter()
-    d = derive_constrained(T, U, q, holonomic, nonholonomic, params, forces, velocities,
-                           simplify)
-    return _finish(d, time.perf_counter() - t0, flags, model_only)
+    return _construct("constrained", [T, U, _tup(q), _tup(holonomic), _tup(nonholonomic),
+                                      _tup(forces), _tup(velocities)], params, (simplify,),
+                      lambda: derive_constrained(T, U, q, holonomic, nonholonomic, params,
+                                                 forces, velocities, simplify),
+                      flags, model_only)
+
+
+def _tup(x):
+    """A sympy Tuple of a list of expressions (for the input key)."""
+    if x is None:
+        return None
+    if isinstance(x, sp.MatrixBase):
+        x = list(x)
+    if isinstance(x, (list, tuple)):
+        return sp.Tuple(*x)
+    return x
