@@ -314,3 +314,14 @@ def test_velocity_dependent_mass_and_nonlinear_pfaffian_are_rejected():
     with pytest.raises(ValueError, match="holonomic constraint 0 depends on the velocities"):
         symbolic.constrained_system((x.diff(t)**2 + y.diff(t)**2)/2, 0, [x, y],
                                     holonomic=[x.diff(t) - y])
+
+
+def test_mass_matrix_singular_at_run_time_is_a_failure_not_a_crash():
+    """M = x^2 vanishes at x = 0, reached at t = 1/2 from x = 1, x' = -1 (x x' = -1):
+    the integration stops with success=False at that time, with a message."""
+    import conmech
+    x = dynamicsymbols("x")
+    sysm = symbolic.lagrangian_system(x**2*x.diff(t)**2/2, [x], simplify=False)
+    r = conmech.solve_ivp(sysm, (0, 5), [1.0, -1.0])
+    assert not r.success and r.message
+    assert abs(r.t[-1] - 0.5) < 1e-3
