@@ -13,7 +13,8 @@ endpoint difference symbolic vs builtin. Then the construction costs of conmech.
 a fresh cache: sympy derivation, code generation, first compile (gfortran), and a second
 construction (cache hit) in the same process and in a new process.
 
-Usage:  python bench/bench_symbolic_builtin.py [--repeat 5] [--out bench/results/symbolic_builtin.md]
+Usage:  python bench/bench_symbolic_builtin.py [--repeat 5]
+                                              [--out bench/results/symbolic_builtin.md]
 """
 import argparse
 import datetime

@@ -325,3 +325,46 @@ def test_mass_matrix_singular_at_run_time_is_a_failure_not_a_crash():
     r = conmech.solve_ivp(sysm, (0, 5), [1.0, -1.0])
     assert not r.success and r.message
     assert abs(r.t[-1] - 0.5) < 1e-3
+
+
+def test_nonconservative_forces_enter_q_and_the_exact_jacobian():
+    """Damped pendulum m l^2 th'' = -m g l sin th - c th': the force is in Q, dQ/dv = -c in
+    R, and the energy decays at the rate -c th'^2 along the solution."""
+    import conmech
+    th = dynamicsymbols("theta")
+    m, g, l, c = sp.symbols("m g l c")
+    L = m*l**2*th.diff(t)**2/2 + m*g*l*sp.cos(th)
+    P = dict(m=1.0, g=9.81, l=1.0, c=0.3)
+    sysm = symbolic.lagrangian_system(L, [th], params=P, forces=[-c*th.diff(t)])
+    mod = symbolic.model_of(sysm)
+    assert rel(mod.call("forces", 0.0, [0.4], [1.5]), [-9.81*np.sin(0.4) - 0.3*1.5]) < 1e-15
+    R = mod.call("forces_jac", 0.0, [0.4], [1.5], [0.0])
+    assert rel(R, [[-9.81*np.cos(0.4), -0.3]]) < 1e-15
+    r = conmech.solve_ivp(sysm, (0, 4), [1.0, 0.0], rtol=1e-11, atol=1e-11,
+                          t_eval=np.linspace(0, 4, 401), dense_output=False)
+    E = np.array([mod.call("energy", 0.0, [a], [b]) for a, b in r.y.T])
+    dE = np.gradient(E, r.t)
+    assert np.max(np.abs(dE[5:-5] + 0.3*r.y[1, 5:-5]**2)) < 1e-3
+    # with_params: no damping, the energy is conserved (same library)
+    r0 = conmech.solve_ivp(sysm.with_params(c=0.0), (0, 4), [1.0, 0.0], rtol=1e-11,
+                           atol=1e-11)
+    E0 = [mod.call("energy", 0.0, [a], [b], params=[1.0, 9.81, 1.0, 0.0]) for a, b in r0.y.T]
+    assert np.max(np.abs(np.array(E0) - E0[0])) < 1e-9
+
+
+def test_constrained_with_params_changes_the_multiplier():
+    """Cartesian pendulum at rest at the bottom: lambda = m/l^2 (y g - v^2) = -m g / l (seed
+    000, phi = (x^2+y^2-l^2)/2), and with_params(m=2) doubles it without recompiling."""
+    import conmech
+    x, y = dynamicsymbols("x y")
+    m, g, l = sp.symbols("m g l")
+    sysm = symbolic.constrained_system(m*(x.diff(t)**2 + y.diff(t)**2)/2, m*g*y, [x, y],
+                                       holonomic=[(x**2 + y**2 - l**2)/2],
+                                       params=dict(m=1.0, g=9.81, l=1.5))
+    for mass in (1.0, 2.0):
+        s = sysm.with_params(m=mass)
+        r = conmech.constrained.solve(s, (0, 1), [0.0, -1.5], [0.0, 0.0], rtol=1e-12,
+                                      atol=1e-12)
+        assert r.success
+        assert np.max(np.abs(r.lam[0] + mass*9.81/1.5)) < 1e-10
+        assert symbolic.model_of(s) is symbolic.model_of(sysm)

@@ -27,7 +27,8 @@ import keyword
 import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
-__all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare", "ENTRY_POINTS"]
+__all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
+           "ENTRY_POINTS"]
 
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {

@@ -203,11 +203,6 @@ class _Coords:
         return out
 
 
-def _time_symbol(exprs):
-    """The time symbol: the free symbol named 't' (the same as dynamicsymbols._t)."""
-    return sp.Symbol("t")
-
-
 def _unify_time(exprs, t):
     """Replace every free symbol named 't' (whatever its assumptions) by t."""
     out = []
@@ -347,7 +342,7 @@ def _euler_lagrange(L, q, v, t):
         dpdt = sum((sp.diff(p[i], q[j]) * v[j] for j in range(n)), sp.Integer(0)) \
             + sp.diff(p[i], t)
         Q.append(sp.diff(L, q[i]) - dpdt)
-    return M, sp.Matrix(Q), p
+    return M, sp.Matrix(Q)
 
 
 def _energy(L, M, v):
@@ -403,7 +398,7 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
     Lp, fq = _maybe_simplify(exprs[0], simplify), exprs[1:]
-    M, Q, mom = _euler_lagrange(Lp, c.plain, c.speeds, t)
+    M, Q = _euler_lagrange(Lp, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
     Ma = M * sp.Matrix(c.accels)
@@ -450,7 +445,7 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     if Up.free_symbols & set(c.speeds):
         raise ValueError("U must not depend on the velocities")
     L = _maybe_simplify(Tp - Up, simplify)
-    M, Q, mom = _euler_lagrange(L, c.plain, c.speeds, t)
+    M, Q = _euler_lagrange(L, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
     energy = _energy(L, M, c.speeds)
