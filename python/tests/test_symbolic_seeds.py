@@ -263,3 +263,21 @@ def test_events_on_a_symbolic_system():
     te = np.asarray(r.t_events[0])
     assert te.size == 2
     assert np.max(np.abs(te - [period/4, 3*period/4])) < 1e-9
+
+
+def test_periodic_orbit_limit_cycle_of_a_symbolic_ode():
+    """Van der Pol's limit cycle by Newton shooting (periodic_orbit, free period) on the
+    formulas vs the built-in: same period and multipliers; the nontrivial multiplier is
+    exp(integral of the divergence) < 1 (stable), the other is 1."""
+    x, v, mu = sp.symbols("x v mu")
+    sym = symbolic.ode_system([v, mu*(1 - x**2)*v - x], [x, v], params={mu: 1.0})
+    built = conmech.systems.vanderpol(mu=1.0)
+    guess = [2.0, 0.0]
+    oa = stability.periodic_orbit(sym, guess, 6.66)
+    ob = stability.periodic_orbit(built, guess, 6.66)
+    assert abs(oa.period - 6.663286859323130) < 1e-8          # Van der Pol, mu = 1
+    assert abs(oa.period - ob.period) < 1e-10
+    ma = np.sort(np.abs(oa.multipliers))
+    mb = np.sort(np.abs(ob.multipliers))
+    assert abs(ma[1] - 1.0) < 1e-7 and ma[0] < 0.1
+    assert abs(ma[0] - mb[0]) < 1e-7
