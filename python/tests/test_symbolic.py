@@ -368,3 +368,26 @@ def test_constrained_with_params_changes_the_multiplier():
         assert r.success
         assert np.max(np.abs(r.lam[0] + mass*9.81/1.5)) < 1e-10
         assert symbolic.model_of(s) is symbolic.model_of(sysm)
+
+
+def test_elementary_and_piecewise_functions_compile_exactly():
+    """abs, exp, log, tanh, atan2, Piecewise, Max, sign, Heaviside, asin, cube roots and
+    real powers: generated values and Jacobians equal sympy's (the Jacobian of sign /
+    Heaviside is taken away from the jump)."""
+    x, v = sp.symbols("x v", real=True)
+    f = [sp.Abs(x)*sp.exp(-v) + sp.log(1 + x**2),
+         sp.tanh(v) + sp.atan2(v, x) + sp.Piecewise((x, x > 0), (x**2, True)) + sp.Max(x, v)
+         + sp.sign(x) + sp.asin(x/5) + sp.cbrt(x**2 + 1) + (x**2 + 1)**0.7 + sp.Heaviside(v)]
+    mod = symbolic.ode_system(f, [x, v], model_only=True)
+    F = sp.lambdify([x, v], f)
+    J = sp.lambdify([x, v], sp.Matrix(f).jacobian([x, v]).replace(sp.DiracDelta,
+                                                                   lambda *a: 0))
+    for s in ([0.5, 0.3], [1.2, -0.4], [-0.5, 0.7], [-1.3, -0.2]):
+        assert np.max(np.abs(mod.call("rhs", 0.0, s) - np.array(F(*s)))) < 1e-14
+        assert np.max(np.abs(mod.call("jac", 0.0, s) - np.array(J(*s), float))) < 1e-14
+
+
+def test_unsupported_function_is_a_clear_error():
+    x, v = sp.symbols("x v")
+    with pytest.raises(ValueError, match="cannot generate Fortran for"):
+        symbolic.ode_system([v, sp.gamma(x)], [x, v])

@@ -264,6 +264,32 @@ def _resolve_params(params, exprs, known, t):
     return psyms, names, values, sub
 
 
+def _realify(exprs, t, c, psyms):
+    """Replace t, the coordinates, velocities, accelerations and parameters by real
+    Dummies of the same names (so that e.g. d|x|/dx = sign(x), not re/im terms); updates
+    the coordinate record in place; returns (exprs, t, params)."""
+    sub = {}
+
+    def real(s):
+        r = sp.Dummy(s.name, real=True)
+        sub[s] = r
+        return r
+    t_r = real(t)
+    c.plain = [real(s) for s in c.plain]
+    c.speeds = [real(s) for s in c.speeds]
+    c.accels = [real(s) for s in c.accels]
+    p_r = [real(s) for s in psyms]
+    return [e.xreplace(sub) for e in exprs], t_r, p_r
+
+
+def _ae(mat):
+    """Jacobians almost everywhere: the DiracDelta of a differentiated sign / Heaviside
+    (e.g. Coulomb friction) is dropped (the derivative away from the jump)."""
+    if mat.has(sp.DiracDelta):
+        return mat.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
+    return mat
+
+
 def _subs_all(exprs, sub):
     return [e.xreplace(sub) if sub else e for e in exprs]
 
@@ -324,8 +350,9 @@ def derive_ode(f, y, params=None):
     f = c.convert(f, "f")
     psyms, names, values, sub = _resolve_params(params, f, c.plain, t)
     f = _subs_all(f, sub)
+    f, t, psyms = _realify(f, t, c, psyms)
     F = sp.Matrix(f)
-    J = F.jacobian(c.plain)
+    J = _ae(F.jacobian(c.plain))
     return Derived("ode", t=t, coords=c.plain, coord_names=c.names, params=psyms,
                    param_names=names, param_values=values, f=F, jac=J)
 
@@ -397,12 +424,13 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     known = list(c.plain) + list(c.speeds)
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
+    exprs, t, psyms = _realify(exprs, t, c, psyms)
     Lp, fq = _maybe_simplify(exprs[0], simplify), exprs[1:]
     M, Q = _euler_lagrange(Lp, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
     Ma = M * sp.Matrix(c.accels)
-    R = (Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds))
+    R = _ae((Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds)))
     energy = _energy(Lp, M, c.speeds)
     return Derived("generalized", t=t, coords=c.plain, coord_names=c.names,
                    speeds=c.speeds, accels=c.accels, params=psyms, param_names=names,
@@ -439,6 +467,7 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     known = list(c.plain) + list(c.speeds)
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
+    exprs, t, psyms = _realify(exprs, t, c, psyms)
     Tp, Up, fq = exprs[0], exprs[1], exprs[2:2 + n]
     hol = exprs[2 + n:2 + n + len(hol)]
     nh = exprs[2 + n + len(hol):]
