@@ -391,3 +391,15 @@ def test_unsupported_function_is_a_clear_error():
     x, v = sp.symbols("x v")
     with pytest.raises(ValueError, match="cannot generate Fortran for"):
         symbolic.ode_system([v, sp.gamma(x)], [x, v])
+
+
+def test_symbol_with_a_coordinate_name_and_equation_constraints():
+    x, y = dynamicsymbols("x y")
+    m, l = sp.symbols("m l")
+    T = m*(x.diff(t)**2 + y.diff(t)**2)/2
+    with pytest.raises(ValueError, match="has the name of a coordinate"):
+        symbolic.lagrangian_system(T - sp.Symbol("x")**2, [x, y], params={m: 1.0})
+    # a holonomic constraint may be written as an equation lhs == rhs
+    mod = symbolic.constrained_system(T, 0, [x, y], holonomic=[sp.Eq(x**2 + y**2, l**2)],
+                                      params={m: 1.0, l: 2.0}, model_only=True)
+    assert rel(mod.call("phi", 0.0, [1.0, 1.0]), [-2.0]) < 1e-15

@@ -112,9 +112,14 @@ def _sympify_list(exprs, what):
     out = []
     for e in exprs:
         try:
-            out.append(sp.sympify(e))
+            e = sp.sympify(e)
         except (sp.SympifyError, TypeError) as exc:
             raise TypeError(f"{what}: cannot read {e!r} as a sympy expression") from exc
+        if isinstance(e, sp.Equality):          # a constraint written as lhs == rhs
+            e = e.lhs - e.rhs
+        if not isinstance(e, sp.Expr):
+            raise TypeError(f"{what}: {e!r} is not a scalar expression")
+        out.append(e)
     return out
 
 
@@ -228,8 +233,13 @@ def _resolve_params(params, exprs, known, t):
     for e in exprs:
         free |= e.free_symbols
     by_name = {}
+    known_set = set(known) | {t}
     for s in free:
         if s.name in known_names:
+            if s not in known_set:
+                raise ValueError(f"the symbol '{s.name}' has the name of a coordinate or "
+                                 "velocity but is not it (write the coordinate as given in q, "
+                                 "e.g. the dynamicsymbol x and x.diff(t))")
             continue
         by_name.setdefault(s.name, []).append(s)
     names, values = [], []
