@@ -403,3 +403,20 @@ def test_symbol_with_a_coordinate_name_and_equation_constraints():
     mod = symbolic.constrained_system(T, 0, [x, y], holonomic=[sp.Eq(x**2 + y**2, l**2)],
                                       params={m: 1.0, l: 2.0}, model_only=True)
     assert rel(mod.call("phi", 0.0, [1.0, 1.0]), [-2.0]) < 1e-15
+
+
+def test_without_exact_jacobian():
+    """jacobian=False: no forces_jac entry; the system integrates the same (the Jacobian
+    then comes from differences)."""
+    import conmech
+    from conmech import compiled
+    T, U, q, P = cart_lagrangian()
+    a = symbolic.lagrangian_system(T - U, q, params=P)
+    b = symbolic.lagrangian_system(T - U, q, params=P, jacobian=False)
+    assert "forces_jac" not in symbolic.model_of(b).addresses
+    y = [0.1, 2.5, 0.3, -0.2]
+    assert compiled.evaluate(a, 0.0, y)["analytic"] and not compiled.evaluate(b, 0.0,
+                                                                               y)["analytic"]
+    kw = dict(rtol=1e-11, atol=1e-11, t_eval=[0.0, 1.0, 2.0])
+    ra, rb = conmech.solve_ivp(a, (0, 2), y, **kw), conmech.solve_ivp(b, (0, 2), y, **kw)
+    assert rel(ra.y, rb.y) < 1e-12

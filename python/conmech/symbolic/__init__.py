@@ -264,7 +264,7 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      flags=None, model_only=False):
+                      jacobian=True, flags=None, model_only=False):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -273,12 +273,15 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     forces : optional generalized non-conservative forces, one expression per coordinate
              (in t, q, q' and the parameters).
     params : dict {Symbol or name: value}.
-    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, when L is
-               small enough: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
+    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, part by
+               part: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
+    jacobian : generate the exact Jacobian of the accelerations (forces_jac); False saves
+               derivation and compile time for large systems that are only integrated.
     """
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
-                      (simplify,),
-                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify),
+                      (simplify, bool(jacobian)),
+                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
+                                                bool(jacobian)),
                       flags, model_only)
 
 

@@ -400,14 +400,40 @@ def _cheap_simplify(expr):
     return TR10i(e)
 
 
-def _maybe_simplify(expr, simplify):
-    """simplify: True, False or "auto" (only when the expression is small enough for the
-    clean-up to take well under a few seconds)."""
-    if simplify is True or (simplify == "auto" and sp.count_ops(expr) <= 600):
-        return _cheap_simplify(expr)
+def _maybe_simplify(expr, simplify, v=()):
+    """simplify: True, False or "auto". A Lagrangian at most quadratic in the velocities v
+    is cleaned up by parts, L = v^T M v / 2 + l1 . v + L0, each entry of M, l1 and L0 on its
+    own (small expressions, so the clean-up stays fast for long chains); "auto" skips parts
+    too large for it (more than 600 operations)."""
     if simplify not in (True, False, "auto"):
         raise ValueError(f"simplify must be True, False or 'auto', got {simplify!r}")
-    return expr
+    if simplify is False:
+        return expr
+
+    def part(e):
+        if e == 0:
+            return e
+        if simplify is True or sp.count_ops(e) <= 600:
+            return _cheap_simplify(e)
+        return e
+    v = list(v)
+    if v:
+        n = len(v)
+        grad = [sp.diff(expr, vi) for vi in v]
+        H = [[sp.diff(grad[i], v[j]) for j in range(n)] for i in range(n)]
+        if not any(h.free_symbols & set(v) for row in H for h in row):
+            zero = {vi: 0 for vi in v}
+            Hs = {}
+            for i in range(n):
+                for j in range(i, n):
+                    Hs[i, j] = part(H[i][j])
+            l1 = [part(g.xreplace(zero)) for g in grad]
+            L0 = part(expr.xreplace(zero))
+            quad = sum((Hs[i, i]*v[i]**2/2 for i in range(n)), sp.Integer(0)) \
+                + sum((Hs[i, j]*v[i]*v[j] for i in range(n) for j in range(i + 1, n)),
+                      sp.Integer(0))
+            return quad + sum((c*vi for c, vi in zip(l1, v)), sp.Integer(0)) + L0
+    return part(expr)
 
 
 def _forces_list(forces, n, what="forces"):
@@ -419,10 +445,12 @@ def _forces_list(forces, n, what="forces"):
     return fl
 
 
-def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify="auto"):
+def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify="auto",
+                      jacobian=True):
     """M q'' = Q from the Lagrangian L(t, q, q'); optional generalized forces.
     ``simplify`` (True, False, "auto") cleans L up first (sin^2 + cos^2 = 1, products of
-    sines and cosines into cosines of differences) so that M and Q come out compact."""
+    sines and cosines into cosines of differences) so that M and Q come out compact.
+    ``jacobian=False`` skips R (the integrators then difference the accelerations)."""
     t = sp.Symbol("t")
     c = _Coords(q, velocities, t, need_speeds=True)
     n = len(c.plain)
@@ -435,12 +463,14 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
     exprs, t, psyms = _realify(exprs, t, c, psyms)
-    Lp, fq = _maybe_simplify(exprs[0], simplify), exprs[1:]
+    Lp, fq = _maybe_simplify(exprs[0], simplify, c.speeds), exprs[1:]
     M, Q = _euler_lagrange(Lp, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
-    Ma = M * sp.Matrix(c.accels)
-    R = _ae((Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds)))
+    R = None
+    if jacobian:
+        Ma = M * sp.Matrix(c.accels)
+        R = _ae((Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds)))
     energy = _energy(Lp, M, c.speeds)
     return Derived("generalized", t=t, coords=c.plain, coord_names=c.names,
                    speeds=c.speeds, accels=c.accels, params=psyms, param_names=names,
@@ -483,7 +513,7 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     nh = exprs[2 + n + len(hol):]
     if Up.free_symbols & set(c.speeds):
         raise ValueError("U must not depend on the velocities")
-    L = _maybe_simplify(Tp - Up, simplify)
+    L = _maybe_simplify(Tp - Up, simplify, c.speeds)
     M, Q = _euler_lagrange(L, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
