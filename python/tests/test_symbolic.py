@@ -420,3 +420,11 @@ def test_without_exact_jacobian():
     kw = dict(rtol=1e-11, atol=1e-11, t_eval=[0.0, 1.0, 2.0])
     ra, rb = conmech.solve_ivp(a, (0, 2), y, **kw), conmech.solve_ivp(b, (0, 2), y, **kw)
     assert rel(ra.y, rb.y) < 1e-12
+
+
+def test_singular_mass_of_a_large_system_is_seen_on_the_compiled_code():
+    """Nine coordinates, the last one without kinetic energy: M is singular everywhere."""
+    q = dynamicsymbols("q1:10")
+    T = sum(qi.diff(t)**2 for qi in q[:-1])/2
+    with pytest.raises(ValueError, match="singular"):
+        symbolic.lagrangian_system(T - sum(qi**2 for qi in q)/2, list(q))

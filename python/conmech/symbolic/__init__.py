@@ -234,6 +234,24 @@ def _store(key, model, flags):
             pass
 
 
+def _check_compiled_mass(model):
+    """Large systems: the singularity check of the mass matrix on the compiled code (random
+    states, the given and perturbed parameter values)."""
+    from .derive import singular_everywhere
+    rng = np.random.default_rng(12345)
+    d = model.derived
+
+    def mass_at(trial):
+        p = np.asarray(d.param_values, float)
+        if trial:
+            p = np.where(p != 0, p*rng.uniform(0.7, 1.3, p.size), rng.uniform(0.5, 1.5, p.size))
+        with np.errstate(all="ignore"):
+            return model.call("mass", rng.uniform(0.3, 1.3), rng.uniform(-1, 1, d.n), params=p)
+    if singular_everywhere(mass_at, d.n, rng):
+        raise ValueError("the mass matrix is singular at every sampled state (det M = 0): a "
+                         "coordinate has no kinetic energy, or the coordinates are dependent")
+
+
 def _construct(kind, inputs, params, options, derive, flags, model_only):
     """Derive (or take the derivation from the cache), compile (or load), wrap."""
     t0 = time.perf_counter()
@@ -245,6 +263,8 @@ def _construct(kind, inputs, params, options, derive, flags, model_only):
         t1 = time.perf_counter()
         model = compile_model(d, flags)
         model.times["derive"] = t1 - t0
+        if d.kind != "ode" and d.n > 8:
+            _check_compiled_mass(model)
         if key:
             _store(key, model, flags)
     model.times["total"] = time.perf_counter() - t0
