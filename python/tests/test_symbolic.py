@@ -428,3 +428,16 @@ def test_singular_mass_of_a_large_system_is_seen_on_the_compiled_code():
     T = sum(qi.diff(t)**2 for qi in q[:-1])/2
     with pytest.raises(ValueError, match="singular"):
         symbolic.lagrangian_system(T - sum(qi**2 for qi in q)/2, list(q))
+
+
+def test_model_call_checks_its_arguments():
+    T, U, q, P = cart_lagrangian()
+    mod = symbolic.lagrangian_system(T - U, q, params=P, model_only=True)
+    with pytest.raises(ValueError, match="takes t and 2 array"):
+        mod.call("forces", 0.0, [0.1, 0.2])
+    with pytest.raises(ValueError, match="params must have 4 values"):
+        mod.call("mass", 0.0, [0.1, 0.2], params=[1.0])
+    with pytest.raises(ValueError, match="shape"):
+        mod.call("mass", 0.0, [0.1, 0.2, 0.3])
+    with pytest.raises(ValueError, match="no entry point 'rhs'"):
+        mod.call("rhs", 0.0, [0.1, 0.2])

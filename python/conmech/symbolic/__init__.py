@@ -90,8 +90,14 @@ class CompiledModel:
                              f"(has: {', '.join(self.addresses)})")
         p = np.ascontiguousarray(self.derived.param_values if params is None else params,
                                  dtype=float)
+        if p.ndim != 1 or p.size != len(self.derived.param_names):
+            raise ValueError(f"params must have {len(self.derived.param_names)} values "
+                             f"({', '.join(self.derived.param_names)})")
         if p.size == 0:
             p = np.zeros(1)
+        n_in = int(_SIG[entry][0][2:])
+        if len(arrays) != n_in:
+            raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = self.derived.n
         for a in ins:
