@@ -1,4 +1,5 @@
-!> conmech: mechanical systems with constraints and the stability of their motions.
+!> The umbrella module of conmech, mechanical systems with constraints and the stability of
+!! their motions.
 !!
 !! `use conmech` gives the public API of every layer.
 module conmech
