@@ -164,23 +164,27 @@ contains
     !! `nfields` numbers with an integer key in [lo, hi] first (`ordered`: keys lo, lo+1,..).
     !! A last line without its newline (torn by a kill) is dropped; with `repair` it is also
     !! cut from the file. Any other bad line is an error naming the file and line.
-    !! rows(key)%s / have(key) receive the rows (the first copy of a key wins).
-    subroutine load_rows(cli, file, header, nfields, lo, hi, ordered, repair, rows, have, &
-                         nrows)
+    !! have(key) / rows(key)%s receive the rows (the first copy of a key wins); nfail counts
+    !! the rows whose field `status_col` is not 0.
+    subroutine load_rows(cli, file, header, nfields, lo, hi, ordered, repair, have, nrows, &
+                         rows, status_col, nfail)
         type(cli_parser), intent(inout) :: cli
         character(len=*), intent(in) :: file, header
         integer, intent(in) :: nfields, lo, hi
         logical, intent(in) :: ordered, repair
-        type(row_t), intent(inout) :: rows(lo:)
         logical, intent(inout) :: have(lo:)
         integer, intent(out) :: nrows
+        type(row_t), intent(inout), optional :: rows(lo:)
+        integer, intent(in), optional :: status_col
+        integer, intent(out), optional :: nfail
         integer(int64) :: sz, keep
         integer :: u, ios, ln, key, nf, a, b, j, sl
         character(len=8192) :: line
         character :: last
-        logical :: torn, ok
+        logical :: torn, ok, failed
         character(len=16) :: lnum
         nrows = 0
+        if (present(nfail)) nfail = 0
         sz = file_size(file)
         if (sz <= 0) return
         open (newunit=u, file=file, access="stream", form="unformatted", action="read", &
@@ -229,6 +233,7 @@ contains
             ! a row: nfields comma-separated numbers, the first an integer key
             ok = sl <= len(line)
             nf = 0
+            failed = .false.
             if (ok) then
                 a = 1
                 do j = 1, nfields
@@ -252,6 +257,9 @@ contains
                         if (ordered) ok = ok .and. key == lo + nrows
                     else
                         ok = csv_number(line(a:b - 1))
+                        if (present(status_col)) then
+                            if (j == status_col) failed = trim(line(a:b - 1)) /= "0"
+                        end if
                     end if
                     if (.not. ok) exit
                     a = b + 1
@@ -262,7 +270,8 @@ contains
             nrows = nrows + 1
             if (.not. have(key)) then
                 have(key) = .true.
-                rows(key)%s = line(:sl)
+                if (present(rows)) rows(key)%s = line(:sl)
+                if (present(nfail) .and. failed) nfail = nfail + 1
             end if
         end do
         close (u)

@@ -394,30 +394,20 @@ contains
     !> done(job) from OUT (repair: cut a torn last line).
     subroutine mark_done(repair)
         logical, intent(in) :: repair
-        type(row_t), allocatable :: rows(:)
         integer :: nr
-        allocate (rows(0:count_ - 1))
         call load_rows(cli, trim(out_file), header, n + 5, 0, count_ - 1, .false., repair, &
-                       rows, done, nr)
+                       done, nr)
     end subroutine mark_done
 
     !> Rows and failed jobs (status /= 0) in OUT.
     subroutine count_results(nr, nf)
         integer, intent(out) :: nr, nf
-        type(row_t), allocatable :: rows(:)
         logical, allocatable :: have(:)
-        integer :: j, c
-        allocate (rows(0:count_ - 1), have(0:count_ - 1))
+        allocate (have(0:count_ - 1))
         have = .false.
         call load_rows(cli, trim(out_file), header, n + 5, 0, count_ - 1, .false., .false., &
-                       rows, have, nr)
+                       have, nr, status_col=n + 5, nfail=nf)
         nr = count(have)
-        nf = 0
-        do j = 0, count_ - 1
-            if (.not. have(j)) cycle
-            c = index(rows(j)%s, ",", back=.true.)
-            if (rows(j)%s(c + 1:) /= "0") nf = nf + 1
-        end do
     end subroutine count_results
 
     !> Index (0-based) into todo of the next job to run, shared by all threads and ranks.
@@ -501,11 +491,11 @@ contains
         allocate (rows(0:count_ - 1), have(0:count_ - 1))
         have = .false.
         call load_rows(cli, trim(out_file), header, n + 5, 0, count_ - 1, .false., .false., &
-                       rows, have, nr)
+                       have, nr, rows)
         nparts = 0
         do while (file_exists(trim(out_file)//".rank"//itoa(nparts)))
             call load_rows(cli, trim(out_file)//".rank"//itoa(nparts), header, n + 5, 0, &
-                           count_ - 1, .false., .false., rows, have, nr)
+                           count_ - 1, .false., .false., have, nr, rows)
             nparts = nparts + 1
         end do
         if (nparts == 0 .and. .not. at_end) return
