@@ -31,6 +31,7 @@ module app_batch
         integer :: total = 0, start_done = 0
         logical :: on = .true.
         integer(int64) :: t0 = 0, last = 0, rate = 1
+        real(dp) :: every = 5.0_dp   !! seconds between lines (CONMECH_PROGRESS_SECONDS)
     contains
         procedure :: begin => progress_begin
         procedure :: tick => progress_tick
@@ -290,15 +291,24 @@ contains
         character(len=*), intent(in) :: prog
         integer, intent(in) :: total, start_done
         logical, intent(in) :: on
+        character(len=32) :: env
+        integer :: l, st
+        real(dp) :: x
+        logical :: ok
         self%prog = prog
         self%total = total
         self%start_done = start_done
         self%on = on
+        call get_environment_variable("CONMECH_PROGRESS_SECONDS", env, l, st)
+        if (st == 0 .and. l > 0) then
+            call parse_real(env(:l), x, ok)
+            if (ok .and. x >= 0.0_dp) self%every = x
+        end if
         call system_clock(self%t0, self%rate)
         self%last = self%t0
     end subroutine progress_begin
 
-    !> Print "PROG: done/total, rate/s, ETA" if 5 s passed since the last line.
+    !> Print "PROG: done/total, rate/s, ETA" if `every` seconds passed since the last line.
     subroutine progress_tick(self, ndone)
         class(progress_t), intent(inout) :: self
         integer, intent(in) :: ndone
@@ -306,14 +316,14 @@ contains
         real(dp) :: el, rate, eta
         if (.not. self%on) return
         call system_clock(now)
-        if (real(now - self%last, dp) < 5.0_dp*real(self%rate, dp)) return
+        if (real(now - self%last, dp) < self%every*real(self%rate, dp)) return
         self%last = now
         el = real(now - self%t0, dp)/real(self%rate, dp)
         rate = real(ndone - self%start_done, dp)/max(el, 1.0e-9_dp)
         eta = real(self%total - ndone, dp)/max(rate, 1.0e-12_dp)
-        write (error_unit, '(a,i0,a,i0,a,f5.1,a,g0.4,a,f0.0,a)') self%prog//": ", ndone, &
+        write (error_unit, '(a,i0,a,i0,a,f0.1,a,f0.1,a,i0,a)') self%prog//": ", ndone, &
             "/", self%total, " (", 100.0_dp*real(ndone, dp)/real(max(self%total, 1), dp), &
-            "%), ", rate, " per s, ETA ", eta, " s"
+            "%), ", rate, " per s, ETA ", nint(min(eta, 1.0e9_dp)), " s"
         flush (error_unit)
     end subroutine progress_tick
 

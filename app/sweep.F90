@@ -223,6 +223,8 @@ program sweep
     do
         !$omp critical (sweep_next)
         i = next_job()
+        ! with ranks, rank 0 reports the jobs handed out so far (all ranks)
+        if (nranks > 1) call progress%tick(count_ - ntodo + min(i, ntodo))
         !$omp end critical (sweep_next)
         if (i >= ntodo) exit
         call run_job(todo(i + 1))
@@ -474,7 +476,7 @@ contains
         write (u, '(a)') line
         flush (u)
         nfinished = nfinished + 1
-        call progress%tick(nfinished)
+        if (nranks == 1) call progress%tick(nfinished)
         !$omp end critical (sweep_output)
     end subroutine run_job
 

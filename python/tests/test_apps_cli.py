@@ -206,6 +206,18 @@ def test_outputs_never_silently_overwritten(exes, tmp_path):
     assert r.returncode == 2 and "exists without family.csv.args" in r.stderr
 
 
+def test_progress_line_on_stderr_and_quiet(exes, tmp_path):
+    env = dict(os.environ, CONMECH_PROGRESS_SECONDS="0")  # a line at every step
+    args = ["--m0", "0.02", "--m1", "0.03", "--n", "64", "--batch", "32"]
+    r = run([exes["hill_family"], *args, "--out", "a.csv"], tmp_path, env=env)
+    assert r.returncode == 0
+    assert re.search(r"hill_family: 64/64 \(100\.0%\), [0-9.]+ per s, ETA 0 s", r.stderr)
+    r = run([exes["hill_family"], *args, "--out", "b.csv", "--quiet"], tmp_path, env=env)
+    assert r.returncode == 0 and r.stderr == ""
+    r = run([exes["sweep"], *SWEEP[:-1], "--count", "3", "--t-end", "1"], tmp_path, env=env)
+    assert r.returncode == 0 and "sweep: 3/3 (100.0%)" in r.stderr, r.stderr
+
+
 # ------------------------------------------------------------------ sweep resume
 
 def test_sweep_failed_jobs_exit_1_with_a_count(exes, tmp_path):
