@@ -383,13 +383,12 @@ contains
             write (uu, '(a)') header
             close (uu)
         end if
-#ifdef CONMECH_MPI
+        ! parts of an earlier MPI run (even when this run has one rank): merge them first
         if (nranks > 1 .or. file_exists(trim(out_file)//".rank0")) then
             call merge_parts(.false.)
             call mark_done(.false.)
             return
         end if
-#endif
         call mark_done(.true.)
     end subroutine prepare_output
 
@@ -480,7 +479,6 @@ contains
         !$omp end critical (sweep_output)
     end subroutine run_job
 
-#ifdef CONMECH_MPI
     !> Rank 0: OUT and every OUT.rankR into OUT (sorted by job, first copy of a job wins),
     !! written to OUT.tmp, fsync'ed and renamed; only then are the parts deleted.
     subroutine merge_parts(at_end)
@@ -515,7 +513,6 @@ contains
             call delete_file(trim(out_file)//".rank"//itoa(r))
         end do
     end subroutine merge_parts
-#endif
 
     !> Before an exit from the command-line layer: MPI finalize (same on every rank) or
     !! abort (an error found by rank 0 alone).

@@ -304,9 +304,10 @@ def test_sweep_mpi_kill_resume(mpi_sweep, serial, tmp_path):
     assert not list(tmp_path.glob("m.csv.rank*")) and not (tmp_path / "m.csv.tmp").exists()
 
 
-@pytest.mark.parametrize("stage", ["before_rename", "after_rename"])
-def test_sweep_mpi_kill_during_merge(mpi_sweep, serial, tmp_path, stage):
-    """The states a kill during the final merge leaves, resumed with 2 ranks."""
+@pytest.mark.parametrize("stage", ["before_rename", "after_rename", "serial_resume"])
+def test_sweep_mpi_kill_during_merge(exes, mpi_sweep, serial, tmp_path, stage):
+    """The states a kill during the final merge leaves, resumed with 2 ranks (or by the
+    serial build, which merges the parts first)."""
     ref = serial[0]
     keys = sorted(ref)
     header = "job,value,y1,y2,return_time,nfev,status\n"
@@ -314,14 +315,17 @@ def test_sweep_mpi_kill_during_merge(mpi_sweep, serial, tmp_path, stage):
     # rebuild the interrupted state from the reference rows
     rank0 = [ref[k] for k in keys if k % 2 == 0]
     rank1 = [ref[k] for k in keys if k % 2 == 1]
-    if stage == "before_rename":
+    if stage in ("before_rename", "serial_resume"):
         (tmp_path / "m.csv").write_text(header + "".join(ref[k] + "\n" for k in keys[:4]))
         (tmp_path / "m.csv.tmp").write_text(header + ref[keys[0]] + "\n" + ref[keys[1]][:9])
     else:  # merged file in place, the parts not yet deleted
         (tmp_path / "m.csv").write_text(header + "".join(ref[k] + "\n" for k in keys))
     (tmp_path / "m.csv.rank0").write_text(header + "".join(x + "\n" for x in rank0[:-2]))
     (tmp_path / "m.csv.rank1").write_text(header + "".join(x + "\n" for x in rank1))
-    r = run(mpirun(2, mpi_sweep, *SWEEP, "--out", "m.csv"), tmp_path, env=MPI_ENV)
+    if stage == "serial_resume":
+        r = run([exes["sweep"], *SWEEP, "--out", "m.csv"], tmp_path)
+    else:
+        r = run(mpirun(2, mpi_sweep, *SWEEP, "--out", "m.csv"), tmp_path, env=MPI_ENV)
     assert r.returncode == 0, r.stdout + r.stderr
     assert rows(tmp_path / "m.csv") == ref
     assert not list(tmp_path.glob("m.csv.rank*"))
