@@ -35,6 +35,7 @@ module app_batch
     contains
         procedure :: begin => progress_begin
         procedure :: tick => progress_tick
+        procedure :: clear => progress_clear
     end type progress_t
 
     interface
@@ -326,5 +327,10 @@ contains
             "%), ", rate, " per s, ETA ", nint(min(eta, 1.0e9_dp)), " s"
         flush (error_unit)
     end subroutine progress_tick
+
+    subroutine progress_clear(self)
+        class(progress_t), intent(inout) :: self
+        if (allocated(self%prog)) deallocate (self%prog)
+    end subroutine progress_clear
 
 end module app_batch

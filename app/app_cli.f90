@@ -52,6 +52,7 @@ module app_cli
         procedure :: fail => cli_fail
         procedure :: bad_name => cli_bad_name
         procedure :: done => cli_done
+        procedure :: clear => cli_clear
     end type cli_parser
 
 contains
@@ -242,6 +243,16 @@ contains
         if (associated(self%cleanup)) call self%cleanup(0)
         stop 0, quiet=.true.
     end subroutine cli_done
+
+    !> Release the strings (before a normal end: the programs end valgrind-clean).
+    subroutine cli_clear(self)
+        class(cli_parser), intent(inout) :: self
+        if (allocated(self%prog)) deallocate (self%prog)
+        if (allocated(self%help)) deallocate (self%help)
+        if (allocated(self%input)) deallocate (self%input)
+        if (allocated(self%key)) deallocate (self%key)
+        if (allocated(self%pending)) deallocate (self%pending)
+    end subroutine cli_clear
 
     ! ------------------------------------------------------------------ strict parsing
 

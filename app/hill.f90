@@ -126,6 +126,9 @@ program hill
             write (*, '(a)') "wrote "//trim(phi_file)
         end if
     end if
+    if (allocated(t)) deallocate (t, states, phi_)
+    deallocate (key)
+    call cli%clear()
 
 contains
 

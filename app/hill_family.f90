@@ -154,6 +154,9 @@ program hill_family_app
                    status_col=8, nfail=nfail)
     write (*, '(a, i0, a)') "wrote "//trim(out_file)//" (", nrows, " orbits)"
     flush (output_unit)
+    deallocate (key, canon, ms, have)
+    call cli%clear()
+    call progress%clear()
     if (nrows /= n_) then
         write (error_unit, '(a)') "hill_family: error: the file is incomplete"
         stop 1, quiet=.true.

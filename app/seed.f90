@@ -153,6 +153,11 @@ program seed
     else
         call run_generalized()
     end if
+    if (allocated(cs)) deallocate (cs)
+    if (allocated(gs)) deallocate (gs)
+    deallocate (key, pars, qstart, vstart, t_eval)
+    if (allocated(msg)) deallocate (msg)
+    call cli%clear()
 
 contains
 

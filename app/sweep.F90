@@ -251,6 +251,9 @@ program sweep
 #ifdef CONMECH_MPI
     call mpi_finalize(ierr)
 #endif
+    deallocate (pars, ystart, done, todo, key, header, canon, part_file)
+    call cli%clear()
+    call progress%clear()
     if (rank == 0 .and. nfail > 0) stop 1, quiet=.true.
 
 contains

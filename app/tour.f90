@@ -19,6 +19,8 @@ program tour
     do while (cli%next(key))
         call cli%unknown()
     end do
+    deallocate (key)
+    call cli%clear()
     write (*, '(a)') "conmech tour"
     write (*, '(a)') "============"
     call pendulum_part()

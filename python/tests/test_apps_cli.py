@@ -218,6 +218,21 @@ def test_progress_line_on_stderr_and_quiet(exes, tmp_path):
     assert r.returncode == 0 and "sweep: 3/3 (100.0%)" in r.stderr, r.stderr
 
 
+def test_programs_valgrind_clean(exes, tmp_path):
+    """No invalid access, no uninitialised value, no leak (a list with an empty field used
+    to read an uninitialised value; a failed job used to read res%y(:, 0))."""
+    if shutil.which("valgrind") is None:
+        pytest.fail("valgrind is not installed (apt-get install valgrind)")
+    vg = ["valgrind", "-q", "--error-exitcode=9", "--leak-check=full"]
+    for args, want in [
+            (["sweep", "--system", "harmonic", "--params", "1", "--y0", "1e-150,0", "--vary",
+              "y0:1", "--from", "1e-150", "--to", "1e150", "--count", "2", "--t-end", "1"],
+             (0, 1)),
+            (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,))]:
+        r = run([*vg, exes[args[0]], *args[1:]], tmp_path)
+        assert r.returncode in want and "==" not in r.stderr, (args, r.stderr)
+
+
 # ------------------------------------------------------------------ sweep resume
 
 def test_sweep_failed_jobs_exit_1_with_a_count(exes, tmp_path):
