@@ -87,6 +87,9 @@ program sweep
         "Options:"//new_line("a")// &
         "  --system NAME     "//ode_names//","//new_line("a")// &
         "                    or a generalized seed system (y = [q, v])"//new_line("a")// &
+        "  --model LIB.so    instead of --system: a compiled user model (an ode or"// &
+        new_line("a")//"                    generalized one, e.g. from python -m "// &
+        "conmech.symbolic)"//new_line("a")// &
         "  --params P1,P2..  system parameters (at most as many as it has; the rest keep"// &
         new_line("a")//"                    their defaults)"//new_line("a")// &
         "  --y0 Y1,Y2,..     initial state (the system's dimension)"//new_line("a")// &
@@ -114,7 +117,8 @@ program sweep
 
     type(cli_parser) :: cli
     character(len=64) :: sys_name, method_name
-    character(len=1024) :: out_file, vary_spec
+    character(len=1024) :: out_file, vary_spec, model_path
+    type(model_library) :: model
     real(dp), allocatable :: pars(:), ystart(:)
     real(dp) :: vfrom, vto, tend, rtol_, atol_
     integer :: count_, isec, n, i, u, rank, nranks, nthreads, ntodo, next_free, nfail
@@ -137,6 +141,7 @@ program sweep
 #endif
     call cli%start("sweep", help, talk=rank == 0, cleanup=cleanup)
     sys_name = ""
+    model_path = ""
     method_name = "DOP853"
     out_file = "sweep.csv"
     vary_spec = ""
@@ -155,6 +160,7 @@ program sweep
     do while (cli%next(key))
         select case (key)
         case ("--system"); call cli%get_string(sys_name)
+        case ("--model"); call cli%get_string(model_path)
         case ("--method"); call cli%get_string(method_name)
         case ("--params"); call cli%get_list(pars)
         case ("--y0")
@@ -176,7 +182,8 @@ program sweep
     end do
     call validate()
     header = csv_header()
-    canon = "system="//trim(sys_name)//" params="//fmt_list(pars)//" y0="// &
+    canon = trim(merge("model= ", "system=", len_trim(model_path) > 0))// &
+        trim(sys_name)//trim(model_path)//" params="//fmt_list(pars)//" y0="// &
         fmt_list(ystart)//" vary="//trim(vary_spec)//" from="//fmt_real(vfrom)//" to="// &
         fmt_real(vto)//" count="//itoa(count_)//" t_end="//fmt_real(tend)//" section="// &
         itoa(isec)//" rtol="//fmt_real(rtol_)//" atol="//fmt_real(atol_)//" method="// &
@@ -270,14 +277,15 @@ contains
     !! read before the command line (which overrides them).
     subroutine read_input()
         character(len=64) :: system, method
-        character(len=1024) :: out, vary
+        character(len=1024) :: out, vary, model
         real(dp) :: params(64), y0(64), from, to, t_end, rtol, atol
         integer :: count, section, uu, ios
         logical :: force, quiet
         character(len=512) :: msg
-        namelist /sweep/ system, method, params, y0, vary, from, to, count, t_end, section, &
-            rtol, atol, out, force, quiet
+        namelist /sweep/ system, model, method, params, y0, vary, from, to, count, t_end, &
+            section, rtol, atol, out, force, quiet
         system = sys_name; method = method_name; out = out_file; vary = vary_spec
+        model = model_path
         params = unset; y0 = unset
         from = vfrom; to = vto; t_end = tend; rtol = rtol_; atol = atol_
         count = count_; section = isec; force = force_; quiet = quiet_
@@ -287,6 +295,7 @@ contains
         if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &sweep: "//trim(msg))
         close (uu)
         sys_name = system; method_name = method; out_file = out; vary_spec = vary
+        model_path = model
         pars = nml_list(cli, params, "params")
         ystart = nml_list(cli, y0, "y0")
         have_y0 = size(ystart) > 0
@@ -297,14 +306,19 @@ contains
     subroutine validate()
         integer :: np
         logical :: ok
-        if (len_trim(sys_name) == 0) call cli%fail("--system NAME is required; valid: "// &
-                                                   ode_names//" "//generalized_names)
-        n = system_dimension(sys_name)
-        if (n == 0) call cli%bad_name("system", sys_name, ode_names//" "//generalized_names)
-        np = param_count(sys_name)
-        if (np >= 0 .and. size(pars) > np) call cli%fail("--params: "//trim(sys_name)// &
-            " has "//itoa(np)//" parameter(s) ("//param_help(sys_name)//"), got "// &
-            itoa(size(pars)))
+        if (len_trim(model_path) > 0) then
+            call check_model()
+        else
+            if (len_trim(sys_name) == 0) call cli%fail("--system NAME (or --model LIB.so) "// &
+                "is required; valid names: "//ode_names//" "//generalized_names)
+            n = system_dimension(sys_name)
+            if (n == 0) call cli%bad_name("system", sys_name, ode_names//" "// &
+                                          generalized_names)
+            np = param_count(sys_name)
+            if (np >= 0 .and. size(pars) > np) call cli%fail("--params: "//trim(sys_name)// &
+                " has "//itoa(np)//" parameter(s) ("//param_help(sys_name)//"), got "// &
+                itoa(size(pars)))
+        end if
         if (.not. have_y0) call cli%fail("--y0 is required ("//itoa(n)//" values for "// &
                                          trim(sys_name)//")")
         if (size(ystart) /= n) call cli%fail("--y0: "//trim(sys_name)//" has dimension "// &
@@ -353,6 +367,29 @@ contains
         opt%save_steps = .false.
         if (len_trim(out_file) == 0) call cli%fail("--out must not be empty")
     end subroutine validate
+
+    !> --model: load the library, check its kind and the parameters (missing trailing ones
+    !! take the model's defaults).
+    subroutine check_model()
+        integer :: info, np
+        character(len=:), allocatable :: msg
+        if (len_trim(sys_name) > 0) call cli%fail("give --system or --model, not both")
+        call load_model(trim(model_path), model, info, msg)
+        if (info /= CM_SUCCESS) call cli%fail("--model: "//msg)
+        select case (model%kind)
+        case (MODEL_KIND_ODE)
+            n = model%n
+        case (MODEL_KIND_GENERALIZED)
+            n = 2*model%n
+        case default
+            call cli%fail("--model "//trim(model_path)//" is a constrained model; sweep "// &
+                          "needs an ode or generalized one")
+        end select
+        np = size(model%defaults)
+        if (size(pars) > np) call cli%fail("--params: the model has "//itoa(np)// &
+            " parameter(s) ("//model%param_names//"), got "//itoa(size(pars)))
+        pars = [pars, model%defaults(size(pars) + 1:)]
+    end subroutine check_model
 
     function csv_header() result(h)
         character(len=:), allocatable :: h
@@ -449,7 +486,11 @@ contains
         end if
         tret = nan
         yend = nan
-        call make_system(sys_name, p, sys, info, msg)
+        if (len_trim(model_path) > 0) then
+            call model_system(model, p, sys, info, msg)
+        else
+            call make_system(sys_name, p, sys, info, msg)
+        end if
         if (info == CM_SUCCESS) then
             if (isec > 0) then
                 allocate (ev%direction(1), ev%terminal(1))

@@ -6,6 +6,7 @@ in jobs/ (0) without ERROR STOP or a backtrace; sweep and hill_family resume aft
 bit-identical to an uninterrupted serial run. Runs `fpm` from the repository root
 (scripts/test.sh puts the venv's fpm on PATH); counts are small to keep CI fast.
 """
+import math
 import os
 import re
 import shutil
@@ -231,6 +232,35 @@ def test_programs_valgrind_clean(exes, tmp_path):
             (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,))]:
         r = run([*vg, exes[args[0]], *args[1:]], tmp_path)
         assert r.returncode in want and "==" not in r.stderr, (args, r.stderr)
+
+
+def test_sweep_model_library_matches_builtin_and_kepler(exes, tmp_path):
+    """--model LIB.so: a compiled user model (conmech_model_library's C convention) sweeps
+    like the built-in system: the same rows as --system kepler, periods by Kepler's law."""
+    cc = shutil.which("gcc") or shutil.which("cc")
+    assert cc, "a C compiler is needed (gfortran brings gcc)"
+    lib = tmp_path / "kepler.so"
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(lib),
+                    str(ROOT / "python/tests/data/c_model_kepler.c"), "-lm"], check=True)
+    grid = ["--y0", "1,0,0,1", "--vary", "y0:4", "--from", "0.9", "--to", "1.1", "--count",
+            "5", "--t-end", "10", "--section", "2", "--rtol", "1e-12", "--atol", "1e-12"]
+    r = run([exes["sweep"], "--model", str(lib), *grid, "--out", "m.csv"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    r = run([exes["sweep"], "--system", "kepler", *grid, "--out", "b.csv"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    m, b = rows(tmp_path / "m.csv"), rows(tmp_path / "b.csv")
+    assert m.keys() == b.keys() == set(range(5))
+    for k in m:
+        xm = [float(x) for x in m[k].split(",")]
+        xb = [float(x) for x in b[k].split(",")]
+        assert all(abs(p - q) <= 1e-12 * max(1, abs(q)) for p, q in zip(xm, xb))
+        v = xm[1]
+        a = 1 / (2 - v * v)  # vis-viva at r = 1, mu = 1
+        assert abs(xm[6] - 2 * math.pi * a ** 1.5) < 1e-9, (v, xm[6])
+    r = run([exes["sweep"], "--model", str(lib), "--params", "1,2", *grid], tmp_path)
+    assert r.returncode == 2 and "the model has 1 parameter(s) (mu), got 2" in r.stderr
+    r = run([exes["sweep"], "--model", "nope.so", *grid], tmp_path)
+    assert r.returncode == 2 and "cannot load the model library" in r.stderr
 
 
 # ------------------------------------------------------------------ sweep resume
