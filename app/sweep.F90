@@ -238,6 +238,8 @@ program sweep
     end do
     !$omp end parallel
     close (u)
+    if (nranks > 1) write (*, '(a,i0,a,i0,a)') "sweep: rank ", rank, " ran ", &
+        nfinished - (count_ - ntodo), " job(s)"
 
 #ifdef CONMECH_MPI
     call mpi_win_free(win, ierr)

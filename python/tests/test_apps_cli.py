@@ -349,6 +349,46 @@ def test_sweep_mpi_kill_resume(mpi_sweep, serial, tmp_path):
     assert not list(tmp_path.glob("m.csv.rank*")) and not (tmp_path / "m.csv.tmp").exists()
 
 
+def rank_pids(pid):
+    """{MPI rank: process id} of the ranks below pid."""
+    out = {}
+    for c in descendants(pid):
+        try:
+            env = Path(f"/proc/{c}/environ").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        for e in env:
+            if e.startswith(b"OMPI_COMM_WORLD_RANK="):
+                out[int(e.split(b"=")[1])] = c
+    return out
+
+
+def wait_for(cond, what, timeout=120):
+    t0 = time.time()
+    while not cond():
+        assert time.time() - t0 < timeout, f"timed out waiting for {what}"
+        time.sleep(0.005)
+
+
+def test_sweep_mpi_a_free_rank_takes_the_next_job(mpi_sweep, tmp_path):
+    """Rank 1 runs under valgrind's no-op tool (several times slower, still computing):
+    rank 0 takes most jobs (the static split it replaced gave each rank half), and the
+    merge is complete."""
+    if shutil.which("valgrind") is None:
+        pytest.fail("valgrind is not installed (apt-get install valgrind)")
+    args = [*SWEEP, "--t-end", "100", "--out", "d.csv"]  # (the last --t-end wins)
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "1", mpi_sweep, *args,
+           ":", "-n", "1", "valgrind", "-q", "--tool=none", mpi_sweep, *args]
+    r = run(cmd, tmp_path, env=MPI_ENV)
+    assert r.returncode == 0, r.stdout + r.stderr
+    ran = {int(a): int(b) for a, b in re.findall(r"rank (\d) ran (\d+) job", r.stdout)}
+    assert ran.keys() == {0, 1} and sum(ran.values()) == 40, r.stdout
+    assert ran[0] >= 28, ran
+    done = rows(tmp_path / "d.csv")
+    assert sorted(done) == list(range(40))
+    assert all(line.endswith(",0") for line in done.values())
+
+
 @pytest.mark.parametrize("stage", ["before_rename", "after_rename", "serial_resume"])
 def test_sweep_mpi_kill_during_merge(exes, mpi_sweep, serial, tmp_path, stage):
     """The states a kill during the final merge leaves, resumed with 2 ranks (or by the
