@@ -515,9 +515,11 @@ contains
             ! a run that failed before its first output point has no final state
             if (res%nt >= 1 .and. allocated(res%y)) yend = res%y(:, res%nt)
         end if
+        ! formatted inside the critical section: concurrent internal writes corrupted rows
+        ! (libgfortran 12, OpenMP)
+        !$omp critical (sweep_output)
         line = itoa(i)//","//fmt_real(v)//","//fmt_list(yend)//","//fmt_real(tret)//","// &
             itoa(res%stats%nfev)//","//itoa(info)
-        !$omp critical (sweep_output)
         write (u, '(a)') line
         flush (u)
         nfinished = nfinished + 1
