@@ -90,7 +90,8 @@ program sweep
         "  --model LIB.so    instead of --system: a compiled user model (an ode or"// &
         new_line("a")//"                    generalized one, e.g. from python -m "// &
         "conmech.symbolic)"//new_line("a")// &
-        "  --params P1,P2..  system parameters (at most as many as it has; the rest keep"// &
+        "  --list            print the names of the built-in systems and exit"// &
+        new_line("a")//"  --params P1,P2..  system parameters (at most as many as it has; the rest keep"// &
         new_line("a")//"                    their defaults)"//new_line("a")// &
         "  --y0 Y1,Y2,..     initial state (the system's dimension)"//new_line("a")// &
         "  --vary param:K | y0:K   what the grid varies (1-based index)"//new_line("a")// &
@@ -160,6 +161,11 @@ program sweep
     do while (cli%next(key))
         select case (key)
         case ("--system"); call cli%get_string(sys_name)
+        case ("--list")
+            call cli%flag()
+            if (rank == 0) write (*, '(a)') "built-in systems: "//ode_names//" "// &
+                generalized_names
+            call cli%done()
         case ("--model"); call cli%get_string(model_path)
         case ("--method"); call cli%get_string(method_name)
         case ("--params"); call cli%get_list(pars)

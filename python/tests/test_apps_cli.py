@@ -178,6 +178,11 @@ def test_errors_name_the_problem(exes, tmp_path):
     assert not list(tmp_path.iterdir())  # nothing written by a refused command
 
 
+def test_sweep_list(exes, tmp_path):
+    r = run([exes["sweep"], "--list"], tmp_path)
+    assert r.returncode == 0 and "harmonic pendulum" in r.stdout and "cart_pendulum" in r.stdout
+
+
 def test_namelist_errors_and_command_line_override(exes, tmp_path):
     (tmp_path / "gap.nml").write_text("&sweep system='pendulum', params=9.81,,1 /\n")
     r = run([exes["sweep"], "--input", "gap.nml"], tmp_path)
