@@ -91,15 +91,16 @@ program sweep
         new_line("a")//"                    generalized one, e.g. from python -m "// &
         "conmech.symbolic)"//new_line("a")// &
         "  --list            print the names of the built-in systems and exit"// &
-        new_line("a")//"  --params P1,P2..  system parameters (at most as many as it has; the rest keep"// &
-        new_line("a")//"                    their defaults)"//new_line("a")// &
+        new_line("a")//"  --params P1,P2..  system parameters (at most as many as it has; "// &
+        "the rest keep"//new_line("a")//"                    their defaults)"// &
+        new_line("a")// &
         "  --y0 Y1,Y2,..     initial state (the system's dimension)"//new_line("a")// &
         "  --vary param:K | y0:K   what the grid varies (1-based index)"//new_line("a")// &
         "  --from A --to B --count N   the grid (N <= 10000000)"//new_line("a")// &
         "  --t-end T         end time of each integration (default 10)"//new_line("a")// &
         "  --section K       record the first return to y(K) = y0(K) (0: off, default)"// &
         new_line("a")//"  --rtol R --atol A tolerances (default 1e-10)"//new_line("a")// &
-        "  --method M        DOP853 (default), DOPRI5, VERNER98, RK4"//new_line("a")// &
+        "  --method M        DOP853 (default), DOPRI5, VERNER98"//new_line("a")// &
         "  --out FILE        results CSV (default sweep.csv in the current directory);"// &
         new_line("a")//"                    an existing FILE made by the same arguments is"// &
         " resumed"//new_line("a")// &
@@ -367,7 +368,7 @@ contains
             call cli%fail("--atol must be positive and finite")
         opt%method = method_from_name(method_name)
         if (opt%method == 0) call cli%bad_name("method", method_name, &
-                                               "DOP853 DOPRI5 RK45 VERNER98 RK4")
+                                               "DOP853 DOPRI5 RK45 VERNER98")
         if (opt%method == METHOD_RK4) call cli%fail("--method RK4 has no error control; "// &
             "use DOP853, DOPRI5 or VERNER98")
         opt%rtol = rtol_
