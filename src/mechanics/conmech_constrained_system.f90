@@ -20,6 +20,17 @@
 !! redundant (rank < n_hol + n_nh) the minimum-norm multipliers come from dgelsd. The
 !! reaction C^T lambda is unique either way.
 !!
+!! Structure that makes large systems cheap (declared by the system; every built-in with a
+!! diagonal mass sets it):
+!! - `diagonal_mass`: M is diagonal, given by `mass_diagonal` (default: the diagonal of
+!!   `mass`); M^-1 is a division, no factorisation per evaluation;
+!! - `jac_width` > 0 (with a diagonal mass and holonomic constraints only): row i of G has
+!!   its nonzeros in the jac_width consecutive columns first(i) .. first(i) + jac_width - 1
+!!   given by `phi_jac_band`; then S = G M^-1 G^T is banded (bandwidth detected from
+!!   `first`) and factorised by LAPACK's banded Cholesky (conmech_constrained_band): a chain
+!!   of N links costs O(N) per evaluation and per projection. When the banded S is not
+!!   positive definite (redundant constraints) the dense rank-revealing path above runs.
+!!
 !! Users extend `constrained_system` and implement `mass` and `forces`, and, as needed,
 !! `phi` and `phi_jac` (holonomic), `nh_matrix` (non-holonomic). Defaults:
 !! - `phi_jac`: central differences, step eps^(1/3) max(|q_j|, 1);
@@ -35,6 +46,7 @@ module conmech_constrained_system
     use conmech_status
     use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd, la_finite
     use conmech_generalized, only: mass_cholesky
+    use conmech_constrained_band, only: band_width_of, band_gmul
     implicit none
     private
 
@@ -62,6 +74,8 @@ module conmech_constrained_system
         integer :: n_hol = 0         !! number of holonomic constraints phi(t, q) = 0
         integer :: n_nh = 0          !! number of non-holonomic constraints A q' + b = 0
         logical :: rheonomic = .false.  !! phi depends explicitly on t
+        logical :: diagonal_mass = .false.  !! M is diagonal (see mass_diagonal)
+        integer :: jac_width = 0     !! > 0: row-window width of G (see phi_jac_band)
     contains
         procedure(cs_mass), deferred :: mass
         procedure(cs_forces), deferred :: forces
@@ -71,6 +85,8 @@ module conmech_constrained_system
         procedure :: phi_gamma => cs_fd_phi_gamma
         procedure :: nh_matrix => cs_no_nh
         procedure :: nh_gamma => cs_fd_nh_gamma
+        procedure :: mass_diagonal => cs_mass_diagonal
+        procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: energy => cs_no_energy
         procedure :: has_energy => cs_has_no_energy
     end type constrained_system
@@ -94,9 +110,97 @@ module conmech_constrained_system
         end subroutine cs_forces
     end interface
 
+    ! The banded paths (submodule conmech_constrained_system_band). Each sets ok = .false.
+    ! when it does not apply (mass not positive, windows not banded, S not positive
+    ! definite): the caller then runs the dense path.
+    interface
+        !> Diagonal mass, row-window G, holonomic constraints only.
+        pure module logical function band_ready(sys)
+            class(constrained_system), intent(in) :: sys
+        end function band_ready
+        !> constrained_accel by the banded Schur complement.
+        module subroutine band_accel(sys, t, q, v, a, lam, ok, alpha, beta)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:)
+            real(dp), intent(out) :: a(:), lam(:)
+            logical, intent(out) :: ok
+            real(dp), intent(in), optional :: alpha, beta
+        end subroutine band_accel
+        !> project_position by the banded Schur complement; ph = phi(t, q) on entry.
+        module subroutine band_project_position(sys, t, q, ph, tol, max_iter, full, iters, &
+                                                info, msg, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(inout) :: q(:)
+            real(dp), intent(in) :: ph(:)
+            real(dp), intent(in) :: tol
+            integer, intent(in) :: max_iter
+            logical, intent(in) :: full
+            integer, intent(out) :: iters, info
+            character(len=:), allocatable, intent(inout) :: msg
+            logical, intent(out) :: ok
+        end subroutine band_project_position
+        !> project_velocity by the banded Schur complement.
+        module subroutine band_project_velocity(sys, t, q, v, info, msg, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:)
+            real(dp), intent(inout) :: v(:)
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(inout) :: msg
+            logical, intent(out) :: ok
+        end subroutine band_project_velocity
+    end interface
+
 contains
 
     ! ------------------------------------------------------------------ defaults
+
+    !> Default: d = the diagonal of `mass` (override it: O(n) instead of O(n^2)).
+    subroutine cs_mass_diagonal(self, t, q, d)
+        class(constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: d(:)
+        real(dp) :: mm(self%n, self%n)
+        integer :: i
+        call self%mass(t, q, mm)
+        do i = 1, self%n
+            d(i) = mm(i, i)
+        end do
+    end subroutine cs_mass_diagonal
+
+    !> Default row windows of G from the dense `phi_jac`: gb(i, :) = G(i, first(i) + 0:w-1)
+    !! (w = jac_width). A row whose nonzeros do not fit in w columns gives first = 0 (then
+    !! the dense path is used).
+    subroutine cs_phi_jac_band(self, t, q, gb, first)
+        class(constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: gb(:, :)
+        integer, intent(out) :: first(:)
+        real(dp) :: g(self%n_hol, self%n)
+        integer :: i, j0, j1, w
+        w = size(gb, 2)
+        call self%phi_jac(t, q, g)
+        do i = 1, self%n_hol
+            j0 = 1
+            do while (j0 < self%n .and. g(i, j0) == 0.0_dp)
+                j0 = j0 + 1
+            end do
+            j1 = self%n
+            do while (j1 > j0 .and. g(i, j1) == 0.0_dp)
+                j1 = j1 - 1
+            end do
+            if (j1 - j0 + 1 > w .or. w > self%n) then
+                first = 0
+                return
+            end if
+            first(i) = min(j0, self%n - w + 1)
+            gb(i, :) = g(i, first(i):first(i) + w - 1)
+        end do
+    end subroutine cs_phi_jac_band
 
     !> Default: no holonomic constraints.
     subroutine cs_no_phi(self, t, q, c)
@@ -307,8 +411,9 @@ contains
         real(dp) :: mm(sys%n, sys%n), x(sys%n, 1 + sys%n_hol + sys%n_nh)
         real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh)
         real(dp) :: gam(sys%n_hol + sys%n_nh, 1), s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh)
-        real(dp) :: ph(sys%n_hol)
-        integer :: n, m, mh, lainfo, rk
+        real(dp) :: ph(sys%n_hol), dg(sys%n)
+        integer :: n, m, mh, lainfo, rk, j
+        logical :: ok
         character(len=:), allocatable :: m2
         n = sys%n
         mh = sys%n_hol
@@ -319,22 +424,44 @@ contains
             if (present(msg)) msg = "bad input: q, v, a need n elements and lambda n_hol + n_nh"
             return
         end if
-        call sys%mass(t, q, mm)
-        if (present(msg)) then
-            ! (a local string: passing the optional deferred-length msg straight through
-            ! loses its length with gfortran)
-            call mass_cholesky(mm, info, m2)
-            msg = m2
-        else
-            call mass_cholesky(mm, info)
+        if (band_ready(sys)) then
+            call band_accel(sys, t, q, v, a, lam, ok, alpha, beta)
+            if (ok) then
+                if (present(rank)) rank = m
+                info = CM_SUCCESS
+                if (present(msg)) msg = "success"
+                return
+            end if
         end if
-        if (info /= CM_SUCCESS) return
+        ok = .false.
+        if (sys%diagonal_mass) then
+            call sys%mass_diagonal(t, q, dg)
+            ok = all(dg > 0.0_dp .and. dg < huge(1.0_dp))
+        end if
+        if (.not. ok) then
+            call sys%mass(t, q, mm)
+            if (present(msg)) then
+                ! (a local string: passing the optional deferred-length msg straight
+                ! through loses its length with gfortran)
+                call mass_cholesky(mm, info, m2)
+                msg = m2
+            else
+                call mass_cholesky(mm, info)
+            end if
+            if (info /= CM_SUCCESS) return
+        end if
         call sys%forces(t, q, v, x(:, 1))
         if (m > 0) then
             call constraint_matrix(sys, t, q, c, c0)
             x(:, 2:m + 1) = transpose(c)
         end if
-        call dpotrs('U', n, m + 1, mm, n, x, n, lainfo)
+        if (ok) then
+            do j = 1, m + 1
+                x(:, j) = x(:, j)/dg
+            end do
+        else
+            call dpotrs('U', n, m + 1, mm, n, x, n, lainfo)
+        end if
         a = x(:, 1)
         rk = 0
         if (m > 0) then
@@ -368,14 +495,29 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: rpos, rvel
-        real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh), ph(sys%n_hol)
+        real(dp), allocatable :: c(:, :), c0(:)
+        real(dp) :: ph(sys%n_hol)
         rpos = 0.0_dp
         rvel = 0.0_dp
         if (sys%n_hol > 0) then
             call sys%phi(t, q, ph)
             rpos = maxval(abs(ph))
         end if
+        if (band_ready(sys)) then
+            block
+                real(dp) :: gb(sys%n_hol, sys%jac_width), gv(sys%n_hol), pt(sys%n_hol)
+                integer :: first(sys%n_hol)
+                call sys%phi_jac_band(t, q, gb, first)
+                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
+                    call band_gmul(gb, first, v, gv)
+                    call sys%phi_t(t, q, pt)
+                    rvel = maxval(abs(gv + pt))
+                    return
+                end if
+            end block
+        end if
         if (sys%n_hol + sys%n_nh > 0) then
+            allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
             call constraint_matrix(sys, t, q, c, c0)
             rvel = maxval(abs(matmul(c, v) + c0))
         end if
@@ -402,7 +544,7 @@ contains
         real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
         real(dp) :: rnorm
         integer :: n, mh, lainfo, rk
-        logical :: full
+        logical :: full, ok
         character(len=32) :: buf
         n = sys%n
         mh = sys%n_hol
@@ -413,6 +555,13 @@ contains
         call sys%phi(t, q, ph(:, 1))
         rnorm = maxval(abs(ph(:, 1)))
         if (rnorm <= tol) return
+        full = .false.
+        if (present(newton)) full = newton
+        if (band_ready(sys)) then
+            call band_project_position(sys, t, q, ph(:, 1), tol, max_iter, full, iters, info, &
+                                       msg, ok)
+            if (ok) return
+        end if
         call sys%mass(t, q, mm)
         call mass_cholesky(mm, info, msg)
         if (info /= CM_SUCCESS) return
@@ -420,8 +569,6 @@ contains
         x = transpose(g)
         call dpotrs('U', n, mh, mm, n, x, n, lainfo)
         s = matmul(g, x)
-        full = .false.
-        if (present(newton)) full = newton
         qk = q
         do iters = 1, max_iter
             if (full .and. iters > 1) then
@@ -473,11 +620,16 @@ contains
         real(dp) :: s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh), r(sys%n_hol + sys%n_nh, 1)
         real(dp) :: r0, vscale
         integer :: n, m, lainfo, rk
+        logical :: ok
         n = sys%n
         m = sys%n_hol + sys%n_nh
         info = CM_SUCCESS
         msg = "success"
         if (m == 0) return
+        if (band_ready(sys)) then
+            call band_project_velocity(sys, t, q, v, info, msg, ok)
+            if (ok) return
+        end if
         call sys%mass(t, q, mm)
         call mass_cholesky(mm, info, msg)
         if (info /= CM_SUCCESS) return
