@@ -7,7 +7,8 @@ module test_chain_systems
     use conmech_constrained_system, only: constrained_system
     implicit none
     private
-    public :: twice_pendulum
+    public :: twice_pendulum, skew_mass
+
 
     !> A point mass with the same circle constraint twice (redundant: rank 1), with a
     !! declared diagonal mass and row windows of width 2 (the default band routines).
@@ -19,6 +20,14 @@ module test_chain_systems
         procedure :: phi_jac => tw_jac
         procedure :: phi_gamma => tw_gamma
     end type twice_pendulum
+
+    !> A constant, non-diagonal mass on the unit circle (for the kept mass factor).
+    type, extends(twice_pendulum) :: skew_mass
+    contains
+        procedure :: mass => sk_mass
+        procedure :: phi => sk_phi
+        procedure :: phi_jac => sk_jac
+    end type skew_mass
 
 contains
 
@@ -61,19 +70,42 @@ contains
         gam = -sum(v**2)
     end subroutine tw_gamma
 
+    subroutine sk_mass(self, t, q, mm)
+        class(skew_mass), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: mm(:, :)
+        mm = reshape([2.0_dp, 0.5_dp, 0.5_dp, 1.0_dp], [2, 2])
+    end subroutine sk_mass
+    subroutine sk_phi(self, t, q, c)
+        class(skew_mass), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: c(:)
+        c(1) = 0.5_dp*(q(1)**2 + q(2)**2 - 1.0_dp)
+    end subroutine sk_phi
+    subroutine sk_jac(self, t, q, g)
+        class(skew_mass), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: g(:, :)
+        g(1, :) = q
+    end subroutine sk_jac
+
 end module test_chain_systems
 
 program test_mechanics_chain
     use conmech
     use conmech_systems_chain, only: pendulum_chain_xy
     use conmech_testing, only: test_suite
-    use test_chain_systems, only: twice_pendulum
+    use test_chain_systems, only: twice_pendulum, skew_mass
     implicit none
     type(test_suite) :: ts
     class(constrained_system), allocatable :: band, dense, pend
     type(constrained_options) :: opt
     type(constrained_result) :: res
     type(twice_pendulum) :: tw
+    type(skew_mass) :: sk
     real(dp), allocatable :: q0(:), v0(:), q(:), v(:), qd(:), vd(:)
     real(dp), allocatable :: a1(:), a2(:), l1(:), l2(:)
     real(dp) :: e0, rp, rv, rp2, rv2
@@ -161,6 +193,25 @@ program test_mechanics_chain
                       "redundant pair: the pendulum's acceleration")
     call ts%check_less(abs(l1(1) - 0.5_dp*l2(1)) + abs(l1(2) - 0.5_dp*l2(1)), 1.0e-12_dp, &
                       "redundant pair: minimum-norm multipliers (halves)")
+
+    ! ---- a constant mass: factorised once (prepare_mass), the same results
+    sk%n = 2
+    sk%n_hol = 1
+    q = [0.6_dp, -0.8_dp]
+    v = [0.8_dp, 0.6_dp]
+    call constrained_accel(sk, 0.0_dp, q, v, a2(1:2), l2(1:1), info)
+    sk%constant_mass = .true.
+    call prepare_mass(sk, 0.0_dp, q)
+    call ts%check(allocated(sk%mass_factor), "constant mass: factor kept")
+    call constrained_accel(sk, 0.0_dp, q, v, a1(1:2), l1(1:1), info)
+    call ts%check(all(a1(1:2) == a2(1:2)) .and. l1(1) == l2(1), &
+                  "constant mass: the kept factor gives the same accelerations")
+    call constrained_solve(sk, [0.0_dp, 2.0_dp], q, v, opt, res)
+    call ts%check(res%success .and. maxval(res%res_pos) < 1.0e-13_dp, &
+                  "constant mass: projected run, residual at round-off")
+    sk%constant_mass = .false.
+    call prepare_mass(sk, 0.0_dp, q)
+    call ts%check(.not. allocated(sk%mass_factor), "not constant: no factor kept")
 
     ! ---- bad N
     call make_constrained("pendulum_chain_xy", [2.5_dp], band, info, msg)

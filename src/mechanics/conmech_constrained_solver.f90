@@ -276,10 +276,12 @@ contains
 
         ! ------------------------------------------------------------ integration
         allocate (f%mech, source=sys)
+        call prepare_mass(f%mech, t_span(1), q)     ! a constant M: factorised once
         f%baumgarte = options%projection == PROJ_BAUMGARTE
         f%alpha = options%alpha
         f%beta = options%beta
         allocate (hk%mech, source=sys)
+        call prepare_mass(hk%mech, t_span(1), q)
         hk%projection = options%projection
         hk%every = options%every
         hk%proj_tol = options%proj_tol

@@ -22,6 +22,9 @@
 !!
 !! Structure that makes large systems cheap (declared by the system; every built-in with a
 !! diagonal mass sets it):
+!! - `constant_mass`: M does not depend on (t, q); `prepare_mass` (called by
+!!   constrained_solve on its copy of the system) keeps its Cholesky factor, and the KKT
+!!   solves and projections use it instead of factorising M at every evaluation;
 !! - `diagonal_mass`: M is diagonal, given by `mass_diagonal` (default: the diagonal of
 !!   `mass`); M^-1 is a division, no factorisation per evaluation;
 !! - `jac_width` > 0 (with a diagonal mass and holonomic constraints only): row i of G has
@@ -51,7 +54,7 @@ module conmech_constrained_system
     private
 
     public :: constrained_system, constrained_accel, constraint_matrix
-    public :: project_position, project_velocity, constraint_residuals
+    public :: project_position, project_velocity, constraint_residuals, prepare_mass
     !> The finite-difference defaults, for extensions that choose at run time (e.g. the
     !! Python layer) whether an analytic Jacobian / acceleration term exists.
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
@@ -75,6 +78,8 @@ module conmech_constrained_system
         integer :: n_nh = 0          !! number of non-holonomic constraints A q' + b = 0
         logical :: rheonomic = .false.  !! phi depends explicitly on t
         logical :: diagonal_mass = .false.  !! M is diagonal (see mass_diagonal)
+        logical :: constant_mass = .false.  !! M is constant (see prepare_mass)
+        real(dp), allocatable :: mass_factor(:, :)  !! Cholesky factor kept by prepare_mass
         integer :: jac_width = 0     !! > 0: row-window width of G (see phi_jac_band)
     contains
         procedure(cs_mass), deferred :: mass
@@ -394,6 +399,33 @@ contains
         if (lainfo /= 0) info = CM_LAPACK_ERROR
     end subroutine schur_solve
 
+    !> For a system with `constant_mass`: factorise M(t, q) once and keep the factor in
+    !! `mass_factor` (otherwise, or if M is not positive definite, drop it: the
+    !! per-evaluation path then runs and reports). Call it again after changing the
+    !! system's mass parameters.
+    subroutine prepare_mass(sys, t, q)
+        class(constrained_system), intent(inout) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), allocatable :: mm(:, :)
+        integer :: info
+        if (allocated(sys%mass_factor)) deallocate (sys%mass_factor)
+        if (.not. sys%constant_mass .or. sys%diagonal_mass .or. size(q) /= sys%n) return
+        allocate (mm(sys%n, sys%n))
+        call sys%mass(t, q, mm)
+        call mass_cholesky(mm, info)
+        if (info == CM_SUCCESS) call move_alloc(mm, sys%mass_factor)
+    end subroutine prepare_mass
+
+    !> A constant mass with its factor kept by prepare_mass.
+    pure logical function has_mass_factor(sys) result(yes)
+        class(constrained_system), intent(in) :: sys
+        yes = .false.
+        if (.not. sys%constant_mass) return
+        if (.not. allocated(sys%mass_factor)) return
+        yes = size(sys%mass_factor, 1) == sys%n .and. size(sys%mass_factor, 2) == sys%n
+    end function has_mass_factor
+
     !> Accelerations a and multipliers lam (n_hol + n_nh) at (t, q, v) from the
     !! acceleration-level KKT system. With `alpha`, `beta` (Baumgarte) the acceleration
     !! constraint becomes C a = gamma - 2 alpha (C v + c0) - beta^2 [phi; 0].
@@ -413,7 +445,7 @@ contains
         real(dp) :: gam(sys%n_hol + sys%n_nh, 1), s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh)
         real(dp) :: ph(sys%n_hol), dg(sys%n)
         integer :: n, m, mh, lainfo, rk, j
-        logical :: ok
+        logical :: ok, cached
         character(len=:), allocatable :: m2
         n = sys%n
         mh = sys%n_hol
@@ -438,7 +470,9 @@ contains
             call sys%mass_diagonal(t, q, dg)
             ok = all(dg > 0.0_dp .and. dg < huge(1.0_dp))
         end if
-        if (.not. ok) then
+        cached = .false.
+        if (.not. ok) cached = has_mass_factor(sys)
+        if (.not. (ok .or. cached)) then
             call sys%mass(t, q, mm)
             if (present(msg)) then
                 ! (a local string: passing the optional deferred-length msg straight
@@ -459,6 +493,8 @@ contains
             do j = 1, m + 1
                 x(:, j) = x(:, j)/dg
             end do
+        else if (cached) then
+            call dpotrs('U', n, m + 1, sys%mass_factor, n, x, n, lainfo)
         else
             call dpotrs('U', n, m + 1, mm, n, x, n, lainfo)
         end if
@@ -562,9 +598,13 @@ contains
                                        msg, ok)
             if (ok) return
         end if
-        call sys%mass(t, q, mm)
-        call mass_cholesky(mm, info, msg)
-        if (info /= CM_SUCCESS) return
+        if (has_mass_factor(sys)) then
+            mm = sys%mass_factor        ! factorised once by prepare_mass
+        else
+            call sys%mass(t, q, mm)
+            call mass_cholesky(mm, info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
         call sys%phi_jac(t, q, g)
         x = transpose(g)
         call dpotrs('U', n, mh, mm, n, x, n, lainfo)
@@ -630,9 +670,13 @@ contains
             call band_project_velocity(sys, t, q, v, info, msg, ok)
             if (ok) return
         end if
-        call sys%mass(t, q, mm)
-        call mass_cholesky(mm, info, msg)
-        if (info /= CM_SUCCESS) return
+        if (has_mass_factor(sys)) then
+            mm = sys%mass_factor        ! factorised once by prepare_mass
+        else
+            call sys%mass(t, q, mm)
+            call mass_cholesky(mm, info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
         call constraint_matrix(sys, t, q, c, c0)
         r(:, 1) = matmul(c, v) + c0
         r0 = maxval(abs(r(:, 1)))
