@@ -25,7 +25,7 @@ program bench_chain
     nrep = 3
     if (quick) nrep = 1
     do i = 1, size(ns)
-        call run(ns(i), .true., merge(0.2_dp, 1.0_dp, quick), tb(i), sb(i), rb(i))
+        call run(ns(i), .true., merge(0.5_dp, 5.0_dp, quick), tb(i), sb(i), rb(i))
         call run(ns(i), .false., merge(0.02_dp, merge(0.5_dp, 0.1_dp, ns(i) <= 32), quick), &
                  td(i), sd(i), rd(i))
     end do

@@ -49,12 +49,13 @@ module conmech_constrained_system
     use conmech_status
     use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd, la_finite
     use conmech_generalized, only: mass_cholesky
-    use conmech_constrained_band, only: band_width_of, band_gmul
+    use conmech_constrained_band, only: band_width_of, band_gmul, band_gtmul
     implicit none
     private
 
     public :: constrained_system, constrained_accel, constraint_matrix
     public :: project_position, project_velocity, constraint_residuals, prepare_mass
+    public :: constraint_reaction
     !> The finite-difference defaults, for extensions that choose at run time (e.g. the
     !! Python layer) whether an analytic Jacobian / acceleration term exists.
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
@@ -524,6 +525,31 @@ contains
         info = CM_SUCCESS
         if (present(msg)) msg = "success"
     end subroutine constrained_accel
+
+    !> Reaction force r = C(t, q)^T lam (n): O(n) for a row-window G.
+    subroutine constraint_reaction(sys, t, q, lam, r)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), lam(:)
+        real(dp), intent(out) :: r(:)
+        real(dp), allocatable :: c(:, :), c0(:)
+        r = 0.0_dp
+        if (sys%n_hol + sys%n_nh == 0) return
+        if (band_ready(sys)) then
+            block
+                real(dp) :: gb(sys%n_hol, sys%jac_width)
+                integer :: first(sys%n_hol)
+                call sys%phi_jac_band(t, q, gb, first)
+                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
+                    call band_gtmul(gb, first, lam, r)
+                    return
+                end if
+            end block
+        end if
+        allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
+        call constraint_matrix(sys, t, q, c, c0)
+        r = matmul(lam, c)
+    end subroutine constraint_reaction
 
     !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
     subroutine constraint_residuals(sys, t, q, v, rpos, rvel)
