@@ -217,7 +217,7 @@ contains
         integer :: n, nt, k, ne, nthr, chunk, i, i0, i1, first_bad
         logical :: cancel
         real(dp) :: nan
-        character(len=:), allocatable :: msgs(:)
+        character(len=160), allocatable :: msgs(:)
         character(len=24) :: buf
 
         if (present(ens_options)) eo = ens_options
@@ -291,7 +291,7 @@ contains
             chunk = eo%chunk
             if (chunk == 0) chunk = max(16*nthr, (m + 99)/100)
         end if
-        allocate (character(len=160) :: msgs(m))
+        allocate (msgs(m))
 
         cancel = .false.
         i0 = 1
