@@ -26,6 +26,7 @@ system's values)::
     res = ensemble.solve(conmech.systems.pendulum(), (0, 10), [1.0, 0.0],
                          params={"l": np.linspace(0.5, 2.0, 100)})
 """
+import inspect
 import math
 import numbers
 
@@ -33,6 +34,7 @@ import numpy as np
 
 from . import _conmech
 from ._ivp import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
+from ._ivp import solve_ivp as _solve_ivp
 from .systems import BuiltinSystem
 
 __all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
@@ -41,6 +43,9 @@ _CM_BAD_INPUT = -4
 _NOT_RUN = -99
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
+# the defaults of solve_ivp (method, rtol, atol), so that a member equals solve_ivp's run
+_IVP_DEFAULTS = {k: v.default for k, v in inspect.signature(_solve_ivp).parameters.items()
+                 if k in ("method", "rtol", "atol")}
 
 
 class Crossing:
@@ -113,6 +118,9 @@ class EnsembleResult(OdeResult):
 def _check_system(system):
     if isinstance(system, BuiltinSystem):
         return system
+    if type(system).__name__ == "BuiltinConstrained":
+        raise TypeError("ensemble.solve integrates first-order systems (conmech.systems "
+                        "...); constrained systems are not supported in ensembles")
     if callable(system):
         raise TypeError("ensemble.solve integrates compiled systems (conmech.systems ...) in "
                         "parallel threads; a Python function cannot run there: use "
@@ -175,8 +183,8 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
-def solve(system, t_span, y0, params=None, *, t_eval=None, method="RK45", rtol=1e-3,
-          atol=1e-6, first_step=None, max_step=np.inf, max_steps=100000, events=None,
+def solve(system, t_span, y0, params=None, *, t_eval=None, method=None, rtol=None,
+          atol=None, first_step=None, max_step=np.inf, max_steps=100000, events=None,
           max_events=1, terminal=False, threads=None, chunk=None, progress=None):
     """Integrate an ensemble of members of one compiled system in parallel.
 
@@ -194,7 +202,8 @@ def solve(system, t_span, y0, params=None, *, t_eval=None, method="RK45", rtol=1
     t_eval : array_like, optional
         Common output times (sorted in the direction of integration, inside t_span).
     method, rtol, atol, first_step, max_step, max_steps
-        As in :func:`conmech.solve_ivp` (the same defaults), shared by every member.
+        As in :func:`conmech.solve_ivp`, shared by every member; None (method, rtol,
+        atol): solve_ivp's defaults.
     events : Crossing or list of Crossing, optional
         Built-in event kinds (:func:`crossing`); Python callables cannot run in threads.
     max_events : int
@@ -222,6 +231,9 @@ def solve(system, t_span, y0, params=None, *, t_eval=None, method="RK45", rtol=1
     """
     system = _check_system(system)
     n = system.dimension
+    method = _IVP_DEFAULTS["method"] if method is None else method
+    rtol = _IVP_DEFAULTS["rtol"] if rtol is None else rtol
+    atol = _IVP_DEFAULTS["atol"] if atol is None else atol
     if not isinstance(method, str):
         raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
     code = _METHOD_CODES.get(method.upper(), 0)

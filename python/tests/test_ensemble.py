@@ -62,12 +62,11 @@ def test_parameters_per_member():
                               method="DOP853", rtol=1e-10, atol=1e-10)
         assert np.array_equal(res.y_final[i], s.y[:, -1]) and res.nfev[i] == s.nfev
         assert np.array_equal(res2.y_final[i], s.y[:, -1])
-    # initial states and parameters both per member
+    # initial states and parameters both per member; solve_ivp's default method and tolerances
     y0 = np.column_stack([np.linspace(0.1, 1.0, 4), np.zeros(4)])
     res = ensemble.solve(conmech.systems.pendulum(), (0, 2), y0, params={"l": lengths})
     for i in range(4):
-        s = conmech.solve_ivp(conmech.systems.pendulum(l=lengths[i]), (0, 2), y0[i],
-                              method="RK45")
+        s = conmech.solve_ivp(conmech.systems.pendulum(l=lengths[i]), (0, 2), y0[i])
         assert np.array_equal(res.y_final[i], s.y[:, -1])
 
 
@@ -139,6 +138,7 @@ def test_progress_reports_and_cancel():
 
 @pytest.mark.parametrize("kwargs, exc, text", [
     (dict(system=lambda t, y: y), TypeError, "Python function"),
+    (dict(system=conmech.systems.pendulum_xy()), TypeError, "constrained"),
     (dict(y0=np.zeros((3, 3))), ValueError, "shape"),
     (dict(y0=np.full((2, 4), np.nan)), ValueError, "NaN"),
     (dict(params=np.ones((3, 2))), ValueError, "params"),
