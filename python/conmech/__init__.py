@@ -8,10 +8,11 @@ numpy.f2py + meson-python). The integrators follow SciPy's names::
 """
 from . import constrained, systems
 from . import hill, stability
+from . import compiled
 from ._ivp import DenseOutput, OdeResult, solve_ivp
 from . import ensemble  # noqa: E402  (after _ivp: it builds on it)
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability",
-           "constrained"]
+           "constrained", "compiled"]
 __all__ += ["ensemble"]
 __version__ = "0.1.0"
