@@ -118,7 +118,7 @@ class EnsembleResult(OdeResult):
 def _check_system(system):
     if isinstance(system, BuiltinSystem):
         return system
-    if type(system).__name__ == "BuiltinConstrained":
+    if type(system).__name__ in ("BuiltinConstrained", "CompiledConstrained"):
         raise TypeError("ensemble.solve integrates first-order systems (conmech.systems "
                         "...); constrained systems are not supported in ensembles")
     if callable(system):
@@ -376,9 +376,11 @@ def solve(system, t_span, y0, params=None, *, t_eval=None, method=None, rtol=Non
         return 0
 
     nt = t_ev.size
+    name, _, _, nspec, spec = system._flat_args()
     (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,
      info, message) = _conmech.flat_ensemble_builtin(
-        name=system.name, np=system.params.size, mp=mp, params=ptab, n=n, m=m, my0=my0,
+        name=name, np=system.params.size, mp=mp, params=ptab, nspec=nspec, spec=spec, n=n,
+        m=m, my0=my0,
         y0=np.asfortranarray(y0a.T), t_span=np.array([t0, tf]), method=code, rtol=rtol_v,
         atol=atol_v, first_step=h0, max_step=hmax, max_steps=int(max_steps), neval=nt,
         t_eval=t_ev if nt else _PAD, ne=ne,

@@ -2,28 +2,29 @@
 !! sets of one built-in system integrated with OpenMP threads, results as arrays. The
 !! Python API is conmech/ensemble.py. Conventions as in flat_ode.f90.
 
-!> Ensemble of the built-in system `name` (conmech_systems::make_system).
-!! params(np, mp): one column shared by every member (mp = 1) or one per member (mp = m);
-!! y0(n, my0): likewise. Events: ne functions g_j = y(ev_comp(j)) - ev_value(j) with
-!! direction ev_dir(j) (+1, -1, 0); the first k events of each member are kept; terminal
-!! /= 0 stops a member at its k-th event. threads = 0: the OpenMP default; chunk: members
-!! between progress calls (0 automatic); use_progress /= 0 calls progress(done, total,
-!! cancel) between chunks (cancel /= 0 skips the rest). meval = m if neval > 0 else 1,
-!! mev = m if k > 0 and ne > 0 else 1 (sizes of the outputs). Member status: conmech's
-!! codes (0 end, 1 terminal event, < 0 failure, -99 not run); info and message: the first
-!! failure (or bad input, or the cancel).
-subroutine flat_ensemble_builtin(name, np, mp, params, n, m, my0, y0, t_span, method, rtol, &
-                                 atol, first_step, max_step, max_steps, neval, t_eval, ne, &
-                                 ev_comp, ev_value, ev_dir, k, terminal, threads, chunk, &
-                                 use_progress, progress, meval, mev, y_eval, t_final, &
-                                 y_final, status, nfev, naccept, nreject, nev, ev_t, ev_y, &
-                                 ev_id, done, info, message)
+!> Ensemble of the built-in system `name` or of a compiled one (nspec, spec: see
+!! conmech_flat_spec). params(np, mp): one column shared by every member (mp = 1) or one
+!! per member (mp = m); y0(n, my0): likewise. Events: ne functions
+!! g_j = y(ev_comp(j)) - ev_value(j) with direction ev_dir(j) (+1, -1, 0); the first k
+!! events of each member are kept; terminal /= 0 stops a member at its k-th event.
+!! threads = 0: the OpenMP default; chunk: members between progress calls (0 automatic);
+!! use_progress /= 0 calls progress(done, total, cancel) between chunks (cancel /= 0
+!! skips the rest). meval = m if neval > 0 else 1, mev = m if k > 0 and ne > 0 else 1
+!! (sizes of the outputs). Member status: conmech's codes (0 end, 1 terminal event,
+!! < 0 failure, -99 not run); info and message: the first failure (or bad input, or the
+!! cancel).
+subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y0, t_span, &
+                                 method, rtol, atol, first_step, max_step, max_steps, &
+                                 neval, t_eval, ne, ev_comp, ev_value, ev_dir, k, terminal, &
+                                 threads, chunk, use_progress, progress, meval, mev, &
+                                 y_eval, t_final, y_final, status, nfev, naccept, nreject, &
+                                 nev, ev_t, ev_y, ev_id, done, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options
-    use conmech_systems, only: make_system, system_dimension
+    use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_ensemble, only: ode_ensemble, ensemble_options, ensemble_result, &
         crossing_events
     use conmech_flat_ode_support, only: copy_message
@@ -32,6 +33,8 @@ subroutine flat_ensemble_builtin(name, np, mp, params, n, m, my0, y0, t_span, me
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, mp, n, m, my0
     real(c_double), intent(in) :: params(max(np, 1), mp)
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: y0(n, my0)
     real(c_double), intent(in) :: t_span(2)
     integer(c_int), intent(in) :: method
@@ -103,14 +106,14 @@ subroutine flat_ensemble_builtin(name, np, mp, params, n, m, my0, y0, t_span, me
                           message)
         return
     end if
-    call make_system(name, real(params(1:np, 1), dp), sys, info, msg)
+    call spec_system(name, real(params(1:np, 1), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
     end if
-    if (system_dimension(name) /= n) then
+    if (spec_dimension(name, nspec, spec) /= n) then
         info = CM_BAD_INPUT
-        write (buf, '(i0)') system_dimension(name)
+        write (buf, '(i0)') spec_dimension(name, nspec, spec)
         call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
                           //trim(name)//"'", message)
         return
@@ -151,6 +154,8 @@ subroutine flat_ensemble_builtin(name, np, mp, params, n, m, my0, y0, t_span, me
     else
         members%name = name
         members%params = real(params(1:np, :), dp)
+        members%spec = spec(1:max(nspec, 1))
+        members%nspec = nspec
         call ode_ensemble(members, t_span, y0, opt, res, te, evs, eo, pg)
     end if
 

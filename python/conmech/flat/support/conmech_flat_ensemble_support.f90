@@ -1,14 +1,15 @@
 !> Support of the flat f2py layer for ensembles (compiled into the extension, not wrapped).
 !!
-!! `builtin_members` gives member i the built-in system `name` with the parameters of
-!! column i of a table (conmech_systems::make_system); `callback_progress` relays the
-!! ensemble's progress reports to an external procedure progress(done, total, cancel)
+!! `builtin_members` gives member i the built-in system `name` (or the compiled system of
+!! `spec`, conmech_flat_spec) with the parameters of column i of a table;
+!! `callback_progress` relays the ensemble's progress reports to an external procedure
+!! progress(done, total, cancel)
 !! (an f2py callback into Python, called by the calling thread between chunks only).
 module conmech_flat_ensemble_support
-    use, intrinsic :: iso_c_binding, only: c_int
+    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
     use conmech_kinds, only: dp
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system
+    use conmech_flat_spec, only: spec_system
     use conmech_ensemble, only: ensemble_members, ensemble_progress
     implicit none
     private
@@ -18,6 +19,8 @@ module conmech_flat_ensemble_support
     type, extends(ensemble_members) :: builtin_members
         character(len=:), allocatable :: name
         real(dp), allocatable :: params(:, :)   !! (np, m)
+        integer :: nspec = 0                    !! 0: built-in `name`
+        integer(c_int64_t), allocatable :: spec(:)
     contains
         procedure :: count => builtin_count
         procedure :: system => builtin_system
@@ -43,7 +46,7 @@ contains
         class(ode_system), allocatable, intent(out) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        call make_system(self%name, self%params(:, i), sys, info, msg)
+        call spec_system(self%name, self%params(:, i), self%nspec, self%spec, sys, info, msg)
     end subroutine builtin_system
 
     subroutine callback_report(self, done, total, cancel)
