@@ -1,5 +1,7 @@
 """Ensembles: many initial states and/or parameter sets of one system, integrated in
-parallel in Fortran (OpenMP threads, no Python in the loop).
+parallel in Fortran (OpenMP threads, no Python in the loop). The system is a built-in one
+(``conmech.systems``) or a compiled one (``conmech.compiled.ode_system`` /
+``generalized_system``, e.g. from ``conmech.symbolic``): they take the same path.
 
 Each member is the single integration :func:`conmech.solve_ivp` would do with the same
 system, initial state, parameters and options, bit for bit, whatever the number of threads.
@@ -190,8 +192,10 @@ def solve(system, t_span, y0, params=None, *, t_eval=None, method=None, rtol=Non
 
     Parameters
     ----------
-    system : conmech.systems.BuiltinSystem
-        The system (its parameters are the default of every member).
+    system : conmech.systems.BuiltinSystem or a compiled system
+        The system (its parameters are the default of every member): built-in
+        (``conmech.systems``) or compiled (``conmech.compiled.ode_system``,
+        ``generalized_system``); constrained systems are not supported.
     t_span : 2-sequence of float
         (t0, tf), common to every member; tf < t0 integrates backwards.
     y0 : array_like, shape (m, n) or (n,)
