@@ -54,6 +54,16 @@ def run_conmech(y0, tol, threads, repeat, method):
     return t, res.y_final, int(res.nfev.sum())
 
 
+def run_conmech_loop(y0, tol, method):
+    """The same members as a Python loop of conmech.solve_ivp calls (one run)."""
+    T = 2 * np.pi
+    kep = conmech.systems.kepler()
+    t = time.perf_counter()
+    yf = np.array([conmech.solve_ivp(kep, (0, T), y, method=method, rtol=tol,
+                                     atol=tol).y[:, -1] for y in y0])
+    return time.perf_counter() - t, yf
+
+
 def heyoka_kepler(hy, tol, batch=None):
     x, y, vx, vy = hy.make_vars("x", "y", "vx", "vy")
     r3 = (x**2 + y**2) ** 1.5
@@ -158,6 +168,8 @@ def main():
                 t, yf, nfev = run_conmech(y0, tol, th, args.repeat, method)
                 rows.append((f"conmech {method}", th, t, *errors(yf, y0), f"{nfev} f-evals"))
             if th == 1:
+                t, yf = run_conmech_loop(y0, tol, "DOP853")
+                rows.append(("conmech DOP853, loop of solve_ivp", th, t, *errors(yf, y0), ""))
                 t, yf = run_heyoka_loop(hy, y0, tol, args.repeat)
                 rows.append(("heyoka scalar, Python loop", th, t, *errors(yf, y0), ""))
             # heyoka's ensemble deep-copies the integrator for every member: slow, run once
