@@ -25,6 +25,7 @@ module conmech
     use conmech_floquet
     use conmech_shooting
     use conmech_hill_orbit
+    use conmech_ensemble
     implicit none
     public
 end module conmech
