@@ -4,6 +4,7 @@
 !! METHOD_GAUSS4 / METHOD_GAUSS6 to `gauss_solve`.
 submodule(conmech_ode_solver) conmech_radau_dispatch
     use conmech_radau, only: radau_solve
+    use conmech_gauss, only: gauss_solve
     implicit none
 
 contains
@@ -19,6 +20,10 @@ contains
         select case (options%method)
         case (METHOD_RADAU5)
             call radau_solve(sys, t_span, y0, options, res, t_eval, events)
+        case (METHOD_GAUSS4)
+            call gauss_solve(sys, 2, t_span, y0, options, res, t_eval, events)
+        case (METHOD_GAUSS6)
+            call gauss_solve(sys, 3, t_span, y0, options, res, t_eval, events)
         case (METHOD_RATTLE)
             res%message = "bad input: RATTLE is a method for constrained systems " &
                           //"(rattle_solve, constrained.solve)"
