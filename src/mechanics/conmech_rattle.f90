@@ -35,7 +35,7 @@ module conmech_rattle
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dgetrf, dgetrs, dpotrs
+    use conmech_lapack, only: dgetrs
     use conmech_generalized, only: mass_cholesky
     use conmech_constrained_system, only: constrained_system, constrained_accel, &
         constraint_matrix, constraint_residuals
@@ -46,12 +46,30 @@ module conmech_rattle
 
     public :: rattle_solve
 
+    interface
+        !> Unblocked LU (no block-size query: fast for the small constraint matrices).
+        subroutine dgetf2(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetf2
+        !> Inverse from the Cholesky factor (upper triangle).
+        subroutine dpotri(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotri
+    end interface
+
     !> The state at one grid point with what the next step reuses.
     type :: rattle_state
         real(dp) :: t = 0.0_dp
         real(dp), allocatable :: q(:), v(:)
         real(dp), allocatable :: f(:)       !! Q(t, q, v)
-        real(dp), allocatable :: mc(:, :)   !! Cholesky factor of M(t, q)
+        real(dp), allocatable :: mc(:, :)   !! M(t, q)^{-1} (from its Cholesky factor)
         real(dp), allocatable :: x(:, :)    !! M^{-1} G^T (n x n_hol)
         real(dp), allocatable :: g(:, :)    !! G (n_hol x n)
     end type rattle_state
@@ -70,7 +88,8 @@ contains
         type(constrained_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
 
-        type(rattle_state) :: s, s1, side
+        type(rattle_state) :: st(2), side
+        integer :: cur
         real(dp), allocatable :: tout(:), qout(:, :), vout(:, :), q(:), v(:), acc(:), lam(:)
         real(dp) :: h, t0, tf, posneg
         integer :: n, m, nsteps, k, nout, n_eval, i_eval, info, iters, j
@@ -143,7 +162,8 @@ contains
             call fail(info, msg)
             return
         end if
-        call prepare(s, t0, q, v, info, msg)
+        cur = 1
+        call prepare(st(1), t0, q, v, info, msg)
         if (info /= CM_SUCCESS) then
             call fail(info, msg)
             return
@@ -168,34 +188,35 @@ contains
             ! t_eval points strictly inside (t_{k-1}, t_k): a side step from t_{k-1}
             do while (i_eval <= n_eval)
                 if ((t_eval(i_eval) - (t0 + k*h))*posneg >= 0.0_dp) exit
-                call step(s, t_eval(i_eval) - s%t, side, info, msg)
+                call step(st(cur), t_eval(i_eval) - st(cur)%t, side, info, msg)
                 if (info /= CM_SUCCESS) exit
                 call push(t_eval(i_eval), side%q, side%v)
                 i_eval = i_eval + 1
             end do
             if (info /= CM_SUCCESS) exit
-            call step(s, h, s1, info, msg)
+            call step(st(cur), h, st(3 - cur), info, msg)
             if (info /= CM_SUCCESS) exit
+            cur = 3 - cur
             if (k == nsteps) then
-                s1%t = tf
+                st(cur)%t = tf
             else
-                s1%t = t0 + k*h
+                st(cur)%t = t0 + k*h
             end if
-            call move_state(s1, s)
             res%naccept = res%naccept + 1
             if (n_eval == 0) then
-                if (options%save_steps .or. k == nsteps) call push(s%t, s%q, s%v)
+                if (options%save_steps .or. k == nsteps) &
+                    call push(st(cur)%t, st(cur)%q, st(cur)%v)
             else
                 ! points on this grid point (at the end: every remaining point, = tf)
                 do while (i_eval <= n_eval)
-                    if (k < nsteps .and. t_eval(i_eval) /= s%t) exit
-                    call push(t_eval(i_eval), s%q, s%v)
+                    if (k < nsteps .and. t_eval(i_eval) /= st(cur)%t) exit
+                    call push(t_eval(i_eval), st(cur)%q, st(cur)%v)
                     i_eval = i_eval + 1
                 end do
             end if
         end do
         if (info /= CM_SUCCESS) then
-            write (buf, '(es14.6)') s%t
+            write (buf, '(es14.6)') st(cur)%t
             res%status = info
             res%message = msg//" (RATTLE step from t ="//trim(buf)//")"
         else
@@ -308,14 +329,19 @@ contains
             type(rattle_state), intent(inout) :: st
             integer, intent(out) :: inf
             character(len=:), allocatable, intent(out) :: mg
-            integer :: lainfo
+            integer :: lainfo, jj
             call sys%mass(st%t, st%q, st%mc)
             call mass_cholesky(st%mc, inf, mg)
             if (inf /= CM_SUCCESS) return
+            ! the explicit inverse (small matrices: one LAPACK call per step instead of a
+            ! triangular solve per right-hand side)
+            call dpotri('U', n, st%mc, n, lainfo)
+            do jj = 1, n - 1
+                st%mc(jj + 1:n, jj) = st%mc(jj, jj + 1:n)
+            end do
             if (m > 0) then
                 call sys%phi_jac(st%t, st%q, st%g)
-                st%x = transpose(st%g)
-                call dpotrs('U', n, m, st%mc, n, st%x, n, lainfo)
+                st%x = matmul(st%mc, transpose(st%g))
             end if
             mg = "success"
         end subroutine factor_mass
@@ -327,42 +353,43 @@ contains
             type(rattle_state), intent(inout) :: s2
             integer, intent(out) :: inf
             character(len=:), allocatable, intent(out) :: mg
-            real(dp) :: afree(n, 1), vhalf(n), qt(n), ph(m, 1), sm(m, m), gt(m, n), dq(n)
-            real(dp) :: lam_s(m), w(n, 1), r(m, 1), vprev(n), t1, rnorm
+            real(dp) :: afree(n), vhalf(n), qt(n), ph(m), sm(m, m), gt(m, n), dq(n)
+            real(dp) :: dqsum(n), w(n), r(m), vprev(n), t1, rnorm, pt(m, n)
             integer :: ipiv(m), lainfo, it, kk
             character(len=32) :: b2
             t1 = st%t + hs
             if (.not. allocated(s2%f)) allocate (s2%q(n), s2%v(n), s2%f(n), s2%mc(n, n), &
                                                  s2%x(n, m), s2%g(m, n))
             ! first half kick without the constraint force, unconstrained predictor
-            afree(:, 1) = st%f
-            call dpotrs('U', n, 1, st%mc, n, afree, n, lainfo)
-            qt = st%q + hs*st%v + (0.5_dp*hs*hs)*afree(:, 1)
-            lam_s = 0.0_dp
+            afree = matmul(st%mc, st%f)
+            qt = st%q + hs*st%v + (0.5_dp*hs*hs)*afree
+            dqsum = 0.0_dp
             s2%q = qt
             if (m > 0) then
                 call sys%phi_jac(t1, qt, gt)
                 sm = matmul(gt, st%x)
-                call dgetrf(m, m, sm, m, ipiv, lainfo)
+                call dgetf2(m, m, sm, m, ipiv, lainfo)
                 if (lainfo /= 0) then
                     inf = CM_SINGULAR
                     mg = "singular constraint matrix G M^-1 G^T in the position solve " &
                          //"(redundant constraints?)"
                     return
                 end if
+                ! pk = X S^{-1} (n x m) from S^T pk^T = X^T
+                pt = transpose(st%x)
+                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
                 inf = CM_NO_CONVERGENCE
                 do it = 1, options%proj_max_iter + 1
-                    call sys%phi(t1, s2%q, ph(:, 1))
-                    rnorm = maxval(abs(ph(:, 1)))
+                    call sys%phi(t1, s2%q, ph)
+                    rnorm = maxval(abs(ph))
                     if (.not. rnorm < huge(1.0_dp)) exit
                     if (rnorm <= options%proj_tol) then
                         inf = CM_SUCCESS
                         exit
                     end if
                     if (it > options%proj_max_iter) exit
-                    call dgetrs('N', m, 1, sm, m, ipiv, ph, m, lainfo)
-                    lam_s = lam_s - ph(:, 1)
-                    dq = matmul(st%x, ph(:, 1))
+                    dq = matmul(ph, pt)
+                    dqsum = dqsum + dq
                     s2%q = s2%q - dq
                     if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*maxval(abs(s2%q))) then
                         inf = CM_SUCCESS
@@ -379,20 +406,22 @@ contains
                     return
                 end if
             end if
-            vhalf = st%v + (0.5_dp*hs)*afree(:, 1)
-            if (m > 0) vhalf = vhalf + matmul(st%x, lam_s)/hs
+            ! v_{1/2} = (q_{n+1} - q_n)/h without the cancellation
+            vhalf = st%v + (0.5_dp*hs)*afree - dqsum/hs
             ! second half kick at q_{n+1}, velocity constraints
             s2%t = t1
             call factor_mass(s2, inf, mg)
             if (inf /= CM_SUCCESS) return
             if (m > 0) then
                 sm = matmul(s2%g, s2%x)
-                call dgetrf(m, m, sm, m, ipiv, lainfo)
+                call dgetf2(m, m, sm, m, ipiv, lainfo)
                 if (lainfo /= 0) then
                     inf = CM_SINGULAR
                     mg = "singular constraint matrix G M^-1 G^T in the velocity solve"
                     return
                 end if
+                pt = transpose(s2%x)
+                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
             end if
             s2%v = 2.0_dp*vhalf - st%v
             inf = CM_NO_CONVERGENCE
@@ -400,17 +429,14 @@ contains
                 call sys%forces(t1, s2%q, s2%v, s2%f)
                 res%nfev = res%nfev + 1
                 if (.not. all(ieee_is_finite(s2%f))) exit
-                w(:, 1) = s2%f
-                call dpotrs('U', n, 1, s2%mc, n, w, n, lainfo)
-                w(:, 1) = vhalf + (0.5_dp*hs)*w(:, 1)
+                w = vhalf + (0.5_dp*hs)*matmul(s2%mc, s2%f)
                 if (m > 0) then
-                    call sys%phi_t(t1, s2%q, r(:, 1))
-                    r(:, 1) = -(matmul(s2%g, w(:, 1)) + r(:, 1))
-                    call dgetrs('N', m, 1, sm, m, ipiv, r, m, lainfo)
-                    w(:, 1) = w(:, 1) + matmul(s2%x, r(:, 1))
+                    call sys%phi_t(t1, s2%q, r)
+                    r = -(matmul(s2%g, w) + r)
+                    w = w + matmul(r, pt)
                 end if
                 vprev = s2%v
-                s2%v = w(:, 1)
+                s2%v = w
                 if (kk > 1 .and. maxval(abs(s2%v - vprev)) <= 4.0_dp*epsilon(1.0_dp)* &
                     max(maxval(abs(s2%v)), tiny(1.0_dp))) then
                     ! converged: Q(t1, q1, v1) equals s2%f to round-off
@@ -423,17 +449,6 @@ contains
                      //"converge (or are not finite)"
             end if
         end subroutine step
-
-        subroutine move_state(a, b)
-            type(rattle_state), intent(inout) :: a, b
-            b%t = a%t
-            call move_alloc(a%q, b%q)
-            call move_alloc(a%v, b%v)
-            call move_alloc(a%f, b%f)
-            call move_alloc(a%mc, b%mc)
-            call move_alloc(a%x, b%x)
-            call move_alloc(a%g, b%g)
-        end subroutine move_state
 
     end subroutine rattle_solve
 
