@@ -12,7 +12,9 @@
 !! - Step size: h_new = h / max(1/8, min(5, err^(1/4)/fac)), fac = min(0.9, 0.9 (2 nit
 !!   + 1)/(newt + 2 nit)), then the predictive controller of Gustafsson. The Jacobian is
 !!   re-evaluated after an accepted step only when the Newton iteration was slow (more
-!!   than two iterations and theta > 0.001; RADAU5 uses theta alone, SciPy this rule);
+!!   than two iterations and theta > 0.001; RADAU5 uses theta alone, SciPy this rule),
+!!   and after a Newton failure if it is not current; a step rejected by the error test
+!!   keeps it (SciPy; RADAU5 refreshes it there);
 !!   otherwise the step and the LU are kept when the proposed ratio is below 1.2 (SciPy's
 !!   window; RADAU5's default is [1, 1.2]). With these two choices the counts of steps,
 !!   Jacobians and LUs are within a few per cent of SciPy's Radau (bench/bench_radau.py).
@@ -322,7 +324,7 @@ contains
                 end if
                 if (res%stats%naccept >= 1) res%stats%nreject = res%stats%nreject + 1
                 need_lu = .true.
-                if (.not. caljac) need_jac = .true.
+                ! (the Jacobian is kept: SciPy's rule; RADAU5 refreshes an old one here)
             end if
         end do
         call finish(CM_SUCCESS, "success")
