@@ -13,6 +13,7 @@ module conmech
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_rattle
+    use conmech_rattle_dae
     use conmech_radau
     use conmech_gauss
     use conmech_systems_generalized

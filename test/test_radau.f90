@@ -35,6 +35,20 @@ program test_radau
     call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
     call ts%check_less(maxval(abs(r%y(:, r%nt) - ref)), 3.0e-8_dp, "FD Jacobian: error")
 
+    ! mass-matrix form: y1' = y2, 0 = y2 + y1 (index 1), so y1 = exp(-t)
+    f%f => dae
+    f%jac => null()
+    opt%dense_output = .false.
+    opt%rtol = 1.0e-8_dp
+    opt%atol = 1.0e-10_dp
+    call radau_solve(f, [0.0_dp, 3.0_dp], [1.0_dp, -1.0_dp], opt, r, &
+                     mass=reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))
+    call ts%check(r%success, "index-1 DAE: "//r%message)
+    call ts%check_less(abs(r%y(1, r%nt) - exp(-3.0_dp)), 1.0e-8_dp, "DAE: y1(3) = exp(-3)")
+    call ts%check_less(maxval(abs(r%y(1, :) + r%y(2, :))), 1.0e-12_dp, &
+                       "DAE: algebraic equation at every step")
+    f%f => vdp
+
     ! bad input
     opt%rtol = -1.0_dp
     call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
@@ -57,6 +71,13 @@ contains
         real(dp), intent(out) :: dydt(:)
         dydt = [y(2), ((1.0_dp - y(1)**2)*y(2) - y(1))/1.0e-6_dp]
     end subroutine vdp
+
+    subroutine dae(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt = [y(2), y(2) + y(1)]
+    end subroutine dae
 
     subroutine vdp_jac(t, y, dfdy)
         real(dp), intent(in) :: t

@@ -30,7 +30,7 @@ BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
 _METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
-            "RATTLE": 8}
+            "RATTLE": 8, "Radau": 5, "RADAU5": 5}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
@@ -262,7 +262,10 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         RATTLE: the symplectic constrained integrator for holonomic constraints (fixed
         step ``first_step``; constraints solved to round-off every step; ``projection``,
         rtol and atol are not used; a t_eval point between grid points is reached by a
-        side step, so every output is on the manifold).
+        side step, so every output is on the manifold). Radau: Radau IIA (order 5,
+        adaptive, rtol/atol) on the stabilised index-2 DAE [q, v, lambda, mu] in
+        mass-matrix form: no drift and no projection; stiff forces welcome; the mass
+        matrix must be constant.
     projection : "position+velocity" (default), "velocity", "baumgarte", "none"
     t_eval : array_like, optional
         Output times (sorted, inside t_span; the steps hit them exactly). Default: every

@@ -142,3 +142,30 @@ def test_bad_jac():
                           jac=lambda t, y: np.eye(3))
     with pytest.raises(ValueError, match="jac"):
         conmech.solve_ivp(vdp, (0, 1), [2.0, 0.0], method="DOP853", jac=vdp_jac)
+
+
+def test_constrained_dae_form():
+    from conmech import constrained
+    # the stabilised index-2 DAE: both constraint levels to the tolerance, no projection
+    r = constrained.solve("double_pendulum_xy", (0, 10), method="Radau", rtol=1e-8,
+                          atol=1e-8, t_eval=np.linspace(0, 10, 11))
+    ref = constrained.solve("double_pendulum_xy", (0, 10), method="DOP853", rtol=1e-12,
+                            atol=1e-12, t_eval=np.linspace(0, 10, 11))
+    assert r.success and r.nproj == 0
+    assert np.abs(r.q - ref.q).max() < 1e-7
+    assert np.abs(r.res_pos).max() < 1e-9 and np.abs(r.res_vel).max() < 1e-7
+    assert np.abs(r.lam - ref.lam).max() < 1e-5 * np.abs(ref.lam).max()
+    # tighter tolerance, smaller residuals and errors
+    r2 = constrained.solve("double_pendulum_xy", (0, 10), method="Radau", rtol=1e-10,
+                           atol=1e-10, t_eval=np.linspace(0, 10, 11))
+    assert np.abs(r2.q - ref.q).max() < 0.05 * np.abs(r.q - ref.q).max()
+
+
+def test_constrained_dae_needs_constant_mass():
+    from conmech import constrained
+    sysm = constrained.ConstrainedSystem(
+        2, lambda t, q: np.diag([1.0 + q[0] ** 2, 1.0]), lambda t, q, v: [0.0, -9.81],
+        phi=lambda t, q: [0.5 * (q[0] ** 2 + q[1] ** 2 - 1)], n_hol=1)
+    with pytest.raises(ValueError, match="constant mass matrix"):
+        constrained.solve(sysm, (0, 1), [np.sin(1), -np.cos(1)], [0.0, 0.0],
+                          method="Radau", rtol=1e-6, atol=1e-6)

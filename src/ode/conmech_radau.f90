@@ -32,6 +32,11 @@
 !!   halves the step; 0.1 |h| <= eps |t| ends the run (CM_STEP_TOO_SMALL, with the time);
 !!   a singular iteration matrix halves the step, five singular ones in a row end the run
 !!   (CM_SINGULAR).
+!! - Mass-matrix form M y' = f(t, y) with a constant, possibly singular M (differential-
+!!   algebraic systems of index 1 and 2, RADAU5's IMAS = 1): optional arguments `mass`
+!!   and `index2` (index-2 components get their error scaled by h, as RADAU5's NIND2);
+!!   the initial step is then 1e-6 unless given. The constrained layer uses it through
+!!   conmech_rattle_dae (the stabilised index-2 formulation).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
 module conmech_radau
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -101,7 +106,7 @@ contains
     !> Solve y' = f(t, y) on t_span with Radau IIA (order 5); outputs as `ode_solve`
     !! (every accepted step, or t_eval interpolated on the collocation polynomial; dense
     !! output; events). res%stats counts nfev, njev, nlu, naccept, nreject.
-    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events)
+    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events, mass, index2)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: y0(:)
@@ -109,11 +114,16 @@ contains
         type(ode_result), intent(inout) :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        !> constant mass matrix M of M y' = f(t, y) (n x n, may be singular: a DAE)
+        real(dp), intent(in), optional :: mass(:, :)
+        !> the index-2 algebraic components (their error is scaled by h, as RADAU5)
+        logical, intent(in), optional :: index2(:)
 
         type(step_output) :: o
         real(dp), allocatable :: y(:), f0(:), jac(:, :), e1(:, :), z1(:), z2(:), z3(:)
         real(dp), allocatable :: w1(:), w2(:), w3(:), a1(:), a2(:), a3(:), scal(:), cont(:)
-        real(dp), allocatable :: rtolv(:), atolv(:), fc(:, :), ynew(:), ystop(:)
+        real(dp), allocatable :: rtolv(:), atolv(:), fc(:, :), ynew(:), ystop(:), scal0(:)
+        real(dp), allocatable :: b1(:), b2(:), b3(:)
         complex(dp), allocatable :: e2(:, :), zc(:)
         integer, allocatable :: ip1(:), ip2(:)
         real(dp) :: t0, tf, t, h, hmax, posneg, uround, fnewt, faccon, theta, thqold
@@ -133,7 +143,7 @@ contains
         if (res%status /= CM_SUCCESS) return
         allocate (y(n), f0(n), jac(n, n), e1(n, n), z1(n), z2(n), z3(n), w1(n), w2(n), &
                   w3(n), a1(n), a2(n), a3(n), scal(n), cont(n), fc(n, 0:3), ynew(n), &
-                  ystop(n), e2(n, n), zc(n), ip1(n), ip2(n))
+                  ystop(n), e2(n, n), zc(n), ip1(n), ip2(n), scal0(n), b1(n), b2(n), b3(n))
         y = y0
         t = t0
         call out_init(o, res, opt, t0, tf, y0, 3, t_eval, events)
@@ -161,8 +171,11 @@ contains
             return
         end if
         scal = atolv + rtolv*abs(y)
+        scal0 = scal
         if (opt%first_step > 0.0_dp) then
             h = min(opt%first_step, hmax)*posneg
+        else if (present(mass)) then
+            h = min(1.0e-6_dp, hmax)*posneg     ! RADAU5's default for DAEs
         else
             h = initial_step()
         end if
@@ -232,6 +245,10 @@ contains
                 nsing = 0
             end if
             nsteps = nsteps + 1
+            scal = scal0
+            if (present(index2)) then
+                where (index2) scal = scal0/abs(h)
+            end if
 
             call newton()
             if (.not. converged) then
@@ -296,7 +313,7 @@ contains
                     call finish(CM_NONFINITE, "non-finite right-hand side at t ="//trim(buf))
                     return
                 end if
-                scal = atolv + rtolv*abs(y)
+                scal0 = atolv + rtolv*abs(y)
                 hnew = posneg*min(abs(hnew), hmax)
                 if (reject) hnew = posneg*min(abs(hnew), abs(h))
                 reject = .false.
@@ -348,8 +365,22 @@ contains
                 res%message = "bad input: first_step exceeds the length of t_span"
             else if (opt%max_steps < 1) then
                 res%message = "bad input: max_steps must be positive"
+            else if (present(mass)) then
+                if (size(mass, 1) /= n .or. size(mass, 2) /= n) then
+                    res%message = "bad input: the mass matrix must be n x n"
+                else if (.not. all(ieee_is_finite(mass))) then
+                    res%message = "bad input: the mass matrix contains NaN or Inf"
+                else
+                    res%status = CM_SUCCESS
+                end if
             else
                 res%status = CM_SUCCESS
+            end if
+            if (res%status == CM_SUCCESS .and. present(index2)) then
+                if (size(index2) /= n) then
+                    res%status = CM_BAD_INPUT
+                    res%message = "bad input: index2 must have n elements"
+                end if
             end if
             if (res%status /= CM_SUCCESS) return
             call tolerance_vectors(opt, n, rtolv, atolv, res%status, m2)
@@ -444,12 +475,17 @@ contains
             integer :: ii
             fac1 = GAM0/h
             sig = cmplx(ALPH/h, BETA/h, kind=dp)
-            e1 = -jac
-            e2 = cmplx(-jac, 0.0_dp, kind=dp)
-            do ii = 1, n
-                e1(ii, ii) = e1(ii, ii) + fac1
-                e2(ii, ii) = e2(ii, ii) + sig
-            end do
+            if (present(mass)) then
+                e1 = fac1*mass - jac
+                e2 = sig*mass - jac
+            else
+                e1 = -jac
+                e2 = cmplx(-jac, 0.0_dp, kind=dp)
+                do ii = 1, n
+                    e1(ii, ii) = e1(ii, ii) + fac1
+                    e2(ii, ii) = e2(ii, ii) + sig
+                end do
+            end if
             call dgetrf(n, n, e1, n, ip1, linfo)
             res%stats%nlu = res%stats%nlu + 1
             if (linfo /= 0) return
@@ -501,12 +537,21 @@ contains
                 call rhs(t + h, y + z3, a3)
                 if (.not. (all(ieee_is_finite(a1)) .and. all(ieee_is_finite(a2)) .and. &
                            all(ieee_is_finite(a3)))) exit
-                z1 = TI11*a1 + TI12*a2 + TI13*a3 - fac1*w1
+                if (present(mass)) then
+                    b1 = matmul(mass, w1)
+                    b2 = matmul(mass, w2)
+                    b3 = matmul(mass, w3)
+                else
+                    b1 = w1
+                    b2 = w2
+                    b3 = w3
+                end if
+                z1 = TI11*a1 + TI12*a2 + TI13*a3 - fac1*b1
                 do i = 1, n
                     s2 = TI21*a1(i) + TI22*a2(i) + TI23*a3(i)
                     s3 = TI31*a1(i) + TI32*a2(i) + TI33*a3(i)
-                    zc(i) = cmplx(s2 - alphn*w2(i) + betan*w3(i), &
-                                  s3 - alphn*w3(i) - betan*w2(i), kind=dp)
+                    zc(i) = cmplx(s2 - alphn*b2(i) + betan*b3(i), &
+                                  s3 - alphn*b3(i) - betan*b2(i), kind=dp)
                 end do
                 call dgetrs('N', n, 1, e1, n, ip1, z1, n, linfo)
                 call zgetrs('N', n, 1, e2, n, ip2, zc, n, linfo)
@@ -562,6 +607,7 @@ contains
             hee2 = DD2/h
             hee3 = DD3/h
             a2 = hee1*z1 + hee2*z2 + hee3*z3
+            if (present(mass)) a2 = matmul(mass, a2)
             cont = a2 + f0
             call dgetrs('N', n, 1, e1, n, ip1, cont, n, linfo)
             err = max(sqrt(sum((cont/scal)**2)/real(n, dp)), 1.0e-10_dp)
