@@ -76,6 +76,7 @@ contains
         n = size(y0)
         t0 = t_span(1)
         tf = t_span(2)
+        h = 0.0_dp
         res%status = CM_BAD_INPUT
         if (s /= 2 .and. s /= 3) then
             res%message = "bad input: Gauss methods have s = 2 or 3 stages"

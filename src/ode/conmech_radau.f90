@@ -139,6 +139,7 @@ contains
         n = size(y0)
         t0 = t_span(1)
         tf = t_span(2)
+        h = 0.0_dp
         call validate()
         if (res%status /= CM_SUCCESS) return
         allocate (y(n), f0(n), jac(n, n), e1(n, n), z1(n), z2(n), z3(n), w1(n), w2(n), &
