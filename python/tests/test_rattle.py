@@ -82,3 +82,16 @@ def test_bad_input():
     r = constrained.solve("pendulum_xy", (0, 10), Q0, [0.0, 0.0], method="RATTLE",
                           first_step=1e-3, max_steps=100)
     assert not r.success and "max_steps" in r.message
+
+
+def test_rheonomic_constraint():
+    # pendulum on a moving support: phi depends on t, G v + phi_t = 0 holds at round-off
+    s = constrained.builtin("pendulum_moving_xy")
+    ref = constrained.solve(s, (0, 3), method="DOP853", rtol=1e-12, atol=1e-12)
+    errs = []
+    for h in (0.01, 0.005):
+        r = constrained.solve(s, (0, 3), method="RATTLE", first_step=h)
+        assert r.success
+        assert np.abs(r.res_pos).max() <= 1e-12 and np.abs(r.res_vel).max() <= 1e-12
+        errs.append(np.abs(r.q[:, -1] - ref.q[:, -1]).max())
+    assert abs(np.log2(errs[0] / errs[1]) - 2) < 0.2
