@@ -235,15 +235,16 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     max_steps : int
         Attempted steps before giving up (status -1).
     jac : callable, array_like or None
-        method="Radau" only: ``jac(t, y, *args) -> (n, n)`` (dense) or a constant matrix,
-        as SciPy's; None: forward differences (n evaluations of fun per Jacobian).
+        Used by method="Radau" (the other methods ignore it with a warning, as SciPy's):
+        ``jac(t, y, *args) -> (n, n)`` (dense) or a constant matrix; None: forward
+        differences (n evaluations of fun per Jacobian).
 
     Returns
     -------
     OdeResult
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
-        None), nfev, njev, nlu (implicit methods), status (0 reached the end, 1 terminal event, -1
-        failure), message, success, and the step counts naccept, nreject.
+        None), nfev, njev, nlu (Radau; 0 otherwise), status (0 reached the end, 1 terminal
+        event, -1 failure), message, success, and the step counts naccept, nreject.
 
     The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step and
     max_steps (SciPy's ``**options``) are keyword-only.
@@ -319,7 +320,10 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
     if jac is not None and code != 5:
-        raise ValueError("jac is used by method='Radau' only")
+        import warnings
+        warnings.warn("The following arguments have no effect for a chosen solver: jac.",
+                      stacklevel=2)
+        jac = None
     hmax = _real_scalar(max_step, "max_step")
     if not hmax > 0:
         raise ValueError("max_step must be positive")
