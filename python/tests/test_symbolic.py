@@ -409,6 +409,7 @@ def test_without_exact_jacobian():
     """jacobian=False: no forces_jac entry; the system integrates the same (the Jacobian
     then comes from differences)."""
     import conmech
+    import conmech
     from conmech import compiled
     T, U, q, P = cart_lagrangian()
     a = symbolic.lagrangian_system(T - U, q, params=P)
@@ -452,3 +453,33 @@ def test_stale_build_directories_of_killed_processes_are_removed(monkeypatch, tm
     x, v = sp.symbols("x v")
     symbolic.ode_system([v, -x/3], [x, v], model_only=True)
     assert not old.exists() and fresh.exists()     # a build in progress is left alone
+
+
+def test_save_model_runs_in_python_and_sweep(tmp_path):
+    """A symbolic system saved as a model library loads with compiled.load_model (its
+    parameters as defaults) and runs in the sweep program like the built-in it equals."""
+    import subprocess
+    import conmech
+    from conmech import compiled
+    x, v, w = sp.symbols("x v omega")
+    osc = symbolic.ode_system([v, -w**2*x], [x, v], params={w: 2.0})
+    path = symbolic.save_model(osc.with_params(omega=3.0), tmp_path / "libosc.so")
+    m = compiled.load_model(path)
+    assert m.kind == "ode" and m.parameters == {"omega": 3.0}
+    r = conmech.solve_ivp(m, (0, 1), [1.0, 0.0], rtol=1e-12, atol=1e-12)
+    assert r.success and abs(r.y[0, -1] - np.cos(3.0)) < 1e-10
+    exe = subprocess.run(["fpm", "run", "sweep", "--runner", "echo"], capture_output=True,
+                         text=True, check=True).stdout.strip().splitlines()[-1]
+    out = {}
+    for name, sysargs in (("model", ["--model", str(path)]),
+                          ("builtin", ["--system", "harmonic", "--params", "3"])):
+        out[name] = tmp_path / f"{name}.csv"
+        p = subprocess.run([exe, *sysargs, "--y0", "1,0", "--vary", "y0:1", "--from", "0.5",
+                            "--to", "1.5", "--count", "3", "--t-end", "1", "--rtol", "1e-12",
+                            "--atol", "1e-12", "--quiet", "--out", str(out[name])],
+                           capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+    a = np.genfromtxt(out["model"], delimiter=",", skip_header=1)
+    b = np.genfromtxt(out["builtin"], delimiter=",", skip_header=1)
+    assert a.shape == b.shape == (3, b.shape[1])
+    np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14)

@@ -32,6 +32,7 @@ import ctypes
 import hashlib
 import os
 import pickle
+import shutil
 import time
 
 import numpy as np
@@ -42,7 +43,7 @@ from .codegen import CODEGEN_VERSION, generate
 from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
-           "CompileError", "cache_dir", "Derived", "compile_model", "model_of"]
+           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model"]
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
@@ -126,6 +127,23 @@ def compile_model(derived, flags=None):
     t3 = time.perf_counter()
     times = {"generate": t1 - t0, "compile_or_load": t2 - t1, "load": t3 - t2}
     return CompiledModel(derived, src, path, lib, addr, hit, times)
+
+
+def save_model(system, path, flags=None):
+    """Write the system as a model library to ``path`` (a shared library with the model
+    description of ``conmech_model_library``: its kind, dimensions, parameter names and the
+    system's current parameter values as defaults), for the Fortran programs
+    (``sweep --model PATH``) and :func:`conmech.compiled.load_model`. The library is
+    compiled once (cached like the others) and copied atomically to ``path``."""
+    model = model_of(system)
+    values = [float(v) for v in np.asarray(system.params, dtype=float).ravel()]
+    src, _ = generate(model.derived, model_values=values)
+    lib_path, _ = compile_source(src, flags)
+    path = os.fspath(path)
+    tmp = f"{path}.tmp{os.getpid()}"
+    shutil.copyfile(lib_path, tmp)
+    os.replace(tmp, path)
+    return path
 
 
 def model_of(system):

@@ -141,10 +141,11 @@ def compile_source(source, flags=None):
 
 
 def load(path, entries):
-    """Load the library; returns (CDLL, {entry: address}) for the bind(C) names cm_<entry>."""
+    """Load the library; returns (CDLL, {entry: address}) for the bind(C) names
+    conmech_<entry>."""
     lib = ctypes.CDLL(path)
     addr = {}
     for e in entries:
-        fn = getattr(lib, f"cm_{e}")
+        fn = getattr(lib, f"conmech_{e}")
         addr[e] = ctypes.cast(fn, ctypes.c_void_p).value
     return lib, addr

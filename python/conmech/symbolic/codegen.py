@@ -39,9 +39,9 @@ ENTRY_POINTS = {
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "1"
+CODEGEN_VERSION = "2"   # 2: conmech_* entry names, model-library description
 
-_SQRT = sp.Function("cm_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
+_SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
 
 class FortranPrinter(FCodePrinter):
@@ -276,9 +276,49 @@ def _names(d):
     return names
 
 
-def generate(d, module="conmech_symbolic_model"):
+def _model_info(d, values):
+    """The description procedures of a model library (conmech_model_library's convention):
+    kind, dimensions, default parameter values `values` and parameter names."""
+    kind = {"ode": 1, "generalized": 2, "constrained": 3}[d.kind]
+    n_hol = getattr(d, "n_hol", 0) or 0
+    n_nh = getattr(d, "n_nh", 0) or 0
+    rheo = int(bool(getattr(d, "rheonomic", False)))
+    npar = len(d.params)
+    names = " ".join(d.param_names)
+    vals = ", ".join(FortranPrinter({})._real(float(v)) for v in values) or "0.0_dp"
+    ind = "        "
+    return [
+        '    subroutine conmech_model_info(info) bind(C, name="conmech_model_info")',
+        f"{ind}integer(c_int), intent(out) :: info(6)",
+        f"{ind}info = [{kind}, {d.n}, {n_hol}, {n_nh}, {rheo}, {npar}]",
+        "    end subroutine conmech_model_info",
+        "",
+        '    subroutine conmech_model_params(p) bind(C, name="conmech_model_params")',
+        f"{ind}real(dp), intent(out) :: p({max(npar, 1)})",
+        f"{ind}p = [{vals}]" if npar else f"{ind}p = 0.0_dp",
+        "    end subroutine conmech_model_params",
+        "",
+        '    subroutine conmech_model_param_names(buf, n) bind(C, '
+        'name="conmech_model_param_names")',
+        f"{ind}integer(c_int), value, intent(in) :: n",
+        f"{ind}character(kind=c_char), intent(out) :: buf(n)",
+        f'{ind}character(len=*), parameter :: names = "{names}"',
+        f"{ind}integer :: i",
+        f"{ind}buf = c_null_char",
+        f"{ind}do i = 1, min(n - 1, len(names))",
+        f"{ind}    buf(i) = names(i:i)",
+        f"{ind}end do",
+        "    end subroutine conmech_model_param_names",
+        "",
+    ]
+
+
+def generate(d, module="conmech_symbolic_model", model_values=None):
     """Fortran source of the bind(C) module for the derived system `d`; returns
-    (source, list of the entry points present, e.g. ["mass", "forces", ...])."""
+    (source, list of the entry points present, e.g. ["mass", "forces", ...]).
+    With `model_values` (the default parameter values), the module also describes itself
+    as a model library (conmech_model_info, conmech_model_params,
+    conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`."""
     if not module.isidentifier() or keyword.iskeyword(module):
         raise ValueError(f"bad module name {module!r}")
     pr = FortranPrinter(_names(d))
@@ -293,49 +333,49 @@ def generate(d, module="conmech_symbolic_model"):
 
     procs, entries = [], []
     if d.kind == "ode":
-        procs.append(_procedure(pr, "cm_rhs", ["t", "y", "dydt", "p"],
+        procs.append(_procedure(pr, "conmech_rhs", ["t", "y", "dydt", "p"],
                                 [T, arr("y", [n]), arr("dydt", [n], "out"), P],
                                 [("dydt", d.f, False)]))
-        procs.append(_procedure(pr, "cm_jac", ["t", "y", "dfdy", "p"],
+        procs.append(_procedure(pr, "conmech_jac", ["t", "y", "dfdy", "p"],
                                 [T, arr("y", [n]), arr("dfdy", [n, n], "out"), P],
                                 [("dfdy", d.jac, True)]))
         entries = ["rhs", "jac"]
     else:
         Q1 = [T, arr("q", [n])]
         QV = Q1 + [arr("v", [n])]
-        procs.append(_procedure(pr, "cm_mass", ["t", "q", "mm", "p"],
+        procs.append(_procedure(pr, "conmech_mass", ["t", "q", "mm", "p"],
                                 Q1 + [arr("mm", [n, n], "out"), P], [("mm", d.M, True)]))
-        procs.append(_procedure(pr, "cm_forces", ["t", "q", "v", "f", "p"],
+        procs.append(_procedure(pr, "conmech_forces", ["t", "q", "v", "f", "p"],
                                 QV + [arr("f", [n], "out"), P], [("f", d.Q, False)]))
         entries += ["mass", "forces"]
         if d.kind == "generalized" and d.R is not None:
-            procs.append(_procedure(pr, "cm_forces_jac", ["t", "q", "v", "a", "r", "p"],
+            procs.append(_procedure(pr, "conmech_forces_jac", ["t", "q", "v", "a", "r", "p"],
                                     QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],
                                     [("r", d.R, True)]))
             entries.append("forces_jac")
         if d.energy is not None:
-            procs.append(_procedure(pr, "cm_energy", ["t", "q", "v", "p"], QV + [P], [],
+            procs.append(_procedure(pr, "conmech_energy", ["t", "q", "v", "p"], QV + [P], [],
                                     result=d.energy))
             entries.append("energy")
         if d.kind == "constrained" and d.n_hol:
             h = d.n_hol
-            procs.append(_procedure(pr, "cm_phi", ["t", "q", "c", "p"],
+            procs.append(_procedure(pr, "conmech_phi", ["t", "q", "c", "p"],
                                     Q1 + [arr("c", [h], "out"), P], [("c", d.phi, False)]))
-            procs.append(_procedure(pr, "cm_phi_jac", ["t", "q", "g", "p"],
+            procs.append(_procedure(pr, "conmech_phi_jac", ["t", "q", "g", "p"],
                                     Q1 + [arr("g", [h, n], "out"), P],
                                     [("g", d.G, True)]))
-            procs.append(_procedure(pr, "cm_phi_t", ["t", "q", "pt", "p"],
+            procs.append(_procedure(pr, "conmech_phi_t", ["t", "q", "pt", "p"],
                                     Q1 + [arr("pt", [h], "out"), P], [("pt", d.phi_t, False)]))
-            procs.append(_procedure(pr, "cm_phi_gamma", ["t", "q", "v", "gam", "p"],
+            procs.append(_procedure(pr, "conmech_phi_gamma", ["t", "q", "v", "gam", "p"],
                                     QV + [arr("gam", [h], "out"), P],
                                     [("gam", d.gamma_h, False)]))
             entries += ["phi", "phi_jac", "phi_t", "phi_gamma"]
         if d.kind == "constrained" and d.n_nh:
             k = d.n_nh
-            procs.append(_procedure(pr, "cm_nh_matrix", ["t", "q", "am", "b", "p"],
+            procs.append(_procedure(pr, "conmech_nh_matrix", ["t", "q", "am", "b", "p"],
                                     Q1 + [arr("am", [k, n], "out"), arr("b", [k], "out"), P],
                                     [("am", d.A, True), ("b", d.b, False)]))
-            procs.append(_procedure(pr, "cm_nh_gamma", ["t", "q", "v", "gam", "p"],
+            procs.append(_procedure(pr, "conmech_nh_gamma", ["t", "q", "v", "gam", "p"],
                                     QV + [arr("gam", [k], "out"), P],
                                     [("gam", d.gamma_n, False)]))
             entries += ["nh_matrix", "nh_gamma"]
@@ -344,13 +384,18 @@ def generate(d, module="conmech_symbolic_model"):
         f"!> Generated by conmech.symbolic: {d.kind} system, coordinates {names};",
         f"!! parameters p = [{', '.join(d.param_names)}]. Do not edit.",
         f"module {module}",
-        "    use, intrinsic :: iso_c_binding, only: c_double",
+        "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char, c_null_char",
         "    implicit none",
         "    integer, parameter :: dp = c_double",
         "    public",
         "contains",
         "",
     ]
+    if model_values is not None:
+        if len(model_values) != len(d.params):
+            raise ValueError(f"{len(model_values)} parameter values for {len(d.params)} "
+                             "parameters")
+        procs.append(_model_info(d, model_values))
     body = []
     for p in procs:
         body += p
