@@ -48,13 +48,15 @@ module conmech_hill_orbit
 
     public :: hill_orbit, hill_orbit_options, hill_variation_orbit, hill_family
     public :: hill_orbit_guess, hill_perigee_c, hill_phi, hill_transverse, hill_transverse_result
-    public :: hill_orbit_sample
+    public :: hill_orbit_sample, hill_locate_index
 
     !> Options of the variation-orbit solver.
     type :: hill_orbit_options
-        integer :: nsteps = 20           !! DOP853 steps per quarter period
-        integer :: max_iter = 30         !! Newton iterations
-        real(dp) :: tol = 1.0e-13_dp     !! accept when |du| <= tol max(1, |u|)
+        integer :: nsteps = 20           !! initial DOP853 steps per quarter period
+        integer :: max_nsteps = 2560     !! upper bound of the error-controlled step count
+        integer :: max_iter = 30         !! Newton iterations (per step count)
+        real(dp) :: tol = 1.0e-14_dp     !! accept when |du| <= tol max(1, |u|)
+        real(dp) :: closure_tol = 1.0e-12_dp  !! bound on the true closure error |(x, y')(T/4)|
         logical :: full_period = .false. !! monodromy by direct integration over 2 pi
         logical :: eigenvalues = .true.  !! compute the multipliers with dgeev
     end type hill_orbit_options
@@ -72,9 +74,12 @@ module conmech_hill_orbit
         real(dp) :: mr(4) = 0.0_dp, mi(4) = 0.0_dp  !! multipliers (dgeev)
         real(dp) :: stability_index = 0.0_dp  !! S = (trace M - 2)/2, stable iff |S| < 1
         real(dp) :: c = 0.0_dp                !! perigee constant
-        real(dp) :: residual = 0.0_dp         !! |(x, y')(pi/2)| at the solution
-        integer :: iterations = 0             !! Newton iterations
-        integer :: nfev = 0                   !! right-hand side evaluations (20-dim)
+        real(dp) :: residual = 0.0_dp         !! true closure |(x, y')(pi/2)| (estimated)
+        real(dp) :: newton_residual = 0.0_dp  !! closure of the discretised problem
+        real(dp) :: quarter_state(4) = 0.0_dp !! state at T/4: [0, y, x'(T/4), 0]
+        integer :: nsteps = 0                 !! steps per quarter period used
+        integer :: iterations = 0             !! Newton iterations (all step counts)
+        integer :: nfev = 0                   !! right-hand side evaluations (20- and 4-dim)
     end type hill_orbit
 
     !> Transverse linearisation along a variation orbit.
@@ -171,6 +176,32 @@ contains
         nfev = nfev + 12*nsteps
     end subroutine integrate_var
 
+    !> Fixed-step DOP853 for the state alone (the closure check).
+    pure subroutine integrate_state(tab, m, kappa, t1, nsteps, s, nfev)
+        type(rk_tableau), intent(in) :: tab
+        real(dp), intent(in) :: m, kappa, t1
+        integer, intent(in) :: nsteps
+        real(dp), intent(inout) :: s(4)
+        integer, intent(inout) :: nfev
+        real(dp) :: k(4, 12), st(4), h, fx, fy
+        integer :: istep, i, j
+        h = t1/nsteps
+        do istep = 1, nsteps
+            do i = 1, 12
+                st = s
+                do j = 1, i - 1
+                    if (tab%a(i, j) /= 0.0_dp) st = st + (h*tab%a(i, j))*k(:, j)
+                end do
+                call hill_grad_f(m, kappa, st(1), st(2), fx, fy)
+                k(:, i) = [st(3), st(4), 2.0_dp*m*st(4) + fx, -2.0_dp*m*st(3) + fy]
+            end do
+            do j = 1, 12
+                if (tab%b(j) /= 0.0_dp) s = s + (h*tab%b(j))*k(:, j)
+            end do
+        end do
+        nfev = nfev + 12*nsteps
+    end subroutine integrate_state
+
     pure subroutine start_state(u, z)
         real(dp), intent(in) :: u(2)
         real(dp), intent(out) :: z(20)
@@ -185,8 +216,21 @@ contains
 
     !> The variation orbit for (m, kappa) with its monodromy, multipliers and c.
     !! `guess` = (x0, v0) to start Newton from (default: `hill_orbit_guess`).
+    !!
+    !! Error control: Newton runs on the fixed-step problem with n = `nsteps` steps per
+    !! quarter period; the true closure error of its solution is then estimated by
+    !! integrating the state alone from the converged start with 2n steps (the 8th-order
+    !! error of that run is 2^-8 of the estimated one). While the estimate exceeds
+    !! `closure_tol`, n grows (by the 8th-order error model, at least doubled, at most
+    !! `max_nsteps`) and Newton restarts from the last solution. `residual` is this true
+    !! closure estimate; `newton_residual` the closure of the discretised problem.
+    !! Newton accepts when its step |du| <= 8 eps max(1, |u|), or on the second consecutive
+    !! step below tol max(1, |u|) (round-off floor); the monodromy is the STM at that last
+    !! iterate (within |du| of the solution: S is sensitive to the point, dS/du ~ 1e2 at
+    !! small m, so the STM must be taken at the converged point, not one step before).
     !! info: CM_SUCCESS; CM_BAD_INPUT (m < 0, kappa <= 0, bad options); CM_SINGULAR
-    !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged).
+    !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged, another
+    !! orbit was found, or the closure tolerance cannot be met with `max_nsteps`).
     subroutine hill_variation_orbit(m, kappa, orb, options, guess)
         real(dp), intent(in) :: m, kappa
         type(hill_orbit), intent(out) :: orb
@@ -194,16 +238,19 @@ contains
         real(dp), intent(in), optional :: guess(2)
         type(hill_orbit_options) :: opt
         type(rk_tableau) :: tab
-        real(dp) :: u(2), du(2), g(2), z(20), a(4, 4), det, scale
-        integer :: it
-        logical :: final
+        real(dp) :: u(2), u0(2), a(4, 4), zq(4), s(4), err
+        integer :: n, nretry
+        character(len=40) :: buf
         if (present(options)) opt = options
         orb%m = m
         orb%kappa = kappa
         if (.not. (m >= 0.0_dp .and. kappa > 0.0_dp .and. ieee_is_finite(m) .and. &
-                   ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1) then
+                   ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1 .or. &
+            opt%max_nsteps < opt%nsteps .or. .not. (opt%closure_tol > 0.0_dp) .or. &
+            .not. (opt%tol > 0.0_dp)) then
             orb%info = CM_BAD_INPUT
-            orb%message = "hill_variation_orbit: need m >= 0, kappa > 0, nsteps >= 1"
+            orb%message = "hill_variation_orbit: need m >= 0, kappa > 0, 1 <= nsteps <= "// &
+                          "max_nsteps, tol > 0, closure_tol > 0"
             return
         end if
         if (present(guess)) then
@@ -217,48 +264,39 @@ contains
             return
         end if
         tab = dop853_tableau()
-        final = .false.
-        orb%info = CM_NO_CONVERGENCE
-        orb%message = "hill_variation_orbit: Newton did not converge"
-        do it = 1, opt%max_iter
-            orb%iterations = it
-            call start_state(u, z)
-            call integrate_var(tab, m, kappa, 0.5_dp*pi, opt%nsteps, z, orb%nfev)
-            if (.not. all(ieee_is_finite(z))) then
+        u0 = u
+        n = opt%nsteps
+        nretry = 0
+        do
+            call hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
+            if (orb%info /= CM_SUCCESS) then
+                ! a coarse discretisation can defeat Newton: retry from the guess with
+                ! more steps (twice at most)
+                if (nretry >= 2 .or. 4*n > opt%max_nsteps .or. &
+                    orb%info == CM_BAD_INPUT) return
+                nretry = nretry + 1
+                n = 4*n
+                u = u0
+                cycle
+            end if
+            s = [u(1), 0.0_dp, 0.0_dp, u(2)]
+            call integrate_state(tab, m, kappa, 0.5_dp*pi, 2*n, s, orb%nfev)
+            err = sqrt(s(1)**2 + s(4)**2)
+            if (.not. ieee_is_finite(err)) err = huge(1.0_dp)
+            orb%residual = err
+            orb%nsteps = n
+            if (err <= opt%closure_tol) exit
+            if (n >= opt%max_nsteps) then
+                write (buf, '(es9.2, a, i0)') err, " with nsteps = ", n
                 orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
+                orb%message = "hill_variation_orbit: the true closure error "// &
+                              trim(buf)//" exceeds closure_tol (raise max_nsteps)"
                 return
             end if
-            a = reshape(z(5:20), [4, 4])
-            g = [z(1), z(4)]
-            det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
-            scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
-            if (abs(det) <= 1.0e-13_dp*scale) then
-                orb%info = CM_SINGULAR
-                orb%message = "hill_variation_orbit: singular Newton matrix"
-                return
-            end if
-            du(1) = -(a(4, 4)*g(1) - a(1, 4)*g(2))/det
-            du(2) = -(-a(4, 1)*g(1) + a(1, 1)*g(2))/det
-            orb%residual = sqrt(g(1)**2 + g(2)**2)
-            scale = max(1.0_dp, maxval(abs(u)))
-            if (maxval(abs(du)) <= opt%tol*scale .or. &
-                (final .and. maxval(abs(du)) <= 1.0e-10_dp*scale)) then
-                u = u + du
-                orb%info = CM_SUCCESS
-                orb%message = "success"
-                exit
-            end if
-            u = u + du
-            final = maxval(abs(du)) <= 1.0e-7_dp*scale
-            if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
-                orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: Newton diverged"
-                return
-            end if
+            n = min(opt%max_nsteps, max(2*n, &
+                    ceiling(1.2_dp*n*(err/opt%closure_tol)**0.125_dp)))
         end do
-        if (orb%info /= CM_SUCCESS) return
-        if (.not. (u(2) > 0.0_dp .and. z(2) > 0.0_dp)) then
+        if (.not. (u(2) > 0.0_dp .and. zq(2) > 0.0_dp)) then
             ! Newton found another symmetric periodic solution (e.g. a retrograde one)
             orb%info = CM_NO_CONVERGENCE
             orb%message = "hill_variation_orbit: converged to another periodic orbit, "// &
@@ -266,12 +304,16 @@ contains
             return
         end if
         orb%y0 = [u(1), 0.0_dp, 0.0_dp, u(2)]
+        orb%quarter_state = zq
         orb%jacobi = hill_jacobi(m, kappa, orb%y0)
         orb%quarter_stm = a
         if (opt%full_period) then
-            call start_state(u, z)
-            call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*opt%nsteps, z, orb%nfev)
-            orb%monodromy = reshape(z(5:20), [4, 4])
+            block
+                real(dp) :: z(20)
+                call start_state(u, z)
+                call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*n, z, orb%nfev)
+                orb%monodromy = reshape(z(5:20), [4, 4])
+            end block
         else
             call monodromy_from_quarter(a, orb%monodromy, orb%info)
             if (orb%info /= CM_SUCCESS) then
@@ -282,6 +324,11 @@ contains
         orb%stability_index = 0.5_dp*(orb%monodromy(1, 1) + orb%monodromy(2, 2) + &
                                       orb%monodromy(3, 3) + orb%monodromy(4, 4) - 2.0_dp)
         orb%c = hill_perigee_c(orb%stability_index)
+        if (.not. ieee_is_finite(orb%stability_index)) then
+            orb%info = CM_NONFINITE
+            orb%message = "hill_variation_orbit: non-finite monodromy"
+            return
+        end if
         if (opt%eigenvalues) then
             call la_eig(orb%monodromy, orb%mr, orb%mi, orb%info)
             if (orb%info /= CM_SUCCESS) then
@@ -290,6 +337,66 @@ contains
             end if
         end if
     end subroutine hill_variation_orbit
+
+    !> Newton's method on the fixed-step problem with n steps per quarter period.
+    !! On success u is the solution, a the STM and zq the state at pi/2 of the last iterate.
+    subroutine hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
+        type(rk_tableau), intent(in) :: tab
+        real(dp), intent(in) :: m, kappa
+        integer, intent(in) :: n
+        type(hill_orbit_options), intent(in) :: opt
+        real(dp), intent(inout) :: u(2)
+        real(dp), intent(out) :: a(4, 4), zq(4)
+        type(hill_orbit), intent(inout) :: orb
+        real(dp) :: du(2), g(2), z(20), det, scale
+        integer :: it
+        logical :: small
+        small = .false.
+        orb%info = CM_NO_CONVERGENCE
+        orb%message = "hill_variation_orbit: Newton did not converge"
+        a = 0.0_dp
+        zq = 0.0_dp
+        do it = 1, opt%max_iter
+            orb%iterations = orb%iterations + 1
+            call start_state(u, z)
+            call integrate_var(tab, m, kappa, 0.5_dp*pi, n, z, orb%nfev)
+            if (.not. all(ieee_is_finite(z))) then
+                orb%info = CM_NO_CONVERGENCE
+                orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
+                return
+            end if
+            a = reshape(z(5:20), [4, 4])
+            zq = z(1:4)
+            g = [z(1), z(4)]
+            det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
+            scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
+            if (abs(det) <= 1.0e-13_dp*scale) then
+                orb%info = CM_SINGULAR
+                orb%message = "hill_variation_orbit: singular Newton matrix"
+                return
+            end if
+            du(1) = -(a(4, 4)*g(1) - a(1, 4)*g(2))/det
+            du(2) = -(-a(4, 1)*g(1) + a(1, 1)*g(2))/det
+            orb%newton_residual = sqrt(g(1)**2 + g(2)**2)
+            scale = max(1.0_dp, maxval(abs(u)))
+            u = u + du
+            if (maxval(abs(du)) <= opt%tol*scale) then
+                ! the STM is that of the last iterate: accept once it is within round-off
+                ! of the solution (|du| <= 8 eps) or on the second step below tol
+                if (small .or. maxval(abs(du)) <= 8.0_dp*epsilon(1.0_dp)*scale) then
+                    orb%info = CM_SUCCESS
+                    orb%message = "success"
+                    return
+                end if
+                small = .true.
+            end if
+            if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
+                orb%info = CM_NO_CONVERGENCE
+                orb%message = "hill_variation_orbit: Newton diverged"
+                return
+            end if
+        end do
+    end subroutine hill_newton
 
     !> M = B^2, B = G1 A^-1 G1 A (see the module notes).
     subroutine monodromy_from_quarter(a, mono, info)
@@ -324,58 +431,198 @@ contains
     end subroutine monodromy_from_quarter
 
     !> The family over ms (any order; continuation works best for sorted, close values).
-    !! Each orbit starts Newton from the quadratic extrapolation of the previous three of its
-    !! chunk (cold start at the chunk's first). With OpenMP the index range is cut into one
-    !! contiguous chunk per thread (`nchunks` overrides the number of chunks).
-    subroutine hill_family(ms, kappa, orbs, options, nchunks)
+    !! The index range is cut into chunks of `chunk_size` consecutive orbits (default 256;
+    !! `nchunks` instead gives the number of chunks). First, serially, the first orbit of
+    !! every chunk is computed by continuation with a stride of chunk_size/8 points
+    !! (quadratic extrapolation; point by point where a stride fails; a cold start,
+    !! `hill_orbit_guess`, for the first one). Then the chunks run in parallel with OpenMP,
+    !! each orbit starting Newton from the cubic extrapolation of the previous four of its chunk
+    !! and with the step count its predecessor needed (the error control may raise it).
+    !! Nothing depends on the number of threads, so neither do the results (bit for bit).
+    !! Every orbit meets the same Newton and closure tolerances as a single orbit.
+    subroutine hill_family(ms, kappa, orbs, options, nchunks, chunk_size)
         real(dp), intent(in) :: ms(:)
         real(dp), intent(in) :: kappa
         type(hill_orbit), intent(out) :: orbs(:)
         type(hill_orbit_options), intent(in), optional :: options
-        integer, intent(in), optional :: nchunks
-        type(hill_orbit_options) :: opt
-        integer :: nc, ic, i, i0, i1, n, nprev, j
-        real(dp) :: u(2), mm(3), uu(2, 3), w
+        integer, intent(in), optional :: nchunks, chunk_size
+        type(hill_orbit_options) :: opt, opti, opt0
+        integer :: nc, ic, i, i0, i1, n, nprev, j, cs, ilast, np0
+        real(dp) :: u(2), mm(4), uu(2, 4), mm0(4), uu0(2, 4)
         if (present(options)) opt = options
         n = size(ms)
-        nc = 1
-        !$ nc = omp_get_max_threads()
-        if (present(nchunks)) nc = nchunks
-        nc = max(1, min(nc, n))
-        !$omp parallel do schedule(static, 1) default(shared) &
-        !$omp private(ic, i, i0, i1, nprev, u, mm, uu, j, w)
+        if (n < 1) return
+        cs = 256
+        if (present(chunk_size)) cs = max(1, chunk_size)
+        if (present(nchunks)) cs = (n + max(1, nchunks) - 1)/max(1, nchunks)
+        nc = (n + cs - 1)/cs
+        ! serial pass: walk to every chunk start with a stride of cs/8 points (point by
+        ! point where a stride fails), keeping the chunk starts
+        nprev = 0
+        opti = opt
+        ilast = 0
         do ic = 1, nc
-            i0 = (ic - 1)*n/nc + 1
-            i1 = ic*n/nc
-            nprev = 0
-            do i = i0, i1
-                if (nprev == 0) then
-                    call hill_variation_orbit(ms(i), kappa, orbs(i), opt)
-                else
-                    ! Lagrange extrapolation through the last min(nprev, 3) orbits
-                    u = 0.0_dp
-                    do j = 1, min(nprev, 3)
-                        w = lagrange_weight(ms(i), mm, min(nprev, 3), j)
-                        u = u + w*uu(:, j)
+            i1 = (ic - 1)*cs + 1
+            do while (ilast < i1)
+                i = min(i1, ilast + max(1, cs/8))
+                if (ilast == 0) i = 1
+                mm0 = mm
+                uu0 = uu
+                np0 = nprev
+                opt0 = opti
+                call serial_orbit(ms(i), kappa, orbs(i), opti, opt, mm, uu, nprev)
+                if (orbs(i)%info /= CM_SUCCESS .and. i > ilast + 1 .and. np0 > 0) then
+                    mm = mm0
+                    uu = uu0
+                    nprev = np0
+                    opti = opt0
+                    do j = ilast + 1, i
+                        call serial_orbit(ms(j), kappa, orbs(j), opti, opt, mm, uu, nprev)
                     end do
-                    call hill_variation_orbit(ms(i), kappa, orbs(i), opt, guess=u)
                 end if
-                if (orbs(i)%info == CM_SUCCESS) then
-                    mm(2:3) = mm(1:2)
-                    uu(:, 2:3) = uu(:, 1:2)
-                    mm(1) = ms(i)
-                    uu(:, 1) = [orbs(i)%y0(1), orbs(i)%y0(4)]
-                    nprev = nprev + 1
+                ilast = i
+            end do
+        end do
+        !$omp parallel do schedule(dynamic, 1) default(shared) &
+        !$omp private(ic, i, i0, i1, nprev, u, mm, uu, opti)
+        do ic = 1, nc
+            i0 = (ic - 1)*cs + 1
+            i1 = min(n, ic*cs)
+            nprev = 0
+            opti = opt
+            call push_orbit(orbs(i0), mm, uu, nprev, opti, opt)
+            do i = i0 + 1, i1
+                if (nprev == 0) then
+                    opti%nsteps = opt%nsteps
+                    call hill_variation_orbit(ms(i), kappa, orbs(i), opti)
                 else
-                    nprev = 0
+                    call extrapolate_u(ms(i), mm, uu, min(nprev, 4), u)
+                    call hill_variation_orbit(ms(i), kappa, orbs(i), opti, guess=u)
                 end if
+                call push_orbit(orbs(i), mm, uu, nprev, opti, opt)
             end do
         end do
         !$omp end parallel do
     end subroutine hill_family
 
+    !> One orbit of the serial pass: from the extrapolation of the history (quadratic),
+    !! else cold; pushed into the history.
+    subroutine serial_orbit(m, kappa, orb, opti, opt, mm, uu, nprev)
+        real(dp), intent(in) :: m, kappa
+        type(hill_orbit), intent(inout) :: orb
+        type(hill_orbit_options), intent(inout) :: opti
+        type(hill_orbit_options), intent(in) :: opt
+        real(dp), intent(inout) :: mm(4), uu(2, 4)
+        integer, intent(inout) :: nprev
+        real(dp) :: u(2)
+        if (nprev > 0) then
+            call extrapolate_u(m, mm, uu, min(nprev, 3), u)
+            call hill_variation_orbit(m, kappa, orb, opti, guess=u)
+        end if
+        if (nprev == 0 .or. orb%info /= CM_SUCCESS) then
+            opti%nsteps = opt%nsteps
+            call hill_variation_orbit(m, kappa, orb, opti)
+        end if
+        call push_orbit(orb, mm, uu, nprev, opti, opt)
+    end subroutine serial_orbit
+
+    !> Lagrange extrapolation of (x0, v0) to m through the last np orbits.
+    pure subroutine extrapolate_u(m, mm, uu, np, u)
+        real(dp), intent(in) :: m, mm(4), uu(2, 4)
+        integer, intent(in) :: np
+        real(dp), intent(out) :: u(2)
+        integer :: j
+        u = 0.0_dp
+        do j = 1, np
+            u = u + lagrange_weight(m, mm, np, j)*uu(:, j)
+        end do
+    end subroutine extrapolate_u
+
+    !> Record a converged orbit in the extrapolation history (reset it on failure); the
+    !! next orbit starts from this one's error-controlled step count.
+    pure subroutine push_orbit(orb, mm, uu, nprev, opti, opt)
+        type(hill_orbit), intent(in) :: orb
+        real(dp), intent(inout) :: mm(4), uu(2, 4)
+        integer, intent(inout) :: nprev
+        type(hill_orbit_options), intent(inout) :: opti
+        type(hill_orbit_options), intent(in) :: opt
+        if (orb%info == CM_SUCCESS) then
+            opti%nsteps = max(opt%nsteps, orb%nsteps)
+            mm(2:4) = mm(1:3)
+            uu(:, 2:4) = uu(:, 1:3)
+            mm(1) = orb%m
+            uu(:, 1) = [orb%y0(1), orb%y0(4)]
+            nprev = nprev + 1
+        else
+            nprev = 0
+            mm = 0.0_dp
+            uu = 0.0_dp
+        end if
+    end subroutine push_orbit
+
+    !> Locate the m where the stability index S crosses `target` (+1: a multiplier pair
+    !! through +1, the loss of stability of the variation family near m = 0.195; -1:
+    !! through -1) between two orbits `oa`, `ob` of the family whose S - target differ in
+    !! sign. Illinois (modified regula falsi) on S(m) - target; each orbit is warm-started
+    !! from the linear interpolation of the bracket's orbits. Converged when the bracket
+    !! is below `mtol` (default 1e-13 max(1, m)) or S - target vanishes; `orb` is the orbit
+    !! at the located m (its info and message say whether the location succeeded).
+    subroutine hill_locate_index(oa, ob, target, orb, options, mtol)
+        type(hill_orbit), intent(in) :: oa, ob
+        real(dp), intent(in) :: target
+        type(hill_orbit), intent(out) :: orb
+        type(hill_orbit_options), intent(in), optional :: options
+        real(dp), intent(in), optional :: mtol
+        type(hill_orbit_options) :: opt
+        real(dp) :: ma, mb, fa, fb, ua(2), ub(2), mc, fc, tl, w
+        integer :: it, side
+        if (present(options)) opt = options
+        tl = 1.0e-13_dp
+        if (present(mtol)) tl = mtol
+        ma = oa%m
+        mb = ob%m
+        fa = oa%stability_index - target
+        fb = ob%stability_index - target
+        if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS .or. .not. (fa*fb <= 0.0_dp) &
+            .or. oa%kappa /= ob%kappa .or. ma == mb) then
+            orb%info = CM_BAD_INPUT
+            orb%message = "hill_locate_index: need two converged orbits (same kappa) with "// &
+                          "S - target of opposite signs"
+            return
+        end if
+        ua = [oa%y0(1), oa%y0(4)]
+        ub = [ob%y0(1), ob%y0(4)]
+        side = 0
+        do it = 1, 100
+            mc = (ma*fb - mb*fa)/(fb - fa)
+            if (.not. (abs(fb - fa) > 0.0_dp)) mc = 0.5_dp*(ma + mb)
+            w = (mc - ma)/(mb - ma)
+            call hill_variation_orbit(mc, oa%kappa, orb, opt, guess=(1.0_dp - w)*ua + w*ub)
+            if (orb%info /= CM_SUCCESS) return
+            fc = orb%stability_index - target
+            if (fc == 0.0_dp .or. abs(mb - ma) <= tl*max(1.0_dp, abs(mc))) return
+            if (fc*fb < 0.0_dp) then
+                ma = mb
+                fa = fb
+                ua = ub
+                mb = mc
+                fb = fc
+                ub = [orb%y0(1), orb%y0(4)]
+                side = 0
+            else
+                mb = mc
+                fb = fc
+                ub = [orb%y0(1), orb%y0(4)]
+                if (side == 1) fa = 0.5_dp*fa
+                side = 1
+            end if
+        end do
+        orb%info = CM_NO_CONVERGENCE
+        orb%message = "hill_locate_index: no convergence in 100 iterations"
+    end subroutine hill_locate_index
+
     pure real(dp) function lagrange_weight(x, xs, np, j) result(w)
-        real(dp), intent(in) :: x, xs(3)
+        real(dp), intent(in) :: x, xs(:)
         integer, intent(in) :: np, j
         integer :: k
         w = 1.0_dp
@@ -449,13 +696,15 @@ contains
         res%info = CM_SUCCESS
     end subroutine hill_transverse
 
-    !> The orbit and Phi at the times t (e.g. for CSV output): states(4, nt), phi(nt).
-    subroutine hill_orbit_sample(orb, t, states, phi, info)
+    !> The orbit and Phi at the times t (e.g. for CSV output): states(4, nt), phi(nt),
+    !! integrated by DOP853 at rtol = atol = `rtol` (default 1e-12).
+    subroutine hill_orbit_sample(orb, t, states, phi, info, rtol)
         type(hill_orbit), intent(in) :: orb
         real(dp), intent(in) :: t(:)
         real(dp), intent(out) :: states(:, :)
         real(dp), intent(out) :: phi(:)
         integer, intent(out) :: info
+        real(dp), intent(in), optional :: rtol
         type(hill_problem) :: hp
         type(ode_options) :: opt
         type(ode_result) :: r
@@ -467,7 +716,8 @@ contains
         hp%m = orb%m
         hp%kappa = orb%kappa
         opt%rtol = 1.0e-12_dp
-        opt%atol = 1.0e-12_dp
+        if (present(rtol)) opt%rtol = rtol
+        opt%atol = opt%rtol
         call ode_solve(hp, [0.0_dp, max(orb%period, maxval(t))], orb%y0, opt, r, t_eval=t)
         info = r%status
         if (info < 0) return

@@ -10,21 +10,25 @@
 !> Hill's variation orbit with its monodromy (see conmech_hill_orbit).
 !! use_guess /= 0: Newton starts from guess = (x0, v0). full_period /= 0: monodromy by
 !! direct integration over 2 pi instead of the symmetry.
-subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, y0, period, &
-                           jacobi, mono, mr, mi, s, c, residual, iterations, nfev, info, message)
+subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, closure_tol, &
+                           max_nsteps, y0, period, jacobi, mono, mr, mi, s, c, residual, &
+                           quarter, nsteps_used, iterations, nfev, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
     implicit none
     real(c_double), intent(in) :: m, kappa
     integer(c_int), intent(in) :: nsteps, full_period, use_guess
-    real(c_double), intent(in) :: guess(2)
+    real(c_double), intent(in) :: guess(2), closure_tol
+    integer(c_int), intent(in) :: max_nsteps
     real(c_double), intent(out) :: y0(4), period, jacobi, mono(4, 4), mr(4), mi(4), s, c
-    real(c_double), intent(out) :: residual
-    integer(c_int), intent(out) :: iterations, nfev, info
+    real(c_double), intent(out) :: residual, quarter(4)
+    integer(c_int), intent(out) :: nsteps_used, iterations, nfev, info
     character(len=256), intent(out) :: message
     type(hill_orbit) :: orb
     type(hill_orbit_options) :: opt
     if (nsteps > 0) opt%nsteps = nsteps
+    if (closure_tol > 0.0_c_double) opt%closure_tol = closure_tol
+    if (max_nsteps > 0) opt%max_nsteps = max_nsteps
     opt%full_period = full_period /= 0
     if (use_guess /= 0) then
         call hill_variation_orbit(m, kappa, orb, opt, guess)
@@ -40,30 +44,78 @@ subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, y0, 
     s = orb%stability_index
     c = orb%c
     residual = orb%residual
+    quarter = orb%quarter_state
+    nsteps_used = orb%nsteps
     iterations = orb%iterations
     nfev = orb%nfev
     info = orb%info
     message = orb%message
 end subroutine flat_hill_orbit
 
+!> Locate the m where the stability index S of the variation family crosses `target`
+!! (+1 or -1) between the orbits at ma (start ua = (x0, v0)) and mb (ub); see
+!! hill_locate_index. Returns the located m, its orbit's (x0, v0), S, c, true closure.
+subroutine flat_hill_locate(ma, ua, mb, ub, kappa, target, mtol, m_star, u_star, s, c, &
+                            residual, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_hill_orbit, only: hill_orbit, hill_variation_orbit, hill_locate_index
+    implicit none
+    real(c_double), intent(in) :: ma, ua(2), mb, ub(2), kappa, target, mtol
+    real(c_double), intent(out) :: m_star, u_star(2), s, c, residual
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    type(hill_orbit) :: oa, ob, orb
+    m_star = 0.0_c_double
+    u_star = 0.0_c_double
+    s = 0.0_c_double
+    c = 0.0_c_double
+    residual = 0.0_c_double
+    call hill_variation_orbit(ma, kappa, oa, guess=ua)
+    call hill_variation_orbit(mb, kappa, ob, guess=ub)
+    if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS) then
+        info = merge(oa%info, ob%info, oa%info /= CM_SUCCESS)
+        message = "the bracketing orbits did not converge"
+        return
+    end if
+    call hill_locate_index(oa, ob, target, orb, mtol=mtol)
+    info = orb%info
+    message = orb%message
+    if (info /= CM_SUCCESS) return
+    m_star = orb%m
+    u_star = [orb%y0(1), orb%y0(4)]
+    s = orb%stability_index
+    c = orb%c
+    residual = orb%residual
+end subroutine flat_hill_locate
+
 !> The family of variation orbits over ms(nm) by continuation (see hill_family).
-subroutine flat_hill_family(nm, ms, kappa, nsteps, y0s, jacobis, monos, ss, cs, infos, iters)
+subroutine flat_hill_family(nm, ms, kappa, nsteps, chunk_size, y0s, jacobis, monos, ss, cs, &
+                            residuals, quarters, nsteps_used, infos, iters)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_family
     implicit none
     integer(c_int), intent(in) :: nm
     real(c_double), intent(in) :: ms(nm), kappa
-    integer(c_int), intent(in) :: nsteps
+    integer(c_int), intent(in) :: nsteps, chunk_size
     real(c_double), intent(out) :: y0s(4, nm), jacobis(nm), monos(4, 4, nm), ss(nm), cs(nm)
-    integer(c_int), intent(out) :: infos(nm), iters(nm)
+    real(c_double), intent(out) :: residuals(nm), quarters(4, nm)
+    integer(c_int), intent(out) :: nsteps_used(nm), infos(nm), iters(nm)
     type(hill_orbit), allocatable :: orbs(:)
     type(hill_orbit_options) :: opt
     integer :: i
     if (nsteps > 0) opt%nsteps = nsteps
     opt%eigenvalues = .false.
     allocate (orbs(nm))
-    call hill_family(ms, kappa, orbs, opt)
+    if (chunk_size > 0) then
+        call hill_family(ms, kappa, orbs, opt, chunk_size=chunk_size)
+    else
+        call hill_family(ms, kappa, orbs, opt)
+    end if
     do i = 1, nm
+        residuals(i) = orbs(i)%residual
+        quarters(:, i) = orbs(i)%quarter_state
+        nsteps_used(i) = orbs(i)%nsteps
         y0s(:, i) = orbs(i)%y0
         jacobis(i) = orbs(i)%jacobi
         monos(:, :, i) = orbs(i)%monodromy
@@ -107,7 +159,7 @@ subroutine flat_hill_transverse(m, kappa, y0, rtol, nt, t, states, phi, mono2, h
     states = 0.0_c_double
     phi = 0.0_c_double
     if (info /= CM_SUCCESS .or. nt < 1) return
-    call hill_orbit_sample(orb, t, states, phi, inf)
+    call hill_orbit_sample(orb, t, states, phi, inf, rtol)
     if (inf /= CM_SUCCESS) then
         info = inf
         message = "sampling the orbit failed"
