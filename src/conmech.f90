@@ -21,6 +21,7 @@ module conmech
     use conmech_floquet
     use conmech_shooting
     use conmech_hill_orbit
+    use conmech_continuation
     implicit none
     public
 end module conmech
