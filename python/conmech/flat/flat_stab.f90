@@ -417,3 +417,85 @@ subroutine flat_hill_equation_callback(phi, period, rtol, mono, half_trace, det,
     end interface
     call callback_hill_solve(phi, period, rtol, mono, half_trace, det, info, message)
 end subroutine flat_hill_equation_callback
+
+!> Pseudo-arclength continuation of a periodic orbit of a built-in system in its parameter
+!! params(ip) (see conmech_continuation; options packed as in run_continuation). The branch
+!! in arrays of mp points (npts used), the special points (nsp, at most 64).
+subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, iopt, nfree, &
+                                     free_idx, ntg, targets, mp, npts, pp, per, ys, mr, mi, &
+                                     s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
+                                     sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_systems, only: make_system
+    use conmech_support_cont, only: builtin_param_system, run_continuation
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, ip, n, iopt(9), nfree, ntg, mp
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
+    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
+    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
+    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
+    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
+    character(len=256), intent(out) :: message
+    type(builtin_param_system) :: sys
+    character(len=:), allocatable :: msg
+    npts = 0
+    nsp = 0
+    if (ip < 1 .or. ip > np) then
+        info = CM_BAD_INPUT
+        message = "the continuation parameter index is out of range"
+        return
+    end if
+    sys%name = trim(name)
+    sys%params = params(1:np)
+    sys%ip = ip
+    call make_system(sys%name, sys%params, sys%inner, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call run_continuation(sys, n, y0, period, params(ip), ropt, iopt, nfree, free_idx, ntg, &
+                          targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, &
+                          sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, &
+                          message)
+end subroutine flat_continuation_builtin
+
+!> As flat_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from the
+!! parameter value p0 (finite-difference Jacobian).
+subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree, free_idx, &
+                                      ntg, targets, mp, npts, pp, per, ys, mr, mi, s, psi, &
+                                      res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
+                                      sp_mr, sp_mi, sp_s, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_support_cont, only: callback_param_system, run_continuation
+    implicit none
+    integer(c_int), intent(in) :: n, iopt(9), nfree, ntg, mp
+    real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
+    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
+    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
+    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
+    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, p, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t, p
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_param_system) :: sys
+    sys%f => fun
+    sys%n = n
+    sys%p = p0
+    call run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, targets, &
+                          mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sp_kind, &
+                          sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
+end subroutine flat_continuation_callback

@@ -1,0 +1,91 @@
+"""Pseudo-arclength continuation of periodic orbits and their special points (issue 9).
+
+The period-doubling, branch-point and Neimark-Sacker points against closed forms are
+tested in Fortran (test/test_continuation.f90, a 7-dimensional normal form); here the
+Python API on built-in and callback systems."""
+import numpy as np
+import pytest
+
+from conmech import hill, stability, systems
+
+
+def fold_cycle(t, y, p):
+    """r' = r (p + r^2 - r^4), theta' = 1 + r^2: a fold of cycles at p = -1/4 (closed
+    form: r^2 = 1/2, period 2 pi/(1 + 1/2) = 4 pi/3)."""
+    r2 = y[0]**2 + y[1]**2
+    g = p + r2 - r2*r2
+    return [y[0]*g - y[1]*(1 + r2), y[1]*g + y[0]*(1 + r2)]
+
+
+def test_hill_loss_of_stability_by_continuation():
+    """The variation family continued in m by symmetric shooting (adaptive DOP853 on the
+    variational equations): S crosses +1 at m = 0.195... (REFERENCE.md), located as a
+    branch point; it agrees to 1e-10 with the fast path's own location (fixed-step,
+    error-controlled, Illinois in m): two independent methods."""
+    o = hill.variation_orbit(0.15)
+    br = stability.continuation(systems.hill(m=0.15), o.y0, 2*np.pi, param="m",
+                                free=[0, 3], targets=[0, 3], period_factor=4,
+                                conservative=True, ds=0.01, ds_max=0.05, p_range=(0, 0.25),
+                                rtol=1e-12, atol=1e-12)
+    assert br.success and br.param == "m"
+    assert np.allclose(br.period, 2*np.pi)
+    bp = [s for s in br.special if s.kind == "branch point"]
+    assert len(bp) == 1
+    assert 0.195 < bp[0].p < 0.196
+    assert bp[0].stability_index == pytest.approx(1.0, abs=1e-9)
+    ref = hill.locate_stability_change(0.19, 0.2)
+    assert abs(bp[0].p - ref["m"]) < 1e-10
+    # stable before, unstable after; S from the continuation = S of the fast path
+    assert np.all(br.stable[br.p < bp[0].p - 1e-6]) and not np.any(br.stable[br.p > bp[0].p])
+    fast = hill.variation_orbit(br.p[1], guess=br.y0[1, [0, 3]])
+    assert br.stability_index[1] == pytest.approx(fast.stability_index, abs=1e-9)
+
+
+def test_fold_on_a_callback_system():
+    br = stability.continuation(fold_cycle, [1, 0], 3.0, p0=0.0, direction=-1, ds=0.05,
+                                max_points=18, energy=lambda y, p: y[0]**2 + y[1]**2)
+    assert br.success and len(br) == 18
+    folds = [s for s in br.special if s.kind == "fold"]
+    assert len(folds) == 1 and len(br.special) == 1
+    f = folds[0]
+    assert f.p == pytest.approx(-0.25, abs=1e-9)
+    assert np.sum(f.y0**2) == pytest.approx(0.5, abs=1e-5)
+    assert f.period == pytest.approx(4*np.pi/3, abs=1e-5)
+    # the branch turns: outer stable cycles, then inner unstable ones
+    assert br.p[-1] > -0.25 and br.energy[-1] < 0.5 < br.energy[0]
+    assert br.stable[0] and not br.stable[-1]
+
+
+def test_builtin_limit_cycle_against_single_orbits():
+    """Van der Pol's limit cycle continued in mu: every point is a periodic orbit of the
+    built-in system (checked by independent shooting at the last point)."""
+    br = stability.continuation(systems.vanderpol(1.0), [2.0, 0.0], 6.66, param="mu",
+                                ds=0.1, ds_max=0.3, p_range=(0.5, 2.0), max_points=30)
+    assert br.success and br.p[-1] >= 2.0
+    assert not br.special and np.all(br.stable)
+    one = stability.periodic_orbit(systems.vanderpol(br.p[-1]), br.y0[-1], br.period[-1])
+    assert one.period == pytest.approx(br.period[-1], abs=1e-8)
+    assert np.all(br.residual < 1e-8)
+
+
+def test_bad_input_and_failures():
+    with pytest.raises(ValueError, match="param"):
+        stability.continuation(systems.vanderpol(1.0), [2, 0], 6.6, param="nope")
+    with pytest.raises(ValueError, match="p0"):
+        stability.continuation(fold_cycle, [1, 0], 3.0)
+    with pytest.raises(ValueError, match="period"):
+        stability.continuation(fold_cycle, [1, 0], -3.0, p0=0.0)
+    with pytest.raises(TypeError):
+        stability.continuation("vanderpol", [2, 0], 6.6, p0=1.0)
+    # a degenerate start: the harmonic oscillator's orbits are not isolated
+    with pytest.raises(RuntimeError, match="isolated"):
+        stability.continuation(systems.harmonic(1.0), [1, 0], 2*np.pi, param="omega")
+
+    # the model breaks down below p = -0.1: the branch so far, and the parameter value
+    def broken(t, y, p):
+        return fold_cycle(t, y, p) if p >= -0.1 else [np.nan, np.nan]
+    br = stability.continuation(broken, [1, 0], 3.0, p0=0.0, direction=-1, ds=0.05,
+                                max_points=30)
+    assert not br.success and len(br) >= 2
+    assert "stopped at p = -" in br.message
+    assert -0.1 - 1e-6 <= br.p[-1] < -0.09
