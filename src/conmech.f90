@@ -22,6 +22,7 @@ module conmech
     use conmech_shooting
     use conmech_hill_orbit
     use conmech_continuation
+    use conmech_transverse
     implicit none
     public
 end module conmech
