@@ -89,3 +89,56 @@ def test_bad_input_and_failures():
     assert not br.success and len(br) >= 2
     assert "stopped at p = -" in br.message
     assert -0.1 - 1e-6 <= br.p[-1] < -0.09
+
+
+# ------------------------------------------------------- transverse linearisation (2 DOF)
+
+def _henon_heiles(t, s):
+    x, y, vx, vy = s
+    return [vx, vy, -(x + 2*x*y), -(y + x*x - y*y)]
+
+
+def _hh_potential(q):
+    """Henon and Heiles (1964): V = (x^2 + y^2)/2 + x^2 y - y^3/3."""
+    x, y = q
+    return (0.5*(x*x + y*y) + x*x*y - y**3/3, [x + 2*x*y, y + x*x - y*y],
+            [[1 + 2*y, 2*x], [2*x, 1 - 2*y]])
+
+
+def test_transverse_henon_heiles_loop_orbit():
+    """A loop orbit (symmetric about the y axis, period fixed at 1.97 pi, E ~ 0.05): the
+    2 x 2 multipliers of N'' + Phi N = 0 are the non-trivial ones of the 4 x 4 monodromy."""
+    o = stability.symmetric_orbit(_henon_heiles, [0, 0.2, 0.25, 0], [1, 2], [0, 3],
+                                  1.97*np.pi, period_factor=2, rtol=1e-13, atol=1e-13)
+    assert abs(o.y0[2]) > 0.1                        # a loop, not the line orbit
+    r = stability.transverse(_hh_potential, o.y0, o.period, rtol=1e-13,
+                             t=np.linspace(0, o.period, 9))
+    assert r["closure"] < 1e-11
+    assert r["half_trace"] == pytest.approx(r["stability_index4"], abs=1e-12)
+    assert r["det"] == pytest.approx(1.0, abs=1e-12)
+    mu4 = np.linalg.eigvals(r["monodromy4"])
+    nontrivial = mu4[np.argsort(np.abs(mu4 - 1))][2:]
+    assert np.allclose(np.sort_complex(nontrivial), np.sort_complex(r["multipliers"]),
+                       atol=1e-10)
+    # Phi has the orbit's symmetry: Phi(t) = Phi(T - t)
+    assert np.allclose(r["phi"], r["phi"][::-1], atol=1e-9)
+    with pytest.raises(ValueError):
+        stability.transverse(_hh_potential, [0, 0.2, 0.25], o.period)
+
+
+def test_transverse_general_equals_hill():
+    """Hill's problem as V = -F, omega = -m: the general construction gives the perigee
+    constant's half trace (the fast path's S by symmetry) to 1e-12."""
+    m = hill.M_HILL
+    orb = hill.variation_orbit(m)
+
+    def pot(q):
+        x, y = q
+        r = np.hypot(x, y)
+        v = -(1/r + 1.5*m*m*x*x)
+        g = [x/r**3 - 3*m*m*x, y/r**3]
+        h = [[1/r**3 - 3*x*x/r**5 - 3*m*m, -3*x*y/r**5], [-3*x*y/r**5, 1/r**3 - 3*y*y/r**5]]
+        return v, g, h
+    r = stability.transverse(pot, orb.y0, orb.period, omega=-m, rtol=1e-14)
+    assert r["half_trace"] == pytest.approx(orb.stability_index, abs=1e-12)
+    assert 1 + np.arccos(r["half_trace"])/(2*np.pi) == pytest.approx(hill.C_HILL, abs=1e-12)

@@ -499,3 +499,74 @@ subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree,
                           mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sp_kind, &
                           sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
 end subroutine flat_continuation_callback
+
+!> Transverse linearisation of a periodic orbit (y0, period) of the planar natural system
+!! q'' = -grad V + 2 omega J q' with V from the callback pot(q, v, g, h): the 2 x 2 monodromy
+!! of N'' + Phi N = 0, its half trace and determinant, the closure of the orbit integrated,
+!! the 4 x 4 monodromy (same integrator) and Phi at the times t(nt) along the orbit.
+subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, mono2, &
+                                    half_trace, det, closure, mono4, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_ode_solver, only: ode_options, ode_integrate
+    use conmech_variational, only: integrate_stm
+    use conmech_transverse, only: transverse_result, transverse_monodromy, transverse_phi
+    use conmech_support_transverse, only: callback_natural
+    implicit none
+    real(c_double), intent(in) :: omega, y0(4), period, rtol
+    integer(c_int), intent(in) :: nt
+    real(c_double), intent(in) :: t(nt)
+    real(c_double), intent(out) :: phi_t(nt), mono2(2, 2), half_trace, det, closure
+    real(c_double), intent(out) :: mono4(4, 4)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external pot
+    interface
+        subroutine pot(q, v, g, h)
+            use, intrinsic :: iso_c_binding, only: c_double
+            real(c_double), intent(in) :: q(2)
+            real(c_double), intent(out) :: v, g(2), h(2, 2)
+        end subroutine pot
+    end interface
+    type(callback_natural) :: sys
+    type(transverse_result) :: tr
+    type(ode_options) :: oo
+    real(c_double) :: y(4), tprev
+    integer :: i, j
+    character(len=:), allocatable :: msg
+    sys%pot => pot
+    sys%omega = omega
+    phi_t = 0.0_c_double
+    mono4 = 0.0_c_double
+    call transverse_monodromy(sys, y0, period, tr, rtol)
+    info = tr%info
+    message = tr%message
+    mono2 = tr%monodromy
+    half_trace = tr%half_trace
+    det = tr%det
+    closure = tr%closure
+    if (info /= CM_SUCCESS) return
+    oo%rtol = rtol
+    oo%atol = rtol
+    y = y0
+    do j = 1, 4
+        mono4(j, j) = 1.0_c_double
+    end do
+    call integrate_stm(sys, 0.0_c_double, period, y, mono4, oo, info, msg)
+    if (info < 0) then
+        message = msg
+        return
+    end if
+    y = y0
+    tprev = 0.0_c_double
+    do i = 1, nt
+        if (t(i) > tprev) call ode_integrate(sys, tprev, t(i), y, oo, info, message=msg)
+        if (info < 0) then
+            message = msg
+            return
+        end if
+        tprev = max(tprev, t(i))
+        phi_t(i) = transverse_phi(sys, y)
+    end do
+    info = CM_SUCCESS
+end subroutine flat_transverse_callback
