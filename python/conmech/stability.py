@@ -8,15 +8,23 @@
 - :func:`periodic_orbit`, :func:`symmetric_orbit`: Newton shooting, with the monodromy
   matrix and Floquet multipliers;
 - :func:`floquet`: multipliers, exponents and the planar stability index of a monodromy;
-- :func:`hill_equation`: N'' + Phi(t) N = 0 with Phi a callable or periodic samples.
+- :func:`hill_equation`: N'' + Phi(t) N = 0 with Phi a callable or periodic samples;
+- :func:`continuation`: pseudo-arclength continuation of periodic orbits in a parameter,
+  with folds, branch points, period doublings and Neimark-Sacker points located
+  (:class:`Branch`, :class:`SpecialPoint`; :func:`plot_branch`, :func:`plot_multipliers`);
+- :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
+  of a periodic orbit of any planar natural (+ gyroscopic) system;
+- :func:`find_equilibrium`, :func:`equilibria` (from a :func:`grid` of guesses,
+  deduplicated), :func:`lagrange_dirichlet_potential` (Hessian exact or by differences).
 """
 import numpy as np
 
 from . import _conmech
 from .systems import BuiltinSystem
 
-__all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation", "transverse",
-           "equilibrium", "lagrange_dirichlet", "stm",
+__all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
+           "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
+           "lagrange_dirichlet_potential", "equilibrium", "lagrange_dirichlet", "stm",
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate"}
@@ -488,3 +496,98 @@ def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):
     if tt.size:
         out["phi"] = np.array(phi)
     return out
+
+
+# ------------------------------------------------------------------ equilibria (issue 9)
+
+def find_equilibrium(system, guess, t=0.0, tol=1e-12, max_iter=50, classify_tol=1e-8):
+    """Newton's method for f(t, y) = 0 from ``guess`` (analytic Jacobian of built-in
+    systems, central differences for callables), then :func:`equilibrium` at the root:
+    returns the classified :class:`Equilibrium`. Raises RuntimeError when Newton fails
+    (singular Jacobian or no convergence) or the residual at the root exceeds sqrt(tol)."""
+    y = _state(guess, "guess")
+    _check_dim(system, y)
+    if not (np.isfinite(tol) and tol > 0) or int(max_iter) < 1:
+        raise ValueError("tol must be positive and max_iter >= 1")
+    if isinstance(system, BuiltinSystem):
+        yout, info, message = _conmech.flat_find_equilibrium_builtin(
+            system.name, system.params.size, _params(system), y, float(t), float(tol),
+            int(max_iter))
+    else:
+        yout, info, message = _conmech.flat_find_equilibrium_callback(
+            _callback(system, y.size), y, float(t), float(tol), int(max_iter))
+    if info != 0:
+        _raise(info, message)
+    e = equilibrium(system, np.array(yout), t=t, tol=classify_tol)
+    if not e.residual <= max(np.sqrt(tol), 1e-8)*max(1.0, np.max(np.abs(e.y))):
+        raise RuntimeError(f"find_equilibrium: residual {e.residual:.3g} at the root")
+    return e
+
+
+def equilibria(system, guesses, t=0.0, tol=1e-12, dedup_tol=1e-8, classify_tol=1e-8):
+    """All equilibria reached by Newton from an array of guesses (shape (k, n)), e.g. a
+    grid; duplicates (max-norm distance <= dedup_tol max(1, |y|)) removed. Guesses whose
+    Newton fails are skipped. Returns a list of :class:`Equilibrium`, sorted by y."""
+    g = np.asarray(guesses, dtype=float)
+    if g.ndim != 2 or g.shape[0] == 0:
+        raise ValueError("guesses must be a non-empty (k, n) array")
+    found = []
+    for y in g:
+        try:
+            e = find_equilibrium(system, y, t=t, tol=tol, classify_tol=classify_tol)
+        except RuntimeError:
+            continue
+        if not any(np.max(np.abs(e.y - f.y)) <= dedup_tol*max(1.0, np.max(np.abs(f.y)))
+                   for f in found):
+            found.append(e)
+    found.sort(key=lambda e: tuple(e.y))
+    return found
+
+
+def grid(bounds, num):
+    """Guesses on a regular grid: ``bounds`` = [(lo, hi), ...] per component, ``num``
+    points per component (an int or a list). Returns a (k, n) array for
+    :func:`equilibria`."""
+    bounds = [tuple(map(float, b)) for b in bounds]
+    num = [int(num)]*len(bounds) if np.isscalar(num) else [int(k) for k in num]
+    if len(num) != len(bounds) or min(num) < 1:
+        raise ValueError("num must be a positive int or one per bound")
+    axes = [np.linspace(lo, hi, k) for (lo, hi), k in zip(bounds, num)]
+    return np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=1)
+
+
+def potential_hessian(potential, q, h=None):
+    """Central-difference Hessian of a potential V(q) (step eps^(1/4) max(|q_i|, 1), error
+    O(h^2) ~ 1e-8 relative)."""
+    q = _state(q, "q")
+    n = q.size
+    hs = np.full(n, np.finfo(float).eps**0.25)*np.maximum(np.abs(q), 1.0) if h is None \
+        else np.full(n, float(h))
+    H = np.empty((n, n))
+    v0 = float(potential(q))
+    for i in range(n):
+        e_i = np.zeros(n)
+        e_i[i] = hs[i]
+        H[i, i] = (float(potential(q + e_i)) - 2*v0 + float(potential(q - e_i)))/hs[i]**2
+        for j in range(i + 1, n):
+            e_j = np.zeros(n)
+            e_j[j] = hs[j]
+            H[i, j] = H[j, i] = (float(potential(q + e_i + e_j))
+                                 - float(potential(q + e_i - e_j))
+                                 - float(potential(q - e_i + e_j))
+                                 + float(potential(q - e_i - e_j)))/(4*hs[i]*hs[j])
+    return H
+
+
+def lagrange_dirichlet_potential(potential, q, hessian=None, tol=1e-6):
+    """Lagrange-Dirichlet test at q from the potential: a strict minimum (positive-definite
+    Hessian) is a stable equilibrium of a conservative system. ``hessian(q)`` if given
+    (exact, e.g. symbolic), else :func:`potential_hessian`. Returns (stable, eigenvalues,
+    hessian); ``tol`` is relative to the largest |eigenvalue| (finite differences carry
+    ~1e-8)."""
+    q = _state(q, "q")
+    H = np.asarray(hessian(q), dtype=float) if hessian is not None else \
+        potential_hessian(potential, q)
+    H = 0.5*(H + H.T)
+    stable, w = lagrange_dirichlet(H, tol=tol)
+    return stable, w, H

@@ -142,3 +142,61 @@ def test_transverse_general_equals_hill():
     r = stability.transverse(pot, orb.y0, orb.period, omega=-m, rtol=1e-14)
     assert r["half_trace"] == pytest.approx(orb.stability_index, abs=1e-12)
     assert 1 + np.arccos(r["half_trace"])/(2*np.pi) == pytest.approx(hill.C_HILL, abs=1e-12)
+
+
+# --------------------------------------------------------------------- equilibria
+
+def test_equilibria_of_the_pendulum_from_a_grid():
+    eqs = stability.equilibria(systems.pendulum(g=9.81, l=1.0),
+                               stability.grid([(-4, 4), (-1, 1)], [9, 3]))
+    assert [round(e.y[0], 12) for e in eqs] == [round(-np.pi, 12), 0.0, round(np.pi, 12)]
+    kinds = [e.kind for e in eqs]
+    assert kinds == ["unstable", "centre", "unstable"] and eqs[0].saddle
+    assert np.max(eqs[1].eigenvalues.imag) == pytest.approx(np.sqrt(9.81), abs=1e-10)
+
+
+def test_bead_on_hoop_equilibria_and_lagrange_dirichlet():
+    """REFERENCE.md: off-axis equilibria cos th* = g/(R W^2) when W^2 > g/R, oscillating
+    at W sin th*; th = 0 is then unstable."""
+    g, R, W = 9.81, 1.0, 5.0
+    sys = systems.bead_hoop(m=1.0, R=R, omega=W, g=g)
+    eqs = stability.equilibria(sys, stability.grid([(-3, 3), (0, 0)], [13, 1]))
+    th = np.arccos(g/(R*W**2))
+    ys = np.array([e.y[0] for e in eqs])
+    for target in (-th, 0.0, th):
+        assert np.min(np.abs(ys - target)) < 1e-10
+    off = [e for e in eqs if abs(abs(e.y[0]) - th) < 1e-10]
+    assert all(e.kind == "centre" for e in off)
+    assert np.max(off[0].eigenvalues.imag) == pytest.approx(W*np.sin(th), rel=1e-9)
+    assert [e for e in eqs if abs(e.y[0]) < 1e-10][0].kind == "unstable"
+
+    # the effective potential in the rotating frame: V = -m g R cos th - m R^2 W^2 sin^2/2
+    def V(q):
+        return -g*R*np.cos(q[0]) - 0.5*R**2*W**2*np.sin(q[0])**2
+    ok, w, H = stability.lagrange_dirichlet_potential(V, [th])
+    exact = (R*W*np.sin(th))**2     # V''(th*) = m R^2 W^2 sin^2 th*
+    assert ok and H[0, 0] == pytest.approx(exact, rel=1e-7)
+    ok0, w0, _ = stability.lagrange_dirichlet_potential(V, [0.0])
+    assert not ok0 and w0[0] < 0
+    ok2, _, H2 = stability.lagrange_dirichlet_potential(
+        V, [th], hessian=lambda q: [[R**2*W**2*np.sin(q[0])**2]])
+    assert ok2 and H2[0, 0] == pytest.approx(exact, rel=1e-14)
+
+
+def test_equilibria_callback_and_failures():
+    m = hill.M_HILL
+    xe = (1/(3*m*m))**(1/3)
+
+    def hill_rhs(t, s):
+        x, y, vx, vy = s
+        r3 = np.hypot(x, y)**3
+        return [vx, vy, 2*m*vy - x/r3 + 3*m*m*x, -2*m*vx - y/r3]
+    eqs = stability.equilibria(hill_rhs, [[xe*1.1, 0.1, 0, 0], [-xe*0.9, 0, 0, 0],
+                                          [xe*0.95, -0.05, 0, 0]])
+    assert len(eqs) == 2
+    assert eqs[0].y[0] == pytest.approx(-xe, rel=1e-10) and eqs[1].y[0] == pytest.approx(xe)
+    assert all(e.kind == "unstable" and e.saddle for e in eqs)
+    with pytest.raises(RuntimeError):
+        stability.find_equilibrium(lambda t, y: [1.0, y[1]], [0.0, 0.0])
+    with pytest.raises(ValueError):
+        stability.equilibria(hill_rhs, [])

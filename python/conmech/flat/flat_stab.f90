@@ -570,3 +570,59 @@ subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, 
     end do
     info = CM_SUCCESS
 end subroutine flat_transverse_callback
+
+!> Newton's method for an equilibrium f(t, y) = 0 of a built-in system from the guess y.
+subroutine flat_find_equilibrium_builtin(name, np, params, n, y, t, tol, max_iter, yout, info, &
+                                         message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_systems, only: make_system
+    use conmech_equilibria, only: find_equilibrium
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n, max_iter
+    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    real(c_double), intent(out) :: yout(n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    yout = y
+    call make_system(name, params(1:np), sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
+    message = msg
+end subroutine flat_find_equilibrium_builtin
+
+!> As flat_find_equilibrium_builtin for a Python right-hand side (FD Jacobian).
+subroutine flat_find_equilibrium_callback(fun, n, y, t, tol, max_iter, yout, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_equilibria, only: find_equilibrium
+    implicit none
+    integer(c_int), intent(in) :: n, max_iter
+    real(c_double), intent(in) :: y(n), t, tol
+    real(c_double), intent(out) :: yout(n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    character(len=:), allocatable :: msg
+    sys%f => fun
+    sys%n = n
+    yout = y
+    call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
+    message = msg
+end subroutine flat_find_equilibrium_callback
