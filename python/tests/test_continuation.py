@@ -200,3 +200,17 @@ def test_equilibria_callback_and_failures():
         stability.find_equilibrium(lambda t, y: [1.0, y[1]], [0.0, 0.0])
     with pytest.raises(ValueError):
         stability.equilibria(hill_rhs, [])
+
+
+def test_plots(tmp_path):
+    mpl = pytest.importorskip("matplotlib")
+    mpl.use("Agg")
+    import matplotlib.pyplot as plt
+    br = stability.continuation(fold_cycle, [1, 0], 3.0, p0=0.0, direction=-1, ds=0.08,
+                                max_points=10)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    stability.plot_branch(br, axes[0], y="period")
+    stability.plot_multipliers(br, axes[1])
+    fig.savefig(tmp_path / "branch.png")
+    plt.close(fig)
+    assert (tmp_path / "branch.png").stat().st_size > 1000
