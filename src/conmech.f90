@@ -10,11 +10,14 @@ module conmech
     use conmech_systems_basic
     use conmech_systems
     use conmech_generalized
+    use conmech_c_system
+    use conmech_c_mechanics
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_mech
+    use conmech_model_library
     use conmech_hill
     use conmech_equilibria
     use conmech_variational
