@@ -26,6 +26,7 @@ module conmech
     use conmech_hill_orbit
     use conmech_continuation
     use conmech_transverse
+    use conmech_param_system
     implicit none
     public
 end module conmech

@@ -435,9 +435,8 @@ subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, 
                                      s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
                                      sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_status, only: CM_BAD_INPUT
-    use conmech_systems, only: make_system
-    use conmech_support_cont, only: builtin_param_system, run_continuation
+    use conmech_param_system, only: builtin_param_system, make_param_system
+    use conmech_support_cont, only: run_continuation
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, ip, n, iopt(9), nfree, ntg, mp
@@ -453,15 +452,7 @@ subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, 
     character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
-    if (ip < 1 .or. ip > np) then
-        info = CM_BAD_INPUT
-        message = "the continuation parameter index is out of range"
-        return
-    end if
-    sys%name = trim(name)
-    sys%params = params(1:np)
-    sys%ip = ip
-    call make_system(sys%name, sys%params, sys%inner, info, msg)
+    call make_param_system(name, params(1:np), ip, sys, info, msg)
     if (info /= 0) then
         message = msg
         return

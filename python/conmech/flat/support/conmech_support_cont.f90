@@ -7,27 +7,15 @@ module conmech_support_cont
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system
+    use conmech_param_system, only: builtin_param_system, set_builtin_param
     use conmech_shooting, only: set_parameter_proc
     use conmech_continuation, only: cont_options, branch, continue_orbits
     implicit none
     private
-    public :: builtin_param_system, callback_param_system, set_param_any, run_continuation
+    public :: callback_param_system, set_param_any, run_continuation
     public :: MAX_SPECIAL
 
     integer, parameter :: MAX_SPECIAL = 64
-
-    !> A built-in system (by name) whose parameter params(ip) is set by `set_param_any`.
-    type, extends(ode_system) :: builtin_param_system
-        class(ode_system), allocatable :: inner
-        character(len=:), allocatable :: name
-        real(dp), allocatable :: params(:)
-        integer :: ip = 1
-    contains
-        procedure :: rhs => bp_rhs
-        procedure :: jacobian => bp_jac
-        procedure :: has_jacobian => bp_has_jac
-    end type builtin_param_system
 
     !> A Python right-hand side fun(t, y, p, dydt, n) with the parameter p.
     type, extends(ode_system) :: callback_param_system
@@ -39,27 +27,6 @@ module conmech_support_cont
     end type callback_param_system
 
 contains
-
-    subroutine bp_rhs(self, t, y, dydt)
-        class(builtin_param_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        call self%inner%rhs(t, y, dydt)
-    end subroutine bp_rhs
-
-    subroutine bp_jac(self, t, y, dfdy)
-        class(builtin_param_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        call self%inner%jacobian(t, y, dfdy)
-    end subroutine bp_jac
-
-    logical function bp_has_jac(self)
-        class(builtin_param_system), intent(in) :: self
-        bp_has_jac = self%inner%has_jacobian()
-    end function bp_has_jac
 
     subroutine cp_rhs(self, t, y, dydt)
         class(callback_param_system), intent(in) :: self
@@ -73,12 +40,9 @@ contains
     subroutine set_param_any(sys, p)
         class(ode_system), intent(inout) :: sys
         real(dp), intent(in) :: p
-        integer :: info
-        character(len=:), allocatable :: msg
         select type (sys)
         type is (builtin_param_system)
-            sys%params(sys%ip) = p
-            call make_system(sys%name, sys%params, sys%inner, info, msg)
+            call set_builtin_param(sys, p)
         type is (callback_param_system)
             sys%p = p
         end select
