@@ -214,3 +214,39 @@ def test_plots(tmp_path):
     fig.savefig(tmp_path / "branch.png")
     plt.close(fig)
     assert (tmp_path / "branch.png").stat().st_size > 1000
+
+
+# ------------------------------------------------------------------ the family program
+
+def test_family_program_resumes(tmp_path):
+    """`fpm run family`: Hill's variation orbits continued in m past the loss of stability
+    (branch point at m = 0.195...), interrupted after 5 points and resumed."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+    if shutil.which("fpm") is None:
+        pytest.fail("fpm is not on PATH: run the tests through scripts/test.sh")
+    root = Path(__file__).resolve().parents[2]
+    out, sp = tmp_path / "b.csv", tmp_path / "s.csv"
+    args = ["fpm", "run", "family", "--", "--system", "hill", "--params", "0.15,1",
+            "--param", "1", "--y0", "0.8,0,0,1", "--period", str(2*np.pi), "--free", "1,4",
+            "--targets", "1,4", "--period-factor", "4", "--conservative", "--p-max", "0.25",
+            "--ds", "0.005", "--ds-max", "0.01", "--out", str(out), "--special", str(sp)]
+    r = subprocess.run(args + ["--max-points", "5"], cwd=root, capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    first = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert first.shape[0] == 5 and first[-1, 1] < 0.195
+    r = subprocess.run(args + ["--max-points", "12"], cwd=root, capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    assert "resuming after 5 points" in r.stdout
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.array_equal(rows[:5], first) and rows[-1, 1] > 0.195
+    assert np.all(np.diff(rows[:, 0]) == 1)
+    lines = sp.read_text().splitlines()
+    assert len(lines) == 2 and lines[1].startswith("branch point")
+    assert abs(float(lines[1].split(",")[2]) - 0.19510399668) < 1e-9
+    bad = subprocess.run(["fpm", "run", "family", "--", "--system", "nope", "--y0", "1",
+                          "--period", "1"], cwd=root, capture_output=True, text=True)
+    assert bad.returncode == 2 and "unknown --system" in bad.stderr
