@@ -60,10 +60,9 @@ def test_family_continuation():
     assert np.all(np.diff(fam.c) > 0)
     assert np.all(np.abs(fam.stability_index) < 1)
     one = hill.variation_orbit(ms[123])
-    assert fam.c[123] == pytest.approx(one.c, abs=1e-12)   # round-off floor of S
-    # continuation: apart from the chunk starts, Newton needs at most 2 iterations (one from
-    # the extrapolated start, one to take the STM at the converged point)
-    assert np.mean(fam.iterations <= 2) > 0.9
+    assert fam.c[123] == pytest.approx(one.c, abs=5e-12)   # round-off floor of S
+    # continuation: apart from the chunk starts, Newton needs at most 2 iterations
+    assert np.mean(fam.iterations <= 2) > 0.95
 
 
 def test_hill_bad_input():
@@ -331,5 +330,5 @@ def test_family_bitwise_independent_of_threads_and_matches_single_orbits():
     for i in (0, 77, 150, 299):
         one = hill.variation_orbit(fam.ms[i])
         # round-off floor of S: dS/du ~ 1e3, the start is known to ~1e-15
-        assert abs(fam.c[i] - one.c) <= 1e-12
+        assert abs(fam.c[i] - one.c) <= 5e-12
         assert abs(fam.y0[i, 0] - one.y0[0]) <= 1e-14

@@ -224,10 +224,10 @@ contains
     !! `closure_tol`, n grows (by the 8th-order error model, at least doubled, at most
     !! `max_nsteps`) and Newton restarts from the last solution. `residual` is this true
     !! closure estimate; `newton_residual` the closure of the discretised problem.
-    !! Newton accepts when its step |du| <= 8 eps max(1, |u|), or on the second consecutive
-    !! step below tol max(1, |u|) (round-off floor); the monodromy is the STM at that last
-    !! iterate (within |du| of the solution: S is sensitive to the point, dS/du ~ 1e2 at
-    !! small m, so the STM must be taken at the converged point, not one step before).
+    !! Newton accepts when its step |du| <= tol max(1, |u|) (1e-14); the monodromy is the
+    !! STM at that last iterate, within |du| of the solution. S is sensitive to the start
+    !! (dS/du ~ 1e3 at small m) and the start is known only to ~1e-15 (round-off in the
+    !! closure): S and c carry a round-off floor of ~1e-12, whatever the Newton start.
     !! info: CM_SUCCESS; CM_BAD_INPUT (m < 0, kappa <= 0, bad options); CM_SINGULAR
     !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged, another
     !! orbit was found, or the closure tolerance cannot be met with `max_nsteps`).
@@ -350,8 +350,6 @@ contains
         type(hill_orbit), intent(inout) :: orb
         real(dp) :: du(2), g(2), z(20), det, scale
         integer :: it
-        logical :: small
-        small = .false.
         orb%info = CM_NO_CONVERGENCE
         orb%message = "hill_variation_orbit: Newton did not converge"
         a = 0.0_dp
@@ -381,14 +379,10 @@ contains
             scale = max(1.0_dp, maxval(abs(u)))
             u = u + du
             if (maxval(abs(du)) <= opt%tol*scale) then
-                ! the STM is that of the last iterate: accept once it is within round-off
-                ! of the solution (|du| <= 8 eps) or on the second step below tol
-                if (small .or. maxval(abs(du)) <= 8.0_dp*epsilon(1.0_dp)*scale) then
-                    orb%info = CM_SUCCESS
-                    orb%message = "success"
-                    return
-                end if
-                small = .true.
+                ! the STM is that of the last iterate, within |du| <= tol of the solution
+                orb%info = CM_SUCCESS
+                orb%message = "success"
+                return
             end if
             if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
                 orb%info = CM_NO_CONVERGENCE
