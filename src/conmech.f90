@@ -27,6 +27,7 @@ module conmech
     use conmech_continuation
     use conmech_transverse
     use conmech_param_system
+    use conmech_branch_switch
     implicit none
     public
 end module conmech

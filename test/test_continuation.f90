@@ -125,7 +125,36 @@ contains
         call ts%check_close(found(SP_NS), 3.0_dp, 1.0e-8_dp, "Neimark-Sacker at p = 3")
         call ts%check_close(br%points(br%npoints)%period, 8.0_dp*atan(1.0_dp), 1.0e-9_dp, &
                             "the period stays 2 pi")
+        ! branch switching at the period doubling: the doubled orbit has period 4 pi and
+        ! u^2 + w^2 = |xi|^2 = p - 1 (closed form), p > 1 (supercritical)
+        do k = 1, br%nspecial
+            if (br%special(k)%kind == SP_PD) call check_doubled(sys, br%special(k))
+        end do
     end subroutine test_pd_bp_ns
+
+    subroutine check_doubled(sys, sp)
+        type(nf_cycles), intent(inout) :: sys
+        type(special_point), intent(in) :: sp
+        type(branch) :: b2
+        type(cont_options) :: o
+        real(dp) :: err
+        integer :: k
+        o%ds = 0.05_dp
+        o%ds_max = 0.1_dp
+        o%max_points = 8
+        call switch_period_doubling(sys, set_p, sp, b2, o)
+        call ts%check(b2%info == CM_SUCCESS .and. b2%npoints == 8, &
+                      "doubled branch: "//b2%message)
+        err = 0.0_dp
+        do k = 2, b2%npoints
+            err = max(err, abs(b2%points(k)%period - 16.0_dp*atan(1.0_dp)), &
+                      abs(b2%points(k)%y0(3)**2 + b2%points(k)%y0(4)**2 - &
+                          (b2%points(k)%p - 1.0_dp)))
+        end do
+        call ts%check(b2%npoints >= 2 .and. all(b2%points(2:b2%npoints)%p > 1.0_dp), &
+                      "doubled orbits for p > 1")
+        call ts%check_less(err, 1.0e-8_dp, "doubled orbit: period 4 pi, u^2 + w^2 = p - 1")
+    end subroutine check_doubled
 
     subroutine test_fold()
         type(fold_cycle) :: sys

@@ -76,7 +76,7 @@ module conmech_continuation
         real(dp), allocatable :: mr(:), mi(:) !! multipliers
         real(dp) :: stability_index = 0.0_dp  !! S (conservative 4 x 4) or max |mu| nontrivial
         real(dp) :: psi(4) = 0.0_dp           !! test functions: fold, bp, pd, ns
-        real(dp) :: residual = 0.0_dp         !! max |G| at the point
+        real(dp) :: residual = 0.0_dp         !! max |G| one Newton step before it (a bound)
         real(dp) :: ds = 0.0_dp               !! step length that reached it
         integer :: iterations = 0
     end type cont_point
@@ -136,7 +136,7 @@ contains
     !! when the corrector failed below ds_min (the branch so far is kept; the message names
     !! the parameter value), CM_SINGULAR / CM_NO_CONVERGENCE / CM_BAD_INPUT for a bad start.
     subroutine continue_orbits(sys, set_param, p0, y0, period, br, options, free, targets, &
-                               free_time, period_factor)
+                               free_time, period_factor, tangent0)
         class(ode_system), intent(inout) :: sys
         procedure(set_parameter_proc) :: set_param
         real(dp), intent(in) :: p0
@@ -147,8 +147,9 @@ contains
         integer, intent(in), optional :: free(:), targets(:)
         logical, intent(in), optional :: free_time
         real(dp), intent(in), optional :: period_factor
+        real(dp), intent(in), optional :: tangent0(:)  !! first tangent (branch switching)
         type(cproblem) :: pb
-        real(dp), allocatable :: x(:), t(:), xn(:), tn(:), xp(:)
+        real(dp), allocatable :: x(:), t(:), xn(:), tn(:), xp(:), gl(:), dgl(:, :), phil(:, :)
         type(cont_point) :: pt
         real(dp) :: ds
         integer :: info, it, k
@@ -163,9 +164,17 @@ contains
         end if
         allocate (br%points(pb%o%max_points), br%special(64))
         allocate (x(pb%nx), t(pb%nx), xn(pb%nx), tn(pb%nx), xp(pb%nx))
+        allocate (gl(pb%neq), dgl(pb%neq, pb%nx), phil(pb%n, pb%n))
         ! the first point: Newton at fixed p
         call pack_start(pb, y0, period, p0, x)
-        call correct(sys, set_param, pb, x, t, .true., it, info, msg)
+        ! a given tangent0 starts at a bifurcation point (already a solution, not isolated)
+        it = 0
+        info = CM_SUCCESS
+        if (present(tangent0)) then
+            call set_reference(sys, set_param, pb, x)
+        else
+            call correct(sys, set_param, pb, x, t, .true., it, info, msg)
+        end if
         if (info /= CM_SUCCESS) then
             br%info = info
             br%message = "continuation: the start is not a periodic orbit: "//msg
@@ -174,7 +183,16 @@ contains
         ! the first tangent: the null vector of DG with t_p of sign `direction`
         t = 0.0_dp
         t(pb%nx) = real(sign(1, pb%o%direction), dp)
-        call make_point(sys, set_param, pb, x, t, it, 0.0_dp, br%points(1), info)
+        if (present(tangent0)) then
+            if (size(tangent0) /= pb%nx .or. .not. (norm2(tangent0) > 0.0_dp)) then
+                br%info = CM_BAD_INPUT
+                br%message = "continuation: tangent0 must have one entry per unknown"
+                return
+            end if
+            t = tangent0/norm2(tangent0)
+        end if
+        call make_point(sys, set_param, pb, x, t, it, 0.0_dp, br%points(1), info, &
+                        keep_t=present(tangent0))
         if (info /= CM_SUCCESS) then
             br%info = CM_SINGULAR
             br%message = "continuation: degenerate start (no unique tangent: the orbit is "// &
@@ -189,10 +207,10 @@ contains
             call set_reference(sys, set_param, pb, x)
             xn = x + ds*t
             xp = xn
-            call correct(sys, set_param, pb, xn, t, .false., it, info, msg, xp)
+            call correct(sys, set_param, pb, xn, t, .false., it, info, msg, xp, gl, dgl, phil)
             tn = t
             if (info == CM_SUCCESS) call make_point(sys, set_param, pb, xn, tn, it, ds, pt, &
-                                                     info)
+                                                     info, gl, dgl, phil)
             if (info /= CM_SUCCESS) then
                 ds = 0.5_dp*ds
                 if (ds < pb%o%ds_min) then
@@ -403,7 +421,7 @@ contains
 
     !> Newton corrector. first: at fixed p (the start); else with the arclength equation
     !! t . (X - xp) = 0 about the predicted point xp.
-    subroutine correct(sys, set_param, pb, x, t, first, it, info, msg, xp)
+    subroutine correct(sys, set_param, pb, x, t, first, it, info, msg, xp, gl, dgl, phil)
         class(ode_system), intent(inout) :: sys
         procedure(set_parameter_proc) :: set_param
         type(cproblem), intent(inout) :: pb
@@ -413,6 +431,7 @@ contains
         integer, intent(out) :: it, info
         character(len=:), allocatable, intent(out) :: msg
         real(dp), intent(in), optional :: xp(:)
+        real(dp), intent(out), optional :: gl(:), dgl(:, :), phil(:, :)  !! last evaluation
         real(dp) :: g(pb%neq), dg(pb%neq, pb%nx), phi(pb%n, pb%n), a(pb%neq + 1, pb%nx)
         real(dp) :: r(pb%neq + 1), dx(pb%nx), res
         integer :: rank, nun
@@ -422,6 +441,9 @@ contains
         do it = 1, pb%o%max_iter
             call evaluate(sys, set_param, pb, x, g, dg, phi, info, msg)
             if (info /= CM_SUCCESS) return
+            if (present(gl)) gl = g
+            if (present(dgl)) dgl = dg
+            if (present(phil)) phil = phi
             res = maxval(abs(g))
             if (first) then
                 nun = pb%nx - 1
@@ -456,7 +478,7 @@ contains
     !> The point of the branch at X: the unit tangent (solving [DG; t_old] t = [0; 1]; t is
     !! the old tangent on entry, the new one on exit), period, state, monodromy, multipliers,
     !! test functions.
-    subroutine make_point(sys, set_param, pb, x, t, it, ds, pt, info)
+    subroutine make_point(sys, set_param, pb, x, t, it, ds, pt, info, g0, dg0, phi0, keep_t)
         class(ode_system), intent(inout) :: sys
         procedure(set_parameter_proc) :: set_param
         type(cproblem), intent(in) :: pb
@@ -465,6 +487,8 @@ contains
         integer, intent(in) :: it
         type(cont_point), intent(out) :: pt
         integer, intent(out) :: info
+        real(dp), intent(in), optional :: g0(:), dg0(:, :), phi0(:, :)  !! the corrector's last
+        logical, intent(in), optional :: keep_t   !! keep t (a bifurcation point: no unique one)
         real(dp) :: y(pb%n), tend, per, phi(pb%n, pb%n), psi(3), g(pb%neq)
         real(dp) :: dg(pb%neq, pb%nx), a(pb%neq + 1, pb%nx), r(pb%neq + 1), tn(pb%nx)
         real(dp) :: f(pb%n)
@@ -477,8 +501,16 @@ contains
         pt%y0 = y
         pt%iterations = it
         pt%ds = ds
-        call evaluate(sys, set_param, pb, x, g, dg, phi, info, msg)
-        if (info /= CM_SUCCESS) return
+        if (present(g0) .and. present(dg0) .and. present(phi0)) then
+            ! the corrector's last evaluation, one Newton step (<= tol) from x
+            g = g0
+            dg = dg0
+            phi = phi0
+            info = CM_SUCCESS
+        else
+            call evaluate(sys, set_param, pb, x, g, dg, phi, info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
         pt%residual = maxval(abs(g))
         a(1:pb%neq, :) = dg
         a(pb%neq + 1, :) = t
@@ -486,6 +518,12 @@ contains
         r(pb%neq + 1) = 1.0_dp
         call lstsq_solve(a, r, tn, rank, info, pb%o%rcond)
         if (info /= CM_SUCCESS) return
+        if (present(keep_t)) then
+            if (keep_t) then
+                rank = pb%nx
+                tn = t
+            end if
+        end if
         if (rank < pb%nx .or. .not. (norm2(tn) > 0.0_dp)) then
             info = CM_SINGULAR
             return
@@ -570,6 +608,7 @@ contains
         integer :: iter, side, it
         type(cont_point) :: trial, qa, qb
         character(len=:), allocatable :: msg
+        real(dp) :: gl(pb%neq), dgl(pb%neq, pb%nx), phil(pb%n, pb%n)
         if (kind == SP_FOLD) fold = .true.
         sa = 0.0_dp
         sb = ds
@@ -582,10 +621,11 @@ contains
             sc = (sa*fb - sb*fa)/(fb - fa)
             if (.not. (sc > min(sa, sb) .and. sc < max(sa, sb))) sc = 0.5_dp*(sa + sb)
             x = x0 + sc*t0
-            call correct(sys, set_param, pb, x, t0, .false., it, info, msg, x0 + sc*t0)
+            call correct(sys, set_param, pb, x, t0, .false., it, info, msg, x0 + sc*t0, gl, &
+                         dgl, phil)
             if (info == CM_SUCCESS) then
                 t = t0
-                call make_point(sys, set_param, pb, x, t, it, sc, trial, info)
+                call make_point(sys, set_param, pb, x, t, it, sc, trial, info, gl, dgl, phil)
             end if
             if (info /= CM_SUCCESS) exit
             fc = trial%psi(kind)
