@@ -24,6 +24,7 @@ module conmech
     use conmech_floquet
     use conmech_shooting
     use conmech_hill_orbit
+    use conmech_hill_family
     use conmech_continuation
     use conmech_transverse
     use conmech_param_system

@@ -9,6 +9,7 @@ program test_hill
     use conmech_floquet, only: hill_result, hill_solve_samples
     use conmech_hill
     use conmech_hill_orbit
+    use conmech_hill_family
     use conmech_testing, only: test_suite
     implicit none
     type(test_suite) :: ts

@@ -59,7 +59,8 @@ subroutine flat_hill_locate(ma, ua, mb, ub, kappa, target, mtol, m_star, u_star,
                             residual, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
-    use conmech_hill_orbit, only: hill_orbit, hill_variation_orbit, hill_locate_index
+    use conmech_hill_orbit, only: hill_orbit, hill_variation_orbit
+    use conmech_hill_family, only: hill_locate_index
     implicit none
     real(c_double), intent(in) :: ma, ua(2), mb, ub(2), kappa, target, mtol
     real(c_double), intent(out) :: m_star, u_star(2), s, c, residual
@@ -93,7 +94,8 @@ end subroutine flat_hill_locate
 subroutine flat_hill_family(nm, ms, kappa, nsteps, chunk_size, y0s, jacobis, monos, ss, cs, &
                             residuals, quarters, nsteps_used, infos, iters)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_family
+    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options
+    use conmech_hill_family, only: hill_family
     implicit none
     integer(c_int), intent(in) :: nm
     real(c_double), intent(in) :: ms(nm), kappa
