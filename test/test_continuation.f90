@@ -90,6 +90,7 @@ program test_continuation
     implicit none
     type(test_suite) :: ts
 
+    ts%name = "test_continuation"
     call test_pd_bp_ns()
     call test_fold()
     call test_bad_input()

@@ -54,6 +54,7 @@ program test_transverse
     type(test_suite) :: ts
     real(dp), parameter :: m_hill = 0.080848933808312_dp
 
+    ts%name = "test_transverse"
     call test_henon_heiles()
     call test_hill()
     call ts%finish()
