@@ -25,6 +25,7 @@ from .systems import BuiltinSystem
 __all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
            "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
            "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
+           "switch_period_doubling",
            "equilibrium", "lagrange_dirichlet", "stm",
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
 
@@ -348,7 +349,7 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                  autonomous=True, fixed_period=False, conservative=False, free=None,
                  targets=None, free_time=False, period_factor=2.0, rtol=1e-11, atol=1e-11,
                  tol=1e-10, res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11,
-                 energy=None):
+                 energy=None, _switch=False):
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -388,7 +389,7 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                      rtol, atol, locate_tol, period_factor], dtype=float)
     iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(autonomous),
                      bool(fixed_period), bool(conservative), bool(locate), sym,
-                     bool(free_time)], dtype=np.int32)
+                     bool(free_time), bool(_switch)], dtype=np.int32)
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
             int(max_points))
     if isinstance(system, BuiltinSystem):
@@ -589,6 +590,21 @@ def lagrange_dirichlet_potential(potential, q, hessian=None, tol=1e-6):
     H = 0.5*(H + H.T)
     stable, w = lagrange_dirichlet(H, tol=tol)
     return stable, w, H
+
+
+def switch_period_doubling(system, point, param=None, **options):
+    """Branch switching at a located period doubling: the branch of orbits of twice the
+    period that bifurcates at ``point`` (a :class:`SpecialPoint` of kind 'period doubling'
+    from :func:`continuation` on the same ``system``/``param``). The first step follows the
+    eigenvector of the multiplier -1 (``direction`` picks its sign); the other options as
+    for :func:`continuation` (general shooting of an autonomous system)."""
+    if not isinstance(point, SpecialPoint) or point.kind != "period doubling":
+        raise ValueError("point must be a 'period doubling' SpecialPoint of a Branch")
+    for bad in ("free", "targets", "p0", "_switch"):
+        if bad in options:
+            raise ValueError(f"{bad} is not an option of switch_period_doubling")
+    return continuation(system, point.y0, point.period, param=param, p0=point.p,
+                        _switch=True, **options)
 
 
 # --------------------------------------------------------------------------- plots

@@ -250,3 +250,36 @@ def test_family_program_resumes(tmp_path):
     bad = subprocess.run(["fpm", "run", "family", "--", "--system", "nope", "--y0", "1",
                           "--period", "1"], cwd=root, capture_output=True, text=True)
     assert bad.returncode == 2 and "unknown --system" in bad.stderr
+
+
+def _moebius(t, s, p):
+    """The cycle x = cos t, y = sin t with (u, w) turning by half the angle (a Moebius band):
+    in the half-angle frame xi' = diag(p - 1, -1) xi - |xi|^2 xi, so the multiplier
+    -exp(2 pi (p - 1)) passes -1 at p = 1 and the doubled orbit (period 4 pi) has
+    u^2 + w^2 = p - 1 (closed forms by construction)."""
+    x, y, u, w = s
+    r2 = x*x + y*y
+    r = np.sqrt(r2)
+    c, sn = x/r, y/r
+    a, b = p - 1.0, -1.0
+    q2 = u*u + w*w
+    return [x*(1 - r2) - y, y*(1 - r2) + x,
+            -0.5*w + 0.5*(a + b)*u + 0.5*(a - b)*(c*u + sn*w) - q2*u,
+            0.5*u + 0.5*(a + b)*w + 0.5*(a - b)*(sn*u - c*w) - q2*w]
+
+
+def test_period_doubling_and_branch_switching():
+    br = stability.continuation(_moebius, [1, 0, 0, 0], 6.3, p0=0.7, ds=0.2, ds_max=0.3,
+                                p_range=(0, 1.3), rtol=1e-10, atol=1e-10, locate_tol=1e-10)
+    assert br.success and [s.kind for s in br.special] == ["period doubling"]
+    pd = br.special[0]
+    assert pd.p == pytest.approx(1.0, abs=1e-8)
+    assert np.min(np.abs(pd.multipliers + 1)) < 1e-7
+    b2 = stability.switch_period_doubling(_moebius, pd, ds=0.05, max_points=4, rtol=1e-10,
+                                          atol=1e-10)
+    assert b2.success and len(b2) == 4
+    assert np.allclose(b2.period, 4*np.pi, atol=1e-9)
+    assert np.all(b2.p[1:] > 1)
+    assert np.allclose(b2.y0[:, 2]**2 + b2.y0[:, 3]**2, b2.p - 1, atol=1e-9)
+    with pytest.raises(ValueError, match="period doubling"):
+        stability.switch_period_doubling(_moebius, br)

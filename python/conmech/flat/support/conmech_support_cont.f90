@@ -9,7 +9,9 @@ module conmech_support_cont
     use conmech_ode_system, only: ode_system
     use conmech_param_system, only: builtin_param_system, set_builtin_param
     use conmech_shooting, only: set_parameter_proc
-    use conmech_continuation, only: cont_options, branch, continue_orbits
+    use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &
+                                    SP_PD
+    use conmech_branch_switch, only: switch_period_doubling
     implicit none
     private
     public :: callback_param_system, set_param_any, run_continuation
@@ -50,13 +52,15 @@ contains
 
     !> Run the continuation and pack the branch. ropt = [ds, ds_min, ds_max, p_min, p_max,
     !! tol, res_tol, rtol, atol, locate_tol, period_factor]; iopt = [max_points, direction,
-    !! max_iter, autonomous, fixed_period, conservative, locate, symmetric, free_time].
+    !! max_iter, autonomous, fixed_period, conservative, locate, symmetric, free_time,
+    !! switch]: switch /= 0 starts the doubled-period branch at the period-doubling point
+    !! (p0, y0, period).
     subroutine run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, &
                                 targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, &
                                 nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, &
                                 sp_s, info, message)
         class(ode_system), intent(inout) :: sys
-        integer(c_int), intent(in) :: n, iopt(9), nfree, ntg, mp
+        integer(c_int), intent(in) :: n, iopt(10), nfree, ntg, mp
         real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
         integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
         integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(MAX_SPECIAL)
@@ -69,6 +73,7 @@ contains
         character(len=256), intent(out) :: message
         type(cont_options) :: o
         type(branch) :: br
+        type(special_point) :: sp
         integer :: k
         npts = 0
         nsp = 0
@@ -94,7 +99,13 @@ contains
         o%conservative = iopt(6) /= 0
         o%locate = iopt(7) /= 0
         call set_param_any(sys, p0)
-        if (iopt(8) /= 0) then
+        if (iopt(10) /= 0) then
+            sp%kind = SP_PD
+            sp%point%p = p0
+            sp%point%y0 = y0
+            sp%point%period = period
+            call switch_period_doubling(sys, set_param_any, sp, br, o)
+        else if (iopt(8) /= 0) then
             call continue_orbits(sys, set_param_any, p0, y0, period, br, o, &
                                  free_idx(1:nfree), targets(1:ntg), iopt(9) /= 0, ropt(11))
         else
