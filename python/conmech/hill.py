@@ -341,7 +341,8 @@ def plot_multipliers(orbit, ax=None):
 
 
 def plot_family(fam, ax=None):
-    """Stability index S and perigee constant c along a family (matplotlib)."""
+    """Stability index S and perigee constant c along a family, the located stability
+    changes (S = +-1) marked (matplotlib)."""
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots()
@@ -349,6 +350,11 @@ def plot_family(fam, ax=None):
     ax.plot(fam.ms, fam.c, label="c")
     ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
     ax.axhline(-1.0, color="0.6", lw=0.8, ls="--")
+    for sp in getattr(fam, "special", None) or []:
+        if np.isfinite(sp.get("m", np.nan)):
+            ax.plot([sp["m"]], [sp["stability_index"]], "o", color="C3")
+            ax.annotate(f"{sp['kind']}\nm = {sp['m']:.12f}", (sp["m"], sp["stability_index"]),
+                        textcoords="offset points", xytext=(6, -24), fontsize=8)
     ax.set_xlabel("m")
     ax.legend(loc="best")
     ax.set_title("Hill's variation orbits: stability along the family")
