@@ -376,6 +376,8 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                     ("atol", atol), ("tol", tol), ("res_tol", res_tol)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be positive and finite")
+    if not rtol < 1:
+        raise ValueError("rtol must be < 1")
     lo, hi = (float(v) for v in p_range)
     sym = free is not None or targets is not None
     if sym and (free is None or targets is None):
@@ -469,8 +471,8 @@ def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):
     period = float(period)
     if not period > 0:
         raise ValueError("period must be positive")
-    if not (np.isfinite(rtol) and rtol > 0):
-        raise ValueError("rtol must be positive")
+    if not (np.isfinite(rtol) and 0 < rtol < 1):
+        raise ValueError("rtol must be in (0, 1)")
     tt = np.zeros(0) if t is None else np.ascontiguousarray(np.asarray(t, float).ravel())
     if tt.size and (not np.all(np.isfinite(tt)) or np.any(np.diff(tt) < 0) or tt[0] < 0):
         raise ValueError("t must be finite, non-negative and increasing")

@@ -283,3 +283,13 @@ def test_period_doubling_and_branch_switching():
     assert np.allclose(b2.y0[:, 2]**2 + b2.y0[:, 3]**2, b2.p - 1, atol=1e-9)
     with pytest.raises(ValueError, match="period doubling"):
         stability.switch_period_doubling(_moebius, br)
+
+
+def test_tolerances_checked():
+    orb = hill.variation_orbit(hill.M_HILL)
+    with pytest.raises((ValueError, RuntimeError), match="rtol"):
+        hill.transverse(orb, rtol=1e300)
+    with pytest.raises(ValueError, match="rtol"):
+        stability.transverse(_hh_potential, [0, 0.2, 0.25, 0], 6.2, rtol=2.0)
+    with pytest.raises(ValueError, match="rtol"):
+        stability.continuation(fold_cycle, [1, 0], 3.0, p0=0.0, rtol=5.0)

@@ -475,6 +475,11 @@ contains
         ts%kappa = orb%kappa
         opt%rtol = 1.0e-13_dp
         if (present(rtol)) opt%rtol = rtol
+        if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
+            res%info = CM_BAD_INPUT
+            res%message = "hill_transverse: rtol must be in (0, 1)"
+            return
+        end if
         opt%atol = opt%rtol
         z = [orb%y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, orb%period, z, opt, res%info, message=msg)

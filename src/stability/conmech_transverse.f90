@@ -157,10 +157,15 @@ contains
             res%message = "transverse_monodromy: need period > 0, finite y0, |q'| > 0"
             return
         end if
-        allocate (ts%base, source=sys)
         opt%method = METHOD_DOP853
         opt%rtol = 1.0e-12_dp
         if (present(rtol)) opt%rtol = rtol
+        if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
+            res%info = CM_BAD_INPUT
+            res%message = "transverse_monodromy: rtol must be in (0, 1)"
+            return
+        end if
+        allocate (ts%base, source=sys)
         opt%atol = opt%rtol
         z = [y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, period, z, opt, res%info, message=msg)
