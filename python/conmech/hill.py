@@ -24,7 +24,7 @@ import numpy as np
 from . import _conmech
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
-           "locate_stability_change",
+           "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
            "M_HILL", "C_HILL", "plot_orbit", "plot_multipliers", "plot_family"]
 
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
@@ -300,6 +300,41 @@ def transverse(orbit, t=None, rtol=1e-13):
         out["states"] = np.array(states)
         out["phi"] = np.array(phi)
     return out
+
+
+# ------------------------------------------------------------------- Henon's units
+
+def to_henon(m, state, kappa=1.0):
+    """A state [x, y, x', y'] in Hill's units (synodic period 2 pi, the equations of seed
+    000) in Henon's units (x'' - 2 y' = 3 x - x/r^3, y'' + 2 x' = -y/r^3): time t_H = m t,
+    lengths x_H = m^(2/3) kappa^(-1/3) x, velocities v_H = m^(-1/3) kappa^(-1/3) v. The
+    synodic period becomes 2 pi m."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    st = np.asarray(state, dtype=float)
+    if st.shape[-1] != 4:
+        raise ValueError("state must end with 4 components [x, y, x', y']")
+    f = kappa**(-1/3)
+    return np.concatenate([st[..., :2]*m**(2/3)*f, st[..., 2:]*m**(-1/3)*f], axis=-1)
+
+
+def from_henon(m, state, kappa=1.0):
+    """Inverse of :func:`to_henon`."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    st = np.asarray(state, dtype=float)
+    if st.shape[-1] != 4:
+        raise ValueError("state must end with 4 components [x, y, x', y']")
+    f = kappa**(1/3)
+    return np.concatenate([st[..., :2]*m**(-2/3)*f, st[..., 2:]*m**(1/3)*f], axis=-1)
+
+
+def henon_gamma(m, jacobi, kappa=1.0):
+    """Henon's Jacobi constant Gamma = 3 x^2 + 2/r - v^2 (Henon's units and sign) from
+    Hill's I = v^2 - 2 F (kappa = 1: Gamma = -I m^(-2/3))."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    return -np.asarray(jacobi, dtype=float)*m**(-2/3)*kappa**(-2/3)
 
 
 # --------------------------------------------------------------------------- plots

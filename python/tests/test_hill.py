@@ -332,3 +332,25 @@ def test_family_bitwise_independent_of_threads_and_matches_single_orbits():
         # round-off floor of S: dS/du ~ 1e3, the start is known to ~1e-15
         assert abs(fam.c[i] - one.c) <= 5e-12
         assert abs(fam.y0[i, 0] - one.y0[0]) <= 1e-14
+
+
+def test_henon_units():
+    """Henon's form x'' - 2 y' = 3 x - x/r^3, y'' + 2 x' = -y/r^3: the converted variation
+    orbit is periodic with period 2 pi m there, and Gamma = 3 x^2 + 2/r - v^2 of the
+    converted state equals -I m^(-2/3)."""
+    m = 0.3
+    fam = hill.family(np.linspace(0.1, m, 60))
+    y0 = fam.y0[-1]
+    yh = hill.to_henon(m, y0)
+    assert np.allclose(hill.from_henon(m, yh), y0, rtol=1e-15, atol=0)
+    x, y, vx, vy = yh
+    gamma = 3*x*x + 2/np.hypot(x, y) - vx*vx - vy*vy
+    assert gamma == pytest.approx(hill.henon_gamma(m, fam.jacobi[-1]), rel=1e-13)
+
+    def henon(t, s):
+        x, y, vx, vy = s
+        r3 = np.hypot(x, y)**3
+        return [vx, vy, 2*vy + 3*x - x/r3, -2*vx - y/r3]
+    sol = conmech.solve_ivp(henon, (0, 2*np.pi*m), yh, method="VERNER98", rtol=1e-13,
+                            atol=1e-13)
+    assert np.max(np.abs(sol.y[:, -1] - yh)) < 1e-9
