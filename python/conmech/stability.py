@@ -349,7 +349,7 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                  autonomous=True, fixed_period=False, conservative=False, free=None,
                  targets=None, free_time=False, period_factor=2.0, rtol=1e-11, atol=1e-11,
                  tol=1e-10, res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11,
-                 energy=None, _switch=False):
+                 energy=None, in_period=False, _switch=False):
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -359,8 +359,10 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
     ``autonomous`` systems) or symmetric shooting (``free``, ``targets``: 0-based indices of
     the free initial components and of the components of y(tau) that vanish; tau =
     period/period_factor, free if ``free_time``). ``conservative``: a second trivial
-    multiplier (energy); continue at a fixed period. ``energy(y, p)``: optional, evaluated
-    along the branch. Raises ValueError on bad input and RuntimeError when the start is not
+    multiplier (energy); continue at a fixed period, or with ``in_period`` along the family
+    of a conservative system without a parameter: the period is the continued quantity
+    (``p`` holds it; ``param``/``p0`` are not needed and a callable is ``fun(t, y)``).
+    ``energy(y, p)``: optional, evaluated along the branch. Raises ValueError on bad input and RuntimeError when the start is not
     a periodic orbit or not isolated; a branch that stops later is returned with
     success False and a message naming the parameter value.
     """
@@ -391,10 +393,14 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                      rtol, atol, locate_tol, period_factor], dtype=float)
     iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(autonomous),
                      bool(fixed_period), bool(conservative), bool(locate), sym,
-                     bool(free_time), bool(_switch)], dtype=np.int32)
+                     bool(free_time), bool(_switch), bool(in_period)], dtype=np.int32)
+    if in_period and (sym or not autonomous):
+        raise ValueError("in_period is for general shooting of autonomous systems")
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
             int(max_points))
     if isinstance(system, BuiltinSystem):
+        if param is None and in_period:
+            param = 0
         if param is None:
             raise ValueError("param (name or index of the continuation parameter) is needed")
         ip = _param_index(system, param)
@@ -408,11 +414,14 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
         if not callable(system):
             raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
                             "fun(t, y, p)")
+        if p0 is None and in_period:
+            p0 = 0.0
         if p0 is None:
             raise ValueError("p0 (the start value of the parameter) is needed for a callable")
 
         def rhs(t, y, p):
-            o = np.asarray(system(t, y, p), dtype=float).ravel()
+            o = np.asarray(system(t, y) if in_period else system(t, y, p),
+                           dtype=float).ravel()
             if o.size != n:
                 raise ValueError(f"fun(t, y, p) returned {o.size} values, expected {n}")
             return o
@@ -447,7 +456,7 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                   stability_index=s, stable=stable, tests=np.array(psi[:, k]).T.copy(),
                   residual=np.array(res[k]), iterations=np.array(iters[k], dtype=int),
                   energy=en, special=special, status=int(info), message=_msg(message),
-                  param=pname, conservative=bool(conservative))
+                  param="period" if in_period else pname, conservative=bool(conservative))
 
 
 def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):

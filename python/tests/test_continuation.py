@@ -293,3 +293,27 @@ def test_tolerances_checked():
         stability.transverse(_hh_potential, [0, 0.2, 0.25, 0], 6.2, rtol=2.0)
     with pytest.raises(ValueError, match="rtol"):
         stability.continuation(fold_cycle, [1, 0], 3.0, p0=0.0, rtol=5.0)
+
+
+def test_conservative_family_in_the_period():
+    """Henon-Heiles loop orbits continued along their family (no parameter: the period is
+    the continued quantity, the energy a function of the point): every point is a periodic
+    orbit (independent closure check with Verner 9(8)), the energy changes monotonically,
+    and the transverse linearisation gives each point's stability index."""
+    import conmech
+    o = stability.symmetric_orbit(_henon_heiles, [0, 0.2, 0.25, 0], [1, 2], [0, 3],
+                                  1.97*np.pi, period_factor=2, rtol=1e-12, atol=1e-12)
+
+    def energy(s, p):
+        return _hh_potential(s[:2])[0] + 0.5*(s[2]**2 + s[3]**2)
+    br = stability.continuation(_henon_heiles, o.y0, o.period, in_period=True,
+                                conservative=True, direction=-1, ds=0.05, max_points=6,
+                                energy=energy)
+    assert br.success and br.param == "period" and len(br) == 6
+    assert np.all(np.diff(br.p) < 0) and np.all(np.diff(br.energy) > 0)
+    for y0, T in zip(br.y0[::2], br.p[::2]):
+        s = conmech.solve_ivp(_henon_heiles, (0, T), y0, method="VERNER98", rtol=1e-13,
+                              atol=1e-13)
+        assert np.max(np.abs(s.y[:, -1] - y0)) < 1e-9
+    r = stability.transverse(_hh_potential, br.y0[-1], br.p[-1], rtol=1e-13)
+    assert r["half_trace"] == pytest.approx(br.stability_index[-1], abs=1e-8)

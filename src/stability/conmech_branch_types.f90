@@ -32,6 +32,8 @@ module conmech_branch_types
         logical :: autonomous = .true.        !! phase condition and trivial multiplier 1
         logical :: fixed_period = .false.     !! the period is not an unknown
         logical :: conservative = .false.     !! a second trivial multiplier (energy)
+        logical :: in_period = .false.        !! continue in the period T (no parameter):
+                                              !! the families of conservative systems
         logical :: locate = .true.            !! locate the special points
         real(dp) :: locate_tol = 1.0e-11_dp   !! bracket in arclength when locating
     end type cont_options

@@ -11,7 +11,11 @@
 !!   G = y(tau)(targets), the period is `period_factor` * tau.
 !! The Jacobian comes from the state transition matrix (variational equations) and, for the
 !! parameter, from a central difference of two state integrations (step `fd_step` max(1,
-!! |p|)). The parameter is set through the callback `set_param(sys, p)`.
+!! |p|)). The parameter is set through the callback `set_param(sys, p)`. With `in_period`
+!! (conservative systems, no parameter) the period itself is the continued quantity:
+!! X = [y0, T], G = [y(T) - y0; phase] (rank n), so the branch is the family of orbits
+!! through the energy levels (the energy is a function of the point; folds in T, where the
+!! period is extremal along the family, are passed by the arclength).
 !!
 !! Predictor: X + ds t (t the unit tangent, the null vector of DG, oriented by the previous
 !! one); corrector: Newton on [G(X); t . (X - X_pred)] = 0. Step length: grown by 1.5 after
@@ -182,6 +186,10 @@ contains
             return
         end if
         pb%sym = present(free)
+        if (pb%o%in_period .and. (pb%sym .or. .not. pb%o%autonomous)) then
+            msg = "continuation: in_period is for general shooting of autonomous systems"
+            return
+        end if
         if (pb%sym .neqv. present(targets)) then
             msg = "continuation: symmetric shooting needs both free and targets"
             return
@@ -209,7 +217,8 @@ contains
             pb%ntriv = 0
             if (pb%o%autonomous) pb%ntriv = 1
         else
-            pb%tfree = pb%o%autonomous .and. .not. pb%o%fixed_period
+            pb%tfree = pb%o%autonomous .and. .not. pb%o%fixed_period .and. &
+                       .not. pb%o%in_period
             pb%tfix = period
             pb%nx = pb%n + 1
             if (pb%tfree) pb%nx = pb%nx + 1
@@ -240,6 +249,7 @@ contains
             if (pb%tfree) x(pb%n + 1) = period
         end if
         x(pb%nx) = p0
+        if (pb%o%in_period) x(pb%nx) = period
     end subroutine pack_start
 
     !> (full initial state, integration time, period) of X.
@@ -259,6 +269,7 @@ contains
             y = x(1:pb%n)
             tend = pb%tfix
             if (pb%tfree) tend = x(pb%n + 1)
+            if (pb%o%in_period) tend = x(pb%nx)
             per = tend
         end if
     end subroutine unpack
@@ -272,7 +283,7 @@ contains
         real(dp) :: tend, per
         if (pb%sym .or. .not. pb%o%autonomous) return
         call unpack(pb, x, pb%yref, tend, per)
-        call set_param(sys, x(pb%nx))
+        if (.not. pb%o%in_period) call set_param(sys, x(pb%nx))
         call sys%rhs(0.0_dp, pb%yref, pb%fref)
     end subroutine set_reference
 
@@ -298,16 +309,18 @@ contains
             msg = "the period became non-positive"
             return
         end if
-        h = pb%o%fd_step*max(1.0_dp, abs(p))
-        call set_param(sys, p + h)
-        yp = y0
-        call ode_integrate(sys, 0.0_dp, tend, yp, oo, info, message=msg)
-        if (info < 0) return
-        call set_param(sys, p - h)
-        ym = y0
-        call ode_integrate(sys, 0.0_dp, tend, ym, oo, info, message=msg)
-        if (info < 0) return
-        call set_param(sys, p)
+        if (.not. pb%o%in_period) then
+            h = pb%o%fd_step*max(1.0_dp, abs(p))
+            call set_param(sys, p + h)
+            yp = y0
+            call ode_integrate(sys, 0.0_dp, tend, yp, oo, info, message=msg)
+            if (info < 0) return
+            call set_param(sys, p - h)
+            ym = y0
+            call ode_integrate(sys, 0.0_dp, tend, ym, oo, info, message=msg)
+            if (info < 0) return
+            call set_param(sys, p)
+        end if
         y = y0
         phi = 0.0_dp
         do j = 1, n
@@ -332,7 +345,11 @@ contains
                 dg(j, j) = dg(j, j) - 1.0_dp
             end do
             if (pb%tfree) dg(1:n, n + 1) = f
-            dg(1:n, pb%nx) = (yp - ym)/(2.0_dp*h)
+            if (pb%o%in_period) then
+                dg(1:n, pb%nx) = f                  ! d y(T)/dT
+            else
+                dg(1:n, pb%nx) = (yp - ym)/(2.0_dp*h)
+            end if
             if (pb%o%autonomous) then
                 g(n + 1) = dot_product(pb%fref, y0 - pb%yref)
                 dg(n + 1, 1:n) = pb%fref
@@ -455,7 +472,7 @@ contains
             return
         end if
         t = tn/norm2(tn)
-        call set_param(sys, pt%p)
+        if (.not. pb%o%in_period) call set_param(sys, pt%p)
         call sys%rhs(0.0_dp, y, f)
         if (pb%sym) then
             ! the monodromy over the full period

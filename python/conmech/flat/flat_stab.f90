@@ -441,7 +441,7 @@ subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, 
     use conmech_support_cont, only: run_continuation
     implicit none
     character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, ip, n, iopt(10), nfree, ntg, mp
+    integer(c_int), intent(in) :: np, ip, n, iopt(11), nfree, ntg, mp
     real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
@@ -474,7 +474,7 @@ subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree,
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_support_cont, only: callback_param_system, run_continuation
     implicit none
-    integer(c_int), intent(in) :: n, iopt(10), nfree, ntg, mp
+    integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
     real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info

@@ -53,14 +53,14 @@ contains
     !> Run the continuation and pack the branch. ropt = [ds, ds_min, ds_max, p_min, p_max,
     !! tol, res_tol, rtol, atol, locate_tol, period_factor]; iopt = [max_points, direction,
     !! max_iter, autonomous, fixed_period, conservative, locate, symmetric, free_time,
-    !! switch]: switch /= 0 starts the doubled-period branch at the period-doubling point
-    !! (p0, y0, period).
+    !! switch, in_period]: switch /= 0 starts the doubled-period branch at the
+    !! period-doubling point (p0, y0, period); in_period /= 0 continues in the period.
     subroutine run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, &
                                 targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, &
                                 nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, &
                                 sp_s, info, message)
         class(ode_system), intent(inout) :: sys
-        integer(c_int), intent(in) :: n, iopt(10), nfree, ntg, mp
+        integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
         real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
         integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
         integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(MAX_SPECIAL)
@@ -98,6 +98,7 @@ contains
         o%fixed_period = iopt(5) /= 0
         o%conservative = iopt(6) /= 0
         o%locate = iopt(7) /= 0
+        o%in_period = iopt(11) /= 0
         call set_param_any(sys, p0)
         if (iopt(10) /= 0) then
             sp%kind = SP_PD
