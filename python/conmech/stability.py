@@ -362,9 +362,9 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
     multiplier (energy); continue at a fixed period, or with ``in_period`` along the family
     of a conservative system without a parameter: the period is the continued quantity
     (``p`` holds it; ``param``/``p0`` are not needed and a callable is ``fun(t, y)``).
-    ``energy(y, p)``: optional, evaluated along the branch. Raises ValueError on bad input and RuntimeError when the start is not
-    a periodic orbit or not isolated; a branch that stops later is returned with
-    success False and a message naming the parameter value.
+    ``energy(y, p)``: optional, evaluated along the branch. Raises ValueError on bad input
+    and RuntimeError when the start is not a periodic orbit or not isolated; a branch that
+    stops later is returned with success False and a message naming the parameter value.
     """
     y0 = _state(y0)
     _check_dim(system, y0)
