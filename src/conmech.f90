@@ -30,6 +30,11 @@ module conmech
     use conmech_shooting
     use conmech_hill_orbit
     use conmech_ensemble
+    use conmech_hill_family
+    use conmech_continuation
+    use conmech_transverse
+    use conmech_param_system
+    use conmech_branch_switch
     implicit none
     public
 end module conmech

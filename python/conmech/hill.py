@@ -24,6 +24,7 @@ import numpy as np
 from . import _conmech
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
+           "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
            "M_HILL", "C_HILL", "plot_orbit", "plot_multipliers", "plot_family"]
 
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
@@ -74,12 +75,21 @@ class HillOrbit:
     c : float
         Perigee constant, 1 + arccos(S)/(2 pi) (nan if |S| > 1). Ill-conditioned as
         m -> 0 (S -> 1): about 1e-13 at Hill's m, 3e-9 at m = 1e-6.
+    residual : float
+        The true closure error |(x, y')(T/4)| of the orbit (estimated by integrating its
+        start with twice the steps: not the residual of the discretised problem); at most
+        ``closure_tol``.
+    quarter_state : ndarray (4,)
+        State at T/4, [0, y, x', 0]: x'(T/4) -> 0 at the cusp orbit (maximum lunation).
+    nsteps : int
+        DOP853 steps per quarter period chosen by the error control.
     iterations, nfev : int
         Newton iterations and right-hand side evaluations.
     """
 
     __slots__ = ("m", "kappa", "y0", "period", "jacobi", "monodromy", "multipliers",
-                 "stability_index", "c", "residual", "iterations", "nfev")
+                 "stability_index", "c", "residual", "quarter_state", "nsteps", "iterations",
+                 "nfev")
 
     def __init__(self, **kw):
         for k in self.__slots__:
@@ -106,7 +116,8 @@ class HillOrbit:
                 f"{self.stability_index!r}, y0={self.y0.tolist()!r})")
 
 
-def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
+def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False, closure_tol=1e-12,
+                    max_nsteps=2560):
     """The variation orbit of Hill's problem for the parameter m.
 
     Parameters
@@ -118,9 +129,12 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
     guess : (x0, v0), optional
         Newton start (default: the circular Kepler orbit of mean motion 1 + m).
     nsteps : int, optional
-        DOP853 steps per quarter period (0: the default, 20).
+        Initial DOP853 steps per quarter period (0: the default, 20); the error control
+        raises it (up to ``max_nsteps``) until the true closure error is <= closure_tol.
     full_period : bool, optional
         Compute the monodromy by direct integration over 2 pi instead of the symmetry.
+    closure_tol : float, optional
+        Bound on the true closure error |(x, y')(T/4)| (default 1e-12).
 
     Returns
     -------
@@ -142,9 +156,12 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
         use = 1
     if int(nsteps) < 0:
         raise ValueError("nsteps must be >= 0")
-    (y0, period, jacobi, mono, mr, mi, s, c, residual, iterations, nfev, info,
+    closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
+    if int(max_nsteps) < max(int(nsteps), 20):
+        raise ValueError("max_nsteps must be >= nsteps (and >= 20)")
+    (y0, period, jacobi, mono, mr, mi, s, c, residual, quarter, nsu, iterations, nfev, info,
      message) = _conmech.flat_hill_orbit(m, kappa, int(nsteps), int(bool(full_period)),
-                                         use, g)
+                                         use, g, closure_tol, int(max_nsteps))
     if info != 0:
         msg = _msg(message) or _STATUS.get(int(info), "failure")
         if info == -4:
@@ -154,18 +171,23 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
                      jacobi=float(jacobi), monodromy=np.array(mono),
                      multipliers=np.asarray(mr) + 1j*np.asarray(mi),
                      stability_index=float(s), c=float(c), residual=float(residual),
+                     quarter_state=np.array(quarter), nsteps=int(nsu),
                      iterations=int(iterations), nfev=int(nfev))
 
 
 class HillFamily:
     """The family of variation orbits over m (arrays indexed like ``ms``).
 
-    Attributes: ms, y0 (n, 4), jacobi, monodromy (n, 4, 4), stability_index, c, status
-    (0 = success), iterations, success (bool array).
+    Attributes: ms, y0 (n, 4), jacobi, monodromy (n, 4, 4), stability_index, c (nan past
+    the loss of stability, |S| > 1), residual (true closure error of each orbit),
+    quarter_state (n, 4) (x'(T/4) = quarter_state[:, 2]), nsteps, status (0 = success),
+    iterations, success (bool array), special (list of dicts: the located crossings of
+    S = +1 / -1 between consecutive converged orbits: kind, index (the orbit before it), m,
+    y0, stability_index, c, residual).
     """
 
     __slots__ = ("ms", "kappa", "y0", "jacobi", "monodromy", "stability_index", "c",
-                 "status", "iterations")
+                 "residual", "quarter_state", "nsteps", "status", "iterations", "special")
 
     def __init__(self, **kw):
         for k in self.__slots__:
@@ -179,31 +201,81 @@ class HillFamily:
         return len(self.ms)
 
     def __repr__(self):
-        return f"HillFamily(n={len(self.ms)}, failures={int(np.sum(~self.success))})"
+        return (f"HillFamily(n={len(self.ms)}, failures={int(np.sum(~self.success))}, "
+                f"special={[(p['kind'], p['m']) for p in self.special]})")
 
 
-def family(ms, kappa=1.0, nsteps=0):
+def locate_stability_change(m_a, m_b, kappa=1.0, target=1.0, guess_a=None, guess_b=None,
+                            mtol=1e-13):
+    """The m in [m_a, m_b] where the stability index S of the variation orbit equals
+    ``target`` (+1: loss of stability through +1, near m = 0.195; -1: through -1), by
+    Illinois' regula falsi on S(m) - target with warm-started orbits. Returns a dict: m,
+    y0, stability_index, c, residual (true closure error). Raises ValueError when S - target
+    has the same sign at both ends."""
+    ga = variation_orbit(m_a, kappa, guess=guess_a)
+    gb = variation_orbit(m_b, kappa, guess=guess_b)
+    return _locate(ga.m, ga.y0, gb.m, gb.y0, kappa, target, mtol)
+
+
+def _locate(ma, ya, mb, yb, kappa, target, mtol):
+    m_star, u, s, c, res, info, message = _conmech.flat_hill_locate(
+        float(ma), np.array([ya[0], ya[3]]), float(mb), np.array([yb[0], yb[3]]), kappa,
+        float(target), float(mtol))
+    if info != 0:
+        msg = _msg(message)
+        if info == -4:
+            raise ValueError(msg)
+        raise RuntimeError(msg)
+    return {"m": float(m_star), "y0": np.array([u[0], 0.0, 0.0, u[1]]),
+            "stability_index": float(s), "c": float(c), "residual": float(res)}
+
+
+def family(ms, kappa=1.0, nsteps=0, chunk_size=256, locate=True, mtol=1e-13):
     """The family of variation orbits over ``ms`` by continuation (sorted, close values work
-    best: each orbit starts from the extrapolation of its predecessors). Failed orbits have
-    status < 0 and nan entries; nothing is raised for them."""
+    best: each orbit starts from the extrapolation of its predecessors in its chunk of
+    ``chunk_size`` orbits; the chunks run on OpenMP threads and do not depend on their
+    number, so the results do not either). Every orbit meets the single-orbit tolerances
+    (Newton step 1e-14, true closure error 1e-12). Failed orbits have status < 0 and nan
+    entries; nothing is raised for them. With ``locate``, every crossing of S = +1 or -1
+    between consecutive converged orbits is located to ``mtol`` in m (``special``)."""
     ms = np.ascontiguousarray(np.asarray(ms, dtype=float).ravel())
     if ms.size == 0:
         raise ValueError("ms must not be empty")
     if not np.all(np.isfinite(ms)) or np.any(ms < 0):
         raise ValueError("ms must be finite and non-negative")
     kappa = _check_float(kappa, "kappa", positive=True)
-    y0s, jac, monos, ss, cs, infos, iters = _conmech.flat_hill_family(ms, kappa, int(nsteps))
+    if int(chunk_size) < 1:
+        raise ValueError("chunk_size must be >= 1")
+    (y0s, jac, monos, ss, cs, res, quarters, nsu, infos,
+     iters) = _conmech.flat_hill_family(ms, kappa, int(nsteps), int(chunk_size))
     ok = np.asarray(infos) == 0
     y0s = np.array(y0s).T.copy()
+    quarters = np.array(quarters).T.copy()
     monos = np.moveaxis(np.array(monos), 2, 0).copy()
     ss = np.array(ss)
     cs = np.array(cs)
     jac = np.array(jac)
-    for a in (y0s, monos, ss, cs, jac):
+    res = np.array(res)
+    for a in (y0s, monos, ss, cs, jac, res, quarters):
         a[~ok] = np.nan
+    special = []
+    if locate:
+        for target, kind in ((1.0, "S=+1"), (-1.0, "S=-1")):
+            f = ss - target
+            idx = np.nonzero(ok[:-1] & ok[1:] & (f[:-1]*f[1:] <= 0)
+                             & ~((f[:-1] == 0) & (f[1:] == 0)))[0]
+            for i in idx:
+                try:
+                    p = _locate(ms[i], y0s[i], ms[i + 1], y0s[i + 1], kappa, target, mtol)
+                except (RuntimeError, ValueError) as exc:
+                    p = {"m": np.nan, "error": str(exc)}
+                p.update(kind=kind, index=int(i))
+                special.append(p)
+        special.sort(key=lambda p: p["index"])
     return HillFamily(ms=ms, kappa=kappa, y0=y0s, jacobi=jac, monodromy=monos,
-                      stability_index=ss, c=cs, status=np.asarray(infos, dtype=int),
-                      iterations=np.asarray(iters, dtype=int))
+                      stability_index=ss, c=cs, residual=res, quarter_state=quarters,
+                      nsteps=np.asarray(nsu, dtype=int), status=np.asarray(infos, dtype=int),
+                      iterations=np.asarray(iters, dtype=int), special=special)
 
 
 def transverse(orbit, t=None, rtol=1e-13):
@@ -228,6 +300,41 @@ def transverse(orbit, t=None, rtol=1e-13):
         out["states"] = np.array(states)
         out["phi"] = np.array(phi)
     return out
+
+
+# ------------------------------------------------------------------- Henon's units
+
+def to_henon(m, state, kappa=1.0):
+    """A state [x, y, x', y'] in Hill's units (synodic period 2 pi, the equations of seed
+    000) in Henon's units (x'' - 2 y' = 3 x - x/r^3, y'' + 2 x' = -y/r^3): time t_H = m t,
+    lengths x_H = m^(2/3) kappa^(-1/3) x, velocities v_H = m^(-1/3) kappa^(-1/3) v. The
+    synodic period becomes 2 pi m."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    st = np.asarray(state, dtype=float)
+    if st.shape[-1] != 4:
+        raise ValueError("state must end with 4 components [x, y, x', y']")
+    f = kappa**(-1/3)
+    return np.concatenate([st[..., :2]*m**(2/3)*f, st[..., 2:]*m**(-1/3)*f], axis=-1)
+
+
+def from_henon(m, state, kappa=1.0):
+    """Inverse of :func:`to_henon`."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    st = np.asarray(state, dtype=float)
+    if st.shape[-1] != 4:
+        raise ValueError("state must end with 4 components [x, y, x', y']")
+    f = kappa**(1/3)
+    return np.concatenate([st[..., :2]*m**(-2/3)*f, st[..., 2:]*m**(1/3)*f], axis=-1)
+
+
+def henon_gamma(m, jacobi, kappa=1.0):
+    """Henon's Jacobi constant Gamma = 3 x^2 + 2/r - v^2 (Henon's units and sign) from
+    Hill's I = v^2 - 2 F (kappa = 1: Gamma = -I m^(-2/3))."""
+    m = _check_float(m, "m", positive=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    return -np.asarray(jacobi, dtype=float)*m**(-2/3)*kappa**(-2/3)
 
 
 # --------------------------------------------------------------------------- plots
@@ -269,7 +376,8 @@ def plot_multipliers(orbit, ax=None):
 
 
 def plot_family(fam, ax=None):
-    """Stability index S and perigee constant c along a family (matplotlib)."""
+    """Stability index S and perigee constant c along a family, the located stability
+    changes (S = +-1) marked (matplotlib)."""
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots()
@@ -277,6 +385,11 @@ def plot_family(fam, ax=None):
     ax.plot(fam.ms, fam.c, label="c")
     ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
     ax.axhline(-1.0, color="0.6", lw=0.8, ls="--")
+    for sp in getattr(fam, "special", None) or []:
+        if np.isfinite(sp.get("m", np.nan)):
+            ax.plot([sp["m"]], [sp["stability_index"]], "o", color="C3")
+            ax.annotate(f"{sp['kind']}\nm = {sp['m']:.12f}", (sp["m"], sp["stability_index"]),
+                        textcoords="offset points", xytext=(6, -24), fontsize=8)
     ax.set_xlabel("m")
     ax.legend(loc="best")
     ax.set_title("Hill's variation orbits: stability along the family")

@@ -8,14 +8,25 @@
 - :func:`periodic_orbit`, :func:`symmetric_orbit`: Newton shooting, with the monodromy
   matrix and Floquet multipliers;
 - :func:`floquet`: multipliers, exponents and the planar stability index of a monodromy;
-- :func:`hill_equation`: N'' + Phi(t) N = 0 with Phi a callable or periodic samples.
+- :func:`hill_equation`: N'' + Phi(t) N = 0 with Phi a callable or periodic samples;
+- :func:`continuation`: pseudo-arclength continuation of periodic orbits in a parameter,
+  with folds, branch points, period doublings and Neimark-Sacker points located
+  (:class:`Branch`, :class:`SpecialPoint`; :func:`plot_branch`, :func:`plot_multipliers`);
+- :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
+  of a periodic orbit of any planar natural (+ gyroscopic) system;
+- :func:`find_equilibrium`, :func:`equilibria` (from a :func:`grid` of guesses,
+  deduplicated), :func:`lagrange_dirichlet_potential` (Hessian exact or by differences).
 """
 import numpy as np
 
 from . import _conmech
 from .systems import BuiltinSystem
 
-__all__ = ["Equilibrium", "PeriodicOrbit", "equilibrium", "lagrange_dirichlet", "stm",
+__all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
+           "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
+           "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
+           "switch_period_doubling",
+           "equilibrium", "lagrange_dirichlet", "stm",
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate"}
@@ -267,3 +278,395 @@ def hill_equation(phi, period, rtol=1e-12):
     return HillEquationResult(monodromy=mono, half_trace=float(ht), det=float(det),
                               multipliers=np.linalg.eigvals(mono),
                               stable=bool(abs(ht) < 1.0))
+
+
+# ------------------------------------------------------------------ continuation (issue 9)
+
+_SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
+
+
+class SpecialPoint:
+    """A located special point of a branch: kind ('fold', 'branch point', 'period
+    doubling', 'Neimark-Sacker'), index (between branch points index and index + 1), p,
+    period, y0, multipliers, stability_index."""
+
+    __slots__ = ("kind", "index", "p", "period", "y0", "multipliers", "stability_index")
+
+    def __init__(self, **kw):
+        for k in self.__slots__:
+            setattr(self, k, kw.get(k))
+
+    def __repr__(self):
+        return f"SpecialPoint({self.kind!r}, p={self.p!r}, index={self.index})"
+
+
+class Branch:
+    """A branch of periodic orbits from :func:`continuation`.
+
+    Arrays over the points: p (parameter), period, y0 (N, n), multipliers (N, n) complex,
+    stability_index (S = (trace M - 2)/2 for a conservative planar orbit, else the largest
+    |mu| of the non-trivial multipliers), stable (bool), tests (N, 4: fold = parameter
+    component of the tangent, branch point, period doubling, Neimark-Sacker), residual,
+    iterations, energy (if an energy function was given); special (list of SpecialPoint);
+    success, status, message (a branch that stopped early keeps its points: success False
+    and the message names the parameter value)."""
+
+    __slots__ = ("p", "period", "y0", "multipliers", "stability_index", "stable", "tests",
+                 "residual", "iterations", "energy", "special", "status", "message",
+                 "param", "conservative")
+
+    def __init__(self, **kw):
+        for k in self.__slots__:
+            setattr(self, k, kw.get(k))
+
+    @property
+    def success(self):
+        return self.status == 0
+
+    def __len__(self):
+        return len(self.p)
+
+    def __repr__(self):
+        return (f"Branch(points={len(self.p)}, p=[{self.p[0]:.6g} .. {self.p[-1]:.6g}], "
+                f"special={[(s.kind, round(s.p, 12)) for s in self.special]}, "
+                f"message={self.message!r})")
+
+
+def _param_index(system, param):
+    names = system.param_names or tuple(f"p{i}" for i in range(system.params.size))
+    if isinstance(param, str):
+        if param not in names:
+            raise ValueError(f"param {param!r} is not a parameter of '{system.name}' "
+                             f"(parameters: {', '.join(names)})")
+        return names.index(param)
+    if isinstance(param, (int, np.integer)) and 0 <= int(param) < system.params.size:
+        return int(param)
+    raise ValueError(f"param must be a parameter name or index of '{system.name}'")
+
+
+def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.01,
+                 ds_min=1e-8, ds_max=0.1, p_range=(-np.inf, np.inf), max_points=200,
+                 autonomous=True, fixed_period=False, conservative=False, free=None,
+                 targets=None, free_time=False, period_factor=2.0, rtol=1e-11, atol=1e-11,
+                 tol=1e-10, res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11,
+                 energy=None, in_period=False, _switch=False):
+    """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
+    ``period``) in a parameter, with its special points located (see conmech_continuation).
+
+    ``system``: a built-in system (``param`` = the parameter's name or index; it starts
+    from the system's value, or ``p0``) or a callable ``fun(t, y, p)`` (``p0`` required).
+    General shooting (unknowns y0, period (unless ``fixed_period``), p; phase condition for
+    ``autonomous`` systems) or symmetric shooting (``free``, ``targets``: 0-based indices of
+    the free initial components and of the components of y(tau) that vanish; tau =
+    period/period_factor, free if ``free_time``). ``conservative``: a second trivial
+    multiplier (energy); continue at a fixed period, or with ``in_period`` along the family
+    of a conservative system without a parameter: the period is the continued quantity
+    (``p`` holds it; ``param``/``p0`` are not needed and a callable is ``fun(t, y)``).
+    ``energy(y, p)``: optional, evaluated along the branch. Raises ValueError on bad input
+    and RuntimeError when the start is not a periodic orbit or not isolated; a branch that
+    stops later is returned with success False and a message naming the parameter value.
+    """
+    y0 = _state(y0)
+    _check_dim(system, y0)
+    n = y0.size
+    period = float(period)
+    if not period > 0:
+        raise ValueError("period must be positive")
+    if int(max_points) < 1:
+        raise ValueError("max_points must be >= 1")
+    for name, v in (("ds", ds), ("ds_min", ds_min), ("ds_max", ds_max), ("rtol", rtol),
+                    ("atol", atol), ("tol", tol), ("res_tol", res_tol)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be positive and finite")
+    if not rtol < 1:
+        raise ValueError("rtol must be < 1")
+    lo, hi = (float(v) for v in p_range)
+    sym = free is not None or targets is not None
+    if sym and (free is None or targets is None):
+        raise ValueError("symmetric shooting needs both free and targets")
+    fr = np.ascontiguousarray(np.asarray(free if sym else [0], dtype=np.int32).ravel() + 1)
+    tg = np.ascontiguousarray(np.asarray(targets if sym else [0], dtype=np.int32).ravel() + 1)
+    if sym and (fr.size == 0 or tg.size == 0 or fr.min() < 1 or fr.max() > n
+                or tg.min() < 1 or tg.max() > n):
+        raise ValueError("free and targets must be non-empty state indices in range(len(y0))")
+    ropt = np.array([ds, ds_min, ds_max, max(lo, -1e300), min(hi, 1e300), tol, res_tol,
+                     rtol, atol, locate_tol, period_factor], dtype=float)
+    iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(autonomous),
+                     bool(fixed_period), bool(conservative), bool(locate), sym,
+                     bool(free_time), bool(_switch), bool(in_period)], dtype=np.int32)
+    if in_period and (sym or not autonomous):
+        raise ValueError("in_period is for general shooting of autonomous systems")
+    args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
+            int(max_points))
+    if isinstance(system, BuiltinSystem):
+        if param is None and in_period:
+            param = 0
+        if param is None:
+            raise ValueError("param (name or index of the continuation parameter) is needed")
+        ip = _param_index(system, param)
+        params = np.array(system.params, dtype=float)
+        if p0 is not None:
+            params[ip] = float(p0)
+        out = _conmech.flat_continuation_builtin(system.name, params.size, params, ip + 1,
+                                                 y0, period, *args)
+        pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
+    else:
+        if not callable(system):
+            raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+                            "fun(t, y, p)")
+        if p0 is None and in_period:
+            p0 = 0.0
+        if p0 is None:
+            raise ValueError("p0 (the start value of the parameter) is needed for a callable")
+
+        def rhs(t, y, p):
+            o = np.asarray(system(t, y) if in_period else system(t, y, p),
+                           dtype=float).ravel()
+            if o.size != n:
+                raise ValueError(f"fun(t, y, p) returned {o.size} values, expected {n}")
+            return o
+        out = _conmech.flat_continuation_callback(rhs, y0, period, float(p0), *args)
+        pname = param if isinstance(param, str) else "p"
+    (npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sk, si, sp_p, sp_per, sp_y,
+     sp_mr, sp_mi, sp_s, info, message) = out
+    npts = int(npts)
+    if npts == 0:
+        _raise(info, message)
+    k = slice(0, npts)
+    mult = (np.asarray(mr)[:, k] + 1j*np.asarray(mi)[:, k]).T.copy()
+    s = np.array(s[k])
+    if conservative and n == 4:
+        stable = np.abs(s) < 1
+    else:
+        stable = s < 1
+    special = []
+    for j in range(int(nsp)):
+        special.append(SpecialPoint(kind=_SPECIAL.get(int(sk[j]), "unknown"),
+                                    index=int(si[j]) - 1, p=float(sp_p[j]),
+                                    period=float(sp_per[j]), y0=np.array(sp_y[:, j]),
+                                    multipliers=np.asarray(sp_mr[:, j])
+                                    + 1j*np.asarray(sp_mi[:, j]),
+                                    stability_index=float(sp_s[j])))
+    ys = np.array(ys[:, k]).T.copy()
+    pp = np.array(pp[k])
+    en = None
+    if energy is not None:
+        en = np.array([float(energy(y, p)) for y, p in zip(ys, pp)])
+    return Branch(p=pp, period=np.array(per[k]), y0=ys, multipliers=mult,
+                  stability_index=s, stable=stable, tests=np.array(psi[:, k]).T.copy(),
+                  residual=np.array(res[k]), iterations=np.array(iters[k], dtype=int),
+                  energy=en, special=special, status=int(info), message=_msg(message),
+                  param="period" if in_period else pname, conservative=bool(conservative))
+
+
+def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):
+    """Transverse linearisation (seed 000) of a periodic orbit of the planar natural system
+    q'' = -grad V(q) + 2 omega J q' (J q' = (-q2', q1'); omega: a rotating frame, e.g.
+    Hill's problem is V = -F, omega = -m): the normal deviation obeys Hill's equation
+    N'' + Phi(t) N = 0, Phi = n^T V'' n + 3 (phi' - omega)^2 + omega^2 (phi' the turning
+    rate of the velocity). ``potential(q)`` returns (V, grad V (2,), Hessian (2, 2)).
+    ``t`` (increasing times in [0, period]) samples Phi along the orbit; ``rtol`` is the
+    integrators' tolerance (rtol = atol) everywhere.
+
+    Returns a dict: monodromy (2, 2), half_trace, det, multipliers (2,), the 4 x 4
+    ``monodromy4`` of the orbit (same tolerance), its stability index
+    ``stability_index4`` = (trace - 2)/2 (equal to half_trace: the 2 x 2 multipliers are
+    the non-trivial ones), closure (max |y(T) - y0|), and ``phi`` at t."""
+    if not callable(potential):
+        raise TypeError("potential must be a callable q -> (V, grad, hessian)")
+    y0 = _state(y0)
+    if y0.size != 4:
+        raise ValueError("y0 must be [q1, q2, q1', q2'] (4 values)")
+    period = float(period)
+    if not period > 0:
+        raise ValueError("period must be positive")
+    if not (np.isfinite(rtol) and 0 < rtol < 1):
+        raise ValueError("rtol must be in (0, 1)")
+    tt = np.zeros(0) if t is None else np.ascontiguousarray(np.asarray(t, float).ravel())
+    if tt.size and (not np.all(np.isfinite(tt)) or np.any(np.diff(tt) < 0) or tt[0] < 0):
+        raise ValueError("t must be finite, non-negative and increasing")
+
+    def pot(q):
+        v, g, h = potential(np.array(q))
+        g = np.asarray(g, dtype=float).ravel()
+        h = np.asarray(h, dtype=float)
+        if g.size != 2 or h.shape != (2, 2):
+            raise ValueError("potential(q) must return (V, grad (2,), hessian (2, 2))")
+        return float(v), g, h
+    ttx = tt if tt.size else np.zeros(1)
+    phi, m2, ht, det, closure, m4, info, message = _conmech.flat_transverse_callback(
+        pot, float(omega), y0, period, float(rtol), ttx)
+    if info != 0:
+        _raise(info, message)
+    m2 = np.array(m2)
+    m4 = np.array(m4)
+    out = {"monodromy": m2, "half_trace": float(ht), "det": float(det),
+           "multipliers": np.linalg.eigvals(m2), "monodromy4": m4,
+           "stability_index4": 0.5*(np.trace(m4) - 2.0), "closure": float(closure)}
+    if tt.size:
+        out["phi"] = np.array(phi)
+    return out
+
+
+# ------------------------------------------------------------------ equilibria (issue 9)
+
+def find_equilibrium(system, guess, t=0.0, tol=1e-12, max_iter=50, classify_tol=1e-8):
+    """Newton's method for f(t, y) = 0 from ``guess`` (analytic Jacobian of built-in
+    systems, central differences for callables), then :func:`equilibrium` at the root:
+    returns the classified :class:`Equilibrium`. Raises RuntimeError when Newton fails
+    (singular Jacobian or no convergence) or the residual at the root exceeds sqrt(tol)."""
+    y = _state(guess, "guess")
+    _check_dim(system, y)
+    if not (np.isfinite(tol) and tol > 0) or int(max_iter) < 1:
+        raise ValueError("tol must be positive and max_iter >= 1")
+    if isinstance(system, BuiltinSystem):
+        yout, info, message = _conmech.flat_find_equilibrium_builtin(
+            system.name, system.params.size, _params(system), y, float(t), float(tol),
+            int(max_iter))
+    else:
+        yout, info, message = _conmech.flat_find_equilibrium_callback(
+            _callback(system, y.size), y, float(t), float(tol), int(max_iter))
+    if info != 0:
+        _raise(info, message)
+    e = equilibrium(system, np.array(yout), t=t, tol=classify_tol)
+    if not e.residual <= max(np.sqrt(tol), 1e-8)*max(1.0, np.max(np.abs(e.y))):
+        raise RuntimeError(f"find_equilibrium: residual {e.residual:.3g} at the root")
+    return e
+
+
+def equilibria(system, guesses, t=0.0, tol=1e-12, dedup_tol=1e-8, classify_tol=1e-8):
+    """All equilibria reached by Newton from an array of guesses (shape (k, n)), e.g. a
+    grid; duplicates (max-norm distance <= dedup_tol max(1, |y|)) removed. Guesses whose
+    Newton fails are skipped. Returns a list of :class:`Equilibrium`, sorted by y."""
+    g = np.asarray(guesses, dtype=float)
+    if g.ndim != 2 or g.shape[0] == 0:
+        raise ValueError("guesses must be a non-empty (k, n) array")
+    found = []
+    for y in g:
+        try:
+            e = find_equilibrium(system, y, t=t, tol=tol, classify_tol=classify_tol)
+        except RuntimeError:
+            continue
+        if not any(np.max(np.abs(e.y - f.y)) <= dedup_tol*max(1.0, np.max(np.abs(f.y)))
+                   for f in found):
+            found.append(e)
+    found.sort(key=lambda e: tuple(e.y))
+    return found
+
+
+def grid(bounds, num):
+    """Guesses on a regular grid: ``bounds`` = [(lo, hi), ...] per component, ``num``
+    points per component (an int or a list). Returns a (k, n) array for
+    :func:`equilibria`."""
+    bounds = [tuple(map(float, b)) for b in bounds]
+    num = [int(num)]*len(bounds) if np.isscalar(num) else [int(k) for k in num]
+    if len(num) != len(bounds) or min(num) < 1:
+        raise ValueError("num must be a positive int or one per bound")
+    axes = [np.linspace(lo, hi, k) for (lo, hi), k in zip(bounds, num)]
+    return np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=1)
+
+
+def potential_hessian(potential, q, h=None):
+    """Central-difference Hessian of a potential V(q) (step eps^(1/4) max(|q_i|, 1), error
+    O(h^2) ~ 1e-8 relative)."""
+    q = _state(q, "q")
+    n = q.size
+    hs = np.full(n, np.finfo(float).eps**0.25)*np.maximum(np.abs(q), 1.0) if h is None \
+        else np.full(n, float(h))
+    H = np.empty((n, n))
+    v0 = float(potential(q))
+    for i in range(n):
+        e_i = np.zeros(n)
+        e_i[i] = hs[i]
+        H[i, i] = (float(potential(q + e_i)) - 2*v0 + float(potential(q - e_i)))/hs[i]**2
+        for j in range(i + 1, n):
+            e_j = np.zeros(n)
+            e_j[j] = hs[j]
+            H[i, j] = H[j, i] = (float(potential(q + e_i + e_j))
+                                 - float(potential(q + e_i - e_j))
+                                 - float(potential(q - e_i + e_j))
+                                 + float(potential(q - e_i - e_j)))/(4*hs[i]*hs[j])
+    return H
+
+
+def lagrange_dirichlet_potential(potential, q, hessian=None, tol=1e-6):
+    """Lagrange-Dirichlet test at q from the potential: a strict minimum (positive-definite
+    Hessian) is a stable equilibrium of a conservative system. ``hessian(q)`` if given
+    (exact, e.g. symbolic), else :func:`potential_hessian`. Returns (stable, eigenvalues,
+    hessian); ``tol`` is relative to the largest |eigenvalue| (finite differences carry
+    ~1e-8)."""
+    q = _state(q, "q")
+    H = np.asarray(hessian(q), dtype=float) if hessian is not None else \
+        potential_hessian(potential, q)
+    H = 0.5*(H + H.T)
+    stable, w = lagrange_dirichlet(H, tol=tol)
+    return stable, w, H
+
+
+def switch_period_doubling(system, point, param=None, **options):
+    """Branch switching at a located period doubling: the branch of orbits of twice the
+    period that bifurcates at ``point`` (a :class:`SpecialPoint` of kind 'period doubling'
+    from :func:`continuation` on the same ``system``/``param``). The first step follows the
+    eigenvector of the multiplier -1 (``direction`` picks its sign); the other options as
+    for :func:`continuation` (general shooting of an autonomous system)."""
+    if not isinstance(point, SpecialPoint) or point.kind != "period doubling":
+        raise ValueError("point must be a 'period doubling' SpecialPoint of a Branch")
+    for bad in ("free", "targets", "p0", "_switch"):
+        if bad in options:
+            raise ValueError(f"{bad} is not an option of switch_period_doubling")
+    return continuation(system, point.y0, point.period, param=param, p0=point.p,
+                        _switch=True, **options)
+
+
+# --------------------------------------------------------------------------- plots
+
+def plot_branch(branch, ax=None, y="stability_index", label_special=True):
+    """Bifurcation diagram: the parameter against ``y`` ('stability_index', 'period',
+    'energy' or a callable branch -> array), stable parts solid, unstable dashed, special
+    points marked and labelled (matplotlib)."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots()
+    if callable(y):
+        vals, name = np.asarray(y(branch), dtype=float), getattr(y, "__name__", "y")
+    else:
+        vals, name = np.asarray(getattr(branch, y), dtype=float), y
+    p = branch.p
+    st = np.asarray(branch.stable)
+    for mask, style, lab in ((st, "-", "stable"), (~st, "--", "unstable")):
+        v = np.where(mask, vals, np.nan)
+        ax.plot(p, v, style, color="C0", label=lab)
+    marks = {"fold": "s", "branch point": "o", "period doubling": "D",
+             "Neimark-Sacker": "^"}
+    for s in branch.special:
+        i = s.index
+        w = 0.0 if p[i + 1] == p[i] else (s.p - p[i])/(p[i + 1] - p[i])
+        yv = vals[i] + w*(vals[i + 1] - vals[i]) if name != "period" else s.period
+        ax.plot([s.p], [yv], marks.get(s.kind, "x"), color="C3", ms=8)
+        if label_special:
+            ax.annotate(f"{s.kind}\n{branch.param} = {s.p:.10g}", (s.p, yv),
+                        textcoords="offset points", xytext=(6, 6), fontsize=8)
+    ax.set_xlabel(branch.param)
+    ax.set_ylabel(name)
+    ax.legend(loc="best")
+    ax.set_title("branch of periodic orbits")
+    return ax
+
+
+def plot_multipliers(branch, ax=None):
+    """The Floquet multipliers of every point of a branch in the complex plane, coloured by
+    the parameter, with the unit circle (matplotlib)."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots()
+    th = np.linspace(0.0, 2.0*np.pi, 400)
+    ax.plot(np.cos(th), np.sin(th), color="0.6", lw=1)
+    mu = branch.multipliers
+    pp = np.repeat(branch.p[:, None], mu.shape[1], axis=1)
+    sc = ax.scatter(mu.real.ravel(), mu.imag.ravel(), c=pp.ravel(), s=8, cmap="viridis")
+    plt.colorbar(sc, ax=ax, label=branch.param)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re mu")
+    ax.set_ylabel("Im mu")
+    ax.set_title("multipliers along the branch")
+    return ax

@@ -31,8 +31,7 @@
 !! N'' + Phi(t) N = 0 with Phi = 3 (omega + m)^2 + m^2 - n^T H n. Its 2 x 2 monodromy over
 !! 2 pi has the non-trivial multipliers of the 4 x 4 monodromy.
 !!
-!! Thread safety: no saved state; `hill_family` runs chunks of the family in parallel with
-!! OpenMP when compiled with -fopenmp.
+!! Thread safety: no saved state (the family over m, in parallel: conmech_hill_family).
 module conmech_hill_orbit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp, pi
@@ -42,19 +41,20 @@ module conmech_hill_orbit
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate, ode_solve, ode_result
     use conmech_hill, only: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f
-    !$ use omp_lib, only: omp_get_max_threads
     implicit none
     private
 
-    public :: hill_orbit, hill_orbit_options, hill_variation_orbit, hill_family
+    public :: hill_orbit, hill_orbit_options, hill_variation_orbit
     public :: hill_orbit_guess, hill_perigee_c, hill_phi, hill_transverse, hill_transverse_result
     public :: hill_orbit_sample
 
     !> Options of the variation-orbit solver.
     type :: hill_orbit_options
-        integer :: nsteps = 20           !! DOP853 steps per quarter period
-        integer :: max_iter = 30         !! Newton iterations
-        real(dp) :: tol = 1.0e-13_dp     !! accept when |du| <= tol max(1, |u|)
+        integer :: nsteps = 20           !! initial DOP853 steps per quarter period
+        integer :: max_nsteps = 2560     !! upper bound of the error-controlled step count
+        integer :: max_iter = 30         !! Newton iterations (per step count)
+        real(dp) :: tol = 1.0e-14_dp     !! accept when |du| <= tol max(1, |u|)
+        real(dp) :: closure_tol = 1.0e-12_dp  !! bound on the true closure error |(x, y')(T/4)|
         logical :: full_period = .false. !! monodromy by direct integration over 2 pi
         logical :: eigenvalues = .true.  !! compute the multipliers with dgeev
     end type hill_orbit_options
@@ -72,9 +72,12 @@ module conmech_hill_orbit
         real(dp) :: mr(4) = 0.0_dp, mi(4) = 0.0_dp  !! multipliers (dgeev)
         real(dp) :: stability_index = 0.0_dp  !! S = (trace M - 2)/2, stable iff |S| < 1
         real(dp) :: c = 0.0_dp                !! perigee constant
-        real(dp) :: residual = 0.0_dp         !! |(x, y')(pi/2)| at the solution
-        integer :: iterations = 0             !! Newton iterations
-        integer :: nfev = 0                   !! right-hand side evaluations (20-dim)
+        real(dp) :: residual = 0.0_dp         !! true closure |(x, y')(pi/2)| (estimated)
+        real(dp) :: newton_residual = 0.0_dp  !! closure of the discretised problem
+        real(dp) :: quarter_state(4) = 0.0_dp !! state at T/4: [0, y, x'(T/4), 0]
+        integer :: nsteps = 0                 !! steps per quarter period used
+        integer :: iterations = 0             !! Newton iterations (all step counts)
+        integer :: nfev = 0                   !! right-hand side evaluations (20- and 4-dim)
     end type hill_orbit
 
     !> Transverse linearisation along a variation orbit.
@@ -171,6 +174,35 @@ contains
         nfev = nfev + 12*nsteps
     end subroutine integrate_var
 
+    !> Fixed-step DOP853 for the state alone (the closure check).
+    pure subroutine integrate_state(tab, m, kappa, t1, nsteps, s, nfev)
+        type(rk_tableau), intent(in) :: tab
+        real(dp), intent(in) :: m, kappa, t1
+        integer, intent(in) :: nsteps
+        real(dp), intent(inout) :: s(4)
+        integer, intent(inout) :: nfev
+        real(dp) :: k(4, 12), st(4), h, fx, fy
+        integer :: istep, i, j
+        h = t1/nsteps
+        do istep = 1, nsteps
+            do i = 1, 12
+                st = s
+                do j = 1, i - 1
+                    if (tab%a(i, j) /= 0.0_dp) st = st + (h*tab%a(i, j))*k(:, j)
+                end do
+                call hill_grad_f(m, kappa, st(1), st(2), fx, fy)
+                k(1, i) = st(3)
+                k(2, i) = st(4)
+                k(3, i) = 2.0_dp*m*st(4) + fx
+                k(4, i) = -2.0_dp*m*st(3) + fy
+            end do
+            do j = 1, 12
+                if (tab%b(j) /= 0.0_dp) s = s + (h*tab%b(j))*k(:, j)
+            end do
+        end do
+        nfev = nfev + 12*nsteps
+    end subroutine integrate_state
+
     pure subroutine start_state(u, z)
         real(dp), intent(in) :: u(2)
         real(dp), intent(out) :: z(20)
@@ -185,8 +217,22 @@ contains
 
     !> The variation orbit for (m, kappa) with its monodromy, multipliers and c.
     !! `guess` = (x0, v0) to start Newton from (default: `hill_orbit_guess`).
+    !!
+    !! Error control: Newton runs on the fixed-step problem with n = `nsteps` steps per
+    !! quarter period; the true closure error of its solution is then estimated by
+    !! integrating the state alone from the converged start with nc = 1.5 n steps: that
+    !! closure is (1 - 1/r) times the n-step solution's true closure error, r = (nc/n)^8 =
+    !! 25.6 (8th order), and is scaled back by r/(r - 1). While the estimate exceeds
+    !! `closure_tol`, n grows (by the 8th-order error model, at least doubled, at most
+    !! `max_nsteps`) and Newton restarts from the last solution. `residual` is this true
+    !! closure estimate; `newton_residual` the closure of the discretised problem.
+    !! Newton accepts when its step |du| <= tol max(1, |u|) (1e-14); the monodromy is the
+    !! STM at that last iterate, within |du| of the solution. S is sensitive to the start
+    !! (dS/du ~ 1e3 at small m) and the start is known only to ~1e-15 (round-off in the
+    !! closure): S and c carry a round-off floor of ~1e-12, whatever the Newton start.
     !! info: CM_SUCCESS; CM_BAD_INPUT (m < 0, kappa <= 0, bad options); CM_SINGULAR
-    !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged).
+    !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged, another
+    !! orbit was found, or the closure tolerance cannot be met with `max_nsteps`).
     subroutine hill_variation_orbit(m, kappa, orb, options, guess)
         real(dp), intent(in) :: m, kappa
         type(hill_orbit), intent(out) :: orb
@@ -194,16 +240,19 @@ contains
         real(dp), intent(in), optional :: guess(2)
         type(hill_orbit_options) :: opt
         type(rk_tableau) :: tab
-        real(dp) :: u(2), du(2), g(2), z(20), a(4, 4), det, scale
-        integer :: it
-        logical :: final
+        real(dp) :: u(2), u0(2), a(4, 4), zq(4), s(4), err, r8
+        integer :: n, nretry, nc
+        character(len=40) :: buf
         if (present(options)) opt = options
         orb%m = m
         orb%kappa = kappa
         if (.not. (m >= 0.0_dp .and. kappa > 0.0_dp .and. ieee_is_finite(m) .and. &
-                   ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1) then
+                   ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1 .or. &
+            opt%max_nsteps < opt%nsteps .or. .not. (opt%closure_tol > 0.0_dp) .or. &
+            .not. (opt%tol > 0.0_dp)) then
             orb%info = CM_BAD_INPUT
-            orb%message = "hill_variation_orbit: need m >= 0, kappa > 0, nsteps >= 1"
+            orb%message = "hill_variation_orbit: need m >= 0, kappa > 0, 1 <= nsteps <= "// &
+                          "max_nsteps, tol > 0, closure_tol > 0"
             return
         end if
         if (present(guess)) then
@@ -217,48 +266,43 @@ contains
             return
         end if
         tab = dop853_tableau()
-        final = .false.
-        orb%info = CM_NO_CONVERGENCE
-        orb%message = "hill_variation_orbit: Newton did not converge"
-        do it = 1, opt%max_iter
-            orb%iterations = it
-            call start_state(u, z)
-            call integrate_var(tab, m, kappa, 0.5_dp*pi, opt%nsteps, z, orb%nfev)
-            if (.not. all(ieee_is_finite(z))) then
+        u0 = u
+        n = opt%nsteps
+        nretry = 0
+        do
+            call hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
+            if (orb%info /= CM_SUCCESS) then
+                ! a coarse discretisation can defeat Newton: retry from the guess with
+                ! more steps (twice at most)
+                if (nretry >= 2 .or. 4*n > opt%max_nsteps .or. &
+                    orb%info == CM_BAD_INPUT) return
+                nretry = nretry + 1
+                n = 4*n
+                u = u0
+                cycle
+            end if
+            ! the closure of the same start with nc = 1.5 n steps is (1 - 1/r) times the true
+            ! closure error of the n-step solution, r = (nc/n)^8 (8th order)
+            nc = n + (n + 1)/2
+            s = [u(1), 0.0_dp, 0.0_dp, u(2)]
+            call integrate_state(tab, m, kappa, 0.5_dp*pi, nc, s, orb%nfev)
+            r8 = (real(nc, dp)/real(n, dp))**8
+            err = sqrt(s(1)**2 + s(4)**2)*r8/(r8 - 1.0_dp)
+            if (.not. ieee_is_finite(err)) err = huge(1.0_dp)
+            orb%residual = err
+            orb%nsteps = n
+            if (err <= opt%closure_tol) exit
+            if (n >= opt%max_nsteps) then
+                write (buf, '(es9.2, a, i0)') err, " with nsteps = ", n
                 orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
+                orb%message = "hill_variation_orbit: the true closure error "// &
+                              trim(buf)//" exceeds closure_tol (raise max_nsteps)"
                 return
             end if
-            a = reshape(z(5:20), [4, 4])
-            g = [z(1), z(4)]
-            det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
-            scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
-            if (abs(det) <= 1.0e-13_dp*scale) then
-                orb%info = CM_SINGULAR
-                orb%message = "hill_variation_orbit: singular Newton matrix"
-                return
-            end if
-            du(1) = -(a(4, 4)*g(1) - a(1, 4)*g(2))/det
-            du(2) = -(-a(4, 1)*g(1) + a(1, 1)*g(2))/det
-            orb%residual = sqrt(g(1)**2 + g(2)**2)
-            scale = max(1.0_dp, maxval(abs(u)))
-            if (maxval(abs(du)) <= opt%tol*scale .or. &
-                (final .and. maxval(abs(du)) <= 1.0e-10_dp*scale)) then
-                u = u + du
-                orb%info = CM_SUCCESS
-                orb%message = "success"
-                exit
-            end if
-            u = u + du
-            final = maxval(abs(du)) <= 1.0e-7_dp*scale
-            if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
-                orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: Newton diverged"
-                return
-            end if
+            n = min(opt%max_nsteps, max(2*n, &
+                    ceiling(1.2_dp*n*(err/opt%closure_tol)**0.125_dp)))
         end do
-        if (orb%info /= CM_SUCCESS) return
-        if (.not. (u(2) > 0.0_dp .and. z(2) > 0.0_dp)) then
+        if (.not. (u(2) > 0.0_dp .and. zq(2) > 0.0_dp)) then
             ! Newton found another symmetric periodic solution (e.g. a retrograde one)
             orb%info = CM_NO_CONVERGENCE
             orb%message = "hill_variation_orbit: converged to another periodic orbit, "// &
@@ -266,12 +310,16 @@ contains
             return
         end if
         orb%y0 = [u(1), 0.0_dp, 0.0_dp, u(2)]
+        orb%quarter_state = zq
         orb%jacobi = hill_jacobi(m, kappa, orb%y0)
         orb%quarter_stm = a
         if (opt%full_period) then
-            call start_state(u, z)
-            call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*opt%nsteps, z, orb%nfev)
-            orb%monodromy = reshape(z(5:20), [4, 4])
+            block
+                real(dp) :: z(20)
+                call start_state(u, z)
+                call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*n, z, orb%nfev)
+                orb%monodromy = reshape(z(5:20), [4, 4])
+            end block
         else
             call monodromy_from_quarter(a, orb%monodromy, orb%info)
             if (orb%info /= CM_SUCCESS) then
@@ -282,6 +330,11 @@ contains
         orb%stability_index = 0.5_dp*(orb%monodromy(1, 1) + orb%monodromy(2, 2) + &
                                       orb%monodromy(3, 3) + orb%monodromy(4, 4) - 2.0_dp)
         orb%c = hill_perigee_c(orb%stability_index)
+        if (.not. ieee_is_finite(orb%stability_index)) then
+            orb%info = CM_NONFINITE
+            orb%message = "hill_variation_orbit: non-finite monodromy"
+            return
+        end if
         if (opt%eigenvalues) then
             call la_eig(orb%monodromy, orb%mr, orb%mi, orb%info)
             if (orb%info /= CM_SUCCESS) then
@@ -290,6 +343,60 @@ contains
             end if
         end if
     end subroutine hill_variation_orbit
+
+    !> Newton's method on the fixed-step problem with n steps per quarter period.
+    !! On success u is the solution, a the STM and zq the state at pi/2 of the last iterate.
+    subroutine hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
+        type(rk_tableau), intent(in) :: tab
+        real(dp), intent(in) :: m, kappa
+        integer, intent(in) :: n
+        type(hill_orbit_options), intent(in) :: opt
+        real(dp), intent(inout) :: u(2)
+        real(dp), intent(out) :: a(4, 4), zq(4)
+        type(hill_orbit), intent(inout) :: orb
+        real(dp) :: du(2), g(2), z(20), det, scale
+        integer :: it
+        orb%info = CM_NO_CONVERGENCE
+        orb%message = "hill_variation_orbit: Newton did not converge"
+        a = 0.0_dp
+        zq = 0.0_dp
+        do it = 1, opt%max_iter
+            orb%iterations = orb%iterations + 1
+            call start_state(u, z)
+            call integrate_var(tab, m, kappa, 0.5_dp*pi, n, z, orb%nfev)
+            if (.not. all(ieee_is_finite(z))) then
+                orb%info = CM_NO_CONVERGENCE
+                orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
+                return
+            end if
+            a = reshape(z(5:20), [4, 4])
+            zq = z(1:4)
+            g = [z(1), z(4)]
+            det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
+            scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
+            if (abs(det) <= 1.0e-13_dp*scale) then
+                orb%info = CM_SINGULAR
+                orb%message = "hill_variation_orbit: singular Newton matrix"
+                return
+            end if
+            du(1) = -(a(4, 4)*g(1) - a(1, 4)*g(2))/det
+            du(2) = -(-a(4, 1)*g(1) + a(1, 1)*g(2))/det
+            orb%newton_residual = sqrt(g(1)**2 + g(2)**2)
+            scale = max(1.0_dp, maxval(abs(u)))
+            u = u + du
+            if (maxval(abs(du)) <= opt%tol*scale) then
+                ! the STM is that of the last iterate, within |du| <= tol of the solution
+                orb%info = CM_SUCCESS
+                orb%message = "success"
+                return
+            end if
+            if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
+                orb%info = CM_NO_CONVERGENCE
+                orb%message = "hill_variation_orbit: Newton diverged"
+                return
+            end if
+        end do
+    end subroutine hill_newton
 
     !> M = B^2, B = G1 A^-1 G1 A (see the module notes).
     subroutine monodromy_from_quarter(a, mono, info)
@@ -322,67 +429,6 @@ contains
         mono = matmul(b, b)
         info = CM_SUCCESS
     end subroutine monodromy_from_quarter
-
-    !> The family over ms (any order; continuation works best for sorted, close values).
-    !! Each orbit starts Newton from the quadratic extrapolation of the previous three of its
-    !! chunk (cold start at the chunk's first). With OpenMP the index range is cut into one
-    !! contiguous chunk per thread (`nchunks` overrides the number of chunks).
-    subroutine hill_family(ms, kappa, orbs, options, nchunks)
-        real(dp), intent(in) :: ms(:)
-        real(dp), intent(in) :: kappa
-        type(hill_orbit), intent(out) :: orbs(:)
-        type(hill_orbit_options), intent(in), optional :: options
-        integer, intent(in), optional :: nchunks
-        type(hill_orbit_options) :: opt
-        integer :: nc, ic, i, i0, i1, n, nprev, j
-        real(dp) :: u(2), mm(3), uu(2, 3), w
-        if (present(options)) opt = options
-        n = size(ms)
-        nc = 1
-        !$ nc = omp_get_max_threads()
-        if (present(nchunks)) nc = nchunks
-        nc = max(1, min(nc, n))
-        !$omp parallel do schedule(static, 1) default(shared) &
-        !$omp private(ic, i, i0, i1, nprev, u, mm, uu, j, w)
-        do ic = 1, nc
-            i0 = (ic - 1)*n/nc + 1
-            i1 = ic*n/nc
-            nprev = 0
-            do i = i0, i1
-                if (nprev == 0) then
-                    call hill_variation_orbit(ms(i), kappa, orbs(i), opt)
-                else
-                    ! Lagrange extrapolation through the last min(nprev, 3) orbits
-                    u = 0.0_dp
-                    do j = 1, min(nprev, 3)
-                        w = lagrange_weight(ms(i), mm, min(nprev, 3), j)
-                        u = u + w*uu(:, j)
-                    end do
-                    call hill_variation_orbit(ms(i), kappa, orbs(i), opt, guess=u)
-                end if
-                if (orbs(i)%info == CM_SUCCESS) then
-                    mm(2:3) = mm(1:2)
-                    uu(:, 2:3) = uu(:, 1:2)
-                    mm(1) = ms(i)
-                    uu(:, 1) = [orbs(i)%y0(1), orbs(i)%y0(4)]
-                    nprev = nprev + 1
-                else
-                    nprev = 0
-                end if
-            end do
-        end do
-        !$omp end parallel do
-    end subroutine hill_family
-
-    pure real(dp) function lagrange_weight(x, xs, np, j) result(w)
-        real(dp), intent(in) :: x, xs(3)
-        integer, intent(in) :: np, j
-        integer :: k
-        w = 1.0_dp
-        do k = 1, np
-            if (k /= j) w = w*(x - xs(k))/(xs(j) - xs(k))
-        end do
-    end function lagrange_weight
 
     ! ------------------------------------------------------------ transverse linearisation
 
@@ -437,6 +483,11 @@ contains
         ts%kappa = orb%kappa
         opt%rtol = 1.0e-13_dp
         if (present(rtol)) opt%rtol = rtol
+        if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
+            res%info = CM_BAD_INPUT
+            res%message = "hill_transverse: rtol must be in (0, 1)"
+            return
+        end if
         opt%atol = opt%rtol
         z = [orb%y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, orb%period, z, opt, res%info, message=msg)
@@ -449,13 +500,15 @@ contains
         res%info = CM_SUCCESS
     end subroutine hill_transverse
 
-    !> The orbit and Phi at the times t (e.g. for CSV output): states(4, nt), phi(nt).
-    subroutine hill_orbit_sample(orb, t, states, phi, info)
+    !> The orbit and Phi at the times t (e.g. for CSV output): states(4, nt), phi(nt),
+    !! integrated by DOP853 at rtol = atol = `rtol` (default 1e-12).
+    subroutine hill_orbit_sample(orb, t, states, phi, info, rtol)
         type(hill_orbit), intent(in) :: orb
         real(dp), intent(in) :: t(:)
         real(dp), intent(out) :: states(:, :)
         real(dp), intent(out) :: phi(:)
         integer, intent(out) :: info
+        real(dp), intent(in), optional :: rtol
         type(hill_problem) :: hp
         type(ode_options) :: opt
         type(ode_result) :: r
@@ -467,7 +520,8 @@ contains
         hp%m = orb%m
         hp%kappa = orb%kappa
         opt%rtol = 1.0e-12_dp
-        opt%atol = 1.0e-12_dp
+        if (present(rtol)) opt%rtol = rtol
+        opt%atol = opt%rtol
         call ode_solve(hp, [0.0_dp, max(orb%period, maxval(t))], orb%y0, opt, r, t_eval=t)
         info = r%status
         if (info < 0) return

@@ -10,21 +10,25 @@
 !> Hill's variation orbit with its monodromy (see conmech_hill_orbit).
 !! use_guess /= 0: Newton starts from guess = (x0, v0). full_period /= 0: monodromy by
 !! direct integration over 2 pi instead of the symmetry.
-subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, y0, period, &
-                           jacobi, mono, mr, mi, s, c, residual, iterations, nfev, info, message)
+subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, closure_tol, &
+                           max_nsteps, y0, period, jacobi, mono, mr, mi, s, c, residual, &
+                           quarter, nsteps_used, iterations, nfev, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
     implicit none
     real(c_double), intent(in) :: m, kappa
     integer(c_int), intent(in) :: nsteps, full_period, use_guess
-    real(c_double), intent(in) :: guess(2)
+    real(c_double), intent(in) :: guess(2), closure_tol
+    integer(c_int), intent(in) :: max_nsteps
     real(c_double), intent(out) :: y0(4), period, jacobi, mono(4, 4), mr(4), mi(4), s, c
-    real(c_double), intent(out) :: residual
-    integer(c_int), intent(out) :: iterations, nfev, info
+    real(c_double), intent(out) :: residual, quarter(4)
+    integer(c_int), intent(out) :: nsteps_used, iterations, nfev, info
     character(len=256), intent(out) :: message
     type(hill_orbit) :: orb
     type(hill_orbit_options) :: opt
     if (nsteps > 0) opt%nsteps = nsteps
+    if (closure_tol > 0.0_c_double) opt%closure_tol = closure_tol
+    if (max_nsteps > 0) opt%max_nsteps = max_nsteps
     opt%full_period = full_period /= 0
     if (use_guess /= 0) then
         call hill_variation_orbit(m, kappa, orb, opt, guess)
@@ -40,30 +44,80 @@ subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, y0, 
     s = orb%stability_index
     c = orb%c
     residual = orb%residual
+    quarter = orb%quarter_state
+    nsteps_used = orb%nsteps
     iterations = orb%iterations
     nfev = orb%nfev
     info = orb%info
     message = orb%message
 end subroutine flat_hill_orbit
 
-!> The family of variation orbits over ms(nm) by continuation (see hill_family).
-subroutine flat_hill_family(nm, ms, kappa, nsteps, y0s, jacobis, monos, ss, cs, infos, iters)
+!> Locate the m where the stability index S of the variation family crosses `target`
+!! (+1 or -1) between the orbits at ma (start ua = (x0, v0)) and mb (ub); see
+!! hill_locate_index. Returns the located m, its orbit's (x0, v0), S, c, true closure.
+subroutine flat_hill_locate(ma, ua, mb, ub, kappa, target, mtol, m_star, u_star, s, c, &
+                            residual, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_family
+    use conmech_status, only: CM_SUCCESS
+    use conmech_hill_orbit, only: hill_orbit, hill_variation_orbit
+    use conmech_hill_family, only: hill_locate_index
+    implicit none
+    real(c_double), intent(in) :: ma, ua(2), mb, ub(2), kappa, target, mtol
+    real(c_double), intent(out) :: m_star, u_star(2), s, c, residual
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    type(hill_orbit) :: oa, ob, orb
+    m_star = 0.0_c_double
+    u_star = 0.0_c_double
+    s = 0.0_c_double
+    c = 0.0_c_double
+    residual = 0.0_c_double
+    call hill_variation_orbit(ma, kappa, oa, guess=ua)
+    call hill_variation_orbit(mb, kappa, ob, guess=ub)
+    if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS) then
+        info = merge(oa%info, ob%info, oa%info /= CM_SUCCESS)
+        message = "the bracketing orbits did not converge"
+        return
+    end if
+    call hill_locate_index(oa, ob, target, orb, mtol=mtol)
+    info = orb%info
+    message = orb%message
+    if (info /= CM_SUCCESS) return
+    m_star = orb%m
+    u_star = [orb%y0(1), orb%y0(4)]
+    s = orb%stability_index
+    c = orb%c
+    residual = orb%residual
+end subroutine flat_hill_locate
+
+!> The family of variation orbits over ms(nm) by continuation (see hill_family).
+subroutine flat_hill_family(nm, ms, kappa, nsteps, chunk_size, y0s, jacobis, monos, ss, cs, &
+                            residuals, quarters, nsteps_used, infos, iters)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options
+    use conmech_hill_family, only: hill_family
     implicit none
     integer(c_int), intent(in) :: nm
     real(c_double), intent(in) :: ms(nm), kappa
-    integer(c_int), intent(in) :: nsteps
+    integer(c_int), intent(in) :: nsteps, chunk_size
     real(c_double), intent(out) :: y0s(4, nm), jacobis(nm), monos(4, 4, nm), ss(nm), cs(nm)
-    integer(c_int), intent(out) :: infos(nm), iters(nm)
+    real(c_double), intent(out) :: residuals(nm), quarters(4, nm)
+    integer(c_int), intent(out) :: nsteps_used(nm), infos(nm), iters(nm)
     type(hill_orbit), allocatable :: orbs(:)
     type(hill_orbit_options) :: opt
     integer :: i
     if (nsteps > 0) opt%nsteps = nsteps
     opt%eigenvalues = .false.
     allocate (orbs(nm))
-    call hill_family(ms, kappa, orbs, opt)
+    if (chunk_size > 0) then
+        call hill_family(ms, kappa, orbs, opt, chunk_size=chunk_size)
+    else
+        call hill_family(ms, kappa, orbs, opt)
+    end if
     do i = 1, nm
+        residuals(i) = orbs(i)%residual
+        quarters(:, i) = orbs(i)%quarter_state
+        nsteps_used(i) = orbs(i)%nsteps
         y0s(:, i) = orbs(i)%y0
         jacobis(i) = orbs(i)%jacobi
         monos(:, :, i) = orbs(i)%monodromy
@@ -107,7 +161,7 @@ subroutine flat_hill_transverse(m, kappa, y0, rtol, nt, t, states, phi, mono2, h
     states = 0.0_c_double
     phi = 0.0_c_double
     if (info /= CM_SUCCESS .or. nt < 1) return
-    call hill_orbit_sample(orb, t, states, phi, inf)
+    call hill_orbit_sample(orb, t, states, phi, inf, rtol)
     if (inf /= CM_SUCCESS) then
         info = inf
         message = "sampling the orbit failed"
@@ -374,3 +428,203 @@ subroutine flat_hill_equation_callback(phi, period, rtol, mono, half_trace, det,
     end interface
     call callback_hill_solve(phi, period, rtol, mono, half_trace, det, info, message)
 end subroutine flat_hill_equation_callback
+
+!> Pseudo-arclength continuation of a periodic orbit of a built-in system in its parameter
+!! params(ip) (see conmech_continuation; options packed as in run_continuation). The branch
+!! in arrays of mp points (npts used), the special points (nsp, at most 64).
+subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, iopt, nfree, &
+                                     free_idx, ntg, targets, mp, npts, pp, per, ys, mr, mi, &
+                                     s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
+                                     sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_param_system, only: builtin_param_system, make_param_system
+    use conmech_support_cont, only: run_continuation
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, ip, n, iopt(11), nfree, ntg, mp
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
+    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
+    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
+    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
+    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
+    character(len=256), intent(out) :: message
+    type(builtin_param_system) :: sys
+    character(len=:), allocatable :: msg
+    npts = 0
+    nsp = 0
+    call make_param_system(name, params(1:np), ip, sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call run_continuation(sys, n, y0, period, params(ip), ropt, iopt, nfree, free_idx, ntg, &
+                          targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, &
+                          sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, &
+                          message)
+end subroutine flat_continuation_builtin
+
+!> As flat_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from the
+!! parameter value p0 (finite-difference Jacobian).
+subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree, free_idx, &
+                                      ntg, targets, mp, npts, pp, per, ys, mr, mi, s, psi, &
+                                      res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
+                                      sp_mr, sp_mi, sp_s, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_support_cont, only: callback_param_system, run_continuation
+    implicit none
+    integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
+    real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
+    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
+    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
+    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
+    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, p, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t, p
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_param_system) :: sys
+    sys%f => fun
+    sys%n = n
+    sys%p = p0
+    call run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, targets, &
+                          mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sp_kind, &
+                          sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
+end subroutine flat_continuation_callback
+
+!> Transverse linearisation of a periodic orbit (y0, period) of the planar natural system
+!! q'' = -grad V + 2 omega J q' with V from the callback pot(q, v, g, h): the 2 x 2 monodromy
+!! of N'' + Phi N = 0, its half trace and determinant, the closure of the orbit integrated,
+!! the 4 x 4 monodromy (same integrator) and Phi at the times t(nt) along the orbit.
+subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, mono2, &
+                                    half_trace, det, closure, mono4, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_ode_solver, only: ode_options, ode_integrate
+    use conmech_variational, only: integrate_stm
+    use conmech_transverse, only: transverse_result, transverse_monodromy, transverse_phi
+    use conmech_support_transverse, only: callback_natural
+    implicit none
+    real(c_double), intent(in) :: omega, y0(4), period, rtol
+    integer(c_int), intent(in) :: nt
+    real(c_double), intent(in) :: t(nt)
+    real(c_double), intent(out) :: phi_t(nt), mono2(2, 2), half_trace, det, closure
+    real(c_double), intent(out) :: mono4(4, 4)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external pot
+    interface
+        subroutine pot(q, v, g, h)
+            use, intrinsic :: iso_c_binding, only: c_double
+            real(c_double), intent(in) :: q(2)
+            real(c_double), intent(out) :: v, g(2), h(2, 2)
+        end subroutine pot
+    end interface
+    type(callback_natural) :: sys
+    type(transverse_result) :: tr
+    type(ode_options) :: oo
+    real(c_double) :: y(4), tprev
+    integer :: i, j
+    character(len=:), allocatable :: msg
+    sys%pot => pot
+    sys%omega = omega
+    phi_t = 0.0_c_double
+    mono4 = 0.0_c_double
+    call transverse_monodromy(sys, y0, period, tr, rtol)
+    info = tr%info
+    message = tr%message
+    mono2 = tr%monodromy
+    half_trace = tr%half_trace
+    det = tr%det
+    closure = tr%closure
+    if (info /= CM_SUCCESS) return
+    oo%rtol = rtol
+    oo%atol = rtol
+    y = y0
+    do j = 1, 4
+        mono4(j, j) = 1.0_c_double
+    end do
+    call integrate_stm(sys, 0.0_c_double, period, y, mono4, oo, info, msg)
+    if (info < 0) then
+        message = msg
+        return
+    end if
+    y = y0
+    tprev = 0.0_c_double
+    do i = 1, nt
+        if (t(i) > tprev) call ode_integrate(sys, tprev, t(i), y, oo, info, message=msg)
+        if (info < 0) then
+            message = msg
+            return
+        end if
+        tprev = max(tprev, t(i))
+        phi_t(i) = transverse_phi(sys, y)
+    end do
+    info = CM_SUCCESS
+end subroutine flat_transverse_callback
+
+!> Newton's method for an equilibrium f(t, y) = 0 of a built-in system from the guess y.
+subroutine flat_find_equilibrium_builtin(name, np, params, n, y, t, tol, max_iter, yout, info, &
+                                         message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_systems, only: make_system
+    use conmech_equilibria, only: find_equilibrium
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n, max_iter
+    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    real(c_double), intent(out) :: yout(n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    yout = y
+    call make_system(name, params(1:np), sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
+    message = msg
+end subroutine flat_find_equilibrium_builtin
+
+!> As flat_find_equilibrium_builtin for a Python right-hand side (FD Jacobian).
+subroutine flat_find_equilibrium_callback(fun, n, y, t, tol, max_iter, yout, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_equilibria, only: find_equilibrium
+    implicit none
+    integer(c_int), intent(in) :: n, max_iter
+    real(c_double), intent(in) :: y(n), t, tol
+    real(c_double), intent(out) :: yout(n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    character(len=:), allocatable :: msg
+    sys%f => fun
+    sys%n = n
+    yout = y
+    call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
+    message = msg
+end subroutine flat_find_equilibrium_callback

@@ -1,0 +1,144 @@
+!> Support of the flat f2py layer for the continuation of periodic orbits (compiled, not
+!! wrapped): a built-in system with one parameter made settable, a Python right-hand side
+!! fun(t, y, p, dydt, n) with the parameter p, and `run_continuation`, which runs
+!! `continue_orbits` from plain arguments and packs the branch into explicit-shape arrays.
+module conmech_support_cont
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_ode_system, only: ode_system
+    use conmech_param_system, only: builtin_param_system, set_builtin_param
+    use conmech_shooting, only: set_parameter_proc
+    use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &
+                                    SP_PD
+    use conmech_branch_switch, only: switch_period_doubling
+    implicit none
+    private
+    public :: callback_param_system, set_param_any, run_continuation
+    public :: MAX_SPECIAL
+
+    integer, parameter :: MAX_SPECIAL = 64
+
+    !> A Python right-hand side fun(t, y, p, dydt, n) with the parameter p.
+    type, extends(ode_system) :: callback_param_system
+        procedure(), pointer, nopass :: f => null()
+        real(c_double) :: p = 0.0_dp
+        integer(c_int) :: n = 0
+    contains
+        procedure :: rhs => cp_rhs
+    end type callback_param_system
+
+contains
+
+    subroutine cp_rhs(self, t, y, dydt)
+        class(callback_param_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        call self%f(t, y, self%p, dydt, self%n)
+    end subroutine cp_rhs
+
+    !> set_param for both wrappers (a built-in system is rebuilt with the new parameter).
+    subroutine set_param_any(sys, p)
+        class(ode_system), intent(inout) :: sys
+        real(dp), intent(in) :: p
+        select type (sys)
+        type is (builtin_param_system)
+            call set_builtin_param(sys, p)
+        type is (callback_param_system)
+            sys%p = p
+        end select
+    end subroutine set_param_any
+
+    !> Run the continuation and pack the branch. ropt = [ds, ds_min, ds_max, p_min, p_max,
+    !! tol, res_tol, rtol, atol, locate_tol, period_factor]; iopt = [max_points, direction,
+    !! max_iter, autonomous, fixed_period, conservative, locate, symmetric, free_time,
+    !! switch, in_period]: switch /= 0 starts the doubled-period branch at the
+    !! period-doubling point (p0, y0, period); in_period /= 0 continues in the period.
+    subroutine run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, &
+                                targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, &
+                                nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, &
+                                sp_s, info, message)
+        class(ode_system), intent(inout) :: sys
+        integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
+        real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
+        integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+        integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(MAX_SPECIAL)
+        integer(c_int), intent(out) :: sp_index(MAX_SPECIAL), info
+        real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
+        real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
+        real(c_double), intent(out) :: sp_p(MAX_SPECIAL), sp_per(MAX_SPECIAL)
+        real(c_double), intent(out) :: sp_y(n, MAX_SPECIAL), sp_mr(n, MAX_SPECIAL)
+        real(c_double), intent(out) :: sp_mi(n, MAX_SPECIAL), sp_s(MAX_SPECIAL)
+        character(len=256), intent(out) :: message
+        type(cont_options) :: o
+        type(branch) :: br
+        type(special_point) :: sp
+        integer :: k
+        npts = 0
+        nsp = 0
+        pp = 0.0_dp; per = 0.0_dp; ys = 0.0_dp; mr = 0.0_dp; mi = 0.0_dp; s = 0.0_dp
+        psi = 0.0_dp; res = 0.0_dp; iters = 0
+        sp_kind = 0; sp_index = 0; sp_p = 0.0_dp; sp_per = 0.0_dp; sp_y = 0.0_dp
+        sp_mr = 0.0_dp; sp_mi = 0.0_dp; sp_s = 0.0_dp
+        o%ds = ropt(1)
+        o%ds_min = ropt(2)
+        o%ds_max = ropt(3)
+        o%p_min = ropt(4)
+        o%p_max = ropt(5)
+        o%tol = ropt(6)
+        o%res_tol = ropt(7)
+        o%rtol = ropt(8)
+        o%atol = ropt(9)
+        o%locate_tol = ropt(10)
+        o%max_points = min(iopt(1), mp)
+        o%direction = iopt(2)
+        o%max_iter = iopt(3)
+        o%autonomous = iopt(4) /= 0
+        o%fixed_period = iopt(5) /= 0
+        o%conservative = iopt(6) /= 0
+        o%locate = iopt(7) /= 0
+        o%in_period = iopt(11) /= 0
+        call set_param_any(sys, p0)
+        if (iopt(10) /= 0) then
+            sp%kind = SP_PD
+            sp%point%p = p0
+            sp%point%y0 = y0
+            sp%point%period = period
+            call switch_period_doubling(sys, set_param_any, sp, br, o)
+        else if (iopt(8) /= 0) then
+            call continue_orbits(sys, set_param_any, p0, y0, period, br, o, &
+                                 free_idx(1:nfree), targets(1:ntg), iopt(9) /= 0, ropt(11))
+        else
+            call continue_orbits(sys, set_param_any, p0, y0, period, br, o)
+        end if
+        info = br%info
+        message = br%message
+        npts = br%npoints
+        do k = 1, npts
+            pp(k) = br%points(k)%p
+            per(k) = br%points(k)%period
+            ys(:, k) = br%points(k)%y0
+            mr(:, k) = br%points(k)%mr
+            mi(:, k) = br%points(k)%mi
+            s(k) = br%points(k)%stability_index
+            psi(:, k) = br%points(k)%psi
+            res(k) = br%points(k)%residual
+            iters(k) = br%points(k)%iterations
+        end do
+        nsp = min(br%nspecial, MAX_SPECIAL)
+        do k = 1, nsp
+            sp_kind(k) = br%special(k)%kind
+            sp_index(k) = br%special(k)%index
+            sp_p(k) = br%special(k)%point%p
+            sp_per(k) = br%special(k)%point%period
+            sp_y(:, k) = br%special(k)%point%y0
+            if (allocated(br%special(k)%point%mr)) then
+                sp_mr(:, k) = br%special(k)%point%mr
+                sp_mi(:, k) = br%special(k)%point%mi
+            end if
+            sp_s(k) = br%special(k)%point%stability_index
+        end do
+    end subroutine run_continuation
+
+end module conmech_support_cont

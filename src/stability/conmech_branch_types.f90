@@ -1,0 +1,91 @@
+!> The types of a continuation: its options, the points of a branch, the located special
+!! points and the branch itself (see conmech_continuation).
+module conmech_branch_types
+    use conmech_kinds, only: dp
+    use conmech_status
+    implicit none
+    private
+
+    integer, parameter, public :: SP_FOLD = 1  !! fold (limit point) in the parameter
+    integer, parameter, public :: SP_BP = 2    !! a multiplier through +1 (branch point)
+    integer, parameter, public :: SP_PD = 3    !! a multiplier through -1 (period doubling)
+    integer, parameter, public :: SP_NS = 4    !! a complex pair through |mu| = 1
+
+    public :: cont_options, cont_point, special_point, branch, special_name
+
+    !> Options of `continue_orbits`.
+    type :: cont_options
+        real(dp) :: ds = 0.01_dp              !! first step length (arclength in X)
+        real(dp) :: ds_min = 1.0e-8_dp        !! smallest step before giving up
+        real(dp) :: ds_max = 0.1_dp           !! largest step
+        integer :: max_points = 200           !! points on the branch (the start included)
+        real(dp) :: p_min = -huge(1.0_dp)     !! stop when p leaves [p_min, p_max]
+        real(dp) :: p_max = huge(1.0_dp)
+        integer :: direction = 1              !! first step towards larger (+1) or smaller p
+        integer :: max_iter = 12              !! corrector iterations
+        real(dp) :: tol = 1.0e-10_dp          !! corrector: |dX| <= tol max(1, |X|)
+        real(dp) :: res_tol = 1.0e-8_dp       !! and max |G| <= res_tol
+        real(dp) :: rtol = 1.0e-11_dp         !! integrator (DOP853) tolerances
+        real(dp) :: atol = 1.0e-11_dp
+        real(dp) :: rcond = 1.0e-12_dp        !! rank threshold of the Newton matrices
+        real(dp) :: fd_step = 1.0e-5_dp       !! relative step of the parameter derivative
+        logical :: autonomous = .true.        !! phase condition and trivial multiplier 1
+        logical :: fixed_period = .false.     !! the period is not an unknown
+        logical :: conservative = .false.     !! a second trivial multiplier (energy)
+        logical :: in_period = .false.        !! continue in the period T (no parameter):
+                                              !! the families of conservative systems
+        logical :: locate = .true.            !! locate the special points
+        real(dp) :: locate_tol = 1.0e-11_dp   !! bracket in arclength when locating
+    end type cont_options
+
+    !> A point of the branch.
+    type :: cont_point
+        real(dp) :: p = 0.0_dp                !! parameter
+        real(dp) :: period = 0.0_dp
+        real(dp), allocatable :: y0(:)        !! initial state
+        real(dp), allocatable :: mr(:), mi(:) !! multipliers
+        real(dp) :: stability_index = 0.0_dp  !! S (conservative 4 x 4) or max |mu| nontrivial
+        real(dp) :: psi(4) = 0.0_dp           !! test functions: fold, bp, pd, ns
+        real(dp) :: residual = 0.0_dp         !! max |G| one Newton step before it (a bound)
+        real(dp) :: ds = 0.0_dp               !! step length that reached it
+        integer :: iterations = 0
+    end type cont_point
+
+    !> A located special point.
+    type :: special_point
+        integer :: kind = 0                   !! SP_FOLD, SP_BP, SP_PD, SP_NS
+        integer :: index = 0                  !! between points index and index + 1
+        type(cont_point) :: point
+    end type special_point
+
+    !> A branch: its points and special points, the status and a message.
+    type :: branch
+        integer :: info = CM_BAD_INPUT
+        character(len=:), allocatable :: message
+        integer :: npoints = 0
+        type(cont_point), allocatable :: points(:)
+        integer :: nspecial = 0
+        type(special_point), allocatable :: special(:)
+    end type branch
+
+contains
+
+    !> Name of a special-point kind.
+    pure function special_name(kind) result(s)
+        integer, intent(in) :: kind
+        character(len=:), allocatable :: s
+        select case (kind)
+        case (SP_FOLD)
+            s = "fold"
+        case (SP_BP)
+            s = "branch point"
+        case (SP_PD)
+            s = "period doubling"
+        case (SP_NS)
+            s = "Neimark-Sacker"
+        case default
+            s = "unknown"
+        end select
+    end function special_name
+
+end module conmech_branch_types
