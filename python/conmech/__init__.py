@@ -9,6 +9,7 @@ numpy.f2py + meson-python). The integrators follow SciPy's names::
 from . import constrained, systems
 from . import hill, stability
 from ._ivp import DenseOutput, OdeResult, solve_ivp
+from ._stepper import DOP853, DOPRI5, RK4, RK45, VERNER98  # noqa: F401 (stepper classes)
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability",
            "constrained"]

@@ -56,6 +56,20 @@ contains
         real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
         real(dp), intent(inout) :: k(n, 7)
         real(dp), intent(out) :: ynew(n), ytmp(n), err
+        if (n == 4) then    ! a constant size: the compiler's clone has no loop overhead
+            call dopri5_kernel(sys, 4, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
+        else
+            call dopri5_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
+        end if
+    end subroutine dopri5_attempt
+
+    subroutine dopri5_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
+        class(ode_system), intent(in) :: sys
+        integer, intent(in) :: n
+        type(rk_tableau), intent(in) :: tb
+        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
+        real(dp), intent(inout) :: k(n, 7)
+        real(dp), intent(out) :: ynew(n), ytmp(n), err
         real(dp) :: s, sk, e
         integer :: i
         do i = 1, n
@@ -85,26 +99,42 @@ contains
                                 + tb%b(5)*k(i, 5) + tb%b(6)*k(i, 6))
         end do
         call sys%rhs(t + h, ynew, k(:, 7))
-        s = 0.0_dp
-        do i = 1, n     ! e2 = 0
+        do i = 1, n     ! e2 = 0; a non-finite ynew makes the norm NaN
             e = tb%e(1)*k(i, 1) + tb%e(3)*k(i, 3) + tb%e(4)*k(i, 4) + tb%e(5)*k(i, 5) &
                 + tb%e(6)*k(i, 6) + tb%e(7)*k(i, 7)
             sk = atol(i) + rtol(i)*max(abs(y(i)), abs(ynew(i)))
-            s = s + (e/sk)**2
+            ytmp(i) = (e/sk)**2 + (ynew(i) - ynew(i))
+        end do
+        s = 0.0_dp
+        do i = 1, n
+            s = s + ytmp(i)
         end do
         err = abs(h)*sqrt(s/real(n, dp))
-        if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
-    end subroutine dopri5_attempt
+    end subroutine dopri5_kernel
 
     !> Dormand-Prince 8(5,3) step: stages 2..12; ynew; err (the FSAL stage 13 is the
     !! caller's, after acceptance).
-    subroutine dop853_attempt(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
+    subroutine dop853_attempt(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         class(ode_system), intent(in) :: sys
         integer, intent(in) :: n
         type(rk_tableau), intent(in) :: tb
         real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
         real(dp), intent(inout) :: k(n, 12)
-        real(dp), intent(out) :: ynew(n), ytmp(n), err
+        real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
+        if (n == 4) then    ! a constant size: the compiler's clone has no loop overhead
+            call dop853_kernel(sys, 4, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
+        else
+            call dop853_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
+        end if
+    end subroutine dop853_attempt
+
+    subroutine dop853_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
+        class(ode_system), intent(in) :: sys
+        integer, intent(in) :: n
+        type(rk_tableau), intent(in) :: tb
+        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
+        real(dp), intent(inout) :: k(n, 12)
+        real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
         real(dp) :: err5, err3, deno, sk, bs, e3, e5
         integer :: i
         associate (a => tb%a, c => tb%c)
@@ -163,8 +193,8 @@ contains
             end do
             call sys%rhs(t + h, ytmp, k(:, 12))
         end associate
-        err5 = 0.0_dp
-        err3 = 0.0_dp
+        ! ynew and the two estimators, scaled, in one vectorisable pass (w3, ytmp); a
+        ! non-finite ynew makes w3 NaN (ynew - ynew), hence err NaN; then the sums in order
         associate (b => tb%b, e => tb%e, bh => tb%bhh)
             do i = 1, n
                 bs = b(1)*k(i, 1) + b(6)*k(i, 6) + b(7)*k(i, 7) + b(8)*k(i, 8) &
@@ -174,15 +204,20 @@ contains
                 e3 = bs - bh(1)*k(i, 1) - bh(9)*k(i, 9) - bh(12)*k(i, 12)
                 e5 = e(1)*k(i, 1) + e(6)*k(i, 6) + e(7)*k(i, 7) + e(8)*k(i, 8) &
                      + e(9)*k(i, 9) + e(10)*k(i, 10) + e(11)*k(i, 11) + e(12)*k(i, 12)
-                err3 = err3 + (e3/sk)**2
-                err5 = err5 + (e5/sk)**2
+                w3(i) = (e3/sk)**2 + (ynew(i) - ynew(i))
+                ytmp(i) = (e5/sk)**2
             end do
         end associate
+        err5 = 0.0_dp
+        err3 = 0.0_dp
+        do i = 1, n
+            err3 = err3 + w3(i)
+            err5 = err5 + ytmp(i)
+        end do
         deno = err5 + 0.01_dp*err3
         if (deno <= 0.0_dp) deno = 1.0_dp
         err = abs(h)*err5*sqrt(1.0_dp/(real(n, dp)*deno))
-        if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
-    end subroutine dop853_attempt
+    end subroutine dop853_kernel
 
     !> Verner 9(8) step: stages 2..16, ynew from the 9th-order weights, err.
     subroutine verner_attempt(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
