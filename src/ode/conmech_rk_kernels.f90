@@ -56,20 +56,6 @@ contains
         real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
         real(dp), intent(inout) :: k(n, 7)
         real(dp), intent(out) :: ynew(n), ytmp(n), err
-        if (n == 4) then    ! a constant size: the compiler's clone has no loop overhead
-            call dopri5_kernel(sys, 4, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
-        else
-            call dopri5_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
-        end if
-    end subroutine dopri5_attempt
-
-    subroutine dopri5_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, rtol, atol, err)
-        class(ode_system), intent(in) :: sys
-        integer, intent(in) :: n
-        type(rk_tableau), intent(in) :: tb
-        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
-        real(dp), intent(inout) :: k(n, 7)
-        real(dp), intent(out) :: ynew(n), ytmp(n), err
         real(dp) :: s, sk, e
         integer :: i
         do i = 1, n
@@ -110,7 +96,7 @@ contains
             s = s + ytmp(i)
         end do
         err = abs(h)*sqrt(s/real(n, dp))
-    end subroutine dopri5_kernel
+    end subroutine dopri5_attempt
 
     !> Dormand-Prince 8(5,3) step: stages 2..12; ynew; err (the FSAL stage 13 is the
     !! caller's, after acceptance).
@@ -121,12 +107,24 @@ contains
         real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
         real(dp), intent(inout) :: k(n, 12)
         real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
-        if (n == 4) then    ! a constant size: the compiler's clone has no loop overhead
-            call dop853_kernel(sys, 4, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
+        if (n == 4) then    ! a constant size: loops without overhead (one AVX2 vector)
+            call dop853_kernel4(sys, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         else
             call dop853_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         end if
     end subroutine dop853_attempt
+
+    subroutine dop853_kernel4(sys, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
+        class(ode_system), intent(in) :: sys
+        integer, parameter :: n = 4
+        type(rk_tableau), intent(in) :: tb
+        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
+        real(dp), intent(inout) :: k(n, 12)
+        real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
+        real(dp) :: err5, err3, deno, sk, bs, e3, e5
+        integer :: i
+        include "conmech_rk_dop853_body.inc"
+    end subroutine dop853_kernel4
 
     subroutine dop853_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         class(ode_system), intent(in) :: sys
@@ -137,86 +135,7 @@ contains
         real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
         real(dp) :: err5, err3, deno, sk, bs, e3, e5
         integer :: i
-        associate (a => tb%a, c => tb%c)
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(2, 1)*k(i, 1))
-            end do
-            call sys%rhs(t + c(2)*h, ytmp, k(:, 2))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(3, 1)*k(i, 1) + a(3, 2)*k(i, 2))
-            end do
-            call sys%rhs(t + c(3)*h, ytmp, k(:, 3))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(4, 1)*k(i, 1) + a(4, 3)*k(i, 3))
-            end do
-            call sys%rhs(t + c(4)*h, ytmp, k(:, 4))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(5, 1)*k(i, 1) + a(5, 3)*k(i, 3) + a(5, 4)*k(i, 4))
-            end do
-            call sys%rhs(t + c(5)*h, ytmp, k(:, 5))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(6, 1)*k(i, 1) + a(6, 4)*k(i, 4) + a(6, 5)*k(i, 5))
-            end do
-            call sys%rhs(t + c(6)*h, ytmp, k(:, 6))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(7, 1)*k(i, 1) + a(7, 4)*k(i, 4) + a(7, 5)*k(i, 5) &
-                                    + a(7, 6)*k(i, 6))
-            end do
-            call sys%rhs(t + c(7)*h, ytmp, k(:, 7))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(8, 1)*k(i, 1) + a(8, 4)*k(i, 4) + a(8, 5)*k(i, 5) &
-                                    + a(8, 6)*k(i, 6) + a(8, 7)*k(i, 7))
-            end do
-            call sys%rhs(t + c(8)*h, ytmp, k(:, 8))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(9, 1)*k(i, 1) + a(9, 4)*k(i, 4) + a(9, 5)*k(i, 5) &
-                                    + a(9, 6)*k(i, 6) + a(9, 7)*k(i, 7) + a(9, 8)*k(i, 8))
-            end do
-            call sys%rhs(t + c(9)*h, ytmp, k(:, 9))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(10, 1)*k(i, 1) + a(10, 4)*k(i, 4) + a(10, 5)*k(i, 5) &
-                                    + a(10, 6)*k(i, 6) + a(10, 7)*k(i, 7) + a(10, 8)*k(i, 8) &
-                                    + a(10, 9)*k(i, 9))
-            end do
-            call sys%rhs(t + c(10)*h, ytmp, k(:, 10))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(11, 1)*k(i, 1) + a(11, 4)*k(i, 4) + a(11, 5)*k(i, 5) &
-                                    + a(11, 6)*k(i, 6) + a(11, 7)*k(i, 7) + a(11, 8)*k(i, 8) &
-                                    + a(11, 9)*k(i, 9) + a(11, 10)*k(i, 10))
-            end do
-            call sys%rhs(t + c(11)*h, ytmp, k(:, 11))
-            do i = 1, n
-                ytmp(i) = y(i) + h*(a(12, 1)*k(i, 1) + a(12, 4)*k(i, 4) + a(12, 5)*k(i, 5) &
-                                    + a(12, 6)*k(i, 6) + a(12, 7)*k(i, 7) + a(12, 8)*k(i, 8) &
-                                    + a(12, 9)*k(i, 9) + a(12, 10)*k(i, 10) &
-                                    + a(12, 11)*k(i, 11))
-            end do
-            call sys%rhs(t + h, ytmp, k(:, 12))
-        end associate
-        ! ynew and the two estimators, scaled, in one vectorisable pass (w3, ytmp); a
-        ! non-finite ynew makes w3 NaN (ynew - ynew), hence err NaN; then the sums in order
-        associate (b => tb%b, e => tb%e, bh => tb%bhh)
-            do i = 1, n
-                bs = b(1)*k(i, 1) + b(6)*k(i, 6) + b(7)*k(i, 7) + b(8)*k(i, 8) &
-                     + b(9)*k(i, 9) + b(10)*k(i, 10) + b(11)*k(i, 11) + b(12)*k(i, 12)
-                ynew(i) = y(i) + h*bs
-                sk = atol(i) + rtol(i)*max(abs(y(i)), abs(ynew(i)))
-                e3 = bs - bh(1)*k(i, 1) - bh(9)*k(i, 9) - bh(12)*k(i, 12)
-                e5 = e(1)*k(i, 1) + e(6)*k(i, 6) + e(7)*k(i, 7) + e(8)*k(i, 8) &
-                     + e(9)*k(i, 9) + e(10)*k(i, 10) + e(11)*k(i, 11) + e(12)*k(i, 12)
-                w3(i) = (e3/sk)**2 + (ynew(i) - ynew(i))
-                ytmp(i) = (e5/sk)**2
-            end do
-        end associate
-        err5 = 0.0_dp
-        err3 = 0.0_dp
-        do i = 1, n
-            err3 = err3 + w3(i)
-            err5 = err5 + ytmp(i)
-        end do
-        deno = err5 + 0.01_dp*err3
-        if (deno <= 0.0_dp) deno = 1.0_dp
-        err = abs(h)*err5*sqrt(1.0_dp/(real(n, dp)*deno))
+        include "conmech_rk_dop853_body.inc"
     end subroutine dop853_kernel
 
     !> Verner 9(8) step: stages 2..16, ynew from the 9th-order weights, err.

@@ -270,6 +270,7 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         real(dp) :: err, fac11, fac, hnew, h_unclipped, t_new
+        real(dp), allocatable :: yswap(:)
         integer :: n
         character(len=32) :: buf
         n = self%n
@@ -387,8 +388,11 @@ contains
         end if
         self%fsal_pending = .not. self%defer_fsal
         self%dense_ready = .false.
-        self%y_old = self%y
-        self%y = self%ynew
+        ! (y_old, y, ynew) <- (y, ynew, y_old): a rotation of the buffers, no copies
+        call move_alloc(self%y_old, yswap)
+        call move_alloc(self%y, self%y_old)
+        call move_alloc(self%ynew, self%y)
+        call move_alloc(yswap, self%ynew)
         self%t_old = self%t
         self%t = t_new
         self%h_done = self%h

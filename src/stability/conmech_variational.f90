@@ -31,20 +31,65 @@ module conmech_variational
 
 contains
 
+    !> z' = [f(t, y); vec(J Phi)]. The Jacobian lives in a fixed-size stack buffer for
+    !! n <= NSMALL (no allocation per evaluation); the product is one matrix product in
+    !! column-axpy form, structure-aware for the first-order form of a mechanical system
+    !! (J = [0 I; A B], detected per call: then the top half of J Phi is the bottom half of
+    !! Phi, and only [A B] Phi is computed).
     subroutine var_rhs(self, t, y, dydt)
         class(variational_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dydt(:)
-        real(dp) :: jac(self%n, self%n)
-        integer :: n, j
+        integer, parameter :: NSMALL = 16
+        real(dp) :: jsmall(NSMALL, NSMALL)
+        real(dp), allocatable :: jbig(:, :)
+        integer :: n
         n = self%n
         call self%base%rhs(t, y(1:n), dydt(1:n))
-        call self%base%jacobian(t, y(1:n), jac)
-        do j = 1, n
-            dydt(n*j + 1:n*j + n) = matmul(jac, y(n*j + 1:n*j + n))
-        end do
+        if (n <= NSMALL) then
+            call self%base%jacobian(t, y(1:n), jsmall(1:n, 1:n))
+            call stm_product(n, NSMALL, jsmall, y(n + 1:), dydt(n + 1:))
+        else
+            allocate (jbig(n, n))
+            call self%base%jacobian(t, y(1:n), jbig)
+            call stm_product(n, n, jbig, y(n + 1:), dydt(n + 1:))
+        end if
     end subroutine var_rhs
+
+    !> dphi = jac(1:n, 1:n) phi, all n x n (jac with leading dimension ld).
+    pure subroutine stm_product(n, ld, jac, phi, dphi)
+        integer, intent(in) :: n, ld
+        real(dp), intent(in) :: jac(ld, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
+        integer :: i, j, l, m, r0
+        logical :: mech
+        m = n/2
+        mech = 2*m == n
+        if (mech) then      ! J = [0 I; A B] ?
+            check: do j = 1, n
+                do i = 1, m
+                    if (jac(i, j) /= merge(1.0_dp, 0.0_dp, j == i + m)) then
+                        mech = .false.
+                        exit check
+                    end if
+                end do
+            end do check
+        end if
+        r0 = 1
+        if (mech) r0 = m + 1
+        do j = 1, n
+            if (mech) dphi(1:m, j) = phi(m + 1:n, j)
+            do i = r0, n
+                dphi(i, j) = jac(i, 1)*phi(1, j)
+            end do
+            do l = 2, n
+                do i = r0, n
+                    dphi(i, j) = dphi(i, j) + jac(i, l)*phi(l, j)
+                end do
+            end do
+        end do
+    end subroutine stm_product
 
     !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
     !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.
