@@ -31,11 +31,12 @@ module conmech_variational
 
 contains
 
-    !> z' = [f(t, y); vec(J Phi)]. The Jacobian lives in a fixed-size stack buffer for
-    !! n <= NSMALL (no allocation per evaluation); the product is one matrix product in
-    !! column-axpy form, structure-aware for the first-order form of a mechanical system
-    !! (J = [0 I; A B], detected per call: then the top half of J Phi is the bottom half of
-    !! Phi, and only [A B] Phi is computed).
+    !> z' = [f(t, y); vec(J Phi)], f and J from the system's `rhs_jacobian` (one call, so a
+    !! system may share their common work). J lives in a fixed-size stack buffer for
+    !! n <= NSMALL (no allocation per evaluation). The product J Phi is one matrix product
+    !! in column-axpy form, structure-aware for the first-order form of a mechanical system
+    !! (J = [0 I; A B], detected per call: the top half of J Phi is then the bottom half of
+    !! Phi, and only [A B] Phi is computed); loops of constant length for n = 2, 4, 6.
     subroutine var_rhs(self, t, y, dydt)
         class(variational_system), intent(in) :: self
         real(dp), intent(in) :: t
@@ -46,50 +47,64 @@ contains
         real(dp), allocatable :: jbig(:, :)
         integer :: n
         n = self%n
-        call self%base%rhs(t, y(1:n), dydt(1:n))
         if (n <= NSMALL) then
-            call self%base%jacobian(t, y(1:n), jsmall(1:n, 1:n))
-            call stm_product(n, NSMALL, jsmall, y(n + 1:), dydt(n + 1:))
+            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jsmall(1:n, 1:n))
+            select case (n)
+            case (2)
+                call product2(NSMALL, jsmall, y, dydt)
+            case (4)
+                call product4(NSMALL, jsmall, y, dydt)
+            case (6)
+                call product6(NSMALL, jsmall, y, dydt)
+            case default
+                call product_n(n, NSMALL, jsmall, y, dydt)
+            end select
         else
             allocate (jbig(n, n))
-            call self%base%jacobian(t, y(1:n), jbig)
-            call stm_product(n, n, jbig, y(n + 1:), dydt(n + 1:))
+            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jbig)
+            call product_n(n, n, jbig, y, dydt)
         end if
     end subroutine var_rhs
 
-    !> dphi = jac(1:n, 1:n) phi, all n x n (jac with leading dimension ld).
-    pure subroutine stm_product(n, ld, jac, phi, dphi)
-        integer, intent(in) :: n, ld
-        real(dp), intent(in) :: jac(ld, n), phi(n, n)
-        real(dp), intent(out) :: dphi(n, n)
-        integer :: i, j, l, m, r0
+    !> dydt(n+1:) = vec(jac(1:n, 1:n) Phi), Phi = reshape(y(n+1:), [n, n]): n = 2, 4, 6, any.
+    pure subroutine product2(ld, jac, y, dydt)
+        integer, parameter :: n = 2
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
         logical :: mech
-        m = n/2
-        mech = 2*m == n
-        if (mech) then      ! J = [0 I; A B] ?
-            check: do j = 1, n
-                do i = 1, m
-                    if (jac(i, j) /= merge(1.0_dp, 0.0_dp, j == i + m)) then
-                        mech = .false.
-                        exit check
-                    end if
-                end do
-            end do check
-        end if
-        r0 = 1
-        if (mech) r0 = m + 1
-        do j = 1, n
-            if (mech) dphi(1:m, j) = phi(m + 1:n, j)
-            do i = r0, n
-                dphi(i, j) = jac(i, 1)*phi(1, j)
-            end do
-            do l = 2, n
-                do i = r0, n
-                    dphi(i, j) = dphi(i, j) + jac(i, l)*phi(l, j)
-                end do
-            end do
-        end do
-    end subroutine stm_product
+        include "conmech_stm_product_body.inc"
+    end subroutine product2
+
+    pure subroutine product4(ld, jac, y, dydt)
+        integer, parameter :: n = 4
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product4
+
+    pure subroutine product6(ld, jac, y, dydt)
+        integer, parameter :: n = 6
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product6
+
+    pure subroutine product_n(n, ld, jac, y, dydt)
+        integer, intent(in) :: n, ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product_n
 
     !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
     !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.
