@@ -229,3 +229,19 @@ def test_independent_objects_interleave():
     while b.status == "running":
         b.step()
     assert np.array_equal(a.y, b.y) and a.nfev == b.nfev
+
+
+@pytest.mark.parametrize("method", ["DOP853", "RK45"])
+@pytest.mark.parametrize("y0", [1e-150, 5e149])
+def test_extreme_magnitudes_work_as_in_scipy(method, y0):
+    # scale-safe norms: the initial-step heuristic and DOP853's error norm neither
+    # overflow (|f/sk| ~ 1e155) nor divide 0 by an underflowed denominator
+    for yy, f, exact in (([y0], lambda t, y: -y, np.exp(-1.0)),
+                         ([y0, 0.0], lambda t, y: [y[1], -y[0]], np.cos(1.0))):
+        r = conmech.solve_ivp(f, (0, 1), yy, method=method, rtol=1e-6, atol=1e-6 * y0)
+        assert r.success, r.message
+        assert abs(r.y[0, -1] / (y0 * exact) - 1) < 1e-4
+        s = si.solve_ivp(f, (0, 1), yy, method=method)
+        c = conmech.solve_ivp(f, (0, 1), yy, method=method)
+        assert s.success and c.success
+        assert abs(c.y[0, -1] / s.y[0, -1] - 1) < 1e-3

@@ -229,27 +229,47 @@ contains
         self%reject = .false.
     end subroutine rk_start
 
-    !> Hairer's initial step size (hinit of dopri5.f / dop853.f).
+    !> Hairer's initial step size (hinit of dopri5.f / dop853.f), with scale-safe norms.
     subroutine hinit(self, sys)
         type(rk_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
-        real(dp) :: hh, dnf, dny, der2, der12, h1
+        real(dp) :: hh, dnf, dny, der2, der12, h1, nf, ny
         associate (sk => self%sk, y => self%y, k => self%k, ytmp => self%ytmp)
+            ! Hairer's sums of squares; where they overflow (|f/sk| ~ 1e155), scaled norms
             sk = self%atol + self%rtol*abs(y)
             dnf = sum((k(:, 1)/sk)**2)
             dny = sum((y/sk)**2)
+            if (dnf <= huge(1.0_dp) .and. dny <= huge(1.0_dp)) then
+                nf = sqrt(dnf)
+                ny = sqrt(dny)
+            else
+                ytmp = k(:, 1)/sk
+                nf = scaled_norm(ytmp)
+                ytmp = y/sk
+                ny = scaled_norm(ytmp)
+                dnf = nf**2
+                dny = ny**2
+            end if
             if (dnf <= 1.0e-10_dp .or. dny <= 1.0e-10_dp) then
                 hh = 1.0e-6_dp
-            else
+            else if (dnf <= huge(1.0_dp) .and. dny <= huge(1.0_dp)) then
                 hh = sqrt(dny/dnf)*0.01_dp
+            else
+                hh = (ny/nf)*0.01_dp
             end if
             hh = min(hh, self%hmax)*self%posneg
             ytmp = y + hh*k(:, 1)
             call sys%rhs(self%t + hh, ytmp, k(:, 2))
             self%st%nfev = self%st%nfev + 1
-            der2 = sqrt(sum(((k(:, 2) - k(:, 1))/sk)**2))/abs(hh)
+            der2 = sum(((k(:, 2) - k(:, 1))/sk)**2)
+            if (der2 <= huge(1.0_dp)) then
+                der2 = sqrt(der2)/abs(hh)
+            else if (der2 == der2) then
+                ytmp = (k(:, 2) - k(:, 1))/sk
+                der2 = scaled_norm(ytmp)/abs(hh)
+            end if
             if (der2 /= der2) der2 = huge(1.0_dp)
-            der12 = max(abs(der2), sqrt(dnf))
+            der12 = max(abs(der2), nf)
             if (der12 <= 1.0e-15_dp) then
                 h1 = max(1.0e-6_dp, abs(hh)*1.0e-3_dp)
             else
@@ -258,6 +278,27 @@ contains
             self%h = min(100.0_dp*abs(hh), h1, self%hmax)*self%posneg
         end associate
     end subroutine hinit
+
+    !> Euclidean norm without overflow or underflow: m sqrt(sum((x/m)^2)), m = max|x_i|
+    !! (NaN if x has a NaN). Written out, not NORM2, so that every build rounds alike.
+    pure real(dp) function scaled_norm(x) result(r)
+        real(dp), intent(in) :: x(:)
+        real(dp) :: m, s
+        integer :: i
+        m = 0.0_dp
+        do i = 1, size(x)
+            if (.not. abs(x(i)) <= m) m = abs(x(i))     ! NaN propagates into m
+        end do
+        if (m == 0.0_dp .or. .not. m <= huge(1.0_dp)) then
+            r = m
+            return
+        end if
+        s = 0.0_dp
+        do i = 1, size(x)
+            s = s + (x(i)/m)**2
+        end do
+        r = m*sqrt(s)
+    end function scaled_norm
 
     !> Attempt steps until one is accepted, then advance to its end. `target` is the point
     !! a step lands on if it reaches it (tf, or the next output point; Hairer's rule:
