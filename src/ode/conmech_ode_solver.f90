@@ -35,6 +35,7 @@ module conmech_ode_solver
     public :: METHOD_RK4, METHOD_DOPRI5, METHOD_DOP853, METHOD_VERNER98
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name
+    public :: rk_stepper, rk_init, rk_start, rk_step     ! the stepper, for step-by-step use
 
 contains
 
