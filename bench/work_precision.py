@@ -1,7 +1,10 @@
 """Work-precision diagrams: error against run time over tolerances 1e-4 .. 1e-14 for the
 Arenstorf orbit (one period), Kepler e = 0.9 (one period, error = closure |y(T) - y0|,
-exact) and the double pendulum (angles, t = 10), conmech's methods beside SciPy's and
-heyoka's. The Arenstorf and double-pendulum references are VERNER98 runs at 1e-15, checked
+exact) and the Cartesian double pendulum (t = 10, error in the positions x1, y1, x2, y2),
+conmech's methods beside SciPy's and heyoka's. conmech integrates the double pendulum in
+Cartesian coordinates with its two constraints (conmech.constrained.solve, built-in system,
+position + velocity projection); SciPy and heyoka integrate the same motion in the angles
+(an ODE they can take), mapped to the same positions. The Arenstorf and double-pendulum references are VERNER98 runs at 1e-15, checked
 against heyoka at 1e-16 (Arenstorf's published initial state closes only to ~1e-10, so its
 closure is no reference at tight tolerances).
 
@@ -78,6 +81,19 @@ def f_double(t, y):
     return [w1, w2, a1, a2]
 
 
+def positions(y):
+    """(x1, y1, x2, y2) of the double pendulum from (theta1, theta2, ...), y downwards."""
+    x1, y1 = np.sin(y[0]), -np.cos(y[0])
+    return np.array([x1, y1, x1 + np.sin(y[1]), y1 - np.cos(y[1])])
+
+
+def cartesian_state(y):
+    q = positions(y)
+    vx1, vy1 = y[2] * np.cos(y[0]), y[2] * np.sin(y[0])
+    v = np.array([vx1, vy1, vx1 + y[3] * np.cos(y[1]), vy1 + y[3] * np.sin(y[1])])
+    return q, v
+
+
 def heyoka_system(name):
     if name == "arenstorf":
         x, y, vx, vy = hy.make_vars("x", "y", "vx", "vy")
@@ -118,7 +134,7 @@ PROBLEMS = {
     "kepler": dict(f=f_kepler, builtin=conmech.systems.kepler(), y0=Y0_K, T=T_K,
                    title="Kepler e = 0.9, one period (closure error)"),
     "double_pendulum": dict(f=f_double, builtin=None, y0=Y0_D, T=T_D,
-                            title="double pendulum (angles), t = 10"),
+                            title="Cartesian double pendulum, t = 10 (positions)"),
 }
 
 
@@ -134,21 +150,30 @@ def run_problem(name, p):
         err = float(np.max(np.abs(np.asarray(y) - ref)))
         curves.setdefault(label, []).append((tol, seconds, err))
 
-    fun_c = p["builtin"] if p["builtin"] is not None else p["f"]
-    kind = "built-in" if p["builtin"] is not None else "Python rhs"
+    cart = name == "double_pendulum"
+    if cart:
+        ref = positions(ref)
+        q0, v0 = cartesian_state(p["y0"])
+        sys_xy = conmech.systems.double_pendulum_xy()
     for tol in TOLS:
         for m in ("DOP853", "DOPRI5", "VERNER98"):
             if m == "DOPRI5" and tol < 1e-11:
                 continue
-            s, r = best_time(lambda: conmech.solve_ivp(fun_c, (0, p["T"]), p["y0"], method=m,
-                                                       rtol=tol, atol=tol))
-            add(f"conmech {m} ({kind})", tol, s, r.y[:, -1])
+            if cart:
+                s, r = best_time(lambda: conmech.constrained.solve(
+                    sys_xy, (0, p["T"]), q0, v0, method=m, rtol=tol, atol=tol))
+                add(f"conmech {m} (Cartesian, projected)", tol, s, r.q[:, -1])
+                continue
+            s, r = best_time(lambda: conmech.solve_ivp(p["builtin"], (0, p["T"]), p["y0"],
+                                                       method=m, rtol=tol, atol=tol))
+            add(f"conmech {m} (built-in)", tol, s, r.y[:, -1])
         for m in ("DOP853", "RK45"):
             if m == "RK45" and tol < 1e-11:
                 continue
             s, r = best_time(lambda: si.solve_ivp(p["f"], (0, p["T"]), p["y0"], method=m,
                                                   rtol=tol, atol=tol))
-            add(f"SciPy {m} (Python rhs)", tol, s, r.y[:, -1])
+            y = positions(r.y[:, -1]) if cart else r.y[:, -1]
+            add(f"SciPy {m} (Python rhs{', angles' if cart else ''})", tol, s, y)
         if hy is not None:
             ta = hy.taylor_adaptive(heyoka_system(name if name != "double_pendulum"
                                                   else "double"), p["y0"].copy(), tol=tol)
@@ -159,7 +184,8 @@ def run_problem(name, p):
                 ta.propagate_until(p["T"])
                 return ta.state.copy()
             s, y = best_time(prop)
-            add("heyoka taylor_adaptive (compiled)", tol, s, y)
+            add(f"heyoka taylor_adaptive (compiled{', angles' if cart else ''})", tol, s,
+                positions(y) if cart else y)
     return curves
 
 
