@@ -18,6 +18,7 @@
 !! failure when 0.1|h| <= |t| eps. All state is in the object: thread-safe.
 module conmech_rk_stepper
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+    use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
@@ -552,12 +553,13 @@ contains
     pure logical function all_finite(n, x)
         integer, intent(in) :: n
         real(dp), intent(in) :: x(n)
-        integer :: i, bad
-        bad = 0
+        integer :: i
+        integer(int64) :: bad     ! 64-bit lanes like the compared doubles: no repacking
+        bad = 0_int64
         do i = 1, n
-            if (.not. abs(x(i)) <= huge(1.0_dp)) bad = bad + 1
+            if (.not. abs(x(i)) <= huge(1.0_dp)) bad = bad + 1_int64
         end do
-        all_finite = bad == 0
+        all_finite = bad == 0_int64
     end function all_finite
 
 end module conmech_rk_stepper
