@@ -202,8 +202,10 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state.
-    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4",
-              "Radau" (alias "RADAU5"), "GAUSS4", "GAUSS6"}
+    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4", "Radau"
+              (alias "RADAU5"), "GAUSS4", "GAUSS6"} or a stepper class
+        A stepper class is accepted too: conmech.DOP853, conmech.RK45, ..., and SciPy's
+        scipy.integrate.RK45 / DOP853 (mapped to conmech's counterparts).
         DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
         5(4), dense output of order 4. VERNER98: Verner's 9(8) pair, dense output of
         order 8, for tight tolerances. RK4: classical fixed-step RK4, step ``first_step``.
@@ -271,9 +273,16 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         args = ()
 
     # ---------------------------------------------------------------- method
-    if not isinstance(method, str):
+    if isinstance(method, type):     # a stepper class: conmech.DOP853, scipy.integrate.RK45
+        from ._stepper import method_code
+        code = method_code(method)
+        if code == 0:
+            raise ValueError(f"method {method.__name__} has no counterpart in conmech; use "
+                             f"one of {', '.join(_METHODS)} or conmech.DOP853, ...")
+    elif not isinstance(method, str):
         raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
-    code = _METHOD_CODES.get(method.upper(), 0)
+    else:
+        code = _METHOD_CODES.get(method.upper(), 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
 

@@ -5,6 +5,9 @@
 !! optional: the default `jacobian` is a central finite difference (step
 !! h_j = eps^(1/3) * max(|y_j|, 1)), and `has_jacobian` tells whether an analytic one exists.
 !!
+!! `rhs_jacobian` gives both at once (used by the variational equations); its default calls
+!! `rhs` and `jacobian`, a system may override it to share their common work.
+!!
 !! For simple use, `ode_function` wraps a plain procedure `f(t, y, dydt)` (and optionally
 !! `jac(t, y, dfdy)`) without a derived type of one's own.
 !!
@@ -24,6 +27,7 @@ module conmech_ode_system
         procedure(ode_rhs), deferred :: rhs
         procedure :: jacobian => ode_fd_jacobian
         procedure :: has_jacobian => ode_no_jacobian
+        procedure :: rhs_jacobian => ode_rhs_jacobian
     end type ode_system
 
     abstract interface
@@ -124,6 +128,17 @@ contains
             dfdy(:, j) = (fp - fm)/(2.0_dp*h)
         end do
     end subroutine ode_fd_jacobian
+
+    !> f and df/dy at one point (default: `rhs`, then `jacobian`).
+    subroutine ode_rhs_jacobian(self, t, y, dydt, dfdy)
+        class(ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        call self%rhs(t, y, dydt)
+        call self%jacobian(t, y, dfdy)
+    end subroutine ode_rhs_jacobian
 
     logical function ode_no_jacobian(self)
         class(ode_system), intent(in) :: self

@@ -31,20 +31,80 @@ module conmech_variational
 
 contains
 
+    !> z' = [f(t, y); vec(J Phi)], f and J from the system's `rhs_jacobian` (one call, so a
+    !! system may share their common work). J lives in a fixed-size stack buffer for
+    !! n <= NSMALL (no allocation per evaluation). The product J Phi is one matrix product
+    !! in column-axpy form, structure-aware for the first-order form of a mechanical system
+    !! (J = [0 I; A B], detected per call: the top half of J Phi is then the bottom half of
+    !! Phi, and only [A B] Phi is computed); loops of constant length for n = 2, 4, 6.
     subroutine var_rhs(self, t, y, dydt)
         class(variational_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dydt(:)
-        real(dp) :: jac(self%n, self%n)
-        integer :: n, j
+        integer, parameter :: NSMALL = 16
+        real(dp) :: jsmall(NSMALL, NSMALL)
+        real(dp), allocatable :: jbig(:, :)
+        integer :: n
         n = self%n
-        call self%base%rhs(t, y(1:n), dydt(1:n))
-        call self%base%jacobian(t, y(1:n), jac)
-        do j = 1, n
-            dydt(n*j + 1:n*j + n) = matmul(jac, y(n*j + 1:n*j + n))
-        end do
+        if (n <= NSMALL) then
+            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jsmall(1:n, 1:n))
+            select case (n)
+            case (2)
+                call product2(NSMALL, jsmall, y, dydt)
+            case (4)
+                call product4(NSMALL, jsmall, y, dydt)
+            case (6)
+                call product6(NSMALL, jsmall, y, dydt)
+            case default
+                call product_n(n, NSMALL, jsmall, y, dydt)
+            end select
+        else
+            allocate (jbig(n, n))
+            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jbig)
+            call product_n(n, n, jbig, y, dydt)
+        end if
     end subroutine var_rhs
+
+    !> dydt(n+1:) = vec(jac(1:n, 1:n) Phi), Phi = reshape(y(n+1:), [n, n]): n = 2, 4, 6, any.
+    pure subroutine product2(ld, jac, y, dydt)
+        integer, parameter :: n = 2
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product2
+
+    pure subroutine product4(ld, jac, y, dydt)
+        integer, parameter :: n = 4
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product4
+
+    pure subroutine product6(ld, jac, y, dydt)
+        integer, parameter :: n = 6
+        integer, intent(in) :: ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product6
+
+    pure subroutine product_n(n, ld, jac, y, dydt)
+        integer, intent(in) :: n, ld
+        real(dp), intent(in) :: jac(ld, n), y(:)
+        real(dp), intent(inout) :: dydt(:)
+        integer :: i, j, l, m
+        logical :: mech
+        include "conmech_stm_product_body.inc"
+    end subroutine product_n
 
     !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
     !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.

@@ -1,0 +1,83 @@
+!> Options, counters and method codes of conmech's integrators (shared by the stepper, the
+!! drivers `ode_solve` / `ode_integrate` and the flat layer).
+!!
+!! Method codes 1-4 are the explicit Runge-Kutta methods; codes 5 and above are reserved
+!! for the implicit families (Radau IIA, Gauss).
+module conmech_ode_options
+    use conmech_kinds, only: dp
+    implicit none
+    private
+
+    integer, parameter, public :: METHOD_RK4 = 1     !! classical RK4, fixed step
+    integer, parameter, public :: METHOD_DOPRI5 = 2  !! Dormand-Prince 5(4), dense order 4
+    integer, parameter, public :: METHOD_DOP853 = 3  !! Dormand-Prince 8(5,3), dense order 7
+    integer, parameter, public :: METHOD_VERNER98 = 4 !! Verner 9(8), dense order 8
+    ! implicit methods (conmech_radau, conmech_gauss; reached through implicit_solve)
+    integer, parameter, public :: METHOD_RADAU5 = 5  !! Radau IIA order 5, stiff, adaptive
+    integer, parameter, public :: METHOD_GAUSS4 = 6  !! Gauss-Legendre s = 2, fixed step
+    integer, parameter, public :: METHOD_GAUSS6 = 7  !! Gauss-Legendre s = 3, fixed step
+    integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (rattle_solve)
+
+    public :: ode_options, ode_stats, method_from_name
+
+    !> Options of the integrators. Zero means "use the method's default" for
+    !! first_step, safety, fac_min, fac_max; beta < 0 means the default.
+    type :: ode_options
+        integer :: method = METHOD_DOP853
+        real(dp) :: rtol = 1.0e-3_dp               !! relative tolerance (scalar)
+        real(dp) :: atol = 1.0e-6_dp               !! absolute tolerance (scalar)
+        real(dp), allocatable :: rtol_vec(:)       !! per-component rtol (overrides rtol)
+        real(dp), allocatable :: atol_vec(:)       !! per-component atol (overrides atol)
+        real(dp) :: first_step = 0.0_dp            !! initial step (RK4: the step); 0 = auto
+        real(dp) :: max_step = huge(1.0_dp)        !! largest |h|
+        integer :: max_steps = 100000              !! attempted steps before giving up
+        real(dp) :: safety = 0.0_dp                !! Hairer's safe (default 0.9)
+        real(dp) :: fac_min = 0.0_dp               !! smallest step ratio hnew/h
+        real(dp) :: fac_max = 0.0_dp               !! largest step ratio hnew/h
+        real(dp) :: beta = -1.0_dp                 !! Lund stabilisation exponent
+        logical :: dense_output = .false.          !! keep a dense_solution in the result
+        logical :: save_steps = .true.             !! without t_eval: store every step
+        logical :: hit_t_eval = .false.            !! shorten steps to land on t_eval points
+                                                   !! (outputs are step ends, not interpolated)
+    end type ode_options
+
+    !> Counters of one integration.
+    type :: ode_stats
+        integer :: nfev = 0       !! right-hand side evaluations
+        integer :: naccept = 0    !! accepted steps
+        integer :: nreject = 0    !! rejected steps
+        real(dp) :: h_next = 0.0_dp   !! step size proposed for a continuation
+        integer :: njev = 0       !! Jacobian evaluations (implicit methods)
+        integer :: nlu = 0        !! LU decompositions (implicit methods)
+    end type ode_stats
+
+contains
+
+    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98",
+    !! "RADAU5"/"Radau", "GAUSS4", "GAUSS6", "RATTLE"; 0 if unknown.
+    pure function method_from_name(name) result(m)
+        character(len=*), intent(in) :: name
+        integer :: m
+        select case (trim(adjustl(name)))
+        case ("RK4", "rk4")
+            m = METHOD_RK4
+        case ("DOPRI5", "dopri5", "RK45", "rk45")
+            m = METHOD_DOPRI5
+        case ("DOP853", "dop853")
+            m = METHOD_DOP853
+        case ("VERNER98", "verner98", "RKV98", "rkv98", "Vern9")
+            m = METHOD_VERNER98
+        case ("RADAU5", "radau5", "Radau", "RADAU", "radau")
+            m = METHOD_RADAU5
+        case ("GAUSS4", "gauss4")
+            m = METHOD_GAUSS4
+        case ("GAUSS6", "gauss6")
+            m = METHOD_GAUSS6
+        case ("RATTLE", "rattle")
+            m = METHOD_RATTLE
+        case default
+            m = 0
+        end select
+    end function method_from_name
+
+end module conmech_ode_options
