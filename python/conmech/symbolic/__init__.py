@@ -313,14 +313,23 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
 
-    q : dynamicsymbols (functions of t), or plain Symbols with ``velocities=[...]``.
-    forces : optional generalized non-conservative forces, one expression per coordinate
-             (in t, q, q' and the parameters).
-    params : dict {Symbol or name: value}.
-    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, part by
-               part: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
-    jacobian : generate the exact Jacobian of the accelerations (forces_jac); False saves
-               derivation and compile time for large systems that are only integrated.
+    Parameters
+    ----------
+    L : sympy expression
+        The Lagrangian T - U.
+    q : list
+        dynamicsymbols (functions of t), or plain Symbols with ``velocities=[...]``.
+    params : dict
+        {Symbol or name: value}.
+    forces : list, optional
+        Generalized non-conservative forces, one expression per coordinate (in t, q, q'
+        and the parameters).
+    simplify : True, False or "auto"
+        "auto": a fast trigonometric clean-up of L first, part by part (sin^2 + cos^2 = 1,
+        cos a cos b + sin a sin b = cos(a - b)).
+    jacobian : bool
+        Generate the exact Jacobian of the accelerations (forces_jac); False saves
+        derivation and compile time for large systems that are only integrated.
     """
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
                       (simplify, bool(jacobian)),
