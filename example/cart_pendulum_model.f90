@@ -66,14 +66,12 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: mm(:, :)
-        real(dp) :: w1, w2, w3
-        w1 = cos(q(2))
-        w2 = self%l*self%m*w1
-        w3 = 2.0_dp*self%l**2
+        real(dp) :: w1
+        w1 = self%l*self%m*cos(q(2))
         mm(1, 1) = self%m + self%mc
-        mm(2, 1) = w2
-        mm(1, 2) = w2
-        mm(2, 2) = (0.5_dp)*self%m*(w1**2*w3 + w3*sin(q(2))**2)
+        mm(2, 1) = w1
+        mm(1, 2) = w1
+        mm(2, 2) = self%l**2*self%m
     end subroutine cart_pendulum_sym_mech_mass
 
     !> f = Q(t, q, v).
@@ -83,18 +81,10 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(in) :: v(:)
         real(dp), intent(out) :: f(:)
-        real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9
-        w1 = v(2)**2
-        w2 = sin(q(2))
-        w3 = self%l*w2
-        w4 = self%m*w3
-        w5 = v(2)*self%l
-        w6 = cos(q(2))
-        w7 = 2.0_dp*v(1) + 2.0_dp*w5*w6
-        w8 = 2.0_dp*self%l**2*w2*w6
-        w9 = (0.5_dp)*self%m
-        f(1) = w1*w4
-        f(2) = -v(2)*w9*(v(2)*w8 - w3*w7) + self%g*w4 + w9*(w1*w8 - w2*w5*w7)
+        real(dp) :: w1
+        w1 = self%l*self%m*sin(q(2))
+        f(1) = v(2)**2*w1
+        f(2) = self%g*w1
     end subroutine cart_pendulum_sym_mech_forces
 
     !> The energy (Jacobi integral).
@@ -104,12 +94,11 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(in) :: v(:)
         real(dp) :: e
-        real(dp) :: w1, w2, w3, w4
+        real(dp) :: w1, w2
         w1 = (0.5_dp)*v(1)**2
-        w2 = cos(q(2))
-        w3 = self%l*self%m*w2
-        w4 = (0.5_dp)*v(2)**2*self%l**2*self%m
-        e = v(2)*v(1)*w3 + self%g*w3 + self%m*w1 + self%mc*w1 + w2**2*w4 + w4*sin(q(2))**2
+        w2 = self%l*self%m*cos(q(2))
+        e = (0.5_dp)*v(2)**2*self%l**2*self%m + v(2)*v(1)*w2 + self%g*w2 + self%m*w1 +&
+            & self%mc*w1
     end function cart_pendulum_sym_mech_energy
 
     !> The energy is defined.
@@ -128,25 +117,16 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: mm(2, 2), a(2)
         integer :: info
-        real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9, w10
-        real(dp) :: w11
-        w1 = cos(y(2))
-        w2 = self%l*w1
-        w3 = self%m*w2
-        w4 = 2.0_dp*self%l**2
-        w5 = sin(y(2))
-        w6 = (0.5_dp)*self%m
-        w7 = y(4)**2
-        w8 = self%l*w5
-        w9 = self%m*w8
-        w10 = 2.0_dp*w8*(y(4)*w2 + y(3))
-        w11 = w1*w4*w5
+        real(dp) :: w1, w2, w3
+        w1 = self%l*self%m
+        w2 = w1*cos(y(2))
+        w3 = w1*sin(y(2))
         mm(1, 1) = self%m + self%mc
-        mm(2, 1) = w3
-        mm(1, 2) = w3
-        mm(2, 2) = w6*(w1**2*w4 + w4*w5**2)
-        a(1) = w7*w9
-        a(2) = -y(4)*w6*(y(4)*w11 - w10) + self%g*w9 + w6*(-y(4)*w10 + w11*w7)
+        mm(2, 1) = w2
+        mm(1, 2) = w2
+        mm(2, 2) = self%l**2*self%m
+        a(1) = y(4)**2*w3
+        a(2) = self%g*w3
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
             a = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -167,26 +147,17 @@ contains
         real(dp), intent(out) :: dfdy(:, :)
         real(dp) :: mm(2, 2), a(2), r(2, 4)
         integer :: info, i
-        real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9, w10
-        real(dp) :: w11
-        real(dp) :: u1, u2, u3, u4, u5, u6, u7, u8, u9
-        w1 = cos(y(2))
-        w2 = self%l*w1
-        w3 = self%m*w2
-        w4 = 2.0_dp*self%l**2
-        w5 = sin(y(2))
-        w6 = (0.5_dp)*self%m
-        w7 = y(4)**2
-        w8 = self%l*w5
-        w9 = self%m*w8
-        w10 = 2.0_dp*w8*(y(4)*w2 + y(3))
-        w11 = w1*w4*w5
+        real(dp) :: w1, w2, w3
+        real(dp) :: u1, u2, u3
+        w1 = self%l*self%m
+        w2 = w1*cos(y(2))
+        w3 = w1*sin(y(2))
         mm(1, 1) = self%m + self%mc
-        mm(2, 1) = w3
-        mm(1, 2) = w3
-        mm(2, 2) = w6*(w1**2*w4 + w4*w5**2)
-        a(1) = w7*w9
-        a(2) = -y(4)*w6*(y(4)*w11 - w10) + self%g*w9 + w6*(-y(4)*w10 + w11*w7)
+        mm(2, 1) = w2
+        mm(1, 2) = w2
+        mm(2, 2) = self%l**2*self%m
+        a(1) = y(4)**2*w3
+        a(2) = self%g*w3
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
             dfdy = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -194,18 +165,12 @@ contains
         end if
         call dpotrs('U', 2, 1, mm, 2, a, 2, info)
         r = 0.0_dp
-        u1 = y(4)**2
-        u2 = cos(y(2))
-        u3 = self%l*u2
-        u4 = self%m*u3
-        u5 = self%l*self%m*sin(y(2))
-        u6 = 2.0_dp*self%l**2*u2**2
-        u7 = y(4)*u3
-        u8 = 2.0_dp*y(3) + 2.0_dp*u7
-        u9 = (0.5_dp)*self%m
-        r(1, 2) = a(2)*u5 + u1*u4
-        r(2, 2) = -y(4)*u9*(y(4)*u6 - u3*u8) + a(1)*u5 + self%g*u4 + u9*(u1*u6 - u7*u8)
-        r(1, 4) = 2.0_dp*y(4)*u5
+        u1 = self%l*self%m
+        u2 = u1*cos(y(2))
+        u3 = u1*sin(y(2))
+        r(1, 2) = y(4)**2*u2 + a(2)*u3
+        r(2, 2) = a(1)*u3 + self%g*u2
+        r(1, 4) = 2.0_dp*y(4)*u3
         call dpotrs('U', 2, 4, mm, 2, r, 2, info)
         dfdy = 0.0_dp
         do i = 1, 2
@@ -226,12 +191,11 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp) :: e
-        real(dp) :: w1, w2, w3, w4
+        real(dp) :: w1, w2
         w1 = (0.5_dp)*y(3)**2
-        w2 = cos(y(2))
-        w3 = self%l*self%m*w2
-        w4 = (0.5_dp)*y(4)**2*self%l**2*self%m
-        e = y(4)*y(3)*w3 + self%g*w3 + self%m*w1 + self%mc*w1 + w2**2*w4 + w4*sin(y(2))**2
+        w2 = self%l*self%m*cos(y(2))
+        e = (0.5_dp)*y(4)**2*self%l**2*self%m + y(4)*y(3)*w2 + self%g*w2 + self%m*w1 +&
+            & self%mc*w1
     end function cart_pendulum_sym_energy
 
 end module cart_pendulum_model

@@ -10,6 +10,8 @@ module conmech
     use conmech_systems_basic
     use conmech_systems
     use conmech_generalized
+    use conmech_c_system
+    use conmech_c_mechanics
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_systems_generalized

@@ -393,8 +393,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     probe_calls = 0
     if builtin:
         nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
-            fun.name, fun.params.size, fun.params if fun.params.size else _PAD, events_cb,
-            store, **common)
+            *fun._flat_args(), events_cb, store, **common)
     else:
         # One probe call checks the shape of fun's output and gives a clear error.
         f0 = np.asarray(fun(t0, y0.copy(), *args))

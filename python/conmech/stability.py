@@ -96,9 +96,8 @@ def equilibrium(system, y, t=0.0, tol=1e-8):
     _check_dim(system, y)
     n = y.size
     if isinstance(system, BuiltinSystem):
-        out = _conmech.flat_equilibrium_builtin(system.name, system.params.size,
-                                                _params(system), y,
-                                                float(t), float(tol))
+        out = _conmech.flat_equilibrium_builtin(*system._flat_args(), y, float(t),
+                                                float(tol))
     else:
         out = _conmech.flat_equilibrium_callback(_callback(system, n), y, float(t),
                                                  float(tol))
@@ -134,8 +133,7 @@ def stm(system, t_span, y0, rtol=1e-12, atol=1e-12):
     t0, t1 = (float(v) for v in t_span)
     if isinstance(system, BuiltinSystem):
         y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
-            system.name, system.params.size, _params(system), y0, t0, t1,
-            float(rtol), float(atol))
+            *system._flat_args(), y0, t0, t1, float(rtol), float(atol))
     else:
         y1, phi, nfev, info, message = _conmech.flat_stm_callback(
             _callback(system, y0.size), y0, t0, t1, float(rtol), float(atol))
@@ -204,8 +202,7 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     args = (y0, period, kind, mode, nfree, fr, ntg, tg, int(bool(free_time)),
             float(period_factor), float(rtol), float(atol), int(max_iter))
     if isinstance(system, BuiltinSystem):
-        out = _conmech.flat_orbit_builtin(system.name, system.params.size,
-                                          _params(system), *args)
+        out = _conmech.flat_orbit_builtin(*system._flat_args(), *args)
     else:
         out = _conmech.flat_orbit_callback(_callback(system, y0.size), *args)
     y0o, po, mono, mr, mi, residual, iterations, info, message = out

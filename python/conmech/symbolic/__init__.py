@@ -1,5 +1,316 @@
-"""conmech.symbolic (in progress)."""
+"""conmech.symbolic: your own system from formulas, a Lagrangian or constraints, compiled.
 
-# exactness of Pfaffian constraints (holonomic or not; integrating factors)
-from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: E402,F401
+Three constructors derive the equations with sympy (exact Jacobians, common-subexpression
+elimination), emit Fortran with the C ABI of conmech's compiled systems, compile it with
+gfortran into an on-disk cache (``$CONMECH_CACHE``, default ``~/.cache/conmech``) and load
+it; the result runs in :func:`conmech.solve_ivp`, ``conmech.stability.*`` and (constrained)
+``conmech.constrained.solve`` with no Python in the loop:
+
+- :func:`ode_system` (y' = f(t, y, p), exact df/dy),
+- :func:`lagrangian_system` (generalized coordinates, L = T - U, optional forces),
+- :func:`constrained_system` (excessive coordinates, T, U, holonomic and Pfaffian
+  constraints, rheonomic detected).
+
+Parameters are run-time values: ``system.with_params(m=2.0)`` gives a copy without
+recompiling. Example (the cart pendulum of seed 000)::
+
+    import sympy as sp
+    from sympy.physics.mechanics import dynamicsymbols
+    from conmech import symbolic
+    t = dynamicsymbols._t
+    x, th = dynamicsymbols("x theta")
+    M, m, l, g = sp.symbols("M m l g")
+    T = (M + m)*x.diff(t)**2/2 + m*l*sp.cos(th)*x.diff(t)*th.diff(t) + m*l**2*th.diff(t)**2/2
+    U = m*g*l*sp.cos(th)
+    cart = symbolic.lagrangian_system(T - U, [x, th], params={M: 1, m: 1, l: 1, g: 9.81})
+
+Layout: ``derive.py`` (pure sympy, the :class:`~conmech.symbolic.derive.Derived` record),
+``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), this file (the
+public constructors).
+"""
+import ctypes
+import hashlib
+import os
+import pickle
+import time
+
+import numpy as np
+import sympy as sp
+
+from .build import CompileError, _conmech_version, cache_dir, compile_source, load
+from .codegen import CODEGEN_VERSION, generate
+from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
+
+__all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
+           "CompileError", "cache_dir", "Derived", "compile_model", "model_of"]
+
+_D = ctypes.c_double
+_P = ctypes.POINTER(ctypes.c_double)
+# argument layouts of the C ABI (after t): number of input arrays, output arrays
+_SIG = {
+    "rhs": ("in1", "out1"), "jac": ("in1", "out1"),
+    "mass": ("in1", "out1"), "forces": ("in2", "out1"), "forces_jac": ("in3", "out1"),
+    "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
+    "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
+    "nh_gamma": ("in2", "out1"),
+}
+
+
+class CompiledModel:
+    """A derived system compiled and loaded: the library, the entry-point addresses, the
+    generated source, and timings (``times``: derive, generate, compile_or_load, load;
+    ``cache_hit``). :meth:`call` evaluates an entry point through ctypes (for tests)."""
+
+    def __init__(self, derived, source, path, lib, addresses, cache_hit, times):
+        self.derived = derived
+        self.source = source
+        self.path = path
+        self.lib = lib
+        self.addresses = addresses
+        self.cache_hit = cache_hit
+        self.times = times
+
+    @property
+    def kind(self):
+        return self.derived.kind
+
+    def _shapes(self, entry):
+        d = self.derived
+        n, h, k = d.n, d.n_hol, d.n_nh
+        return {"rhs": [(n,)], "jac": [(n, n)], "mass": [(n, n)], "forces": [(n,)],
+                "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
+                "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
+                "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)]}[entry]
+
+    def call(self, entry, t, *arrays, params=None):
+        """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
+        (y; q; q, v; q, v, a), with the model's parameters or `params`."""
+        if entry not in self.addresses:
+            raise ValueError(f"this model has no entry point '{entry}' "
+                             f"(has: {', '.join(self.addresses)})")
+        p = np.ascontiguousarray(self.derived.param_values if params is None else params,
+                                 dtype=float)
+        if p.size == 0:
+            p = np.zeros(1)
+        ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
+        n = self.derived.n
+        for a in ins:
+            if a.shape != (n,):
+                raise ValueError(f"input arrays must have shape ({n},), got {a.shape}")
+        outs = [np.zeros(s, order="F") for s in self._shapes(entry)]
+        kind = _SIG[entry][1]
+        restype = _D if kind == "ret" else None
+        fn = ctypes.CFUNCTYPE(restype, _D, *([_P] * (len(ins) + len(outs) + 1)))(
+            self.addresses[entry])
+        ptr = [a.ctypes.data_as(_P) for a in ins + outs + [p]]
+        r = fn(float(t), *ptr)
+        if kind == "ret":
+            return float(r)
+        return outs[0] if len(outs) == 1 else tuple(outs)
+
+
+def compile_model(derived, flags=None):
+    """Generate, compile (or take from the cache) and load the Fortran of `derived`."""
+    t0 = time.perf_counter()
+    src, entries = generate(derived)
+    t1 = time.perf_counter()
+    path, hit = compile_source(src, flags)
+    t2 = time.perf_counter()
+    lib, addr = load(path, entries)
+    t3 = time.perf_counter()
+    times = {"generate": t1 - t0, "compile_or_load": t2 - t1, "load": t3 - t2}
+    return CompiledModel(derived, src, path, lib, addr, hit, times)
+
+
+def model_of(system):
+    """The :class:`CompiledModel` (derived expressions, source, library) behind a system
+    made by this module (also after ``with_params``)."""
+    keep = getattr(system, "_keep", None)
+    if isinstance(system, CompiledModel):
+        return system
+    if isinstance(keep, tuple) and keep and isinstance(keep[0], CompiledModel):
+        return keep[0]
+    raise TypeError("not a system made by conmech.symbolic")
+
+
+def _compiled_module():
+    try:
+        from .. import compiled
+    except ImportError:
+        return None
+    return compiled
+
+
+def _system(model):
+    """The conmech.compiled system for a model (or the model itself when the compiled
+    module is not available in this build)."""
+    compiled = _compiled_module()
+    d = model.derived
+    if compiled is None:
+        return model
+    a = model.addresses
+    common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model,
+                  name="symbolic")
+    if d.kind == "ode":
+        return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], **common)
+    if d.kind == "generalized":
+        return compiled.generalized_system(d.n, a["mass"], a["forces"],
+                                           forces_jac=a.get("forces_jac"),
+                                           energy=a.get("energy"), **common)
+    return compiled.constrained_system(
+        d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
+        phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
+        nh_matrix=a.get("nh_matrix"), nh_gamma=a.get("nh_gamma"), energy=a.get("energy"),
+        rheonomic=bool(d.rheonomic), **common)
+
+
+def _input_key(kind, inputs, params, options):
+    """Key of a construction's inputs (expressions, parameter names, options), or None when
+    the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
+    if not isinstance(params, dict):
+        return None
+    names = []
+    for k, v in params.items():
+        if isinstance(k, sp.Symbol):
+            names.append(k.name)
+        elif isinstance(k, str):
+            names.append(k)
+        else:
+            return None
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+            return None
+    try:
+        text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
+                            for x in inputs], names, options, CODEGEN_VERSION,
+                     _conmech_version()))
+    except (sp.SympifyError, TypeError, AttributeError):
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _entry_path(key):
+    return os.path.join(cache_dir(), f"conmech_{key}.derived.pickle")
+
+
+def _from_cache(key, params, flags):
+    """The model from the derivation cache (derived record + source), or None."""
+    path = _entry_path(key)
+    if not os.path.isfile(path):
+        return None
+    t0 = time.perf_counter()
+    try:
+        with open(path, "rb") as fh:
+            d, src, entries, fl = pickle.load(fh)
+    except Exception:        # a stale or foreign entry: derive again
+        return None
+    if fl != (list(flags) if flags is not None else None):
+        return None
+    d.param_values = [float(v) for v in params.values()]
+    if len(d.param_values) != len(d.param_names) or not np.all(np.isfinite(d.param_values)):
+        return None
+    t1 = time.perf_counter()
+    lib_path, hit = compile_source(src, flags)
+    t2 = time.perf_counter()
+    lib, addr = load(lib_path, entries)
+    t3 = time.perf_counter()
+    times = {"derive": 0.0, "derived_cache": t1 - t0, "generate": 0.0,
+             "compile_or_load": t2 - t1, "load": t3 - t2}
+    return CompiledModel(d, src, lib_path, lib, addr, hit, times)
+
+
+def _store(key, model, flags):
+    path = _entry_path(key)
+    d = model.derived
+    tmp = f"{path}.{os.getpid()}.tmp"
+    try:
+        with open(tmp, "wb") as fh:
+            pickle.dump((d, model.source, list(model.addresses),
+                         list(flags) if flags is not None else None), fh)
+        os.replace(tmp, path)
+    except Exception:        # the derivation cache is an optimisation only
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
+def _construct(kind, inputs, params, options, derive, flags, model_only):
+    """Derive (or take the derivation from the cache), compile (or load), wrap."""
+    t0 = time.perf_counter()
+    params = {} if params is None else params
+    key = _input_key(kind, inputs, params, options)
+    model = _from_cache(key, params, flags) if key else None
+    if model is None:
+        d = derive()
+        t1 = time.perf_counter()
+        model = compile_model(d, flags)
+        model.times["derive"] = t1 - t0
+        if key:
+            _store(key, model, flags)
+    model.times["total"] = time.perf_counter() - t0
+    return model if model_only else _system(model)
+
+
+def ode_system(f, y, params=None, *, flags=None, model_only=False):
+    """A compiled first-order system y' = f(t, y, p) with its exact Jacobian df/dy.
+
+    f : list of sympy expressions (one per state variable), in t, y and the parameters.
+    y : list of sympy Symbols (or dynamicsymbols), the state variables.
+    params : dict {Symbol or name: value}; every other free symbol is an error.
+    Returns a ``conmech.compiled`` system (``model_only=True``: the :class:`CompiledModel`).
+    """
+    return _construct("ode", [_tup(f), _tup(y)], params, (), lambda: derive_ode(f, y, params),
+                      flags, model_only)
+
+
+def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
+                      flags=None, model_only=False):
+    """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
+    the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
+    (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
+
+    q : dynamicsymbols (functions of t), or plain Symbols with ``velocities=[...]``.
+    forces : optional generalized non-conservative forces, one expression per coordinate
+             (in t, q, q' and the parameters).
+    params : dict {Symbol or name: value}.
+    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, when L is
+               small enough: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
+    """
+    return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
+                      (simplify,),
+                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify),
+                      flags, model_only)
+
+
+def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
+                       velocities=None, simplify="auto", flags=None, model_only=False):
+    """A compiled system in excessive coordinates for ``conmech.constrained.solve``:
+    kinetic energy T, potential U, holonomic constraints phi(t, q) = 0 and non-holonomic
+    constraints given as expressions linear in the velocities (A(t, q) q' + b(t, q) = 0).
+    Derives M, Q, G = d phi/dq, phi_t, gamma_h, A, b, gamma_n and the energy T + U (Jacobi
+    integral); rheonomic constraints (explicit t) are detected.
+    """
+    return _construct("constrained", [T, U, _tup(q), _tup(holonomic), _tup(nonholonomic),
+                                      _tup(forces), _tup(velocities)], params, (simplify,),
+                      lambda: derive_constrained(T, U, q, holonomic, nonholonomic, params,
+                                                 forces, velocities, simplify),
+                      flags, model_only)
+
+
+def _tup(x):
+    """A sympy Tuple of a list of expressions (for the input key)."""
+    if x is None:
+        return None
+    if isinstance(x, sp.MatrixBase):
+        x = list(x)
+    if isinstance(x, (list, tuple)):
+        return sp.Tuple(*x)
+    return x
+
+
+# exactness of Pfaffian constraints: holonomic or not, integrating factor, integral
+from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: E402
                        pfaffian_from_velocities, pfaffian_system)
+
+__all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "PfaffianResult",
+            "PfaffianSystemResult"]

@@ -27,7 +27,8 @@ import keyword
 import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
-__all__ = ["FortranPrinter", "assignments", "generate", "prepare", "ENTRY_POINTS"]
+__all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
+           "ENTRY_POINTS"]
 
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
@@ -36,6 +37,9 @@ ENTRY_POINTS = {
     "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
                     "nh_matrix", "nh_gamma"],
 }
+
+#: bump when the generated code or the derivation changes (invalidates the derivation cache)
+CODEGEN_VERSION = "1"
 
 _SQRT = sp.Function("cm_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 

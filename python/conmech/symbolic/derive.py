@@ -203,11 +203,6 @@ class _Coords:
         return out
 
 
-def _time_symbol(exprs):
-    """The time symbol: the free symbol named 't' (the same as dynamicsymbols._t)."""
-    return sp.Symbol("t")
-
-
 def _unify_time(exprs, t):
     """Replace every free symbol named 't' (whatever its assumptions) by t."""
     out = []
@@ -347,7 +342,7 @@ def _euler_lagrange(L, q, v, t):
         dpdt = sum((sp.diff(p[i], q[j]) * v[j] for j in range(n)), sp.Integer(0)) \
             + sp.diff(p[i], t)
         Q.append(sp.diff(L, q[i]) - dpdt)
-    return M, sp.Matrix(Q), p
+    return M, sp.Matrix(Q)
 
 
 def _energy(L, M, v):
@@ -355,6 +350,27 @@ def _energy(L, M, v):
     (T + U for a natural scleronomic system)."""
     vv = sp.Matrix(v)
     return sp.expand((vv.T * M * vv)[0, 0] / 2) - L.xreplace({vi: 0 for vi in v})
+
+
+def _cheap_simplify(expr):
+    """Fast trigonometric clean-up of a Lagrangian: expand, sin(x)^2 -> 1 - cos(x)^2 (so
+    that cos^2 + sin^2 cancels), then cos a cos b + sin a sin b -> cos(a - b) (fu's TR10i)."""
+    from sympy.simplify.fu import TR10i
+    e = sp.expand(expr)
+    e = e.replace(lambda u: u.is_Pow and u.exp == 2 and isinstance(u.base, sp.sin),
+                  lambda u: 1 - sp.cos(u.base.args[0])**2)
+    e = sp.expand(e)
+    return TR10i(e)
+
+
+def _maybe_simplify(expr, simplify):
+    """simplify: True, False or "auto" (only when the expression is small enough for the
+    clean-up to take well under a few seconds)."""
+    if simplify is True or (simplify == "auto" and sp.count_ops(expr) <= 600):
+        return _cheap_simplify(expr)
+    if simplify not in (True, False, "auto"):
+        raise ValueError(f"simplify must be True, False or 'auto', got {simplify!r}")
+    return expr
 
 
 def _forces_list(forces, n, what="forces"):
@@ -366,8 +382,10 @@ def _forces_list(forces, n, what="forces"):
     return fl
 
 
-def derive_lagrangian(L, q, params=None, forces=None, velocities=None):
-    """M q'' = Q from the Lagrangian L(t, q, q'); optional generalized forces."""
+def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify="auto"):
+    """M q'' = Q from the Lagrangian L(t, q, q'); optional generalized forces.
+    ``simplify`` (True, False, "auto") cleans L up first (sin^2 + cos^2 = 1, products of
+    sines and cosines into cosines of differences) so that M and Q come out compact."""
     t = sp.Symbol("t")
     c = _Coords(q, velocities, t, need_speeds=True)
     n = len(c.plain)
@@ -379,8 +397,8 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None):
     known = list(c.plain) + list(c.speeds)
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
-    Lp, fq = exprs[0], exprs[1:]
-    M, Q, mom = _euler_lagrange(Lp, c.plain, c.speeds, t)
+    Lp, fq = _maybe_simplify(exprs[0], simplify), exprs[1:]
+    M, Q = _euler_lagrange(Lp, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
     Ma = M * sp.Matrix(c.accels)
@@ -402,7 +420,7 @@ def _check_no_accel(exprs, c):
 # ------------------------------------------------------------------------------ constrained
 
 def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None,
-                       velocities=None):
+                       velocities=None, simplify="auto"):
     """Excessive coordinates q with L = T - U, holonomic phi(t, q) = 0 and Pfaffian
     constraints given as expressions linear in the velocities (A q' + b = 0)."""
     t = sp.Symbol("t")
@@ -426,8 +444,8 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     nh = exprs[2 + n + len(hol):]
     if Up.free_symbols & set(c.speeds):
         raise ValueError("U must not depend on the velocities")
-    L = Tp - Up
-    M, Q, mom = _euler_lagrange(L, c.plain, c.speeds, t)
+    L = _maybe_simplify(Tp - Up, simplify)
+    M, Q = _euler_lagrange(L, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
     energy = _energy(L, M, c.speeds)
