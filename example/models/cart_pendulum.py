@@ -16,7 +16,8 @@ from conmech.symbolic.derive import derive_lagrangian
 name = "cart_pendulum_sym"   # the Fortran type (module: the output file's stem)
 
 
-def model():
+def inputs():
+    """(L, q, params): also for conmech.symbolic.lagrangian_system(*inputs())."""
     x, th = dynamicsymbols("x theta")
     t = dynamicsymbols._t
     mc, m, l, g = sp.symbols("mc m l g", positive=True)   # mc: the cart's mass M
@@ -24,4 +25,9 @@ def model():
     T = mc * xd ** 2 / 2 + m * ((xd + l * sp.cos(th) * thd) ** 2
                                 + (l * sp.sin(th) * thd) ** 2) / 2
     U = m * g * l * sp.cos(th)
-    return derive_lagrangian(T - U, [x, th], params={mc: 1.0, m: 1.0, l: 1.0, g: 9.81})
+    return T - U, [x, th], {mc: 1.0, m: 1.0, l: 1.0, g: 9.81}
+
+
+def model():
+    L, q, params = inputs()
+    return derive_lagrangian(L, q, params=params)

@@ -17,7 +17,8 @@ from conmech.symbolic.derive import derive_constrained
 name = "rolling_ball_sym"
 
 
-def model():
+def inputs():
+    """Keyword arguments of conmech.symbolic.constrained_system(**inputs())."""
     x, y, e0, e1, e2, e3 = q = sp.symbols("x y e0 e1 e2 e3")
     v = sp.symbols("xd yd e0d e1d e2d e3d")
     m, R, I, g, alpha = sp.symbols("m R I g alpha")
@@ -26,7 +27,10 @@ def model():
     w = 2 * H * ed
     T = m / 2 * (v[0] ** 2 + v[1] ** 2) + 2 * I * (ed.T * ed)[0, 0]
     U = -m * g * sp.sin(alpha) * x
-    return derive_constrained(
-        T, U, q, holonomic=[(e0 ** 2 + e1 ** 2 + e2 ** 2 + e3 ** 2 - 1) / 2],
-        nonholonomic=[v[0] - R * w[1], v[1] + R * w[0], w[2]],
-        params={m: 1.3, R: 0.7, I: 0.2, g: 9.81, alpha: 0.3}, velocities=v)
+    return dict(T=T, U=U, q=q, holonomic=[(e0 ** 2 + e1 ** 2 + e2 ** 2 + e3 ** 2 - 1) / 2],
+                nonholonomic=[v[0] - R * w[1], v[1] + R * w[0], w[2]],
+                params={m: 1.3, R: 0.7, I: 0.2, g: 9.81, alpha: 0.3}, velocities=v)
+
+
+def model():
+    return derive_constrained(**inputs())

@@ -140,3 +140,36 @@ def test_symbolic_derivation_agrees_with_builtin():
     assert np.max(np.abs(rs.q - rb.q) / scale) < 1e-10
     assert np.max(np.abs(rs.v - rb.v)) < 1e-10
     assert np.max(np.abs(rs.lam - rb.lam)) < 1e-10 * max(1.0, np.max(np.abs(rb.lam)))
+
+
+def test_compiled_symbolic_ball_agrees_with_builtin():
+    """conmech.symbolic.constrained_system (derived, emitted, compiled with gfortran) from the
+    same T, U and constraints: trajectory and multipliers equal the built-in's to 1e-10."""
+    from conmech import symbolic
+    x, y, e0, e1, e2, e3 = q = sp.symbols("x y e0 e1 e2 e3")
+    v = sp.symbols("xd yd e0d e1d e2d e3d")
+    m, R, I, g, al = sp.symbols("m R I g alpha")
+    ed = sp.Matrix(v[2:])
+    H = sp.Matrix([[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]])
+    wv = 2 * H * ed
+    alpha = 0.3
+    ball = symbolic.constrained_system(
+        m / 2 * (v[0] ** 2 + v[1] ** 2) + 2 * I * (ed.T * ed)[0, 0],
+        -m * g * sp.sin(al) * x, q,
+        holonomic=[(e0 ** 2 + e1 ** 2 + e2 ** 2 + e3 ** 2 - 1) / 2],
+        nonholonomic=[v[0] - R * wv[1], v[1] + R * wv[0], wv[2]],
+        params={m: M_, R: R_, I: I_, g: G_, al: alpha}, velocities=v)
+    q0, v0 = rolling_state([0.5, 0.5, -0.5, 0.5], 0.4, 1.1)
+    t = np.linspace(0, 3, 16)
+    kw = dict(t_eval=t, rtol=1e-12, atol=1e-12)
+    rb = constrained.solve(systems.rolling_ball(M_, R_, I_, G_, alpha), (0, 3), q0, v0, **kw)
+    rs = constrained.solve(ball, (0, 3), q0, v0, **kw)
+    assert rb.success and rs.success
+    assert np.max(np.abs(rs.q - rb.q)) < 1e-10 * np.max(np.abs(rb.q))
+    assert np.max(np.abs(rs.v - rb.v)) < 1e-10 * np.max(np.abs(rb.v))
+    assert np.max(np.abs(rs.lam - rb.lam)) < 1e-10 * np.max(np.abs(rb.lam))
+    assert np.max(np.abs(rs.energy - rb.energy)) < 1e-10 * np.max(np.abs(rb.energy))
+    # with_params: a flat plane without recompiling gives the straight line
+    flat = ball.with_params(alpha=0.0)
+    rf = constrained.solve(flat, (0, 3), q0, v0, **kw)
+    assert np.max(np.abs(rf.q[0] - 0.4 * t)) < 1e-10

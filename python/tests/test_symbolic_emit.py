@@ -117,9 +117,41 @@ def value(out, label, k=1):
     return [float(s) for s in m.group(1).split()]
 
 
+def load_model_module(model):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(f"_emit_test_{model}",
+                                                  EXAMPLE / "models" / f"{model}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_model_file_with_a_compiled_system(tmp_path):
+    """MODEL.py may define `system = symbolic.lagrangian_system(...)`: same module text."""
+    f = tmp_path / "cart_model_compiled.py"
+    base = str(EXAMPLE / "models" / "cart_pendulum.py")
+    f.write_text("import importlib.util, sys\n"
+                 "from conmech import symbolic\n"
+                 f"spec = importlib.util.spec_from_file_location('m', {base!r})\n"
+                 "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+                 "L, q, params = m.inputs()\n"
+                 "system = symbolic.lagrangian_system(L, q, params)\n"
+                 "name = 'cart_pendulum_sym'\n")
+    out = EXAMPLE / "cart_pendulum_model.f90"
+    src, _, _ = emit_file(f, out)
+    assert src.split("\n", 1)[1] == out.read_text().split("\n", 1)[1]  # header names the file
+
+
 def test_fpm_example_user_model_agrees_with_builtins():
     out = fpm_example("user_model")
     y_fortran = np.array(value(out, "y(5):", 4))
+    # the same model compiled from Python (conmech.symbolic) and integrated there
+    from conmech import symbolic
+    L, q, params = load_model_module("cart_pendulum").inputs()
+    compiled = symbolic.lagrangian_system(L, q, params)
+    rc = conmech.solve_ivp(compiled, (0, 5), [0.3, 2.5, 0.4, 1.0], rtol=1e-12, atol=1e-12)
+    assert rc.success
+    assert np.max(np.abs(y_fortran - rc.y[:, -1])) < 1e-10
     r = conmech.solve_ivp(systems.cart_pendulum(), (0, 5), [0.3, 2.5, 0.4, 1.0],
                           rtol=1e-12, atol=1e-12)
     assert r.success

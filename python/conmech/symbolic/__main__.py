@@ -5,8 +5,9 @@
 
 `emit` writes a standalone Fortran module (see conmech.symbolic.emit_fortran) for the model
 defined in MODEL.py: a function ``model()`` returning it, or a module-level ``model`` or
-``system`` (a conmech.symbolic.derive.Derived record, or an object with a ``derived``
-attribute); an optional module-level ``name`` sets the Fortran type name. Exit codes:
+``system`` (a conmech.symbolic.derive.Derived record, a system made by
+conmech.symbolic.lagrangian_system / constrained_system / ode_system, or an object with a
+``derived`` attribute); an optional module-level ``name`` sets the Fortran type name. Exit codes:
 0 success, 1 --check found a difference, 2 bad input (message on stderr).
 """
 import argparse
@@ -35,6 +36,12 @@ def load_model(path):
         raise ValueError(f"{path}: defines neither model() nor model/system")
     if callable(obj) and not isinstance(obj, Derived) and not hasattr(obj, "derived"):
         obj = obj()
+    if not isinstance(obj, Derived) and not hasattr(obj, "derived"):
+        try:   # a compiled system made by conmech.symbolic (lagrangian_system, ...)
+            from . import model_of
+            obj = model_of(obj)
+        except (ImportError, TypeError):
+            pass
     if hasattr(obj, "derived") and not isinstance(obj, Derived):
         obj = obj.derived
     if not isinstance(obj, Derived):

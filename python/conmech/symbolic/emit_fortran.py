@@ -33,8 +33,8 @@ Command line (see ``python -m conmech.symbolic --help``)::
 
 MODEL.py defines the system with conmech.symbolic, as one of (first found wins):
 a function ``model()`` returning it, or a module-level ``model`` or ``system``; "it" is a
-``Derived`` record (``conmech.symbolic.derive.derive_*``) or an object with a ``derived``
-attribute holding one (the compiled systems of ``conmech.symbolic``). Optionally
+``Derived`` record (``conmech.symbolic.derive.derive_*``, no compilation) or a system made
+by ``conmech.symbolic.lagrangian_system`` / ``constrained_system`` / ``ode_system``. Optionally
 ``name = "..."`` sets the type name (default: the output file's stem without a trailing
 ``_model``).
 """
