@@ -8,8 +8,11 @@ Both tools derive it from its kinematics:
              chain), code generation by pydy.codegen.ode_function_generators with its
              fastest backend (cython if it builds, else lambdify), integrated by SciPy's
              solve_ivp(method="DOP853");
-  * conmech  conmech.symbolic.lagrangian_system(T - U) with T = sum m |r_i'|^2 / 2 of the
-             same positions, compiled with gfortran, integrated by conmech.solve_ivp(DOP853).
+  * conmech  conmech.symbolic.lagrangian_system(T - U), compiled with gfortran, integrated
+             by conmech.solve_ivp(DOP853), with T written two ways:
+             "positions": T = sum m_i |r_i'|^2 / 2 of the same positions as PyDy's,
+             "textbook":  T = 1/2 sum_ij (sum_{k >= max(i,j)} m_k) l_i l_j cos(th_i - th_j)
+                          th_i' th_j' (the chain's kinetic energy as the notes write it).
 Same tolerance (rtol = atol = --tol) over [0, --tf]; both endpoints are compared with a tight
 reference (conmech, rtol = atol = 1e-13) so that they are shown to reach the same accuracy.
 Reported: integration wall time (best of --repeat) and the ratio PyDy/conmech, and the
@@ -44,7 +47,7 @@ def chain_positions(N, sp, q):
     return pos
 
 
-def build_conmech(N):
+def build_conmech(N, form):
     """(system, times dict): derive + generate + compile in the current CONMECH_CACHE."""
     import sympy
     from sympy.physics.mechanics import dynamicsymbols
@@ -52,11 +55,20 @@ def build_conmech(N):
     t = dynamicsymbols._t
     q = dynamicsymbols(f"th1:{N + 1}")
     syms = {"m": sympy.symbols(f"m1:{N + 1}"), "l": sympy.symbols(f"l1:{N + 1}")}
+    m, l = syms["m"], syms["l"]
     g = sympy.Symbol("g")
     T = U = 0
-    for i, (x, y) in enumerate(chain_positions(N, syms, q)):
-        T += syms["m"][i] * (x.diff(t) ** 2 + y.diff(t) ** 2) / 2
-        U += syms["m"][i] * g * y
+    if form == "positions":
+        for i, (x, y) in enumerate(chain_positions(N, syms, q)):
+            T += m[i] * (x.diff(t) ** 2 + y.diff(t) ** 2) / 2
+            U += m[i] * g * y
+    else:
+        qd = [qi.diff(t) for qi in q]
+        for i in range(N):
+            T += sum(m[i:]) * l[i] ** 2 * qd[i] ** 2 / 2
+            U -= sum(m[i:]) * g * l[i] * sympy.cos(q[i])
+            for j in range(i + 1, N):
+                T += sum(m[j:]) * l[i] * l[j] * sympy.cos(q[i] - q[j]) * qd[i] * qd[j]
     params = {**{s: 1.0 for s in syms["m"]}, **{s: 1.0 for s in syms["l"]}, g: 9.81}
     t0 = time.perf_counter()
     model = symbolic.lagrangian_system(T - U, q, params, model_only=True)
@@ -81,7 +93,7 @@ def build_pydy(N):
     A = me.ReferenceFrame("A")
     O = me.Point("O")
     O.set_vel(A, 0)
-    frames, points, particles, forces, kdes = [], [O], [], [], []
+    points, particles, forces, kdes = [O], [], [], []
     for i in range(N):
         Bi = A.orientnew(f"B{i}", "Axis", [q[i], A.z])
         Bi.set_ang_vel(A, u[i] * A.z)
@@ -125,21 +137,23 @@ def best_of(fn, repeat):
     return best, out
 
 
-def run(N, args):
+def run(N, form, args, pydy_cache):
     import conmech
     from scipy.integrate import solve_ivp as scipy_ivp
     y0 = np.concatenate([np.linspace(0.9, 0.3, N), np.zeros(N)])
-    res = {"N": N}
+    res = {"N": N, "form": form}
     with tempfile.TemporaryDirectory() as cache:
         os.environ["CONMECH_CACHE"] = cache
-        sysc, tc, inputs = build_conmech(N)
+        sysc, tc, inputs = build_conmech(N, form)
         # a second construction of the same system: cache hit (same process)
         from conmech import symbolic
         t0 = time.perf_counter()
         symbolic.lagrangian_system(*inputs)
         res["conmech_hit"] = time.perf_counter() - t0
     res["conmech_times"] = tc
-    fpy, tp, backend = build_pydy(N)
+    if N not in pydy_cache:
+        pydy_cache[N] = build_pydy(N)
+    fpy, tp, backend = pydy_cache[N]
     res["pydy_times"], res["backend"] = tp, backend
     ref = conmech.solve_ivp(sysc, (0, args.tf), y0, method="DOP853", rtol=1e-13, atol=1e-13)
     assert ref.success, ref.message
@@ -156,14 +170,14 @@ def run(N, args):
 
 
 def table(rows, args):
-    head = ["N", "PyDy backend", "conmech [s]", "PyDy [s]", "PyDy/conmech",
+    head = ["N", "conmech T", "PyDy backend", "conmech [s]", "PyDy [s]", "PyDy/conmech",
             "err conmech", "err PyDy", "nfev c/P", "conmech derive", "conmech gen+compile",
             "conmech cache hit", "PyDy derive", "PyDy gen+compile"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         tc, tp = r["conmech_times"], r["pydy_times"]
         out.append("| " + " | ".join([
-            str(r["N"]), str(r["backend"]), f"{r['t_conmech']:.4f}", f"{r['t_pydy']:.4f}",
+            str(r["N"]), r["form"], str(r["backend"]), f"{r['t_conmech']:.4f}", f"{r['t_pydy']:.4f}",
             f"{r['t_pydy'] / r['t_conmech']:.1f}x", f"{r['err_conmech']:.1e}",
             f"{r['err_pydy']:.1e}", f"{r['nfev_conmech']}/{r['nfev_pydy']}",
             f"{tc.get('derive', float('nan')):.2f} s",
@@ -179,18 +193,22 @@ def main():
     ap.add_argument("--tol", type=float, default=1e-10)
     ap.add_argument("--tf", type=float, default=10.0)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--forms", nargs="+", default=["positions", "textbook"],
+                    choices=["positions", "textbook"])
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
-    rows = []
+    rows, pydy_cache = [], {}
     for N in args.n:
-        t0 = time.perf_counter()
-        r = run(N, args)
-        rows.append(r)
-        print("\n".join(table([r], args)[2:]), f"  ({time.perf_counter() - t0:.0f} s)",
-              flush=True)
+        for form in args.forms:
+            t0 = time.perf_counter()
+            r = run(N, form, args, pydy_cache)
+            rows.append(r)
+            print("\n".join(table([r], args)[2:]), f"  ({time.perf_counter() - t0:.0f} s)",
+                  flush=True)
     lines = [f"# conmech.symbolic vs PyDy (planar N-link chain), "
              f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC", "",
              f"`python bench/bench_symbolic_pydy.py --n {' '.join(map(str, args.n))} "
+             f"--forms {' '.join(args.forms)} "
              f"--tol {args.tol:g} --tf {args.tf:g} --repeat {args.repeat}` on "
              f"{platform.machine()}, {os.cpu_count()} cores (shared), Python "
              f"{platform.python_version()}.", "",

@@ -236,7 +236,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     if d.kind == "ode":
         lines += [f"    public :: {name}, new_{name}",
                   f"    integer, parameter, public :: {name}_n = {n}   !! state dimension",
-                  "", f"    !> y' = f(t, y) with the exact Jacobian df/dy.",
+                  "", "    !> y' = f(t, y) with the exact Jacobian df/dy.",
                   f"    type, extends(ode_system) :: {name}"]
         lines += _components(d)
         lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
@@ -384,7 +384,7 @@ def _mass_solve(n, nrhs, rhs_name):
 def _gen_rhs(em, name, pry, d):
     n = d.n
     decl, lines = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)])
-    return ([f"    !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).",
+    return (["    !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).",
              f"    subroutine {name}_rhs(self, t, y, dydt)",
              f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{_IND}use conmech_lapack, only: dpotrs",
@@ -400,7 +400,7 @@ def _gen_jac(em, name, pry, d):
     n = d.n
     decl1, lines1 = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)], prefix="w")
     decl2, lines2 = em.body(pry, [("r", d.R, True)], prefix="u")
-    lines = [f"    !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].",
+    lines = ["    !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].",
              f"    subroutine {name}_jacobian(self, t, y, dfdy)",
              f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{_IND}use conmech_lapack, only: dpotrs",
