@@ -227,6 +227,46 @@ def test_rubber_ball_constraints_non_holonomic():
     assert all(not r.integrable for r in res.each[1:])
 
 
+# ------------------------------------------------------------------ derived systems
+def test_pfaffian_of_derived_systems():
+    """The rubber ball's non-holonomic constraints are not integrable; the pendulum's
+    x x' + y y' = 0 given as 'non-holonomic' is found holonomic with f = (x^2 + y^2)/2; a
+    rheonomic Pfaffian constraint x' - w t = 0 integrates to x - w t^2/2."""
+    from conmech.symbolic import pfaffian_of
+    from conmech.symbolic.derive import derive_constrained
+    e0, e1, e2, e3 = sp.symbols("e0:4")
+    q = sp.symbols("x y e0 e1 e2 e3")
+    v = sp.symbols("xd yd e0d e1d e2d e3d")
+    Rb = sp.Symbol("R")
+    ed = sp.Matrix(v[2:])
+    H = sp.Matrix([[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]])
+    w = 2 * H * ed
+    d = derive_constrained(ed.dot(ed) + (v[0] ** 2 + v[1] ** 2) / 2, 0, list(q),
+                           holonomic=[(e0 ** 2 + e1 ** 2 + e2 ** 2 + e3 ** 2
+                                       - 1) / 2],
+                           nonholonomic=[v[0] - Rb * w[1], v[1] + Rb * w[0], w[2]],
+                           params={Rb: 0.7}, velocities=v)
+    r = pfaffian_of(d)
+    assert not r.integrable and r.residual
+    assert all(not e.integrable for e in r.each)
+    xs, ys, xd, yd, wv = sp.symbols("x y xd yd w")
+    d2 = derive_constrained((xd ** 2 + yd ** 2) / 2, 9.81 * ys, [xs, ys],
+                            nonholonomic=[xs * xd + ys * yd, xd - wv * sp.Symbol("t")],
+                            params={wv: 2.0}, velocities=[xd, yd])
+    r2 = pfaffian_of(d2)
+    tt = sp.Symbol("t")
+    assert r2.each[0].integrable and r2.each[1].integrable
+    f0, f1 = r2.each[0].integral, r2.each[1].integral
+    assert all(_zero(sp.diff(2 * f0 - xs ** 2 - ys ** 2, s)) for s in (xs, ys, tt))
+    assert all(_zero(sp.diff(f1 - (xs - wv * tt ** 2 / 2), s))
+               for s in (xs, ys, tt))
+    with pytest.raises(ValueError, match="no non-holonomic"):
+        pfaffian_of(derive_constrained((xd ** 2 + yd ** 2) / 2, 0, [xs, ys],
+                                       holonomic=[xs ** 2 + ys ** 2 - 1], velocities=[xd, yd]))
+    with pytest.raises(TypeError, match="Derived"):
+        pfaffian_of(42)
+
+
 # ------------------------------------------------------------------ bad input
 def test_bad_input():
     with pytest.raises(ValueError, match="coefficients for"):

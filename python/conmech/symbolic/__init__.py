@@ -310,7 +310,7 @@ def _tup(x):
 
 # exactness of Pfaffian constraints: holonomic or not, integrating factor, integral
 from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: E402
-                       pfaffian_from_velocities, pfaffian_system)
+                       pfaffian_from_velocities, pfaffian_of, pfaffian_system)
 
-__all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "PfaffianResult",
-            "PfaffianSystemResult"]
+__all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
+            "PfaffianResult", "PfaffianSystemResult"]

@@ -23,9 +23,10 @@ variables the ODE dq_2/dq_1 = -a_1/a_2 solved by `sympy.dsolve`, whose constant 
 gives the integral F and mu = (dF/dq_1)/a_1. Every candidate is verified: d(mu omega) = 0
 simplifies to zero. The integral f is built by line integration and verified: grad f = mu a.
 
-`pfaffian_system(forms, coords)` checks several constraints together (Frobenius), and
+`pfaffian_system(forms, coords)` checks several constraints together (Frobenius),
 `pfaffian_from_velocities(expr, q, qdot)` reads the form from a velocity-level constraint
-sum_i a_i q_i' + a_0 = 0 (as written in the seeds: x' + r phi' cos(theta) = 0).
+sum_i a_i q_i' + a_0 = 0 (as written in the seeds: x' + r phi' cos(theta) = 0), and
+`pfaffian_of(system)` checks the non-holonomic constraints of a derived constrained system.
 
 Example (the seed's pendulum, and the rolling coin):
 
@@ -48,7 +49,8 @@ from typing import Dict, Optional, Sequence, Tuple
 import sympy as sp
 
 __all__ = ["PfaffianResult", "PfaffianSystemResult", "pfaffian", "pfaffian_system",
-           "pfaffian_from_velocities", "exterior_derivative", "wedge", "frobenius_residual"]
+           "pfaffian_of", "pfaffian_from_velocities", "exterior_derivative", "wedge",
+           "frobenius_residual"]
 
 Form = Dict[Tuple[int, ...], sp.Expr]
 
@@ -542,3 +544,29 @@ def pfaffian_from_velocities(expr, coords: Sequence[sp.Symbol], velocities: Sequ
                              "pass t= to keep it")
         return pfaffian(coeffs, coords)
     return pfaffian(coeffs + [a0], coords + (t,))
+
+
+def pfaffian_of(system) -> PfaffianSystemResult:
+    """Exactness of the non-holonomic constraints A(t, q) q' + b(t, q) = 0 of a derived
+    constrained system (a conmech.symbolic.derive.Derived record of kind "constrained", or a
+    system made by conmech.symbolic.constrained_system). Each row is the form
+    sum_j A_ij dq_j + b_i dt (t joins the coordinates when b or A depends on t): a row found
+    integrable (`each[i].integrable`, with its `integral`) is in truth holonomic and could be
+    given as `holonomic=[integral - const]`; `integrable` tells the set as a whole."""
+    d = system
+    if not hasattr(d, "kind"):
+        try:
+            from . import model_of
+            d = model_of(system).derived
+        except (ImportError, TypeError):
+            raise TypeError("pfaffian_of: expected a Derived record or a conmech.symbolic "
+                            "constrained system") from None
+    if getattr(d, "kind", None) != "constrained" or not d.n_nh:
+        raise ValueError("pfaffian_of: the system has no non-holonomic constraints")
+    coords = tuple(d.coords)
+    timed = any(d.b[i] != 0 or d.A.row(i).has(d.t) for i in range(d.n_nh))
+    forms = []
+    for i in range(d.n_nh):
+        row = list(d.A.row(i))
+        forms.append(row + [d.b[i]] if timed else row)
+    return pfaffian_system(forms, coords + ((d.t,) if timed else ()))
