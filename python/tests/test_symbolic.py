@@ -368,3 +368,76 @@ def test_constrained_with_params_changes_the_multiplier():
         assert r.success
         assert np.max(np.abs(r.lam[0] + mass*9.81/1.5)) < 1e-10
         assert symbolic.model_of(s) is symbolic.model_of(sysm)
+
+
+def test_elementary_and_piecewise_functions_compile_exactly():
+    """abs, exp, log, tanh, atan2, Piecewise, Max, sign, Heaviside, asin, cube roots and
+    real powers: generated values and Jacobians equal sympy's (the Jacobian of sign /
+    Heaviside is taken away from the jump)."""
+    x, v = sp.symbols("x v", real=True)
+    f = [sp.Abs(x)*sp.exp(-v) + sp.log(1 + x**2),
+         sp.tanh(v) + sp.atan2(v, x) + sp.Piecewise((x, x > 0), (x**2, True)) + sp.Max(x, v)
+         + sp.sign(x) + sp.asin(x/5) + sp.cbrt(x**2 + 1) + (x**2 + 1)**0.7 + sp.Heaviside(v)]
+    mod = symbolic.ode_system(f, [x, v], model_only=True)
+    F = sp.lambdify([x, v], f)
+    J = sp.lambdify([x, v], sp.Matrix(f).jacobian([x, v]).replace(sp.DiracDelta,
+                                                                   lambda *a: 0))
+    for s in ([0.5, 0.3], [1.2, -0.4], [-0.5, 0.7], [-1.3, -0.2]):
+        assert np.max(np.abs(mod.call("rhs", 0.0, s) - np.array(F(*s)))) < 1e-14
+        assert np.max(np.abs(mod.call("jac", 0.0, s) - np.array(J(*s), float))) < 1e-14
+
+
+def test_unsupported_function_is_a_clear_error():
+    x, v = sp.symbols("x v")
+    with pytest.raises(ValueError, match="cannot generate Fortran for"):
+        symbolic.ode_system([v, sp.gamma(x)], [x, v])
+
+
+def test_symbol_with_a_coordinate_name_and_equation_constraints():
+    x, y = dynamicsymbols("x y")
+    m, l = sp.symbols("m l")
+    T = m*(x.diff(t)**2 + y.diff(t)**2)/2
+    with pytest.raises(ValueError, match="has the name of a coordinate"):
+        symbolic.lagrangian_system(T - sp.Symbol("x")**2, [x, y], params={m: 1.0})
+    # a holonomic constraint may be written as an equation lhs == rhs
+    mod = symbolic.constrained_system(T, 0, [x, y], holonomic=[sp.Eq(x**2 + y**2, l**2)],
+                                      params={m: 1.0, l: 2.0}, model_only=True)
+    assert rel(mod.call("phi", 0.0, [1.0, 1.0]), [-2.0]) < 1e-15
+
+
+def test_without_exact_jacobian():
+    """jacobian=False: no forces_jac entry; the system integrates the same (the Jacobian
+    then comes from differences)."""
+    import conmech
+    from conmech import compiled
+    T, U, q, P = cart_lagrangian()
+    a = symbolic.lagrangian_system(T - U, q, params=P)
+    b = symbolic.lagrangian_system(T - U, q, params=P, jacobian=False)
+    assert "forces_jac" not in symbolic.model_of(b).addresses
+    y = [0.1, 2.5, 0.3, -0.2]
+    assert compiled.evaluate(a, 0.0, y)["analytic"] and not compiled.evaluate(b, 0.0,
+                                                                               y)["analytic"]
+    kw = dict(rtol=1e-11, atol=1e-11, t_eval=[0.0, 1.0, 2.0])
+    ra, rb = conmech.solve_ivp(a, (0, 2), y, **kw), conmech.solve_ivp(b, (0, 2), y, **kw)
+    assert rel(ra.y, rb.y) < 1e-12
+
+
+def test_singular_mass_of_a_large_system_is_seen_on_the_compiled_code():
+    """Nine coordinates, the last one without kinetic energy: M is singular everywhere."""
+    q = dynamicsymbols("q1:10")
+    T = sum(qi.diff(t)**2 for qi in q[:-1])/2
+    with pytest.raises(ValueError, match="singular"):
+        symbolic.lagrangian_system(T - sum(qi**2 for qi in q)/2, list(q))
+
+
+def test_model_call_checks_its_arguments():
+    T, U, q, P = cart_lagrangian()
+    mod = symbolic.lagrangian_system(T - U, q, params=P, model_only=True)
+    with pytest.raises(ValueError, match="takes t and 2 array"):
+        mod.call("forces", 0.0, [0.1, 0.2])
+    with pytest.raises(ValueError, match="params must have 4 values"):
+        mod.call("mass", 0.0, [0.1, 0.2], params=[1.0])
+    with pytest.raises(ValueError, match="shape"):
+        mod.call("mass", 0.0, [0.1, 0.2, 0.3])
+    with pytest.raises(ValueError, match="no entry point 'rhs'"):
+        mod.call("rhs", 0.0, [0.1, 0.2])

@@ -90,8 +90,14 @@ class CompiledModel:
                              f"(has: {', '.join(self.addresses)})")
         p = np.ascontiguousarray(self.derived.param_values if params is None else params,
                                  dtype=float)
+        if p.ndim != 1 or p.size != len(self.derived.param_names):
+            raise ValueError(f"params must have {len(self.derived.param_names)} values "
+                             f"({', '.join(self.derived.param_names)})")
         if p.size == 0:
             p = np.zeros(1)
+        n_in = int(_SIG[entry][0][2:])
+        if len(arrays) != n_in:
+            raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = self.derived.n
         for a in ins:
@@ -234,6 +240,24 @@ def _store(key, model, flags):
             pass
 
 
+def _check_compiled_mass(model):
+    """Large systems: the singularity check of the mass matrix on the compiled code (random
+    states, the given and perturbed parameter values)."""
+    from .derive import singular_everywhere
+    rng = np.random.default_rng(12345)
+    d = model.derived
+
+    def mass_at(trial):
+        p = np.asarray(d.param_values, float)
+        if trial:
+            p = np.where(p != 0, p*rng.uniform(0.7, 1.3, p.size), rng.uniform(0.5, 1.5, p.size))
+        with np.errstate(all="ignore"):
+            return model.call("mass", rng.uniform(0.3, 1.3), rng.uniform(-1, 1, d.n), params=p)
+    if singular_everywhere(mass_at, d.n, rng):
+        raise ValueError("the mass matrix is singular at every sampled state (det M = 0): a "
+                         "coordinate has no kinetic energy, or the coordinates are dependent")
+
+
 def _construct(kind, inputs, params, options, derive, flags, model_only):
     """Derive (or take the derivation from the cache), compile (or load), wrap."""
     t0 = time.perf_counter()
@@ -245,6 +269,8 @@ def _construct(kind, inputs, params, options, derive, flags, model_only):
         t1 = time.perf_counter()
         model = compile_model(d, flags)
         model.times["derive"] = t1 - t0
+        if d.kind != "ode" and d.n > 8:
+            _check_compiled_mass(model)
         if key:
             _store(key, model, flags)
     model.times["total"] = time.perf_counter() - t0
@@ -264,7 +290,7 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      flags=None, model_only=False):
+                      jacobian=True, flags=None, model_only=False):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -273,12 +299,15 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     forces : optional generalized non-conservative forces, one expression per coordinate
              (in t, q, q' and the parameters).
     params : dict {Symbol or name: value}.
-    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, when L is
-               small enough: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
+    simplify : True, False or "auto" (a fast trigonometric clean-up of L first, part by
+               part: sin^2 + cos^2 = 1, cos a cos b + sin a sin b = cos(a - b)).
+    jacobian : generate the exact Jacobian of the accelerations (forces_jac); False saves
+               derivation and compile time for large systems that are only integrated.
     """
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
-                      (simplify,),
-                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify),
+                      (simplify, bool(jacobian)),
+                      lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
+                                                bool(jacobian)),
                       flags, model_only)
 
 

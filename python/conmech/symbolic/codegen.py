@@ -52,6 +52,8 @@ class FortranPrinter(FCodePrinter):
         super().__init__({"source_format": "free", "standard": 2008, "strict": False})
         self.names = dict(names)
         self.kind_suffix = kind_suffix
+        self._not_supported = set()
+        self._number_symbols = set()
 
     def _real(self, x):
         s = repr(float(x))
@@ -103,6 +105,31 @@ class FortranPrinter(FCodePrinter):
         if expr.func == _SQRT:
             return f"sqrt({self._print(expr.args[0])})"
         return super()._print_Function(expr)
+
+    def _print_sign(self, expr):
+        a = self._print(expr.args[0])
+        one, zero = self._real(1), self._real(0)
+        return f"(merge({one}, {zero}, {a} > 0) - merge({one}, {zero}, {a} < 0))"
+
+    def _print_Heaviside(self, expr):
+        a = self._print(expr.args[0])
+        h0 = expr.args[1] if len(expr.args) > 1 else sp.S.Half
+        return (f"merge({self._real(1)}, merge({self._print(h0)}, {self._real(0)}, "
+                f"{a} == 0), {a} > 0)")
+
+    def _minmax(self, expr, name):
+        args = [self._print(a) for a in expr.args]
+        return f"{name}({', '.join(args)})"
+
+    def _print_Max(self, expr):
+        return self._minmax(expr, "max")
+
+    def _print_Min(self, expr):
+        return self._minmax(expr, "min")
+
+    def _print_not_supported(self, expr):
+        raise ValueError(f"cannot generate Fortran for {type(expr).__name__} ({expr}): "
+                         "not supported in compiled code")
 
     def _print_Pow(self, expr):
         b, e = expr.base, expr.exp

@@ -22,12 +22,17 @@ of the expressions that is not t, a coordinate or a velocity must be a parameter
 ValueError naming it); a parameter without a value is a ValueError naming it. Parameters are
 identified by name (Symbol("m", positive=True) and Symbol("m") are the same parameter).
 
+All symbols of a :class:`Derived` record (t, coordinates, velocities, accelerations,
+parameters) are real-valued sympy Dummies carrying the user's names (``coord_names``,
+``param_names``); code generators map them to array elements by position.
+
 The :class:`Derived` record (attributes; absent items are None):
 
 =============  ==============================================================================
 kind           "ode", "generalized" or "constrained"
 t              the time Symbol
-coords         list of Symbols: y (ode) or q (generalized, constrained)
+coords         list of Symbols: y (ode) or q (generalized, constrained); coord_names
+lagrangian     the (cleaned-up) Lagrangian used (generalized, constrained)
 speeds         list of Symbols v (velocities; [] for ode)
 accels         list of Symbols a (accelerations, used in R; [] for ode)
 params         list of parameter Symbols, in the order of the run-time array p
@@ -112,9 +117,14 @@ def _sympify_list(exprs, what):
     out = []
     for e in exprs:
         try:
-            out.append(sp.sympify(e))
+            e = sp.sympify(e)
         except (sp.SympifyError, TypeError) as exc:
             raise TypeError(f"{what}: cannot read {e!r} as a sympy expression") from exc
+        if isinstance(e, sp.Equality):          # a constraint written as lhs == rhs
+            e = e.lhs - e.rhs
+        if not isinstance(e, sp.Expr):
+            raise TypeError(f"{what}: {e!r} is not a scalar expression")
+        out.append(e)
     return out
 
 
@@ -228,8 +238,13 @@ def _resolve_params(params, exprs, known, t):
     for e in exprs:
         free |= e.free_symbols
     by_name = {}
+    known_set = set(known) | {t}
     for s in free:
         if s.name in known_names:
+            if s not in known_set:
+                raise ValueError(f"the symbol '{s.name}' has the name of a coordinate or "
+                                 "velocity but is not it (write the coordinate as given in q, "
+                                 "e.g. the dynamicsymbol x and x.diff(t))")
             continue
         by_name.setdefault(s.name, []).append(s)
     names, values = [], []
@@ -264,8 +279,50 @@ def _resolve_params(params, exprs, known, t):
     return psyms, names, values, sub
 
 
+def _realify(exprs, t, c, psyms):
+    """Replace t, the coordinates, velocities, accelerations and parameters by real
+    Dummies of the same names (so that e.g. d|x|/dx = sign(x), not re/im terms); updates
+    the coordinate record in place; returns (exprs, t, params)."""
+    sub = {}
+
+    def real(s):
+        r = sp.Dummy(s.name, real=True)
+        sub[s] = r
+        return r
+    t_r = real(t)
+    c.plain = [real(s) for s in c.plain]
+    c.speeds = [real(s) for s in c.speeds]
+    c.accels = [real(s) for s in c.accels]
+    p_r = [real(s) for s in psyms]
+    return [e.xreplace(sub) for e in exprs], t_r, p_r
+
+
+def _ae(mat):
+    """Jacobians almost everywhere: the DiracDelta of a differentiated sign / Heaviside
+    (e.g. Coulomb friction) is dropped (the derivative away from the jump)."""
+    if mat.has(sp.DiracDelta):
+        return mat.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
+    return mat
+
+
 def _subs_all(exprs, sub):
     return [e.xreplace(sub) if sub else e for e in exprs]
+
+
+def singular_everywhere(mass_at, n, rng, trials=3):
+    """True if the n x n matrices mass_at(trial) (None: not evaluable) are numerically
+    singular (sigma_min <= 1e-12 sigma_max) at every trial."""
+    for trial in range(trials):
+        A = mass_at(trial)
+        if A is None:
+            return False
+        A = np.asarray(A, dtype=float).reshape(n, n)
+        if not np.all(np.isfinite(A)):
+            return False
+        s = np.linalg.svd(A, compute_uv=False)
+        if s[0] > 0 and s[-1] > 1e-12 * s[0]:
+            return False
+    return True
 
 
 def _check_mass(M, coords, speeds, params, values, t):
@@ -279,11 +336,13 @@ def _check_mass(M, coords, speeds, params, values, t):
     n = M.shape[0]
     if M.shape[0] != M.shape[1]:
         raise ValueError(f"mass matrix is not square ({M.shape[0]} x {M.shape[1]})")
+    if n > 8:      # large: checked on the compiled mass matrix instead (conmech.symbolic)
+        return
     args = [t] + list(coords) + list(params)
     fM = sp.lambdify(args, M, modules="numpy")
     rng = random.Random(12345)
-    singular_everywhere = True
-    for trial in range(3):
+
+    def mass_at(trial):
         vals = [rng.uniform(0.3, 1.3)] + [rng.uniform(-1.0, 1.0) for _ in coords]
         if trial == 0:
             vals += list(values)
@@ -292,18 +351,10 @@ def _check_mass(M, coords, speeds, params, values, t):
                      for v in values]
         try:
             with np.errstate(all="ignore"):
-                A = np.array(fM(*vals), dtype=float).reshape(n, n)
+                return np.array(fM(*vals), dtype=float)
         except (ZeroDivisionError, ValueError, TypeError):
-            singular_everywhere = False
-            continue
-        if not np.all(np.isfinite(A)):
-            singular_everywhere = False
-            continue
-        s = np.linalg.svd(A, compute_uv=False)
-        if s[0] > 0 and s[-1] > 1e-12 * s[0]:
-            singular_everywhere = False
-            break
-    if singular_everywhere:
+            return None
+    if singular_everywhere(mass_at, n, rng):
         det = sp.simplify(M.det()) if n <= 4 else 0
         if det == 0:
             raise ValueError("the mass matrix is singular identically (det M = 0): a "
@@ -324,8 +375,9 @@ def derive_ode(f, y, params=None):
     f = c.convert(f, "f")
     psyms, names, values, sub = _resolve_params(params, f, c.plain, t)
     f = _subs_all(f, sub)
+    f, t, psyms = _realify(f, t, c, psyms)
     F = sp.Matrix(f)
-    J = F.jacobian(c.plain)
+    J = _ae(F.jacobian(c.plain))
     return Derived("ode", t=t, coords=c.plain, coord_names=c.names, params=psyms,
                    param_names=names, param_values=values, f=F, jac=J)
 
@@ -363,14 +415,40 @@ def _cheap_simplify(expr):
     return TR10i(e)
 
 
-def _maybe_simplify(expr, simplify):
-    """simplify: True, False or "auto" (only when the expression is small enough for the
-    clean-up to take well under a few seconds)."""
-    if simplify is True or (simplify == "auto" and sp.count_ops(expr) <= 600):
-        return _cheap_simplify(expr)
+def _maybe_simplify(expr, simplify, v=()):
+    """simplify: True, False or "auto". A Lagrangian at most quadratic in the velocities v
+    is cleaned up by parts, L = v^T M v / 2 + l1 . v + L0, each entry of M, l1 and L0 on its
+    own (small expressions, so the clean-up stays fast for long chains); "auto" skips parts
+    too large for it (more than 600 operations)."""
     if simplify not in (True, False, "auto"):
         raise ValueError(f"simplify must be True, False or 'auto', got {simplify!r}")
-    return expr
+    if simplify is False:
+        return expr
+
+    def part(e):
+        if e == 0:
+            return e
+        if simplify is True or sp.count_ops(e) <= 600:
+            return _cheap_simplify(e)
+        return e
+    v = list(v)
+    if v:
+        n = len(v)
+        grad = [sp.diff(expr, vi) for vi in v]
+        H = [[sp.diff(grad[i], v[j]) for j in range(n)] for i in range(n)]
+        if not any(h.free_symbols & set(v) for row in H for h in row):
+            zero = {vi: 0 for vi in v}
+            Hs = {}
+            for i in range(n):
+                for j in range(i, n):
+                    Hs[i, j] = part(H[i][j])
+            l1 = [part(g.xreplace(zero)) for g in grad]
+            L0 = part(expr.xreplace(zero))
+            quad = sum((Hs[i, i]*v[i]**2/2 for i in range(n)), sp.Integer(0)) \
+                + sum((Hs[i, j]*v[i]*v[j] for i in range(n) for j in range(i + 1, n)),
+                      sp.Integer(0))
+            return quad + sum((c*vi for c, vi in zip(l1, v)), sp.Integer(0)) + L0
+    return part(expr)
 
 
 def _forces_list(forces, n, what="forces"):
@@ -382,10 +460,12 @@ def _forces_list(forces, n, what="forces"):
     return fl
 
 
-def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify="auto"):
+def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify="auto",
+                      jacobian=True):
     """M q'' = Q from the Lagrangian L(t, q, q'); optional generalized forces.
     ``simplify`` (True, False, "auto") cleans L up first (sin^2 + cos^2 = 1, products of
-    sines and cosines into cosines of differences) so that M and Q come out compact."""
+    sines and cosines into cosines of differences) so that M and Q come out compact.
+    ``jacobian=False`` skips R (the integrators then difference the accelerations)."""
     t = sp.Symbol("t")
     c = _Coords(q, velocities, t, need_speeds=True)
     n = len(c.plain)
@@ -397,12 +477,15 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     known = list(c.plain) + list(c.speeds)
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
-    Lp, fq = _maybe_simplify(exprs[0], simplify), exprs[1:]
+    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    Lp, fq = _maybe_simplify(exprs[0], simplify, c.speeds), exprs[1:]
     M, Q = _euler_lagrange(Lp, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
-    Ma = M * sp.Matrix(c.accels)
-    R = (Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds))
+    R = None
+    if jacobian:
+        Ma = M * sp.Matrix(c.accels)
+        R = _ae((Q - Ma).jacobian(c.plain).row_join(Q.jacobian(c.speeds)))
     energy = _energy(Lp, M, c.speeds)
     return Derived("generalized", t=t, coords=c.plain, coord_names=c.names,
                    speeds=c.speeds, accels=c.accels, params=psyms, param_names=names,
@@ -439,12 +522,13 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     known = list(c.plain) + list(c.speeds)
     psyms, names, values, sub = _resolve_params(params, exprs, known, t)
     exprs = _subs_all(exprs, sub)
+    exprs, t, psyms = _realify(exprs, t, c, psyms)
     Tp, Up, fq = exprs[0], exprs[1], exprs[2:2 + n]
     hol = exprs[2 + n:2 + n + len(hol)]
     nh = exprs[2 + n + len(hol):]
     if Up.free_symbols & set(c.speeds):
         raise ValueError("U must not depend on the velocities")
-    L = _maybe_simplify(Tp - Up, simplify)
+    L = _maybe_simplify(Tp - Up, simplify, c.speeds)
     M, Q = _euler_lagrange(L, c.plain, c.speeds, t)
     _check_mass(M, c.plain, c.speeds, psyms, values, t)
     Q = Q + sp.Matrix(fq)
