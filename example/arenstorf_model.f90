@@ -36,14 +36,14 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: w1, w2, w3, w4, w5
         w1 = self%mu + y(1)
-        w2 = w1 + (-1.0_dp)
-        w3 = y(2)**2
-        w4 = self%mu/sqrt(w2**2 + w3)**3
-        w5 = (1.0_dp - self%mu)/sqrt(w1**2 + w3)**3
+        w2 = y(2)**2
+        w3 = (1.0_dp - self%mu)/sqrt(w1**2 + w2)**3
+        w4 = w1 + (-1.0_dp)
+        w5 = self%mu/sqrt(w2 + w4**2)**3
         dydt(1) = y(3)
         dydt(2) = y(4)
-        dydt(3) = 2.0_dp*y(4) - w1*w5 - w2*w4 + y(1)
-        dydt(4) = -2.0_dp*y(3) - w4*y(2) - w5*y(2) + y(2)
+        dydt(3) = 2.0_dp*y(4) + y(1) - w1*w3 - w4*w5
+        dydt(4) = -2.0_dp*y(3) - y(2)*w3 - y(2)*w5 + y(2)
     end subroutine arenstorf_sym_rhs
 
     !> dfdy = df/dy (exact, from sympy).
@@ -55,26 +55,26 @@ contains
         real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9, w10
         real(dp) :: w11, w12, w13, w14, w15, w16
         dfdy = 0.0_dp
-        w1 = y(2)**2
-        w2 = self%mu + y(1)
-        w3 = w2 + (-1.0_dp)
-        w4 = sqrt(w1 + w3**2)
-        w5 = self%mu/w4**3
-        w6 = sqrt(w1 + w2**2)
-        w7 = 1.0_dp - self%mu
-        w8 = w7/w6**3
-        w9 = 1.0_dp/w4**5
-        w10 = w3*w9
-        w11 = 3.0_dp*self%mu
-        w12 = w11 + 3.0_dp*y(1)
-        w13 = self%mu*(3.0_dp - w12)
-        w14 = w7/w6**5
-        w15 = -w12*w14
-        w16 = 3.0_dp*w14
-        dfdy(3, 1) = -w2*w15 - w13*w10 - w5 - w8 + 1.0_dp
-        dfdy(4, 1) = -w13*w9*y(2) - w15*y(2)
-        dfdy(3, 2) = w2*w16*y(2) + w11*w10*y(2)
-        dfdy(4, 2) = w1*w11*w9 + w1*w16 - w5 - w8 + 1.0_dp
+        w1 = self%mu + y(1)
+        w2 = y(2)**2
+        w3 = sqrt(w1**2 + w2)
+        w4 = 1.0_dp - self%mu
+        w5 = w4/w3**3
+        w6 = w1 + (-1.0_dp)
+        w7 = sqrt(w2 + w6**2)
+        w8 = self%mu/w7**3
+        w9 = 3.0_dp*self%mu
+        w10 = 3.0_dp*y(1) + w9
+        w11 = w4/w3**5
+        w12 = -w11*w10
+        w13 = 1.0_dp/w7**5
+        w14 = w13*w6
+        w15 = self%mu*(3.0_dp - w10)
+        w16 = 3.0_dp*w11
+        dfdy(3, 1) = -w1*w12 - w14*w15 - w5 - w8 + 1.0_dp
+        dfdy(4, 1) = -y(2)*w12 - y(2)*w13*w15
+        dfdy(3, 2) = y(2)*w1*w16 + y(2)*w14*w9
+        dfdy(4, 2) = w2*w13*w9 + w2*w16 - w5 - w8 + 1.0_dp
         dfdy(1, 3) = 1.0_dp
         dfdy(4, 3) = -2.0_dp
         dfdy(2, 4) = 1.0_dp

@@ -97,8 +97,8 @@ contains
         real(dp) :: w1, w2
         w1 = (0.5_dp)*v(1)**2
         w2 = self%l*self%m*cos(q(2))
-        e = (0.5_dp)*v(2)**2*self%l**2*self%m + v(2)*v(1)*w2 + self%g*w2 + self%m*w1 +&
-            & self%mc*w1
+        e = self%g*w2 + (0.5_dp)*self%l**2*v(2)**2*self%m + self%m*w1 + self%mc*w1 +&
+            & v(2)*v(1)*w2
     end function cart_pendulum_sym_mech_energy
 
     !> The energy is defined.
@@ -169,7 +169,7 @@ contains
         u2 = u1*cos(y(2))
         u3 = u1*sin(y(2))
         r(1, 2) = y(4)**2*u2 + a(2)*u3
-        r(2, 2) = a(1)*u3 + self%g*u2
+        r(2, 2) = self%g*u2 + a(1)*u3
         r(1, 4) = 2.0_dp*y(4)*u3
         call dpotrs('U', 2, 4, mm, 2, r, 2, info)
         dfdy = 0.0_dp
@@ -194,8 +194,8 @@ contains
         real(dp) :: w1, w2
         w1 = (0.5_dp)*y(3)**2
         w2 = self%l*self%m*cos(y(2))
-        e = (0.5_dp)*y(4)**2*self%l**2*self%m + y(4)*y(3)*w2 + self%g*w2 + self%m*w1 +&
-            & self%mc*w1
+        e = self%g*w2 + (0.5_dp)*self%l**2*y(4)**2*self%m + self%m*w1 + self%mc*w1 +&
+            & y(4)*y(3)*w2
     end function cart_pendulum_sym_energy
 
 end module cart_pendulum_model

@@ -92,7 +92,7 @@ contains
         w1 = (0.5_dp)*self%m
         w2 = 2.0_dp*self%I
         e = v(3)**2*w2 + v(4)**2*w2 + v(5)**2*w2 + v(6)**2*w2 -&
-            & self%g*self%m*q(1)*sin(self%alpha) + w1*v(1)**2 + w1*v(2)**2
+            & self%g*self%m*q(1)*sin(self%alpha) + v(1)**2*w1 + v(2)**2*w1
     end function rolling_ball_sym_energy
 
     !> The energy is defined.
