@@ -3,7 +3,8 @@
 #   1. system packages: gfortran, LAPACK/BLAS, OpenMPI (and python3-venv/-dev if the
 #      Python in use lacks venv or its headers), via apt-get, only if missing;
 #   2. a virtual environment .venv in the repository with numpy, scipy, meson,
-#      meson-python, ninja, pytest, matplotlib, fpm and sympy (conmech.symbolic),
+#      meson-python, ninja, pytest, hypothesis, matplotlib, fpm, sympy (conmech.symbolic),
+#      and ford, sphinx, numpydoc (the docs),
 #      only if something is missing;
 #   3. the conmech Python package itself (pip install --no-build-isolation .), rebuilt only
 #      when the sources changed (hash stamp in .venv/).
@@ -62,15 +63,17 @@ VPY="$VENV/bin/python"
 export PATH="$VENV/bin:$PATH"
 if ! "$VPY" - <<'PYEOF' >/dev/null 2>&1
 import importlib.util, shutil, sys
-mods = ["numpy", "scipy", "mesonpy", "pytest", "matplotlib", "sympy"]
+mods = ["numpy", "scipy", "mesonpy", "pytest", "hypothesis", "matplotlib", "sympy",
+        "sphinx", "numpydoc"]
 ok = all(importlib.util.find_spec(m) is not None for m in mods)
-ok = ok and all(shutil.which(x) for x in ("meson", "ninja", "fpm"))
+ok = ok and all(shutil.which(x) for x in ("meson", "ninja", "fpm", "ford"))
 sys.exit(0 if ok else 1)
 PYEOF
 then
     log "installing Python packages into $VENV"
     "$VPY" -m pip install --upgrade pip
-    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm sympy
+    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest hypothesis matplotlib \
+        fpm sympy ford sphinx numpydoc
 fi
 
 # ------------------------------------------------------------------ 3. the conmech package

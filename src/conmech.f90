@@ -1,4 +1,5 @@
-!> conmech: mechanical systems with constraints and the stability of their motions.
+!> The umbrella module of conmech, mechanical systems with constraints and the stability of
+!! their motions.
 !!
 !! `use conmech` gives the public API of every layer.
 module conmech
@@ -14,9 +15,14 @@ module conmech
     use conmech_c_mechanics
     use conmech_constrained_system
     use conmech_constrained_solver
+    use conmech_rattle
+    use conmech_rattle_dae
+    use conmech_radau
+    use conmech_gauss
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_mech
+    use conmech_model_library
     use conmech_systems_ball
     use conmech_hill
     use conmech_equilibria
@@ -24,6 +30,7 @@ module conmech
     use conmech_floquet
     use conmech_shooting
     use conmech_hill_orbit
+    use conmech_ensemble
     implicit none
     public
 end module conmech

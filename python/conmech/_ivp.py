@@ -6,13 +6,16 @@ import numpy as np
 
 from . import _conmech
 from .systems import BuiltinSystem
+from . import _implicit
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9")
+_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "Radau", "GAUSS4",
+            "GAUSS6")
 # codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
 # method_from_name by the tests (flat_method_code)
-_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
+                 **_implicit.IMPLICIT_CODES}
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -186,7 +189,7 @@ def _event_settings(events):
 
 def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
               events=None, vectorized=False, args=None, *, rtol=1e-3, atol=1e-6,
-              first_step=None, max_step=np.inf, max_steps=100000):
+              first_step=None, max_step=np.inf, max_steps=100000, jac=None):
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
 
     Parameters
@@ -199,11 +202,16 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state.
-    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4"}
+    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4",
+              "Radau" (alias "RADAU5"), "GAUSS4", "GAUSS6"}
         DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
         5(4), dense output of order 4. VERNER98: Verner's 9(8) pair, dense output of
         order 8, for tight tolerances. RK4: classical fixed-step RK4, step ``first_step``.
-        Case-insensitive.
+        Radau: Radau IIA of order 5 for stiff problems (Hairer's RADAU5: simplified
+        Newton with one real and one complex LU, dense output of order 3, events; counts
+        njev and nlu). GAUSS4 / GAUSS6: Gauss-Legendre collocation with 2 / 3 stages
+        (orders 4 / 6), symplectic, fixed step ``first_step``, for long runs of
+        conservative systems. Case-insensitive.
     t_eval : array_like or None
         Times at which to store the solution (sorted in the direction of integration,
         inside t_span), from the dense output. None: every accepted step.
@@ -226,13 +234,17 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         Largest step size (default no limit).
     max_steps : int
         Attempted steps before giving up (status -1).
+    jac : callable, array_like or None
+        Used by method="Radau" (the other methods ignore it with a warning, as SciPy's):
+        ``jac(t, y, *args) -> (n, n)`` (dense) or a constant matrix; None: forward
+        differences (n evaluations of fun per Jacobian).
 
     Returns
     -------
     OdeResult
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
-        None), nfev, njev = 0, nlu = 0, status (0 reached the end, 1 terminal event, -1
-        failure), message, success, and the step counts naccept, nreject.
+        None), nfev, njev, nlu (Radau; 0 otherwise), status (0 reached the end, 1 terminal
+        event, -1 failure), message, success, and the step counts naccept, nreject.
 
     The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step and
     max_steps (SciPy's ``**options``) are keyword-only.
@@ -304,9 +316,14 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
             raise ValueError("first_step must be positive")
         if h0 > abs(tf - t0) and tf != t0:
             raise ValueError("first_step exceeds the length of t_span")
-    if code == 1 and first_step is None:
-        raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
-                         "step size")
+    if code in (1, 6, 7) and first_step is None:
+        raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
+                         "the step size")
+    if jac is not None and code != 5:
+        import warnings
+        warnings.warn("The following arguments have no effect for a chosen solver: jac.",
+                      stacklevel=2)
+        jac = None
     hmax = _real_scalar(max_step, "max_step")
     if not hmax > 0:
         raise ValueError("max_step must be positive")
@@ -391,7 +408,28 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
                   dense=int(bool(dense_output)), neval=t_ev.size,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir, ev_term=ev_term)
     probe_calls = 0
-    if builtin:
+    njev = nlu = 0
+    if code >= 5:
+        rhs = None
+        if not builtin:
+            f0 = np.asarray(fun(t0, y0.copy(), *args))
+            probe_calls = 1
+            if f0.size != n or f0.ndim > 1:
+                raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
+                                 f"shape {f0.shape}")
+            nan_y = np.full(n, math.nan)
+
+            def rhs(t, y):
+                if failure:
+                    return nan_y
+                try:
+                    return fun(t, y.copy(), *args)
+                except BaseException as exc:
+                    failure.append(exc)
+                    return nan_y
+        nfev, njev, nlu, naccept, nreject, form, info, message = _implicit.run(
+            builtin, fun, rhs, jac, args, n, events_cb, store, common, failure)
+    elif builtin:
         nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
             *fun._flat_args(), events_cb, store, **common)
     else:
@@ -429,7 +467,7 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         status = -1
     res = OdeResult(t=out.get("t", np.array([t0])), y=out.get("y", y0[:, None].copy()),
                     sol=None, t_events=None, y_events=None,
-                    nfev=int(nfev) + probe_calls, njev=0, nlu=0, status=status,
+                    nfev=int(nfev) + probe_calls, njev=njev, nlu=nlu, status=status,
                     message=message, success=status >= 0, naccept=int(naccept),
                     nreject=int(nreject))
     if ne > 0 and "ev_t" in out:

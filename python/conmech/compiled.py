@@ -40,7 +40,7 @@ from .systems import BuiltinSystem
 from .constrained import BuiltinConstrained
 
 __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
-           "CompiledConstrained", "evaluate", "function_address"]
+           "CompiledConstrained", "evaluate", "function_address", "load_model"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
 _SPEC_SIZE = 15
@@ -301,3 +301,48 @@ def evaluate(system, t, y, v=None):
         res.update(phi=np.array(phi)[:mh], G=np.array(g)[:mh], gamma_h=np.array(gh)[:mh],
                    A=np.array(a)[:mn], b=np.array(b)[:mn], gamma_n=np.array(gn)[:mn])
     return res
+
+
+def load_model(path, name=None):
+    """A system from a model library: a shared library that exports, with C linkage,
+    ``conmech_model_info(int info[6])`` (kind 1 ode / 2 generalized / 3 constrained, n,
+    n_hol, n_nh, rheonomic, number of parameters), ``conmech_model_params(double *p)``
+    (defaults), ``conmech_model_param_names(char *buf, int len)`` (blank-separated) and the
+    functions of its kind named ``conmech_rhs``, ``conmech_jac``, ``conmech_mass``,
+    ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
+    ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
+    ``conmech_nh_gamma``. The Fortran programs load the same libraries (``sweep --model``,
+    conmech_model_library)."""
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as e:
+        raise ValueError(f"cannot load the model library {str(path)!r}: {e}") from None
+    if not hasattr(lib, "conmech_model_info"):
+        raise ValueError(f"{str(path)!r} is not a conmech model (no conmech_model_info)")
+    info = (ctypes.c_int*6)()
+    lib.conmech_model_info(info)
+    kind, n, n_hol, n_nh, rheo, npar = list(info)
+    if kind not in (1, 2, 3) or n < 1 or npar < 0:
+        raise ValueError(f"{str(path)!r}: invalid description from conmech_model_info")
+    p = (ctypes.c_double*max(npar, 1))()
+    if npar:
+        lib.conmech_model_params(p)
+    names = ()
+    if hasattr(lib, "conmech_model_param_names"):
+        buf = ctypes.create_string_buffer(4096)
+        lib.conmech_model_param_names(buf, ctypes.c_int(4096))
+        names = tuple(buf.value.decode("ascii", "replace").split())
+    if len(names) != npar:
+        names = tuple(f"p{i}" for i in range(npar))
+    params = dict(zip(names, list(p)[:npar]))
+    fn = {k: getattr(lib, "conmech_" + k, None) for k in _SLOTS}
+    name = name or str(path)
+    if kind == _KIND_ODE:
+        return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name)
+    if kind == _KIND_GEN:
+        return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
+                                  params=params, keep=lib, name=name)
+    return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
+                              fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
+                              fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,
+                              name=name)

@@ -171,3 +171,17 @@ def test_bad_constrained_input(lib):
         stability.stm(s, (0, 1), [1.0, 0.0])
     with pytest.raises(ValueError, match="y0 must have shape"):
         conmech.solve_ivp(s, (0, 1), [1.0, 0.0], rtol=1e-8)
+
+
+def test_model_library(tmp_path):
+    cc = shutil.which("gcc") or shutil.which("cc")
+    so = tmp_path / "libkep.so"
+    subprocess.run([cc, "-O2", "-fPIC", "-shared", os.path.join(HERE, "data",
+                    "c_model_kepler.c"), "-o", str(so), "-lm"], check=True)
+    s = compiled.load_model(so)
+    assert s.kind == "ode" and s.dimension == 4 and s.parameters == {"mu": 1.0}
+    r = conmech.solve_ivp(s.with_params(mu=4.0), (0, np.pi), [1.0, 0, 0, 2.0], rtol=1e-10,
+                          atol=1e-10)
+    assert r.success and np.abs(r.y[:, -1] - [1.0, 0, 0, 2.0]).max() < 1e-8  # period pi
+    with pytest.raises(ValueError, match="cannot load the model library"):
+        compiled.load_model(tmp_path / "missing.so")

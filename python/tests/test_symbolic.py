@@ -441,3 +441,14 @@ def test_model_call_checks_its_arguments():
         mod.call("mass", 0.0, [0.1, 0.2, 0.3])
     with pytest.raises(ValueError, match="no entry point 'rhs'"):
         mod.call("rhs", 0.0, [0.1, 0.2])
+
+
+def test_stale_build_directories_of_killed_processes_are_removed(monkeypatch, tmp_path):
+    monkeypatch.setenv("CONMECH_CACHE", str(tmp_path))
+    old, fresh = tmp_path / ".build-old-x", tmp_path / ".build-new-y"
+    old.mkdir()
+    fresh.mkdir()
+    os.utime(old, (0, 0))
+    x, v = sp.symbols("x v")
+    symbolic.ode_system([v, -x/3], [x, v], model_only=True)
+    assert not old.exists() and fresh.exists()     # a build in progress is left alone

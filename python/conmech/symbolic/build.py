@@ -85,6 +85,24 @@ def library_path(source, flags=None):
     return os.path.join(cache_dir(), f"conmech_{key}.so"), key
 
 
+def _remove_stale_builds(d, age=86400.0):
+    """Remove build directories left by killed processes (older than a day)."""
+    import time
+    now = time.time()
+    try:
+        names = os.listdir(d)
+    except OSError:
+        return
+    for name in names:
+        if name.startswith(".build-"):
+            p = os.path.join(d, name)
+            try:
+                if now - os.path.getmtime(p) > age:
+                    shutil.rmtree(p, ignore_errors=True)
+            except OSError:
+                pass
+
+
 def compile_source(source, flags=None):
     """Path of the shared library built from `source` (from the cache when present).
     Returns (path, hit) with hit True when no compilation was needed."""
@@ -98,6 +116,7 @@ def compile_source(source, flags=None):
         os.makedirs(d, exist_ok=True)
     except OSError as exc:
         raise CompileError(f"cannot create the cache directory {d}: {exc}") from exc
+    _remove_stale_builds(d)
     work = tempfile.mkdtemp(prefix=f".build-{key[:12]}-", dir=d)
     try:
         src = os.path.join(work, "model.f90")
