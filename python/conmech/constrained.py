@@ -27,7 +27,7 @@ __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
 
 #: Names of the built-in constrained systems (excessive coordinates).
 BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
-                 "pendulum_moving_xy", "yoyo", "skate", "rolling_disk")
+                 "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "rolling_ball")
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
 _METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
@@ -109,7 +109,8 @@ def builtin(name, params=()):
     """The built-in constrained system ``name`` with ``params`` (documented order:
     pendulum_xy m, g, l | rod_two_masses g, l | double_pendulum_xy m1, m2, l1, l2, g |
     atwood_xy m1, m2, g, L | pendulum_moving_xy m, g, l, a, b, w |
-    yoyo m, r, I, g, ah, vh, h0 | skate m, I, g, alpha | rolling_disk m, R, I_roll, I_turn)."""
+    yoyo m, r, I, g, ah, vh, h0 | skate m, I, g, alpha | rolling_disk m, R, I_roll, I_turn |
+    rolling_ball m, R, I, g, alpha)."""
     return BuiltinConstrained(name, params)
 
 

@@ -209,8 +209,16 @@ def rolling_disk(m=1.0, R=1.0, I_roll=0.5, I_turn=0.25):
     return _constrained("rolling_disk", [m, R, I_roll, I_turn])
 
 
+def rolling_ball(m=1.0, R=1.0, I=0.4, g=9.81, alpha=0.0):
+    """Rubber ball rolling without slip and without spin about the vertical on a plane
+    inclined at alpha (seed 001), q = [x, y, e0, e1, e2, e3] (centre, unit quaternion): one
+    holonomic (|e| = 1) and three non-holonomic constraints; I the central moment of
+    inertia (2/5 m R^2 for a homogeneous ball)."""
+    return _constrained("rolling_ball", [m, R, I, g, alpha])
+
+
 __all__ += ["pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
-            "pendulum_moving_xy", "yoyo", "skate", "rolling_disk"]
+            "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "rolling_ball"]
 
 
 def hill(m=0.080848933808312, kappa=1.0):

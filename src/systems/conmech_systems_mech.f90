@@ -4,7 +4,7 @@
 !!   pendulum_xy: m, g, l | rod_two_masses: g, l | double_pendulum_xy: m1, m2, l1, l2, g |
 !!   atwood_xy: m1, m2, g, L | pendulum_moving_xy: m, g, l, a, b, w |
 !!   yoyo: m, r, I, g, ah, vh, h0 | skate: m, I, g, alpha | rolling_disk: m, R, I_roll, I_turn
-!!   | pendulum_chain_xy: N (links, default 8), m, l, g
+!!   | pendulum_chain_xy: N (links, default 8), m, l, g | rolling_ball: m, R, I, g, alpha
 !! Generalized coordinates (`make_generalized`):
 !!   pendulum_angle: m, g, l | cart_pendulum: M, m, l, g | double_pendulum: m1, m2, l1, l2, g |
 !!   atwood: m1, m2, g | spring_pendulum: m, k, l0, g |
@@ -20,6 +20,7 @@ module conmech_systems_mech
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_chain, only: pendulum_chain_xy, chain_initial_state
+    use conmech_systems_ball, only: rolling_ball
     use conmech_ode_system, only: ode_system
     implicit none
     private
@@ -30,7 +31,7 @@ module conmech_systems_mech
     !> Names of the built-in constrained systems (space separated).
     character(len=*), parameter :: constrained_names = "pendulum_xy rod_two_masses " &
         //"double_pendulum_xy atwood_xy pendulum_moving_xy yoyo skate rolling_disk " &
-        //"pendulum_chain_xy"
+        //"pendulum_chain_xy rolling_ball"
     !> Names of the built-in generalized-coordinate systems.
     character(len=*), parameter :: generalized_names = "pendulum_angle cart_pendulum " &
         //"double_pendulum atwood spring_pendulum double_spring_pendulum three_springs " &
@@ -144,6 +145,15 @@ contains
                 s%n = 2*nint(nl); s%n_hol = nint(nl)
                 s%diagonal_mass = .true.
                 s%jac_width = min(4, s%n)
+                allocate (sys, source=s)
+            end block
+        case ("rolling_ball")
+            block
+                type(rolling_ball) :: s
+                s%m = par(params, 1, s%m); s%r = par(params, 2, s%r); s%i = par(params, 3, s%i)
+                s%g = par(params, 4, s%g); s%alpha = par(params, 5, s%alpha)
+                s%n = 6; s%n_hol = 1; s%n_nh = 3
+                s%constant_mass = .true.; s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case default
@@ -321,6 +331,11 @@ contains
         case ("rolling_disk")
             q0 = [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
             v0 = [par(params, 2, 1.0_dp)*2.0_dp, 0.0_dp, 0.5_dp, 2.0_dp]
+        case ("rolling_ball")
+            ! identity orientation, centre velocity (1, 0.5): e' = [0, -y'/(2R), x'/(2R), 0]
+            l = par(params, 2, 1.0_dp)
+            q0 = [0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
+            v0 = [1.0_dp, 0.5_dp, 0.0_dp, -0.25_dp/l, 0.5_dp/l, 0.0_dp]
         case ("pendulum_angle", "pendulum_moving")
             q0 = [th]; v0 = [0.0_dp]
         case ("cart_pendulum")

@@ -362,3 +362,11 @@ def _tup(x):
     if isinstance(x, (list, tuple)):
         return sp.Tuple(*x)
     return x
+
+
+# exactness of Pfaffian constraints: holonomic or not, integrating factor, integral
+from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: E402
+                       pfaffian_from_velocities, pfaffian_of, pfaffian_system)
+
+__all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
+            "PfaffianResult", "PfaffianSystemResult"]

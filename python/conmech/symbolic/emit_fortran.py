@@ -1,0 +1,426 @@
+"""Standalone Fortran modules from symbolic models, for fpm projects and batch codes.
+
+:func:`emit` turns a :class:`~conmech.symbolic.derive.Derived` record into the source of one
+self-contained Fortran module that needs only ``use conmech`` (no Python, no C ABI, no
+shared library): the parameters are components of the type with their values as defaults.
+
+- ode (``derive_ode``): ``type, extends(ode_system) :: NAME`` with ``rhs`` and the exact
+  ``jacobian`` (``has_jacobian`` true).
+- generalized (``derive_lagrangian``): ``type, extends(generalized_system) :: NAME_mech``
+  (mass, forces, energy: for ``generalized_solve``) and ``type, extends(ode_system) ::
+  NAME`` with y = [q, v]: ``rhs`` solves M a = Q by Cholesky (LAPACK dpotrf/dpotrs through
+  conmech's ``mass_cholesky``), ``jacobian`` is exact: d a/d[q, v] = M^-1 R with
+  R = [dQ/dq - d(M a)/dq |a fixed, dQ/dv]. A mass matrix that is not positive definite makes
+  the right-hand side NaN, so conmech's integrators stop with a non-finite status (as
+  conmech's own ``generalized_ode``).
+- constrained (``derive_constrained``): ``type, extends(constrained_system) :: NAME`` with
+  mass, forces, energy, phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma as present, for
+  ``constrained_solve`` (every projection, multipliers, reactions).
+
+Every type has a constructor function ``new_NAME()`` (and ``new_NAME_mech()``) returning an
+object with the dimensions set (n, n_hol, n_nh, rheonomic / ndof) and the default
+parameters; change a parameter as a component (``s%m = 2.0_dp``). The module also holds
+``NAME_n`` (the number of coordinates, or of state variables for an ode) and, for ode and
+generalized systems, ``NAME_ny`` (state dimension).
+
+The expressions share one common-subexpression elimination per procedure (the printer of
+:mod:`conmech.symbolic.codegen`). The output is deterministic: the same model gives the
+same file byte for byte (tests compare a regenerated file with the committed one).
+
+Command line (see ``python -m conmech.symbolic --help``)::
+
+    python -m conmech.symbolic emit MODEL.py -o cart_pendulum_model.f90
+
+MODEL.py defines the system with conmech.symbolic, as one of (first found wins):
+a function ``model()`` returning it, or a module-level ``model`` or ``system``; "it" is a
+``Derived`` record (``conmech.symbolic.derive.derive_*``, no compilation) or a system made
+by ``conmech.symbolic.lagrangian_system`` / ``constrained_system`` / ``ode_system``. Optionally
+``name = "..."`` sets the type name (default: the output file's stem without a trailing
+``_model``).
+"""
+import keyword
+import re
+
+import sympy as sp
+
+from .codegen import FortranPrinter, assignments
+
+__all__ = ["emit", "fortran_name_check"]
+
+# components and type-bound procedures of conmech's types: a parameter (a component of the
+# generated type, always referenced as self%name) may not take these names
+_RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energy",
+             "has_energy", "phi", "phi_jac", "phi_t", "phi_gamma", "nh_matrix", "nh_gamma",
+             "rhs", "jacobian", "has_jacobian", "self", "dp"}
+_IND = "        "
+
+
+def fortran_name_check(name, what):
+    """ValueError unless `name` is a valid Fortran identifier (letter first, letters,
+    digits, underscores, at most 63 characters)."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", name):
+        raise ValueError(f"{what} '{name}' is not a valid Fortran name (a letter, then "
+                         "letters, digits or underscores; at most 63 characters)")
+    return name
+
+
+def _check_params(d):
+    seen = {}
+    for name in d.param_names:
+        fortran_name_check(name, "parameter")
+        low = name.lower()
+        if low in _RESERVED:
+            raise ValueError(f"parameter '{name}' clashes with a name the generated code "
+                             "uses (rename it in the model)")
+        if low in seen:
+            raise ValueError(f"parameters '{seen[low]}' and '{name}' are the same name in "
+                             "Fortran (case-insensitive): rename one")
+        seen[low] = name
+
+
+def _lit(x):
+    s = repr(float(x))
+    if s in ("inf", "-inf", "nan"):
+        raise ValueError(f"non-finite parameter value {x}")
+    if "." not in s and "e" not in s:
+        s += ".0"
+    return s + "_dp"
+
+
+def _wrap_comment(text, prefix="!! ", width=96):
+    words, lines, cur = text.split(), [], ""
+    for w in words:
+        if cur and len(prefix) + len(cur) + 1 + len(w) > width:
+            lines.append(prefix + cur)
+            cur = w
+        else:
+            cur = (cur + " " + w) if cur else w
+    if cur:
+        lines.append(prefix + cur)
+    return lines
+
+
+class _Emitter:
+    def __init__(self, d, name):
+        self.d = d
+        self.name = name
+        self.n = d.n
+
+    def printer(self, state_in_y=False):
+        d = self.d
+        names = {d.t: "t"}
+        for i, s in enumerate(d.coords):
+            names[s] = f"y({i + 1})" if (state_in_y or d.kind == "ode") else f"q({i + 1})"
+        for i, s in enumerate(d.speeds):
+            names[s] = f"y({self.n + i + 1})" if state_in_y else f"v({i + 1})"
+        for i, s in enumerate(d.accels):
+            names[s] = f"a({i + 1})"
+        for s, pn in zip(d.params, d.param_names):
+            names[s] = f"self%{pn}"
+        return FortranPrinter(names)
+
+    # -------------------------------------------------------------- procedure bodies
+    @staticmethod
+    def _targets(name, obj, matrix):
+        tg, ex = [], []
+        if matrix:
+            rows, cols = obj.shape
+            for j in range(cols):
+                for i in range(rows):
+                    if obj[i, j] != 0:
+                        tg.append(f"{name}({i + 1}, {j + 1})")
+                        ex.append(obj[i, j])
+            zero = len(tg) < rows * cols
+        else:
+            vals = list(obj)
+            tg = [f"{name}({i + 1})" for i in range(len(vals))]
+            ex = vals
+            zero = False
+        return tg, ex, zero
+
+    def body(self, pr, outputs, prefix="w"):
+        """Declarations of temporaries and the statements assigning `outputs`
+        [(target name, sympy Matrix/expression, is_matrix)]."""
+        targets, exprs, zero_lines = [], [], []
+        for name, obj, matrix in outputs:
+            if not matrix and not isinstance(obj, sp.MatrixBase) and not isinstance(obj, list):
+                targets.append(name)
+                exprs.append(obj)
+                continue
+            tg, ex, zero = self._targets(name, obj, matrix)
+            if zero:
+                zero_lines.append(f"{_IND}{name} = 0.0_dp")
+            targets += tg
+            exprs += ex
+        temps, lines = assignments(targets, exprs, pr, _IND, prefix=prefix)
+        decl = [f"{_IND}real(dp) :: " + ", ".join(temps[i:i + 10])
+                for i in range(0, len(temps), 10)]
+        return decl, zero_lines + lines
+
+    def proc(self, kind, tname, pname, args, decls, pr, outputs, doc, result=None):
+        """A type-bound subroutine (or function with `result` = (name, expr))."""
+        self_decl = f"{_IND}class({tname}), intent(in) :: self"
+        outs = list(outputs)
+        if result is not None:
+            outs.append((result[0], result[1], False))
+        tdecl, lines = self.body(pr, outs)
+        if result is None:
+            head = f"    subroutine {pname}({', '.join(['self'] + args)})"
+            tail = f"    end subroutine {pname}"
+        else:
+            head = (f"    function {pname}({', '.join(['self'] + args)}) "
+                    f"result({result[0]})")
+            tail = f"    end function {pname}"
+            decls = decls + [f"{_IND}real(dp) :: {result[0]}"]
+        return ([f"    !> {doc}", head, self_decl] + decls + tdecl + lines + [tail, ""])
+
+
+def _decl(name, shape=None, intent="in"):
+    if shape is None:
+        return f"{_IND}real(dp), intent({intent}) :: {name}"
+    return f"{_IND}real(dp), intent({intent}) :: {name}({', '.join(shape)})"
+
+
+def _logical_true(tname, pname, doc):
+    return [f"    !> {doc}", f"    logical function {pname}(self)",
+            f"{_IND}class({tname}), intent(in) :: self", f"{_IND}{pname} = .true.",
+            f"    end function {pname}", ""]
+
+
+def _components(d):
+    out = []
+    for pn, pv in zip(d.param_names, d.param_values):
+        out.append(f"{_IND[:8]}real(dp) :: {pn} = {_lit(pv)}   !! parameter")
+    return out
+
+
+def emit(d, name, module=None, source="a conmech.symbolic model"):
+    """Fortran source (str) of a standalone module for the derived system `d` whose main
+    type is called `name` (module `module`, default NAME_model). `source` is named in the
+    header comment (e.g. the model file)."""
+    from .derive import Derived
+    if not isinstance(d, Derived):
+        raise TypeError("emit: expected a conmech.symbolic.derive.Derived record")
+    if d.kind not in ("ode", "generalized", "constrained"):
+        raise ValueError(f"emit: unknown kind {d.kind!r}")
+    fortran_name_check(name, "type name")
+    if len(name) > 40:
+        raise ValueError(f"type name '{name}' is longer than 40 characters")
+    if keyword.iskeyword(name) or name.lower() in _RESERVED:
+        raise ValueError(f"type name '{name}' is reserved")
+    module = module or f"{name}_model"
+    fortran_name_check(module, "module name")
+    if module.lower() == name.lower():
+        raise ValueError("the module and the type need different names")
+    _check_params(d)
+    em = _Emitter(d, name)
+    n = d.n
+    coord_names = ", ".join(getattr(d, "coord_names", [str(c) for c in d.coords]))
+    params = ", ".join(f"{a} = {b!r}" for a, b in zip(d.param_names, d.param_values))
+    header = [f"!> {name}: {d.kind} system generated by conmech.symbolic from {source}."]
+    header += _wrap_comment(f"Coordinates: {coord_names}. Parameters (components with "
+                            f"defaults): {params or 'none'}. Generated code: do not edit; "
+                            "regenerate with python -m conmech.symbolic emit.")
+    if d.kind == "ode":
+        header += [f"!! Use: new_{name}() is an ode_system with the exact Jacobian (ode_solve,",
+                   "!! integrate_stm and conmech's stability routines)."]
+    elif d.kind == "generalized":
+        header += [f"!! Use: new_{name}() is an ode_system (y = [q, v]) with the exact "
+                   "Jacobian;", f"!! new_{name}_mech() a generalized_system for "
+                   "generalized_solve."]
+    else:
+        header += [f"!! Use: new_{name}() is a constrained_system for constrained_solve."]
+    lines = header + [f"module {module}", "    use conmech", "    implicit none",
+                      "    private", ""]
+    body = []
+    if d.kind == "ode":
+        lines += [f"    public :: {name}, new_{name}",
+                  f"    integer, parameter, public :: {name}_n = {n}   !! state dimension",
+                  "", "    !> y' = f(t, y) with the exact Jacobian df/dy.",
+                  f"    type, extends(ode_system) :: {name}"]
+        lines += _components(d)
+        lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
+                  f"        procedure :: jacobian => {name}_jacobian",
+                  f"        procedure :: has_jacobian => {name}_has_jacobian",
+                  f"    end type {name}", ""]
+        pr = em.printer()
+        body += _ctor(name, name, [], d)
+        body += em.proc("ode", name, f"{name}_rhs", ["t", "y", "dydt"],
+                        [_decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out")], pr,
+                        [("dydt", d.f, False)], "dydt = f(t, y).")
+        body += em.proc("ode", name, f"{name}_jacobian", ["t", "y", "dfdy"],
+                        [_decl("t"), _decl("y", [":"]), _decl("dfdy", [":", ":"], "out")],
+                        pr, [("dfdy", d.jac, True)], "dfdy = df/dy (exact, from sympy).")
+        body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
+    elif d.kind == "generalized":
+        mech = f"{name}_mech"
+        lines += [f"    public :: {name}, {mech}", f"    public :: new_{name}, new_{mech}",
+                  f"    integer, parameter, public :: {name}_n = {n}   !! coordinates",
+                  f"    integer, parameter, public :: {name}_ny = {2 * n}   !! y = [q, v]",
+                  "", "    !> M(t, q) q'' = Q(t, q, q') (for generalized_solve).",
+                  f"    type, extends(generalized_system) :: {mech}"]
+        lines += _components(d)
+        lines += ["    contains", f"        procedure :: mass => {mech}_mass",
+                  f"        procedure :: forces => {mech}_forces"]
+        if d.energy is not None:
+            lines += [f"        procedure :: energy => {mech}_energy",
+                      f"        procedure :: has_energy => {mech}_has_energy"]
+        lines += [f"    end type {mech}", "",
+                  "    !> First-order form y = [q, v], y' = [v, M^-1 Q], exact Jacobian.",
+                  f"    type, extends(ode_system) :: {name}"]
+        lines += _components(d)
+        lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
+                  f"        procedure :: jacobian => {name}_jacobian",
+                  f"        procedure :: has_jacobian => {name}_has_jacobian"]
+        if d.energy is not None:
+            lines += [f"        procedure :: energy => {name}_energy"]
+        lines += [f"    end type {name}", ""]
+        pr = em.printer()
+        pry = em.printer(state_in_y=True)
+        body += _ctor(mech, mech, [f"s%ndof = {n}"], d)
+        body += _ctor(name, name, [], d)
+        qdecl = [_decl("t"), _decl("q", [":"])]
+        qvdecl = qdecl + [_decl("v", [":"])]
+        body += em.proc("g", mech, f"{mech}_mass", ["t", "q", "mm"],
+                        qdecl + [_decl("mm", [":", ":"], "out")], pr,
+                        [("mm", d.M, True)], "mm = M(t, q).")
+        body += em.proc("g", mech, f"{mech}_forces", ["t", "q", "v", "f"],
+                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
+                        "f = Q(t, q, v).")
+        if d.energy is not None:
+            body += em.proc("g", mech, f"{mech}_energy", ["t", "q", "v"], qvdecl, pr, [],
+                            "The energy (Jacobi integral).", result=("e", d.energy))
+            body += _logical_true(mech, f"{mech}_has_energy", "The energy is defined.")
+        body += _gen_rhs(em, name, pry, d)
+        body += _gen_jac(em, name, pry, d)
+        body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
+        if d.energy is not None:
+            body += em.proc("g", name, f"{name}_energy", ["t", "y"],
+                            [_decl("t"), _decl("y", [":"])], pry, [],
+                            "The energy at y = [q, v].", result=("e", d.energy))
+    else:
+        lines += [f"    public :: {name}, new_{name}",
+                  f"    integer, parameter, public :: {name}_n = {n}   !! coordinates",
+                  f"    integer, parameter, public :: {name}_n_hol = {d.n_hol}",
+                  f"    integer, parameter, public :: {name}_n_nh = {d.n_nh}", "",
+                  "    !> M q'' = Q + G^T lambda_h + A^T lambda_n with the constraints.",
+                  f"    type, extends(constrained_system) :: {name}"]
+        lines += _components(d)
+        procs = ["mass", "forces"]
+        if d.energy is not None:
+            procs += ["energy", "has_energy"]
+        if d.n_hol:
+            procs += ["phi", "phi_jac", "phi_t", "phi_gamma"]
+        if d.n_nh:
+            procs += ["nh_matrix", "nh_gamma"]
+        lines += ["    contains"] + [f"        procedure :: {p} => {name}_{p}" for p in procs]
+        lines += [f"    end type {name}", ""]
+        pr = em.printer()
+        ctor = [f"s%n = {n}", f"s%n_hol = {d.n_hol}", f"s%n_nh = {d.n_nh}",
+                f"s%rheonomic = {'.true.' if d.rheonomic else '.false.'}"]
+        body += _ctor(name, name, ctor, d)
+        qdecl = [_decl("t"), _decl("q", [":"])]
+        qvdecl = qdecl + [_decl("v", [":"])]
+        body += em.proc("c", name, f"{name}_mass", ["t", "q", "mm"],
+                        qdecl + [_decl("mm", [":", ":"], "out")], pr, [("mm", d.M, True)],
+                        "mm = M(t, q).")
+        body += em.proc("c", name, f"{name}_forces", ["t", "q", "v", "f"],
+                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
+                        "f = Q(t, q, v).")
+        if d.energy is not None:
+            body += em.proc("c", name, f"{name}_energy", ["t", "q", "v"], qvdecl, pr, [],
+                            "The energy.", result=("e", d.energy))
+            body += _logical_true(name, f"{name}_has_energy", "The energy is defined.")
+        if d.n_hol:
+            body += em.proc("c", name, f"{name}_phi", ["t", "q", "c"],
+                            qdecl + [_decl("c", [":"], "out")], pr, [("c", d.phi, False)],
+                            "Holonomic constraints phi(t, q).")
+            body += em.proc("c", name, f"{name}_phi_jac", ["t", "q", "g"],
+                            qdecl + [_decl("g", [":", ":"], "out")], pr, [("g", d.G, True)],
+                            "G = d phi/d q.")
+            body += em.proc("c", name, f"{name}_phi_t", ["t", "q", "pt"],
+                            qdecl + [_decl("pt", [":"], "out")], pr,
+                            [("pt", d.phi_t, False)], "d phi/d t.")
+            body += em.proc("c", name, f"{name}_phi_gamma", ["t", "q", "v", "gam"],
+                            qvdecl + [_decl("gam", [":"], "out")], pr,
+                            [("gam", d.gamma_h, False)], "gamma_h = -d/dt [G v + phi_t].")
+        if d.n_nh:
+            body += em.proc("c", name, f"{name}_nh_matrix", ["t", "q", "a", "b"],
+                            qdecl + [_decl("a", [":", ":"], "out"), _decl("b", [":"], "out")],
+                            pr, [("a", d.A, True), ("b", d.b, False)],
+                            "Pfaffian constraints A(t, q) v + b(t, q) = 0.")
+            body += em.proc("c", name, f"{name}_nh_gamma", ["t", "q", "v", "gam"],
+                            qvdecl + [_decl("gam", [":"], "out")], pr,
+                            [("gam", d.gamma_n, False)], "gamma_n = -d/dt [A v + b].")
+    src = lines + ["contains", ""] + body + [f"end module {module}", ""]
+    for ln in src:
+        if len(ln) > 100:
+            raise RuntimeError(f"emit: generated line longer than 100 characters: {ln!r}")
+    return "\n".join(src)
+
+
+def _ctor(tname, fname, sets, d):
+    """Constructor function: dimensions and the default parameter values, assigned
+    explicitly (gfortran does not always default-initialise a function result)."""
+    lines = [f"    !> A {tname} with its dimensions set and the default parameters.",
+             f"    function new_{fname}() result(s)", f"{_IND}type({tname}) :: s"]
+    lines += [f"{_IND}{s}" for s in sets]
+    lines += [f"{_IND}s%{pn} = {_lit(pv)}" for pn, pv in zip(d.param_names, d.param_values)]
+    lines += [f"    end function new_{fname}", ""]
+    return lines
+
+
+def _mass_solve(n, nrhs, rhs_name):
+    """Statements: Cholesky of mm (conmech's mass_cholesky), then dpotrs on rhs_name;
+    NaN on failure."""
+    return [f"{_IND}call mass_cholesky(mm, info)",
+            f"{_IND}if (info /= CM_SUCCESS) then",
+            f"{_IND}    {rhs_name} = ieee_value(1.0_dp, ieee_quiet_nan)",
+            f"{_IND}else",
+            f"{_IND}    call dpotrs('U', {n}, {nrhs}, mm, {n}, {rhs_name}, {n}, info)",
+            f"{_IND}end if"]
+
+
+def _gen_rhs(em, name, pry, d):
+    n = d.n
+    decl, lines = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)])
+    return (["    !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).",
+             f"    subroutine {name}_rhs(self, t, y, dydt)",
+             f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{_IND}use conmech_lapack, only: dpotrs",
+             f"{_IND}class({name}), intent(in) :: self",
+             _decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out"),
+             f"{_IND}real(dp) :: mm({n}, {n}), a({n})", f"{_IND}integer :: info"]
+            + decl + lines + _mass_solve(n, 1, "a")
+            + [f"{_IND}dydt(1:{n}) = y({n + 1}:{2 * n})", f"{_IND}dydt({n + 1}:{2 * n}) = a",
+               f"    end subroutine {name}_rhs", ""])
+
+
+def _gen_jac(em, name, pry, d):
+    n = d.n
+    decl1, lines1 = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)], prefix="w")
+    decl2, lines2 = em.body(pry, [("r", d.R, True)], prefix="u")
+    lines = ["    !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].",
+             f"    subroutine {name}_jacobian(self, t, y, dfdy)",
+             f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{_IND}use conmech_lapack, only: dpotrs",
+             f"{_IND}class({name}), intent(in) :: self",
+             _decl("t"), _decl("y", [":"]), _decl("dfdy", [":", ":"], "out"),
+             f"{_IND}real(dp) :: mm({n}, {n}), a({n}), r({n}, {2 * n})",
+             f"{_IND}integer :: info, i"]
+    lines += decl1 + decl2 + lines1
+    lines += [f"{_IND}call mass_cholesky(mm, info)",
+              f"{_IND}if (info /= CM_SUCCESS) then",
+              f"{_IND}    dfdy = ieee_value(1.0_dp, ieee_quiet_nan)",
+              f"{_IND}    return",
+              f"{_IND}end if",
+              f"{_IND}call dpotrs('U', {n}, 1, mm, {n}, a, {n}, info)"]
+    lines += lines2
+    lines += [f"{_IND}call dpotrs('U', {n}, {2 * n}, mm, {n}, r, {n}, info)",
+              f"{_IND}dfdy = 0.0_dp",
+              f"{_IND}do i = 1, {n}",
+              f"{_IND}    dfdy(i, {n} + i) = 1.0_dp",
+              f"{_IND}end do",
+              f"{_IND}dfdy({n + 1}:{2 * n}, :) = r",
+              f"    end subroutine {name}_jacobian", ""]
+    return lines
