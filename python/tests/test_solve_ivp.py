@@ -222,7 +222,7 @@ def test_kepler_pericentre_apocentre_times():
     # states at the events: pericentre r = 0.5 on +x, apocentre r = 1.5 on -x
     np.testing.assert_allclose(r.y_events[0][:, 0], 0.5, atol=1e-9)
     np.testing.assert_allclose(r.y_events[1][:, 0], -1.5, atol=1e-9)
-    assert r.y_events[0].shape == (3, 4)
+    assert r.y_events[0].shape == (4, 4)
 
 
 def test_terminal_event_stops_the_integration():
