@@ -22,7 +22,8 @@ module conmech_flat_ode_support
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOPRI5
     implicit none
     private
-    public :: callback_system, callback_events, run_solve, copy_message, scipy_first_step
+    public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
+    public :: scipy_first_step
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
     !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
@@ -35,6 +36,14 @@ module conmech_flat_ode_support
     contains
         procedure :: rhs => callback_rhs
     end type callback_system
+
+    !> A system with its exact Jacobian from an external procedure jac(t, y, dfdy, n).
+    type, extends(callback_system) :: callback_jac_system
+        procedure(), pointer, nopass :: jac => null()
+    contains
+        procedure :: jacobian => callback_jacobian
+        procedure :: has_jacobian => callback_has_jacobian
+    end type callback_jac_system
 
     !> Event functions given by one external procedure events(t, y, g, n, ne).
     type, extends(ode_events) :: callback_events
@@ -54,6 +63,19 @@ contains
         real(dp), intent(out) :: dydt(:)
         call self%f(t, y, dydt, self%n)
     end subroutine callback_rhs
+
+    subroutine callback_jacobian(self, t, y, dfdy)
+        class(callback_jac_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        call self%jac(t, y, dfdy, self%n)
+    end subroutine callback_jacobian
+
+    logical function callback_has_jacobian(self)
+        class(callback_jac_system), intent(in) :: self
+        callback_has_jacobian = associated(self%jac)
+    end function callback_has_jacobian
 
     subroutine callback_eval(self, t, y, g)
         class(callback_events), intent(in) :: self
