@@ -22,6 +22,7 @@ symmetric Newton shooting over a quarter period, monodromy from the symmetry).
 import numpy as np
 
 from . import _conmech
+from ._callback import message_text
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
            "M_HILL", "C_HILL", "plot_orbit", "plot_multipliers", "plot_family"]
@@ -29,14 +30,26 @@ __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
 C_HILL = 1.0715832774160     #: Hill's perigee constant for M_HILL
 
+_NOT_PERIODIC = -7     #: family status: Newton stopped on a state that is not periodic
 _STATUS = {0: "success", -4: "bad input", -5: "singular Newton matrix",
-           -6: "Newton did not converge"}
+           -6: "Newton did not converge", _NOT_PERIODIC: "true residual above RESIDUAL_TOL"}
+
+
+#: An orbit is accepted only if its true residual max(|x(pi/2)|, |y'(pi/2)|), from an
+#: independent adaptive integration (DOP853, tolerance 1e-12), is below this.
+RESIDUAL_TOL = 1e-8
 
 
 def _msg(message):
-    if isinstance(message, (bytes, bytearray, np.ndarray)):
-        message = bytes(message).decode("ascii", "replace")
-    return str(message).strip()
+    return message_text(message)
+
+
+def _true_residuals(ms, kappa, y0s):
+    """Residuals of the orbits y0s (n, 4) for ms (n,) by an independent integration of a
+    quarter period (conmech flat_hill_residuals); huge for a failed one."""
+    y0s = np.asfortranarray(np.asarray(y0s, dtype=float).T)
+    return np.asarray(_conmech.flat_hill_residuals(np.ascontiguousarray(ms, dtype=float),
+                                                   float(kappa), y0s))
 
 
 def _check_float(value, name, positive=False, nonneg=False):
@@ -140,8 +153,10 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
         if g.size != 2 or not np.all(np.isfinite(g)):
             raise ValueError("guess must be two finite numbers (x0, v0)")
         use = 1
-    if int(nsteps) < 0:
-        raise ValueError("nsteps must be >= 0")
+    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+        raise TypeError("nsteps must be an integer")
+    if not 0 <= int(nsteps) <= 100000:
+        raise ValueError("nsteps must be in [0, 100000]")
     (y0, period, jacobi, mono, mr, mi, s, c, residual, iterations, nfev, info,
      message) = _conmech.flat_hill_orbit(m, kappa, int(nsteps), int(bool(full_period)),
                                          use, g)
@@ -150,7 +165,16 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False):
         if info == -4:
             raise ValueError(msg)
         raise RuntimeError(msg)
-    return HillOrbit(m=m, kappa=kappa, y0=np.array(y0), period=float(period),
+    y0 = np.array(y0)
+    res = float(_true_residuals(np.array([m]), kappa, y0[None, :])[0])
+    if not (res <= RESIDUAL_TOL*max(1.0, float(np.max(np.abs(y0))))):
+        raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
+                           f"periodic to the tolerance (true residual {res:.3g} > "
+                           f"{RESIDUAL_TOL:g}): Newton did not converge to the variation "
+                           "orbit (a better guess or more nsteps is needed)")
+    if not (np.all(np.isfinite(mono)) and np.isfinite(s)):
+        raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
+    return HillOrbit(m=m, kappa=kappa, y0=y0, period=float(period),
                      jacobi=float(jacobi), monodromy=np.array(mono),
                      multipliers=np.asarray(mr) + 1j*np.asarray(mi),
                      stability_index=float(s), c=float(c), residual=float(residual),
@@ -185,15 +209,31 @@ class HillFamily:
 def family(ms, kappa=1.0, nsteps=0):
     """The family of variation orbits over ``ms`` by continuation (sorted, close values work
     best: each orbit starts from the extrapolation of its predecessors). Failed orbits have
-    status < 0 and nan entries; nothing is raised for them."""
+    status < 0 and nan entries; nothing is raised for them. Every orbit Newton accepted is
+    checked by an independent integration of a quarter period: a true residual above
+    :data:`RESIDUAL_TOL` gives status -7."""
     ms = np.ascontiguousarray(np.asarray(ms, dtype=float).ravel())
     if ms.size == 0:
         raise ValueError("ms must not be empty")
     if not np.all(np.isfinite(ms)) or np.any(ms < 0):
         raise ValueError("ms must be finite and non-negative")
     kappa = _check_float(kappa, "kappa", positive=True)
+    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+        raise TypeError("nsteps must be an integer")
+    if not 0 <= int(nsteps) <= 100000:
+        raise ValueError("nsteps must be in [0, 100000]")
     y0s, jac, monos, ss, cs, infos, iters = _conmech.flat_hill_family(ms, kappa, int(nsteps))
-    ok = np.asarray(infos) == 0
+    infos = np.array(infos, dtype=int)
+    # the final check: every orbit called a success has a small true residual
+    conv = infos == 0
+    if conv.any():
+        y0a = np.array(y0s).T
+        res = _true_residuals(ms[conv], kappa, y0a[conv])
+        scale = np.maximum(1.0, np.max(np.abs(y0a[conv]), axis=1))
+        bad = ~(res <= RESIDUAL_TOL*scale)
+        idx = np.nonzero(conv)[0][bad]
+        infos[idx] = _NOT_PERIODIC
+    ok = infos == 0
     y0s = np.array(y0s).T.copy()
     monos = np.moveaxis(np.array(monos), 2, 0).copy()
     ss = np.array(ss)
@@ -216,6 +256,9 @@ def transverse(orbit, t=None, rtol=1e-13):
     """
     if not isinstance(orbit, HillOrbit):
         raise TypeError("orbit must be a HillOrbit (from variation_orbit)")
+    rtol = _check_float(rtol, "rtol", positive=True)
+    if rtol > 1e-3:
+        raise ValueError(f"rtol must be in (0, 1e-3], got {rtol}")
     tt = np.zeros(1) if t is None else np.ascontiguousarray(np.asarray(t, dtype=float).ravel())
     if t is not None and (tt.size == 0 or not np.all(np.isfinite(tt)) or np.any(tt < 0)):
         raise ValueError("t must be finite, non-negative times")
