@@ -606,6 +606,10 @@ contains
             dny = sum((y/sk)**2)
             if (dnf <= 1.0e-10_dp .or. dny <= 1.0e-10_dp) then
                 hh = 1.0e-6_dp
+            else if (dnf > huge(1.0_dp) .or. dny > huge(1.0_dp)) then
+                ! the sums of squares overflowed (huge states): the ratio from norm2
+                hh = norm2(y/sk)/norm2(k(:, 1)/sk)*0.01_dp
+                dnf = huge(1.0_dp)
             else
                 hh = sqrt(dny/dnf)*0.01_dp
             end if
@@ -613,7 +617,7 @@ contains
             ytmp = y + hh*k(:, 1)
             call sys%rhs(t + hh, ytmp, k(:, 2))
             st%nfev = st%nfev + 1
-            der2 = sqrt(sum(((k(:, 2) - k(:, 1))/sk)**2))/abs(hh)
+            der2 = norm2((k(:, 2) - k(:, 1))/sk)/abs(hh)
             if (der2 /= der2) der2 = huge(1.0_dp)
             der12 = max(abs(der2), sqrt(dnf))
             if (der12 <= 1.0e-15_dp) then
@@ -623,6 +627,15 @@ contains
             end if
             hh = min(100.0_dp*abs(hh), h1, hmax)*posneg
         end function hinit
+
+        !> sqrt(mean((v/sk)^2)), the error norm; norm2 (overflow-safe) when the fast sum of
+        !! squares overflows.
+        function rms_scaled(v, sc) result(r)
+            real(dp), intent(in) :: v(:), sc(:)
+            real(dp) :: r
+            r = sqrt(sum((v/sc)**2)/real(size(v), dp))
+            if (r > huge(1.0_dp)) r = norm2(v/sc)/sqrt(real(size(v), dp))
+        end function rms_scaled
 
         !> out = base + sum_{j <= m} w(j) k(:, j). Small systems loop over the components
         !! outside (one pass, the sum in a register; multiplying the tableau's zeros is
@@ -683,7 +696,7 @@ contains
             st%nfev = st%nfev + 1
             call lincomb(zero, tab%e, 7, ytmp)
             sk = atolv + rtolv*max(abs(y), abs(ynew))
-            err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
+            err = abs(h)*rms_scaled(ytmp, sk)
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dopri5_step
 
@@ -701,7 +714,16 @@ contains
             err5 = sum((ytmp/sk)**2)
             deno = err5 + 0.01_dp*err3
             if (deno <= 0.0_dp) deno = 1.0_dp
-            err = abs(h)*err5*sqrt(1.0_dp/(real(n, dp)*deno))
+            if (err5 > huge(1.0_dp) .or. err3 > huge(1.0_dp)) then
+                ! the sums of squares overflowed (huge states): the same norm from norm2
+                err5 = norm2(ytmp/sk)
+                err3 = norm2(((ynew - y)/h - tab%bhh(1)*k(:, 1) - tab%bhh(9)*k(:, 9) &
+                              - tab%bhh(12)*k(:, 12))/sk)
+                err = abs(h)*err5/sqrt(real(n, dp)*(1.0_dp + 0.01_dp*(err3/err5)**2))
+            else
+                ! (err5/sqrt(deno): no overflow of 1/deno when both underflow, tiny states)
+                err = abs(h)*err5/sqrt(real(n, dp)*deno)
+            end if
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine dop853_step
 
@@ -710,7 +732,7 @@ contains
             call lincomb(y, h*tab%b(1:15), 15, ynew)
             call lincomb(zero, tab%e, 16, ytmp)
             sk = atolv + rtolv*max(abs(y), abs(ynew))
-            err = abs(h)*sqrt(sum((ytmp/sk)**2)/real(n, dp))
+            err = abs(h)*rms_scaled(ytmp, sk)
             if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
         end subroutine verner_step
 
