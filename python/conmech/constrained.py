@@ -77,6 +77,8 @@ class BuiltinConstrained:
         params = np.array(params, dtype=float).ravel()
         if not np.all(np.isfinite(params)):
             raise ValueError("params must be finite")
+        from .systems import check_params
+        check_params(name, params)
         kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
             name, params.size, params if params.size else _PAD)
         if kind != 1:
