@@ -31,7 +31,7 @@ def message_text(message):
     if isinstance(message, (bytes, bytearray)):
         message = bytes(message).split(b"\0", 1)[0].decode("ascii", "replace")
     text = str(message)
-    return "".join(c if c.isprintable() else "?" for c in text).strip()
+    return "".join(c if c.isascii() and c.isprintable() else "?" for c in text).strip()
 
 
 def as_result(value, shape, name):
