@@ -322,7 +322,8 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     max_steps : int
         Attempted steps before giving up (status -1).
     jac : callable, array or None
-        SciPy's Jacobian option, validated; the explicit methods do not use it (njev 0).
+        SciPy's Jacobian option, validated; the explicit methods do not use it (njev 0)
+        and warn that it has no effect, as SciPy's do.
     **options
         SciPy's other solver options for implicit methods (jac_sparsity, lband, uband,
         min_step) are accepted and warned about as SciPy does; anything else is a
@@ -362,9 +363,10 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     unknown = [k for k in options if k not in _OPTION_NAMES]
     if unknown:
         raise TypeError(f"solve_ivp() got unexpected keyword arguments: {', '.join(unknown)}")
-    if options:
+    unused = sorted(options) + (["jac"] if jac is not None else [])
+    if unused:   # as SciPy's explicit solvers
         warnings.warn("The following arguments have no effect for a chosen solver: "
-                      f"{', '.join(sorted(options))}.", stacklevel=2)
+                      f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
 
     # ---------------------------------------------------------------- method
     if not isinstance(method, str):
