@@ -363,10 +363,6 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     unknown = [k for k in options if k not in _OPTION_NAMES]
     if unknown:
         raise TypeError(f"solve_ivp() got unexpected keyword arguments: {', '.join(unknown)}")
-    unused = sorted(options) + (["jac"] if jac is not None else [])
-    if unused:   # as SciPy's explicit solvers
-        warnings.warn("The following arguments have no effect for a chosen solver: "
-                      f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
 
     # ---------------------------------------------------------------- method
     if not isinstance(method, str):
@@ -422,6 +418,10 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     if not 1 <= max_steps <= 2**31 - 1:
         raise ValueError("max_steps must be positive (and below 2**31)")
     _validate_jac(jac, n)
+    unused = sorted(options) + (["jac"] if jac is not None else [])
+    if unused:   # as SciPy's explicit solvers
+        warnings.warn("The following arguments have no effect for a chosen solver: "
+                      f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
     if vectorized not in (True, False, 0, 1) or isinstance(vectorized, float):
         raise TypeError("vectorized must be a bool")
     if dense_output not in (True, False, 0, 1) or isinstance(dense_output, float):
