@@ -3,7 +3,7 @@
 #   1. system packages: gfortran, LAPACK/BLAS, OpenMPI (and python3-venv/-dev if the
 #      Python in use lacks venv or its headers), via apt-get, only if missing;
 #   2. a virtual environment .venv in the repository with numpy, scipy, meson,
-#      meson-python, ninja, pytest, matplotlib and fpm, only if something is missing;
+#      meson-python, ninja, pytest, hypothesis, matplotlib and fpm, only if something is missing;
 #   3. the conmech Python package itself (pip install --no-build-isolation .), rebuilt only
 #      when the sources changed (hash stamp in .venv/).
 # Environment: PYTHON (default python3) creates the venv; CONMECH_FORCE_REINSTALL=1 rebuilds.
@@ -61,7 +61,7 @@ VPY="$VENV/bin/python"
 export PATH="$VENV/bin:$PATH"
 if ! "$VPY" - <<'PYEOF' >/dev/null 2>&1
 import importlib.util, shutil, sys
-mods = ["numpy", "scipy", "mesonpy", "pytest", "matplotlib"]
+mods = ["numpy", "scipy", "mesonpy", "pytest", "matplotlib", "hypothesis"]
 ok = all(importlib.util.find_spec(m) is not None for m in mods)
 ok = ok and all(shutil.which(x) for x in ("meson", "ninja", "fpm"))
 sys.exit(0 if ok else 1)
@@ -69,7 +69,7 @@ PYEOF
 then
     log "installing Python packages into $VENV"
     "$VPY" -m pip install --upgrade pip
-    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm
+    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm hypothesis
 fi
 
 # ------------------------------------------------------------------ 3. the conmech package

@@ -215,7 +215,7 @@ def _event_settings(events):
             count = int(bool(term))
         elif isinstance(term, numbers.Real):
             tv = float(term)
-            if not (tv >= 0 and tv == int(tv)) or tv > 2**31 - 1:
+            if not (math.isfinite(tv) and 0 <= tv <= 2**31 - 1 and tv == int(tv)):
                 raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
                                  f"integer (a count of occurrences), got {term!r}")
             count = int(tv)
@@ -432,7 +432,10 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
         t_ev = _PAD[:0]
     else:
         try:
-            t_ev = np.array(t_eval, dtype=float)
+            t_ev = np.asarray(t_eval)
+            if t_ev.dtype.kind not in "biuf":
+                raise TypeError
+            t_ev = np.array(t_ev, dtype=float)
         except (TypeError, ValueError):
             raise TypeError("t_eval must be an array of real numbers") from None
         if t_ev.ndim != 1:

@@ -20,6 +20,8 @@ __all__ = ["Equilibrium", "PeriodicOrbit", "equilibrium", "lagrange_dirichlet", 
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate"}
+#: equilibrium() classifies y only if max|f(t, y)| <= EQUILIBRIUM_RTOL max(1, |J| max(1, |y|))
+EQUILIBRIUM_RTOL = 1e-8
 
 
 def _msg(message):
@@ -142,6 +144,9 @@ class Equilibrium:
 def equilibrium(system, y, t=0.0, tol=1e-8, jac=None):
     """Linearise at y, compute the eigenvalues and classify (see conmech_equilibria).
 
+    y must be an equilibrium: max|f(t, y)| <= EQUILIBRIUM_RTOL max(1, |J| max(1, |y|)),
+    else ValueError (a classification elsewhere would be meaningless).
+
     ``tol`` (in [0, 1)) is relative to max(1, max|lambda|): Re(lambda) within it counts as
     zero. ``jac``: exact Jacobian jac(t, y) -> (n, n) of a Python system (default:
     central finite differences); the result's ``njev`` counts its calls.
@@ -169,6 +174,13 @@ def equilibrium(system, y, t=0.0, tol=1e-8, jac=None):
     jmat, wr, wi, kind, saddle, residual, analytic, info, message = out
     if info != 0:
         _raise(info, message)
+    # a classification is only meaningful at an equilibrium: check the true residual
+    jmax = float(np.max(np.abs(jmat), initial=0.0))
+    scale = max(1.0, jmax*max(1.0, float(np.max(np.abs(y)))))
+    if not (np.all(np.isfinite(jmat)) and residual <= EQUILIBRIUM_RTOL*scale):
+        raise ValueError(f"y is not an equilibrium: max|f(t, y)| = {residual:.3g} > "
+                         f"{EQUILIBRIUM_RTOL:g} x {scale:.3g} (or the Jacobian is not "
+                         "finite)")
     e = Equilibrium(y=y, jacobian=np.array(jmat),
                     eigenvalues=np.asarray(wr) + 1j*np.asarray(wi),
                     kind=_KINDS.get(int(kind), "degenerate"), saddle=bool(saddle),
@@ -239,15 +251,19 @@ def monodromy(system, y0, period, rtol=1e-12, atol=1e-12, jac=None):
 def floquet(m, period):
     """Multipliers (eigenvalues of m), Floquet exponents log(mu)/period and, for a 4 x 4
     monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict."""
-    m = np.asarray(m, dtype=float)
-    if m.ndim != 2 or m.shape[0] != m.shape[1]:
-        raise ValueError("m must be a square matrix")
-    period = float(period)
-    if not period > 0:
-        raise ValueError("period must be positive")
+    m = np.asarray(m)
+    if m.dtype.kind not in "biuf":
+        raise TypeError("m must be a real matrix")
+    m = m.astype(float)
+    if m.ndim != 2 or m.shape[0] != m.shape[1] or m.size == 0:
+        raise ValueError("m must be a non-empty square matrix")
+    if not np.all(np.isfinite(m)):
+        raise ValueError("m must be finite")
+    period = _real(period, "period", 0.0, low_open=True)
     mu = np.linalg.eigvals(m)
-    out = {"multipliers": mu, "exponents": np.log(mu.astype(complex))/period,
-           "trace": float(np.trace(m))}
+    with np.errstate(divide="ignore", invalid="ignore"):   # a zero multiplier: -inf
+        expo = np.log(mu.astype(complex))/period
+    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m))}
     if m.shape == (4, 4):
         out["stability_index"] = 0.5*(np.trace(m) - 2.0)
     return out
