@@ -271,7 +271,9 @@ def floquet(m, period):
 
 class PeriodicOrbit:
     """Result of the shooting functions: y0, period, monodromy, multipliers (complex),
-    stability_index (4 x 4 only: (trace M - 2)/2), residual, iterations."""
+    stability_index (4 x 4 only: (trace M - 2)/2), residual (the true residual of the
+    shooting equations at the result, from an independent integration), iterations, njev
+    (calls of a Python ``jac``)."""
 
     __slots__ = ("y0", "period", "monodromy", "multipliers", "stability_index", "residual",
                  "iterations", "njev")
@@ -336,11 +338,38 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     mono = np.array(mono)
     if not (np.all(np.isfinite(mono)) and np.all(np.isfinite(y0o)) and np.isfinite(po)):
         raise RuntimeError("the orbit or its monodromy is not finite")
-    return PeriodicOrbit(y0=np.array(y0o), period=float(po), monodromy=mono,
+    y0o = np.array(y0o)
+    residual = _true_orbit_residual(system, y0o, float(po), kind, tg[:ntg] - 1,
+                                    period_factor, rtol, atol)
+    return PeriodicOrbit(y0=y0o, period=float(po), monodromy=mono,
                          multipliers=np.asarray(mr) + 1j*np.asarray(mi),
                          stability_index=0.5*(np.trace(mono) - 2.0) if mono.shape == (4, 4)
                          else None, residual=float(residual), iterations=int(iterations),
                          njev=njev)
+
+
+#: An orbit is accepted only if an independent integration from the returned y0 closes to
+#: max(ORBIT_RESIDUAL_TOL, 1e3 max(rtol, atol)) max(1, |y0|).
+ORBIT_RESIDUAL_TOL = 1e-8
+
+
+def _true_orbit_residual(system, y0, period, kind, targets, period_factor, rtol, atol):
+    """The residual of the shooting equations after Newton's last step, from a fresh
+    integration (Newton's own test used the residual before that step): max|y(T) - y0|
+    (general), or max|y_targets(T/period_factor)| (symmetric). RuntimeError if too big."""
+    from ._ivp import solve_ivp
+    tau = period if kind == 1 else period/period_factor
+    r = solve_ivp(system, (0.0, tau), y0, method="DOP853", rtol=rtol, atol=atol,
+                  max_steps=10**6)
+    if not r.success:
+        raise RuntimeError(f"the orbit found could not be checked: {r.message}")
+    y1 = r.y[:, -1]
+    res = float(np.max(np.abs(y1 - y0) if kind == 1 else np.abs(y1[targets])))
+    tol = max(ORBIT_RESIDUAL_TOL, 1e3*max(rtol, atol))*max(1.0, float(np.max(np.abs(y0))))
+    if not res <= tol:
+        raise RuntimeError(f"Newton stopped on a state that is not periodic to the "
+                           f"tolerance: true residual {res:.3g} > {tol:.3g}")
+    return res
 
 
 def periodic_orbit(system, y0, period, fixed_period=False, rtol=1e-12, atol=1e-12,

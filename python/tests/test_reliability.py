@@ -397,3 +397,15 @@ def test_jac_in_equilibrium_and_orbits():
                                   free_time=True, jac=hj)
     assert abs(a.period - 2*np.pi) < 1e-10 and a.njev > 0
     np.testing.assert_allclose(a.monodromy, np.eye(2), atol=1e-9)
+
+
+def test_orbit_residual_is_the_true_one():
+    """Newton's own test used the residual before its last step; the result carries the
+    residual of the returned orbit from a fresh integration (SciPy's agrees)."""
+    from scipy.integrate import solve_ivp as scipy_solve_ivp
+    vdp = lambda t, y: [y[1], (1 - y[0]**2)*y[1] - y[0]]  # noqa: E731
+    o = stability.periodic_orbit(vdp, [2.0, 0.0], 6.5)
+    r = scipy_solve_ivp(vdp, (0, o.period), o.y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    true = np.max(np.abs(r.y[:, -1] - o.y0))
+    assert o.residual <= 1e-8 and true <= 1e-8
+    assert abs(o.residual - true) <= 1e-9
