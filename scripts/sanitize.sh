@@ -19,11 +19,16 @@ trap 'rm -f "$log"' EXIT
 if [ "$#" -gt 0 ]; then
     targets=("$@")
 else
-    mapfile -t targets < <(grep -l '^ *program ' test/*.f90 | xargs -n1 basename | sed 's/\.f90$//')
+    mapfile -t targets < <(grep -l '^ *program ' test/*.f90 | xargs -n1 basename \
+        | sed 's/\.f90$//')
 fi
 status=0
 start=$(date +%s)
-fpm build --tests --flag "$FLAGS" >"$log" 2>&1 || { cat "$log"; echo "[sanitize] build failed" >&2; exit 1; }
+if ! fpm build --tests --flag "$FLAGS" >"$log" 2>&1; then
+    cat "$log"
+    echo "[sanitize] build failed" >&2
+    exit 1
+fi
 for t in "${targets[@]}"; do
     fpm test --flag "$FLAGS" --target "$t" >"$log" 2>&1
     rc=$?
@@ -36,5 +41,6 @@ for t in "${targets[@]}"; do
         echo "[sanitize] clean: $t"
     fi
 done
-echo "[sanitize] ${#targets[@]} program(s) in $(( $(date +%s) - start )) s: $([ $status -eq 0 ] && echo clean || echo FAILED)"
+verdict=$([ "$status" -eq 0 ] && echo clean || echo FAILED)
+echo "[sanitize] ${#targets[@]} program(s) in $(( $(date +%s) - start )) s: $verdict"
 exit "$status"

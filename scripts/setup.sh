@@ -69,7 +69,8 @@ PYEOF
 then
     log "installing Python packages into $VENV"
     "$VPY" -m pip install --upgrade pip
-    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm hypothesis
+    "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm \
+        hypothesis
 fi
 
 # ------------------------------------------------------------------ 3. the conmech package
