@@ -3,7 +3,8 @@
 #   1. system packages: gfortran, LAPACK/BLAS, OpenMPI (and python3-venv/-dev if the
 #      Python in use lacks venv or its headers), via apt-get, only if missing;
 #   2. a virtual environment .venv in the repository with numpy, scipy, meson,
-#      meson-python, ninja, pytest, hypothesis, matplotlib and fpm, only if something is missing;
+#      meson-python, ninja, pytest, hypothesis, matplotlib, fpm, and ford, sphinx, numpydoc
+#      (the docs), only if something is missing;
 #   3. the conmech Python package itself (pip install --no-build-isolation .), rebuilt only
 #      when the sources changed (hash stamp in .venv/).
 # Environment: PYTHON (default python3) creates the venv; CONMECH_FORCE_REINSTALL=1 rebuilds.
@@ -61,16 +62,17 @@ VPY="$VENV/bin/python"
 export PATH="$VENV/bin:$PATH"
 if ! "$VPY" - <<'PYEOF' >/dev/null 2>&1
 import importlib.util, shutil, sys
-mods = ["numpy", "scipy", "mesonpy", "pytest", "matplotlib", "hypothesis"]
+mods = ["numpy", "scipy", "mesonpy", "pytest", "matplotlib", "sphinx", "numpydoc",
+        "hypothesis"]
 ok = all(importlib.util.find_spec(m) is not None for m in mods)
-ok = ok and all(shutil.which(x) for x in ("meson", "ninja", "fpm"))
+ok = ok and all(shutil.which(x) for x in ("meson", "ninja", "fpm", "ford"))
 sys.exit(0 if ok else 1)
 PYEOF
 then
     log "installing Python packages into $VENV"
     "$VPY" -m pip install --upgrade pip
     "$VPY" -m pip install numpy scipy meson meson-python ninja pytest matplotlib fpm \
-        hypothesis
+        ford sphinx numpydoc hypothesis
 fi
 
 # ------------------------------------------------------------------ 3. the conmech package

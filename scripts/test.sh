@@ -41,6 +41,11 @@ elif ! tail -n 3 "$log_dir/pytest.log" | grep -qE '[0-9]+ passed'; then
     echo "[test] FAILED: pytest ended without its summary line (the process died)" >&2
     status=1
 fi
+echo "[test] documentation (FORD + Sphinx, warnings as errors)"
+if ! bash "$ROOT/scripts/docs.sh"; then
+    echo "[test] FAILED: the documentation build" >&2
+    status=1
+fi
 if [ "$status" -eq 0 ]; then
     echo "[test] all tests passed"
 fi

@@ -1,4 +1,5 @@
-!> conmech: mechanical systems with constraints and the stability of their motions.
+!> The umbrella module of conmech, mechanical systems with constraints and the stability of
+!! their motions.
 !!
 !! `use conmech` gives the public API of every layer.
 module conmech
@@ -10,11 +11,14 @@ module conmech
     use conmech_systems_basic
     use conmech_systems
     use conmech_generalized
+    use conmech_c_system
+    use conmech_c_mechanics
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_mech
+    use conmech_model_library
     use conmech_hill
     use conmech_equilibria
     use conmech_variational

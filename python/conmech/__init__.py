@@ -8,8 +8,9 @@ numpy.f2py + meson-python). The integrators follow SciPy's names::
 """
 from . import constrained, systems
 from . import hill, stability
+from . import compiled
 from ._ivp import DenseOutput, OdeResult, solve_ivp
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability",
-           "constrained"]
+           "constrained", "compiled"]
 __version__ = "0.1.0"

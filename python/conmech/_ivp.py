@@ -628,8 +628,7 @@ class _Run:
         if self.builtin:
             fun = self.fun
             nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
-                fun.name, fun.params.size, fun.params if fun.params.size else _PAD,
-                events_cb, store, **kw)
+                *fun._flat_args(), events_cb, store, **kw)
         else:
             nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
                 self.rhs, events_cb, store, **kw)

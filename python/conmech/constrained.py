@@ -20,6 +20,7 @@ import numpy as np
 
 from . import _conmech
 from ._callback import Guard, message_text
+from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
            "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS", "plot_trajectory",
@@ -69,7 +70,7 @@ class ConstrainedResult(dict):
 class BuiltinConstrained:
     """A built-in constrained system of the Fortran registry, by name and parameters."""
 
-    __slots__ = ("name", "params", "n", "n_hol", "n_nh")
+    __slots__ = ("name", "params", "n", "n_hol", "n_nh", "spec", "_keep")
 
     def __init__(self, name, params=()):
         if not isinstance(name, str):
@@ -80,13 +81,21 @@ class BuiltinConstrained:
         from .systems import check_params
         check_params(name, params)
         kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
-            name, params.size, params if params.size else _PAD)
+            name, params.size, params if params.size else _PAD, 0, _NO_SPEC)
         if kind != 1:
             raise ValueError(f"system: unknown built-in constrained system '{name}' "
                              f"(known: {', '.join(BUILTIN_NAMES)})")
         self.name = name
         self.params = params
         self.n, self.n_hol, self.n_nh = int(n), int(mh), int(mn)
+        self.spec = _NO_SPEC
+        self._keep = None
+
+    def _flat_args(self):
+        """(name, np, params, nspec, spec) for the flat routines (built-in or compiled)."""
+        p = self.params if self.params.size else _PAD
+        nspec = self.spec.size if self.spec is not _NO_SPEC else 0
+        return self.name, self.params.size, p, nspec, self.spec
 
     def initial_state(self):
         """Default consistent initial state (q0, v0)."""
@@ -320,9 +329,8 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
                   rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
                   neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD)
     if isinstance(system, BuiltinConstrained):
-        p = system.params
         stats, moved, info, message = _conmech.flat_constrained_builtin(
-            system.name, p.size, p if p.size else _PAD, store, **common)
+            *system._flat_args(), store, **common)
     else:
         guard = Guard()
         cb = system._callbacks(guard)

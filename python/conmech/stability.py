@@ -161,8 +161,7 @@ def equilibrium(system, y, t=0.0, tol=1e-8, jac=None):
     n = y.size
     njev = 0
     if isinstance(system, BuiltinSystem):
-        out = _conmech.flat_equilibrium_builtin(system.name, system.params.size,
-                                                _params(system), y, t, tol)
+        out = _conmech.flat_equilibrium_builtin(*system._flat_args(), y, t, tol)
     else:
         g, rhs, dfdy = _callback(system, n, y, t, jac)
         if dfdy is None:
@@ -224,7 +223,7 @@ def stm(system, t_span, y0, rtol=1e-12, atol=1e-12, jac=None, full_output=False)
     njev = 0
     if isinstance(system, BuiltinSystem):
         y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
-            system.name, system.params.size, _params(system), y0, t0, t1, rtol, atol)
+            *system._flat_args(), y0, t0, t1, rtol, atol)
     else:
         g, rhs, dfdy = _callback(system, y0.size, y0, t0, jac)
         if dfdy is None:
@@ -322,8 +321,7 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
             period_factor, rtol, atol, max_iter)
     njev = 0
     if isinstance(system, BuiltinSystem):
-        out = _conmech.flat_orbit_builtin(system.name, system.params.size,
-                                          _params(system), *args)
+        out = _conmech.flat_orbit_builtin(*system._flat_args(), *args)
     else:
         g, rhs, dfdy = _callback(system, y0.size, y0, 0.0, jac)
         if dfdy is None:

@@ -14,6 +14,9 @@ import numpy as np
 
 from . import _conmech
 
+_PAD = np.zeros(1)
+_NO_SPEC = np.zeros(1, dtype=np.int64)   # spec kind 0: a built-in system, by name
+
 __all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill"]
 
 
@@ -63,7 +66,7 @@ class BuiltinSystem:
         Names of the parameters, for ``repr`` and ``parameters``.
     """
 
-    __slots__ = ("name", "params", "param_names", "dimension")
+    __slots__ = ("name", "params", "param_names", "dimension", "spec", "_keep")
 
     def __init__(self, name, params=(), param_names=()):
         if not isinstance(name, str) or not name:
@@ -82,6 +85,15 @@ class BuiltinSystem:
         self.params = params
         self.param_names = param_names
         self.dimension = dim
+        self.spec = _NO_SPEC
+        self._keep = None
+
+    def _flat_args(self):
+        """(name, np, params, nspec, spec): the leading arguments of the flat routines
+        that build a system (built-in by name, or compiled from its spec)."""
+        p = self.params if self.params.size else _PAD
+        nspec = self.spec.size if self.spec is not _NO_SPEC else 0
+        return self.name, self.params.size, p, nspec, self.spec
 
     @property
     def parameters(self):

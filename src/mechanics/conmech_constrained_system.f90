@@ -98,7 +98,7 @@ contains
 
     ! ------------------------------------------------------------------ defaults
 
-    !> Default: no holonomic constraints.
+    !> The default has no holonomic constraints.
     subroutine cs_no_phi(self, t, q, c)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
@@ -173,7 +173,7 @@ contains
         gam = -(-c2p + 16.0_dp*cp - 30.0_dp*c0 + 16.0_dp*cm - c2m)/(12.0_dp*s**2)
     end subroutine cs_fd_phi_gamma
 
-    !> Default: no non-holonomic constraints.
+    !> The default has no non-holonomic constraints.
     subroutine cs_no_nh(self, t, q, a, b)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t

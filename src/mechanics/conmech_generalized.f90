@@ -16,7 +16,7 @@ module conmech_generalized
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_lapack, only: dpotrf, dpotf2, dpotrs, la_finite
-    use conmech_ode_system, only: ode_system, ode_events
+    use conmech_ode_system, only: ode_system, ode_events, ode_fd_jacobian
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     implicit none
     private
@@ -32,6 +32,8 @@ module conmech_generalized
         procedure(gen_forces), deferred :: forces
         procedure :: energy => gen_no_energy
         procedure :: has_energy => gen_has_no_energy
+        procedure :: forces_jacobian => gen_no_forces_jacobian
+        procedure :: has_forces_jacobian => gen_has_no_forces_jacobian
     end type generalized_system
 
     abstract interface
@@ -58,6 +60,8 @@ module conmech_generalized
         class(generalized_system), allocatable :: mech   !! the mechanical system
     contains
         procedure :: rhs => genode_rhs
+        procedure :: jacobian => genode_jacobian
+        procedure :: has_jacobian => genode_has_jacobian
     end type generalized_ode
 
 contains
@@ -75,6 +79,22 @@ contains
         class(generalized_system), intent(in) :: self
         gen_has_no_energy = .false.
     end function gen_has_no_energy
+
+    !> Exact derivatives of the accelerations, optional: r = [dQ/dq - d(M a)/dq, dQ/dv]
+    !! (ndof x 2 ndof) at the accelerations a = M^{-1} Q, so that d a/d[q, v] = M^{-1} r.
+    !! The default is not defined (`has_forces_jacobian` false: finite differences).
+    subroutine gen_no_forces_jacobian(self, t, q, v, a, r)
+        class(generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        r = 0.0_dp
+    end subroutine gen_no_forces_jacobian
+
+    logical function gen_has_no_forces_jacobian(self)
+        class(generalized_system), intent(in) :: self
+        gen_has_no_forces_jacobian = .false.
+    end function gen_has_no_forces_jacobian
 
     !> Cholesky factor (upper, in place) of an SPD matrix, with a clear status:
     !! CM_SINGULAR if dpotrf fails or the factor's diagonal ratio squared is below 1e-14
@@ -166,6 +186,43 @@ contains
         call generalized_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), info)
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine genode_rhs
+
+    !> Jacobian of y' = [v, M^{-1} Q]: exact when the system has `forces_jacobian`
+    !! ([0 I; M^{-1} r], one Cholesky of M), else central differences.
+    subroutine genode_jacobian(self, t, y, dfdy)
+        class(generalized_ode), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        real(dp) :: mm(self%mech%ndof, self%mech%ndof), a(self%mech%ndof)
+        real(dp) :: r(self%mech%ndof, 2*self%mech%ndof)
+        integer :: n, info, j
+        if (.not. self%mech%has_forces_jacobian()) then
+            call ode_fd_jacobian(self, t, y, dfdy)
+            return
+        end if
+        n = self%mech%ndof
+        dfdy = 0.0_dp
+        do j = 1, n
+            dfdy(j, n + j) = 1.0_dp
+        end do
+        call self%mech%mass(t, y(1:n), mm)
+        call self%mech%forces(t, y(1:n), y(n + 1:2*n), a)
+        call mass_cholesky(mm, info)
+        if (info /= CM_SUCCESS) then
+            dfdy(n + 1:2*n, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+            return
+        end if
+        call dpotrs('U', n, 1, mm, n, a, n, info)
+        call self%mech%forces_jacobian(t, y(1:n), y(n + 1:2*n), a, r)
+        call dpotrs('U', n, 2*n, mm, n, r, n, info)
+        dfdy(n + 1:2*n, :) = r
+    end subroutine genode_jacobian
+
+    logical function genode_has_jacobian(self)
+        class(generalized_ode), intent(in) :: self
+        genode_has_jacobian = self%mech%has_forces_jacobian()
+    end function genode_has_jacobian
 
     !> Solve M q'' = Q from (q0, v0) on t_span with `ode_solve`; res%y = [q; v] (events
     !! see y = [q; v] too). Checks the dimensions and the mass matrix at the start first.

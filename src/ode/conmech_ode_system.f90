@@ -17,6 +17,7 @@ module conmech_ode_system
     private
 
     public :: ode_system, ode_function, ode_events, ode_step_hook, rhs_proc, jac_proc
+    public :: ode_fd_jacobian
 
     type, abstract :: ode_system
     contains

@@ -1,4 +1,4 @@
-!> Equilibria: linearisation, eigenvalues, classification and the Lagrange-Dirichlet test.
+!> Equilibria (linearisation, eigenvalues, classification) and the Lagrange-Dirichlet test.
 !!
 !! `linearize` returns A = df/dy at (t, y): the system's analytic Jacobian when it has one
 !! (`has_jacobian()`), otherwise the documented central finite difference of

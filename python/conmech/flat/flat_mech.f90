@@ -1,37 +1,47 @@
 !> Flat f2py layer of the constrained mechanical systems (conventions: see flat_ode.f90).
 !! The Python side is conmech/constrained.py.
 
-!> Kind and dimensions of a built-in mechanical system: kind 1 constrained (excessive
-!! coordinates; n, n_hol, n_nh), 2 generalized coordinates (n = ndof), 0 unknown.
-subroutine flat_mech_info(name, np, params, kind, n, mh, mn, info, message)
+!> Kind and dimensions of a mechanical system (built-in `name`, or compiled: spec):
+!! kind 1 constrained (excessive coordinates; n, n_hol, n_nh), 2 generalized coordinates
+!! (n = ndof), 0 unknown.
+subroutine flat_mech_info(name, np, params, nspec, spec, kind, n, mh, mn, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
     use conmech_constrained_system, only: constrained_system
     use conmech_generalized, only: generalized_system
-    use conmech_systems_mech, only: make_constrained, make_generalized
+    use conmech_flat_spec, only: spec_constrained, spec_generalized, spec_kind, KIND_BUILTIN, &
+                                 KIND_CONSTRAINED
     use conmech_flat_ode_support, only: copy_message
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
     real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(out) :: kind, n, mh, mn, info
     character(len=256), intent(out) :: message
     class(constrained_system), allocatable :: cs
     class(generalized_system), allocatable :: gs
     character(len=:), allocatable :: msg
+    integer :: sk
     kind = 0
     n = 0
     mh = 0
     mn = 0
-    call make_constrained(name, real(params(1:np), dp), cs, info, msg)
-    if (info == CM_SUCCESS) then
-        kind = 1
-        n = cs%n
-        mh = cs%n_hol
-        mn = cs%n_nh
-    else
-        call make_generalized(name, real(params(1:np), dp), gs, info, msg)
+    sk = spec_kind(nspec, spec)
+    info = -1
+    if (sk == KIND_BUILTIN .or. sk == KIND_CONSTRAINED) then
+        call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
+        if (info == CM_SUCCESS) then
+            kind = 1
+            n = cs%n
+            mh = cs%n_hol
+            mn = cs%n_nh
+        end if
+    end if
+    if (info /= CM_SUCCESS .and. sk /= KIND_CONSTRAINED) then
+        call spec_generalized(name, real(params(1:np), dp), nspec, spec, gs, info, msg)
         if (info == CM_SUCCESS) then
             kind = 2
             n = gs%ndof
@@ -70,20 +80,23 @@ end subroutine flat_mech_initial_state
 !! iopt = [projection, every, proj_max_iter, max_steps]; ropt = [first_step, max_step,
 !! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank,
 !! proj_iter_max]; moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
-subroutine flat_constrained_builtin(name, np, params, store, n, t_span, q0, v0, method, &
+subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, n, t_span, q0, v0, &
+                                    method, &
                                     rtol, atol, iopt, ropt, neval, t_eval, stats, moved, &
                                     info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
     use conmech_constrained_system, only: constrained_system
-    use conmech_systems_mech, only: make_constrained
+    use conmech_flat_spec, only: spec_constrained
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_mech_support, only: run_constrained
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
     real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
     integer(c_int), intent(in) :: method
@@ -112,7 +125,7 @@ subroutine flat_constrained_builtin(name, np, params, store, n, t_span, q0, v0, 
     character(len=:), allocatable :: msg
     stats = 0
     moved = 0.0_dp
-    call make_constrained(name, real(params(1:np), dp), cs, info, msg)
+    call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return

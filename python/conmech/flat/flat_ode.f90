@@ -112,7 +112,8 @@ end subroutine flat_solve_callback
 !! conmech_systems::make_system; params has at least one element, np of them are used):
 !! no Python in the loop unless there are events.
 !! Other arguments as in flat_solve_callback.
-subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, method, rtol, &
+subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t_span, y0, &
+                              method, rtol, &
                               atol, first_step, max_step, max_steps, dense, neval, t_eval, &
                               ne, ev_dir, ev_term, nfev, naccept, nreject, dense_form, &
                               info, message)
@@ -120,12 +121,14 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system, system_dimension
+    use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_flat_ode_support, only: run_solve, copy_message
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
     real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)
@@ -168,14 +171,14 @@ subroutine flat_solve_builtin(name, np, params, events, store, n, t_span, y0, me
     naccept = 0
     nreject = 0
     dense_form = 0
-    call make_system(name, real(params(1:np), dp), sys, info, msg)
+    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
     end if
-    if (system_dimension(name) /= n) then
+    if (spec_dimension(name, nspec, spec) /= n) then
         info = CM_BAD_INPUT
-        write (buf, '(i0)') system_dimension(name)
+        write (buf, '(i0)') spec_dimension(name, nspec, spec)
         call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
                           //trim(name)//"'", message)
         return

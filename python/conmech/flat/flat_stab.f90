@@ -115,16 +115,19 @@ subroutine flat_hill_transverse(m, kappa, y0, rtol, nt, t, states, phi, mono2, h
 end subroutine flat_hill_transverse
 
 !> Equilibrium analysis of a built-in system at y.
-subroutine flat_equilibrium_builtin(name, np, params, n, y, t, tol, jac, wr, wi, kind, saddle, &
+subroutine flat_equilibrium_builtin(name, np, params, nspec, spec, n, y, t, tol, jac, wr, wi, &
+                                    kind, saddle, &
                                     residual, analytic, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system
+    use conmech_flat_spec, only: spec_system
     use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
     use conmech_support_stab, only: unpack_eq
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, n
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
     real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual
     integer(c_int), intent(out) :: kind, saddle, analytic, info
@@ -132,7 +135,7 @@ subroutine flat_equilibrium_builtin(name, np, params, n, y, t, tol, jac, wr, wi,
     class(ode_system), allocatable :: sys
     type(equilibrium_result) :: e
     character(len=:), allocatable :: msg
-    call make_system(name, params(1:np), sys, info, msg)
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
     if (info /= 0) then
         message = msg
         return
@@ -189,16 +192,19 @@ end subroutine flat_lagrange_dirichlet
 !> Periodic orbit of a built-in system: general shooting (kind 1; mode 1 free period, 2 fixed
 !! period) or symmetric shooting (kind 2; free_idx(nfree), targets(ntg) one-based, tau = period
 !! guess / period_factor, free_time /= 0). Returns y0, period, monodromy and multipliers.
-subroutine flat_orbit_builtin(name, np, params, n, y0, period, kind, mode, nfree, free_idx, ntg, &
+subroutine flat_orbit_builtin(name, np, params, nspec, spec, n, y0, period, kind, mode, nfree, &
+                              free_idx, ntg, &
                               targets, free_time, period_factor, rtol, atol, max_iter, y0_out, &
                               period_out, mono, mr, mi, residual, iterations, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system
+    use conmech_flat_spec, only: spec_system
     use conmech_support_stab, only: run_orbit
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, n, kind, mode, nfree, ntg, free_time, max_iter
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, period_factor, rtol, atol
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
     real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), residual
@@ -206,7 +212,7 @@ subroutine flat_orbit_builtin(name, np, params, n, y0, period, kind, mode, nfree
     character(len=256), intent(out) :: message
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
-    call make_system(name, params(1:np), sys, info, msg)
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
     if (info /= 0) then
         message = msg
         return
@@ -249,16 +255,19 @@ subroutine flat_orbit_callback(fun, n, y0, period, kind, mode, nfree, free_idx, 
 end subroutine flat_orbit_callback
 
 !> State and state transition matrix of a built-in system from t0 to t1 (DOP853).
-subroutine flat_stm_builtin(name, np, params, n, y0, t0, t1, rtol, atol, y1, phi, nfev, info, &
+subroutine flat_stm_builtin(name, np, params, nspec, spec, n, y0, t0, t1, rtol, atol, y1, phi, &
+                            nfev, info, &
                             message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats
-    use conmech_systems, only: make_system
+    use conmech_flat_spec, only: spec_system
     use conmech_variational, only: integrate_stm
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, n
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: params(max(np, 1)), y0(n), t0, t1, rtol, atol
     real(c_double), intent(out) :: y1(n), phi(n, n)
     integer(c_int), intent(out) :: nfev, info
@@ -274,7 +283,7 @@ subroutine flat_stm_builtin(name, np, params, n, y0, t0, t1, rtol, atol, y1, phi
     do i = 1, n
         phi(i, i) = 1.0_c_double
     end do
-    call make_system(name, params(1:np), sys, info, msg)
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
     if (info /= 0) then
         message = msg
         return

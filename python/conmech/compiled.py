@@ -1,0 +1,348 @@
+"""Systems given by compiled functions: any code with conmech's C signatures runs with no
+Python in the loop (what :mod:`conmech.symbolic` generates, C or Fortran ``bind(C)`` code
+loaded with ctypes, numba ``cfunc``, ``scipy.LowLevelCallable``).
+
+The C signatures (matrices column-major, ``p`` the run-time parameter array, so that one
+compiled function serves every parameter value)::
+
+    void rhs(double t, const double *y, double *dydt, const double *p);      /* n       */
+    void jac(double t, const double *y, double *dfdy, const double *p);      /* n x n   */
+    /* M(t, q) q'' = Q(t, q, q'), ndof coordinates */
+    void mass(double t, const double *q, double *M, const double *p);        /* nd x nd */
+    void forces(double t, const double *q, const double *v, double *Q, const double *p);
+    void forces_jac(double t, const double *q, const double *v, const double *a,
+                    double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv], nd x 2nd */
+    double energy(double t, const double *q, const double *v, const double *p);
+    /* constrained systems (n coordinates): mass, forces, energy as above, and */
+    void phi(double t, const double *q, double *c, const double *p);         /* n_hol   */
+    void phi_jac(double t, const double *q, double *G, const double *p);     /* n_hol x n */
+    void phi_t(double t, const double *q, double *pt, const double *p);      /* n_hol   */
+    void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
+    void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
+    void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+
+with ``gamma_h = -d/dt [G v + phi_t]`` and ``gamma_n = -d/dt [A v + b]`` at fixed v (the
+acceleration-level right-hand sides of ``G q'' = gamma_h``, ``A q'' = gamma_n``). A missing
+optional function falls back to conmech's finite-difference default.
+
+Every function argument below is an int address, a ctypes function pointer, a numba
+``cfunc`` or a ``scipy.LowLevelCallable``. ``keep`` holds whatever must stay alive while
+the system is used (the loaded library, the numba functions); the returned objects hold
+it. A wrong address cannot be detected: it crashes the process, as in any C code.
+"""
+import ctypes
+import math
+
+import numpy as np
+
+from . import _conmech
+from .systems import BuiltinSystem
+from .constrained import BuiltinConstrained
+
+__all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
+           "CompiledConstrained", "evaluate", "function_address", "load_model"]
+
+_KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
+_SPEC_SIZE = 15
+_SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
+          "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
+          "nh_gamma": 15}
+
+
+def function_address(f, what="function"):
+    """The address of a compiled function: an int, a ctypes function pointer or
+    ``c_void_p``, a numba ``cfunc`` (its ``address``) or a ``scipy.LowLevelCallable``.
+    None gives 0 (absent)."""
+    if f is None:
+        return 0
+    if isinstance(f, bool):
+        raise TypeError(f"{what} must be a compiled function or an address, got a bool")
+    if isinstance(f, (int, np.integer)):
+        addr = int(f)
+    elif isinstance(f, ctypes._CFuncPtr):
+        addr = ctypes.cast(f, ctypes.c_void_p).value or 0
+    elif isinstance(f, ctypes.c_void_p):
+        addr = f.value or 0
+    elif type(f).__name__ == "LowLevelCallable":
+        cap = tuple.__getitem__(f, 0)   # the PyCapsule (a LowLevelCallable is a tuple)
+        get_name = ctypes.pythonapi.PyCapsule_GetName
+        get_name.restype, get_name.argtypes = ctypes.c_char_p, [ctypes.py_object]
+        get_ptr = ctypes.pythonapi.PyCapsule_GetPointer
+        get_ptr.restype, get_ptr.argtypes = ctypes.c_void_p, [ctypes.py_object,
+                                                              ctypes.c_char_p]
+        addr = get_ptr(cap, get_name(cap)) or 0
+    elif isinstance(getattr(f, "address", None), int):      # numba cfunc
+        addr = f.address
+    else:
+        raise TypeError(f"{what} must be an address (int), a ctypes function, a numba "
+                        f"cfunc or a scipy.LowLevelCallable, got {type(f).__name__}")
+    if addr <= 0:
+        raise ValueError(f"{what} is a null function pointer")
+    return addr
+
+
+def _params(params, param_names):
+    """(values, names) from a sequence or a dict of parameters."""
+    if isinstance(params, dict):
+        names = tuple(str(k) for k in params)
+        values = list(params.values())
+    else:
+        values = list(np.ravel(np.asarray(params, dtype=float))) if np.size(params) else []
+        names = tuple(param_names) if param_names else tuple(f"p{i}" for i in
+                                                             range(len(values)))
+    try:
+        values = np.array(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise TypeError("params must be real numbers") from None
+    if len(names) != values.size:
+        raise ValueError(f"param_names has {len(names)} names for {values.size} params")
+    if len(set(names)) != len(names):
+        raise ValueError("param_names must be distinct")
+    for k, v in zip(names, values):
+        if not math.isfinite(v):
+            raise ValueError(f"parameter {k} must be finite, got {v}")
+    return values, names
+
+
+def _count(value, what, low):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer")
+    if value < low:
+        raise ValueError(f"{what} must be >= {low}, got {value}")
+    return int(value)
+
+
+def _make_spec(kind, n, n_hol, n_nh, rheonomic, funcs):
+    spec = np.zeros(_SPEC_SIZE, dtype=np.int64)
+    spec[0:5] = [kind, n, n_hol, n_nh, int(bool(rheonomic))]
+    for key, f in funcs.items():
+        spec[_SLOTS[key] - 1] = function_address(f, key)
+    return spec
+
+
+def _with_params(obj, kw):
+    values = dict(zip(obj.param_names, obj.params.tolist()))
+    for k, v in kw.items():
+        if k not in values:
+            raise ValueError(f"unknown parameter {k!r} (known: {', '.join(obj.param_names)})")
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            raise TypeError(f"parameter {k} must be a real number") from None
+        if not math.isfinite(v):
+            raise ValueError(f"parameter {k} must be finite, got {v}")
+        values[k] = v
+    return np.array([values[k] for k in obj.param_names], dtype=float)
+
+
+class CompiledSystem(BuiltinSystem):
+    """A first-order system (``kind`` 'ode') or a system in generalized coordinates
+    (``kind`` 'generalized', state y = [q, q']) given by compiled functions. It works
+    wherever a built-in system does: :func:`conmech.solve_ivp`, :mod:`conmech.stability`.
+    Attributes: name, kind, dimension (state size), ndof (generalized only), params,
+    param_names, spec (the function table handed to Fortran)."""
+
+    __slots__ = ("kind", "ndof")
+
+    def __init__(self, name, kind, spec, params, param_names, keep):
+        self.name = name
+        self.kind = kind
+        self.spec = spec
+        self.params = params
+        self.param_names = param_names
+        self.ndof = int(spec[1]) if kind == "generalized" else None
+        self.dimension = 2*self.ndof if kind == "generalized" else int(spec[1])
+        self._keep = keep
+
+    def with_params(self, **kw):
+        """A copy with new values of some parameters (same compiled code: no rebuild)."""
+        return CompiledSystem(self.name, self.kind, self.spec, _with_params(self, kw),
+                              self.param_names, self._keep)
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
+        return f"<compiled {self.kind} system {self.name!r} n={self.dimension} ({args})>"
+
+
+class CompiledConstrained(BuiltinConstrained):
+    """A constrained system in excessive coordinates given by compiled functions; it
+    works with :func:`conmech.constrained.solve` like a built-in (every projection,
+    multipliers, reactions, energy). q0 and v0 must be given to solve."""
+
+    __slots__ = ("param_names",)
+
+    def __init__(self, name, spec, params, param_names, keep):
+        self.name = name
+        self.spec = spec
+        self.params = params
+        self.param_names = param_names
+        self.n, self.n_hol, self.n_nh = int(spec[1]), int(spec[2]), int(spec[3])
+        self._keep = keep
+
+    @property
+    def parameters(self):
+        """The parameters as a dict (name -> value)."""
+        return dict(zip(self.param_names, self.params.tolist()))
+
+    def with_params(self, **kw):
+        """A copy with new values of some parameters (same compiled code: no rebuild)."""
+        return CompiledConstrained(self.name, self.spec, _with_params(self, kw),
+                                   self.param_names, self._keep)
+
+    def initial_state(self):
+        raise ValueError(f"the compiled system {self.name!r} has no default initial state: "
+                         "pass q0 and v0")
+
+    def __repr__(self):
+        return (f"<compiled constrained system {self.name!r} n={self.n} n_hol={self.n_hol} "
+                f"n_nh={self.n_nh}>")
+
+
+def ode_system(n, rhs, jac=None, params=(), param_names=(), keep=None, name="compiled"):
+    """A first-order system y' = rhs(t, y; p) of dimension ``n`` from compiled functions
+    (``jac``: the exact Jacobian df/dy, column-major; None: finite differences).
+    ``params``: a sequence (names from ``param_names``) or a dict name -> value."""
+    n = _count(n, "n", 1)
+    values, names = _params(params, param_names)
+    spec = _make_spec(_KIND_ODE, n, 0, 0, False, {"rhs": rhs, "jac": jac})
+    if spec[_SLOTS["rhs"] - 1] == 0:
+        raise ValueError("rhs is required")
+    return CompiledSystem(str(name), "ode", spec, values, names, (keep, rhs, jac))
+
+
+def generalized_system(ndof, mass, forces, forces_jac=None, energy=None, params=(),
+                       param_names=(), keep=None, name="compiled"):
+    """M(t, q) q'' = Q(t, q, q') with ``ndof`` coordinates from compiled functions; the
+    state is y = [q, q']. ``forces_jac`` gives the exact Jacobian of the accelerations
+    (see the module's signatures); without it the Jacobian is a finite difference."""
+    ndof = _count(ndof, "ndof", 1)
+    values, names = _params(params, param_names)
+    if mass is None or forces is None:
+        raise ValueError("mass and forces are required")
+    spec = _make_spec(_KIND_GEN, ndof, 0, 0, False, {"mass": mass, "forces": forces,
+                                                     "forces_jac": forces_jac,
+                                                     "energy": energy})
+    return CompiledSystem(str(name), "generalized", spec, values, names,
+                          (keep, mass, forces, forces_jac, energy))
+
+
+def constrained_system(n, mass, forces, n_hol=0, n_nh=0, phi=None, phi_jac=None, phi_t=None,
+                       phi_gamma=None, nh_matrix=None, nh_gamma=None, energy=None,
+                       rheonomic=False, params=(), param_names=(), keep=None,
+                       name="compiled"):
+    """A constrained system in excessive coordinates from compiled functions: ``n``
+    coordinates, ``n_hol`` holonomic constraints phi(t, q) = 0 and ``n_nh`` Pfaffian
+    constraints A(t, q) q' + b(t, q) = 0. Missing phi_jac, phi_t, phi_gamma, nh_gamma
+    fall back to finite differences (phi_t only when ``rheonomic``)."""
+    n = _count(n, "n", 1)
+    n_hol = _count(n_hol, "n_hol", 0)
+    n_nh = _count(n_nh, "n_nh", 0)
+    if n_hol + n_nh >= n:
+        raise ValueError(f"n_hol + n_nh = {n_hol + n_nh} constraints leave no motion for "
+                         f"n = {n} coordinates")
+    if mass is None or forces is None:
+        raise ValueError("mass and forces are required")
+    if n_hol > 0 and phi is None:
+        raise ValueError("phi is required when n_hol > 0")
+    if n_nh > 0 and nh_matrix is None:
+        raise ValueError("nh_matrix is required when n_nh > 0")
+    values, names = _params(params, param_names)
+    funcs = dict(mass=mass, forces=forces, energy=energy, phi=phi, phi_jac=phi_jac,
+                 phi_t=phi_t, phi_gamma=phi_gamma, nh_matrix=nh_matrix, nh_gamma=nh_gamma)
+    spec = _make_spec(_KIND_CON, n, n_hol, n_nh, rheonomic, funcs)
+    return CompiledConstrained(str(name), spec, values, names, (keep, tuple(funcs.values())))
+
+
+def _check(info, message):
+    if info != 0:
+        msg = bytes(message).decode("ascii", "replace").strip() if not isinstance(
+            message, str) else message.strip()
+        raise ValueError(msg)
+
+
+def evaluate(system, t, y, v=None):
+    """The quantities of a built-in or compiled system at one state, as a dict.
+
+    - first-order systems (:class:`conmech.systems.BuiltinSystem`, compiled 'ode' or
+      'generalized'), ``evaluate(system, t, y)``: ``f`` and ``jac`` (``analytic`` tells
+      whether the Jacobian is exact);
+    - mechanical systems, ``evaluate(system, t, q, v)``: ``M``, ``Q``, ``energy`` (None if
+      undefined), and for constrained systems ``phi``, ``G``, ``gamma_h``, ``A``, ``b``,
+      ``gamma_n``. Generalized-coordinate systems (built-in by name, e.g.
+      ``conmech.systems.cart_pendulum()``, or compiled) give M and Q this way too.
+    """
+    t = float(t)
+    y = np.ascontiguousarray(np.asarray(y, dtype=float).ravel())
+    if not isinstance(system, (BuiltinSystem, BuiltinConstrained)):
+        raise TypeError("system must be a built-in or compiled conmech system")
+    name, np_, p, nspec, spec = system._flat_args()
+    if v is None:
+        if not isinstance(system, BuiltinSystem):
+            raise ValueError("a constrained system needs q and v: evaluate(system, t, q, v)")
+        f, jac, analytic, info, message = _conmech.flat_evaluate_ode(
+            name, np_, p, nspec, spec, t=t, y=y)
+        _check(info, message)
+        return dict(f=np.array(f), jac=np.array(jac), analytic=bool(analytic))
+    v = np.ascontiguousarray(np.asarray(v, dtype=float).ravel())
+    if v.size != y.size:
+        raise ValueError(f"q and v must have the same size, got {y.size} and {v.size}")
+    kind, n, mh, mn, info, message = _conmech.flat_mech_info(name, np_, p, nspec, spec)
+    _check(info, message)
+    if kind not in (1, 2):
+        raise ValueError(f"{name!r} is not a mechanical system")
+    if n != y.size:
+        raise ValueError(f"q has {y.size} components; the system has {n}")
+    out = _conmech.flat_evaluate_mech(name, np_, p, nspec, spec, kind=kind, mh=mh, mn=mn, t=t,
+                                      q=y, v=v)
+    mm, qf, energy, has_e, phi, g, gh, a, b, gn, info, message = out
+    _check(info, message)
+    res = dict(M=np.array(mm), Q=np.array(qf), energy=float(energy) if has_e else None)
+    if kind == 1:
+        res.update(phi=np.array(phi)[:mh], G=np.array(g)[:mh], gamma_h=np.array(gh)[:mh],
+                   A=np.array(a)[:mn], b=np.array(b)[:mn], gamma_n=np.array(gn)[:mn])
+    return res
+
+
+def load_model(path, name=None):
+    """A system from a model library: a shared library that exports, with C linkage,
+    ``conmech_model_info(int info[6])`` (kind 1 ode / 2 generalized / 3 constrained, n,
+    n_hol, n_nh, rheonomic, number of parameters), ``conmech_model_params(double *p)``
+    (defaults), ``conmech_model_param_names(char *buf, int len)`` (blank-separated) and the
+    functions of its kind named ``conmech_rhs``, ``conmech_jac``, ``conmech_mass``,
+    ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
+    ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
+    ``conmech_nh_gamma``. The Fortran programs load the same libraries (``sweep --model``,
+    conmech_model_library)."""
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as e:
+        raise ValueError(f"cannot load the model library {str(path)!r}: {e}") from None
+    if not hasattr(lib, "conmech_model_info"):
+        raise ValueError(f"{str(path)!r} is not a conmech model (no conmech_model_info)")
+    info = (ctypes.c_int*6)()
+    lib.conmech_model_info(info)
+    kind, n, n_hol, n_nh, rheo, npar = list(info)
+    if kind not in (1, 2, 3) or n < 1 or npar < 0:
+        raise ValueError(f"{str(path)!r}: invalid description from conmech_model_info")
+    p = (ctypes.c_double*max(npar, 1))()
+    if npar:
+        lib.conmech_model_params(p)
+    names = ()
+    if hasattr(lib, "conmech_model_param_names"):
+        buf = ctypes.create_string_buffer(4096)
+        lib.conmech_model_param_names(buf, ctypes.c_int(4096))
+        names = tuple(buf.value.decode("ascii", "replace").split())
+    if len(names) != npar:
+        names = tuple(f"p{i}" for i in range(npar))
+    params = dict(zip(names, list(p)[:npar]))
+    fn = {k: getattr(lib, "conmech_" + k, None) for k in _SLOTS}
+    name = name or str(path)
+    if kind == _KIND_ODE:
+        return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name)
+    if kind == _KIND_GEN:
+        return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
+                                  params=params, keep=lib, name=name)
+    return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
+                              fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
+                              fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,
+                              name=name)

@@ -1,0 +1,355 @@
+!> Mechanical systems given by compiled C-ABI functions: generalized coordinates
+!! (`c_generalized_system`) and excessive coordinates with constraints
+!! (`c_constrained_system`). The C signatures (column-major matrices, `p` the run-time
+!! parameters):
+!!
+!!     void mass(double t, const double *q, double *M, const double *p);
+!!     void forces(double t, const double *q, const double *v, double *Q, const double *p);
+!!     void forces_jac(double t, const double *q, const double *v, const double *a,
+!!                     double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv] */
+!!     double energy(double t, const double *q, const double *v, const double *p);
+!!     void phi(double t, const double *q, double *c, const double *p);
+!!     void phi_jac(double t, const double *q, double *G, const double *p);
+!!     void phi_t(double t, const double *q, double *pt, const double *p);
+!!     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
+!!     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
+!!     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+!!
+!! Only `mass` and `forces` are required; a missing optional function falls back to the
+!! finite-difference default of the parent type (see conmech_constrained_system).
+module conmech_c_mechanics
+    use, intrinsic :: iso_c_binding, only: c_double, c_funptr, c_associated, &
+                                           c_f_procpointer
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_generalized, only: generalized_system
+    use conmech_constrained_system, only: constrained_system, fd_phi_jac, fd_phi_t, &
+                                          fd_phi_gamma, fd_nh_gamma
+    implicit none
+    private
+
+    public :: c_generalized_system, c_constrained_system, c_mech_pointers
+    public :: make_c_generalized, make_c_constrained
+
+    abstract interface
+        subroutine c_mat_fn(t, q, m, p) bind(c)     ! mass, phi, phi_jac, phi_t
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*)
+            real(c_double), intent(out) :: m(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_mat_fn
+        subroutine c_qv_fn(t, q, v, f, p) bind(c)   ! forces, phi_gamma, nh_gamma
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*), v(*)
+            real(c_double), intent(out) :: f(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_qv_fn
+        subroutine c_fjac_fn(t, q, v, a, r, p) bind(c)
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*), v(*), a(*)
+            real(c_double), intent(out) :: r(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_fjac_fn
+        function c_energy_fn(t, q, v, p) result(e) bind(c)
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*), v(*)
+            real(c_double), intent(in) :: p(*)
+            real(c_double) :: e
+        end function c_energy_fn
+        subroutine c_nh_fn(t, q, a, b, p) bind(c)
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*)
+            real(c_double), intent(out) :: a(*), b(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_nh_fn
+    end interface
+
+    !> The C function pointers of a compiled mechanical system (null where absent).
+    type :: c_mech_pointers
+        type(c_funptr) :: mass, forces, forces_jac, energy
+        type(c_funptr) :: phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma
+    end type c_mech_pointers
+
+    !> M(t, q) q'' = Q(t, q, q') from compiled functions.
+    type, extends(generalized_system) :: c_generalized_system
+        real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
+        procedure(c_mat_fn), pointer, nopass :: mass_f => null()
+        procedure(c_qv_fn), pointer, nopass :: forces_f => null()
+        procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
+        procedure(c_energy_fn), pointer, nopass :: energy_f => null()
+    contains
+        procedure :: mass => cg_mass
+        procedure :: forces => cg_forces
+        procedure :: energy => cg_energy
+        procedure :: has_energy => cg_has_energy
+        procedure :: forces_jacobian => cg_forces_jacobian
+        procedure :: has_forces_jacobian => cg_has_forces_jacobian
+    end type c_generalized_system
+
+    !> A constrained system in excessive coordinates from compiled functions.
+    type, extends(constrained_system) :: c_constrained_system
+        real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
+        procedure(c_mat_fn), pointer, nopass :: mass_f => null()
+        procedure(c_qv_fn), pointer, nopass :: forces_f => null()
+        procedure(c_energy_fn), pointer, nopass :: energy_f => null()
+        procedure(c_mat_fn), pointer, nopass :: phi_f => null()
+        procedure(c_mat_fn), pointer, nopass :: phi_jac_f => null()
+        procedure(c_mat_fn), pointer, nopass :: phi_t_f => null()
+        procedure(c_qv_fn), pointer, nopass :: phi_gamma_f => null()
+        procedure(c_nh_fn), pointer, nopass :: nh_f => null()
+        procedure(c_qv_fn), pointer, nopass :: nh_gamma_f => null()
+    contains
+        procedure :: mass => cc_mass
+        procedure :: forces => cc_forces
+        procedure :: energy => cc_energy
+        procedure :: has_energy => cc_has_energy
+        procedure :: phi => cc_phi
+        procedure :: phi_jac => cc_phi_jac
+        procedure :: phi_t => cc_phi_t
+        procedure :: phi_gamma => cc_phi_gamma
+        procedure :: nh_matrix => cc_nh_matrix
+        procedure :: nh_gamma => cc_nh_gamma
+    end type c_constrained_system
+
+contains
+
+    !> Copy the parameters (at least one entry, f2py/C never see an empty array).
+    subroutine set_params(dst, params)
+        real(dp), allocatable, intent(out) :: dst(:)
+        real(dp), intent(in) :: params(:)
+        allocate (dst(max(size(params), 1)))
+        dst = 0.0_dp
+        dst(1:size(params)) = params
+    end subroutine set_params
+
+    !> Build a compiled generalized system with `ndof` coordinates. Required: mass, forces.
+    subroutine make_c_generalized(ndof, fp, params, sys, info, msg)
+        integer, intent(in) :: ndof
+        type(c_mech_pointers), intent(in) :: fp
+        real(dp), intent(in) :: params(:)
+        type(c_generalized_system), intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        if (ndof < 1) then
+            msg = "bad input: the number of coordinates of a compiled system must be positive"
+            return
+        end if
+        if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then
+            msg = "bad input: the mass and forces function pointers must not be null"
+            return
+        end if
+        sys%ndof = ndof
+        call c_f_procpointer(fp%mass, sys%mass_f)
+        call c_f_procpointer(fp%forces, sys%forces_f)
+        if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
+        if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
+        call set_params(sys%p, params)
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine make_c_generalized
+
+    !> Build a compiled constrained system: n coordinates, n_hol holonomic and n_nh
+    !! non-holonomic constraints. Required: mass, forces; phi when n_hol > 0, nh_matrix
+    !! when n_nh > 0.
+    subroutine make_c_constrained(n, n_hol, n_nh, rheonomic, fp, params, sys, info, msg)
+        integer, intent(in) :: n, n_hol, n_nh
+        logical, intent(in) :: rheonomic
+        type(c_mech_pointers), intent(in) :: fp
+        real(dp), intent(in) :: params(:)
+        type(c_constrained_system), intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        if (n < 1 .or. n_hol < 0 .or. n_nh < 0 .or. n_hol + n_nh >= n) then
+            msg = "bad input: a compiled constrained system needs n >= 1 coordinates and " &
+                  //"0 <= n_hol + n_nh < n constraints"
+            return
+        end if
+        if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then
+            msg = "bad input: the mass and forces function pointers must not be null"
+            return
+        end if
+        if (n_hol > 0 .and. .not. c_associated(fp%phi)) then
+            msg = "bad input: holonomic constraints need the phi function"
+            return
+        end if
+        if (n_nh > 0 .and. .not. c_associated(fp%nh_matrix)) then
+            msg = "bad input: non-holonomic constraints need the nh_matrix function"
+            return
+        end if
+        sys%n = n
+        sys%n_hol = n_hol
+        sys%n_nh = n_nh
+        sys%rheonomic = rheonomic
+        call c_f_procpointer(fp%mass, sys%mass_f)
+        call c_f_procpointer(fp%forces, sys%forces_f)
+        if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
+        if (c_associated(fp%phi)) call c_f_procpointer(fp%phi, sys%phi_f)
+        if (c_associated(fp%phi_jac)) call c_f_procpointer(fp%phi_jac, sys%phi_jac_f)
+        if (c_associated(fp%phi_t)) call c_f_procpointer(fp%phi_t, sys%phi_t_f)
+        if (c_associated(fp%phi_gamma)) call c_f_procpointer(fp%phi_gamma, sys%phi_gamma_f)
+        if (c_associated(fp%nh_matrix)) call c_f_procpointer(fp%nh_matrix, sys%nh_f)
+        if (c_associated(fp%nh_gamma)) call c_f_procpointer(fp%nh_gamma, sys%nh_gamma_f)
+        call set_params(sys%p, params)
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine make_c_constrained
+
+    ! ------------------------------------------------------------ generalized system
+
+    subroutine cg_mass(self, t, q, mm)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: mm(:, :)
+        call self%mass_f(t, q, mm, self%p)
+    end subroutine cg_mass
+
+    subroutine cg_forces(self, t, q, v, f)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: f(:)
+        call self%forces_f(t, q, v, f, self%p)
+    end subroutine cg_forces
+
+    function cg_energy(self, t, q, v) result(e)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp) :: e
+        e = 0.0_dp
+        if (associated(self%energy_f)) e = self%energy_f(t, q, v, self%p)
+    end function cg_energy
+
+    logical function cg_has_energy(self)
+        class(c_generalized_system), intent(in) :: self
+        cg_has_energy = associated(self%energy_f)
+    end function cg_has_energy
+
+    subroutine cg_forces_jacobian(self, t, q, v, a, r)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        call self%fjac_f(t, q, v, a, r, self%p)
+    end subroutine cg_forces_jacobian
+
+    logical function cg_has_forces_jacobian(self)
+        class(c_generalized_system), intent(in) :: self
+        cg_has_forces_jacobian = associated(self%fjac_f)
+    end function cg_has_forces_jacobian
+
+    ! ------------------------------------------------------------ constrained system
+
+    subroutine cc_mass(self, t, q, mm)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: mm(:, :)
+        call self%mass_f(t, q, mm, self%p)
+    end subroutine cc_mass
+
+    subroutine cc_forces(self, t, q, v, f)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: f(:)
+        call self%forces_f(t, q, v, f, self%p)
+    end subroutine cc_forces
+
+    function cc_energy(self, t, q, v) result(e)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp) :: e
+        e = 0.0_dp
+        if (associated(self%energy_f)) e = self%energy_f(t, q, v, self%p)
+    end function cc_energy
+
+    logical function cc_has_energy(self)
+        class(c_constrained_system), intent(in) :: self
+        cc_has_energy = associated(self%energy_f)
+    end function cc_has_energy
+
+    subroutine cc_phi(self, t, q, c)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: c(:)
+        if (associated(self%phi_f)) then
+            call self%phi_f(t, q, c, self%p)
+        else
+            c = 0.0_dp
+        end if
+    end subroutine cc_phi
+
+    subroutine cc_phi_jac(self, t, q, g)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: g(:, :)
+        if (associated(self%phi_jac_f)) then
+            call self%phi_jac_f(t, q, g, self%p)
+        else
+            call fd_phi_jac(self, t, q, g)
+        end if
+    end subroutine cc_phi_jac
+
+    subroutine cc_phi_t(self, t, q, pt)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: pt(:)
+        if (associated(self%phi_t_f)) then
+            call self%phi_t_f(t, q, pt, self%p)
+        else
+            call fd_phi_t(self, t, q, pt)
+        end if
+    end subroutine cc_phi_t
+
+    subroutine cc_phi_gamma(self, t, q, v, gam)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: gam(:)
+        if (associated(self%phi_gamma_f)) then
+            call self%phi_gamma_f(t, q, v, gam, self%p)
+        else
+            call fd_phi_gamma(self, t, q, v, gam)
+        end if
+    end subroutine cc_phi_gamma
+
+    subroutine cc_nh_matrix(self, t, q, a, b)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: a(:, :)
+        real(dp), intent(out) :: b(:)
+        if (associated(self%nh_f)) then
+            call self%nh_f(t, q, a, b, self%p)
+        else
+            a = 0.0_dp
+            b = 0.0_dp
+        end if
+    end subroutine cc_nh_matrix
+
+    subroutine cc_nh_gamma(self, t, q, v, gam)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: gam(:)
+        if (associated(self%nh_gamma_f)) then
+            call self%nh_gamma_f(t, q, v, gam, self%p)
+        else
+            call fd_nh_gamma(self, t, q, v, gam)
+        end if
+    end subroutine cc_nh_gamma
+
+end module conmech_c_mechanics
