@@ -179,7 +179,10 @@ def _tolerance(value, name, n):
             raise ValueError(f"{name} must be finite")
         return np.full(n, v)
     try:
-        arr = np.asarray(value, dtype=float)
+        arr = np.asarray(value)
+        if arr.dtype.kind not in "biuf" or isinstance(value, (bool, np.bool_)):
+            raise TypeError
+        arr = arr.astype(float)
     except (TypeError, ValueError) as exc:
         raise TypeError(f"{name} must be a non-negative number or an array of shape "
                         f"({n},)") from exc
