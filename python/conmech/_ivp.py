@@ -69,7 +69,9 @@ class DenseOutput:
 
     ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
     (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
-    OdeSolution does. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
+    OdeSolution does. SciPy's OdeSolution attributes: ``ts`` (segment boundaries, in the
+    direction of integration), ``ts_sorted``, ``interpolants`` (one callable per step, with
+    t_old and t), ``n_segments``, ``t_min``, ``t_max``, ``ascending``. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
     in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
     RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
     VERNER98), as in conmech_ode_solver's dense_solution.
