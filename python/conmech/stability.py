@@ -103,11 +103,6 @@ def _callback(fun, n, y0, t0, jac=None):
     return g, rhs, dfdy
 
 
-def _params(system):
-    p = np.ascontiguousarray(system.params, dtype=float)
-    return p if p.size else np.zeros(1)
-
-
 def _check_dim(system, y):
     if isinstance(system, BuiltinSystem) and y.size != system.dimension:
         raise ValueError(f"y0 has {y.size} components; the system '{system.name}' has "
