@@ -1,65 +1,78 @@
 !> Hill's lunar problem: the variation orbit for a given m, its monodromy matrix, Floquet
 !! multipliers, stability index and the perigee constant c.
 !!
-!!   fpm run hill -- --m 0.080848933808312 [--kappa 1] [--csv orbit.csv] [--phi phi.csv]
-!!                   [--npoints 401]
+!!   fpm run hill -- --m 0.080848933808312 --csv orbit.csv --phi phi.csv
 !!
 !! --csv writes t,x,y,xd,yd along one period; --phi writes t,phi of the transverse Hill's
 !! equation N'' + Phi(t) N = 0. Exit status 0 on success, 1 on failure, 2 on bad arguments.
 program hill
+    use, intrinsic :: iso_fortran_env, only: error_unit
     use conmech
+    use app_cli
+    use app_batch, only: file_exists, max_jobs
     implicit none
-    real(dp) :: m, kappa
-    character(len=:), allocatable :: csv, phicsv
-    character(len=256) :: arg, val
-    integer :: i, narg, npts, ios, info, u
+    character(len=*), parameter :: help = &
+        "usage: hill [--m M] [--kappa K] [--csv FILE] [--phi FILE] [--npoints N] [--force]"// &
+        new_line("a")//"The variation orbit of Hill's lunar problem for one m: initial "// &
+        "state, period,"//new_line("a")//"Jacobi constant, monodromy matrix, Floquet "// &
+        "multipliers, stability index and"//new_line("a")//"perigee constant c."// &
+        new_line("a")//"Options:"//new_line("a")// &
+        "  --m M             ratio of mean motions (default Hill's 0.080848933808312), > 0"// &
+        new_line("a")//"  --kappa K         mass parameter (default 1), > 0"// &
+        new_line("a")//"  --csv FILE        write t,x,y,xd,yd along one period"// &
+        new_line("a")//"  --phi FILE        write t,phi of the transverse Hill equation"// &
+        new_line("a")//"  --npoints N       points per period in the files (default 401, "// &
+        "2..10000000)"//new_line("a")// &
+        "  --force           overwrite existing --csv / --phi files"//new_line("a")// &
+        "  --input FILE.nml  read the options from a namelist &hill ... / (see jobs/hill.nml)"// &
+        new_line("a")//"  --help, --version"//new_line("a")// &
+        "Exit status: 0 success, 1 the orbit was not found, 2 bad input."//new_line("a")// &
+        "Example:"//new_line("a")// &
+        "  hill --m 0.080848933808312 --csv orbit.csv --phi phi.csv"
+    type(cli_parser) :: cli
+    real(dp) :: m_, kappa_
+    character(len=1024) :: csv_file, phi_file
+    character(len=:), allocatable :: key
+    integer :: i, npts, info, ucsv, uphi
+    logical :: force_
     type(hill_orbit) :: orb
     type(hill_transverse_result) :: tr
-    real(dp), allocatable :: t(:), states(:, :), phi(:)
+    real(dp), allocatable :: t(:), states(:, :), phi_(:)
 
-    m = 0.080848933808312_dp
-    kappa = 1.0_dp
-    csv = ""
-    phicsv = ""
+    call cli%start("hill", help)
+    m_ = 0.080848933808312_dp
+    kappa_ = 1.0_dp
+    csv_file = ""
+    phi_file = ""
     npts = 401
-    narg = command_argument_count()
-    i = 1
-    do while (i <= narg)
-        call get_command_argument(i, arg)
-        if (trim(arg) == "-h" .or. trim(arg) == "--help") then
-            write (*, '(a)') "usage: hill [--m M] [--kappa K] [--csv FILE] [--phi FILE] "// &
-                "[--npoints N]"
-            stop
-        end if
-        if (i == narg) call usage_error("missing value after "//trim(arg))
-        call get_command_argument(i + 1, val)
-        select case (trim(arg))
-        case ("--m")
-            read (val, *, iostat=ios) m
-        case ("--kappa")
-            read (val, *, iostat=ios) kappa
-        case ("--csv")
-            csv = trim(val)
-            ios = 0
-        case ("--phi")
-            phicsv = trim(val)
-            ios = 0
-        case ("--npoints")
-            read (val, *, iostat=ios) npts
-            if (npts < 2) ios = 1
-        case default
-            call usage_error("unknown option "//trim(arg))
+    force_ = .false.
+    if (len(cli%input) > 0) call read_input()
+    do while (cli%next(key))
+        select case (key)
+        case ("--m"); call cli%get_real(m_)
+        case ("--kappa"); call cli%get_real(kappa_)
+        case ("--csv"); call cli%get_string(csv_file)
+        case ("--phi"); call cli%get_string(phi_file)
+        case ("--npoints"); call cli%get_int(npts)
+        case ("--force"); call cli%flag(); force_ = .true.
+        case default; call cli%unknown()
         end select
-        if (ios /= 0) call usage_error("bad value for "//trim(arg)//": "//trim(val))
-        i = i + 2
     end do
+    if (.not. (m_ > 0.0_dp .and. m_ <= huge(m_))) call cli%fail("--m must be positive and finite")
+    if (.not. (kappa_ > 0.0_dp .and. kappa_ <= huge(kappa_))) &
+        call cli%fail("--kappa must be positive and finite")
+    if (npts < 2 .or. npts > max_jobs) call cli%fail("--npoints must be in 2..10000000")
+    ! open the outputs before computing: a bad path is found at once
+    ucsv = open_out(csv_file, "--csv")
+    uphi = open_out(phi_file, "--phi")
 
-    call hill_variation_orbit(m, kappa, orb)
+    call hill_variation_orbit(m_, kappa_, orb)
     if (orb%info /= CM_SUCCESS) then
-        write (*, '(a)') "error: "//orb%message
-        error stop 1
+        write (error_unit, '(a)') "hill: error: "//orb%message
+        call discard()
+        stop 1, quiet=.true.
     end if
-    write (*, '(a, es24.16, a, es24.16)') "m      =", m, "   kappa =", kappa
+    write (*, '(a, es24.16, a, es24.16)') "m      =", m_, "   kappa =", kappa_
     write (*, '(a, 4es24.16)') "y0     =", orb%y0
     write (*, '(a, es24.16)') "period =", orb%period
     write (*, '(a, es24.16)') "jacobi =", orb%jacobi
@@ -84,51 +97,76 @@ program hill
         write (*, '(a, f20.16)') "c from the transverse Hill equation =", tr%c
     end if
 
-    if (len(csv) > 0 .or. len(phicsv) > 0) then
-        allocate (t(npts), states(4, npts), phi(npts))
+    if (ucsv /= 0 .or. uphi /= 0) then
+        allocate (t(npts), states(4, npts), phi_(npts))
         do i = 1, npts
             t(i) = orb%period*real(i - 1, dp)/real(npts - 1, dp)
         end do
-        call hill_orbit_sample(orb, t, states, phi, info)
+        call hill_orbit_sample(orb, t, states, phi_, info)
         if (info /= CM_SUCCESS) then
-            write (*, '(a)') "error: sampling the orbit failed: "//status_message(info)
-            error stop 1
+            write (error_unit, '(a)') "hill: error: sampling the orbit failed: "// &
+                status_message(info)
+            call discard()
+            stop 1, quiet=.true.
         end if
-        if (len(csv) > 0) then
-            open (newunit=u, file=csv, status="replace", action="write", iostat=ios)
-            if (ios /= 0) call fail_io(csv)
-            write (u, '(a)') "t,x,y,xd,yd"
+        if (ucsv /= 0) then
+            write (ucsv, '(a)') "t,x,y,xd,yd"
             do i = 1, npts
-                write (u, '(es24.16, 4(",", es24.16))') t(i), states(:, i)
+                write (ucsv, '(a)') fmt_real(t(i))//","//fmt_list(states(:, i))
             end do
-            close (u)
-            write (*, '(a)') "wrote "//csv
+            close (ucsv)
+            write (*, '(a)') "wrote "//trim(csv_file)
         end if
-        if (len(phicsv) > 0) then
-            open (newunit=u, file=phicsv, status="replace", action="write", iostat=ios)
-            if (ios /= 0) call fail_io(phicsv)
-            write (u, '(a)') "t,phi"
+        if (uphi /= 0) then
+            write (uphi, '(a)') "t,phi"
             do i = 1, npts
-                write (u, '(es24.16, ",", es24.16)') t(i), phi(i)
+                write (uphi, '(a)') fmt_real(t(i))//","//fmt_real(phi_(i))
             end do
-            close (u)
-            write (*, '(a)') "wrote "//phicsv
+            close (uphi)
+            write (*, '(a)') "wrote "//trim(phi_file)
         end if
     end if
+    if (allocated(t)) deallocate (t, states, phi_)
+    deallocate (key)
+    call cli%clear()
 
 contains
 
-    subroutine usage_error(msg)
-        character(len=*), intent(in) :: msg
-        write (*, '(a)') "error: "//msg
-        write (*, '(a)') "usage: hill [--m M] [--kappa K] [--csv FILE] [--phi FILE] [--npoints N]"
-        error stop 2
-    end subroutine usage_error
+    !> Open an output file (0 if none); an existing file needs --force.
+    integer function open_out(name, opt) result(uu)
+        character(len=*), intent(in) :: name, opt
+        integer :: ios
+        uu = 0
+        if (len_trim(name) == 0) return
+        if (file_exists(trim(name)) .and. .not. force_) call cli%fail(opt//" "//trim(name)// &
+            " exists; use --force to overwrite it")
+        open (newunit=uu, file=trim(name), status="replace", action="write", iostat=ios)
+        if (ios /= 0) call cli%fail("cannot write "//opt//" "//trim(name))
+    end function open_out
 
-    subroutine fail_io(name)
-        character(len=*), intent(in) :: name
-        write (*, '(a)') "error: cannot open "//name
-        error stop 1
-    end subroutine fail_io
+    !> Remove the (empty) outputs of a failed run.
+    subroutine discard()
+        if (ucsv /= 0) close (ucsv, status="delete")
+        if (uphi /= 0) close (uphi, status="delete")
+    end subroutine discard
+
+    !> The options from a namelist &hill ... / (the command line overrides them).
+    subroutine read_input()
+        real(dp) :: m, kappa
+        character(len=1024) :: csv, phi
+        integer :: npoints, uu, ios
+        logical :: force
+        character(len=512) :: msg
+        namelist /hill/ m, kappa, csv, phi, npoints, force
+        m = m_; kappa = kappa_; csv = csv_file; phi = phi_file; npoints = npts
+        force = force_
+        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, iomsg=msg)
+        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(msg))
+        read (uu, nml=hill, iostat=ios, iomsg=msg)
+        if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &hill: "//trim(msg))
+        close (uu)
+        m_ = m; kappa_ = kappa; csv_file = csv; phi_file = phi; npts = npoints
+        force_ = force
+    end subroutine read_input
 
 end program hill

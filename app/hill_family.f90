@@ -1,147 +1,201 @@
 !> The family of Hill's variation orbits over m, written incrementally to CSV (resumable).
 !!
-!!   fpm run hill_family -- --m0 0.01 --m1 0.15 --n 10000 --out family.csv [--kappa 1]
-!!                          [--batch 1000]
-!!   (add --flag -fopenmp to run the orbits of a batch on all threads)
+!!   fpm run hill_family -- --m0 0.01 --m1 0.15 --n 10000 --out family.csv
+!!   (add --flag -fopenmp to run blocks of orbits on all threads)
 !!
-!! Columns: i,m,x0,v0,jacobi,stability_index,c,status,iterations. Rows are appended batch
-!! by batch and flushed; rerunning the same command after an interruption keeps the rows
-!! already written and computes only the rest. Exit status 0 when every orbit converged,
-!! 1 if some failed (their rows have status < 0), 2 on bad arguments.
+!! Columns: i,m,x0,v0,jacobi,stability_index,c,status,iterations. The orbits are computed in
+!! fixed blocks of 32 consecutive grid points (block k holds i = 32(k-1)+1 .. 32k): each
+!! block starts Newton cold at its first orbit and continues along the block. The blocks
+!! do not depend on the thread count, the --batch size or where a run was interrupted, so
+!! the file is bit-identical however it was produced. Rows are appended in order, batch by
+!! batch, and flushed; a rerun with the same arguments resumes (a torn last row is dropped
+!! and recomputed), other arguments are refused (OUT.args), --force starts over.
 program hill_family_app
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use conmech
+    use app_cli
+    use app_batch
     implicit none
-    real(dp) :: m0, m1, kappa
-    integer :: n, batch, i, i0, i1, ios, u, ndone, narg, nfail, k
-    character(len=256) :: arg, val, line
-    character(len=:), allocatable :: out
+    !> Orbits per continuation block (part of the result's definition: do not change).
+    integer, parameter :: block = 32
+    character(len=*), parameter :: help = &
+        "usage: hill_family [--m0 M0] [--m1 M1] [--n N] [--kappa K] [--out FILE] "// &
+        "[--batch B] [--force] [--quiet]"//new_line("a")// &
+        "The family of Hill's variation orbits on the grid m = m0 .. m1 (N points), one CSV"// &
+        new_line("a")//"row per orbit: i,m,x0,v0,jacobi,stability_index,c,status,iterations."// &
+        new_line("a")//"Options:"//new_line("a")// &
+        "  --m0 M0 --m1 M1   the range of m (default 0.01 .. 0.15), >= 0"//new_line("a")// &
+        "  --n N             grid points (default 10000, 1..10000000)"//new_line("a")// &
+        "  --kappa K         mass parameter (default 1), > 0"//new_line("a")// &
+        "  --out FILE        results CSV (default family.csv in the current directory);"// &
+        new_line("a")//"                    an existing FILE made by the same arguments is"// &
+        " resumed"//new_line("a")// &
+        "  --batch B         orbits computed between two writes (default 1024; does not"// &
+        new_line("a")//"                    change the results)"//new_line("a")// &
+        "  --force           overwrite FILE made by other arguments"//new_line("a")// &
+        "  --quiet           no progress line on stderr"//new_line("a")// &
+        "  --input FILE.nml  read the options from a namelist &hill_family ... /"// &
+        " (see jobs/hill_family.nml)"//new_line("a")//"  --help, --version"//new_line("a")// &
+        "Threads: fpm run hill_family --flag -fopenmp (results identical to serial)."// &
+        new_line("a")//"Exit status: 0 every orbit converged, 1 some failed (status < 0 in"// &
+        " their rows), 2 bad input."//new_line("a")//"Example:"//new_line("a")// &
+        "  hill_family --m0 0.01 --m1 0.15 --n 10000 --out family.csv"
+    character(len=*), parameter :: header = &
+        "i,m,x0,v0,jacobi,stability_index,c,status,iterations"
+    type(cli_parser) :: cli
+    type(progress_t) :: progress
+    real(dp) :: m0_, m1_, kappa_
+    integer :: n_, batch_, i, b0, b1, ios, u, ndone, nfail, nrows, ib, nb, first_block
+    character(len=1024) :: out_file
+    character(len=:), allocatable :: key, canon
+    logical :: force_, quiet_, fresh
     real(dp), allocatable :: ms(:)
     type(hill_orbit), allocatable :: orbs(:)
-    logical :: exists
+    logical, allocatable :: have(:)
 
-    m0 = 0.01_dp
-    m1 = 0.15_dp
-    n = 10000
-    kappa = 1.0_dp
-    batch = 1000
-    out = "family.csv"
-    narg = command_argument_count()
-    i = 1
-    do while (i <= narg)
-        call get_command_argument(i, arg)
-        if (i == narg) call usage_error("missing value after "//trim(arg))
-        call get_command_argument(i + 1, val)
-        ios = 0
-        select case (trim(arg))
-        case ("--m0")
-            read (val, *, iostat=ios) m0
-        case ("--m1")
-            read (val, *, iostat=ios) m1
-        case ("--n")
-            read (val, *, iostat=ios) n
-            if (n < 1) ios = 1
-        case ("--kappa")
-            read (val, *, iostat=ios) kappa
-        case ("--batch")
-            read (val, *, iostat=ios) batch
-            if (batch < 1) ios = 1
-        case ("--out")
-            out = trim(val)
-        case default
-            call usage_error("unknown option "//trim(arg))
+    call cli%start("hill_family", help)
+    m0_ = 0.01_dp
+    m1_ = 0.15_dp
+    n_ = 10000
+    kappa_ = 1.0_dp
+    batch_ = 1024
+    out_file = "family.csv"
+    force_ = .false.
+    quiet_ = .false.
+    if (len(cli%input) > 0) call read_input()
+    do while (cli%next(key))
+        select case (key)
+        case ("--m0"); call cli%get_real(m0_)
+        case ("--m1"); call cli%get_real(m1_)
+        case ("--n"); call cli%get_int(n_)
+        case ("--kappa"); call cli%get_real(kappa_)
+        case ("--batch"); call cli%get_int(batch_)
+        case ("--out"); call cli%get_string(out_file)
+        case ("--force"); call cli%flag(); force_ = .true.
+        case ("--quiet"); call cli%flag(); quiet_ = .true.
+        case default; call cli%unknown()
         end select
-        if (ios /= 0) call usage_error("bad value for "//trim(arg)//": "//trim(val))
-        i = i + 2
     end do
-    if (.not. (m0 >= 0.0_dp .and. m1 >= 0.0_dp .and. kappa > 0.0_dp)) &
-        call usage_error("need m0, m1 >= 0 and kappa > 0")
+    if (.not. (m0_ >= 0.0_dp .and. m0_ <= huge(m0_))) call cli%fail("--m0 must be >= 0 "// &
+                                                                     "and finite")
+    if (.not. (m1_ >= 0.0_dp .and. m1_ <= huge(m1_))) call cli%fail("--m1 must be >= 0 "// &
+                                                                     "and finite")
+    if (.not. (kappa_ > 0.0_dp .and. kappa_ <= huge(kappa_))) &
+        call cli%fail("--kappa must be positive and finite")
+    if (n_ < 1 .or. n_ > max_jobs) call cli%fail("--n must be in 1..10000000")
+    if (batch_ < 1 .or. batch_ > max_jobs) call cli%fail("--batch must be in 1..10000000")
+    if (len_trim(out_file) == 0) call cli%fail("--out must not be empty")
+    batch_ = block*((batch_ + block - 1)/block)
+    canon = "m0="//fmt_real(m0_)//" m1="//fmt_real(m1_)//" n="//itoa(n_)//" kappa="// &
+        fmt_real(kappa_)//" block="//itoa(block)
 
-    allocate (ms(n))
-    do i = 1, n
-        ms(i) = m0
-        if (n > 1) ms(i) = m0 + (m1 - m0)*real(i - 1, dp)/real(n - 1, dp)
+    allocate (ms(n_))
+    do i = 1, n_
+        ms(i) = m0_
+        if (n_ > 1) ms(i) = m0_ + (m1_ - m0_)*real(i - 1, dp)/real(n_ - 1, dp)
     end do
 
-    ! resume: count the complete rows already written
+    ! ---- resume: check OUT before the first orbit (arguments, header, rows 1..k in order)
+    call check_args_file(cli, trim(out_file), canon, force_, fresh)
+    call write_args_file(cli, trim(out_file), canon)
+    allocate (have(n_))
+    have = .false.
     ndone = 0
-    inquire (file=out, exist=exists)
-    if (exists) then
-        open (newunit=u, file=out, status="old", action="read", iostat=ios)
-        if (ios /= 0) call fail("cannot read "//out)
-        read (u, '(a)', iostat=ios) line
-        do
-            read (u, '(a)', iostat=ios) line
-            if (ios /= 0) exit
-            if (index(line, ",") > 0 .and. len_trim(line) > 20) ndone = ndone + 1
-        end do
+    if (fresh .or. file_size(trim(out_file)) <= 0) then
+        open (newunit=u, file=trim(out_file), status="replace", action="write", iostat=ios)
+        if (ios /= 0) call cli%fail("cannot write "//trim(out_file))
+        write (u, '(a)') header
         close (u)
-        ndone = min(ndone, n)
-        ! rewrite exactly the complete rows (drops a partial last line)
-        call truncate_rows(out, ndone)
-        write (*, '(a, i0, a)') "resuming: ", ndone, " orbits already in "//out
     else
-        open (newunit=u, file=out, status="replace", action="write", iostat=ios)
-        if (ios /= 0) call fail("cannot create "//out)
-        write (u, '(a)') "i,m,x0,v0,jacobi,stability_index,c,status,iterations"
-        close (u)
+        call load_rows(cli, trim(out_file), header, 9, 1, n_, .true., .true., have, ndone)
+        if (file_size(trim(out_file)) <= 0) then
+            ! the header itself was torn: start the file again
+            open (newunit=u, file=trim(out_file), status="replace", action="write")
+            write (u, '(a)') header
+            close (u)
+        end if
+        write (*, '(a, i0, a)') "resuming: ", ndone, " orbits already in "//trim(out_file)
     end if
+    deallocate (have)
+    open (newunit=u, file=trim(out_file), status="old", position="append", action="write", &
+          iostat=ios)
+    if (ios /= 0) call cli%fail("cannot append to "//trim(out_file))
+    call progress%begin("hill_family", n_, ndone, on=.not. quiet_)
 
-    nfail = 0
-    open (newunit=u, file=out, status="old", position="append", action="write", iostat=ios)
-    if (ios /= 0) call fail("cannot append to "//out)
-    do i0 = ndone + 1, n, batch
-        i1 = min(n, i0 + batch - 1)
-        allocate (orbs(i1 - i0 + 1))
-        call hill_family(ms(i0:i1), kappa, orbs)
-        do k = 1, size(orbs)
-            write (u, '(i0, 6(",", es24.16), ",", i0, ",", i0)') i0 + k - 1, ms(i0 + k - 1), &
-                orbs(k)%y0(1), orbs(k)%y0(4), orbs(k)%jacobi, orbs(k)%stability_index, &
-                orbs(k)%c, orbs(k)%info, orbs(k)%iterations
-            if (orbs(k)%info /= CM_SUCCESS) nfail = nfail + 1
+    ! batches of whole blocks, from the block holding the first missing orbit
+    first_block = ndone/block + 1
+    do b0 = (first_block - 1)*block + 1, n_, batch_
+        b1 = min(n_, b0 + batch_ - 1)
+        allocate (orbs(b0:b1))
+        nb = (b1 - b0)/block + 1
+        !$omp parallel do schedule(dynamic) default(shared) private(ib, i)
+        do ib = 1, nb
+            i = b0 + (ib - 1)*block
+            call hill_family(ms(i:min(b1, i + block - 1)), kappa_, &
+                             orbs(i:min(b1, i + block - 1)), nchunks=1)
+        end do
+        !$omp end parallel do
+        do i = max(b0, ndone + 1), b1
+            write (u, '(a)') itoa(i)//","//fmt_real(ms(i))//","//fmt_real(orbs(i)%y0(1))// &
+                ","//fmt_real(orbs(i)%y0(4))//","//fmt_real(orbs(i)%jacobi)//","// &
+                fmt_real(orbs(i)%stability_index)//","//fmt_real(orbs(i)%c)//","// &
+                itoa(orbs(i)%info)//","//itoa(orbs(i)%iterations)
         end do
         flush (u)
         deallocate (orbs)
-        write (*, '(a, i0, a, i0)') "done ", i1, " / ", n
+        call progress%tick(b1)
     end do
     close (u)
-    write (*, '(a, i0, a)') "wrote "//out//" (", nfail, " failures in this run)"
-    if (nfail > 0) error stop 1
+
+    ! the whole file: count rows and failures
+    allocate (have(n_))
+    have = .false.
+    call load_rows(cli, trim(out_file), header, 9, 1, n_, .true., .false., have, nrows, &
+                   status_col=8, nfail=nfail)
+    write (*, '(a, i0, a)') "wrote "//trim(out_file)//" (", nrows, " orbits)"
+    flush (output_unit)
+    deallocate (key, canon, ms, have)
+    call cli%clear()
+    call progress%clear()
+    if (nrows /= n_) then
+        write (error_unit, '(a)') "hill_family: error: the file is incomplete"
+        stop 1, quiet=.true.
+    end if
+    if (nfail > 0) then
+        write (error_unit, '(a, i0, a, i0, a)') "hill_family: ", nfail, " of ", n_, &
+            " orbits failed (status /= 0 in their rows)"
+        stop 1, quiet=.true.
+    end if
 
 contains
 
-    subroutine truncate_rows(name, nrows)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: nrows
-        character(len=512), allocatable :: rows(:)
-        character(len=512) :: hdr
-        integer :: uu, j, ios2
-        allocate (rows(max(nrows, 1)))
-        open (newunit=uu, file=name, status="old", action="read")
-        read (uu, '(a)') hdr
-        do j = 1, nrows
-            read (uu, '(a)', iostat=ios2) rows(j)
-        end do
-        close (uu)
-        open (newunit=uu, file=name, status="replace", action="write")
-        write (uu, '(a)') trim(hdr)
-        do j = 1, nrows
-            write (uu, '(a)') trim(rows(j))
-        end do
-        close (uu)
-    end subroutine truncate_rows
+    function itoa(k) result(s)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: s
+        character(len=16) :: b
+        write (b, '(i0)') k
+        s = trim(b)
+    end function itoa
 
-    subroutine usage_error(msg)
-        character(len=*), intent(in) :: msg
-        write (*, '(a)') "error: "//msg
-        write (*, '(a)') "usage: hill_family [--m0 M0] [--m1 M1] [--n N] [--kappa K] "// &
-            "[--out FILE] [--batch B]"
-        error stop 2
-    end subroutine usage_error
-
-    subroutine fail(msg)
-        character(len=*), intent(in) :: msg
-        write (*, '(a)') "error: "//msg
-        error stop 1
-    end subroutine fail
+    !> The options from a namelist &hill_family ... / (the command line overrides them).
+    subroutine read_input()
+        real(dp) :: m0, m1, kappa
+        integer :: n, batch, uu, ios2
+        character(len=1024) :: out
+        logical :: force, quiet
+        character(len=512) :: msg
+        namelist /hill_family/ m0, m1, n, kappa, batch, out, force, quiet
+        m0 = m0_; m1 = m1_; n = n_; kappa = kappa_; batch = batch_; out = out_file
+        force = force_; quiet = quiet_
+        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios2, &
+              iomsg=msg)
+        if (ios2 /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(msg))
+        read (uu, nml=hill_family, iostat=ios2, iomsg=msg)
+        if (ios2 /= 0) call cli%fail("--input "//cli%input//": namelist &hill_family: "// &
+                                     trim(msg))
+        close (uu)
+        m0_ = m0; m1_ = m1; n_ = n; kappa_ = kappa; batch_ = batch; out_file = out
+        force_ = force; quiet_ = quiet
+    end subroutine read_input
 
 end program hill_family_app

@@ -3,8 +3,24 @@
 program tour
     use conmech
     use app_events, only: theta_events
+    use app_cli, only: cli_parser
     implicit none
+    character(len=*), parameter :: help = "usage: tour [--help] [--version]"//new_line("a")// &
+        "A short tour of conmech printed to the terminal: a pendulum's period against the"// &
+        new_line("a")//"elliptic integral, a Kepler orbit with two integrators, and Hill's"// &
+        " variation orbit"//new_line("a")//"with its perigee constant against Hill's "// &
+        "value. It takes no options."//new_line("a")//"Example:"//new_line("a")// &
+        "  fpm run tour"
+    type(cli_parser) :: cli
+    character(len=:), allocatable :: key
 
+    call cli%start("tour", help)
+    if (len(cli%input) > 0) call cli%fail("tour takes no --input")
+    do while (cli%next(key))
+        call cli%unknown()
+    end do
+    deallocate (key)
+    call cli%clear()
     write (*, '(a)') "conmech tour"
     write (*, '(a)') "============"
     call pendulum_part()

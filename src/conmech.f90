@@ -15,6 +15,10 @@ module conmech
     use conmech_c_mechanics
     use conmech_constrained_system
     use conmech_constrained_solver
+    use conmech_rattle
+    use conmech_rattle_dae
+    use conmech_radau
+    use conmech_gauss
     use conmech_systems_generalized
     use conmech_systems_constrained
     use conmech_systems_mech
@@ -25,6 +29,7 @@ module conmech
     use conmech_floquet
     use conmech_shooting
     use conmech_hill_orbit
+    use conmech_ensemble
     implicit none
     public
 end module conmech

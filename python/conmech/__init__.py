@@ -10,7 +10,9 @@ from . import constrained, systems
 from . import hill, stability
 from . import compiled
 from ._ivp import DenseOutput, OdeResult, solve_ivp
+from . import ensemble  # noqa: E402  (after _ivp: it builds on it)
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability",
            "constrained", "compiled"]
+__all__ += ["ensemble"]
 __version__ = "0.1.0"

@@ -9,15 +9,21 @@ import numpy as np
 from . import _conmech
 from ._callback import Guard, as_result, message_text
 from .systems import BuiltinSystem
+from . import _implicit
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK45", "DOPRI5", "DOP853", "VERNER98", "VERN9", "RK4")
+_METHODS = ("RK45", "DOPRI5", "DOP853", "VERNER98", "VERN9", "RK4", "Radau", "GAUSS4",
+            "GAUSS6")
 # codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
-# method_from_name by the tests (flat_method_code)
-_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 5, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
-# RK45 = 5: DOPRI5 with SciPy's step control and initial step (conmech_flat_ode_support
+# method_from_name by the tests (flat_method_code); the implicit methods' codes are
+# _implicit.IMPLICIT_CODES (their own flat routines)
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 12, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
+                 **_implicit.IMPLICIT_CODES}
+# RK45 = 12: DOPRI5 with SciPy's step control and initial step (conmech_flat_ode_support
 # METHOD_RK45_SCIPY)
+_IMPLICIT = frozenset(_implicit.IMPLICIT_CODES.values())
+_RADAU = _implicit.IMPLICIT_CODES["RADAU"]
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -293,12 +299,18 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state (real; complex states raise TypeError).
-    method : {"RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4"}
+    method : {"RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4",
+              "Radau" (alias "RADAU5"), "GAUSS4", "GAUSS6"}
         RK45: Dormand-Prince 5(4) with SciPy's step control and initial step (SciPy's
         default method). DOPRI5: the same pair with Hairer's control (Lund stabilisation
         beta = 0.04). DOP853: Dormand-Prince 8(5,3), dense output of order 7. VERNER98:
         Verner's 9(8) pair, dense output of order 8, for tight tolerances. RK4: classical
-        fixed-step RK4, step ``first_step``. Case-insensitive.
+        fixed-step RK4, step ``first_step``.
+        Radau: Radau IIA of order 5 for stiff problems (Hairer's RADAU5: simplified
+        Newton with one real and one complex LU, dense output of order 3, events; counts
+        njev and nlu). GAUSS4 / GAUSS6: Gauss-Legendre collocation with 2 / 3 stages
+        (orders 4 / 6), symplectic, fixed step ``first_step``, for long runs of
+        conservative systems. Case-insensitive.
     t_eval : array_like or None
         Times at which to store the solution (strictly monotonic in the direction of
         integration, inside t_span), from the dense output. None: every accepted step.
@@ -326,9 +338,10 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
         Largest step size (default no limit; positive, NaN rejected).
     max_steps : int
         Attempted steps before giving up (status -1).
-    jac : callable, array or None
-        SciPy's Jacobian option, validated; the explicit methods do not use it (njev 0)
-        and warn that it has no effect, as SciPy's do.
+    jac : callable, array_like or None
+        Used by method="Radau": ``jac(t, y, *args) -> (n, n)`` (dense) or a constant
+        matrix; None: forward differences (n evaluations of fun per Jacobian). The other
+        methods validate it and warn that it has no effect, as SciPy's explicit ones.
     **options
         SciPy's other solver options for implicit methods (jac_sparsity, lband, uband,
         min_step) are accepted and warned about as SciPy does; anything else is a
@@ -338,8 +351,8 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     -------
     OdeResult
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
-        None), nfev, njev, nlu (Jacobian evaluations and LU decompositions: 0 for the
-        explicit methods), status (0 reached the end, 1 terminal event, -1 failure),
+        None), nfev, njev, nlu (Jacobian evaluations and LU decompositions: Radau's; 0
+        for the other methods), status (0 reached the end, 1 terminal event, -1 failure),
         message, success, and the step counts naccept, nreject.
 
     The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step,
@@ -414,16 +427,18 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
         h0 = _positive_finite(first_step, "first_step")
         if h0 > abs(tf - t0) and tf != t0:
             raise ValueError("first_step exceeds the length of t_span")
-    if code == 1 and first_step is None:
-        raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
-                         "step size")
+    if code in (1, 6, 7) and first_step is None:
+        raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
+                         "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
     if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
         raise TypeError("max_steps must be an integer")
     if not 1 <= max_steps <= 2**31 - 1:
         raise ValueError("max_steps must be positive (and below 2**31)")
     _validate_jac(jac, n)
-    unused = sorted(options) + (["jac"] if jac is not None else [])
+    unused = sorted(options) + (["jac"] if jac is not None and code != _RADAU else [])
+    if jac is not None and code != _RADAU:
+        jac = None
     if unused:   # as SciPy's explicit solvers
         warnings.warn("The following arguments have no effect for a chosen solver: "
                       f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
@@ -459,7 +474,7 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
     ne = len(settings)
-    run = _Run(fun, builtin, args, n, settings, bool(vectorized), t0)
+    run = _Run(fun, builtin, args, n, settings, bool(vectorized), t0, jac)
     remaining = [s[1] for s in settings]       # occurrences left before termination
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
                   max_steps=int(max_steps), dense=int(bool(dense_output)))
@@ -540,8 +555,10 @@ class _Run:
     """The callbacks of one solve_ivp call (one Guard for fun and the events) and the
     Fortran call of one segment."""
 
-    def __init__(self, fun, builtin, args, n, settings, vectorized, t0):
+    def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None):
         self.guard = Guard()
+        self.jac = jac
+        self.njev = self.nlu = 0
         self.fun, self.builtin, self.args, self.n = fun, builtin, args, n
         self.settings = settings
         self.t0 = t0
@@ -630,7 +647,16 @@ class _Run:
         kw = dict(t_span=np.array([t_a, tf]), y0=y_a, first_step=h0, neval=t_ev.size,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir,
                   ev_term=ev_term, **common)
-        if self.builtin:
+        if kw["method"] in _IMPLICIT:
+            failure = []
+            nfev, njev, nlu, naccept, nreject, form, info, message = _implicit.run(
+                self.builtin, self.fun, self.rhs, self.jac, self.args, n, events_cb, store,
+                kw, failure)
+            if failure:
+                self.guard.fail(failure[0])
+            self.njev += int(njev)
+            self.nlu += int(nlu)
+        elif self.builtin:
             fun = self.fun
             nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
                 *fun._flat_args(), events_cb, store, **kw)
@@ -657,7 +683,7 @@ def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, 
     t = np.concatenate(ts) if ts else np.array([t0])
     y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
     res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None,
-                    nfev=nfev, njev=0, nlu=0, status=status,
+                    nfev=nfev, njev=run.njev, nlu=run.nlu, status=status,
                     message=message, success=status >= 0, naccept=naccept,
                     nreject=nreject)
     if ne > 0:

@@ -31,7 +31,8 @@ BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_
                  "pendulum_moving_xy", "yoyo", "skate", "rolling_disk")
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
-_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4}
+_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
+            "RATTLE": 8, "Radau": 5, "RADAU5": 5}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
@@ -222,7 +223,14 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
     q0, v0 : array_like, optional
         Initial coordinates and velocities (built-ins: their default state if omitted).
         They are projected onto the constraints first; ``dq0``/``dv0`` say how far.
-    method : "RK4" (fixed step ``first_step``), "DOPRI5", "DOP853" or "VERNER98"
+    method : "RK4" (fixed step ``first_step``), "DOPRI5", "DOP853", "VERNER98" or "RATTLE"
+        RATTLE: the symplectic constrained integrator for holonomic constraints (fixed
+        step ``first_step``; constraints solved to round-off every step; ``projection``,
+        rtol and atol are not used; a t_eval point between grid points is reached by a
+        side step, so every output is on the manifold). Radau: Radau IIA (order 5,
+        adaptive, rtol/atol) on the stabilised index-2 DAE [q, v, lambda, mu] in
+        mass-matrix form: no drift and no projection; stiff forces welcome; the mass
+        matrix must be constant.
     projection : "position+velocity" (default), "velocity", "baumgarte", "none"
     t_eval : array_like, optional
         Output times (sorted, inside t_span; the steps hit them exactly). Default: every
@@ -286,8 +294,11 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         raise ValueError("rtol and atol must not both be zero")
     if first_step is not None:
         first_step = _finite(first_step, "first_step", low_open=True)
-    if method == "RK4" and first_step is None:
-        raise ValueError("first_step (the fixed step) is required for RK4")
+    if method in ("RK4", "RATTLE") and first_step is None:
+        raise ValueError(f"first_step (the fixed step) is required for {method}")
+    if method == "RATTLE" and system.n_nh:
+        raise ValueError("RATTLE handles holonomic constraints only (the system has "
+                         f"n_nh = {system.n_nh} non-holonomic ones)")
     max_step = _finite(max_step, "max_step", low_open=True, allow_inf=True)
     max_steps = _int(max_steps, "max_steps")
     every = _int(every, "every")

@@ -251,3 +251,19 @@ def hill(m=0.080848933808312, kappa=1.0):
     """Hill's lunar problem x'' - 2 m y' = F_x, y'' + 2 m x' = F_y,
     F = kappa/r + (3/2) m^2 x^2; y = [x, y, x', y'] (analytic Jacobian)."""
     return BuiltinSystem("hill", [m, kappa], ("m", "kappa"))
+
+
+def pendulum_chain_xy(N=8, m=1.0, l=1.0, g=9.81):
+    """Chain of N Cartesian pendulums q = [x1, y1, ..., xN, yN], N rod constraints (a
+    diagonal mass and a banded constraint Jacobian: O(N) per step in constrained.solve)."""
+    try:
+        whole = float(N) == int(N) and 1 <= int(N) <= 100000
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    if isinstance(N, bool) or not whole:
+        raise ValueError(f"pendulum_chain_xy: N must be a whole number of links in "
+                         f"1..100000, got {N!r}")
+    return _constrained("pendulum_chain_xy", [int(N), m, l, g])
+
+
+__all__ += ["pendulum_chain_xy"]

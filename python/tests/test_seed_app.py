@@ -54,10 +54,10 @@ def test_seed_generalized_and_projection_choice(tmp_path):
 
 def test_seed_bad_input_exit_codes():
     r = fpm("run", "seed", "--", "--system", "nosuch", check=False)
-    assert r.returncode != 0 and "unknown system" in r.stdout
+    assert r.returncode == 2 and "unknown system 'nosuch'; valid: pendulum_xy" in r.stderr
     r = fpm("run", "seed", "--", "--system", "pendulum_xy", "--projection", "sideways",
             check=False)
-    assert r.returncode != 0 and "unknown projection" in r.stdout
+    assert r.returncode == 2 and "unknown projection" in r.stderr
     r = fpm("run", "seed", "--", "--system", "pendulum_xy", "--params", "0,9.81,1",
             check=False)
-    assert r.returncode != 0 and "singular mass matrix" in r.stdout
+    assert r.returncode == 1 and "singular mass matrix" in r.stdout

@@ -417,11 +417,12 @@ def test_nested_solve_inside_fun():
 
 def test_method_codes_match_the_fortran_names():
     from conmech import _conmech, _ivp
-    fortran_names = ["RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "Vern9"]
+    fortran_names = ["RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "Vern9", "Radau", "RADAU5",
+                     "GAUSS4", "GAUSS6"]
     for name in fortran_names:
         code = int(_conmech.flat_method_code(name))
-        if name == "RK45":   # the flat layer's SciPy variant of DOPRI5 (code 5)
-            assert code == _ivp._METHOD_CODES["DOPRI5"] and _ivp._METHOD_CODES["RK45"] == 5
+        if name == "RK45":   # the flat layer's SciPy variant of DOPRI5 (code 12)
+            assert code == _ivp._METHOD_CODES["DOPRI5"] and _ivp._METHOD_CODES["RK45"] == 12
             continue
         assert code > 0 and _ivp._METHOD_CODES[name.upper()] == code
     assert set(_ivp._METHOD_CODES) == {n.upper() for n in fortran_names}

@@ -281,10 +281,12 @@ contains
 
         ! ------------------------------------------------------------ integration
         allocate (f%mech, source=sys)
+        call prepare_mass(f%mech, t_span(1), q)     ! a constant M: factorised once
         f%baumgarte = options%projection == PROJ_BAUMGARTE
         f%alpha = options%alpha
         f%beta = options%beta
         allocate (hk%mech, source=sys)
+        call prepare_mass(hk%mech, t_span(1), q)
         hk%projection = options%projection
         hk%every = options%every
         hk%proj_tol = options%proj_tol
@@ -339,7 +341,7 @@ contains
         subroutine store(j)
             integer, intent(in) :: j
             integer :: inf2
-            real(dp) :: c(m, n), c0(m), t
+            real(dp) :: t
             character(len=:), allocatable :: m2
             t = ores%t(j)
             q = ores%y(1:n, j)
@@ -348,21 +350,17 @@ contains
             res%q(:, j) = q
             res%v(:, j) = v
             if (f%baumgarte) then
-                call constrained_accel(sys, t, q, v, acc, lam, inf2, m2, &
+                call constrained_accel(f%mech, t, q, v, acc, lam, inf2, m2, &
                                        alpha=options%alpha, beta=options%beta)
             else
-                call constrained_accel(sys, t, q, v, acc, lam, inf2, m2)
+                call constrained_accel(f%mech, t, q, v, acc, lam, inf2, m2)
             end if
             if (inf2 /= CM_SUCCESS .and. res%status >= 0) then
                 res%status = inf2
                 res%message = m2
             end if
             res%lam(:, j) = lam
-            res%reaction(:, j) = 0.0_dp
-            if (m > 0) then
-                call constraint_matrix(sys, t, q, c, c0)
-                res%reaction(:, j) = matmul(lam, c)
-            end if
+            call constraint_reaction(f%mech, t, q, lam, res%reaction(:, j))
             call constraint_residuals(sys, t, q, v, res%res_pos(j), res%res_vel(j))
             res%energy(j) = 0.0_dp
             if (sys%has_energy()) res%energy(j) = sys%energy(t, q, v)

@@ -20,6 +20,20 @@
 !! redundant (rank < n_hol + n_nh) the minimum-norm multipliers come from dgelsd. The
 !! reaction C^T lambda is unique either way.
 !!
+!! Structure that makes large systems cheap (declared by the system; every built-in with a
+!! diagonal mass sets it):
+!! - `constant_mass`: M does not depend on (t, q); `prepare_mass` (called by
+!!   constrained_solve on its copy of the system) keeps its Cholesky factor, and the KKT
+!!   solves and projections use it instead of factorising M at every evaluation;
+!! - `diagonal_mass`: M is diagonal, given by `mass_diagonal` (default: the diagonal of
+!!   `mass`); M^-1 is a division, no factorisation per evaluation;
+!! - `jac_width` > 0 (with a diagonal mass and holonomic constraints only): row i of G has
+!!   its nonzeros in the jac_width consecutive columns first(i) .. first(i) + jac_width - 1
+!!   given by `phi_jac_band`; then S = G M^-1 G^T is banded (bandwidth detected from
+!!   `first`) and factorised by LAPACK's banded Cholesky (conmech_constrained_band): a chain
+!!   of N links costs O(N) per evaluation and per projection. When the banded S is not
+!!   positive definite (redundant constraints) the dense rank-revealing path above runs.
+!!
 !! Users extend `constrained_system` and implement `mass` and `forces`, and, as needed,
 !! `phi` and `phi_jac` (holonomic), `nh_matrix` (non-holonomic). Defaults:
 !! - `phi_jac`: central differences, step eps^(1/3) max(|q_j|, 1);
@@ -39,7 +53,12 @@ module conmech_constrained_system
     private
 
     public :: constrained_system, constrained_accel, constraint_matrix
-    public :: project_position, project_velocity, constraint_residuals
+    public :: project_position, project_velocity, constraint_residuals, prepare_mass
+    public :: constraint_reaction
+    !> Building blocks of the submodules (public: gfortran drops private module procedures
+    !! that only a submodule calls): the symmetric positive semi-definite Schur solve and
+    !! the test for a kept constant-mass factor.
+    public :: schur_solve, has_mass_factor
     !> The finite-difference defaults, for extensions that choose at run time (e.g. the
     !! Python layer) whether an analytic Jacobian / acceleration term exists.
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
@@ -62,6 +81,10 @@ module conmech_constrained_system
         integer :: n_hol = 0         !! number of holonomic constraints phi(t, q) = 0
         integer :: n_nh = 0          !! number of non-holonomic constraints A q' + b = 0
         logical :: rheonomic = .false.  !! phi depends explicitly on t
+        logical :: diagonal_mass = .false.  !! M is diagonal (see mass_diagonal)
+        logical :: constant_mass = .false.  !! M is constant (see prepare_mass)
+        real(dp), allocatable :: mass_factor(:, :)  !! Cholesky factor kept by prepare_mass
+        integer :: jac_width = 0     !! > 0: row-window width of G (see phi_jac_band)
     contains
         procedure(cs_mass), deferred :: mass
         procedure(cs_forces), deferred :: forces
@@ -71,6 +94,8 @@ module conmech_constrained_system
         procedure :: phi_gamma => cs_fd_phi_gamma
         procedure :: nh_matrix => cs_no_nh
         procedure :: nh_gamma => cs_fd_nh_gamma
+        procedure :: mass_diagonal => cs_mass_diagonal
+        procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: energy => cs_no_energy
         procedure :: has_energy => cs_has_no_energy
     end type constrained_system
@@ -94,9 +119,143 @@ module conmech_constrained_system
         end subroutine cs_forces
     end interface
 
+    ! Reactions, residuals and projections (submodule conmech_constrained_projection).
+    interface
+        !> Reaction force r = C(t, q)^T lam (n): O(n) for a row-window G.
+        module subroutine constraint_reaction(sys, t, q, lam, r)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), lam(:)
+            real(dp), intent(out) :: r(:)
+        end subroutine constraint_reaction
+        !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
+        module subroutine constraint_residuals(sys, t, q, v, rpos, rvel)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:)
+            real(dp), intent(out) :: rpos, rvel
+        end subroutine constraint_residuals
+        !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
+        !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
+        !! complement frozen at q~. Converged when max|phi| <= tol, or when the Newton
+        !! correction is below the round-off of q (4 eps max|q|); at most max_iter
+        !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
+        !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
+        !! convergence from far away; used for the consistent initial values).
+        module subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg, newton)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(inout) :: q(:)
+            real(dp), intent(in) :: tol
+            integer, intent(in) :: max_iter
+            integer, intent(out) :: iters, info
+            character(len=:), allocatable, intent(out) :: msg
+            logical, intent(in), optional :: newton
+        end subroutine project_position
+        !> Mass-weighted projection of v onto C(t, q) v + c0 = 0 (linear, one solve):
+        !! v = v~ - M^{-1} C^T S^+ (C v~ + c0). CM_NO_CONVERGENCE if the projected residual
+        !! is not small (inconsistent velocity constraints).
+        module subroutine project_velocity(sys, t, q, v, info, msg)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:)
+            real(dp), intent(inout) :: v(:)
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(out) :: msg
+        end subroutine project_velocity
+    end interface
+
+    ! The banded paths (submodule conmech_constrained_system_band). Each sets ok = .false.
+    ! when it does not apply (mass not positive, windows not banded, S not positive
+    ! definite): the caller then runs the dense path.
+    interface
+        !> Diagonal mass, row-window G, holonomic constraints only.
+        pure module logical function band_ready(sys)
+            class(constrained_system), intent(in) :: sys
+        end function band_ready
+        !> constrained_accel by the banded Schur complement.
+        module subroutine band_accel(sys, t, q, v, a, lam, ok, alpha, beta)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:)
+            real(dp), intent(out) :: a(:), lam(:)
+            logical, intent(out) :: ok
+            real(dp), intent(in), optional :: alpha, beta
+        end subroutine band_accel
+        !> project_position by the banded Schur complement; ph = phi(t, q) on entry.
+        module subroutine band_project_position(sys, t, q, ph, tol, max_iter, full, iters, &
+                                                info, msg, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(inout) :: q(:)
+            real(dp), intent(in) :: ph(:)
+            real(dp), intent(in) :: tol
+            integer, intent(in) :: max_iter
+            logical, intent(in) :: full
+            integer, intent(out) :: iters, info
+            character(len=:), allocatable, intent(inout) :: msg
+            logical, intent(out) :: ok
+        end subroutine band_project_position
+        !> project_velocity by the banded Schur complement.
+        module subroutine band_project_velocity(sys, t, q, v, info, msg, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:)
+            real(dp), intent(inout) :: v(:)
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(inout) :: msg
+            logical, intent(out) :: ok
+        end subroutine band_project_velocity
+    end interface
+
 contains
 
     ! ------------------------------------------------------------------ defaults
+
+    !> The default d is the diagonal of `mass` (override it: O(n) instead of O(n^2)).
+    subroutine cs_mass_diagonal(self, t, q, d)
+        class(constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: d(:)
+        real(dp) :: mm(self%n, self%n)
+        integer :: i
+        call self%mass(t, q, mm)
+        do i = 1, self%n
+            d(i) = mm(i, i)
+        end do
+    end subroutine cs_mass_diagonal
+
+    !> Default row windows of G from the dense `phi_jac`: gb(i, :) = G(i, first(i) + 0:w-1)
+    !! (w = jac_width). A row whose nonzeros do not fit in w columns gives first = 0 (then
+    !! the dense path is used).
+    subroutine cs_phi_jac_band(self, t, q, gb, first)
+        class(constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: gb(:, :)
+        integer, intent(out) :: first(:)
+        real(dp) :: g(self%n_hol, self%n)
+        integer :: i, j0, j1, w
+        w = size(gb, 2)
+        call self%phi_jac(t, q, g)
+        do i = 1, self%n_hol
+            j0 = 1
+            do while (j0 < self%n .and. g(i, j0) == 0.0_dp)
+                j0 = j0 + 1
+            end do
+            j1 = self%n
+            do while (j1 > j0 .and. g(i, j1) == 0.0_dp)
+                j1 = j1 - 1
+            end do
+            if (j1 - j0 + 1 > w .or. w > self%n) then
+                first = 0
+                return
+            end if
+            first(i) = min(j0, self%n - w + 1)
+            gb(i, :) = g(i, first(i):first(i) + w - 1)
+        end do
+    end subroutine cs_phi_jac_band
 
     !> The default has no holonomic constraints.
     subroutine cs_no_phi(self, t, q, c)
@@ -290,6 +449,33 @@ contains
         if (lainfo /= 0) info = CM_LAPACK_ERROR
     end subroutine schur_solve
 
+    !> For a system with `constant_mass`: factorise M(t, q) once and keep the factor in
+    !! `mass_factor` (otherwise, or if M is not positive definite, drop it: the
+    !! per-evaluation path then runs and reports). Call it again after changing the
+    !! system's mass parameters.
+    subroutine prepare_mass(sys, t, q)
+        class(constrained_system), intent(inout) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), allocatable :: mm(:, :)
+        integer :: info
+        if (allocated(sys%mass_factor)) deallocate (sys%mass_factor)
+        if (.not. sys%constant_mass .or. sys%diagonal_mass .or. size(q) /= sys%n) return
+        allocate (mm(sys%n, sys%n))
+        call sys%mass(t, q, mm)
+        call mass_cholesky(mm, info)
+        if (info == CM_SUCCESS) call move_alloc(mm, sys%mass_factor)
+    end subroutine prepare_mass
+
+    !> A constant mass with its factor kept by prepare_mass.
+    pure logical function has_mass_factor(sys) result(yes)
+        class(constrained_system), intent(in) :: sys
+        yes = .false.
+        if (.not. sys%constant_mass) return
+        if (.not. allocated(sys%mass_factor)) return
+        yes = size(sys%mass_factor, 1) == sys%n .and. size(sys%mass_factor, 2) == sys%n
+    end function has_mass_factor
+
     !> Accelerations a and multipliers lam (n_hol + n_nh) at (t, q, v) from the
     !! acceleration-level KKT system. With `alpha`, `beta` (Baumgarte) the acceleration
     !! constraint becomes C a = gamma - 2 alpha (C v + c0) - beta^2 [phi; 0].
@@ -307,8 +493,9 @@ contains
         real(dp) :: mm(sys%n, sys%n), x(sys%n, 1 + sys%n_hol + sys%n_nh)
         real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh)
         real(dp) :: gam(sys%n_hol + sys%n_nh, 1), s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh)
-        real(dp) :: ph(sys%n_hol)
-        integer :: n, m, mh, lainfo, rk
+        real(dp) :: ph(sys%n_hol), dg(sys%n)
+        integer :: n, m, mh, lainfo, rk, j
+        logical :: ok, cached
         character(len=:), allocatable :: m2
         n = sys%n
         mh = sys%n_hol
@@ -319,22 +506,48 @@ contains
             if (present(msg)) msg = "bad input: q, v, a need n elements and lambda n_hol + n_nh"
             return
         end if
-        call sys%mass(t, q, mm)
-        if (present(msg)) then
-            ! (a local string: passing the optional deferred-length msg straight through
-            ! loses its length with gfortran)
-            call mass_cholesky(mm, info, m2)
-            msg = m2
-        else
-            call mass_cholesky(mm, info)
+        if (band_ready(sys)) then
+            call band_accel(sys, t, q, v, a, lam, ok, alpha, beta)
+            if (ok) then
+                if (present(rank)) rank = m
+                info = CM_SUCCESS
+                if (present(msg)) msg = "success"
+                return
+            end if
         end if
-        if (info /= CM_SUCCESS) return
+        ok = .false.
+        if (sys%diagonal_mass) then
+            call sys%mass_diagonal(t, q, dg)
+            ok = all(dg > 0.0_dp .and. dg < huge(1.0_dp))
+        end if
+        cached = .false.
+        if (.not. ok) cached = has_mass_factor(sys)
+        if (.not. (ok .or. cached)) then
+            call sys%mass(t, q, mm)
+            if (present(msg)) then
+                ! (a local string: passing the optional deferred-length msg straight
+                ! through loses its length with gfortran)
+                call mass_cholesky(mm, info, m2)
+                msg = m2
+            else
+                call mass_cholesky(mm, info)
+            end if
+            if (info /= CM_SUCCESS) return
+        end if
         call sys%forces(t, q, v, x(:, 1))
         if (m > 0) then
             call constraint_matrix(sys, t, q, c, c0)
             x(:, 2:m + 1) = transpose(c)
         end if
-        call dpotrs('U', n, m + 1, mm, n, x, n, lainfo)
+        if (ok) then
+            do j = 1, m + 1
+                x(:, j) = x(:, j)/dg
+            end do
+        else if (cached) then
+            call dpotrs('U', n, m + 1, sys%mass_factor, n, x, n, lainfo)
+        else
+            call dpotrs('U', n, m + 1, mm, n, x, n, lainfo)
+        end if
         a = x(:, 1)
         rk = 0
         if (m > 0) then
@@ -361,149 +574,5 @@ contains
         info = CM_SUCCESS
         if (present(msg)) msg = "success"
     end subroutine constrained_accel
-
-    !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
-    subroutine constraint_residuals(sys, t, q, v, rpos, rvel)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: rpos, rvel
-        real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh), ph(sys%n_hol)
-        rpos = 0.0_dp
-        rvel = 0.0_dp
-        if (sys%n_hol > 0) then
-            call sys%phi(t, q, ph)
-            rpos = maxval(abs(ph))
-        end if
-        if (sys%n_hol + sys%n_nh > 0) then
-            call constraint_matrix(sys, t, q, c, c0)
-            rvel = maxval(abs(matmul(c, v) + c0))
-        end if
-    end subroutine constraint_residuals
-
-    !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
-    !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
-    !! complement frozen at q~. Converged when max|phi| <= tol, or when the Newton
-    !! correction is below the round-off of q (4 eps max|q|: large coordinates, where
-    !! phi cannot reach an absolute tol); at most max_iter
-    !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
-    !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
-    !! convergence from far away; used for the consistent initial values).
-    subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg, newton)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(inout) :: q(:)
-        real(dp), intent(in) :: tol
-        integer, intent(in) :: max_iter
-        integer, intent(out) :: iters, info
-        character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: newton   !! refresh G at every iterate (far start)
-        real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
-        real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
-        real(dp) :: rnorm
-        integer :: n, mh, lainfo, rk
-        logical :: full
-        character(len=32) :: buf
-        n = sys%n
-        mh = sys%n_hol
-        iters = 0
-        info = CM_SUCCESS
-        msg = "success"
-        if (mh == 0) return
-        call sys%phi(t, q, ph(:, 1))
-        rnorm = maxval(abs(ph(:, 1)))
-        if (rnorm <= tol) return
-        call sys%mass(t, q, mm)
-        call mass_cholesky(mm, info, msg)
-        if (info /= CM_SUCCESS) return
-        call sys%phi_jac(t, q, g)
-        x = transpose(g)
-        call dpotrs('U', n, mh, mm, n, x, n, lainfo)
-        s = matmul(g, x)
-        full = .false.
-        if (present(newton)) full = newton
-        qk = q
-        do iters = 1, max_iter
-            if (full .and. iters > 1) then
-                call sys%phi_jac(t, qk, g)
-                x = transpose(g)
-                call dpotrs('U', n, mh, mm, n, x, n, lainfo)
-                s = matmul(g, x)
-            end if
-            call schur_solve(s, ph, rk, info)
-            if (info /= CM_SUCCESS) then
-                msg = "LAPACK failed in the position projection"
-                return
-            end if
-            dq = matmul(x, ph(:, 1))
-            if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*max(maxval(abs(qk)), tiny(1.0_dp))) &
-                then
-                ! the correction is below the round-off of q: phi is as small as it can get,
-                ! if it is at the round-off level of its terms (~ |G| |q|); otherwise the
-                ! Jacobian cannot reduce it (zero or rank-deficient G, incompatible
-                ! constraints): a failure, not a converged projection
-                if (rnorm > max(tol, 1.0e3_dp*epsilon(1.0_dp)*max(1.0_dp, &
-                                maxval(abs(g))*maxval(abs(qk))))) exit
-                q = qk
-                return
-            end if
-            qk = qk - dq
-            call sys%phi(t, qk, ph(:, 1))
-            rnorm = maxval(abs(ph(:, 1)))
-            if (.not. (rnorm < huge(1.0_dp))) exit
-            if (rnorm <= tol) then
-                q = qk
-                return
-            end if
-        end do
-        iters = min(iters, max_iter)
-        info = CM_NO_CONVERGENCE
-        write (buf, '(es10.3)') rnorm
-        msg = "position projection did not converge: |phi| ="//trim(buf)// &
-              " (inconsistent constraints, or too far from the manifold)"
-    end subroutine project_position
-
-    !> Mass-weighted projection of v onto C(t, q) v + c0 = 0 (linear, one solve):
-    !! v = v~ - M^{-1} C^T S^+ (C v~ + c0). CM_NO_CONVERGENCE if the projected residual is
-    !! not small (inconsistent velocity constraints).
-    subroutine project_velocity(sys, t, q, v, info, msg)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(inout) :: v(:)
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol + sys%n_nh)
-        real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh)
-        real(dp) :: s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh), r(sys%n_hol + sys%n_nh, 1)
-        real(dp) :: r0, vscale
-        integer :: n, m, lainfo, rk
-        n = sys%n
-        m = sys%n_hol + sys%n_nh
-        info = CM_SUCCESS
-        msg = "success"
-        if (m == 0) return
-        call sys%mass(t, q, mm)
-        call mass_cholesky(mm, info, msg)
-        if (info /= CM_SUCCESS) return
-        call constraint_matrix(sys, t, q, c, c0)
-        r(:, 1) = matmul(c, v) + c0
-        r0 = maxval(abs(r(:, 1)))
-        if (r0 == 0.0_dp) return
-        x = transpose(c)
-        call dpotrs('U', n, m, mm, n, x, n, lainfo)
-        s = matmul(c, x)
-        call schur_solve(s, r, rk, info)
-        if (info /= CM_SUCCESS) then
-            msg = "LAPACK failed in the velocity projection"
-            return
-        end if
-        v = v - matmul(x, r(:, 1))
-        vscale = max(maxval(abs(v)), 1.0_dp)*max(maxval(abs(c)), 1.0_dp)
-        if (maxval(abs(matmul(c, v) + c0)) > 1.0e-8_dp*vscale + 1.0e-10_dp*r0) then
-            info = CM_NO_CONVERGENCE
-            msg = "velocity projection failed: the velocity constraints are inconsistent"
-        end if
-    end subroutine project_velocity
 
 end module conmech_constrained_system

@@ -32,6 +32,11 @@ module conmech_ode_solver
     integer, parameter, public :: METHOD_DOPRI5 = 2  !! Dormand-Prince 5(4), dense order 4
     integer, parameter, public :: METHOD_DOP853 = 3  !! Dormand-Prince 8(5,3), dense order 7
     integer, parameter, public :: METHOD_VERNER98 = 4 !! Verner 9(8), dense order 8
+    ! implicit methods (conmech_radau, conmech_gauss; reached through implicit_solve)
+    integer, parameter, public :: METHOD_RADAU5 = 5  !! Radau IIA order 5, stiff, adaptive
+    integer, parameter, public :: METHOD_GAUSS4 = 6  !! Gauss-Legendre s = 2, fixed step
+    integer, parameter, public :: METHOD_GAUSS6 = 7  !! Gauss-Legendre s = 3, fixed step
+    integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (rattle_solve)
 
     integer, parameter :: FORM_HAIRER = 1   !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...)))
     integer, parameter :: FORM_POWER = 2    !! y0 + x F1 + x^2 F2 + ... + x^nf F_nf
@@ -66,6 +71,8 @@ module conmech_ode_solver
         integer :: naccept = 0    !! accepted steps
         integer :: nreject = 0    !! rejected steps
         real(dp) :: h_next = 0.0_dp   !! step size proposed for a continuation
+        integer :: njev = 0       !! Jacobian evaluations (implicit methods)
+        integer :: nlu = 0        !! LU decompositions (implicit methods)
     end type ode_stats
 
     !> Piecewise polynomial dense output, Hairer's form on each step [t0, t0 + h]:
@@ -100,10 +107,24 @@ module conmech_ode_solver
         type(dense_solution) :: sol                !! if options%dense_output
     end type ode_result
 
+    interface
+        !> The implicit methods (METHOD_RADAU5, METHOD_GAUSS4, METHOD_GAUSS6), implemented
+        !! in the submodule conmech_radau_dispatch; arguments as ode_solve.
+        module subroutine implicit_solve(sys, t_span, y0, options, res, t_eval, events)
+            class(ode_system), intent(in) :: sys
+            real(dp), intent(in) :: t_span(2)
+            real(dp), intent(in) :: y0(:)
+            type(ode_options), intent(in) :: options
+            type(ode_result), intent(out) :: res
+            real(dp), intent(in), optional :: t_eval(:)
+            class(ode_events), intent(in), optional :: events
+        end subroutine implicit_solve
+    end interface
+
 contains
 
-    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98";
-    !! 0 if unknown.
+    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98",
+    !! "RADAU5"/"Radau", "GAUSS4", "GAUSS6", "RATTLE"; 0 if unknown.
     pure function method_from_name(name) result(m)
         character(len=*), intent(in) :: name
         integer :: m
@@ -116,6 +137,14 @@ contains
             m = METHOD_DOP853
         case ("VERNER98", "verner98", "RKV98", "rkv98", "Vern9")
             m = METHOD_VERNER98
+        case ("RADAU5", "radau5", "Radau", "RADAU", "radau")
+            m = METHOD_RADAU5
+        case ("GAUSS4", "gauss4")
+            m = METHOD_GAUSS4
+        case ("GAUSS6", "gauss6")
+            m = METHOD_GAUSS6
+        case ("RATTLE", "rattle")
+            m = METHOD_RATTLE
         case default
             m = 0
         end select
@@ -141,6 +170,14 @@ contains
         integer :: i
         character(len=:), allocatable :: msg
 
+        if (options%method >= METHOD_RADAU5) then
+            if (present(hook)) then
+                call fail(res, CM_BAD_INPUT, "bad input: step hooks need an explicit method")
+            else
+                call implicit_solve(sys, t_span, y0, options, res, t_eval, events)
+            end if
+            return
+        end if
         allocate (y(size(y0)))
         y = y0
         allocate (res%t(0), res%y(size(y0), 0), res%ev_t(0), res%ev_y(size(y0), 0), &

@@ -4,6 +4,7 @@
 !!   pendulum_xy: m, g, l | rod_two_masses: g, l | double_pendulum_xy: m1, m2, l1, l2, g |
 !!   atwood_xy: m1, m2, g, L | pendulum_moving_xy: m, g, l, a, b, w |
 !!   yoyo: m, r, I, g, ah, vh, h0 | skate: m, I, g, alpha | rolling_disk: m, R, I_roll, I_turn
+!!   | pendulum_chain_xy: N (links, default 8), m, l, g
 !! Generalized coordinates (`make_generalized`):
 !!   pendulum_angle: m, g, l | cart_pendulum: M, m, l, g | double_pendulum: m1, m2, l1, l2, g |
 !!   atwood: m1, m2, g | spring_pendulum: m, k, l0, g |
@@ -18,6 +19,7 @@ module conmech_systems_mech
     use conmech_constrained_system, only: constrained_system
     use conmech_systems_generalized
     use conmech_systems_constrained
+    use conmech_systems_chain, only: pendulum_chain_xy, chain_initial_state
     use conmech_ode_system, only: ode_system
     implicit none
     private
@@ -27,7 +29,8 @@ module conmech_systems_mech
 
     !> Names of the built-in constrained systems (space separated).
     character(len=*), parameter :: constrained_names = "pendulum_xy rod_two_masses " &
-        //"double_pendulum_xy atwood_xy pendulum_moving_xy yoyo skate rolling_disk"
+        //"double_pendulum_xy atwood_xy pendulum_moving_xy yoyo skate rolling_disk " &
+        //"pendulum_chain_xy"
     !> Names of the built-in generalized-coordinate systems.
     character(len=*), parameter :: generalized_names = "pendulum_angle cart_pendulum " &
         //"double_pendulum atwood spring_pendulum double_spring_pendulum three_springs " &
@@ -59,6 +62,7 @@ contains
                 type(pendulum_xy) :: s
                 s%m = par(params, 1, s%m); s%g = par(params, 2, s%g); s%l = par(params, 3, s%l)
                 s%n = 2; s%n_hol = 1
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("rod_two_masses")
@@ -66,6 +70,7 @@ contains
                 type(rod_two_masses) :: s
                 s%g = par(params, 1, s%g); s%l = par(params, 2, s%l)
                 s%n = 4; s%n_hol = 1; s%n_nh = 1
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("double_pendulum_xy")
@@ -75,6 +80,7 @@ contains
                 s%l1 = par(params, 3, s%l1); s%l2 = par(params, 4, s%l2)
                 s%g = par(params, 5, s%g)
                 s%n = 4; s%n_hol = 2
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("atwood_xy")
@@ -83,6 +89,7 @@ contains
                 s%m1 = par(params, 1, s%m1); s%m2 = par(params, 2, s%m2)
                 s%g = par(params, 3, s%g); s%len = par(params, 4, s%len)
                 s%n = 2; s%n_hol = 1
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("pendulum_moving_xy")
@@ -91,6 +98,7 @@ contains
                 s%m = par(params, 1, s%m); s%g = par(params, 2, s%g); s%l = par(params, 3, s%l)
                 s%a = par(params, 4, s%a); s%b = par(params, 5, s%b); s%w = par(params, 6, s%w)
                 s%n = 2; s%n_hol = 1; s%rheonomic = .true.
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("yoyo")
@@ -100,6 +108,7 @@ contains
                 s%g = par(params, 4, s%g); s%ah = par(params, 5, s%ah)
                 s%vh = par(params, 6, s%vh); s%h0 = par(params, 7, s%h0)
                 s%n = 2; s%n_hol = 1; s%rheonomic = .true.
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("skate")
@@ -108,6 +117,7 @@ contains
                 s%m = par(params, 1, s%m); s%i = par(params, 2, s%i); s%g = par(params, 3, s%g)
                 s%alpha = par(params, 4, s%alpha)
                 s%n = 3; s%n_nh = 1
+                s%diagonal_mass = .true.
                 allocate (sys, source=s)
             end block
         case ("rolling_disk")
@@ -116,6 +126,24 @@ contains
                 s%m = par(params, 1, s%m); s%r = par(params, 2, s%r)
                 s%i_roll = par(params, 3, s%i_roll); s%i_turn = par(params, 4, s%i_turn)
                 s%n = 4; s%n_nh = 2
+                s%diagonal_mass = .true.
+                allocate (sys, source=s)
+            end block
+        case ("pendulum_chain_xy")
+            block
+                type(pendulum_chain_xy) :: s
+                real(dp) :: nl
+                nl = par(params, 1, 8.0_dp)
+                if (.not. (nl >= 1.0_dp .and. nl <= 1.0e5_dp .and. nl == aint(nl))) then
+                    info = CM_BAD_INPUT
+                    msg = "bad input: pendulum_chain_xy needs a whole number of links N " &
+                          //"(1 <= N <= 100000) as its first parameter"
+                    return
+                end if
+                s%m = par(params, 2, s%m); s%l = par(params, 3, s%l); s%g = par(params, 4, s%g)
+                s%n = 2*nint(nl); s%n_hol = nint(nl)
+                s%diagonal_mass = .true.
+                s%jac_width = min(4, s%n)
                 allocate (sys, source=s)
             end block
         case default
@@ -281,6 +309,15 @@ contains
             q0 = [par(params, 7, 0.0_dp), 0.0_dp]; v0 = [par(params, 6, 0.0_dp), 0.0_dp]
         case ("skate")
             q0 = [0.0_dp, 0.0_dp, 0.0_dp]; v0 = [0.0_dp, 0.0_dp, 2.0_dp]
+        case ("pendulum_chain_xy")
+            l = par(params, 3, 1.0_dp)
+            th = par(params, 1, 8.0_dp)
+            if (.not. (th >= 1.0_dp .and. th <= 1.0e5_dp .and. th == aint(th))) then
+                info = CM_BAD_INPUT
+                allocate (q0(0), v0(0))
+                return
+            end if
+            call chain_initial_state(nint(th), l, q0, v0)
         case ("rolling_disk")
             q0 = [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
             v0 = [par(params, 2, 1.0_dp)*2.0_dp, 0.0_dp, 0.5_dp, 2.0_dp]

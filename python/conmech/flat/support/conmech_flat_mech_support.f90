@@ -20,6 +20,9 @@ module conmech_flat_mech_support
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system
     use conmech_constrained_solver
+    use conmech_ode_solver, only: METHOD_RATTLE, METHOD_RADAU5
+    use conmech_rattle, only: rattle_solve
+    use conmech_rattle_dae, only: radau_constrained_solve
     use conmech_flat_ode_support, only: copy_message
     implicit none
     private
@@ -179,7 +182,19 @@ contains
         opt%alpha = ropt(3)
         opt%beta = ropt(4)
         opt%proj_tol = ropt(5)
-        if (neval > 0) then
+        if (method == METHOD_RADAU5) then
+            if (neval > 0) then
+                call radau_constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
+            else
+                call radau_constrained_solve(sys, t_span, q0, v0, opt, r)
+            end if
+        else if (method == METHOD_RATTLE) then
+            if (neval > 0) then
+                call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
+            else
+                call rattle_solve(sys, t_span, q0, v0, opt, r)
+            end if
+        else if (neval > 0) then
             call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
         else
             call constrained_solve(sys, t_span, q0, v0, opt, r)

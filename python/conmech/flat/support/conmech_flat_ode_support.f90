@@ -27,7 +27,7 @@ module conmech_flat_ode_support
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
     !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
-    integer(c_int), parameter, public :: METHOD_RK45_SCIPY = 5
+    integer(c_int), parameter, public :: METHOD_RK45_SCIPY = 12
 
     !> A system whose right-hand side is an external procedure fun(t, y, dydt, n).
     type, extends(ode_system) :: callback_system

@@ -1,0 +1,121 @@
+"""Radau IIA: conmech.solve_ivp(method="Radau") against SciPy's Radau at the same
+tolerances (same Python right-hand side and Jacobian), and a stiff spring chain against
+DOP853.
+
+    python bench/bench_radau.py [--repeat K] [--tight]
+
+Reported: error against a reference (Van der Pol: SciPy's Radau at rtol = atol = 1e-12;
+Robertson: the published values of the Hairer-Wanner / Bari test set at t = 1e11),
+accepted steps, Jacobian evaluations, LU decompositions, best-of-K wall time and the time
+ratio SciPy / conmech. Prints a Markdown table (bench/results/radau.md keeps a run).
+"""
+import argparse
+import time
+
+import numpy as np
+import scipy.integrate as si
+
+import conmech
+
+EPS = 1e-6
+VDP_REF = np.array([1.706167437543211, -0.8928100165510839])   # SciPy Radau, tol 1e-12
+ROBER_REF = np.array([0.2083340149701255e-07, 0.8333360770334713e-13, 0.9999999791665050])
+
+
+def vdp(t, y):
+    return [y[1], ((1 - y[0] ** 2) * y[1] - y[0]) / EPS]
+
+
+def vdp_jac(t, y):
+    return [[0.0, 1.0], [(-2 * y[0] * y[1] - 1) / EPS, (1 - y[0] ** 2) / EPS]]
+
+
+def rober(t, y):
+    return [-0.04 * y[0] + 1e4 * y[1] * y[2],
+            0.04 * y[0] - 1e4 * y[1] * y[2] - 3e7 * y[1] ** 2, 3e7 * y[1] ** 2]
+
+
+def rober_jac(t, y):
+    return [[-0.04, 1e4 * y[2], 1e4 * y[1]],
+            [0.04, -1e4 * y[2] - 6e7 * y[1], -1e4 * y[1]], [0.0, 6e7 * y[1], 0.0]]
+
+
+def chain(n=10, k_soft=1.0, k_stiff=1e8, c_stiff=1e4):
+    """n unit masses in a row, fixed wall on the left; springs alternately soft and stiff
+    (the stiff ones damped): y = [x, v], y' = A y."""
+    k = np.array([k_soft if i % 2 == 0 else k_stiff for i in range(n)])
+    c = np.array([0.0 if i % 2 == 0 else c_stiff for i in range(n)])
+    K = np.zeros((n, n))
+    C = np.zeros((n, n))
+    for i in range(n):           # spring i joins mass i-1 (or the wall) and mass i
+        for M, s in ((K, k[i]), (C, c[i])):
+            M[i, i] += s
+            if i > 0:
+                M[i - 1, i - 1] += s
+                M[i, i - 1] -= s
+                M[i - 1, i] -= s
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]])
+    return A
+
+
+def timed(fn, k):
+    best, r = np.inf, None
+    for _ in range(k):
+        t0 = time.perf_counter()
+        r = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, r
+
+
+def compare(name, fun, jac, span, y0, rtol, atol, ref, k):
+    tc, rc = timed(lambda: conmech.solve_ivp(fun, span, y0, method="Radau", rtol=rtol,
+                                             atol=atol, jac=jac), k)
+    ts, rs = timed(lambda: si.solve_ivp(fun, span, y0, method="Radau", rtol=rtol, atol=atol,
+                                        jac=jac), k)
+    assert rc.success and rs.success
+    ec = np.abs(rc.y[:, -1] - ref).max()
+    es = np.abs(rs.y[:, -1] - ref).max()
+    print(f"| {name} | {rtol:.0e} | {ec:.2e} / {es:.2e} | {rc.naccept} / {rs.t.size - 1} | "
+          f"{rc.njev} / {rs.njev} | {rc.nlu} / {rs.nlu} | {rc.nfev} / {rs.nfev} | "
+          f"{tc * 1e3:.1f} / {ts * 1e3:.0f} | {ts / tc:.1f}x |")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--tight", action="store_true", help="also rtol 1e-8 (slow in SciPy)")
+    a = ap.parse_args()
+    print("| problem | rtol | error conmech / SciPy | steps | njev | nlu | nfev | "
+          "time ms conmech / SciPy | speed-up |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for tol in ((1e-4, 1e-6, 1e-8) if a.tight else (1e-4, 1e-6)):
+        compare("Van der Pol eps 1e-6, t in [0, 2]", vdp, vdp_jac, (0, 2), [2.0, -0.66],
+                tol, tol, VDP_REF, a.repeat)
+    for tol in (1e-6, 1e-8):
+        compare("Robertson to t = 1e11 (atol 1e-4 rtol)", rober, rober_jac, (0, 1e11),
+                [1.0, 0.0, 0.0], tol, 1e-4 * tol, ROBER_REF, a.repeat)
+
+    A = chain()
+    n2 = A.shape[0]
+    y0 = np.zeros(n2)
+    y0[0] = 1.0
+    f = lambda t, y: A @ y
+    tc, rr = timed(lambda: conmech.solve_ivp(f, (0, 20), y0, method="Radau", rtol=1e-5,
+                                             atol=1e-8, jac=A), 1)
+    td, rd = timed(lambda: conmech.solve_ivp(f, (0, 20), y0, method="DOP853", rtol=1e-5,
+                                             atol=1e-8), 1)
+    from scipy.linalg import expm
+    ex = expm(A * 20) @ y0
+    print()
+    print("| stiff chain (10 masses, k = 1 / 1e8, c = 1e4), t in [0, 20], rtol 1e-5 | "
+          "steps | nfev | error | time s |")
+    print("|---|---|---|---|---|")
+    print(f"| Radau | {rr.naccept} | {rr.nfev} | {np.abs(rr.y[:, -1] - ex).max():.1e} | "
+          f"{tc:.2f} |")
+    print(f"| DOP853 | {rd.naccept} | {rd.nfev} | {np.abs(rd.y[:, -1] - ex).max():.1e} | "
+          f"{td:.2f} |")
+    print(f"\nDOP853 / Radau steps: {rd.naccept / rr.naccept:.0f}x")
+
+
+if __name__ == "__main__":
+    main()

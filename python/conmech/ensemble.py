@@ -1,0 +1,425 @@
+"""Ensembles: many initial states and/or parameter sets of one system, integrated in
+parallel in Fortran (OpenMP threads, no Python in the loop). The system is a built-in one
+(``conmech.systems``) or a compiled one (``conmech.compiled.ode_system`` /
+``generalized_system``, e.g. from ``conmech.symbolic``): they take the same path.
+
+Each member is the single integration :func:`conmech.solve_ivp` would do with the same
+system, initial state, parameters and options, bit for bit, whatever the number of threads.
+
+Example: 10,000 Kepler orbits, their states at common times and the first two upward
+crossings of y = 0 of each::
+
+    import numpy as np
+    import conmech
+    from conmech import ensemble
+
+    e = np.linspace(0.0, 0.9, 10_000)
+    y0 = np.column_stack([1 - e, 0 * e, 0 * e, np.sqrt((1 + e) / (1 - e))])
+    res = ensemble.solve(conmech.systems.kepler(), (0, 20), y0, t_eval=np.linspace(0, 20, 5),
+                         method="DOP853", rtol=1e-10, atol=1e-10,
+                         events=ensemble.crossing(1, 0.0, direction=1), max_events=2)
+    res.y          # (10000, 4, 5): member i's solve_ivp(...).y
+    res.t_events   # (10000, 2): the first two crossings (NaN where fewer)
+
+Parameters vary per member through ``params``: an array of shape (m, n_params) in the
+factory's order, or a dict of per-member values by parameter name (the others keep the
+system's values)::
+
+    res = ensemble.solve(conmech.systems.pendulum(), (0, 10), [1.0, 0.0],
+                         params={"l": np.linspace(0.5, 2.0, 100)})
+"""
+import inspect
+import math
+import numbers
+
+import numpy as np
+
+from . import _conmech
+from ._ivp import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
+from ._ivp import solve_ivp as _solve_ivp
+from .systems import BuiltinSystem
+
+__all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
+
+_CM_BAD_INPUT = -4
+_NOT_RUN = -99
+_PAD = np.zeros(1)
+_PADI = np.zeros(1, dtype=np.intc)
+# the defaults of solve_ivp (method, rtol, atol), so that a member equals solve_ivp's run
+_IVP_DEFAULTS = {k: v.default for k, v in inspect.signature(_solve_ivp).parameters.items()
+                 if k in ("method", "rtol", "atol")}
+
+
+class Crossing:
+    """Event kind of an ensemble: the component ``component`` (0-based) of the state
+    crossing ``value``; ``direction`` > 0 rising only, < 0 falling only, 0 both (SciPy's
+    convention). Located on the dense output as :func:`conmech.solve_ivp` locates
+    ``lambda t, y: y[component] - value``, bit for bit."""
+
+    __slots__ = ("component", "value", "direction")
+
+    def __init__(self, component, value=0.0, direction=0):
+        if isinstance(component, (bool, np.bool_)) or \
+                not isinstance(component, numbers.Integral):
+            raise TypeError("crossing: component must be an integer index into the state")
+        self.component = int(component)
+        self.value = _real_scalar(value, "crossing: value")
+        if not math.isfinite(self.value):
+            raise ValueError("crossing: value must be finite")
+        d = _real_scalar(direction, "crossing: direction")
+        if math.isnan(d):
+            raise ValueError("crossing: direction must be a number")
+        self.direction = int(np.sign(d))
+
+    def __call__(self, t, y):
+        """The event function itself, g = y[component] - value (for solve_ivp)."""
+        return y[self.component] - self.value
+
+    def __repr__(self):
+        return (f"conmech.ensemble.crossing({self.component}, {self.value!r}, "
+                f"direction={self.direction})")
+
+
+def crossing(component, value=0.0, direction=0):
+    """A :class:`Crossing` event: state component ``component`` crosses ``value``."""
+    return Crossing(component, value, direction)
+
+
+class EnsembleResult(OdeResult):
+    """Result of :func:`solve`, a dict whose keys are also attributes.
+
+    Keys (m members, state dimension n, nt output times, k events kept):
+
+    - ``t``: the output times (t_eval) or None; ``y``: (m, n, nt) states there, NaN
+      where a member did not get (failure, terminal event, cancel), or None;
+    - ``t_final`` (m,), ``y_final`` (m, n): where each member ended and its state;
+    - ``status`` (m,): 0 reached the end, 1 stopped at its terminal event, -1 failed,
+      -2 not run (cancelled); ``member_success`` (m,): status >= 0; ``codes`` (m,):
+      conmech's status codes;
+    - ``nfev``, ``naccept``, ``nreject`` (m,): counters of each member;
+    - ``t_events`` (m, k), ``y_events`` (m, k, n), ``event_index`` (m, k) (which event of
+      the list, -1 if none), ``n_events`` (m,): the first k events of each member, in
+      time order (NaN-padded); None without events;
+    - ``success``: every member ended normally; ``message``: the first failure;
+      ``done``: members integrated.
+    """
+
+    def __repr__(self):
+        keys = ("message", "success", "done", "status", "t", "y", "t_final", "y_final",
+                "nfev", "t_events", "y_events", "n_events")
+        lines = []
+        for k in keys:
+            v = self.get(k)
+            if isinstance(v, np.ndarray) and v.size > 6:
+                v = f"array of shape {v.shape}"
+            lines.append(f"{k.rjust(9)}: {v}" if isinstance(v, str) else
+                         f"{k.rjust(9)}: {v!r}")
+        return "\n".join(lines)
+
+
+def _check_system(system):
+    if isinstance(system, BuiltinSystem):
+        return system
+    if type(system).__name__ in ("BuiltinConstrained", "CompiledConstrained"):
+        raise TypeError("ensemble.solve integrates first-order systems (conmech.systems "
+                        "...); constrained systems are not supported in ensembles")
+    if callable(system):
+        raise TypeError("ensemble.solve integrates compiled systems (conmech.systems ...) in "
+                        "parallel threads; a Python function cannot run there: use "
+                        "conmech.solve_ivp in a loop for it")
+    raise TypeError("system must be a built-in system from conmech.systems, got "
+                    f"{type(system).__name__}")
+
+
+def _member_params(system, params):
+    """Parameter table (np, mp) in Fortran order, and mp."""
+    base = system.params
+    npar = base.size
+    if params is None:
+        # f2py cannot pass empty arrays: a system without parameters gets one dummy row
+        return (base.reshape(npar, 1) if npar else np.zeros((1, 1))), 1
+    if isinstance(params, dict):
+        names = system.param_names
+        if not names:
+            raise ValueError(f"params: the system '{system.name}' has no parameter names; "
+                             "pass an array of shape (m, n_params)")
+        cols = {}
+        m = None
+        for key, val in params.items():
+            if key not in names:
+                raise ValueError(f"params: unknown parameter {key!r} of the system "
+                                 f"'{system.name}' (its parameters: {', '.join(names)})")
+            try:
+                arr = np.array(val, dtype=float)
+            except (TypeError, ValueError):
+                raise TypeError(f"params[{key!r}] must be an array of real numbers") from None
+            if arr.ndim > 1:
+                raise ValueError(f"params[{key!r}] must be a scalar or 1-dimensional")
+            if arr.ndim == 1:
+                if m is not None and arr.size != m:
+                    raise ValueError("params: the per-member arrays must have the same "
+                                     f"length, got {m} and {arr.size}")
+                m = arr.size
+            cols[names.index(key)] = arr
+        m = 1 if m is None else m
+        table = np.repeat(base.reshape(1, npar), m, axis=0)
+        for j, arr in cols.items():
+            table[:, j] = arr
+    else:
+        try:
+            table = np.array(params, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError("params must be an array of real numbers or a dict") from None
+        if table.ndim == 1:
+            table = table.reshape(1, -1)
+        if table.ndim != 2 or table.shape[1] != npar:
+            raise ValueError(f"params must have shape (m, {npar}) for the system "
+                             f"'{system.name}' ({', '.join(system.param_names)}), got "
+                             f"shape {np.shape(params)}")
+    if table.shape[0] == 0:
+        raise ValueError("params has no rows (no members)")
+    if not np.isfinite(table).all():
+        raise ValueError("params must be finite")
+    if npar == 0:
+        return np.zeros((1, table.shape[0]), order="F"), table.shape[0]
+    return np.asfortranarray(table.T), table.shape[0]
+
+
+def solve(system, t_span, y0, params=None, *, t_eval=None, method=None, rtol=None,
+          atol=None, first_step=None, max_step=np.inf, max_steps=100000, events=None,
+          max_events=1, terminal=False, threads=None, chunk=None, progress=None):
+    """Integrate an ensemble of members of one compiled system in parallel.
+
+    Parameters
+    ----------
+    system : conmech.systems.BuiltinSystem or a compiled system
+        The system (its parameters are the default of every member): built-in
+        (``conmech.systems``) or compiled (``conmech.compiled.ode_system``,
+        ``generalized_system``); constrained systems are not supported.
+    t_span : 2-sequence of float
+        (t0, tf), common to every member; tf < t0 integrates backwards.
+    y0 : array_like, shape (m, n) or (n,)
+        Initial states, one row per member, or one state shared by every member.
+    params : array_like of shape (m, n_params) or (n_params,), or dict, optional
+        Parameters per member in the factory's order, or ``{name: values}`` (values of
+        length m, or scalars) overriding the system's parameters.
+    t_eval : array_like, optional
+        Common output times (sorted in the direction of integration, inside t_span).
+    method, rtol, atol, first_step, max_step, max_steps
+        As in :func:`conmech.solve_ivp`, shared by every member; None (method, rtol,
+        atol): solve_ivp's defaults.
+    events : Crossing or list of Crossing, optional
+        Built-in event kinds (:func:`crossing`); Python callables cannot run in threads.
+    max_events : int
+        Events kept per member (the first ones, in time order).
+    terminal : bool
+        Stop each member at its ``max_events``-th event (then its final state).
+    threads : int, optional
+        OpenMP threads (default: OMP_NUM_THREADS or every core). The results do not
+        depend on it.
+    chunk : int, optional
+        Members between two calls of ``progress`` (default: about 1 % of them).
+    progress : callable, optional
+        ``progress(done, total)``, called between chunks from the calling thread. An
+        exception raised in it cancels the members not yet started and is raised again
+        after the call.
+
+    Returns
+    -------
+    EnsembleResult
+
+    Raises
+    ------
+    TypeError, ValueError
+        On bad input, naming the argument.
+    """
+    system = _check_system(system)
+    n = system.dimension
+    method = _IVP_DEFAULTS["method"] if method is None else method
+    rtol = _IVP_DEFAULTS["rtol"] if rtol is None else rtol
+    atol = _IVP_DEFAULTS["atol"] if atol is None else atol
+    if not isinstance(method, str):
+        raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
+    code = _METHOD_CODES.get(method.upper(), 0)
+    if code == 0:
+        raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+
+    # ---------------------------------------------------------------- t_span, y0, params
+    try:
+        if len(t_span) != 2:
+            raise ValueError("t_span must have two elements (t0, tf)")
+    except TypeError:
+        raise TypeError("t_span must be a sequence (t0, tf)") from None
+    t0 = _real_scalar(t_span[0], "t_span[0]")
+    tf = _real_scalar(t_span[1], "t_span[1]")
+    if not (math.isfinite(t0) and math.isfinite(tf)):
+        raise ValueError("t_span must be finite")
+    y0_in = np.asarray(y0)
+    if y0_in.dtype.kind == "c":
+        raise TypeError("y0 must be real: complex states are not supported")
+    try:
+        y0a = np.array(y0_in, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("y0 must be an array of real numbers") from None
+    if y0a.ndim == 1:
+        y0a = y0a.reshape(1, -1)
+    if y0a.ndim != 2 or y0a.shape[1] != n:
+        raise ValueError(f"y0 must have shape (m, {n}) or ({n},) for the system "
+                         f"'{system.name}', got shape {np.shape(y0)}")
+    if y0a.shape[0] == 0:
+        raise ValueError("y0 has no rows (no members)")
+    if not np.isfinite(y0a).all():
+        raise ValueError("y0 contains NaN or Inf")
+    ptab, mp = _member_params(system, params)
+    my0 = y0a.shape[0]
+    if mp > 1 and my0 > 1 and mp != my0:
+        raise ValueError(f"y0 has {my0} rows and params {mp}: they must agree (or one of "
+                         "them be shared)")
+    m = max(mp, my0)
+
+    # ---------------------------------------------------------------- options
+    rtol_v = _tolerance(rtol, "rtol", n)
+    atol_v = _tolerance(atol, "atol", n)
+    if first_step is None:
+        h0 = 0.0
+    else:
+        h0 = _real_scalar(first_step, "first_step")
+        if not (h0 > 0 and math.isfinite(h0)):
+            raise ValueError("first_step must be positive")
+        if h0 > abs(tf - t0) and tf != t0:
+            raise ValueError("first_step exceeds the length of t_span")
+    if code == 1 and first_step is None:
+        raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
+                         "step size")
+    hmax = _real_scalar(max_step, "max_step")
+    if not hmax > 0:
+        raise ValueError("max_step must be positive")
+    hmax = min(hmax, _HUGE)
+    for value, name in ((max_steps, "max_steps"), (max_events, "max_events")):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name} must be an integer")
+        if not 1 <= value <= 2**31 - 1:
+            raise ValueError(f"{name} must be positive (and below 2**31)")
+    if threads is None:
+        nthreads = 0
+    else:
+        if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, numbers.Integral):
+            raise TypeError("threads must be an integer or None")
+        if not 1 <= threads <= 1024:
+            raise ValueError("threads must be between 1 and 1024")
+        nthreads = int(threads)
+    if chunk is None:
+        nchunk = 0
+    else:
+        if isinstance(chunk, (bool, np.bool_)) or not isinstance(chunk, numbers.Integral):
+            raise TypeError("chunk must be an integer or None")
+        if not 1 <= chunk <= 2**31 - 1:
+            raise ValueError("chunk must be positive")
+        nchunk = int(chunk)
+    if progress is not None and not callable(progress):
+        raise TypeError("progress must be callable or None")
+    if not isinstance(terminal, (bool, np.bool_)):
+        raise TypeError("terminal must be a bool")
+
+    # ---------------------------------------------------------------- t_eval, events
+    if t_eval is None:
+        t_ev = _PAD[:0]
+    else:
+        try:
+            t_ev = np.array(t_eval, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError("t_eval must be an array of real numbers") from None
+        if t_ev.ndim != 1:
+            raise ValueError("t_eval must be 1-dimensional")
+        if not np.all(np.isfinite(t_ev)):
+            raise ValueError("t_eval contains NaN or Inf")
+        lo, hi = min(t0, tf), max(t0, tf)
+        if np.any(t_ev < lo) or np.any(t_ev > hi):
+            raise ValueError("values in t_eval are not within t_span")
+        d = np.diff(t_ev)
+        if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
+            raise ValueError("values in t_eval are not properly sorted (strictly "
+                             "monotonic in the direction of integration)")
+    if events is None:
+        evs = []
+    elif isinstance(events, Crossing) or callable(events):
+        evs = [events]
+    else:
+        try:
+            evs = list(events)
+        except TypeError:
+            raise TypeError("events must be a Crossing (conmech.ensemble.crossing) or a "
+                            "list of them") from None
+    for i, e in enumerate(evs):
+        if not isinstance(e, Crossing):
+            what = "a Python function" if callable(e) else type(e).__name__
+            raise TypeError(f"events[{i}] is {what}: an ensemble takes built-in event kinds "
+                            "(conmech.ensemble.crossing), which run in the threads")
+        if not -n <= e.component < n:
+            raise ValueError(f"events[{i}]: component {e.component} is out of range for a "
+                             f"state of size {n}")
+    if terminal and not evs:
+        raise ValueError("terminal=True needs events")
+    ne = len(evs)
+    k = int(max_events) if ne else 0
+
+    # ---------------------------------------------------------------- run
+    failure = []
+
+    def relay(done, total):
+        if failure:
+            return 1
+        try:
+            progress(int(done), int(total))
+        except BaseException as exc:
+            failure.append(exc)
+            return 1
+        return 0
+
+    def no_progress(done, total):
+        return 0
+
+    nt = t_ev.size
+    name, _, _, nspec, spec = system._flat_args()
+    (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,
+     info, message) = _conmech.flat_ensemble_builtin(
+        name=name, np=system.params.size, mp=mp, params=ptab, nspec=nspec, spec=spec, n=n,
+        m=m, my0=my0,
+        y0=np.asfortranarray(y0a.T), t_span=np.array([t0, tf]), method=code, rtol=rtol_v,
+        atol=atol_v, first_step=h0, max_step=hmax, max_steps=int(max_steps), neval=nt,
+        t_eval=t_ev if nt else _PAD, ne=ne,
+        ev_comp=np.array([e.component % n + 1 for e in evs], dtype=np.intc) if ne else _PADI,
+        ev_value=np.array([e.value for e in evs]) if ne else _PAD,
+        ev_dir=np.array([e.direction for e in evs], dtype=np.intc) if ne else _PADI,
+        k=k, terminal=int(bool(terminal)), threads=nthreads, chunk=nchunk,
+        use_progress=int(progress is not None),
+        progress=relay if progress is not None else no_progress,
+        meval=m if nt else 1, mev=m if k else 1)
+    if failure:
+        raise failure[0]
+    message = bytes(message).decode("ascii", "replace").strip() \
+        if not isinstance(message, str) else message.strip()
+    info = int(info)
+    codes = np.asarray(codes, dtype=int)
+    if info == _CM_BAD_INPUT and (codes == _CM_BAD_INPUT).all():
+        raise ValueError(message)
+    status = np.where(codes >= 0, codes, -1)
+    status[codes == _NOT_RUN] = -2
+    if info >= 0:
+        message = "Every member reached the end of the integration interval." \
+            if (codes == 0).all() else "Every member ended normally (some on their " \
+            "terminal event)."
+    res = EnsembleResult(
+        t=t_ev.copy() if nt else None,
+        y=np.ascontiguousarray(y_eval.transpose(2, 0, 1)) if nt else None,
+        t_final=t_final, y_final=np.ascontiguousarray(y_final.T), status=status,
+        member_success=status >= 0, codes=codes, nfev=nfev.astype(int),
+        naccept=naccept.astype(int), nreject=nreject.astype(int), t_events=None,
+        y_events=None, event_index=None, n_events=None, success=info >= 0, message=message,
+        done=int(done))
+    if k:
+        res.t_events = np.ascontiguousarray(ev_t.T)
+        res.y_events = np.ascontiguousarray(ev_y.transpose(2, 1, 0))
+        res.event_index = np.ascontiguousarray(ev_id.T).astype(int) - 1
+        res.n_events = nev.astype(int)
+    return res

@@ -1,0 +1,151 @@
+!> Banded linear algebra of constrained systems whose constraint Jacobian has a band
+!! (row-window) structure and whose mass matrix is diagonal.
+!!
+!! Row i of G (m x n) has its nonzeros among the w consecutive columns
+!! first(i) .. first(i) + w - 1, stored as gb(i, 1:w) ("row windows"; `first`
+!! nondecreasing). Then the Schur complement S = G D^-1 G^T (D = diag(d)) is banded with
+!! kd = max{k - i : the windows of rows i < k overlap} superdiagonals, and the
+!! acceleration-level KKT system costs O(m (w + kd)^2) instead of O(m^2 n): LAPACK's
+!! banded Cholesky (dpbtrf/dpbtrs) in upper band storage ab(kd + 1, m),
+!! ab(kd + 1 + i - j, j) = S(i, j) for j - kd <= i <= j. A chain of N links has w = 4,
+!! kd = 1 (S tridiagonal): O(N) per evaluation.
+!!
+!! Pure routines on arrays (no system types, no saved state): thread-safe.
+module conmech_constrained_band
+    use conmech_kinds, only: dp
+    implicit none
+    private
+
+    public :: band_width_of, band_schur, band_gmul, band_gtmul, band_factor, band_solve
+    public :: band_dense
+
+    interface
+        subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, kd, ldab
+            real(dp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: info
+        end subroutine dpbtrf
+        subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, kd, nrhs, ldab, ldb
+            real(dp), intent(in) :: ab(ldab, *)
+            real(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dpbtrs
+    end interface
+
+contains
+
+    !> Superdiagonals kd of S = G D^-1 G^T for row windows of width w starting at `first`;
+    !! -1 if `first` is not nondecreasing or a window leaves 1..n (use the dense path).
+    pure integer function band_width_of(first, w, n) result(kd)
+        integer, intent(in) :: first(:), w, n
+        integer :: i, k, m
+        m = size(first)
+        kd = 0
+        do i = 1, m
+            if (first(i) < 1 .or. first(i) + w - 1 > n) then
+                kd = -1
+                return
+            end if
+            if (i > 1) then
+                if (first(i) < first(i - 1)) then
+                    kd = -1
+                    return
+                end if
+            end if
+        end do
+        do i = 1, m
+            k = i + 1
+            do while (k <= m)
+                if (first(k) > first(i) + w - 1) exit
+                k = k + 1
+            end do
+            kd = max(kd, k - 1 - i)
+        end do
+    end function band_width_of
+
+    !> ab = S = G D^-1 G^T in upper band storage (kd superdiagonals).
+    pure subroutine band_schur(gb, first, dinv, kd, ab)
+        real(dp), intent(in) :: gb(:, :), dinv(:)
+        integer, intent(in) :: first(:), kd
+        real(dp), intent(out) :: ab(:, :)
+        integer :: i, k, m, w, j0, j1, j
+        real(dp) :: s
+        m = size(gb, 1)
+        w = size(gb, 2)
+        ab = 0.0_dp
+        do k = 1, m
+            do i = max(1, k - kd), k
+                ! columns shared by the windows of rows i <= k
+                j0 = first(k)
+                j1 = first(i) + w - 1
+                s = 0.0_dp
+                do j = j0, j1
+                    s = s + gb(i, j - first(i) + 1)*gb(k, j - first(k) + 1)*dinv(j)
+                end do
+                ab(kd + 1 + i - k, k) = s
+            end do
+        end do
+    end subroutine band_schur
+
+    !> y = G x (m) from the row windows.
+    pure subroutine band_gmul(gb, first, x, y)
+        real(dp), intent(in) :: gb(:, :), x(:)
+        integer, intent(in) :: first(:)
+        real(dp), intent(out) :: y(:)
+        integer :: i, w
+        w = size(gb, 2)
+        do i = 1, size(gb, 1)
+            y(i) = dot_product(gb(i, :), x(first(i):first(i) + w - 1))
+        end do
+    end subroutine band_gmul
+
+    !> z = G^T lam (n) from the row windows.
+    pure subroutine band_gtmul(gb, first, lam, z)
+        real(dp), intent(in) :: gb(:, :), lam(:)
+        integer, intent(in) :: first(:)
+        real(dp), intent(out) :: z(:)
+        integer :: i, w
+        w = size(gb, 2)
+        z = 0.0_dp
+        do i = 1, size(gb, 1)
+            z(first(i):first(i) + w - 1) = z(first(i):first(i) + w - 1) + lam(i)*gb(i, :)
+        end do
+    end subroutine band_gtmul
+
+    !> Banded Cholesky of ab in place (dpbtrf); info > 0: not positive definite (e.g.
+    !! redundant constraints: use the rank-revealing dense path).
+    subroutine band_factor(ab, kd, info)
+        real(dp), intent(inout) :: ab(:, :)
+        integer, intent(in) :: kd
+        integer, intent(out) :: info
+        call dpbtrf('U', size(ab, 2), kd, ab, size(ab, 1), info)
+    end subroutine band_factor
+
+    !> Solve S x = r with the factor from band_factor; r is overwritten by x.
+    subroutine band_solve(ab, kd, r, info)
+        real(dp), intent(in) :: ab(:, :)
+        integer, intent(in) :: kd
+        real(dp), intent(inout) :: r(:)
+        integer, intent(out) :: info
+        call dpbtrs('U', size(ab, 2), kd, 1, ab, size(ab, 1), r, size(r), info)
+    end subroutine band_solve
+
+    !> The dense G (m x n) of the row windows.
+    pure subroutine band_dense(gb, first, g)
+        real(dp), intent(in) :: gb(:, :)
+        integer, intent(in) :: first(:)
+        real(dp), intent(out) :: g(:, :)
+        integer :: i, w
+        w = size(gb, 2)
+        g = 0.0_dp
+        do i = 1, size(gb, 1)
+            g(i, first(i):first(i) + w - 1) = gb(i, :)
+        end do
+    end subroutine band_dense
+
+end module conmech_constrained_band

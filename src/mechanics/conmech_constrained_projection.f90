@@ -1,0 +1,212 @@
+!> Reactions, residuals and the projections onto the constraint manifold of
+!! conmech_constrained_system (see there): the dense paths, with the banded ones of
+!! conmech_constrained_system_band tried first where the system's structure allows.
+submodule(conmech_constrained_system) conmech_constrained_projection
+    use conmech_constrained_band, only: band_width_of, band_gmul, band_gtmul
+    implicit none
+
+contains
+
+    !> Reaction force r = C(t, q)^T lam (n): O(n) for a row-window G.
+    module subroutine constraint_reaction(sys, t, q, lam, r)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), lam(:)
+        real(dp), intent(out) :: r(:)
+        real(dp), allocatable :: c(:, :), c0(:)
+        r = 0.0_dp
+        if (sys%n_hol + sys%n_nh == 0) return
+        if (band_ready(sys)) then
+            block
+                real(dp) :: gb(sys%n_hol, sys%jac_width)
+                integer :: first(sys%n_hol)
+                call sys%phi_jac_band(t, q, gb, first)
+                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
+                    call band_gtmul(gb, first, lam, r)
+                    return
+                end if
+            end block
+        end if
+        allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
+        call constraint_matrix(sys, t, q, c, c0)
+        r = matmul(lam, c)
+    end subroutine constraint_reaction
+
+    !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
+    module subroutine constraint_residuals(sys, t, q, v, rpos, rvel)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: rpos, rvel
+        real(dp), allocatable :: c(:, :), c0(:)
+        real(dp) :: ph(sys%n_hol)
+        rpos = 0.0_dp
+        rvel = 0.0_dp
+        if (sys%n_hol > 0) then
+            call sys%phi(t, q, ph)
+            rpos = maxval(abs(ph))
+        end if
+        if (band_ready(sys)) then
+            block
+                real(dp) :: gb(sys%n_hol, sys%jac_width), gv(sys%n_hol), pt(sys%n_hol)
+                integer :: first(sys%n_hol)
+                call sys%phi_jac_band(t, q, gb, first)
+                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
+                    call band_gmul(gb, first, v, gv)
+                    call sys%phi_t(t, q, pt)
+                    rvel = maxval(abs(gv + pt))
+                    return
+                end if
+            end block
+        end if
+        if (sys%n_hol + sys%n_nh > 0) then
+            allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
+            call constraint_matrix(sys, t, q, c, c0)
+            rvel = maxval(abs(matmul(c, v) + c0))
+        end if
+    end subroutine constraint_residuals
+
+    !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
+    !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
+    !! complement frozen at q~. Converged when max|phi| <= tol, or when the Newton
+    !! correction is below the round-off of q (4 eps max|q|: large coordinates, where
+    !! phi cannot reach an absolute tol); at most max_iter
+    !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
+    !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
+    !! convergence from far away; used for the consistent initial values).
+    module subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg, newton)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: q(:)
+        real(dp), intent(in) :: tol
+        integer, intent(in) :: max_iter
+        integer, intent(out) :: iters, info
+        character(len=:), allocatable, intent(out) :: msg
+        logical, intent(in), optional :: newton   !! refresh G at every iterate (far start)
+        real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
+        real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
+        real(dp) :: rnorm
+        integer :: n, mh, lainfo, rk
+        logical :: full, ok
+        character(len=32) :: buf
+        n = sys%n
+        mh = sys%n_hol
+        iters = 0
+        info = CM_SUCCESS
+        msg = "success"
+        if (mh == 0) return
+        call sys%phi(t, q, ph(:, 1))
+        rnorm = maxval(abs(ph(:, 1)))
+        if (rnorm <= tol) return
+        full = .false.
+        if (present(newton)) full = newton
+        if (band_ready(sys)) then
+            call band_project_position(sys, t, q, ph(:, 1), tol, max_iter, full, iters, info, &
+                                       msg, ok)
+            if (ok) return
+        end if
+        if (has_mass_factor(sys)) then
+            mm = sys%mass_factor        ! factorised once by prepare_mass
+        else
+            call sys%mass(t, q, mm)
+            call mass_cholesky(mm, info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
+        call sys%phi_jac(t, q, g)
+        x = transpose(g)
+        call dpotrs('U', n, mh, mm, n, x, n, lainfo)
+        s = matmul(g, x)
+        qk = q
+        do iters = 1, max_iter
+            if (full .and. iters > 1) then
+                call sys%phi_jac(t, qk, g)
+                x = transpose(g)
+                call dpotrs('U', n, mh, mm, n, x, n, lainfo)
+                s = matmul(g, x)
+            end if
+            call schur_solve(s, ph, rk, info)
+            if (info /= CM_SUCCESS) then
+                msg = "LAPACK failed in the position projection"
+                return
+            end if
+            dq = matmul(x, ph(:, 1))
+            if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*max(maxval(abs(qk)), tiny(1.0_dp))) &
+                then
+                ! the correction is below the round-off of q: phi is as small as it can get,
+                ! if it is at the round-off level of its terms (~ |G| |q|); otherwise the
+                ! Jacobian cannot reduce it (zero or rank-deficient G, incompatible
+                ! constraints): a failure, not a converged projection
+                if (rnorm > max(tol, 1.0e3_dp*epsilon(1.0_dp)*max(1.0_dp, &
+                                maxval(abs(g))*maxval(abs(qk))))) exit
+                q = qk
+                return
+            end if
+            qk = qk - dq
+            call sys%phi(t, qk, ph(:, 1))
+            rnorm = maxval(abs(ph(:, 1)))
+            if (.not. (rnorm < huge(1.0_dp))) exit
+            if (rnorm <= tol) then
+                q = qk
+                return
+            end if
+        end do
+        iters = min(iters, max_iter)
+        info = CM_NO_CONVERGENCE
+        write (buf, '(es10.3)') rnorm
+        msg = "position projection did not converge: |phi| ="//trim(buf)// &
+              " (inconsistent constraints, or too far from the manifold)"
+    end subroutine project_position
+
+    !> Mass-weighted projection of v onto C(t, q) v + c0 = 0 (linear, one solve):
+    !! v = v~ - M^{-1} C^T S^+ (C v~ + c0). CM_NO_CONVERGENCE if the projected residual is
+    !! not small (inconsistent velocity constraints).
+    module subroutine project_velocity(sys, t, q, v, info, msg)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(inout) :: v(:)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol + sys%n_nh)
+        real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh)
+        real(dp) :: s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh), r(sys%n_hol + sys%n_nh, 1)
+        real(dp) :: r0, vscale
+        integer :: n, m, lainfo, rk
+        logical :: ok
+        n = sys%n
+        m = sys%n_hol + sys%n_nh
+        info = CM_SUCCESS
+        msg = "success"
+        if (m == 0) return
+        if (band_ready(sys)) then
+            call band_project_velocity(sys, t, q, v, info, msg, ok)
+            if (ok) return
+        end if
+        if (has_mass_factor(sys)) then
+            mm = sys%mass_factor        ! factorised once by prepare_mass
+        else
+            call sys%mass(t, q, mm)
+            call mass_cholesky(mm, info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
+        call constraint_matrix(sys, t, q, c, c0)
+        r(:, 1) = matmul(c, v) + c0
+        r0 = maxval(abs(r(:, 1)))
+        if (r0 == 0.0_dp) return
+        x = transpose(c)
+        call dpotrs('U', n, m, mm, n, x, n, lainfo)
+        s = matmul(c, x)
+        call schur_solve(s, r, rk, info)
+        if (info /= CM_SUCCESS) then
+            msg = "LAPACK failed in the velocity projection"
+            return
+        end if
+        v = v - matmul(x, r(:, 1))
+        vscale = max(maxval(abs(v)), 1.0_dp)*max(maxval(abs(c)), 1.0_dp)
+        if (maxval(abs(matmul(c, v) + c0)) > 1.0e-8_dp*vscale + 1.0e-10_dp*r0) then
+            info = CM_NO_CONVERGENCE
+            msg = "velocity projection failed: the velocity constraints are inconsistent"
+        end if
+    end subroutine project_velocity
+
+end submodule conmech_constrained_projection

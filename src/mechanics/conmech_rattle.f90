@@ -1,0 +1,455 @@
+!> RATTLE (Andersen 1983; Hairer-Lubich-Wanner, Geometric Numerical Integration, VII.1)
+!! for mechanical systems with holonomic constraints in excessive coordinates,
+!! M q'' = Q(t, q, q') + G(t, q)^T lambda, phi(t, q) = 0: fixed step h, second order,
+!! symmetric, and symplectic for a constant mass matrix and forces Q(q) from a potential.
+!!
+!! One step from (q_n, v_n):
+!!
+!!     v_{1/2} = v_n + h/2 M_n^{-1} (Q_n + G_n^T lambda)
+!!     q_{n+1} = q_n + h v_{1/2},          phi(t_{n+1}, q_{n+1}) = 0
+!!     v_{n+1} = v_{1/2} + h/2 M_{n+1}^{-1} (Q_{n+1} + G_{n+1}^T mu),
+!!                                         G_{n+1} v_{n+1} + phi_t(t_{n+1}, q_{n+1}) = 0
+!!
+!! - Position constraints: simplified Newton in the scaled multiplier (h^2/2) lambda with
+!!   the matrix G(q~) M_n^{-1} G_n^T (q~ the unconstrained predictor, so the contraction
+!!   factor is O(h^2)), factorised once per step (LAPACK dgetrf), iterated until
+!!   max|phi| <= proj_tol or the correction is below the round-off of q.
+!! - Velocity constraints: one linear solve with G_{n+1} M_{n+1}^{-1} G_{n+1}^T.
+!! - Mass matrix: M(q_n) in the first half kick and the position solve, M(q_{n+1}) in
+!!   the second (the standard variant). For a constant mass matrix this is RATTLE
+!!   exactly; for a configuration-dependent one the method stays symmetric and of order
+!!   2, but is not symplectic.
+!! - Velocity-dependent forces: Q_{n+1} = Q(t_{n+1}, q_{n+1}, v_{n+1}) makes the second
+!!   kick implicit; it is solved by fixed-point iteration (two force evaluations per step
+!!   when Q does not depend on v: the second one confirms the first).
+!! - Output times: the trajectory runs on the grid t_k = t0 + k h (h = (tf - t0)/N, N =
+!!   ceil(|tf - t0|/first_step)); a t_eval point between grid points is reached by one
+!!   RATTLE side step of the remaining length from the grid point before it (so every
+!!   output is on the constraint manifold to round-off; the trajectory itself is not
+!!   altered). Without t_eval every grid point is an output (or only the ends, without
+!!   save_steps). Events are not supported.
+!! Multipliers, reactions, residuals, energy and power at the outputs come from the
+!! acceleration-level KKT system, as in `constrained_solve`; only holonomic constraints
+!! (n_nh = 0).
+module conmech_rattle
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_lapack, only: dgetrs
+    use conmech_generalized, only: mass_cholesky
+    use conmech_constrained_system, only: constrained_system, constrained_accel, &
+        constraint_matrix, constraint_residuals
+    use conmech_constrained_solver, only: constrained_options, constrained_result, &
+        consistent_initial
+    implicit none
+    private
+
+    public :: rattle_solve
+
+    interface
+        !> Unblocked LU (no block-size query: fast for the small constraint matrices).
+        subroutine dgetf2(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetf2
+        !> Inverse from the Cholesky factor (upper triangle).
+        subroutine dpotri(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotri
+    end interface
+
+    !> The state at one grid point with what the next step reuses.
+    type :: rattle_state
+        real(dp) :: t = 0.0_dp
+        real(dp), allocatable :: q(:), v(:)
+        real(dp), allocatable :: f(:)       !! Q(t, q, v)
+        real(dp), allocatable :: mc(:, :)   !! M(t, q)^{-1} (from its Cholesky factor)
+        real(dp), allocatable :: x(:, :)    !! M^{-1} G^T (n x n_hol)
+        real(dp), allocatable :: g(:, :)    !! G (n_hol x n)
+    end type rattle_state
+
+contains
+
+    !> Integrate a holonomic constrained system from (q0, v0) over t_span with RATTLE,
+    !! fixed step options%ode%first_step (see the module documentation). Result and
+    !! options as `constrained_solve` (projection, rtol, atol are not used; proj_tol and
+    !! proj_max_iter control the position solve; max_steps bounds the number of steps).
+    subroutine rattle_solve(sys, t_span, q0, v0, options, res, t_eval)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t_span(2)
+        real(dp), intent(in) :: q0(:), v0(:)
+        type(constrained_options), intent(in) :: options
+        type(constrained_result), intent(out) :: res
+        real(dp), intent(in), optional :: t_eval(:)
+
+        type(rattle_state) :: st(2), side
+        integer :: cur
+        real(dp), allocatable :: tout(:), qout(:, :), vout(:, :), q(:), v(:), acc(:), lam(:)
+        real(dp) :: h, t0, tf, posneg
+        integer :: n, m, nsteps, k, nout, n_eval, i_eval, info, iters, j
+        character(len=:), allocatable :: msg
+        character(len=32) :: buf
+
+        n = sys%n
+        m = sys%n_hol
+        t0 = t_span(1)
+        tf = t_span(2)
+        n_eval = 0
+        if (present(t_eval)) n_eval = size(t_eval)
+        res%message = "bad input"
+        res%status = CM_BAD_INPUT
+        if (n < 1 .or. sys%n_hol < 0) then
+            res%message = "bad input: the system needs n >= 1 coordinates and n_hol >= 0"
+        else if (sys%n_nh /= 0) then
+            res%message = "bad input: RATTLE handles holonomic constraints only (n_nh = 0)"
+        else if (size(q0) /= n .or. size(v0) /= n) then
+            write (buf, '(i0)') n
+            res%message = "bad input: q0 and v0 must have n = "//trim(buf)//" elements"
+        else if (.not. (all(ieee_is_finite(q0)) .and. all(ieee_is_finite(v0)))) then
+            res%message = "bad input: q0 or v0 contains NaN or Inf"
+        else if (.not. (ieee_is_finite(t0) .and. ieee_is_finite(tf))) then
+            res%message = "bad input: t_span must be finite"
+        else if (.not. (options%ode%first_step > 0.0_dp .and. &
+                        options%ode%first_step < huge(1.0_dp))) then
+            res%message = "bad input: RATTLE is a fixed-step method and needs the step " &
+                          //"first_step > 0"
+        else if (options%proj_max_iter < 1 .or. .not. options%proj_tol > 0.0_dp) then
+            res%message = "bad input: proj_max_iter and proj_tol must be positive"
+        else if (.not. t_eval_ok()) then
+            res%message = "bad input: t_eval must lie in t_span, sorted in the direction " &
+                          //"of integration"
+        else
+            res%status = CM_SUCCESS
+        end if
+        if (res%status /= CM_SUCCESS) then
+            call allocate_outputs(0)
+            return
+        end if
+        posneg = sign(1.0_dp, tf - t0)
+        nsteps = 0
+        if (tf /= t0) nsteps = max(1, ceiling(abs(tf - t0)/options%ode%first_step &
+                                              *(1.0_dp - 1.0e-12_dp)))
+        if (nsteps > options%ode%max_steps) then
+            write (buf, '(i0)') nsteps
+            call fail(CM_TOO_MANY_STEPS, "too many steps: the run needs "//trim(buf)// &
+                      " steps of first_step, more than max_steps")
+            return
+        end if
+        h = 0.0_dp
+        if (nsteps > 0) h = (tf - t0)/real(nsteps, dp)
+
+        allocate (q(n), v(n), acc(n), lam(m))
+        q = q0
+        v = v0
+        if (options%project_initial) then
+            call consistent_initial(sys, t0, q, v, options%proj_tol, options%proj_max_iter, &
+                                    res%dq0, res%dv0, iters, info, msg)
+            res%proj_iter = iters
+            res%proj_iter_max = iters
+            if (info /= CM_SUCCESS) then
+                call fail(info, msg)
+                return
+            end if
+        end if
+        call constrained_accel(sys, t0, q, v, acc, lam, info, msg, rank=res%rank)
+        if (info /= CM_SUCCESS) then
+            call fail(info, msg)
+            return
+        end if
+        cur = 1
+        call prepare(st(1), t0, q, v, info, msg)
+        if (info /= CM_SUCCESS) then
+            call fail(info, msg)
+            return
+        end if
+
+        ! ------------------------------------------------------------ outputs at t0
+        allocate (tout(16), qout(n, 16), vout(n, 16))
+        nout = 0
+        i_eval = 1
+        if (n_eval == 0) then
+            call push(t0, q, v)
+        else
+            do while (i_eval <= n_eval)
+                if (t_eval(i_eval) /= t0) exit
+                call push(t0, q, v)
+                i_eval = i_eval + 1
+            end do
+        end if
+
+        ! ------------------------------------------------------------ the grid
+        do k = 1, nsteps
+            ! t_eval points strictly inside (t_{k-1}, t_k): a side step from t_{k-1}
+            do while (i_eval <= n_eval)
+                if ((t_eval(i_eval) - (t0 + k*h))*posneg >= 0.0_dp) exit
+                call step(st(cur), t_eval(i_eval) - st(cur)%t, side, info, msg)
+                if (info /= CM_SUCCESS) exit
+                call push(t_eval(i_eval), side%q, side%v)
+                i_eval = i_eval + 1
+            end do
+            if (info /= CM_SUCCESS) exit
+            call step(st(cur), h, st(3 - cur), info, msg)
+            if (info /= CM_SUCCESS) exit
+            cur = 3 - cur
+            if (k == nsteps) then
+                st(cur)%t = tf
+            else
+                st(cur)%t = t0 + k*h
+            end if
+            res%naccept = res%naccept + 1
+            if (n_eval == 0) then
+                if (options%save_steps .or. k == nsteps) &
+                    call push(st(cur)%t, st(cur)%q, st(cur)%v)
+            else
+                ! points on this grid point (at the end: every remaining point, = tf)
+                do while (i_eval <= n_eval)
+                    if (k < nsteps .and. t_eval(i_eval) /= st(cur)%t) exit
+                    call push(t_eval(i_eval), st(cur)%q, st(cur)%v)
+                    i_eval = i_eval + 1
+                end do
+            end if
+        end do
+        if (info /= CM_SUCCESS) then
+            write (buf, '(es14.6)') st(cur)%t
+            res%status = info
+            res%message = msg//" (RATTLE step from t ="//trim(buf)//")"
+        else
+            res%status = CM_SUCCESS
+            res%message = "success"
+        end if
+
+        ! ------------------------------------------------------------ diagnostics
+        call allocate_outputs(nout)
+        do j = 1, nout
+            call store(j)
+        end do
+        res%success = res%status >= 0
+
+    contains
+
+        logical function t_eval_ok()
+            integer :: i
+            t_eval_ok = .true.
+            if (n_eval == 0) return
+            if (.not. all(ieee_is_finite(t_eval))) t_eval_ok = .false.
+            do i = 1, n_eval
+                if ((t_eval(i) - t0)*(tf - t_eval(i)) < 0.0_dp) t_eval_ok = .false.
+                if (i > 1) then
+                    if ((t_eval(i) - t_eval(i - 1))*(tf - t0) < 0.0_dp) t_eval_ok = .false.
+                end if
+            end do
+        end function t_eval_ok
+
+        subroutine fail(code, text)
+            integer, intent(in) :: code
+            character(len=*), intent(in) :: text
+            res%status = code
+            res%message = text
+            res%success = .false.
+            call allocate_outputs(0)
+        end subroutine fail
+
+        subroutine allocate_outputs(nt)
+            integer, intent(in) :: nt
+            res%nt = nt
+            allocate (res%t(nt), res%q(n, nt), res%v(n, nt), res%lam(m, nt), &
+                      res%reaction(n, nt), res%res_pos(nt), res%res_vel(nt), &
+                      res%energy(nt), res%power(nt))
+        end subroutine allocate_outputs
+
+        subroutine push(tt, qq, vv)
+            real(dp), intent(in) :: tt, qq(:), vv(:)
+            real(dp), allocatable :: t2(:), q2(:, :), v2(:, :)
+            integer :: cap
+            cap = size(tout)
+            if (nout >= cap) then
+                allocate (t2(2*cap), q2(n, 2*cap), v2(n, 2*cap))
+                t2(1:nout) = tout(1:nout)
+                q2(:, 1:nout) = qout(:, 1:nout)
+                v2(:, 1:nout) = vout(:, 1:nout)
+                call move_alloc(t2, tout)
+                call move_alloc(q2, qout)
+                call move_alloc(v2, vout)
+            end if
+            nout = nout + 1
+            tout(nout) = tt
+            qout(:, nout) = qq
+            vout(:, nout) = vv
+        end subroutine push
+
+        subroutine store(jj)
+            integer, intent(in) :: jj
+            integer :: inf2
+            real(dp) :: c(m, n), c0(m), tt
+            character(len=:), allocatable :: m2
+            tt = tout(jj)
+            res%t(jj) = tt
+            res%q(:, jj) = qout(:, jj)
+            res%v(:, jj) = vout(:, jj)
+            call constrained_accel(sys, tt, qout(:, jj), vout(:, jj), acc, lam, inf2, m2)
+            if (inf2 /= CM_SUCCESS .and. res%status >= 0) then
+                res%status = inf2
+                res%message = m2
+            end if
+            res%lam(:, jj) = lam
+            res%reaction(:, jj) = 0.0_dp
+            if (m > 0) then
+                call constraint_matrix(sys, tt, qout(:, jj), c, c0)
+                res%reaction(:, jj) = matmul(lam, c)
+            end if
+            call constraint_residuals(sys, tt, qout(:, jj), vout(:, jj), res%res_pos(jj), &
+                                      res%res_vel(jj))
+            res%energy(jj) = 0.0_dp
+            if (sys%has_energy()) res%energy(jj) = sys%energy(tt, qout(:, jj), vout(:, jj))
+            res%power(jj) = dot_product(res%reaction(:, jj), vout(:, jj))
+        end subroutine store
+
+        !> Fill a state at (tt, qq, vv): forces, Cholesky of M, G and M^{-1} G^T.
+        subroutine prepare(st, tt, qq, vv, inf, mg)
+            type(rattle_state), intent(inout) :: st
+            real(dp), intent(in) :: tt, qq(:), vv(:)
+            integer, intent(out) :: inf
+            character(len=:), allocatable, intent(out) :: mg
+            st%t = tt
+            st%q = qq
+            st%v = vv
+            if (.not. allocated(st%f)) allocate (st%f(n), st%mc(n, n), st%x(n, m), st%g(m, n))
+            call sys%forces(tt, qq, vv, st%f)
+            res%nfev = res%nfev + 1
+            call factor_mass(st, inf, mg)
+        end subroutine prepare
+
+        subroutine factor_mass(st, inf, mg)
+            type(rattle_state), intent(inout) :: st
+            integer, intent(out) :: inf
+            character(len=:), allocatable, intent(out) :: mg
+            integer :: lainfo, jj
+            call sys%mass(st%t, st%q, st%mc)
+            call mass_cholesky(st%mc, inf, mg)
+            if (inf /= CM_SUCCESS) return
+            ! the explicit inverse (small matrices: one LAPACK call per step instead of a
+            ! triangular solve per right-hand side)
+            call dpotri('U', n, st%mc, n, lainfo)
+            do jj = 1, n - 1
+                st%mc(jj + 1:n, jj) = st%mc(jj, jj + 1:n)
+            end do
+            if (m > 0) then
+                call sys%phi_jac(st%t, st%q, st%g)
+                st%x = matmul(st%mc, transpose(st%g))
+            end if
+            mg = "success"
+        end subroutine factor_mass
+
+        !> One RATTLE step of length hs from st to s2 (s2 prepared for the next step).
+        subroutine step(st, hs, s2, inf, mg)
+            type(rattle_state), intent(in) :: st
+            real(dp), intent(in) :: hs
+            type(rattle_state), intent(inout) :: s2
+            integer, intent(out) :: inf
+            character(len=:), allocatable, intent(out) :: mg
+            real(dp) :: afree(n), vhalf(n), qt(n), ph(m), sm(m, m), gt(m, n), dq(n)
+            real(dp) :: dqsum(n), w(n), r(m), vprev(n), t1, rnorm, pt(m, n)
+            integer :: ipiv(m), lainfo, it, kk
+            character(len=32) :: b2
+            t1 = st%t + hs
+            if (.not. allocated(s2%f)) allocate (s2%q(n), s2%v(n), s2%f(n), s2%mc(n, n), &
+                                                 s2%x(n, m), s2%g(m, n))
+            ! first half kick without the constraint force, unconstrained predictor
+            afree = matmul(st%mc, st%f)
+            qt = st%q + hs*st%v + (0.5_dp*hs*hs)*afree
+            dqsum = 0.0_dp
+            s2%q = qt
+            if (m > 0) then
+                call sys%phi_jac(t1, qt, gt)
+                sm = matmul(gt, st%x)
+                call dgetf2(m, m, sm, m, ipiv, lainfo)
+                if (lainfo /= 0) then
+                    inf = CM_SINGULAR
+                    mg = "singular constraint matrix G M^-1 G^T in the position solve " &
+                         //"(redundant constraints?)"
+                    return
+                end if
+                ! pk = X S^{-1} (n x m) from S^T pk^T = X^T
+                pt = transpose(st%x)
+                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
+                inf = CM_NO_CONVERGENCE
+                do it = 1, options%proj_max_iter + 1
+                    call sys%phi(t1, s2%q, ph)
+                    rnorm = maxval(abs(ph))
+                    if (.not. rnorm < huge(1.0_dp)) exit
+                    if (rnorm <= options%proj_tol) then
+                        inf = CM_SUCCESS
+                        exit
+                    end if
+                    if (it > options%proj_max_iter) exit
+                    dq = matmul(ph, pt)
+                    dqsum = dqsum + dq
+                    s2%q = s2%q - dq
+                    if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*maxval(abs(s2%q))) then
+                        inf = CM_SUCCESS
+                        exit
+                    end if
+                end do
+                res%proj_iter = res%proj_iter + it
+                res%proj_iter_max = max(res%proj_iter_max, it)
+                res%nproj = res%nproj + 1
+                if (inf /= CM_SUCCESS) then
+                    write (b2, '(es10.3)') rnorm
+                    mg = "position constraints not solved: |phi| ="//trim(b2)// &
+                         " after proj_max_iter simplified Newton iterations"
+                    return
+                end if
+            end if
+            ! v_{1/2} = (q_{n+1} - q_n)/h without the cancellation
+            vhalf = st%v + (0.5_dp*hs)*afree - dqsum/hs
+            ! second half kick at q_{n+1}, velocity constraints
+            s2%t = t1
+            call factor_mass(s2, inf, mg)
+            if (inf /= CM_SUCCESS) return
+            if (m > 0) then
+                sm = matmul(s2%g, s2%x)
+                call dgetf2(m, m, sm, m, ipiv, lainfo)
+                if (lainfo /= 0) then
+                    inf = CM_SINGULAR
+                    mg = "singular constraint matrix G M^-1 G^T in the velocity solve"
+                    return
+                end if
+                pt = transpose(s2%x)
+                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
+            end if
+            s2%v = 2.0_dp*vhalf - st%v
+            inf = CM_NO_CONVERGENCE
+            do kk = 1, 50
+                call sys%forces(t1, s2%q, s2%v, s2%f)
+                res%nfev = res%nfev + 1
+                if (.not. all(ieee_is_finite(s2%f))) exit
+                w = vhalf + (0.5_dp*hs)*matmul(s2%mc, s2%f)
+                if (m > 0) then
+                    call sys%phi_t(t1, s2%q, r)
+                    r = -(matmul(s2%g, w) + r)
+                    w = w + matmul(r, pt)
+                end if
+                vprev = s2%v
+                s2%v = w
+                if (kk > 1 .and. maxval(abs(s2%v - vprev)) <= 4.0_dp*epsilon(1.0_dp)* &
+                    max(maxval(abs(s2%v)), tiny(1.0_dp))) then
+                    ! converged: Q(t1, q1, v1) equals s2%f to round-off
+                    inf = CM_SUCCESS
+                    exit
+                end if
+            end do
+            if (inf /= CM_SUCCESS) then
+                mg = "the velocity-dependent forces of the second half kick did not " &
+                     //"converge (or are not finite)"
+            end if
+        end subroutine step
+
+    end subroutine rattle_solve
+
+end module conmech_rattle

@@ -1,0 +1,430 @@
+!> Output machinery shared by the implicit integrators (Radau IIA, Gauss-Legendre): the
+!! solution points (every step, or t_eval interpolated on the collocation polynomial),
+!! the dense output, and event location, for one accepted step at a time.
+!!
+!! A step [t, t + h] is described by its collocation polynomial in the power basis,
+!! u(t + x h) = fc(:, 0) + x fc(:, 1) + ... + x^nf fc(:, nf) (dense_solution%form = 2, the
+!! power form of conmech_ode_solver). Event zeros are located on it by Brent's method.
+!! Everything lives in the caller's `step_output` object: thread-safe.
+module conmech_radau_common
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_ode_system, only: ode_events
+    use conmech_ode_solver, only: ode_options, ode_result, dense_solution
+    implicit none
+    private
+
+    integer, parameter, public :: FORM_POWER_BASIS = 2  !! dense_solution%form of the power basis
+
+    public :: step_output, out_init, out_step, out_finish, poly_eval, check_t_eval
+    public :: tolerance_vectors, power_basis_matrix
+
+    !> State of the outputs during one integration.
+    type :: step_output
+        integer :: n = 0, nf = 0
+        integer :: n_eval = 0, i_eval = 1, ne = 0
+        logical :: has_events = .false., store_steps = .false., dense = .false.
+        real(dp) :: posneg = 1.0_dp
+        real(dp), allocatable :: g_old(:), g_new(:), ye(:)
+    end type step_output
+
+contains
+
+    !> Check t_eval (finite, inside t_span, sorted in the direction of integration).
+    subroutine check_t_eval(t_span, t_eval, info, msg)
+        real(dp), intent(in) :: t_span(2), t_eval(:)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        integer :: i
+        info = CM_BAD_INPUT
+        if (.not. all(ieee_is_finite(t_eval))) then
+            msg = "bad input: t_eval contains non-finite values"
+            return
+        end if
+        do i = 1, size(t_eval)
+            if ((t_eval(i) - t_span(1))*(t_span(2) - t_eval(i)) < 0.0_dp) then
+                msg = "bad input: t_eval values must lie in t_span"
+                return
+            end if
+            if (i > 1) then
+                if ((t_eval(i) - t_eval(i - 1))*(t_span(2) - t_span(1)) < 0.0_dp) then
+                    msg = "bad input: t_eval must be sorted in the direction of integration"
+                    return
+                end if
+            end if
+        end do
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine check_t_eval
+
+    !> Per-component tolerances from the options (rtol raised to 100 eps, as SciPy).
+    subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg)
+        type(ode_options), intent(in) :: opt
+        integer, intent(in) :: n
+        real(dp), allocatable, intent(out) :: rtolv(:), atolv(:)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        allocate (rtolv(n), atolv(n))
+        info = CM_BAD_INPUT
+        if (allocated(opt%rtol_vec)) then
+            if (size(opt%rtol_vec) /= n) then
+                msg = "bad input: rtol must be a scalar or have the size of y0"
+                return
+            end if
+            rtolv = opt%rtol_vec
+        else
+            rtolv = opt%rtol
+        end if
+        if (allocated(opt%atol_vec)) then
+            if (size(opt%atol_vec) /= n) then
+                msg = "bad input: atol must be a scalar or have the size of y0"
+                return
+            end if
+            atolv = opt%atol_vec
+        else
+            atolv = opt%atol
+        end if
+        if (.not. (all(rtolv >= 0.0_dp) .and. all(atolv >= 0.0_dp))) then
+            msg = "bad input: rtol and atol must be non-negative"
+            return
+        end if
+        rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine tolerance_vectors
+
+    !> Matrix P (s x s) of the interpolation in the power basis through the origin: the
+    !! polynomial u with u(0) = 0 and u(c_i) = z_i is u(x) = sum_j x^j sum_i P(j, i) z_i
+    !! (expanded Lagrange basis x/c_i prod_{k /= i} (x - c_k)/(c_i - c_k); nodes distinct
+    !! and non-zero).
+    pure function power_basis_matrix(c) result(p)
+        real(dp), intent(in) :: c(:)
+        real(dp) :: p(size(c), size(c))
+        real(dp) :: poly(0:size(c)), den
+        integer :: i, k, j, s
+        s = size(c)
+        do i = 1, s
+            ! poly = x * prod_{k /= i} (x - c_k), coefficients of x^0..x^s
+            poly = 0.0_dp
+            poly(1) = 1.0_dp
+            den = c(i)
+            do k = 1, s
+                if (k == i) cycle
+                do j = s, 1, -1
+                    poly(j) = poly(j - 1) - c(k)*poly(j)
+                end do
+                poly(0) = -c(k)*poly(0)
+                den = den*(c(i) - c(k))
+            end do
+            p(:, i) = poly(1:s)/den
+        end do
+    end function power_basis_matrix
+
+    !> u(x) = fc(:, 0) + x fc(:, 1) + ... + x^nf fc(:, nf) (Horner).
+    pure subroutine poly_eval(fc, x, u)
+        real(dp), intent(in) :: fc(:, 0:)
+        real(dp), intent(in) :: x
+        real(dp), intent(out) :: u(:)
+        integer :: j, nf
+        nf = ubound(fc, 2)
+        u = fc(:, nf)
+        do j = nf - 1, 0, -1
+            u = fc(:, j) + x*u
+        end do
+    end subroutine poly_eval
+
+    !> Start the outputs at (t0, y0): allocate the result arrays, store the first point.
+    subroutine out_init(o, res, opt, t0, tf, y0, nf, t_eval, events)
+        type(step_output), intent(out) :: o
+        type(ode_result), intent(inout) :: res
+        type(ode_options), intent(in) :: opt
+        real(dp), intent(in) :: t0, tf, y0(:)
+        integer, intent(in) :: nf
+        real(dp), intent(in), optional :: t_eval(:)
+        class(ode_events), intent(in), optional :: events
+        integer :: n
+        n = size(y0)
+        o%n = n
+        o%nf = nf
+        o%posneg = sign(1.0_dp, tf - t0)
+        if (present(t_eval)) o%n_eval = size(t_eval)
+        if (present(events)) o%has_events = events%n_events() > 0
+        o%store_steps = o%n_eval == 0 .and. opt%save_steps
+        o%dense = opt%dense_output
+        if (.not. allocated(res%t)) allocate (res%t(0), res%y(n, 0))
+        if (.not. allocated(res%ev_t)) allocate (res%ev_t(0), res%ev_y(n, 0), res%ev_id(0))
+        res%nt = 0
+        res%nev = 0
+        if (o%n_eval == 0) call push_point(res, t0, y0)
+        o%i_eval = 1
+        do while (o%i_eval <= o%n_eval)
+            if (t_eval(o%i_eval) /= t0) exit
+            call push_point(res, t0, y0)
+            o%i_eval = o%i_eval + 1
+        end do
+        if (o%dense) then
+            res%sol%n = n
+            res%sol%nf = nf
+            res%sol%form = FORM_POWER_BASIS
+            res%sol%nseg = 0
+            res%sol%t_first = t0
+            res%sol%t_last = t0
+            allocate (res%sol%ts(16), res%sol%hs(16), res%sol%coef(n, 0:nf, 16))
+        end if
+        if (o%has_events) then
+            o%ne = events%n_events()
+            allocate (o%g_old(o%ne), o%g_new(o%ne), o%ye(n))
+            call events%eval(t0, y0, o%g_old)
+        end if
+    end subroutine out_init
+
+    !> Outputs of the accepted step [t, t + h] (polynomial fc, end state ynew): events,
+    !! t_eval points, the step end, the dense output. If a terminal event occurs, stop_now
+    !! is set and (t_stop, y_stop) is the event point, the last output.
+    subroutine out_step(o, res, t, h, fc, ynew, stop_now, t_stop, y_stop, t_eval, events)
+        type(step_output), intent(inout) :: o
+        type(ode_result), intent(inout) :: res
+        real(dp), intent(in) :: t, h, fc(:, 0:), ynew(:)
+        logical, intent(out) :: stop_now
+        real(dp), intent(out) :: t_stop, y_stop(:)
+        real(dp), intent(in), optional :: t_eval(:)
+        class(ode_events), intent(in), optional :: events
+        real(dp) :: t_new, u(o%n)
+        t_new = t + h
+        stop_now = .false.
+        t_stop = t_new
+        y_stop = ynew
+        if (o%has_events) call find_events()
+        do while (o%i_eval <= o%n_eval)
+            if (stop_now) then
+                if ((t_eval(o%i_eval) - t_stop)*o%posneg > 0.0_dp) exit
+            else
+                if ((t_eval(o%i_eval) - t_new)*o%posneg > 0.0_dp) exit
+            end if
+            if (t_eval(o%i_eval) == t_new .and. .not. stop_now) then
+                call push_point(res, t_new, ynew)
+            else
+                call poly_eval(fc, (t_eval(o%i_eval) - t)/h, u)
+                call push_point(res, t_eval(o%i_eval), u)
+            end if
+            o%i_eval = o%i_eval + 1
+        end do
+        if (o%store_steps) call push_point(res, t_stop, y_stop)
+        if (o%dense) call dense_push(res%sol, t, h, fc, t_stop)
+
+    contains
+
+        subroutine find_events()
+            integer :: i, j, nfound, ids(o%ne), order(o%ne), tmp
+            real(dp) :: times(o%ne), tmin, te
+            logical :: cross
+            call events%eval(t_new, ynew, o%g_new)
+            nfound = 0
+            do i = 1, o%ne
+                cross = .false.
+                if (o%g_old(i) < 0.0_dp .and. o%g_new(i) >= 0.0_dp .and. &
+                    events%direction(i) >= 0) cross = .true.
+                if (o%g_old(i) > 0.0_dp .and. o%g_new(i) <= 0.0_dp .and. &
+                    events%direction(i) <= 0) cross = .true.
+                if (cross) then
+                    nfound = nfound + 1
+                    ids(nfound) = i
+                    if (o%g_new(i) == 0.0_dp) then
+                        times(nfound) = t_new
+                    else
+                        times(nfound) = event_root(i, o%g_old(i), o%g_new(i))
+                    end if
+                end if
+            end do
+            o%g_old = o%g_new
+            if (nfound == 0) return
+            do i = 1, nfound
+                order(i) = i
+            end do
+            do i = 2, nfound
+                j = i
+                do while (j > 1)
+                    if ((times(order(j)) - times(order(j - 1)))*o%posneg >= 0.0_dp) exit
+                    tmp = order(j); order(j) = order(j - 1); order(j - 1) = tmp
+                    j = j - 1
+                end do
+            end do
+            tmin = t_new
+            do j = 1, nfound
+                i = order(j)
+                te = times(i)
+                if (stop_now .and. (te - tmin)*o%posneg > 0.0_dp) exit
+                if (te == t_new) then
+                    o%ye = ynew
+                else
+                    call poly_eval(fc, (te - t)/h, o%ye)
+                end if
+                call push_event(res, te, o%ye, ids(i))
+                if (events%terminal(ids(i)) .and. .not. stop_now) then
+                    stop_now = .true.
+                    tmin = te
+                    t_stop = te
+                    y_stop = o%ye
+                end if
+            end do
+        end subroutine find_events
+
+        !> Zero of event ie on the polynomial of the step (Brent's method in x in [0, 1]).
+        function event_root(ie, ga, gb) result(root)
+            integer, intent(in) :: ie
+            real(dp), intent(in) :: ga, gb
+            real(dp) :: root
+            real(dp) :: a, b, c, fa, fb, fcc, d, e, tol, m, p, q, r, s, gv(o%ne)
+            integer :: it
+            a = 0.0_dp; b = 1.0_dp; fa = ga; fb = gb
+            c = a; fcc = fa; d = b - a; e = d
+            do it = 1, 200
+                if (abs(fcc) < abs(fb)) then
+                    a = b; b = c; c = a
+                    fa = fb; fb = fcc; fcc = fa
+                end if
+                tol = max(2.0_dp*epsilon(1.0_dp)*abs(t + b*h)/abs(h), 2.0_dp*epsilon(1.0_dp))
+                m = 0.5_dp*(c - b)
+                if (abs(m) <= tol .or. fb == 0.0_dp) exit
+                if (abs(e) < tol .or. abs(fa) <= abs(fb)) then
+                    d = m; e = m
+                else
+                    s = fb/fa
+                    if (a == c) then
+                        p = 2.0_dp*m*s
+                        q = 1.0_dp - s
+                    else
+                        q = fa/fcc
+                        r = fb/fcc
+                        p = s*(2.0_dp*m*q*(q - r) - (b - a)*(r - 1.0_dp))
+                        q = (q - 1.0_dp)*(r - 1.0_dp)*(s - 1.0_dp)
+                    end if
+                    if (p > 0.0_dp) then
+                        q = -q
+                    else
+                        p = -p
+                    end if
+                    if (2.0_dp*p < min(3.0_dp*m*q - abs(tol*q), abs(e*q))) then
+                        e = d
+                        d = p/q
+                    else
+                        d = m; e = m
+                    end if
+                end if
+                a = b; fa = fb
+                if (abs(d) > tol) then
+                    b = b + d
+                else
+                    b = b + sign(tol, m)
+                end if
+                call poly_eval(fc, b, o%ye)
+                call events%eval(t + b*h, o%ye, gv)
+                fb = gv(ie)
+                if ((fb > 0.0_dp .and. fcc > 0.0_dp) .or. (fb < 0.0_dp .and. fcc < 0.0_dp)) then
+                    c = a; fcc = fa; d = b - a; e = d
+                end if
+            end do
+            root = t + b*h
+        end function event_root
+
+    end subroutine out_step
+
+    !> End of the run: the last point when only the end points are kept, sizes trimmed.
+    subroutine out_finish(o, res, t, y)
+        type(step_output), intent(in) :: o
+        type(ode_result), intent(inout) :: res
+        real(dp), intent(in) :: t, y(:)
+        real(dp), allocatable :: tt(:), yy(:, :)
+        integer, allocatable :: ii(:)
+        if (o%n_eval == 0 .and. .not. o%store_steps) then
+            if (res%nt == 0) then
+                call push_point(res, t, y)
+            else if (res%t(res%nt) /= t) then
+                call push_point(res, t, y)
+            end if
+        end if
+        if (size(res%t) /= res%nt) then
+            tt = res%t(1:res%nt)
+            yy = res%y(:, 1:res%nt)
+            call move_alloc(tt, res%t)
+            call move_alloc(yy, res%y)
+        end if
+        if (size(res%ev_t) /= res%nev) then
+            tt = res%ev_t(1:res%nev)
+            yy = res%ev_y(:, 1:res%nev)
+            ii = res%ev_id(1:res%nev)
+            call move_alloc(tt, res%ev_t)
+            call move_alloc(yy, res%ev_y)
+            call move_alloc(ii, res%ev_id)
+        end if
+        if (o%dense) res%sol%t_last = t
+    end subroutine out_finish
+
+    subroutine push_point(res, t, y)
+        type(ode_result), intent(inout) :: res
+        real(dp), intent(in) :: t, y(:)
+        real(dp), allocatable :: tt(:), yy(:, :)
+        integer :: cap
+        cap = size(res%t)
+        if (res%nt >= cap) then
+            cap = max(16, 2*cap)
+            allocate (tt(cap), yy(size(y), cap))
+            tt(1:res%nt) = res%t(1:res%nt)
+            yy(:, 1:res%nt) = res%y(:, 1:res%nt)
+            call move_alloc(tt, res%t)
+            call move_alloc(yy, res%y)
+        end if
+        res%nt = res%nt + 1
+        res%t(res%nt) = t
+        res%y(:, res%nt) = y
+    end subroutine push_point
+
+    subroutine push_event(res, t, y, id)
+        type(ode_result), intent(inout) :: res
+        real(dp), intent(in) :: t, y(:)
+        integer, intent(in) :: id
+        real(dp), allocatable :: tt(:), yy(:, :)
+        integer, allocatable :: ii(:)
+        integer :: cap
+        cap = size(res%ev_t)
+        if (res%nev >= cap) then
+            cap = max(8, 2*cap)
+            allocate (tt(cap), yy(size(y), cap), ii(cap))
+            tt(1:res%nev) = res%ev_t(1:res%nev)
+            yy(:, 1:res%nev) = res%ev_y(:, 1:res%nev)
+            ii(1:res%nev) = res%ev_id(1:res%nev)
+            call move_alloc(tt, res%ev_t)
+            call move_alloc(yy, res%ev_y)
+            call move_alloc(ii, res%ev_id)
+        end if
+        res%nev = res%nev + 1
+        res%ev_t(res%nev) = t
+        res%ev_y(:, res%nev) = y
+        res%ev_id(res%nev) = id
+    end subroutine push_event
+
+    subroutine dense_push(sol, t, h, fc, t_end)
+        type(dense_solution), intent(inout) :: sol
+        real(dp), intent(in) :: t, h, fc(:, 0:), t_end
+        real(dp), allocatable :: ts(:), hs(:), cc(:, :, :)
+        integer :: cap
+        cap = size(sol%ts)
+        if (sol%nseg >= cap) then
+            cap = 2*cap
+            allocate (ts(cap), hs(cap), cc(sol%n, 0:sol%nf, cap))
+            ts(1:sol%nseg) = sol%ts(1:sol%nseg)
+            hs(1:sol%nseg) = sol%hs(1:sol%nseg)
+            cc(:, :, 1:sol%nseg) = sol%coef(:, :, 1:sol%nseg)
+            call move_alloc(ts, sol%ts)
+            call move_alloc(hs, sol%hs)
+            call move_alloc(cc, sol%coef)
+        end if
+        sol%nseg = sol%nseg + 1
+        sol%ts(sol%nseg) = t
+        sol%hs(sol%nseg) = h
+        sol%coef(:, :, sol%nseg) = fc
+        sol%t_last = t_end
+    end subroutine dense_push
+
+end module conmech_radau_common

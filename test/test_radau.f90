@@ -1,0 +1,90 @@
+!> Radau IIA (order 5) through ode_solve: Hairer's scaled Van der Pol (eps = 1e-6) against
+!! a tight reference, counters, dense output, bad input.
+program test_radau
+    use conmech
+    use conmech_testing, only: test_suite
+    implicit none
+    type(test_suite) :: ts
+    type(ode_function) :: f
+    type(ode_options) :: opt
+    type(ode_result) :: r
+    real(dp) :: ref(2), y(2)
+
+    ts%name = "test_radau"
+    f%f => vdp
+    f%jac => vdp_jac
+    call ts%check(method_from_name("Radau") == METHOD_RADAU5, "method name Radau")
+    ! reference: SciPy's Radau at rtol = atol = 1e-12 (independent implementation)
+    ref = [1.706167437543211_dp, -0.8928100165510839_dp]
+    opt%method = METHOD_RADAU5
+    opt%rtol = 1.0e-6_dp
+    opt%atol = 1.0e-6_dp
+    opt%dense_output = .true.
+    call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
+    call ts%check(r%success, "Van der Pol eps = 1e-6: "//r%message)
+    call ts%check_less(maxval(abs(r%y(:, r%nt) - ref)), 3.0e-8_dp, "error at t = 2")
+    call ts%check(r%stats%naccept > 500 .and. r%stats%naccept < 1100 .and. &
+                  r%stats%njev > 0 .and. r%stats%nlu >= 2*r%stats%njev, "counters")
+    call r%sol%eval(2.0_dp, y)
+    call ts%check_less(maxval(abs(y - r%y(:, r%nt))), 1.0e-12_dp, "dense output at the end")
+    call r%sol%eval(1.0_dp, y)
+    call ts%check(abs(y(1)) < 2.1_dp .and. abs(y(1)) > 1.0_dp, "dense output inside")
+
+    ! the same with the finite-difference Jacobian
+    f%jac => null()
+    call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
+    call ts%check_less(maxval(abs(r%y(:, r%nt) - ref)), 3.0e-8_dp, "FD Jacobian: error")
+
+    ! mass-matrix form: y1' = y2, 0 = y2 + y1 (index 1), so y1 = exp(-t)
+    f%f => dae
+    f%jac => null()
+    opt%dense_output = .false.
+    opt%rtol = 1.0e-8_dp
+    opt%atol = 1.0e-10_dp
+    call radau_solve(f, [0.0_dp, 3.0_dp], [1.0_dp, -1.0_dp], opt, r, &
+                     mass=reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))
+    call ts%check(r%success, "index-1 DAE: "//r%message)
+    call ts%check_less(abs(r%y(1, r%nt) - exp(-3.0_dp)), 1.0e-8_dp, "DAE: y1(3) = exp(-3)")
+    call ts%check_less(maxval(abs(r%y(1, :) + r%y(2, :))), 1.0e-12_dp, &
+                       "DAE: algebraic equation at every step")
+    f%f => vdp
+
+    ! bad input
+    opt%rtol = -1.0_dp
+    call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
+    call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "rtol") > 0, &
+                  "negative rtol: "//r%message)
+    opt%rtol = 1.0e-6_dp
+    call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r, t_eval=[3.0_dp])
+    call ts%check(r%status == CM_BAD_INPUT, "t_eval outside t_span: "//r%message)
+    opt%method = METHOD_RATTLE
+    call ode_solve(f, [0.0_dp, 2.0_dp], [2.0_dp, -0.66_dp], opt, r)
+    call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "constrained") > 0, &
+                  "RATTLE in ode_solve: "//r%message)
+    call ts%finish()
+
+contains
+
+    subroutine vdp(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt = [y(2), ((1.0_dp - y(1)**2)*y(2) - y(1))/1.0e-6_dp]
+    end subroutine vdp
+
+    subroutine dae(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt = [y(2), y(2) + y(1)]
+    end subroutine dae
+
+    subroutine vdp_jac(t, y, dfdy)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        dfdy(1, :) = [0.0_dp, 1.0_dp]
+        dfdy(2, :) = [(-2.0_dp*y(1)*y(2) - 1.0_dp)/1.0e-6_dp, (1.0_dp - y(1)**2)/1.0e-6_dp]
+    end subroutine vdp_jac
+
+end program test_radau
