@@ -18,10 +18,11 @@ _METHODS = ("RK45", "DOPRI5", "DOP853", "VERNER98", "VERN9", "RK4", "Radau", "GA
 # codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
 # method_from_name by the tests (flat_method_code); the implicit methods' codes are
 # _implicit.IMPLICIT_CODES (their own flat routines)
-_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 12, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
+_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
                  **_implicit.IMPLICIT_CODES}
-# RK45 = 12: DOPRI5 with SciPy's step control and initial step (conmech_flat_ode_support
-# METHOD_RK45_SCIPY)
+# solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
+# (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
+_RK45_SCIPY = 12
 _IMPLICIT = frozenset(_implicit.IMPLICIT_CODES.values())
 _RADAU = _implicit.IMPLICIT_CODES["RADAU"]
 _MESSAGES = {
@@ -388,6 +389,8 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
     code = _METHOD_CODES.get(method.upper(), 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+    if method.upper() == "RK45":
+        code = _RK45_SCIPY
 
     # ---------------------------------------------------------------- t_span, y0
     try:
