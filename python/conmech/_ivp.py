@@ -300,9 +300,9 @@ def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
         Initial state (real; complex states raise TypeError).
-    method : {"RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4",
-              "Radau" (alias "RADAU5"), "GAUSS4", "GAUSS6"}
-        RK45: Dormand-Prince 5(4) with SciPy's step control and initial step (SciPy's
+    method : str
+        "RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4", "Radau"
+        (alias "RADAU5"), "GAUSS4" or "GAUSS6". RK45: Dormand-Prince 5(4) with SciPy's step control and initial step (SciPy's
         default method). DOPRI5: the same pair with Hairer's control (Lund stabilisation
         beta = 0.04). DOP853: Dormand-Prince 8(5,3), dense output of order 7. VERNER98:
         Verner's 9(8) pair, dense output of order 8, for tight tolerances. RK4: classical
