@@ -11,7 +11,22 @@ module test_mech_bad_types
         procedure :: phi_jac => inc_jac
     end type pendulum_inconsistent
 
+    !> A pendulum whose constraint Jacobian is (wrongly) zero: the constraint cannot be
+    !! enforced or projected back onto.
+    type, extends(pendulum_xy) :: pendulum_zero_jac
+    contains
+        procedure :: phi_jac => zero_jac
+    end type pendulum_zero_jac
+
 contains
+
+    subroutine zero_jac(self, t, q, g)
+        class(pendulum_zero_jac), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:)
+        real(dp), intent(out) :: g(:, :)
+        g = 0.0_dp
+    end subroutine zero_jac
 
     subroutine inc_phi(self, t, q, c)
         class(pendulum_inconsistent), intent(in) :: self
@@ -156,5 +171,28 @@ program test_mechanics_bad_input
                   projection_from_name("baumgarte") == PROJ_BAUMGARTE .and. &
                   projection_from_name("sideways") == -1, "projection names")
 
+    ! ---------------------------------------------------------------- zero constraint Jacobian
+    block
+        type(pendulum_zero_jac) :: zj
+        type(constrained_options) :: zopt
+        real(dp) :: qz(2)
+        integer :: iters
+        zj%n = 2
+        zj%n_hol = 1
+        call constrained_solve(zj, [0.0_dp, 1.0_dp], [0.6_dp, -0.8_dp], [0.0_dp, 0.0_dp], &
+                               zopt, r)
+        call ts%check(r%status == CM_BAD_INPUT .and. .not. r%success .and. &
+                      index(r%message, "Jacobian is zero") > 0, &
+                      "zero constraint Jacobian at the start -> CM_BAD_INPUT: "//r%message)
+        ! a projection that cannot reduce |phi| fails instead of keeping the state
+        qz = [0.7_dp, -0.8_dp]
+        call project_position(zj, 0.0_dp, qz, 1.0e-14_dp, 10, iters, info, msg)
+    end block
+    call ts%check(info == CM_NO_CONVERGENCE .and. index(msg, "did not converge") > 0, &
+                  "project_position with a zero Jacobian -> CM_NO_CONVERGENCE: "//msg)
+
+    ! gfortran keeps a deferred-length character of the main program on its stack, not in
+    ! static storage: free it, or LeakSanitizer reports its last value as leaked
+    if (allocated(msg)) deallocate (msg)
     call ts%finish()
 end program test_mechanics_bad_input

@@ -217,5 +217,17 @@ program test_mechanics_chain
     call make_constrained("pendulum_chain_xy", [2.5_dp], band, info, msg)
     call ts%check(info == CM_BAD_INPUT .and. index(msg, "whole number") > 0, &
                   "N = 2.5: bad input")
+    ! gfortran keeps the main program's allocatables on its stack, not in static storage:
+    ! free them, or LeakSanitizer reports them as leaked
+    if (allocated(msg)) deallocate (msg)
+    if (allocated(q0)) deallocate (q0, v0)
+    if (allocated(q)) deallocate (q)
+    if (allocated(v)) deallocate (v)
+    if (allocated(qd)) deallocate (qd)
+    if (allocated(vd)) deallocate (vd)
+    if (allocated(a1)) deallocate (a1, a2, l1, l2)
+    if (allocated(band)) deallocate (band)
+    if (allocated(dense)) deallocate (dense)
+    if (allocated(pend)) deallocate (pend)
     call ts%finish()
 end program test_mechanics_chain

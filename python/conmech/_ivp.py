@@ -2,20 +2,29 @@
 import math
 import numbers
 
+import warnings
+
 import numpy as np
 
 from . import _conmech
+from ._callback import Guard, as_result, message_text
 from .systems import BuiltinSystem
 from . import _implicit
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "Radau", "GAUSS4",
+_METHODS = ("RK45", "DOPRI5", "DOP853", "VERNER98", "VERN9", "RK4", "Radau", "GAUSS4",
             "GAUSS6")
 # codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
-# method_from_name by the tests (flat_method_code)
+# method_from_name by the tests (flat_method_code); the implicit methods' codes are
+# _implicit.IMPLICIT_CODES (their own flat routines)
 _METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
                  **_implicit.IMPLICIT_CODES}
+# solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
+# (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
+_RK45_SCIPY = 12
+_IMPLICIT = frozenset(_implicit.IMPLICIT_CODES.values())
+_RADAU = _implicit.IMPLICIT_CODES["RADAU"]
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -67,7 +76,9 @@ class DenseOutput:
 
     ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
     (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
-    OdeSolution does. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
+    OdeSolution does. SciPy's OdeSolution attributes: ``ts`` (segment boundaries, in the
+    direction of integration), ``ts_sorted``, ``interpolants`` (one callable per step, with
+    t_old and t), ``n_segments``, ``t_min``, ``t_max``, ``ascending``. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
     in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
     RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
     VERNER98), as in conmech_ode_solver's dense_solution.
@@ -89,6 +100,27 @@ class DenseOutput:
         self.ts = np.append(self.t_start, self.t_start[-1] + self.h[-1]) \
             if self.n_segments else np.array([t_min])
         self._ascending = self.n_segments == 0 or self.h[0] > 0
+
+    # SciPy's OdeSolution attributes
+    @property
+    def ascending(self):
+        """True when the integration went forward in time."""
+        return bool(self._ascending)
+
+    @property
+    def ts_sorted(self):
+        """The segment boundaries in ascending order."""
+        return self.ts if self._ascending else self.ts[::-1]
+
+    @property
+    def side(self):
+        return "right" if self._ascending else "left"
+
+    @property
+    def interpolants(self):
+        """One callable per step (SciPy's DenseOutput objects): ``interpolants[i](t)``
+        evaluates the polynomial of step i, with attributes t_old, t, t_min, t_max."""
+        return [_Segment(self, i) for i in range(self.n_segments)]
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
@@ -117,6 +149,25 @@ class DenseOutput:
         return y[:, 0] if scalar else y
 
 
+class _Segment:
+    """The polynomial of one step of a :class:`DenseOutput` (SciPy's DenseOutput)."""
+
+    __slots__ = ("_sol", "_i", "t_old", "t", "t_min", "t_max")
+
+    def __init__(self, sol, i):
+        self._sol, self._i = sol, i
+        self.t_old = float(sol.t_start[i])
+        self.t = float(sol.t_start[i] + sol.h[i])
+        self.t_min, self.t_max = min(self.t_old, self.t), max(self.t_old, self.t)
+
+    def __call__(self, t):
+        sol = DenseOutput(self._sol.t_start[self._i:self._i + 1],
+                          self._sol.h[self._i:self._i + 1],
+                          self._sol.coef[:, :, self._i:self._i + 1], self.t_old, self.t,
+                          form=self._sol.form)
+        return sol(t)
+
+
 def _real_scalar(value, name):
     if type(value) is float or type(value) is int:
         return float(value)
@@ -137,7 +188,10 @@ def _tolerance(value, name, n):
             raise ValueError(f"{name} must be finite")
         return np.full(n, v)
     try:
-        arr = np.asarray(value, dtype=float)
+        arr = np.asarray(value)
+        if arr.dtype.kind not in "biuf" or isinstance(value, (bool, np.bool_)):
+            raise TypeError
+        arr = arr.astype(float)
     except (TypeError, ValueError) as exc:
         raise TypeError(f"{name} must be a non-negative number or an array of shape "
                         f"({n},)") from exc
@@ -154,6 +208,8 @@ def _tolerance(value, name, n):
 
 
 def _event_settings(events):
+    """(function, terminal count (0: not terminal), direction) per event, SciPy's rules:
+    ``terminal`` is a bool or a positive integer (stop at that occurrence)."""
     if events is None:
         return []
     evs = [events] if callable(events) else events
@@ -166,16 +222,18 @@ def _event_settings(events):
             raise TypeError(f"events[{i}] is not callable")
     settings = []
     for i, e in enumerate(evs):
-        term = getattr(e, "terminal", False)
-        if isinstance(term, (bool, np.bool_)):
-            term = bool(term)
-        elif isinstance(term, numbers.Integral) and term in (0, 1):
-            term = bool(term)
-        elif isinstance(term, numbers.Integral) and term > 1:
-            raise ValueError(f"events[{i}].terminal: a count of occurrences before "
-                             f"termination ({term}) is not supported; use True or False")
+        term = getattr(e, "terminal", None)
+        if term is None or isinstance(term, (bool, np.bool_)):
+            count = int(bool(term))
+        elif isinstance(term, numbers.Real):
+            tv = float(term)
+            if not (math.isfinite(tv) and 0 <= tv <= 2**31 - 1 and tv == int(tv)):
+                raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
+                                 f"integer (a count of occurrences), got {term!r}")
+            count = int(tv)
         else:
-            raise ValueError(f"events[{i}].terminal must be a bool")
+            raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
+                             f"integer (a count of occurrences), got {term!r}")
         direction = getattr(e, "direction", 0)
         try:
             direction = float(direction)
@@ -183,73 +241,125 @@ def _event_settings(events):
             raise ValueError(f"events[{i}].direction must be a number") from None
         if math.isnan(direction):
             raise ValueError(f"events[{i}].direction must be a number")
-        settings.append((e, term, int(np.sign(direction))))
+        settings.append((e, count, int(np.sign(direction))))
     return settings
 
 
-def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
+class _StopAtStart(Exception):
+    """Internal: a terminal event zero at t0 stops the run there (SciPy's rule)."""
+
+
+def _validate_jac(jac, n):
+    """SciPy's ``jac`` option: None, a callable jac(t, y) -> (n, n), or a constant
+    (n, n) array. Returns (callable or None, constant array or None)."""
+    if jac is None:
+        return None, None
+    if callable(jac):
+        return jac, None
+    try:
+        j = np.array(jac, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("jac must be None, a callable jac(t, y) or an (n, n) array") from None
+    if j.shape != (n, n):
+        raise ValueError(f"jac must have shape ({n}, {n}), got {j.shape}")
+    if not np.all(np.isfinite(j)):
+        raise ValueError("jac must be finite")
+    return None, j
+
+
+def _positive_finite(value, name, allow_inf=False):
+    v = _real_scalar(value, name)
+    if math.isnan(v) or not v > 0 or (v == math.inf and not allow_inf):
+        raise ValueError(f"{name} must be a positive{'' if allow_inf else ' finite'} "
+                         f"number, got {v}")
+    return v
+
+
+_OPTION_NAMES = ("jac", "jac_sparsity", "lband", "uband", "min_step")
+
+
+def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
               events=None, vectorized=False, args=None, *, rtol=1e-3, atol=1e-6,
-              first_step=None, max_step=np.inf, max_steps=100000, jac=None):
+              first_step=None, max_step=np.inf, max_steps=100000, jac=None, **options):
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
+
+    A drop-in for ``scipy.integrate.solve_ivp`` with the explicit methods: the same
+    defaults (method RK45, rtol 1e-3, atol 1e-6, so a default run takes the same steps
+    and about the same nfev), the same event rules (``terminal`` as a count, an event zero
+    at t0 counted as SciPy does) and the same result fields.
 
     Parameters
     ----------
     fun : callable or conmech.systems.BuiltinSystem
         ``fun(t, y, *args) -> dydt`` (array of shape (n,)), called from Fortran through
         an f2py callback; or a compiled built-in system such as
-        ``conmech.systems.kepler(mu=1.0)``, integrated with no Python in the loop.
+        ``conmech.systems.kepler(mu=1.0)``, integrated with no Python in the loop. The
+        return value is checked on every call: None, a complex value or a wrong shape
+        raises ValueError/TypeError (as SciPy).
     t_span : 2-sequence of float
         (t0, tf); tf < t0 integrates backwards.
     y0 : array_like, shape (n,)
-        Initial state.
-    method : {"DOP853", "DOPRI5" (alias "RK45"), "VERNER98" (alias "Vern9"), "RK4", "Radau"
-              (alias "RADAU5"), "GAUSS4", "GAUSS6"} or a stepper class
-        A stepper class is accepted too: conmech.DOP853, conmech.RK45, ..., and SciPy's
-        scipy.integrate.RK45 / DOP853 (mapped to conmech's counterparts).
-        DOP853: Dormand-Prince 8(5,3), dense output of order 7. DOPRI5: Dormand-Prince
-        5(4), dense output of order 4. VERNER98: Verner's 9(8) pair, dense output of
-        order 8, for tight tolerances. RK4: classical fixed-step RK4, step ``first_step``.
+        Initial state (real; complex states raise TypeError).
+    method : str or a stepper class
+        "RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4", "Radau"
+        (alias "RADAU5"), "GAUSS4" or "GAUSS6"; or a stepper class: conmech.DOP853,
+        conmech.RK45, ..., and SciPy's scipy.integrate.RK45 / DOP853 (mapped to conmech's
+        counterparts). RK45: Dormand-Prince 5(4) with SciPy's step control and initial step
+        (SciPy's default method). DOPRI5: the same pair with Hairer's control (Lund
+        stabilisation beta = 0.04). DOP853: Dormand-Prince 8(5,3), dense output of order 7.
+        VERNER98: Verner's 9(8) pair, dense output of order 8, for tight tolerances. RK4:
+        classical fixed-step RK4, step ``first_step``.
         Radau: Radau IIA of order 5 for stiff problems (Hairer's RADAU5: simplified
         Newton with one real and one complex LU, dense output of order 3, events; counts
         njev and nlu). GAUSS4 / GAUSS6: Gauss-Legendre collocation with 2 / 3 stages
         (orders 4 / 6), symplectic, fixed step ``first_step``, for long runs of
         conservative systems. Case-insensitive.
     t_eval : array_like or None
-        Times at which to store the solution (sorted in the direction of integration,
-        inside t_span), from the dense output. None: every accepted step.
+        Times at which to store the solution (strictly monotonic in the direction of
+        integration, inside t_span), from the dense output. None: every accepted step.
     dense_output : bool
-        Return ``sol``, a callable continuous solution.
+        Return ``sol``, a callable continuous solution (SciPy's OdeSolution attributes:
+        ts, interpolants, n_segments, t_min, t_max, ascending).
     events : callable or list of callables
         ``event(t, y, *args) -> float``; zero crossings are located on the dense output.
-        Optional attributes ``terminal`` (bool) and ``direction`` (>0 rising, <0 falling,
-        0 both), as in SciPy.
+        Optional attributes ``terminal`` (bool, or a positive integer: stop at that
+        occurrence) and ``direction`` (>0 rising, <0 falling, 0 both), as in SciPy >= 1.11.
+        An event that is zero at t0 is reported at t0 when the first step moves it in its
+        direction (SciPy's rule).
     vectorized : bool
-        Accepted for SciPy compatibility and without effect: explicit Runge-Kutta methods
-        call ``fun`` with one state of shape (n,) at a time, as SciPy's do.
+        As SciPy's explicit methods: ``fun`` is called with y of shape (n, 1) and its
+        result flattened.
     args : tuple or None
-        Extra arguments passed to ``fun`` and to every event function.
+        Extra arguments passed to ``fun``, ``jac`` and every event function.
     rtol, atol : float or array_like of shape (n,)
-        Relative and absolute tolerances (rtol is raised to 100 eps at least, as SciPy).
+        Relative and absolute tolerances (finite, non-negative; rtol is raised to 100 eps
+        at least, as SciPy).
     first_step : float or None
-        Initial step (None: Hairer's heuristic). Required by RK4 (its fixed step).
+        Initial step (None: SciPy's heuristic for RK45, Hairer's for the others).
+        Required by RK4 (its fixed step).
     max_step : float
-        Largest step size (default no limit).
+        Largest step size (default no limit; positive, NaN rejected).
     max_steps : int
         Attempted steps before giving up (status -1).
     jac : callable, array_like or None
-        Used by method="Radau" (the other methods ignore it with a warning, as SciPy's):
-        ``jac(t, y, *args) -> (n, n)`` (dense) or a constant matrix; None: forward
-        differences (n evaluations of fun per Jacobian).
+        Used by method="Radau": ``jac(t, y, *args) -> (n, n)`` (dense) or a constant
+        matrix; None: forward differences (n evaluations of fun per Jacobian). The other
+        methods validate it and warn that it has no effect, as SciPy's explicit ones.
+    **options
+        SciPy's other solver options for implicit methods (jac_sparsity, lband, uband,
+        min_step) are accepted and warned about as SciPy does; anything else is a
+        TypeError.
 
     Returns
     -------
     OdeResult
         t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
-        None), nfev, njev, nlu (Radau; 0 otherwise), status (0 reached the end, 1 terminal
-        event, -1 failure), message, success, and the step counts naccept, nreject.
+        None), nfev, njev, nlu (Jacobian evaluations and LU decompositions: Radau's; 0
+        for the other methods), status (0 reached the end, 1 terminal event, -1 failure),
+        message, success, and the step counts naccept, nreject.
 
-    The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step and
-    max_steps (SciPy's ``**options``) are keyword-only.
+    The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step,
+    max_steps and jac (SciPy's ``**options``) are keyword-only.
 
     Raises
     ------
@@ -271,6 +381,9 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
                             "parameters to the factory in conmech.systems")
     else:
         args = ()
+    unknown = [k for k in options if k not in _OPTION_NAMES]
+    if unknown:
+        raise TypeError(f"solve_ivp() got unexpected keyword arguments: {', '.join(unknown)}")
 
     # ---------------------------------------------------------------- method
     if isinstance(method, type):     # a stepper class: conmech.DOP853, scipy.integrate.RK45
@@ -285,6 +398,11 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         code = _METHOD_CODES.get(method.upper(), 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+    if isinstance(method, str) and method.upper() == "RK45":
+        code = _RK45_SCIPY
+    elif isinstance(method, type) and method.__module__.startswith("scipy.integrate") \
+            and method.__name__ == "RK45":
+        code = _RK45_SCIPY      # SciPy's own RK45: its step control, as the name "RK45"
 
     # ---------------------------------------------------------------- t_span, y0
     try:
@@ -298,7 +416,8 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         raise ValueError("t_span must be finite")
     y0_in = np.asarray(y0)
     if y0_in.dtype.kind == "c":
-        raise TypeError("y0 must be real: complex states are not supported")
+        raise TypeError("y0 must be real: complex states are not supported (split them "
+                        "into real and imaginary parts)")
     try:
         y0 = np.array(y0_in, dtype=float)
     except (TypeError, ValueError):
@@ -320,34 +439,38 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
     if first_step is None:
         h0 = 0.0
     else:
-        h0 = _real_scalar(first_step, "first_step")
-        if not (h0 > 0 and math.isfinite(h0)):
-            raise ValueError("first_step must be positive")
+        h0 = _positive_finite(first_step, "first_step")
         if h0 > abs(tf - t0) and tf != t0:
             raise ValueError("first_step exceeds the length of t_span")
     if code in (1, 6, 7) and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
-    if jac is not None and code != 5:
-        import warnings
-        warnings.warn("The following arguments have no effect for a chosen solver: jac.",
-                      stacklevel=2)
-        jac = None
-    hmax = _real_scalar(max_step, "max_step")
-    if not hmax > 0:
-        raise ValueError("max_step must be positive")
-    hmax = min(hmax, _HUGE)
+    hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
     if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
         raise TypeError("max_steps must be an integer")
     if not 1 <= max_steps <= 2**31 - 1:
         raise ValueError("max_steps must be positive (and below 2**31)")
+    _validate_jac(jac, n)
+    unused = sorted(options) + (["jac"] if jac is not None and code != _RADAU else [])
+    if jac is not None and code != _RADAU:
+        jac = None
+    if unused:   # as SciPy's explicit solvers
+        warnings.warn("The following arguments have no effect for a chosen solver: "
+                      f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
+    if vectorized not in (True, False, 0, 1) or isinstance(vectorized, float):
+        raise TypeError("vectorized must be a bool")
+    if dense_output not in (True, False, 0, 1) or isinstance(dense_output, float):
+        raise TypeError("dense_output must be a bool")
 
     # ---------------------------------------------------------------- t_eval
     if t_eval is None:
         t_ev = _PAD[:0]
     else:
         try:
-            t_ev = np.array(t_eval, dtype=float)
+            t_ev = np.asarray(t_eval)
+            if t_ev.dtype.kind not in "biuf":
+                raise TypeError
+            t_ev = np.array(t_ev, dtype=float)
         except (TypeError, ValueError):
             raise TypeError("t_eval must be an array of real numbers") from None
         if t_ev.ndim != 1:
@@ -360,137 +483,239 @@ def solve_ivp(fun, t_span, y0, method="DOP853", t_eval=None, dense_output=False,
         d = np.diff(t_ev)
         if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
             raise ValueError("values in t_eval are not properly sorted (strictly "
-                             "monotonic in the direction of integration)")
+                             "monotonic in the direction of integration, no repeated "
+                             "values)")
 
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
     ne = len(settings)
-    ev_funs = [s[0] for s in settings]
-
-    # A Python exception raised in a callback is kept and the callback returns NaN from
-    # then on without calling the user's function again: the Fortran solver stops at once
-    # on the non-finite values (status "non-finite") and returns normally, freeing its
-    # memory, and the exception is raised again here, unchanged. (Letting it go through
-    # f2py instead would longjmp over the Fortran frames and leak their arrays.)
-    failure = []
-
-    if ne > 0:
-        nan_g = [math.nan] * ne
-
-        def events_cb(t, y):
-            if failure:
-                return nan_g
-            yc = y.copy()
-            try:
-                return [e(t, yc, *args) for e in ev_funs]
-            except BaseException as exc:
-                failure.append(exc)
-                return nan_g
-    else:
-        def events_cb(t, y):  # never called when ne = 0
-            raise RuntimeError("conmech: events callback called without events")
-
-    out = {}
-
-    def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
-        # the arrays wrap Fortran memory that is freed on return: copy them
-        out["t"] = t.copy()
-        out["y"] = y.reshape(n, t.size).copy()
-        if ne:
-            out["ev_t"] = ev_t.copy()
-            out["ev_y"] = ev_y.reshape(n, ev_t.size).copy()
-            out["ev_id"] = ev_id.copy()
-        if dense_output:
-            out["ts"] = ts.copy()
-            out["hs"] = hs.copy()
-            out["coef"] = coef.reshape(n, -1, ts.size).copy()
-
-    # f2py cannot pass empty arrays: t_eval, ev_dir, ev_term get at least one element
-    # and their counts neval, ne say how many are used.
+    run = _Run(fun, builtin, args, n, settings, bool(vectorized), t0, jac)
+    remaining = [s[1] for s in settings]       # occurrences left before termination
+    common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
+                  max_steps=int(max_steps), dense=int(bool(dense_output)))
     if ne:
         ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
-        ev_term = np.array([int(s[1]) for s in settings], dtype=np.intc)
     else:
-        ev_dir = ev_term = _PADI
-    common = dict(t_span=np.array([t0, tf]), y0=y0, method=code, rtol=rtol_v, atol=atol_v,
-                  first_step=h0, max_step=hmax, max_steps=int(max_steps),
-                  dense=int(bool(dense_output)), neval=t_ev.size,
-                  t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir, ev_term=ev_term)
-    probe_calls = 0
-    njev = nlu = 0
-    if code >= 5:
-        rhs = None
-        if not builtin:
-            f0 = np.asarray(fun(t0, y0.copy(), *args))
-            probe_calls = 1
-            if f0.size != n or f0.ndim > 1:
-                raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
-                                 f"shape {f0.shape}")
-            nan_y = np.full(n, math.nan)
+        ev_dir = _PADI
 
-            def rhs(t, y):
-                if failure:
-                    return nan_y
-                try:
-                    return fun(t, y.copy(), *args)
-                except BaseException as exc:
-                    failure.append(exc)
-                    return nan_y
-        nfev, njev, nlu, naccept, nreject, form, info, message = _implicit.run(
-            builtin, fun, rhs, jac, args, n, events_cb, store, common, failure)
-    elif builtin:
-        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
-            *fun._flat_args(), events_cb, store, **common)
-    else:
-        # One probe call checks the shape of fun's output and gives a clear error.
-        f0 = np.asarray(fun(t0, y0.copy(), *args))
-        probe_calls = 1
-        if f0.size != n or f0.ndim > 1:
-            raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
-                             f"shape {f0.shape}")
-        nan_y = np.full(n, math.nan)
-        nan_y.flags.writeable = False
-
-        def rhs(t, y):
-            if failure:
-                return nan_y
-            try:
-                return fun(t, y.copy(), *args)
-            except BaseException as exc:
-                failure.append(exc)
-                return nan_y
-        nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
-            rhs, events_cb, store, **common)
-    if failure:
-        raise failure[0]
-
-    message = bytes(message).decode("ascii", "replace").strip() \
-        if not isinstance(message, str) else message.strip()
-    info = int(info)
-    if info == _CM_BAD_INPUT:
-        raise ValueError(message)
-    if info >= 0:
-        status = int(info)
-        message = _MESSAGES.get(status, message)
-    else:
-        status = -1
-    res = OdeResult(t=out.get("t", np.array([t0])), y=out.get("y", y0[:, None].copy()),
-                    sol=None, t_events=None, y_events=None,
-                    nfev=int(nfev) + probe_calls, njev=njev, nlu=nlu, status=status,
-                    message=message, success=status >= 0, naccept=int(naccept),
-                    nreject=int(nreject))
-    if ne > 0 and "ev_t" in out:
-        ids = out["ev_id"]
-        res.t_events = [out["ev_t"][ids == i + 1] for i in range(ne)]
-        res.y_events = [out["ev_y"][:, ids == i + 1].T.copy() for i in range(ne)]
-    elif ne > 0:
-        res.t_events = [np.zeros(0) for _ in range(ne)]
-        res.y_events = [np.zeros((0, n)) for _ in range(ne)]
-    if dense_output and "ts" in out and out["ts"].size > 0:
-        t_last = float(res.t[-1]) if res.t.size else tf
+    # The integration runs in segments: a terminal event whose count is not reached yet
+    # ends a segment and the next one starts at the event (its function is taken as zero
+    # there, so it is not found again at once).
+    t_cur, y_cur, t_ev_cur, first_seg = t0, y0, t_ev, True
+    segs = []
+    nfev = naccept = nreject = 0
+    status, message, form = 0, "", 0
+    while True:
+        ev_term = np.array([int(r > 0) for r in remaining], dtype=np.intc) if ne else _PADI
+        out = run.call(t_cur, tf, y_cur, t_ev_cur, h0 if first_seg else 0.0, ev_dir,
+                       ev_term, common)
+        stop_at_start = isinstance(run.guard.error, _StopAtStart)
+        if stop_at_start:
+            run.guard.error = None
+        run.guard.check()
+        nfev += out["nfev"]
+        naccept += out["naccept"]
+        nreject += out["nreject"]
+        form = out["form"] or form
+        info, message = out["info"], out["message"]
+        if info == _CM_BAD_INPUT and not stop_at_start:
+            raise ValueError(message)
+        if stop_at_start:
+            # SciPy: a terminal event zero at t0, moving in its direction, stops there
+            segs.append(dict(t=np.array([t0, t0]) if t_eval is None else
+                             t_ev[t_ev == t0], y=None, ev=run.start_events, dense=None))
+            status = 1
+            break
+        if not first_seg:
+            out = _drop_first_point(out, t_eval is not None)
+        segs.append(out)
+        if first_seg and run.start_events:
+            out["ev"] = run.start_events + out["ev"]
+        first_seg = False
+        if info != 1 or not ne:
+            status = info if info >= 0 else -1
+            break
+        # a terminal event: count the occurrences of this segment
+        t_stop = out["ev"][-1][1] if out["ev"] else tf
+        fired = set()
+        stop = False
+        for i, te, _ in out["ev"]:
+            if remaining[i] > 0:
+                remaining[i] -= 1
+                if remaining[i] == 0:
+                    stop = True
+            if te == t_stop:
+                fired.add(i)
+        if stop or t_stop == tf:
+            status = 1
+            break
+        t_cur, y_cur = t_stop, out["ev"][-1][2].copy()
         if t_eval is not None:
-            t_last = float(out["ts"][-1] + out["hs"][-1])
-            if status == 1 and ne > 0:
-                t_last = float(np.max(out["ev_t"]) if tf > t0 else np.min(out["ev_t"]))
-        res.sol = DenseOutput(out["ts"], out["hs"], out["coef"], t0, t_last, form=int(form))
+            t_ev_cur = t_ev_cur[(t_ev_cur - t_stop)*math.copysign(1.0, tf - t0) > 0]
+        run.zero_at_start = fired
+
+    return _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status,
+                     message, nfev, naccept, nreject)
+
+
+def _drop_first_point(out, with_t_eval):
+    """A continuation segment repeats its start point (the event): drop it."""
+    if not with_t_eval and out["t"].size:
+        out["t"] = out["t"][1:]
+        out["y"] = out["y"][:, 1:]
+    return out
+
+
+class _Run:
+    """The callbacks of one solve_ivp call (one Guard for fun and the events) and the
+    Fortran call of one segment."""
+
+    def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None):
+        self.guard = Guard()
+        self.jac = jac
+        self.njev = self.nlu = 0
+        self.fun, self.builtin, self.args, self.n = fun, builtin, args, n
+        self.settings = settings
+        self.t0 = t0
+        self.zero_at_start = set()      # events taken as zero at a segment's start
+        self.start_events = []          # SciPy's events at t0: (i, t0, y0)
+        self.first_segment = True
+        self.rhs = None
+        if not builtin:
+            if vectorized:
+                def user(t, y, *a):
+                    r = fun(t, y[:, None], *a)
+                    return None if r is None else np.asarray(r).reshape(-1)
+            else:
+                user = fun
+            self.rhs = self.guard.wrap(user, 2, (n,), "fun", extra=args)
+
+    def events_callback(self, y_start):
+        """The events callback of a segment: g of every event, checked (one scalar each);
+        SciPy's rule for an event exactly zero at t0 (first segment), and zero at a
+        continuation's start for the events that ended the previous segment."""
+        settings, args, guard = self.settings, self.args, self.guard
+        ne = len(settings)
+        funs = [s[0] for s in settings]
+        nan_g = np.full(ne, np.nan)
+        state = {"calls": 0, "zero": []}
+        first = self.first_segment
+        zero_at_start = set(self.zero_at_start)
+
+        def events_cb(t, y):
+            if guard.error is not None:
+                return nan_g
+            try:
+                yc = y.copy()
+                g = np.empty(ne)
+                for i, e in enumerate(funs):
+                    r = e(t, yc, *args)
+                    if r is None:
+                        raise ValueError(f"events[{i}] returned None; expected a number")
+                    g[i] = as_result(r, (), f"events[{i}]")
+                k = state["calls"]
+                state["calls"] = k + 1
+                if k == 0:
+                    for i in zero_at_start:
+                        g[i] = 0.0
+                    if first:
+                        state["zero"] = [i for i in range(ne) if g[i] == 0.0
+                                         and i not in zero_at_start]
+                elif k == 1 and state["zero"]:
+                    self._scipy_start_rule(state["zero"], g, y_start)
+                return g
+            except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
+                guard.fail(exc)
+                return nan_g
+        return events_cb
+
+    def _scipy_start_rule(self, zero, g_new, y_start):
+        # SciPy's find_active_events with g = 0 at t0: up if g_new >= 0, down if <= 0;
+        # the root is t0 itself.
+        for i in zero:
+            d = self.settings[i][2]
+            up, down = g_new[i] >= 0, g_new[i] <= 0
+            if (d > 0 and up) or (d < 0 and down) or (d == 0 and (up or down)):
+                self.start_events.append((i, self.t0, y_start.copy()))
+                if self.settings[i][1] == 1:
+                    raise _StopAtStart()
+
+    def call(self, t_a, tf, y_a, t_ev, h0, ev_dir, ev_term, common):
+        ne = len(self.settings)
+        n = self.n
+        res = {}
+
+        def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
+            # the arrays wrap Fortran memory that is freed on return: copy them
+            res["t"] = t.copy()
+            res["y"] = y.reshape(n, t.size).copy()
+            res["ev"] = [(int(i) - 1, float(te), ev_y.reshape(n, -1)[:, k].copy())
+                         for k, (te, i) in enumerate(zip(ev_t, ev_id))]
+            if ts.size:
+                res["dense"] = (ts.copy(), hs.copy(), coef.reshape(n, -1, ts.size).copy())
+
+        if ne:
+            events_cb = self.events_callback(y_a)
+        else:
+            def events_cb(t, y):  # never called when ne = 0
+                return _PAD
+        kw = dict(t_span=np.array([t_a, tf]), y0=y_a, first_step=h0, neval=t_ev.size,
+                  t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir,
+                  ev_term=ev_term, **common)
+        if kw["method"] in _IMPLICIT:
+            failure = []
+            nfev, njev, nlu, naccept, nreject, form, info, message = _implicit.run(
+                self.builtin, self.fun, self.rhs, self.jac, self.args, n, events_cb, store,
+                kw, failure)
+            if failure:
+                self.guard.fail(failure[0])
+            self.njev += int(njev)
+            self.nlu += int(nlu)
+        elif self.builtin:
+            fun = self.fun
+            nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
+                *fun._flat_args(), events_cb, store, **kw)
+        else:
+            nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
+                self.rhs, events_cb, store, **kw)
+        self.first_segment = False
+        res.setdefault("t", np.array([t_a]))
+        res.setdefault("y", y_a[:, None].copy())
+        res.setdefault("ev", [])
+        res.setdefault("dense", None)
+        res.update(nfev=int(nfev), naccept=int(naccept), nreject=int(nreject),
+                   form=int(form), info=int(info), message=message_text(message))
+        return res
+
+
+def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, message,
+              nfev, naccept, nreject):
+    if status >= 0:
+        message = _MESSAGES.get(status, message)
+    ts = [s["t"] for s in segs]
+    ys = [s["y"] if s["y"] is not None else np.repeat(y0[:, None], s["t"].size, axis=1)
+          for s in segs]
+    t = np.concatenate(ts) if ts else np.array([t0])
+    y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
+    res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None,
+                    nfev=nfev, njev=run.njev, nlu=run.nlu, status=status,
+                    message=message, success=status >= 0, naccept=naccept,
+                    nreject=nreject)
+    if ne > 0:
+        evs = [e for s in segs for e in s["ev"]]
+        res.t_events = [np.array([te for i, te, _ in evs if i == k]) for k in range(ne)]
+        res.y_events = [np.array([ye for i, _, ye in evs if i == k]).reshape(-1, n)
+                        for k in range(ne)]
+    dens = [s["dense"] for s in segs if s.get("dense") is not None]
+    if dense_output and dens:
+        t_last = float(t[-1]) if t_eval is None and t.size else None
+        last = dens[-1]
+        if t_last is None:
+            t_last = float(last[0][-1] + last[1][-1])
+            if status == 1 and ne > 0 and any(s["ev"] for s in segs):
+                t_last = [e for s in segs for e in s["ev"]][-1][1]
+        res.sol = DenseOutput(np.concatenate([d[0] for d in dens]),
+                              np.concatenate([d[1] for d in dens]),
+                              np.concatenate([d[2] for d in dens], axis=2), t0, t_last,
+                              form=int(form))
     return res

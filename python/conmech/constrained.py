@@ -19,6 +19,7 @@ entirely in Fortran.
 import numpy as np
 
 from . import _conmech
+from ._callback import Guard, message_text
 from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
@@ -78,6 +79,8 @@ class BuiltinConstrained:
         params = np.array(params, dtype=float).ravel()
         if not np.all(np.isfinite(params)):
             raise ValueError("params must be finite")
+        from .systems import check_params
+        check_params(name, params)
         kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
             name, params.size, params if params.size else _PAD, 0, _NO_SPEC)
         if kind != 1:
@@ -165,94 +168,47 @@ class ConstrainedSystem:
         self.nh, self.nh_gamma, self.rheonomic = nh, nh_gamma, bool(rheonomic)
         self.energy = energy
 
-    def _callbacks(self, failure):
-        """The f2py callbacks. An exception raised by a user function is kept in
-        ``failure`` and the callbacks return NaN from then on (the Fortran solver stops on
-        the non-finite values and returns normally); :func:`solve` re-raises it."""
-        n, mh, mn = self.n, self.n_hol, self.n_nh
+    def _callbacks(self, guard):
+        """The f2py callbacks, through one :class:`conmech._callback.Guard`: every return
+        is checked (shape, real numbers); an exception raised by a user function is kept
+        and the callbacks return NaN from then on (the Fortran solver stops on the
+        non-finite values and returns normally); :func:`solve` re-raises it."""
+        n, mh, mn = self.n, max(self.n_hol, 1), max(self.n_nh, 1)
+        w = guard.wrap
 
-        # (f2py reads the number of arguments of a callback from its signature: every
-        # guarded callback spells its arguments out)
-        def failed(exc):
-            failure.append(exc)
+        def missing(*args):    # a callback Fortran never calls (count 0 or FD default)
+            raise RuntimeError("conmech: callback called although not defined")
 
-        nan_m = np.full((n, n), np.nan)
-        nan_n = np.full(n, np.nan)
-        nan_h = np.full(max(mh, 1), np.nan)
-        nan_g = np.full((max(mh, 1), n), np.nan)
-        nan_a = np.full((max(mn, 1), n), np.nan)
-        nan_b = np.full(max(mn, 1), np.nan)
+        return (w(self.mass, 2, (n, n), "mass"),
+                w(self.forces, 3, (n,), "forces"),
+                w(self.phi if self.phi is not None else missing, 2, (mh,), "phi"),
+                w(self.jac if self.jac is not None else missing, 2, (mh, n), "jac"),
+                w(self.gamma if self.gamma is not None else missing, 3, (mh,), "gamma"),
+                w(self.nh if self.nh is not None else missing, 2, ((mn, n), (mn,)), "nh"),
+                w(self.nh_gamma if self.nh_gamma is not None else missing, 3, (mn,),
+                  "nh_gamma"))
 
-        def mass(t, q, n_):
-            if failure:
-                return nan_m
-            try:
-                m = np.asarray(self.mass(t, q.copy()), dtype=float)
-                if m.shape != (n, n):
-                    raise ValueError(f"mass must return shape ({n}, {n}), got {m.shape}")
-                return m
-            except BaseException as exc:
-                failed(exc)
-                return nan_m
 
-        def forces(t, q, v, n_):
-            if failure:
-                return nan_n
-            try:
-                return np.asarray(self.forces(t, q.copy(), v.copy()), dtype=float).reshape(n)
-            except BaseException as exc:
-                failed(exc)
-                return nan_n
+def _finite(value, name, low=0.0, low_open=False, allow_inf=False):
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    if np.isnan(v) or (np.isinf(v) and not (allow_inf and v > 0)):
+        raise ValueError(f"{name} must be finite, got {v}")
+    if v < low or (low_open and v == low):
+        raise ValueError(f"{name} must be {'>' if low_open else '>='} {low}, got {v}")
+    return v
 
-        def phi(t, q, n_, mh_):
-            if failure:
-                return nan_h
-            try:
-                return np.asarray(self.phi(t, q.copy()), dtype=float).reshape(mh)
-            except BaseException as exc:
-                failed(exc)
-                return nan_h
 
-        def jac(t, q, n_, mh_):
-            if failure:
-                return nan_g
-            try:
-                return np.asarray(self.jac(t, q.copy()), dtype=float).reshape(mh, n)
-            except BaseException as exc:
-                failed(exc)
-                return nan_g
-
-        def gamma(t, q, v, n_, mh_):
-            if failure:
-                return nan_h
-            try:
-                return np.asarray(self.gamma(t, q.copy(), v.copy()), dtype=float).reshape(mh)
-            except BaseException as exc:
-                failed(exc)
-                return nan_h
-
-        def nh(t, q, n_, mn_):
-            if failure:
-                return nan_a, nan_b
-            try:
-                a, b = self.nh(t, q.copy())
-                return (np.asarray(a, dtype=float).reshape(mn, n),
-                        np.asarray(b, dtype=float).reshape(mn))
-            except BaseException as exc:
-                failed(exc)
-                return nan_a, nan_b
-
-        def nh_gamma(t, q, v, n_, mn_):
-            if failure:
-                return nan_b
-            try:
-                return np.asarray(self.nh_gamma(t, q.copy(), v.copy()),
-                                  dtype=float).reshape(mn)
-            except BaseException as exc:
-                failed(exc)
-                return nan_b
-
-        return mass, forces, phi, jac, gamma, nh, nh_gamma
+def _int(value, name, low=1, high=2**31 - 1):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
+    if not low <= int(value) <= high:
+        raise ValueError(f"{name} must be in [{low}, {high}], got {value}")
+    return int(value)
 
 
 def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="position+velocity",
@@ -312,12 +268,17 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         t0, tf = (float(x) for x in t_span)
     except (TypeError, ValueError) as exc:
         raise ValueError("t_span must be a pair of numbers (t0, tf)") from exc
+    if not (np.isfinite(t0) and np.isfinite(tf)):
+        raise ValueError("t_span must be finite")
     if q0 is None or v0 is None:
         if not isinstance(system, BuiltinConstrained):
             raise ValueError("q0 and v0 are required for a user-defined system")
         dq, dv = system.initial_state()
         q0 = dq if q0 is None else q0
         v0 = dv if v0 is None else v0
+    for name, a in (("q0", q0), ("v0", v0)):
+        if np.asarray(a).dtype.kind not in "biuf":
+            raise TypeError(f"{name} must be an array of real numbers")
     q0 = np.array(q0, dtype=float).ravel()
     v0 = np.array(v0, dtype=float).ravel()
     if q0.size != n:
@@ -326,25 +287,44 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         raise ValueError(f"v0 must have {n} elements, got {v0.size}")
     if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
         raise ValueError("q0 and v0 must be finite")
-    if not (rtol >= 0 and atol >= 0):
-        raise ValueError("rtol and atol must be non-negative")
-    if method in ("RK4", "RATTLE") and not (first_step and first_step > 0):
+    rtol = _finite(rtol, "rtol")
+    atol = _finite(atol, "atol")
+    if rtol > 1.0:
+        raise ValueError(f"rtol must be <= 1, got {rtol}")
+    if rtol == 0.0 and atol == 0.0:
+        raise ValueError("rtol and atol must not both be zero")
+    if first_step is not None:
+        first_step = _finite(first_step, "first_step", low_open=True)
+    if method in ("RK4", "RATTLE") and first_step is None:
         raise ValueError(f"first_step (the fixed step) is required for {method}")
     if method == "RATTLE" and system.n_nh:
         raise ValueError("RATTLE handles holonomic constraints only (the system has "
                          f"n_nh = {system.n_nh} non-holonomic ones)")
-    if int(every) < 1 or int(proj_max_iter) < 1 or not proj_tol > 0:
-        raise ValueError("every, proj_max_iter and proj_tol must be positive")
+    max_step = _finite(max_step, "max_step", low_open=True, allow_inf=True)
+    max_steps = _int(max_steps, "max_steps")
+    every = _int(every, "every")
+    proj_max_iter = _int(proj_max_iter, "proj_max_iter", 1, 10000)
+    proj_tol = _finite(proj_tol, "proj_tol", low_open=True)
+    if proj_tol >= 1.0:
+        raise ValueError(f"proj_tol must be < 1, got {proj_tol}")
+    alpha = _finite(alpha, "alpha")
+    beta = _finite(beta, "beta")
     if t_eval is None:
         t_ev = np.zeros(0)
     else:
-        t_ev = np.array(t_eval, dtype=float).ravel()
+        try:
+            t_ev = np.array(t_eval, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise TypeError("t_eval must be an array of real numbers") from None
+        if not np.all(np.isfinite(t_ev)):
+            raise ValueError("t_eval must be finite")
         lo, hi = min(t0, tf), max(t0, tf)
         if np.any(t_ev < lo) or np.any(t_ev > hi):
             raise ValueError("t_eval values must lie in t_span")
         d = np.diff(t_ev) * np.sign(tf - t0)
-        if np.any(d < 0):
-            raise ValueError("t_eval must be sorted in the direction of integration")
+        if np.any(d <= 0):
+            raise ValueError("t_eval must be strictly monotonic in the direction of "
+                             "integration (sorted, no repeated values)")
     iopt = np.array([PROJECTIONS[projection], int(every), int(proj_max_iter), int(max_steps)],
                     dtype=np.intc)
     mstep = float(max_step) if np.isfinite(max_step) else np.finfo(float).max
@@ -364,24 +344,14 @@ def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="positio
         stats, moved, info, message = _conmech.flat_constrained_builtin(
             *system._flat_args(), store, **common)
     else:
-        failure = []
-        cb = system._callbacks(failure)
-        # probe the callables once, for clear shape errors
-        m0 = np.asarray(system.mass(t0, q0.copy()))
-        if m0.shape != (n, n):
-            raise ValueError(f"mass must return shape ({n}, {n}), got {m0.shape}")
-        if np.asarray(system.forces(t0, q0.copy(), v0.copy())).size != n:
-            raise ValueError(f"forces must return {n} values")
-        if system.n_hol and np.asarray(system.phi(t0, q0.copy())).size != system.n_hol:
-            raise ValueError(f"phi must return n_hol = {system.n_hol} values")
+        guard = Guard()
+        cb = system._callbacks(guard)
         stats, moved, info, message = _conmech.flat_constrained_callback(
             cb[0], cb[1], cb[2], cb[3], cb[4], cb[5], cb[6], int(system.jac is not None),
             int(system.gamma is not None), int(system.nh_gamma is not None),
             int(system.rheonomic), system.n_hol, system.n_nh, store, **common)
-        if failure:
-            raise failure[0]
-    message = bytes(message).decode("ascii", "replace").strip() \
-        if not isinstance(message, str) else message.strip()
+        guard.check()
+    message = message_text(message)
     info = int(info)
     if info == _CM_BAD_INPUT:
         raise ValueError(message)

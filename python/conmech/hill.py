@@ -22,6 +22,7 @@ symmetric Newton shooting over a quarter period, monodromy from the symmetry).
 import numpy as np
 
 from . import _conmech
+from ._callback import message_text
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
            "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
@@ -30,14 +31,26 @@ __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
 C_HILL = 1.0715832774160     #: Hill's perigee constant for M_HILL
 
+_NOT_PERIODIC = -7     #: family status: Newton stopped on a state that is not periodic
 _STATUS = {0: "success", -4: "bad input", -5: "singular Newton matrix",
-           -6: "Newton did not converge"}
+           -6: "Newton did not converge", _NOT_PERIODIC: "true residual above RESIDUAL_TOL"}
+
+
+#: An orbit is accepted only if its true residual max(|x(pi/2)|, |y'(pi/2)|), from an
+#: independent adaptive integration (DOP853, tolerance 1e-12), is below this.
+RESIDUAL_TOL = 1e-8
 
 
 def _msg(message):
-    if isinstance(message, (bytes, bytearray, np.ndarray)):
-        message = bytes(message).decode("ascii", "replace")
-    return str(message).strip()
+    return message_text(message)
+
+
+def _true_residuals(ms, kappa, y0s):
+    """Residuals of the orbits y0s (n, 4) for ms (n,) by an independent integration of a
+    quarter period (conmech flat_hill_residuals); huge for a failed one."""
+    y0s = np.asfortranarray(np.asarray(y0s, dtype=float).T)
+    return np.asarray(_conmech.flat_hill_residuals(np.ascontiguousarray(ms, dtype=float),
+                                                   float(kappa), y0s))
 
 
 def _check_float(value, name, positive=False, nonneg=False):
@@ -154,8 +167,10 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False, closu
         if g.size != 2 or not np.all(np.isfinite(g)):
             raise ValueError("guess must be two finite numbers (x0, v0)")
         use = 1
-    if int(nsteps) < 0:
-        raise ValueError("nsteps must be >= 0")
+    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+        raise TypeError("nsteps must be an integer")
+    if not 0 <= int(nsteps) <= 100000:
+        raise ValueError("nsteps must be in [0, 100000]")
     closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
     if int(max_nsteps) < max(int(nsteps), 20):
         raise ValueError("max_nsteps must be >= nsteps (and >= 20)")
@@ -167,7 +182,16 @@ def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False, closu
         if info == -4:
             raise ValueError(msg)
         raise RuntimeError(msg)
-    return HillOrbit(m=m, kappa=kappa, y0=np.array(y0), period=float(period),
+    y0 = np.array(y0)
+    res = float(_true_residuals(np.array([m]), kappa, y0[None, :])[0])
+    if not (res <= RESIDUAL_TOL*max(1.0, float(np.max(np.abs(y0))))):
+        raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
+                           f"periodic to the tolerance (true residual {res:.3g} > "
+                           f"{RESIDUAL_TOL:g}): Newton did not converge to the variation "
+                           "orbit (a better guess or more nsteps is needed)")
+    if not (np.all(np.isfinite(mono)) and np.isfinite(s)):
+        raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
+    return HillOrbit(m=m, kappa=kappa, y0=y0, period=float(period),
                      jacobi=float(jacobi), monodromy=np.array(mono),
                      multipliers=np.asarray(mr) + 1j*np.asarray(mi),
                      stability_index=float(s), c=float(c), residual=float(residual),
@@ -244,6 +268,10 @@ def family(ms, kappa=1.0, nsteps=0, chunk_size=256, locate=True, mtol=1e-13):
     if not np.all(np.isfinite(ms)) or np.any(ms < 0):
         raise ValueError("ms must be finite and non-negative")
     kappa = _check_float(kappa, "kappa", positive=True)
+    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+        raise TypeError("nsteps must be an integer")
+    if not 0 <= int(nsteps) <= 100000:
+        raise ValueError("nsteps must be in [0, 100000]")
     if int(chunk_size) < 1:
         raise ValueError("chunk_size must be >= 1")
     (y0s, jac, monos, ss, cs, res, quarters, nsu, infos,
@@ -288,6 +316,9 @@ def transverse(orbit, t=None, rtol=1e-13):
     """
     if not isinstance(orbit, HillOrbit):
         raise TypeError("orbit must be a HillOrbit (from variation_orbit)")
+    rtol = _check_float(rtol, "rtol", positive=True)
+    if rtol > 1e-3:
+        raise ValueError(f"rtol must be in (0, 1e-3], got {rtol}")
     tt = np.zeros(1) if t is None else np.ascontiguousarray(np.asarray(t, dtype=float).ravel())
     if t is not None and (tt.size == 0 or not np.all(np.isfinite(tt)) or np.any(tt < 0)):
         raise ValueError("t must be finite, non-negative times")

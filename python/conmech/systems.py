@@ -20,6 +20,39 @@ _NO_SPEC = np.zeros(1, dtype=np.int64)   # spec kind 0: a built-in system, by na
 __all__ = ["BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill"]
 
 
+#: Parameters (by position) that must be positive for each built-in system: the system is
+#: singular (a division by it) or meaningless otherwise. Checked by BuiltinSystem and
+#: conmech.constrained.BuiltinConstrained.
+POSITIVE_PARAMS = {
+    "pendulum": {1: "l"}, "kepler": {0: "mu"}, "hill": {1: "kappa"},
+    "pendulum_angle": {0: "m", 2: "l"}, "cart_pendulum": {0: "M", 1: "m", 2: "l"},
+    "double_pendulum": {0: "m1", 1: "m2", 2: "l1", 3: "l2"},
+    "atwood": {0: "m1", 1: "m2"}, "spring_pendulum": {0: "m"},
+    "double_spring_pendulum": {0: "m1", 1: "m2"}, "three_springs": {0: "m"},
+    "bead_hoop": {0: "m", 1: "R"}, "polar_particle": {0: "m"},
+    "pendulum_moving": {0: "m", 2: "l"}, "yoyo_angle": {0: "m", 1: "r", 2: "I"},
+    "pendulum_xy": {0: "m", 2: "l"}, "rod_two_masses": {1: "l"},
+    "double_pendulum_xy": {0: "m1", 1: "m2", 2: "l1", 3: "l2"},
+    "atwood_xy": {0: "m1", 1: "m2"}, "pendulum_moving_xy": {0: "m", 2: "l"},
+    "yoyo": {0: "m", 1: "r", 2: "I"}, "skate": {0: "m", 1: "I"},
+    "rolling_disk": {0: "m", 1: "R", 2: "I_roll", 3: "I_turn"},
+}
+#: Parameters that must lie in a closed interval.
+RANGE_PARAMS = {"arenstorf": {0: ("mu", 0.0, 1.0)}, "hill": {0: ("m", 0.0, np.inf)}}
+
+
+def check_params(name, params):
+    """ValueError naming a parameter of the built-in ``name`` that is out of its range."""
+    for i, pname in POSITIVE_PARAMS.get(name, {}).items():
+        if i < params.size and not params[i] > 0:
+            raise ValueError(f"{pname} of the system '{name}' must be positive, got "
+                             f"{params[i]:g}")
+    for i, (pname, lo, hi) in RANGE_PARAMS.get(name, {}).items():
+        if i < params.size and not lo <= params[i] <= hi:
+            raise ValueError(f"{pname} of the system '{name}' must be in [{lo:g}, {hi:g}], "
+                             f"got {params[i]:g}")
+
+
 class BuiltinSystem:
     """A compiled first-order system y' = f(t, y), identified by name and parameters.
 
@@ -41,6 +74,7 @@ class BuiltinSystem:
         params = np.array(params, dtype=float).ravel()
         if not np.all(np.isfinite(params)):
             raise ValueError(f"params of the system '{name}' must be finite")
+        check_params(name, params)
         param_names = tuple(param_names)
         if param_names and len(param_names) != params.size:
             raise ValueError("param_names must match params in length")

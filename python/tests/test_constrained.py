@@ -160,8 +160,14 @@ def test_failures_and_bad_input():
         constrained.solve(bad, (0, 1), [0, 0], [0, 0])
     with pytest.raises(TypeError):
         constrained.solve(42, (0, 1))
-    # singular mass matrix: a clear failure, not an exception
-    r = constrained.solve("pendulum_xy", (0, 1), params=[0.0, G, 1.0])
+    # a built-in's mass m = 0 is refused up front, naming the parameter
+    with pytest.raises(ValueError, match="m of the system 'pendulum_xy' must be positive"):
+        constrained.solve("pendulum_xy", (0, 1), params=[0.0, G, 1.0])
+    # singular mass matrix of a user system: a clear failure, not an exception
+    zero_mass = constrained.ConstrainedSystem(
+        2, lambda t, q: np.zeros((2, 2)), lambda t, q, v: np.array([0.0, -G]),
+        phi=lambda t, q: [0.5 * (q @ q - 1)], n_hol=1)
+    r = constrained.solve(zero_mass, (0, 1), [0.0, -1.0], [0.0, 0.0])
     assert not r.success and "singular mass matrix" in r.message
     # inconsistent constraints: no position satisfies both
     sys = constrained.ConstrainedSystem(

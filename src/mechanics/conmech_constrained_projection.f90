@@ -132,7 +132,12 @@ contains
             dq = matmul(x, ph(:, 1))
             if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*max(maxval(abs(qk)), tiny(1.0_dp))) &
                 then
-                ! the correction is below the round-off of q: phi is as small as it can get
+                ! the correction is below the round-off of q: phi is as small as it can get,
+                ! if it is at the round-off level of its terms (~ |G| |q|); otherwise the
+                ! Jacobian cannot reduce it (zero or rank-deficient G, incompatible
+                ! constraints): a failure, not a converged projection
+                if (rnorm > max(tol, 1.0e3_dp*epsilon(1.0_dp)*max(1.0_dp, &
+                                maxval(abs(g))*maxval(abs(qk))))) exit
                 q = qk
                 return
             end if

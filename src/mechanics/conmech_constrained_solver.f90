@@ -273,6 +273,11 @@ contains
             call fail(info, msg)
             return
         end if
+        if (m > 0 .and. res%rank == 0) then
+            call fail(CM_BAD_INPUT, "bad input: the constraint Jacobian is zero at the "// &
+                      "initial state (rank 0): the constraints cannot be enforced")
+            return
+        end if
 
         ! ------------------------------------------------------------ integration
         allocate (f%mech, source=sys)

@@ -19,10 +19,15 @@ module conmech_flat_ode_support
     use conmech_kinds, only: dp
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system, ode_events
-    use conmech_ode_solver, only: ode_options, ode_result, ode_solve
+    use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOPRI5
     implicit none
     private
-    public :: callback_system, callback_events, run_solve, copy_message
+    public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
+    public :: scipy_first_step
+
+    !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
+    !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
+    integer(c_int), parameter, public :: METHOD_RK45_SCIPY = 12
 
     !> A system whose right-hand side is an external procedure fun(t, y, dydt, n).
     type, extends(ode_system) :: callback_system
@@ -31,6 +36,14 @@ module conmech_flat_ode_support
     contains
         procedure :: rhs => callback_rhs
     end type callback_system
+
+    !> A system with its exact Jacobian from an external procedure jac(t, y, dfdy, n).
+    type, extends(callback_system) :: callback_jac_system
+        procedure(), pointer, nopass :: jac => null()
+    contains
+        procedure :: jacobian => callback_jacobian
+        procedure :: has_jacobian => callback_has_jacobian
+    end type callback_jac_system
 
     !> Event functions given by one external procedure events(t, y, g, n, ne).
     type, extends(ode_events) :: callback_events
@@ -50,6 +63,19 @@ contains
         real(dp), intent(out) :: dydt(:)
         call self%f(t, y, dydt, self%n)
     end subroutine callback_rhs
+
+    subroutine callback_jacobian(self, t, y, dfdy)
+        class(callback_jac_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        call self%jac(t, y, dfdy, self%n)
+    end subroutine callback_jacobian
+
+    logical function callback_has_jacobian(self)
+        class(callback_jac_system), intent(in) :: self
+        callback_has_jacobian = associated(self%jac)
+    end function callback_has_jacobian
 
     subroutine callback_eval(self, t, y, g)
         class(callback_events), intent(in) :: self
@@ -106,12 +132,20 @@ contains
             return
         end if
         opt%method = method
+        if (method == METHOD_RK45_SCIPY) then
+            opt%method = METHOD_DOPRI5
+            opt%beta = 0.0_dp
+        end if
         opt%rtol_vec = rtol
         opt%atol_vec = atol
         opt%first_step = first_step
         opt%max_step = max_step
         opt%max_steps = max_steps
         opt%dense_output = dense /= 0
+        if (method == METHOD_RK45_SCIPY .and. .not. first_step > 0.0_c_double) then
+            call scipy_first_step(sys, t_span, y0, max(rtol, 100.0_dp*epsilon(1.0_dp)), &
+                                  atol, max_step, 4, opt%first_step, nfev)
+        end if
         if (ne > 0) then
             ev%g => events
             ev%n = n
@@ -131,7 +165,7 @@ contains
             end if
         end if
 
-        nfev = res%stats%nfev
+        nfev = nfev + res%stats%nfev
         naccept = res%stats%naccept
         nreject = res%stats%nreject
         info = res%status
@@ -155,5 +189,47 @@ contains
                        empty3, n, res%nt, res%nev, 0, 1)
         end if
     end subroutine run_solve
+
+    !> SciPy's initial step (scipy.integrate._ivp.common.select_initial_step, Hairer's
+    !! heuristic with RMS norms): two right-hand side evaluations, counted in nfev.
+    subroutine scipy_first_step(sys, t_span, y0, rtol, atol, max_step, err_order, h, nfev)
+        class(ode_system), intent(in) :: sys
+        real(c_double), intent(in) :: t_span(2), y0(:), rtol(:), atol(:), max_step
+        integer, intent(in) :: err_order
+        real(dp), intent(out) :: h
+        integer(c_int), intent(inout) :: nfev
+        real(dp) :: f0(size(y0)), f1(size(y0)), y1(size(y0)), sc(size(y0))
+        real(dp) :: d0, d1, d2, h0, h1, span, dir
+        integer :: n
+        n = size(y0)
+        h = 0.0_dp
+        span = abs(t_span(2) - t_span(1))
+        if (span == 0.0_dp) return
+        dir = sign(1.0_dp, t_span(2) - t_span(1))
+        call sys%rhs(t_span(1), y0, f0)
+        nfev = nfev + 1
+        sc = atol + abs(y0)*rtol
+        d0 = sqrt(sum((y0/sc)**2)/n)
+        d1 = sqrt(sum((f0/sc)**2)/n)
+        if (.not. (d0 == d0 .and. d1 == d1)) return    ! non-finite: the solver reports it
+        if (d0 < 1.0e-5_dp .or. d1 < 1.0e-5_dp) then
+            h0 = 1.0e-6_dp
+        else
+            h0 = 0.01_dp*d0/d1
+        end if
+        h0 = min(h0, span)
+        y1 = y0 + h0*dir*f0
+        call sys%rhs(t_span(1) + h0*dir, y1, f1)
+        nfev = nfev + 1
+        d2 = sqrt(sum(((f1 - f0)/sc)**2)/n)/h0
+        if (.not. (d2 == d2)) return
+        if (d1 <= 1.0e-15_dp .and. d2 <= 1.0e-15_dp) then
+            h1 = max(1.0e-6_dp, h0*1.0e-3_dp)
+        else
+            h1 = (0.01_dp/max(d1, d2))**(1.0_dp/real(err_order + 1, dp))
+        end if
+        h = min(100.0_dp*h0, h1, span, max_step)
+        if (.not. (h > 0.0_dp .and. h <= span)) h = 0.0_dp
+    end subroutine scipy_first_step
 
 end module conmech_flat_ode_support
