@@ -61,8 +61,7 @@ def run(builtin, fun, rhs, jac, args, n, events_cb, store, common, failure):
         if jac is not None:
             raise TypeError("jac cannot be used with a built-in system (it has its own)")
         counts, form, info, message = _conmech.flat_solve_implicit_builtin(
-            fun.name, fun.params.size, fun.params if fun.params.size else np.zeros(1),
-            events_cb, store, **common)
+            *fun._flat_args(), events_cb, store, **common)
     else:
         jac_cb, has_jac = jacobian_callback(jac, n, args, failure)
         counts, form, info, message = _conmech.flat_solve_implicit_callback(

@@ -21,6 +21,7 @@ import warnings
 import numpy as np
 
 from . import _conmech
+from ._callback import Guard, message_text
 from ._ivp import DenseOutput, _real_scalar, _tolerance
 from .systems import BuiltinSystem
 
@@ -162,29 +163,13 @@ class RungeKutta:
         self._iv = np.zeros(_NI, dtype=np.intc)
         self._w = np.zeros((n, _NW), order="F")
         self._w[:, 0] = y
-        self._failure = []
         self._pending = None
         self._probe = 0
+        self._guard = Guard()
         if not self._builtin:
-            # one probe call checks the shape of fun's output (counted, as in solve_ivp)
-            f0 = np.asarray(fun(t0, y.copy()))
-            self._probe = 1
-            if f0.size != n or f0.ndim > 1:
-                raise ValueError(f"fun must return an array of shape ({n},) like y0, got "
-                                 f"shape {f0.shape}")
-            nan_y = np.full(n, math.nan)
-            nan_y.flags.writeable = False
-            failure = self._failure
-
-            def rhs(t, yy):
-                if failure:
-                    return nan_y
-                try:
-                    return fun(t, yy.copy())
-                except BaseException as exc:
-                    failure.append(exc)
-                    return nan_y
-            self._rhs = rhs
+            # every return of fun is checked (shape, None, complex) by the one wrapper of
+            # conmech._callback; an exception stops the step and is re-raised unchanged
+            self._rhs = self._guard.wrap(fun, 2, (n,), "fun")
         info, message = self._call(0)
         if info == -4:
             raise ValueError(message)
@@ -217,18 +202,13 @@ class RungeKutta:
                       max_step=self._max_step, max_steps=self._max_steps,
                       r=self._r, iv=self._iv, w=self._w)
         if self._builtin:
-            p = self.fun.params
-            info, message = _conmech.flat_stepper_builtin(
-                self.fun.name, p.size, p if p.size else _PAD, **common)
+            info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(), **common)
         else:
             info, message = _conmech.flat_stepper_callback(self._rhs, **common)
-        if self._failure:
+        if self._guard.failed:
             self.status = "failed"
-            exc = self._failure[0]
-            self._failure.clear()
-            raise exc
-        message = bytes(message).decode("ascii", "replace").strip() \
-            if not isinstance(message, str) else message.strip()
+            self._guard.check()
+        message = message_text(message)
         self.nfev = int(self._iv[15]) + self._probe
         if action == 1:
             self.t = float(self._r[0])

@@ -581,8 +581,9 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
         params = np.array(system.params, dtype=float)
         if p0 is not None:
             params[ip] = float(p0)
-        out = _conmech.flat_continuation_builtin(system.name, params.size, params, ip + 1,
-                                                 y0, period, *args)
+        name, _, _, nspec, spec = system._flat_args()
+        out = _conmech.flat_continuation_builtin(name, params.size, params, nspec, spec,
+                                                 ip + 1, y0, period, *args)
         pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
     else:
         if not callable(system):
@@ -695,11 +696,12 @@ def find_equilibrium(system, guess, t=0.0, tol=1e-12, max_iter=50, classify_tol=
         raise ValueError("tol must be positive and max_iter >= 1")
     if isinstance(system, BuiltinSystem):
         yout, info, message = _conmech.flat_find_equilibrium_builtin(
-            system.name, system.params.size, _params(system), y, float(t), float(tol),
-            int(max_iter))
+            *system._flat_args(), y, float(t), float(tol), int(max_iter))
     else:
+        g, rhs, _ = _callback(system, y.size, y, float(t))
         yout, info, message = _conmech.flat_find_equilibrium_callback(
-            _callback(system, y.size), y, float(t), float(tol), int(max_iter))
+            rhs, y, float(t), float(tol), int(max_iter))
+        g.check()
     if info != 0:
         _raise(info, message)
     e = equilibrium(system, np.array(yout), t=t, tol=classify_tol)

@@ -114,7 +114,11 @@ def test_zero_interval_finishes_at_once(cls):
 
 
 # ------------------------------------------------ conmech's own properties
-@pytest.mark.parametrize("cls,name", [(conmech.DOP853, "DOP853"), (conmech.RK45, "RK45"),
+# conmech.RK45 is the class of DOPRI5 (Hairer's control, as in Fortran); the string
+# "RK45" of solve_ivp is SciPy's control (its default method), so the class is compared
+# with "DOPRI5" and with solve_ivp(method=conmech.RK45)
+@pytest.mark.parametrize("cls,name", [(conmech.DOP853, "DOP853"), (conmech.RK45, "DOPRI5"),
+                                      (conmech.RK45, conmech.RK45),
                                       (conmech.VERNER98, "VERNER98")])
 def test_step_loop_is_solve_ivp_bit_for_bit(cls, name):
     y0 = [0.4, 0.0, 0.0, 2.0]
@@ -138,14 +142,15 @@ def test_builtin_system_steps_like_solve_ivp():
     s = conmech.DOP853(sysm, 0.0, y0, 2 * np.pi, rtol=1e-10, atol=1e-10)
     while s.status == "running":
         s.step()
-    r = conmech.solve_ivp(sysm, (0, 2 * np.pi), y0, rtol=1e-10, atol=1e-10)
+    r = conmech.solve_ivp(sysm, (0, 2 * np.pi), y0, method="DOP853", rtol=1e-10, atol=1e-10)
     assert np.array_equal(s.y, r.y[:, -1]) and s.t == r.t[-1]
     assert_allclose(s.y, y0, atol=1e-7)      # one period of the e = 0.6 orbit closes
 
 
 def test_dense_output_matches_solve_ivp_dense():
     y0 = [0.4, 0.0, 0.0, 2.0]
-    r = conmech.solve_ivp(kepler, (0, 3.0), y0, rtol=1e-8, atol=1e-8, dense_output=True)
+    r = conmech.solve_ivp(kepler, (0, 3.0), y0, method="DOP853", rtol=1e-8, atol=1e-8,
+                          dense_output=True)
     s = conmech.DOP853(kepler, 0.0, y0, 3.0, rtol=1e-8, atol=1e-8)
     while s.status == "running":
         s.step()

@@ -95,7 +95,18 @@ contains
         do i = 1, n
             s = s + ytmp(i)
         end do
-        err = abs(h)*sqrt(s/real(n, dp))
+        if (s > huge(1.0_dp)) then     ! squares overflowed (huge states): h inside them
+            s = 0.0_dp
+            do i = 1, n
+                e = tb%e(1)*k(i, 1) + tb%e(3)*k(i, 3) + tb%e(4)*k(i, 4) + tb%e(5)*k(i, 5) &
+                    + tb%e(6)*k(i, 6) + tb%e(7)*k(i, 7)
+                sk = atol(i) + rtol(i)*max(abs(y(i)), abs(ynew(i)))
+                s = s + (h*e/sk)**2
+            end do
+            err = sqrt(s/real(n, dp))
+        else
+            err = abs(h)*sqrt(s/real(n, dp))
+        end if
     end subroutine dopri5_attempt
 
     !> Dormand-Prince 8(5,3) step: stages 2..12; ynew; err (the FSAL stage 13 is the
@@ -158,7 +169,16 @@ contains
             sk = atol(i) + rtol(i)*max(abs(y(i)), abs(ynew(i)))
             s = s + (ytmp(i)/sk)**2
         end do
-        err = abs(h)*sqrt(s/real(n, dp))
+        if (s > huge(1.0_dp)) then     ! squares overflowed (huge states): h inside them
+            s = 0.0_dp
+            do i = 1, n
+                sk = atol(i) + rtol(i)*max(abs(y(i)), abs(ynew(i)))
+                s = s + (h*ytmp(i)/sk)**2
+            end do
+            err = sqrt(s/real(n, dp))
+        else
+            err = abs(h)*sqrt(s/real(n, dp))
+        end if
         if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine verner_attempt
 

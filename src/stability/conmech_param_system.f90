@@ -6,9 +6,13 @@ module conmech_param_system
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_systems, only: make_system
+    use conmech_generalized, only: generalized_ode
+    use conmech_c_system, only: c_ode_system
+    use conmech_c_mechanics, only: c_generalized_system
     implicit none
     private
     public :: builtin_param_system, set_builtin_param, make_param_system
+    public :: make_compiled_param_system
 
     !> The built-in system `name` with parameters `params`; params(ip) is the continued one.
     type, extends(ode_system) :: builtin_param_system
@@ -44,6 +48,56 @@ contains
         call make_system(sys%name, sys%params, sys%inner, info, msg)
     end subroutine make_param_system
 
+    !> The same for a compiled system (conmech_c_system / conmech_c_mechanics: its parameter
+    !! array p is set in place, no rebuild); info CM_BAD_INPUT for ip out of range or a
+    !! system that is not compiled.
+    subroutine make_compiled_param_system(inner, params, ip, sys, info, msg)
+        class(ode_system), intent(in) :: inner
+        real(dp), intent(in) :: params(:)
+        integer, intent(in) :: ip
+        type(builtin_param_system), intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        if (ip < 1 .or. ip > size(params)) then
+            msg = "the continuation parameter index is out of range"
+            return
+        end if
+        sys%name = ""
+        sys%params = params
+        sys%ip = ip
+        allocate (sys%inner, source=inner)
+        if (.not. set_compiled(sys%inner, ip, params(ip))) then
+            msg = "continuation in a parameter needs a built-in or a compiled system"
+            return
+        end if
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine make_compiled_param_system
+
+    !> Set parameter ip of a compiled system in place; false if it is not one.
+    logical function set_compiled(inner, ip, p) result(ok)
+        class(ode_system), intent(inout) :: inner
+        integer, intent(in) :: ip
+        real(dp), intent(in) :: p
+        ok = .false.
+        select type (inner)
+        type is (c_ode_system)
+            if (ip <= size(inner%p)) then
+                inner%p(ip) = p
+                ok = .true.
+            end if
+        type is (generalized_ode)
+            select type (mech => inner%mech)
+            type is (c_generalized_system)
+                if (ip <= size(mech%p)) then
+                    mech%p(ip) = p
+                    ok = .true.
+                end if
+            end select
+        end select
+    end function set_compiled
+
     subroutine bp_rhs(self, t, y, dydt)
         class(builtin_param_system), intent(in) :: self
         real(dp), intent(in) :: t
@@ -74,7 +128,11 @@ contains
         select type (sys)
         type is (builtin_param_system)
             sys%params(sys%ip) = p
-            call make_system(sys%name, sys%params, sys%inner, info, msg)
+            if (len(sys%name) == 0) then
+                if (.not. set_compiled(sys%inner, sys%ip, p)) return
+            else
+                call make_system(sys%name, sys%params, sys%inner, info, msg)
+            end if
         end select
     end subroutine set_builtin_param
 

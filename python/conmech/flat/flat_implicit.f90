@@ -72,7 +72,8 @@ end subroutine flat_solve_implicit_callback
 
 !> The built-in system `name` (parameters as flat_solve_builtin) with an implicit method;
 !! its analytic Jacobian if it has one, else forward differences.
-subroutine flat_solve_implicit_builtin(name, np, params, events, store, n, t_span, y0, &
+subroutine flat_solve_implicit_builtin(name, np, params, nspec, spec, events, store, n, &
+                                       t_span, y0, &
                                        method, rtol, atol, first_step, max_step, max_steps, &
                                        dense, neval, t_eval, ne, ev_dir, ev_term, counts, &
                                        dense_form, info, message)
@@ -80,13 +81,15 @@ subroutine flat_solve_implicit_builtin(name, np, params, events, store, n, t_spa
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system, system_dimension
+    use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_implicit_support, only: run_implicit
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
     real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)
@@ -127,14 +130,14 @@ subroutine flat_solve_implicit_builtin(name, np, params, events, store, n, t_spa
 
     counts = 0
     dense_form = 0
-    call make_system(name, real(params(1:np), dp), sys, info, msg)
+    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
     end if
-    if (system_dimension(name) /= n) then
+    if (spec_dimension(name, nspec, spec) /= n) then
         info = CM_BAD_INPUT
-        write (buf, '(i0)') system_dimension(name)
+        write (buf, '(i0)') spec_dimension(name, nspec, spec)
         call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
                           //trim(name)//"'", message)
         return

@@ -432,16 +432,22 @@ end subroutine flat_hill_equation_callback
 !> Pseudo-arclength continuation of a periodic orbit of a built-in system in its parameter
 !! params(ip) (see conmech_continuation; options packed as in run_continuation). The branch
 !! in arrays of mp points (npts used), the special points (nsp, at most 64).
-subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, iopt, nfree, &
+subroutine flat_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, period, ropt, &
+                                     iopt, nfree, &
                                      free_idx, ntg, targets, mp, npts, pp, per, ys, mr, mi, &
                                      s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
                                      sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_param_system, only: builtin_param_system, make_param_system
+    use conmech_ode_system, only: ode_system
+    use conmech_param_system, only: builtin_param_system, make_param_system, &
+                                    make_compiled_param_system
+    use conmech_flat_spec, only: spec_system, spec_kind, KIND_BUILTIN
     use conmech_support_cont, only: run_continuation
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, ip, n, iopt(11), nfree, ntg, mp
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
@@ -451,10 +457,17 @@ subroutine flat_continuation_builtin(name, np, params, ip, n, y0, period, ropt, 
     real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
     character(len=256), intent(out) :: message
     type(builtin_param_system) :: sys
+    class(ode_system), allocatable :: inner
     character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
-    call make_param_system(name, params(1:np), ip, sys, info, msg)
+    if (spec_kind(nspec, spec) == KIND_BUILTIN) then
+        call make_param_system(name, params(1:np), ip, sys, info, msg)
+    else      ! (no BLOCK construct: f2py reads this file)
+        call spec_system(name, params(1:np), nspec, spec, inner, info, msg)
+        if (info == 0) call make_compiled_param_system(inner, params(1:np), ip, sys, info, &
+                                                       msg)
+    end if
     if (info /= 0) then
         message = msg
         return
@@ -574,13 +587,16 @@ subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, 
 end subroutine flat_transverse_callback
 
 !> Newton's method for an equilibrium f(t, y) = 0 of a built-in system from the guess y.
-subroutine flat_find_equilibrium_builtin(name, np, params, n, y, t, tol, max_iter, yout, info, &
+subroutine flat_find_equilibrium_builtin(name, np, params, nspec, spec, n, y, t, tol, &
+                                         max_iter, yout, info, &
                                          message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system
+    use conmech_flat_spec, only: spec_system
     use conmech_equilibria, only: find_equilibrium
     implicit none
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, n, max_iter
     real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
@@ -590,7 +606,7 @@ subroutine flat_find_equilibrium_builtin(name, np, params, n, y, t, tol, max_ite
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
     yout = y
-    call make_system(name, params(1:np), sys, info, msg)
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
     if (info /= 0) then
         message = msg
         return

@@ -50,19 +50,22 @@ subroutine flat_stepper_callback(fun, action, n, t0, t_bound, y0, method, rtol, 
 end subroutine flat_stepper_callback
 
 !> One stepper action for the built-in system `name` with parameters params(1:np).
-subroutine flat_stepper_builtin(name, np, params, action, n, t0, t_bound, y0, method, rtol, &
+subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, t0, t_bound, y0, &
+                                method, rtol, &
                                 atol, first_step, max_step, max_steps, r, iv, w, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_systems, only: make_system, system_dimension
+    use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np
     real(c_double), intent(in) :: params(max(np, 1))
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: action, n, method, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
@@ -72,12 +75,12 @@ subroutine flat_stepper_builtin(name, np, params, action, n, t0, t_bound, y0, me
     character(len=256), intent(out) :: message
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
-    call make_system(name, real(params(1:np), dp), sys, info, msg)
+    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
     end if
-    if (system_dimension(name) /= n) then
+    if (spec_dimension(name, nspec, spec) /= n) then
         info = CM_BAD_INPUT
         call copy_message("bad input: y0 has the wrong size for the system '"//trim(name) &
                           //"'", message)
