@@ -170,15 +170,24 @@ def frobenius_residual(forms, coords) -> Dict[Tuple[int, ...], sp.Expr]:
 class PfaffianResult:
     """Exactness of one Pfaffian form omega = sum_i a_i dq_i.
 
-    integrable: Frobenius' condition omega ^ d omega = 0 holds (holonomic constraint).
-    exact: the form as given is closed (d omega = 0; the seed's exactness condition, mu = 1).
-    integrating_factor: mu with d(mu omega) = 0 (verified), or None if none was found
-        (or the form is not integrable).
-    integral: f with grad f = mu a (verified): the constraint is f(q) = const; or None.
-    residual: the non-zero components of omega ^ d omega, {(i, j, k): expression}; empty
-        exactly when `integrable`.
-    closedness: the non-zero components of d omega, {(i, j): d_i a_j - d_j a_i}.
-    method: how mu was found; message: a human summary.
+    Attributes
+    ----------
+    integrable : bool
+        Frobenius' condition omega ^ d omega = 0 holds (holonomic constraint).
+    exact : bool
+        The form as given is closed (d omega = 0; the seed's exactness condition, mu = 1).
+    integrating_factor : sympy expression or None
+        mu with d(mu omega) = 0 (verified), or None if none was found (or the form is not
+        integrable).
+    integral : sympy expression or None
+        f with grad f = mu a (verified): the constraint is f(q) = const; or None.
+    residual : dict
+        The non-zero components of omega ^ d omega, {(i, j, k): expression}; empty exactly
+        when ``integrable``.
+    closedness : dict
+        The non-zero components of d omega, {(i, j): d_i a_j - d_j a_i}.
+    method, message : str
+        How mu was found; a human summary.
     """
     coords: Tuple[sp.Symbol, ...]
     coeffs: Tuple[sp.Expr, ...]
