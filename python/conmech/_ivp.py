@@ -1,4 +1,9 @@
 """solve_ivp: SciPy's interface on conmech's Fortran Runge-Kutta integrators."""
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import math
 import numbers
 
@@ -78,7 +83,8 @@ class DenseOutput:
     (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
     OdeSolution does. SciPy's OdeSolution attributes: ``ts`` (segment boundaries, in the
     direction of integration), ``ts_sorted``, ``interpolants`` (one callable per step, with
-    t_old and t), ``n_segments``, ``t_min``, ``t_max``, ``ascending``. On each step [ts, ts + h], with x = (t - ts) / h, the polynomial is
+    t_old and t), ``n_segments``, ``t_min``, ``t_max``, ``ascending``. On each step
+    [ts, ts + h], with x = (t - ts) / h, the polynomial is
     in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
     RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
     VERNER98), as in conmech_ode_solver's dense_solution.
@@ -278,9 +284,15 @@ def _positive_finite(value, name, allow_inf=False):
 _OPTION_NAMES = ("jac", "jac_sparsity", "lband", "uband", "min_step")
 
 
-def solve_ivp(fun, t_span, y0, method="RK45", t_eval=None, dense_output=False,
-              events=None, vectorized=False, args=None, *, rtol=1e-3, atol=1e-6,
-              first_step=None, max_step=np.inf, max_steps=100000, jac=None, **options):
+def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[float],
+              y0: ArrayLike, method: str | type = "RK45", t_eval: ArrayLike | None = None,
+              dense_output: bool = False,
+              events: Callable[..., float] | Sequence[Callable[..., float]] | None = None,
+              vectorized: bool = False, args: tuple | None = None, *,
+              rtol: float | ArrayLike = 1e-3, atol: float | ArrayLike = 1e-6,
+              first_step: float | None = None, max_step: float = np.inf,
+              max_steps: int = 100000, jac: Callable[..., ArrayLike] | ArrayLike | None = None,
+              **options: Any) -> OdeResult:
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
 
     A drop-in for ``scipy.integrate.solve_ivp`` with the explicit methods: the same

@@ -30,6 +30,11 @@ Every function argument below is an int address, a ctypes function pointer, a nu
 the system is used (the loaded library, the numba functions); the returned objects hold
 it. A wrong address cannot be detected: it crashes the process, as in any C code.
 """
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import ctypes
 import math
 
@@ -49,7 +54,7 @@ _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy":
           "nh_gamma": 15}
 
 
-def function_address(f, what="function"):
+def function_address(f, what: str = "function") -> int:
     """The address of a compiled function: an int, a ctypes function pointer or
     ``c_void_p``, a numba ``cfunc`` (its ``address``) or a ``scipy.LowLevelCallable``.
     None gives 0 (absent)."""
@@ -198,7 +203,9 @@ class CompiledConstrained(BuiltinConstrained):
                 f"n_nh={self.n_nh}>")
 
 
-def ode_system(n, rhs, jac=None, params=(), param_names=(), keep=None, name="compiled"):
+def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
+               param_names: Sequence[str] = (), keep=None,
+               name: str = "compiled") -> CompiledSystem:
     """A first-order system y' = rhs(t, y; p) of dimension ``n`` from compiled functions
     (``jac``: the exact Jacobian df/dy, column-major; None: finite differences).
     ``params``: a sequence (names from ``param_names``) or a dict name -> value."""
@@ -210,8 +217,9 @@ def ode_system(n, rhs, jac=None, params=(), param_names=(), keep=None, name="com
     return CompiledSystem(str(name), "ode", spec, values, names, (keep, rhs, jac))
 
 
-def generalized_system(ndof, mass, forces, forces_jac=None, energy=None, params=(),
-                       param_names=(), keep=None, name="compiled"):
+def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
+                       params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
+                       keep=None, name: str = "compiled") -> CompiledSystem:
     """M(t, q) q'' = Q(t, q, q') with ``ndof`` coordinates from compiled functions; the
     state is y = [q, q']. ``forces_jac`` gives the exact Jacobian of the accelerations
     (see the module's signatures); without it the Jacobian is a finite difference."""
@@ -226,10 +234,11 @@ def generalized_system(ndof, mass, forces, forces_jac=None, energy=None, params=
                           (keep, mass, forces, forces_jac, energy))
 
 
-def constrained_system(n, mass, forces, n_hol=0, n_nh=0, phi=None, phi_jac=None, phi_t=None,
-                       phi_gamma=None, nh_matrix=None, nh_gamma=None, energy=None,
-                       rheonomic=False, params=(), param_names=(), keep=None,
-                       name="compiled"):
+def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=None,
+                       phi_jac=None, phi_t=None, phi_gamma=None, nh_matrix=None, nh_gamma=None,
+                       energy=None, rheonomic: bool = False,
+                       params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
+                       keep=None, name: str = "compiled") -> CompiledConstrained:
     """A constrained system in excessive coordinates from compiled functions: ``n``
     coordinates, ``n_hol`` holonomic constraints phi(t, q) = 0 and ``n_nh`` Pfaffian
     constraints A(t, q) q' + b(t, q) = 0. Missing phi_jac, phi_t, phi_gamma, nh_gamma
@@ -260,7 +269,7 @@ def _check(info, message):
         raise ValueError(msg)
 
 
-def evaluate(system, t, y, v=None):
+def evaluate(system: Any, t: float, y: ArrayLike, v: ArrayLike | None = None) -> dict:
     """The quantities of a built-in or compiled system at one state, as a dict.
 
     - first-order systems (:class:`conmech.systems.BuiltinSystem`, compiled 'ode' or
@@ -303,7 +312,7 @@ def evaluate(system, t, y, v=None):
     return res
 
 
-def load_model(path, name=None):
+def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstrained:
     """A system from a model library: a shared library that exports, with C linkage,
     ``conmech_model_info(int info[6])`` (kind 1 ode / 2 generalized / 3 constrained, n,
     n_hol, n_nh, rheonomic, number of parameters), ``conmech_model_params(double *p)``

@@ -16,6 +16,11 @@ A system is a built-in (:func:`builtin` or its name; see :data:`BUILTIN_NAMES`) 
 :class:`ConstrainedSystem` made of Python callables. Integrations of built-ins run
 entirely in Fortran.
 """
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
@@ -108,7 +113,7 @@ class BuiltinConstrained:
         return f"conmech.constrained.builtin({self.name!r}, {self.params.tolist()})"
 
 
-def builtin(name, params=()):
+def builtin(name: str, params: Sequence[float] = ()) -> BuiltinConstrained:
     """The built-in constrained system ``name`` with ``params`` (documented order:
     pendulum_xy m, g, l | rod_two_masses g, l | double_pendulum_xy m1, m2, l1, l2, g |
     atwood_xy m1, m2, g, L | pendulum_moving_xy m, g, l, a, b, w |
@@ -211,9 +216,13 @@ def _int(value, name, low=1, high=2**31 - 1):
     return int(value)
 
 
-def solve(system, t_span, q0=None, v0=None, method="DOP853", projection="position+velocity",
-          t_eval=None, rtol=1e-8, atol=1e-10, params=(), first_step=None, max_step=np.inf,
-          max_steps=1000000, every=1, alpha=5.0, beta=5.0, proj_tol=1e-14, proj_max_iter=10):
+def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence[float],
+          q0: ArrayLike | None = None, v0: ArrayLike | None = None, method: str = "DOP853",
+          projection: str = "position+velocity", t_eval: ArrayLike | None = None,
+          rtol: float = 1e-8, atol: float = 1e-10, params: Sequence[float] = (),
+          first_step: float | None = None, max_step: float = np.inf, max_steps: int = 1000000,
+          every: int = 1, alpha: float = 5.0, beta: float = 5.0, proj_tol: float = 1e-14,
+          proj_max_iter: int = 10) -> ConstrainedResult:
     """Integrate a constrained mechanical system.
 
     Parameters

@@ -28,6 +28,11 @@ system's values)::
     res = ensemble.solve(conmech.systems.pendulum(), (0, 10), [1.0, 0.0],
                          params={"l": np.linspace(0.5, 2.0, 100)})
 """
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import inspect
 import math
 import numbers
@@ -80,7 +85,7 @@ class Crossing:
                 f"direction={self.direction})")
 
 
-def crossing(component, value=0.0, direction=0):
+def crossing(component: int, value: float = 0.0, direction: int = 0) -> Crossing:
     """A :class:`Crossing` event: state component ``component`` crosses ``value``."""
     return Crossing(component, value, direction)
 
@@ -185,9 +190,13 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
-def solve(system, t_span, y0, params=None, *, t_eval=None, method=None, rtol=None,
-          atol=None, first_step=None, max_step=np.inf, max_steps=100000, events=None,
-          max_events=1, terminal=False, threads=None, chunk=None, progress=None):
+def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
+          params: ArrayLike | dict | None = None, *, t_eval: ArrayLike | None = None,
+          method: str | None = None, rtol: float | None = None, atol: float | None = None,
+          first_step: float | None = None, max_step: float = np.inf, max_steps: int = 100000,
+          events=None, max_events: int = 1, terminal: bool = False, threads: int | None = None,
+          chunk: int | None = None,
+          progress: Callable[[int, int], Any] | None = None) -> EnsembleResult:
     """Integrate an ensemble of members of one compiled system in parallel.
 
     Parameters

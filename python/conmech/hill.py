@@ -19,6 +19,11 @@ c = 1 + arccos(S)/(2 pi)::
 Everything runs in Fortran (fixed-step DOP853 on the state and its state transition matrix,
 symmetric Newton shooting over a quarter period, monodromy from the symmetry).
 """
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
@@ -129,8 +134,9 @@ class HillOrbit:
                 f"{self.stability_index!r}, y0={self.y0.tolist()!r})")
 
 
-def variation_orbit(m, kappa=1.0, guess=None, nsteps=0, full_period=False, closure_tol=1e-12,
-                    max_nsteps=2560):
+def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None,
+                    nsteps: int = 0, full_period: bool = False, closure_tol: float = 1e-12,
+                    max_nsteps: int = 2560) -> HillOrbit:
     """The variation orbit of Hill's problem for the parameter m.
 
     Parameters
@@ -229,8 +235,8 @@ class HillFamily:
                 f"special={[(p['kind'], p['m']) for p in self.special]})")
 
 
-def locate_stability_change(m_a, m_b, kappa=1.0, target=1.0, guess_a=None, guess_b=None,
-                            mtol=1e-13):
+def locate_stability_change(m_a: float, m_b: float, kappa: float = 1.0, target: float = 1.0,
+                            guess_a=None, guess_b=None, mtol=1e-13) -> dict:
     """The m in [m_a, m_b] where the stability index S of the variation orbit equals
     ``target`` (+1: loss of stability through +1, near m = 0.195; -1: through -1), by
     Illinois' regula falsi on S(m) - target with warm-started orbits. Returns a dict: m,
@@ -254,7 +260,8 @@ def _locate(ma, ya, mb, yb, kappa, target, mtol):
             "stability_index": float(s), "c": float(c), "residual": float(res)}
 
 
-def family(ms, kappa=1.0, nsteps=0, chunk_size=256, locate=True, mtol=1e-13):
+def family(ms: ArrayLike, kappa: float = 1.0, nsteps: int = 0, chunk_size: int = 256,
+           locate: bool = True, mtol: float = 1e-13) -> HillFamily:
     """The family of variation orbits over ``ms`` by continuation (sorted, close values work
     best: each orbit starts from the extrapolation of its predecessors in its chunk of
     ``chunk_size`` orbits; the chunks run on OpenMP threads and do not depend on their
@@ -306,7 +313,7 @@ def family(ms, kappa=1.0, nsteps=0, chunk_size=256, locate=True, mtol=1e-13):
                       iterations=np.asarray(iters, dtype=int), special=special)
 
 
-def transverse(orbit, t=None, rtol=1e-13):
+def transverse(orbit: HillOrbit, t: ArrayLike | None = None, rtol: float = 1e-13) -> dict:
     """Transverse linearisation along a variation orbit (seed 000): the normal deviation N
     obeys Hill's equation N'' + Phi(t) N = 0,
     Phi = 3 (omega + m)^2 + m^2 - n^T H n, omega = n . grad F/|v| - 2 m.

@@ -17,6 +17,11 @@
 - :func:`find_equilibrium`, :func:`equilibria` (from a :func:`grid` of guesses,
   deduplicated), :func:`lagrange_dirichlet_potential` (Hessian exact or by differences).
 """
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
@@ -147,7 +152,8 @@ class Equilibrium:
         return f"Equilibrium(kind={self.kind!r}, eigenvalues={self.eigenvalues!r})"
 
 
-def equilibrium(system, y, t=0.0, tol=1e-8, jac=None):
+def equilibrium(system: Any, y: ArrayLike, t: float = 0.0, tol: float = 1e-8,
+                jac: Callable[..., ArrayLike] | None = None) -> Equilibrium:
     """Linearise at y, compute the eigenvalues and classify (see conmech_equilibria).
 
     y must be an equilibrium: max|f(t, y)| <= EQUILIBRIUM_RTOL max(1, |J| max(1, |y|)),
@@ -194,7 +200,7 @@ def equilibrium(system, y, t=0.0, tol=1e-8, jac=None):
     return e
 
 
-def lagrange_dirichlet(hessian, tol=1e-10):
+def lagrange_dirichlet(hessian: ArrayLike, tol: float = 1e-10) -> tuple:
     """Lagrange-Dirichlet test: (positive definite?, eigenvalues ascending) of a symmetric
     Hessian of the potential energy (LAPACK dsyev)."""
     h = np.asfortranarray(np.asarray(hessian, dtype=float))
@@ -210,7 +216,9 @@ def lagrange_dirichlet(hessian, tol=1e-10):
     return bool(stable), np.array(w)
 
 
-def stm(system, t_span, y0, rtol=1e-12, atol=1e-12, jac=None, full_output=False):
+def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
+        atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
+        full_output: bool = False) -> tuple:
     """(y(t1), Phi(t1)) of the state and its state transition matrix from t0 to t1
     (DOP853 with the same step control on the state and the STM).
 
@@ -247,13 +255,14 @@ def stm(system, t_span, y0, rtol=1e-12, atol=1e-12, jac=None, full_output=False)
     return np.array(y1), np.array(phi)
 
 
-def monodromy(system, y0, period, rtol=1e-12, atol=1e-12, jac=None):
+def monodromy(system: Any, y0: ArrayLike, period: float, rtol: float = 1e-12,
+              atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None) -> np.ndarray:
     """Monodromy matrix Phi(period) of the orbit through y0 (``jac`` as in :func:`stm`)."""
     period = _real(period, "period", 0.0, low_open=True)
     return stm(system, (0.0, period), y0, rtol, atol, jac=jac)[1]
 
 
-def floquet(m, period):
+def floquet(m: ArrayLike, period: float) -> dict:
     """Multipliers (eigenvalues of m), Floquet exponents log(mu)/period and, for a 4 x 4
     monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict."""
     m = np.asarray(m)
@@ -376,8 +385,9 @@ def _true_orbit_residual(system, y0, period, kind, targets, period_factor, rtol,
     return res
 
 
-def periodic_orbit(system, y0, period, fixed_period=False, rtol=1e-12, atol=1e-12,
-                   max_iter=30, jac=None):
+def periodic_orbit(system: Any, y0: ArrayLike, period: float, fixed_period: bool = False,
+                   rtol: float = 1e-12, atol: float = 1e-12, max_iter=30,
+                   jac=None) -> PeriodicOrbit:
     """Newton shooting for a periodic orbit from the guess (y0, period), with the phase
     condition f(y0_guess) . (y0 - y0_guess) = 0. The period is an unknown unless
     ``fixed_period``. Raises RuntimeError when the Newton matrix is singular (an orbit that
@@ -387,8 +397,9 @@ def periodic_orbit(system, y0, period, fixed_period=False, rtol=1e-12, atol=1e-1
                   rtol, atol, max_iter, jac)
 
 
-def symmetric_orbit(system, y0, free, targets, period, period_factor=2.0, free_time=False,
-                    rtol=1e-12, atol=1e-12, max_iter=30, jac=None):
+def symmetric_orbit(system: Any, y0: ArrayLike, free: Sequence[int], targets: Sequence[int],
+                    period: float, period_factor: float = 2.0, free_time: bool = False,
+                    rtol=1e-12, atol=1e-12, max_iter=30, jac=None) -> PeriodicOrbit:
     """Symmetric shooting: y0 on the symmetry line (its fixed components as given), the
     components ``free`` (0-based) unknown, the components ``targets`` of the state at
     tau = period/period_factor must vanish (2: half period, 4: quarter period for two
@@ -418,7 +429,8 @@ def _band_limited(p):
     return np.ascontiguousarray(np.fft.irfft(c[:k + 1], n=m)*(m/ns))
 
 
-def hill_equation(phi, period, rtol=1e-12):
+def hill_equation(phi: Callable[[float], float] | ArrayLike, period: float,
+                  rtol: float = 1e-12) -> HillEquationResult:
     """Monodromy over one period of N'' + Phi(t) N = 0.
 
     ``phi`` is a callable Phi(t) or an array of equally spaced samples over one period
@@ -518,12 +530,13 @@ def _param_index(system, param):
     raise ValueError(f"param must be a parameter name or index of '{system.name}'")
 
 
-def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.01,
-                 ds_min=1e-8, ds_max=0.1, p_range=(-np.inf, np.inf), max_points=200,
-                 autonomous=True, fixed_period=False, conservative=False, free=None,
-                 targets=None, free_time=False, period_factor=2.0, rtol=1e-11, atol=1e-11,
-                 tol=1e-10, res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11,
-                 energy=None, in_period=False, _switch=False):
+def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | None = None,
+                 p0: float | None = None, *, direction=1, ds=0.01, ds_min=1e-8, ds_max=0.1,
+                 p_range=(-np.inf, np.inf), max_points=200, autonomous=True, fixed_period=False,
+                 conservative=False, free=None, targets=None, free_time=False,
+                 period_factor=2.0, rtol=1e-11, atol=1e-11, tol=1e-10, res_tol=1e-8,
+                 max_iter=12, locate=True, locate_tol=1e-11, energy=None, in_period=False,
+                 _switch=False) -> Branch:
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -634,7 +647,8 @@ def continuation(system, y0, period, param=None, p0=None, *, direction=1, ds=0.0
                   param="period" if in_period else pname, conservative=bool(conservative))
 
 
-def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):
+def transverse(potential: Callable[..., Any], y0: ArrayLike, period: float, omega: float = 0.0,
+               t: ArrayLike | None = None, rtol: float = 1e-12) -> dict:
     """Transverse linearisation (seed 000) of a periodic orbit of the planar natural system
     q'' = -grad V(q) + 2 omega J q' (J q' = (-q2', q1'); omega: a rotating frame, e.g.
     Hill's problem is V = -F, omega = -m): the normal deviation obeys Hill's equation
@@ -685,7 +699,8 @@ def transverse(potential, y0, period, omega=0.0, t=None, rtol=1e-12):
 
 # ------------------------------------------------------------------ equilibria (issue 9)
 
-def find_equilibrium(system, guess, t=0.0, tol=1e-12, max_iter=50, classify_tol=1e-8):
+def find_equilibrium(system: Any, guess: ArrayLike, t: float = 0.0, tol: float = 1e-12,
+                     max_iter: int = 50, classify_tol: float = 1e-8) -> Equilibrium:
     """Newton's method for f(t, y) = 0 from ``guess`` (analytic Jacobian of built-in
     systems, central differences for callables), then :func:`equilibrium` at the root:
     returns the classified :class:`Equilibrium`. Raises RuntimeError when Newton fails
@@ -710,7 +725,8 @@ def find_equilibrium(system, guess, t=0.0, tol=1e-12, max_iter=50, classify_tol=
     return e
 
 
-def equilibria(system, guesses, t=0.0, tol=1e-12, dedup_tol=1e-8, classify_tol=1e-8):
+def equilibria(system: Any, guesses: ArrayLike, t: float = 0.0, tol: float = 1e-12,
+               dedup_tol: float = 1e-8, classify_tol: float = 1e-8) -> list:
     """All equilibria reached by Newton from an array of guesses (shape (k, n)), e.g. a
     grid; duplicates (max-norm distance <= dedup_tol max(1, |y|)) removed. Guesses whose
     Newton fails are skipped. Returns a list of :class:`Equilibrium`, sorted by y."""
@@ -730,7 +746,7 @@ def equilibria(system, guesses, t=0.0, tol=1e-12, dedup_tol=1e-8, classify_tol=1
     return found
 
 
-def grid(bounds, num):
+def grid(bounds: Sequence[Sequence[float]], num: int | Sequence[int]) -> np.ndarray:
     """Guesses on a regular grid: ``bounds`` = [(lo, hi), ...] per component, ``num``
     points per component (an int or a list). Returns a (k, n) array for
     :func:`equilibria`."""
@@ -779,7 +795,8 @@ def lagrange_dirichlet_potential(potential, q, hessian=None, tol=1e-6):
     return stable, w, H
 
 
-def switch_period_doubling(system, point, param=None, **options):
+def switch_period_doubling(system: Any, point: SpecialPoint, param: str | int | None = None,
+                           **options) -> Branch:
     """Branch switching at a located period doubling: the branch of orbits of twice the
     period that bifurcates at ``point`` (a :class:`SpecialPoint` of kind 'period doubling'
     from :func:`continuation` on the same ``system``/``param``). The first step follows the
