@@ -12,6 +12,8 @@ module conmech_radau_common
     use conmech_status
     use conmech_ode_system, only: ode_events
     use conmech_ode_solver, only: ode_options, ode_result, dense_solution
+    use conmech_ode_result, only: push_point, push_event
+    use conmech_ode_dense, only: dense_push
     implicit none
     private
 
@@ -360,71 +362,5 @@ contains
         end if
         if (o%dense) res%sol%t_last = t
     end subroutine out_finish
-
-    subroutine push_point(res, t, y)
-        type(ode_result), intent(inout) :: res
-        real(dp), intent(in) :: t, y(:)
-        real(dp), allocatable :: tt(:), yy(:, :)
-        integer :: cap
-        cap = size(res%t)
-        if (res%nt >= cap) then
-            cap = max(16, 2*cap)
-            allocate (tt(cap), yy(size(y), cap))
-            tt(1:res%nt) = res%t(1:res%nt)
-            yy(:, 1:res%nt) = res%y(:, 1:res%nt)
-            call move_alloc(tt, res%t)
-            call move_alloc(yy, res%y)
-        end if
-        res%nt = res%nt + 1
-        res%t(res%nt) = t
-        res%y(:, res%nt) = y
-    end subroutine push_point
-
-    subroutine push_event(res, t, y, id)
-        type(ode_result), intent(inout) :: res
-        real(dp), intent(in) :: t, y(:)
-        integer, intent(in) :: id
-        real(dp), allocatable :: tt(:), yy(:, :)
-        integer, allocatable :: ii(:)
-        integer :: cap
-        cap = size(res%ev_t)
-        if (res%nev >= cap) then
-            cap = max(8, 2*cap)
-            allocate (tt(cap), yy(size(y), cap), ii(cap))
-            tt(1:res%nev) = res%ev_t(1:res%nev)
-            yy(:, 1:res%nev) = res%ev_y(:, 1:res%nev)
-            ii(1:res%nev) = res%ev_id(1:res%nev)
-            call move_alloc(tt, res%ev_t)
-            call move_alloc(yy, res%ev_y)
-            call move_alloc(ii, res%ev_id)
-        end if
-        res%nev = res%nev + 1
-        res%ev_t(res%nev) = t
-        res%ev_y(:, res%nev) = y
-        res%ev_id(res%nev) = id
-    end subroutine push_event
-
-    subroutine dense_push(sol, t, h, fc, t_end)
-        type(dense_solution), intent(inout) :: sol
-        real(dp), intent(in) :: t, h, fc(:, 0:), t_end
-        real(dp), allocatable :: ts(:), hs(:), cc(:, :, :)
-        integer :: cap
-        cap = size(sol%ts)
-        if (sol%nseg >= cap) then
-            cap = 2*cap
-            allocate (ts(cap), hs(cap), cc(sol%n, 0:sol%nf, cap))
-            ts(1:sol%nseg) = sol%ts(1:sol%nseg)
-            hs(1:sol%nseg) = sol%hs(1:sol%nseg)
-            cc(:, :, 1:sol%nseg) = sol%coef(:, :, 1:sol%nseg)
-            call move_alloc(ts, sol%ts)
-            call move_alloc(hs, sol%hs)
-            call move_alloc(cc, sol%coef)
-        end if
-        sol%nseg = sol%nseg + 1
-        sol%ts(sol%nseg) = t
-        sol%hs(sol%nseg) = h
-        sol%coef(:, :, sol%nseg) = fc
-        sol%t_last = t_end
-    end subroutine dense_push
 
 end module conmech_radau_common
