@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Set up what is missing (scripts/setup.sh), then run every test: fpm test and pytest.
+# Set up what is missing (scripts/setup.sh), then run every test: no compiler warning in src/
+# (scripts/warnings.sh), fpm test, pytest and the documentation build.
 # Exits non-zero if anything fails (pytest collecting no tests counts as a failure).
 set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -10,6 +11,12 @@ cd "$ROOT"
 status=0
 log_dir="$(mktemp -d)"
 trap 'rm -rf "$log_dir"' EXIT
+
+echo "[test] compiler warnings in src/ (scripts/warnings.sh)"
+if ! bash "$ROOT/scripts/warnings.sh"; then
+    echo "[test] FAILED: compiler warnings in src/" >&2
+    status=1
+fi
 
 # A runner that dies without its closing summary (e.g. a library calling STOP, which exits
 # with status 0) must not pass: every Fortran test program ends with "NAME: N passed, N

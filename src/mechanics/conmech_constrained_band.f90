@@ -51,11 +51,11 @@ contains
                 kd = -1
                 return
             end if
-            if (i > 1) then
-                if (first(i) < first(i - 1)) then
-                    kd = -1
-                    return
-                end if
+        end do
+        do i = 2, m
+            if (first(i) < first(i - 1)) then
+                kd = -1
+                return
             end if
         end do
         do i = 1, m

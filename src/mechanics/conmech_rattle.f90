@@ -240,9 +240,8 @@ contains
             if (.not. all(ieee_is_finite(t_eval))) t_eval_ok = .false.
             do i = 1, n_eval
                 if ((t_eval(i) - t0)*(tf - t_eval(i)) < 0.0_dp) t_eval_ok = .false.
-                if (i > 1) then
-                    if ((t_eval(i) - t_eval(i - 1))*(tf - t0) < 0.0_dp) t_eval_ok = .false.
-                end if
+                ! max(i - 1, 1): at i = 1 the difference is 0 (nothing to compare)
+                if ((t_eval(i) - t_eval(max(i - 1, 1)))*(tf - t0) < 0.0_dp) t_eval_ok = .false.
             end do
         end function t_eval_ok
 

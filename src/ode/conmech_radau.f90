@@ -130,10 +130,9 @@ contains
         real(dp) :: dyno, dynold, thq, dyth, qnewt, hhfac, err, fac, quot, hnew, facgus
         real(dp) :: hacc, erracc, hold, safe, facl, facr, cfac, tstop, c3q, xi
         real(dp) :: pmat(3, 3), cvec(3)
-        integer :: n, newt, nsteps, nsing, nfail, lainfo, i, j, info
+        integer :: n, newt, nsteps, nsing, nfail, lainfo, i, j
         logical :: first, reject, last, caljac, need_jac, need_lu, converged, stop_now
         logical :: newton_failed, have_cont
-        character(len=:), allocatable :: msg
         character(len=32) :: buf
 
         n = size(y0)

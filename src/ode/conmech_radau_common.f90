@@ -49,11 +49,10 @@ contains
                 msg = "bad input: t_eval values must lie in t_span"
                 return
             end if
-            if (i > 1) then
-                if ((t_eval(i) - t_eval(i - 1))*(t_span(2) - t_span(1)) < 0.0_dp) then
-                    msg = "bad input: t_eval must be sorted in the direction of integration"
-                    return
-                end if
+            ! max(i - 1, 1): at i = 1 the difference is 0 (nothing to compare)
+            if ((t_eval(i) - t_eval(max(i - 1, 1)))*(t_span(2) - t_span(1)) < 0.0_dp) then
+                msg = "bad input: t_eval must be sorted in the direction of integration"
+                return
             end if
         end do
         info = CM_SUCCESS

@@ -265,11 +265,11 @@ contains
             der2 = sum(((k(:, 2) - k(:, 1))/sk)**2)
             if (der2 <= huge(1.0_dp)) then
                 der2 = sqrt(der2)/abs(hh)
-            else if (der2 == der2) then
+            else if (.not. ieee_is_nan(der2)) then
                 ytmp = (k(:, 2) - k(:, 1))/sk
                 der2 = scaled_norm(ytmp)/abs(hh)
             end if
-            if (der2 /= der2) der2 = huge(1.0_dp)
+            if (ieee_is_nan(der2)) der2 = huge(1.0_dp)
             der12 = max(abs(der2), nf)
             if (der12 <= 1.0e-15_dp) then
                 h1 = max(1.0e-6_dp, abs(hh)*1.0e-3_dp)
@@ -384,7 +384,7 @@ contains
                     msg = "non-finite state in a fixed step from t ="//trim(buf)
                     return
                 end if
-                if (err /= err .or. err > huge(1.0_dp)) then
+                if (ieee_is_nan(err) .or. err > huge(1.0_dp)) then
                     ! non-finite error estimate: cut the step hard
                     self%n_nonfinite = self%n_nonfinite + 1
                     if (self%n_nonfinite > 40) then

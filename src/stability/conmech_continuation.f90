@@ -303,6 +303,8 @@ contains
         oo%rtol = pb%o%rtol
         oo%atol = pb%o%atol
         p = x(pb%nx)
+        ! the parameter's difference step (used below when the parameter is not the period)
+        h = pb%o%fd_step*max(1.0_dp, abs(p))
         call unpack(pb, x, y0, tend, per)
         if (.not. (tend > 0.0_dp)) then
             info = CM_NO_CONVERGENCE
@@ -310,7 +312,6 @@ contains
             return
         end if
         if (.not. pb%o%in_period) then
-            h = pb%o%fd_step*max(1.0_dp, abs(p))
             call set_param(sys, p + h)
             yp = y0
             call ode_integrate(sys, 0.0_dp, tend, yp, oo, info, message=msg)
