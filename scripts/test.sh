@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up what is missing (scripts/setup.sh), then run every test: no compiler warning in src/
-# (scripts/warnings.sh), fpm test, pytest and the documentation build.
+# (scripts/warnings.sh), fpm test, the Fortran tests again under AddressSanitizer/UBSan with
+# leak detection (scripts/sanitize.sh), pytest and the documentation build.
 # Exits non-zero if anything fails (pytest collecting no tests counts as a failure).
 set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -31,6 +32,12 @@ n_prog=$(grep -l '^ *program ' test/*.f90 | wc -l)
 n_done=$(grep -cE '^[a-z_0-9]+: [0-9]+ passed, 0 failed$' "$log_dir/fpm.log" || true)
 if [ "$n_done" -ne "$n_prog" ]; then
     echo "[test] FAILED: $n_done of $n_prog Fortran test programs reported a clean summary" >&2
+    status=1
+fi
+
+echo "[test] Fortran tests under ASan/UBSan, -fcheck=all, leak detection (scripts/sanitize.sh)"
+if ! bash "$ROOT/scripts/sanitize.sh"; then
+    echo "[test] FAILED: a Fortran test under the sanitizers" >&2
     status=1
 fi
 

@@ -65,4 +65,6 @@ program test_stepper
     call rk_init(stp, 0.0_dp, tf, [real(dp) ::], opt, info, msg)
     call ts%check(info == CM_BAD_INPUT, "rk_init rejects an empty y0: "//msg)
     call ts%finish()
+    if (allocated(msg)) deallocate (msg)   ! main-program variables are not freed at exit:
+                                           ! LeakSanitizer would report them
 end program test_stepper

@@ -110,6 +110,8 @@ program test_systems_ball
     end block
 
     call ts%finish()
+    if (allocated(msg)) deallocate (msg)   ! main-program variables are not freed at exit
+    if (allocated(cs)) deallocate (cs)     ! (LeakSanitizer would report them)
 
 contains
 
