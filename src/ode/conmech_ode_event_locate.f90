@@ -7,6 +7,7 @@ module conmech_ode_event_locate
     use conmech_ode_dense, only: interp
     use conmech_ode_result, only: ode_result, push_event
     use conmech_rk_stepper, only: rk_stepper
+    use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
     public :: find_events
@@ -89,61 +90,19 @@ contains
         integer, intent(in) :: ie
         real(dp), intent(in) :: ga, gb
         real(dp) :: root
-        real(dp) :: a, b, c, fa, fb, fcc, d, e, tol, m, p, q, r, s
+        type(brent_state) :: bs
+        logical :: done
         integer :: it
-        real(dp) :: gv(size(events%direction)), ye(stp%n), t, h
-        t = stp%t_old
-        h = stp%h_done
-        a = 0.0_dp; b = 1.0_dp; fa = ga; fb = gb
-        c = a; fcc = fa; d = b - a; e = d
+        real(dp) :: gv(size(events%direction)), ye(stp%n)
+        call brent_init(bs, ga, gb, stp%t_old, stp%h_done)
         do it = 1, 200
-            if (abs(fcc) < abs(fb)) then
-                a = b; b = c; c = a
-                fa = fb; fb = fcc; fcc = fa
-            end if
-            tol = 2.0_dp*epsilon(1.0_dp)*abs(t + b*h)/abs(h) + 0.5_dp*tiny(1.0_dp)
-            tol = max(tol, 2.0_dp*epsilon(1.0_dp))
-            m = 0.5_dp*(c - b)
-            if (abs(m) <= tol .or. fb == 0.0_dp) exit
-            if (abs(e) < tol .or. abs(fa) <= abs(fb)) then
-                d = m; e = m
-            else
-                s = fb/fa
-                if (a == c) then
-                    p = 2.0_dp*m*s
-                    q = 1.0_dp - s
-                else
-                    q = fa/fcc
-                    r = fb/fcc
-                    p = s*(2.0_dp*m*q*(q - r) - (b - a)*(r - 1.0_dp))
-                    q = (q - 1.0_dp)*(r - 1.0_dp)*(s - 1.0_dp)
-                end if
-                if (p > 0.0_dp) then
-                    q = -q
-                else
-                    p = -p
-                end if
-                if (2.0_dp*p < min(3.0_dp*m*q - abs(tol*q), abs(e*q))) then
-                    e = d
-                    d = p/q
-                else
-                    d = m; e = m
-                end if
-            end if
-            a = b; fa = fb
-            if (abs(d) > tol) then
-                b = b + d
-            else
-                b = b + sign(tol, m)
-            end if
-            call interp(stp%fc, stp%form, b, ye)
-            call events%eval(t + b*h, ye, gv)
-            fb = gv(ie)
-            if ((fb > 0.0_dp .and. fcc > 0.0_dp) .or. (fb < 0.0_dp .and. fcc < 0.0_dp)) then
-                c = a; fcc = fa; d = b - a; e = d
-            end if
+            call brent_step(bs, done)
+            if (done) exit
+            call interp(stp%fc, stp%form, bs%b, ye)
+            call events%eval(bs%t + bs%b*bs%h, ye, gv)
+            call brent_take(bs, gv(ie))
         end do
-        root = t + b*h
+        root = bs%t + bs%b*bs%h
     end function event_root
 
 end module conmech_ode_event_locate

@@ -14,6 +14,7 @@ module conmech_radau_common
     use conmech_ode_solver, only: ode_options, ode_result, dense_solution
     use conmech_ode_result, only: push_point, push_event
     use conmech_ode_dense, only: dense_push
+    use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
 
@@ -275,58 +276,19 @@ contains
         function event_root(ie, ga, gb) result(root)
             integer, intent(in) :: ie
             real(dp), intent(in) :: ga, gb
-            real(dp) :: root
-            real(dp) :: a, b, c, fa, fb, fcc, d, e, tol, m, p, q, r, s, gv(o%ne)
+            real(dp) :: root, gv(o%ne)
+            type(brent_state) :: bs
+            logical :: done
             integer :: it
-            a = 0.0_dp; b = 1.0_dp; fa = ga; fb = gb
-            c = a; fcc = fa; d = b - a; e = d
+            call brent_init(bs, ga, gb, t, h)
             do it = 1, 200
-                if (abs(fcc) < abs(fb)) then
-                    a = b; b = c; c = a
-                    fa = fb; fb = fcc; fcc = fa
-                end if
-                tol = max(2.0_dp*epsilon(1.0_dp)*abs(t + b*h)/abs(h), 2.0_dp*epsilon(1.0_dp))
-                m = 0.5_dp*(c - b)
-                if (abs(m) <= tol .or. fb == 0.0_dp) exit
-                if (abs(e) < tol .or. abs(fa) <= abs(fb)) then
-                    d = m; e = m
-                else
-                    s = fb/fa
-                    if (a == c) then
-                        p = 2.0_dp*m*s
-                        q = 1.0_dp - s
-                    else
-                        q = fa/fcc
-                        r = fb/fcc
-                        p = s*(2.0_dp*m*q*(q - r) - (b - a)*(r - 1.0_dp))
-                        q = (q - 1.0_dp)*(r - 1.0_dp)*(s - 1.0_dp)
-                    end if
-                    if (p > 0.0_dp) then
-                        q = -q
-                    else
-                        p = -p
-                    end if
-                    if (2.0_dp*p < min(3.0_dp*m*q - abs(tol*q), abs(e*q))) then
-                        e = d
-                        d = p/q
-                    else
-                        d = m; e = m
-                    end if
-                end if
-                a = b; fa = fb
-                if (abs(d) > tol) then
-                    b = b + d
-                else
-                    b = b + sign(tol, m)
-                end if
-                call poly_eval(fc, b, o%ye)
-                call events%eval(t + b*h, o%ye, gv)
-                fb = gv(ie)
-                if ((fb > 0.0_dp .and. fcc > 0.0_dp) .or. (fb < 0.0_dp .and. fcc < 0.0_dp)) then
-                    c = a; fcc = fa; d = b - a; e = d
-                end if
+                call brent_step(bs, done)
+                if (done) exit
+                call poly_eval(fc, bs%b, o%ye)
+                call events%eval(t + bs%b*h, o%ye, gv)
+                call brent_take(bs, gv(ie))
             end do
-            root = t + b*h
+            root = t + bs%b*h
         end function event_root
 
     end subroutine out_step
