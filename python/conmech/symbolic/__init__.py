@@ -287,7 +287,7 @@ def _construct(kind, inputs, params, options, derive, flags, model_only):
         t1 = time.perf_counter()
         model = compile_model(d, flags)
         model.times["derive"] = t1 - t0
-        if d.kind != "ode" and d.n > 8:
+        if d.kind != "ode" and d.n > 4:
             _check_compiled_mass(model)
         if key:
             _store(key, model, flags)

@@ -28,7 +28,7 @@ import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
 __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
-           "ENTRY_POINTS"]
+           "trig_split", "ENTRY_POINTS"]
 
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
@@ -39,7 +39,8 @@ ENTRY_POINTS = {
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "2"   # 2: conmech_* entry names, model-library description
+CODEGEN_VERSION = "3"   # 2: conmech_* entry names, model-library description;
+#                         3: structured forces / Jacobian, sin and cos by angle addition
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -234,8 +235,64 @@ def _vector_targets(name, vec):
     return [f"{name}({i + 1})" for i in range(len(vec))], list(vec)
 
 
-def _procedure(printer, cname, args, decls, outputs, result=None):
-    """One bind(C) subroutine (or a real(dp) function when `result` is an expression)."""
+def _split(term):
+    """A term of a trigonometric argument as (base, sign): -x -> (x, -1)."""
+    c, r = term.as_coeff_Mul()
+    return (r, -1) if c == -1 else (term, 1)
+
+
+def trig_split(exprs):
+    """Sines and cosines of sums from those of their terms (angle addition), when that
+    needs fewer distinct trigonometric arguments: e.g. the n(n-1)/2 cos(q_i - q_j) of a
+    chain's mass matrix from the n pairs sin(q_i), cos(q_i) (gfortran evaluates sin and cos
+    of one argument as one sincos). Returns (exprs with sin/cos replaced by symbols,
+    [(symbol, definition)] in evaluation order: sin/cos of the single terms first, then the
+    sums, each from an already defined shorter sum and one term). Unchanged when nothing is
+    gained."""
+    atoms = set()
+    for e in exprs:
+        atoms |= e.atoms(sp.sin, sp.cos)
+    args = {a.args[0] for a in atoms}
+    sums = [x for x in args if x.is_Add]
+    if not sums:
+        return exprs, []
+    bases = {_split(tm)[0] for x in sums for tm in x.args}
+    singles = {_split(x)[0] for x in args if not x.is_Add}
+    if len(bases | singles) >= len(args):
+        return exprs, []
+    defs, S, C = [], {}, {}
+    for k, r in enumerate(sorted(bases | singles, key=sp.default_sort_key)):
+        S[r], C[r] = sp.Dummy(f"ts{k}", real=True), sp.Dummy(f"tc{k}", real=True)
+        defs += [(S[r], sp.sin(r)), (C[r], sp.cos(r))]
+
+    def sc(x):
+        if not x.is_Add:
+            r, g = _split(x)
+            return g*S[r], C[r]
+        if x not in S:
+            terms = list(x.args)
+            pick = terms[-1]
+            for tm in terms:
+                rest = sp.Add(*[u for u in terms if u != tm])
+                if not rest.is_Add or rest in S:
+                    pick = tm
+                    break
+            sb, cb = sc(sp.Add(*[u for u in terms if u != pick]))
+            st, ct = sc(pick)
+            k = len(S)
+            S[x], C[x] = sp.Dummy(f"ts{k}", real=True), sp.Dummy(f"tc{k}", real=True)
+            defs.extend([(S[x], sb*ct + cb*st), (C[x], cb*ct - sb*st)])
+        return S[x], C[x]
+    for x in sorted(sums, key=lambda u: (len(u.args), sp.default_sort_key(u))):
+        sc(x)
+    rep = {a: sc(a.args[0])[0 if isinstance(a, sp.sin) else 1] for a in atoms}
+    return [e.xreplace(rep) for e in exprs], defs
+
+
+def _procedure(printer, cname, args, decls, outputs, result=None, defs=(), trig=True):
+    """One bind(C) subroutine (or a real(dp) function when `result` is an expression).
+    `defs` [(Symbol, expr)]: local values computed first (their own common-subexpression
+    elimination), that the outputs refer to; `trig`: :func:`trig_split` over everything."""
     ind = "        "
     targets, exprs, zero = [], [], []
     for name, obj, is_matrix in outputs:
@@ -250,7 +307,27 @@ def _procedure(printer, cname, args, decls, outputs, result=None):
     if result is not None:
         targets.append(cname)
         exprs.append(result)
-    temps, lines = assignments(targets, exprs, printer, ind)
+    defs = list(defs)
+    nd = len(defs)
+    allx = [sp.sympify(e) for _, e in defs] + [sp.sympify(e) for e in exprs]
+    tdefs = []
+    if trig:
+        allx, tdefs = trig_split(allx)
+    extra = {s: f"tg{k + 1}" for k, (s, _) in enumerate(tdefs)}
+    extra.update({s: f"dd{k + 1}" for k, (s, _) in enumerate(defs)})
+    saved = printer.names
+    printer.names = {**saved, **extra}
+    try:
+        lines0 = []
+        for s_, e in tdefs:
+            lines0 += _wrap(f"{extra[s_]} = {printer._print(prepare(e))}", ind)
+        temps1, lines1 = ([], [])
+        if nd:
+            temps1, lines1 = assignments([extra[s_] for s_, _ in defs], allx[:nd], printer,
+                                         ind, prefix="x")
+        temps, lines = assignments(targets, allx[nd:], printer, ind)
+    finally:
+        printer.names = saved
     if result is None:
         head = f"    subroutine {cname}({', '.join(args)}) bind(C, name=\"{cname}\")"
         tail = f"    end subroutine {cname}"
@@ -260,7 +337,8 @@ def _procedure(printer, cname, args, decls, outputs, result=None):
         tail = f"    end function {cname}"
         lines = [ln.replace(f"{ind}{cname} = ", f"{ind}{cname}_r = ", 1) for ln in lines]
         decls = decls + [f"{ind}real(dp) :: {cname}_r"]
-    return [head] + decls + _decl_temps(temps, ind) + zero + lines + [tail, ""]
+    return ([head] + decls + _decl_temps(list(extra.values()) + temps1 + temps, ind) + zero
+            + lines0 + lines1 + lines + [tail, ""])
 
 
 def _names(d):
@@ -345,10 +423,18 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
         QV = Q1 + [arr("v", [n])]
         procs.append(_procedure(pr, "conmech_mass", ["t", "q", "mm", "p"],
                                 Q1 + [arr("mm", [n, n], "out"), P], [("mm", d.M, True)]))
+        st = d.struct if d.kind == "generalized" else None
         procs.append(_procedure(pr, "conmech_forces", ["t", "q", "v", "f", "p"],
-                                QV + [arr("f", [n], "out"), P], [("f", d.Q, False)]))
+                                QV + [arr("f", [n], "out"), P],
+                                [("f", sp.Matrix(st["Q"]) if st else d.Q, False)],
+                                defs=st["defs_Q"] if st else ()))
         entries += ["mass", "forces"]
-        if d.kind == "generalized" and d.R is not None:
+        if st is not None and "R" in st:
+            procs.append(_procedure(pr, "conmech_forces_jac", ["t", "q", "v", "a", "r", "p"],
+                                    QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],
+                                    [("r", st["R"], True)], defs=st["defs_R"]))
+            entries.append("forces_jac")
+        elif d.kind == "generalized" and st is None and d.R is not None:
             procs.append(_procedure(pr, "conmech_forces_jac", ["t", "q", "v", "a", "r", "p"],
                                     QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],
                                     [("r", d.R, True)]))
