@@ -481,21 +481,21 @@ def _structure(L, M, q, v, a, t, fq, jacobian, l1L0=None):
         for key, mono in coef[i].items():
             poly = sum((c*v[x]*v[y] for (x, y), c in mono.items() if c != 0), sp.Integer(0))
             if poly != 0:
-                terms.append((key, poly))
+                terms.append((key, poly, mono))
         quad.append(terms)
     QL = []
     for i in range(n):
-        e = fq[i] + sp.diff(L0, q[i]) - sp.diff(l1[i], t) \
-            - sum((sp.diff(M[i, j], t)*v[j] for j in range(n)), sp.Integer(0))
-        e += sum((sp.diff(l1[j], q[i])*v[j] for j in range(n)), sp.Integer(0))
-        e -= sum((sp.diff(l1[i], q[k])*v[k] for k in range(n)), sp.Integer(0))
+        e = fq[i] + _d(L0, q[i]) - _d(l1[i], t) \
+            - sum((_d(M[i, j], t)*v[j] for j in range(n)), sp.Integer(0))
+        e += sum((_d(l1[j], q[i])*v[j] for j in range(n)), sp.Integer(0))
+        e -= sum((_d(l1[i], q[k])*v[k] for k in range(n)), sp.Integer(0))
         QL.append(_collect_params(sp.expand(e), set().union(
             *(x.free_symbols for x in [L] + list(fq))) - set(q) - set(v) - {t}))
     qlsym = [sp.Dummy(f"ql{i + 1}", real=True) if QL[i] != 0 else sp.Integer(0)
              for i in range(n)]
     defs_Q = [(dsym[k], e) for k, e in dM.items()] \
         + [(s_, e) for s_, e in zip(qlsym, QL) if e != 0]
-    Qs = [qlsym[i] + sum((dsym[key]*poly for key, poly in quad[i]), sp.Integer(0))
+    Qs = [qlsym[i] + sum((dsym[key]*poly for key, poly, _ in quad[i]), sp.Integer(0))
           for i in range(n)]
     out = {"defs_Q": defs_Q, "Q": Qs, "dM": dM, "quad": quad, "QL": QL}
     if not jacobian:
@@ -521,13 +521,16 @@ def _structure(L, M, q, v, a, t, fq, jacobian, l1L0=None):
                 defs_R.append((s_, de))
                 R[i, m] = s_
     for i in range(n):
-        for key, poly in quad[i]:
+        for key, poly, mono in quad[i]:
+            dp = [sp.Integer(0)]*n             # d poly / dv_m from its monomials
+            for (x, y), c in mono.items():
+                dp[x] += c*v[y]
+                dp[y] += c*v[x]
             for m in range(n):
                 if (key, m) in ddsym:
                     R[i, m] += ddsym[key, m]*poly
-                dp = sp.diff(poly, v[m])
-                if dp != 0:
-                    R[i, n + m] += dsym[key]*dp
+                if dp[m] != 0:
+                    R[i, n + m] += dsym[key]*dp[m]
         for m in range(n):
             for j in range(n):
                 key = (min(i, j), max(i, j), m)
@@ -537,6 +540,11 @@ def _structure(L, M, q, v, a, t, fq, jacobian, l1L0=None):
     return out
 
 
+def _d(e, x):
+    """de/dx, skipping expressions free of x."""
+    return sp.diff(e, x) if x in e.free_symbols else sp.Integer(0)
+
+
 def _energy(L, M, v):
     """Jacobi integral h = v . dL/dv - L = v^T M v / 2 - L(v = 0) for L quadratic in v
     (T + U for a natural scleronomic system)."""
@@ -544,18 +552,43 @@ def _energy(L, M, v):
     return sp.expand((vv.T * M * vv)[0, 0] / 2) - L.xreplace({vi: 0 for vi in v})
 
 
-def _cheap_simplify(expr):
+def _cheap_simplify(expr, fixed=None):
     """Fast trigonometric clean-up of a Lagrangian: expand, sin(x)^2 -> 1 - cos(x)^2 (so
-    that cos^2 + sin^2 cancels), then cos a cos b + sin a sin b -> cos(a - b) (fu's TR10i)."""
+    that cos^2 + sin^2 cancels), then cos a cos b + sin a sin b -> cos(a - b) (fu's TR10i).
+    With `fixed` (the parameter symbols), the terms are first grouped by their factors that
+    are not parameters, each group's coefficient a placeholder for TR10i (few terms, fast)
+    and then put back with its common factors pulled out (:func:`_collect_params`)."""
     from sympy.simplify.fu import TR10i
     e = sp.expand(expr)
     e = e.replace(lambda u: u.is_Pow and u.exp == 2 and isinstance(u.base, sp.sin),
                   lambda u: 1 - sp.cos(u.base.args[0])**2)
     e = sp.expand(e)
-    return TR10i(e)
+    if fixed is None or not isinstance(e, sp.Add):
+        return TR10i(e)
+    groups = _groups(e, fixed)
+    holders, back, out = {}, {}, sp.Integer(0)
+    for key, cf in groups.items():
+        num, cf = sp.factor_terms(cf).as_coeff_Mul()
+        if cf not in holders:
+            holders[cf] = sp.Dummy("c")
+            back[holders[cf]] = cf
+        out += num*holders[cf]*key
+    return TR10i(out).xreplace(back)
 
 
-def _maybe_simplify(expr, simplify, v=(), parts=None):
+def _groups(e, fixed):
+    """{non-parameter factor: sum of the parameter factors} over the terms of the sum e."""
+    groups = {}
+    for term in e.args:
+        par, rest = [], []
+        for f in sp.Mul.make_args(term):
+            (par if f.free_symbols <= fixed else rest).append(f)
+        key = sp.Mul(*rest)
+        groups[key] = groups.get(key, sp.Integer(0)) + sp.Mul(*par)
+    return groups
+
+
+def _maybe_simplify(expr, simplify, v=(), parts=None, fixed=None):
     """simplify: True, False or "auto". A Lagrangian at most quadratic in the velocities v
     is cleaned up by parts, L = v^T M v / 2 + l1 . v + L0, each entry of M, l1 and L0 on its
     own (small expressions, so the clean-up stays fast for long chains); "auto" skips parts
@@ -569,21 +602,27 @@ def _maybe_simplify(expr, simplify, v=(), parts=None):
         if e == 0:
             return e
         if simplify is True or sp.count_ops(e) <= 600:
-            return _cheap_simplify(e)
+            return _cheap_simplify(e, fixed)
         return e
     v = list(v)
     if v:
         n = len(v)
-        grad = [sp.diff(expr, vi) for vi in v]
-        H = [[sp.diff(grad[i], v[j]) for j in range(n)] for i in range(n)]
-        if not any(h.free_symbols & set(v) for row in H for h in row):
+        qp = _quadratic_parts(expr, v) if fixed is not None else None
+        if qp is not None:
+            H, l1, L0 = qp
+        else:
+            grad = [sp.diff(expr, vi) for vi in v]
+            H = [[sp.diff(grad[i], v[j]) for j in range(n)] for i in range(n)]
             zero = {vi: 0 for vi in v}
+            l1 = [g.xreplace(zero) for g in grad]
+            L0 = expr.xreplace(zero)
+        if not any(h.free_symbols & set(v) for row in H for h in row):
             Hs = {}
             for i in range(n):
                 for j in range(i, n):
                     Hs[i, j] = part(H[i][j])
-            l1 = [part(g.xreplace(zero)) for g in grad]
-            L0 = part(expr.xreplace(zero))
+            l1 = [part(g) for g in l1]
+            L0 = part(L0)
             if parts is not None:        # the cleaned-up M, l1, L0 for the caller
                 parts.extend([sp.Matrix(n, n, lambda i, j: Hs[min(i, j), max(i, j)]),
                               l1, L0])
@@ -592,6 +631,43 @@ def _maybe_simplify(expr, simplify, v=(), parts=None):
                       sp.Integer(0))
             return quad + sum((c*vi for c, vi in zip(l1, v)), sp.Integer(0)) + L0
     return part(expr)
+
+
+def _quadratic_parts(expr, v):
+    """L = v^T H v / 2 + l1 . v + L0 read off the expanded L term by term (no
+    differentiation): (H as a list of rows, l1, L0), or None if L is not a polynomial of
+    degree <= 2 in the velocities v."""
+    n = len(v)
+    idx = {vi: i for i, vi in enumerate(v)}
+    vset = set(v)
+    H = [[sp.Integer(0)]*n for _ in range(n)]
+    l1 = [sp.Integer(0)]*n
+    L0 = sp.Integer(0)
+    for term in sp.Add.make_args(sp.expand(expr)):
+        pw, rest = [], []
+        for f in sp.Mul.make_args(term):
+            b, e = f.as_base_exp()
+            if b in vset and e.is_Integer and e > 0:
+                pw += [idx[b]]*int(e)
+            elif f.free_symbols & vset:
+                return None
+            else:
+                rest.append(f)
+        c = sp.Mul(*rest)
+        if not pw:
+            L0 += c
+        elif len(pw) == 1:
+            l1[pw[0]] += c
+        elif len(pw) == 2:
+            i, j = sorted(pw)
+            if i == j:
+                H[i][i] += 2*c
+            else:
+                H[i][j] += c
+                H[j][i] += c
+        else:
+            return None
+    return H, l1, L0
 
 
 def _forces_list(forces, n, what="forces"):
@@ -626,7 +702,8 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     exprs = _subs_all(exprs, sub)
     exprs, t, psyms = _realify(exprs, t, c, psyms)
     parts = []
-    Lp, fq = _maybe_simplify(exprs[0], simplify, c.speeds, parts), exprs[1:]
+    Lp, fq = _maybe_simplify(exprs[0], simplify, c.speeds, parts,
+                             set(psyms) if structured else None), exprs[1:]
     struct = None
     if structured:
         M = parts[0] if parts else _mass(Lp, c.speeds)
@@ -652,23 +729,15 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
 
 def _collect_params(e, params):
     """A sum regrouped by its factors that are not parameters, each group's coefficient (a
-    polynomial in the parameters) factored: sum_k m_k l_i l_j cos(..) -> l_i l_j (sum_k m_k)
-    cos(..), so that the code does not repeat the state-dependent factor per parameter."""
+    polynomial in the parameters) with its common factors pulled out: sum_k m_k l_i l_j
+    cos(..) -> l_i l_j (sum_k m_k) cos(..), so that the code does not repeat the
+    state-dependent factor per parameter."""
     if not isinstance(e, sp.Add):
         return e
-    groups = {}
-    for term in e.args:
-        par, rest = [], []
-        for f in sp.Mul.make_args(term):
-            (par if f.free_symbols <= params else rest).append(f)
-        key = sp.Mul(*rest)
-        groups[key] = groups.get(key, sp.Integer(0)) + sp.Mul(*par)
+    groups = _groups(e, params)
     if len(groups) == len(e.args):
         return e
-    out = sp.Integer(0)
-    for key, cf in groups.items():
-        out += sp.factor(cf)*key
-    return out
+    return sp.Add(*[sp.factor_terms(cf)*key for key, cf in groups.items()])
 
 
 def _mass(L, v):
