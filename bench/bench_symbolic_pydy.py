@@ -171,14 +171,17 @@ def run(N, form, args, pydy_cache):
 
 def table(rows, args):
     head = ["N", "conmech T", "PyDy backend", "conmech [s]", "PyDy [s]", "PyDy/conmech",
-            "err conmech", "err PyDy", "nfev c/P", "conmech derive", "conmech gen+compile",
+            "us/eval c/P", "err conmech", "err PyDy", "nfev c/P", "conmech derive",
+            "conmech gen+compile",
             "conmech cache hit", "PyDy derive", "PyDy gen+compile"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         tc, tp = r["conmech_times"], r["pydy_times"]
         out.append("| " + " | ".join([
             str(r["N"]), r["form"], str(r["backend"]), f"{r['t_conmech']:.4f}", f"{r['t_pydy']:.4f}",
-            f"{r['t_pydy'] / r['t_conmech']:.1f}x", f"{r['err_conmech']:.1e}",
+            f"{r['t_pydy'] / r['t_conmech']:.1f}x",
+            f"{1e6 * r['t_conmech'] / r['nfev_conmech']:.1f}/"
+            f"{1e6 * r['t_pydy'] / r['nfev_pydy']:.0f}", f"{r['err_conmech']:.1e}",
             f"{r['err_pydy']:.1e}", f"{r['nfev_conmech']}/{r['nfev_pydy']}",
             f"{tc.get('derive', float('nan')):.2f} s",
             f"{tc.get('generate', 0) + tc.get('compile_or_load', 0):.2f} s",

@@ -13,7 +13,13 @@ parameter array ``p`` last)::
                   cm_phi_gamma(t, q, v, g, p), cm_nh_matrix(t, q, A, b, p),
                   cm_nh_gamma(t, q, v, g, p)
 
-Each procedure's outputs share one common-subexpression elimination (sympy.cse). Powers
+Each procedure's outputs share one common-subexpression elimination (sympy.cse). A
+generalized system derived in structured form (``Derived.struct``) computes the nonzero
+entries dM_ab/dq_k (and for the Jacobian the second derivatives) first, as local values with
+their own elimination, and then Q (R) as short sums over them: O(n^2) operations for a chain
+where the expanded Euler-Lagrange expressions cost O(n^3). Sines and cosines of sums are
+built from those of their terms by angle addition when that needs fewer distinct arguments
+(:func:`trig_split`: a chain's cos(q_i - q_j) from the n pairs sin(q_i), cos(q_i)). Powers
 with half-integer exponents become integer powers of one square root (so r^3 = (x^2+y^2)^(3/2)
 costs one sqrt and two multiplications, and the sqrt is shared by CSE); integer powers are
 printed with integer exponents (gfortran expands them into multiplications); every number is
