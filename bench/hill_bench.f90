@@ -94,7 +94,8 @@ program hill_bench
     do i = 1, nfam
         ms(i) = 0.01_dp + 0.14_dp*real(i - 1, dp)/real(max(nfam - 1, 1), dp)
     end do
-    write (*, '(a, i0, a)') "# family of ", nfam, " orbits, m in [0.01, 0.15]"
+    write (*, '(a, i0, a)') "# family of ", nfam, " orbits, m in [0.01, 0.15] (S, c; no dgeev)"
+    opt%eigenvalues = .false.
     nthr = 1
     !$ nthr = omp_get_max_threads()
     ! best of 3 (the machine is shared), threads alternating
