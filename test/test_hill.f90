@@ -170,6 +170,11 @@ contains
         call hill_variation_orbit(1.0e-3_dp, 1.0_dp, one)
         call ts%check_close((one%c - 1.0_dp - 1.0e-3_dp)/1.0e-6_dp, -0.75_dp, 0.02_dp, &
                             "c - 1 - m ~ -(3/4) m^2 for small m")
+        ! the same at m = 1e-5 needs c to ~1e-13 where 1 - S = 2e-9 (the trace of M gave
+        ! c to ~2e-11 there: -3.9 instead of -0.75)
+        call hill_variation_orbit(1.0e-5_dp, 1.0_dp, one)
+        call ts%check_close((one%c - 1.0_dp - 1.0e-5_dp)/1.0e-10_dp, -0.75_dp, 1.0e-3_dp, &
+                            "c - 1 - m = -(3/4) m^2 at m = 1e-5 (c to 1e-13 as S -> 1)")
         ! kappa scaling: orbit size ~ kappa^(1/3), c unchanged
         call hill_variation_orbit(m_hill, 8.0_dp, one)
         call ts%check_close(one%c, c_hill, 1.0e-12_dp, "c independent of kappa")
