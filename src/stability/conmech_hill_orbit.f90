@@ -8,22 +8,26 @@
 !! are solved by Newton's method with the exact Jacobian from the state transition matrix
 !! A = Phi(pi/2) of the variational equations (symmetric shooting over a quarter period).
 !!
-!! Speed: the state and its STM (20 components) are integrated with a fixed-step DOP853
-!! (8th order, the Dormand-Prince coefficients of `conmech_rk_tableaus`) with the Hill
-!! right-hand side written out; the default 20 steps per quarter period give
-!! |c error| ~ 1e-14 at Hill's m.
+!! Speed: the state and three STM columns (x0, x0', v0: 16 components) are integrated by
+!! a fixed-step DOP853 with the right-hand side and coefficients written out
+!! (`conmech_hill_kernel`); the y0 column follows from the flow, A f(y0) = f(y(pi/2)). The
+!! default 20 steps per quarter period give |c error| ~ 1e-14 (m = 1e-6 .. 0.15).
 !!
 !! Monodromy by symmetry: with the time-reversing reflections G0 = diag(1, -1, -1, 1)
 !! (x axis) and G1 = diag(-1, 1, 1, -1) (y axis), the half-period STM is
-!! B = G1 A^-1 G1 A, and since G1 G0 = -I the monodromy is M = B^2. The option
-!! `full_period` integrates the whole period instead (a check, 4x the work).
+!! B = G1 A^-1 G1 A (A^-1 from the symplectic form), and since G1 G0 = -I the monodromy
+!! is M = B^2. The option `full_period` integrates the whole period instead (a check, 4x
+!! the work; S and c then from the trace of that M).
 !!
-!! Perigee constant: the non-trivial multipliers are exp(+-2 pi i c). From the trace,
+!! Perigee constant: the non-trivial multipliers are exp(+-2 pi i c),
 !! S = (trace M - 2)/2 = cos(2 pi c); the branch is c = 1 + acos(S)/(2 pi), the
 !! continuation of c = 1 at m = 0 (c > 1 along the direct family, valid while
-!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit). Conditioning: an error e in S
-!! gives e/(2 pi sin(2 pi (c - 1))) in c, about e/2.7 at Hill's m, but it grows as m -> 0
-!! (c -> 1, S -> 1: at m = 1e-6, |c error| ~ 3e-9; at m = 0 c = 1 only to ~2e-7).
+!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit). S and c are not read from the
+!! trace (it sums O(1) entries to 1 - S ~ (2 pi m)^2, losing digits as m -> 0: 3e-12 in c
+!! at m = 0.01, 2e-10 at m = 1e-6) but from products of the quarter map between the two
+!! symmetry sections, s = sin^2(pi (c - 1)/2) and t = cos^2(pi (c - 1)/2)
+!! (`section_products`): S = 1 - 8 s t, c = 1 + (2/pi) atan(sqrt(min(s,t)/max(s,t))), to
+!! ~1e-14 for every m.
 !!
 !! Transverse linearisation (seed 000): with tangent tau = v/|v|, normal n = (-tau_y, tau_x),
 !! V = |v|, H the Hessian of F and omega = n.grad F / V - 2 m (the turning rate of the
