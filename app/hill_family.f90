@@ -51,6 +51,7 @@ program hill_family_app
     logical :: force_, quiet_, fresh
     real(dp), allocatable :: ms(:)
     type(hill_orbit), allocatable :: orbs(:)
+    type(hill_orbit_options) :: hopt
     logical, allocatable :: have(:)
 
     call cli%start("hill_family", help)
@@ -122,6 +123,8 @@ program hill_family_app
     if (ios /= 0) call cli%fail("cannot append to "//trim(out_file))
     call progress%begin("hill_family", n_, ndone, on=.not. quiet_)
 
+    ! the multipliers (dgeev) are not written: S and c come from the quarter map
+    hopt%eigenvalues = .false.
     ! batches of whole blocks, from the block holding the first missing orbit
     first_block = ndone/block + 1
     do b0 = (first_block - 1)*block + 1, n_, batch_
@@ -132,7 +135,7 @@ program hill_family_app
         do ib = 1, nb
             i = b0 + (ib - 1)*block
             call hill_family(ms(i:min(b1, i + block - 1)), kappa_, &
-                             orbs(i:min(b1, i + block - 1)), nchunks=1)
+                             orbs(i:min(b1, i + block - 1)), hopt, nchunks=1)
         end do
         !$omp end parallel do
         do i = max(b0, ndone + 1), b1

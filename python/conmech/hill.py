@@ -8,8 +8,9 @@ synodic month is 2 pi::
 The variation orbit is the direct periodic orbit of period 2 pi, symmetric about both axes.
 Its monodromy matrix has the trivial double multiplier 1 (a Jordan block, accurate only to
 ~sqrt(eps) as eigenvalues) and the non-trivial pair exp(+-2 pi i c), where c is Hill's
-perigee constant, read from the trace: S = (trace M - 2)/2 = cos(2 pi c),
-c = 1 + arccos(S)/(2 pi)::
+perigee constant: S = (trace M - 2)/2 = cos(2 pi c), c = 1 + arccos(S)/(2 pi), both
+computed from products of quarter-period map entries (accurate to ~1e-14 also as S -> 1,
+where the trace loses digits)::
 
     >>> import conmech.hill as hill
     >>> orb = hill.variation_orbit(0.080848933808312)
@@ -89,10 +90,11 @@ class HillOrbit:
         Eigenvalues of the monodromy (LAPACK dgeev); the two trivial ones (a Jordan block
         at 1) are accurate only to ~sqrt(eps).
     stability_index : float
-        S = (trace M - 2)/2; linearly stable iff |S| < 1.
+        S = (trace M - 2)/2 (computed as 1 - 8 s t from the quarter-period map, not from
+        the trace); linearly stable iff |S| < 1.
     c : float
-        Perigee constant, 1 + arccos(S)/(2 pi) (nan if |S| > 1). Ill-conditioned as
-        m -> 0 (S -> 1): about 1e-13 at Hill's m, 3e-9 at m = 1e-6.
+        Perigee constant, 1 + arccos(S)/(2 pi) (nan if |S| > 1), to ~2e-14 with the
+        default 20 steps, also as m -> 0 (m = 1e-6 included).
     residual : float
         The true closure error |(x, y')(T/4)| of the orbit (estimated by integrating its
         start with twice the steps: not the residual of the discretised problem); at most

@@ -8,22 +8,26 @@
 !! are solved by Newton's method with the exact Jacobian from the state transition matrix
 !! A = Phi(pi/2) of the variational equations (symmetric shooting over a quarter period).
 !!
-!! Speed: the state and its STM (20 components) are integrated with a fixed-step DOP853
-!! (8th order, the Dormand-Prince coefficients of `conmech_rk_tableaus`) with the Hill
-!! right-hand side written out; the default 20 steps per quarter period give
-!! |c error| ~ 1e-14 at Hill's m.
+!! Speed: the state and three STM columns (x0, x0', v0: 16 components) are integrated by
+!! a fixed-step DOP853 with the right-hand side and coefficients written out
+!! (`conmech_hill_kernel`); the y0 column follows from the flow, A f(y0) = f(y(pi/2)). The
+!! default 20 steps per quarter period give |c error| ~ 1e-14 (m = 1e-6 .. 0.15).
 !!
 !! Monodromy by symmetry: with the time-reversing reflections G0 = diag(1, -1, -1, 1)
 !! (x axis) and G1 = diag(-1, 1, 1, -1) (y axis), the half-period STM is
-!! B = G1 A^-1 G1 A, and since G1 G0 = -I the monodromy is M = B^2. The option
-!! `full_period` integrates the whole period instead (a check, 4x the work).
+!! B = G1 A^-1 G1 A (A^-1 from the symplectic form), and since G1 G0 = -I the monodromy
+!! is M = B^2. The option `full_period` integrates the whole period instead (a check, 4x
+!! the work; S and c then from the trace of that M).
 !!
-!! Perigee constant: the non-trivial multipliers are exp(+-2 pi i c). From the trace,
+!! Perigee constant: the non-trivial multipliers are exp(+-2 pi i c),
 !! S = (trace M - 2)/2 = cos(2 pi c); the branch is c = 1 + acos(S)/(2 pi), the
 !! continuation of c = 1 at m = 0 (c > 1 along the direct family, valid while
-!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit). Conditioning: an error e in S
-!! gives e/(2 pi sin(2 pi (c - 1))) in c, about e/2.7 at Hill's m, but it grows as m -> 0
-!! (c -> 1, S -> 1: at m = 1e-6, |c error| ~ 3e-9; at m = 0 c = 1 only to ~2e-7).
+!! 1 <= c <= 3/2; c is NaN when |S| > 1, an unstable orbit). S and c are not read from the
+!! trace (it sums O(1) entries to 1 - S ~ (2 pi m)^2, losing digits as m -> 0: 3e-12 in c
+!! at m = 0.01, 2e-10 at m = 1e-6) but from products of the quarter map between the two
+!! symmetry sections, s = sin^2(pi (c - 1)/2) and t = cos^2(pi (c - 1)/2)
+!! (`section_products`): S = 1 - 8 s t, c = 1 + (2/pi) atan(sqrt(min(s,t)/max(s,t))), to
+!! ~1e-14 for every m.
 !!
 !! Transverse linearisation (seed 000): with tangent tau = v/|v|, normal n = (-tau_y, tau_x),
 !! V = |v|, H the Hessian of F and omega = n.grad F / V - 2 m (the turning rate of the
@@ -36,11 +40,12 @@ module conmech_hill_orbit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp, pi
     use conmech_status
-    use conmech_lapack, only: dgesv, la_eig, la_finite
+    use conmech_lapack, only: la_eig
     use conmech_rk_tableaus, only: rk_tableau, dop853_tableau
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate, ode_solve, ode_result
     use conmech_hill, only: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f
+    use conmech_hill_kernel, only: hill_kernel_var, hill_kernel_state
     implicit none
     private
 
@@ -174,35 +179,6 @@ contains
         nfev = nfev + 12*nsteps
     end subroutine integrate_var
 
-    !> Fixed-step DOP853 for the state alone (the closure check).
-    pure subroutine integrate_state(tab, m, kappa, t1, nsteps, s, nfev)
-        type(rk_tableau), intent(in) :: tab
-        real(dp), intent(in) :: m, kappa, t1
-        integer, intent(in) :: nsteps
-        real(dp), intent(inout) :: s(4)
-        integer, intent(inout) :: nfev
-        real(dp) :: k(4, 12), st(4), h, fx, fy
-        integer :: istep, i, j
-        h = t1/nsteps
-        do istep = 1, nsteps
-            do i = 1, 12
-                st = s
-                do j = 1, i - 1
-                    if (tab%a(i, j) /= 0.0_dp) st = st + (h*tab%a(i, j))*k(:, j)
-                end do
-                call hill_grad_f(m, kappa, st(1), st(2), fx, fy)
-                k(1, i) = st(3)
-                k(2, i) = st(4)
-                k(3, i) = 2.0_dp*m*st(4) + fx
-                k(4, i) = -2.0_dp*m*st(3) + fy
-            end do
-            do j = 1, 12
-                if (tab%b(j) /= 0.0_dp) s = s + (h*tab%b(j))*k(:, j)
-            end do
-        end do
-        nfev = nfev + 12*nsteps
-    end subroutine integrate_state
-
     pure subroutine start_state(u, z)
         real(dp), intent(in) :: u(2)
         real(dp), intent(out) :: z(20)
@@ -219,17 +195,21 @@ contains
     !! `guess` = (x0, v0) to start Newton from (default: `hill_orbit_guess`).
     !!
     !! Error control: Newton runs on the fixed-step problem with n = `nsteps` steps per
-    !! quarter period; the true closure error of its solution is then estimated by
-    !! integrating the state alone from the converged start with nc = 1.5 n steps: that
-    !! closure is (1 - 1/r) times the n-step solution's true closure error, r = (nc/n)^8 =
-    !! 25.6 (8th order), and is scaled back by r/(r - 1). While the estimate exceeds
+    !! quarter period; the true closure error of its solution is then estimated by step
+    !! doubling: the state alone is integrated from the converged start with nc = n/2
+    !! steps, whose closure is (R - 1) times the n-step solution's true closure error,
+    !! R = (n/nc)^8 (8th order); dividing by R - 1 with R = (n/nc)^7 instead overestimates
+    !! the error twofold (a margin for the coarse solution's pre-asymptotic error; checked
+    !! against adaptive Verner 9(8) in the tests). While the estimate exceeds
     !! `closure_tol`, n grows (by the 8th-order error model, at least doubled, at most
     !! `max_nsteps`) and Newton restarts from the last solution. `residual` is this true
     !! closure estimate; `newton_residual` the closure of the discretised problem.
-    !! Newton accepts when its step |du| <= tol max(1, |u|) (1e-14); the monodromy is the
-    !! STM at that last iterate, within |du| of the solution. S is sensitive to the start
-    !! (dS/du ~ 1e3 at small m) and the start is known only to ~1e-15 (round-off in the
-    !! closure): S and c carry a round-off floor of ~1e-12, whatever the Newton start.
+    !! Newton accepts when its step |du| <= tol max(1, |u|) (1e-14); the quarter-period STM
+    !! is that of the last iterate, within |du| of the solution.
+    !! S and c come from products of quarter-map entries (`section_products`), not from the
+    !! trace of M: the trace sums O(1) entries to 1 - S ~ (2 pi m)^2 and carried a
+    !! round-off floor of ~1e-12 in c; the products keep c to ~1e-14 (family members agree
+    !! with single orbits to < 1e-13 whatever the Newton start).
     !! info: CM_SUCCESS; CM_BAD_INPUT (m < 0, kappa <= 0, bad options); CM_SINGULAR
     !! (singular Newton matrix); CM_NO_CONVERGENCE (Newton failed or diverged, another
     !! orbit was found, or the closure tolerance cannot be met with `max_nsteps`).
@@ -240,7 +220,7 @@ contains
         real(dp), intent(in), optional :: guess(2)
         type(hill_orbit_options) :: opt
         type(rk_tableau) :: tab
-        real(dp) :: u(2), u0(2), a(4, 4), zq(4), s(4), err, r8
+        real(dp) :: u(2), u0(2), ua(2), a(4, 4), zq(4), s(4), err, r8, ss, tt
         integer :: n, nretry, nc
         character(len=40) :: buf
         if (present(options)) opt = options
@@ -265,12 +245,11 @@ contains
             orb%message = "hill_variation_orbit: the guess needs x0 > 0"
             return
         end if
-        tab = dop853_tableau()
         u0 = u
         n = opt%nsteps
         nretry = 0
         do
-            call hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
+            call hill_newton(m, kappa, n, opt, u, ua, a, zq, orb)
             if (orb%info /= CM_SUCCESS) then
                 ! a coarse discretisation can defeat Newton: retry from the guess with
                 ! more steps (twice at most)
@@ -281,13 +260,15 @@ contains
                 u = u0
                 cycle
             end if
-            ! the closure of the same start with nc = 1.5 n steps is (1 - 1/r) times the true
-            ! closure error of the n-step solution, r = (nc/n)^8 (8th order)
-            nc = n + (n + 1)/2
+            ! the closure of the same start with nc = n/2 steps (step doubling) is (R - 1)
+            ! times the true closure error of the n-step solution, R = (n/nc)^p; p = 7
+            ! instead of the order 8 overestimates it (by 2 in the asymptotic regime)
+            nc = n/2
+            if (n < 2) nc = 2
             s = [u(1), 0.0_dp, 0.0_dp, u(2)]
-            call integrate_state(tab, m, kappa, 0.5_dp*pi, nc, s, orb%nfev)
-            r8 = (real(nc, dp)/real(n, dp))**8
-            err = sqrt(s(1)**2 + s(4)**2)*r8/(r8 - 1.0_dp)
+            call hill_kernel_state(m, kappa, 0.5_dp*pi, nc, s, orb%nfev)
+            r8 = (real(n, dp)/real(nc, dp))**7
+            err = sqrt(s(1)**2 + s(4)**2)/abs(r8 - 1.0_dp)
             if (.not. ieee_is_finite(err)) err = huge(1.0_dp)
             orb%residual = err
             orb%nsteps = n
@@ -312,24 +293,32 @@ contains
         orb%y0 = [u(1), 0.0_dp, 0.0_dp, u(2)]
         orb%quarter_state = zq
         orb%jacobi = hill_jacobi(m, kappa, orb%y0)
+        ! the STM column of y0 (e2) from the flow, A f(y(0)) = f(y(pi/2)), at the iterate ua
+        ! of the STM
+        call flow_column(m, kappa, ua, zq, a)
         orb%quarter_stm = a
         if (opt%full_period) then
+            ! a check: the monodromy integrated over 2 pi, S and c from its trace
             block
                 real(dp) :: z(20)
+                tab = dop853_tableau()
                 call start_state(u, z)
                 call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*n, z, orb%nfev)
                 orb%monodromy = reshape(z(5:20), [4, 4])
             end block
+            orb%stability_index = 0.5_dp*(orb%monodromy(1, 1) + orb%monodromy(2, 2) + &
+                                          orb%monodromy(3, 3) + orb%monodromy(4, 4) - 2.0_dp)
+            orb%c = hill_perigee_c(orb%stability_index)
         else
-            call monodromy_from_quarter(a, orb%monodromy, orb%info)
+            call monodromy_from_quarter(m, a, orb%monodromy, orb%info)
             if (orb%info /= CM_SUCCESS) then
-                orb%message = "hill_variation_orbit: singular quarter-period STM"
+                orb%message = "hill_variation_orbit: non-finite quarter-period STM"
                 return
             end if
+            call section_products(m, kappa, ua, zq, a, ss, tt)
+            orb%stability_index = 1.0_dp - 8.0_dp*ss*tt
+            orb%c = perigee_c_from_products(ss, tt)
         end if
-        orb%stability_index = 0.5_dp*(orb%monodromy(1, 1) + orb%monodromy(2, 2) + &
-                                      orb%monodromy(3, 3) + orb%monodromy(4, 4) - 2.0_dp)
-        orb%c = hill_perigee_c(orb%stability_index)
         if (.not. ieee_is_finite(orb%stability_index)) then
             orb%info = CM_NONFINITE
             orb%message = "hill_variation_orbit: non-finite monodromy"
@@ -344,33 +333,43 @@ contains
         end if
     end subroutine hill_variation_orbit
 
-    !> Newton's method on the fixed-step problem with n steps per quarter period.
-    !! On success u is the solution, a the STM and zq the state at pi/2 of the last iterate.
-    subroutine hill_newton(tab, m, kappa, n, opt, u, a, zq, orb)
-        type(rk_tableau), intent(in) :: tab
+    !> Newton's method on the fixed-step problem with n steps per quarter period, on the
+    !! state and the STM columns of x0, x0', v0 (hill_kernel_var). On success u is the
+    !! solution, ua the last iterate (u - ua = its Newton step, |u - ua| <= tol), a the STM
+    !! at ua (columns 1, 3, 4; column 2 is filled by flow_column) and zq its state at pi/2.
+    subroutine hill_newton(m, kappa, n, opt, u, ua, a, zq, orb)
         real(dp), intent(in) :: m, kappa
         integer, intent(in) :: n
         type(hill_orbit_options), intent(in) :: opt
         real(dp), intent(inout) :: u(2)
-        real(dp), intent(out) :: a(4, 4), zq(4)
+        real(dp), intent(out) :: ua(2), a(4, 4), zq(4)
         type(hill_orbit), intent(inout) :: orb
-        real(dp) :: du(2), g(2), z(20), det, scale
+        real(dp) :: du(2), g(2), z(16), det, scale
         integer :: it
         orb%info = CM_NO_CONVERGENCE
         orb%message = "hill_variation_orbit: Newton did not converge"
         a = 0.0_dp
         zq = 0.0_dp
+        ua = u
         do it = 1, opt%max_iter
             orb%iterations = orb%iterations + 1
-            call start_state(u, z)
-            call integrate_var(tab, m, kappa, 0.5_dp*pi, n, z, orb%nfev)
+            z = 0.0_dp
+            z(1) = u(1)
+            z(4) = u(2)
+            z(5) = 1.0_dp
+            z(11) = 1.0_dp
+            z(16) = 1.0_dp
+            call hill_kernel_var(m, kappa, 0.5_dp*pi, n, z, orb%nfev)
             if (.not. all(ieee_is_finite(z))) then
                 orb%info = CM_NO_CONVERGENCE
                 orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
                 return
             end if
-            a = reshape(z(5:20), [4, 4])
+            a(:, 1) = z(5:8)
+            a(:, 3) = z(9:12)
+            a(:, 4) = z(13:16)
             zq = z(1:4)
+            ua = u
             g = [z(1), z(4)]
             det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
             scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
@@ -398,34 +397,90 @@ contains
         end do
     end subroutine hill_newton
 
-    !> M = B^2, B = G1 A^-1 G1 A (see the module notes).
-    subroutine monodromy_from_quarter(a, mono, info)
-        real(dp), intent(in) :: a(4, 4)
+    !> Column 2 of the quarter-period STM (variation of y0) from columns 3 and the flow:
+    !! f(y(0)) = [0, v0, x0'', 0] and A f(y(0)) = f(y(pi/2)) give
+    !! A e2 = (f(y(pi/2)) - x0'' A e3)/v0 (exact for the exact flow).
+    pure subroutine flow_column(m, kappa, u, zq, a)
+        real(dp), intent(in) :: m, kappa, u(2), zq(4)
+        real(dp), intent(inout) :: a(4, 4)
+        real(dp) :: fx, fy, fq(4), xdd0
+        call hill_grad_f(m, kappa, u(1), 0.0_dp, fx, fy)
+        xdd0 = 2.0_dp*m*u(2) + fx
+        call hill_grad_f(m, kappa, zq(1), zq(2), fx, fy)
+        fq = [zq(3), zq(4), 2.0_dp*m*zq(4) + fx, -2.0_dp*m*zq(3) + fy]
+        a(:, 2) = (fq - xdd0*a(:, 3))/u(2)
+    end subroutine flow_column
+
+    !> The products s = alpha delta/D and t = -beta gamma/D (s + t = 1) of the quarter map
+    !! DQ = [alpha, beta; gamma, delta] between two Poincare sections on the energy surface:
+    !! at the start, coordinates along the G0-even variation u_E = e1 + (F_x/v0) e4 (dx0,
+    !! dv0 at fixed energy) and the odd e3 (dx0'); at pi/2, the section through y(pi/2)
+    !! transversal to the flow with coordinates along the G1-even energy direction
+    !! (dy, dx') = (x', F_y) and the G1-odd direction across the flow, (dx, dy') x f. With
+    !! the reversing symmetries the half-period map is H = R0 DQ^-1 R1 DQ (R0, R1 =
+    !! diag(1, -1)), half trace (alpha delta + beta gamma)/D = cos(pi c), so
+    !! s = sin^2(theta/2), t = cos^2(theta/2), theta = pi (c - 1), and
+    !! S = cos(2 pi c) = 1 - 8 s t. alpha and delta vanish as m -> 0 (c -> 1): computed as
+    !! products, s, S and c keep their relative accuracy where 1 - S = 8 s t is small (the
+    !! trace of M loses it there: its entries are O(1) and 1 - S ~ (2 pi m)^2). No
+    !! division by x'(pi/2), which vanishes at the cusp orbit.
+    pure subroutine section_products(m, kappa, u, zq, a, s, t)
+        real(dp), intent(in) :: m, kappa, u(2), zq(4), a(4, 4)
+        real(dp), intent(out) :: s, t
+        real(dp) :: fx, fy, w(4), ydd1, al, be, ga, de, d
+        call hill_grad_f(m, kappa, u(1), 0.0_dp, fx, fy)
+        w = a(:, 1) + (fx/u(2))*a(:, 4)
+        call hill_grad_f(m, kappa, zq(1), zq(2), fx, fy)
+        ydd1 = -2.0_dp*m*zq(3) + fy
+        al = w(2)*zq(3) + w(3)*fy
+        be = a(2, 3)*zq(3) + a(3, 3)*fy
+        ga = w(1)*ydd1 - w(4)*zq(3)
+        de = a(1, 3)*ydd1 - a(4, 3)*zq(3)
+        d = al*de - be*ga
+        s = al*de/d
+        t = -be*ga/d
+    end subroutine section_products
+
+    !> c on the branch c = 1 + acos(S)/(2 pi) (1 <= c <= 3/2) from s, t of
+    !! section_products: c = 1 + (2/pi) atan(sqrt(min(s, t)/max(s, t))); NaN when s or t
+    !! is negative (|S| > 1, unstable).
+    elemental real(dp) function perigee_c_from_products(s, t) result(c)
+        real(dp), intent(in) :: s, t
+        if (s >= 0.0_dp .and. t >= 0.0_dp .and. s + t > 0.0_dp) then
+            c = 1.0_dp + (2.0_dp/pi)*atan2(sqrt(min(s, t)), sqrt(max(s, t)))
+        else
+            c = ieee_value(1.0_dp, ieee_quiet_nan)
+        end if
+    end function perigee_c_from_products
+
+    !> M = B^2, B = G1 A^-1 G1 A (see the module notes), with A^-1 = W^-1 A^T W from the
+    !! symplectic form of Hill's equations in (x, y, x', y'),
+    !! w = dx^dx' + dy^dy' - 2 m dx^dy (A^T W A = W), instead of a factorisation.
+    pure subroutine monodromy_from_quarter(m, a, mono, info)
+        real(dp), intent(in) :: m, a(4, 4)
         real(dp), intent(out) :: mono(4, 4)
         integer, intent(out) :: info
-        real(dp) :: lu(4, 4), x(4, 4), b(4, 4), g1(4)
-        integer :: ipiv(4), i, j
+        real(dp) :: w(4, 4), wi(4, 4), ainv(4, 4), b(4, 4), g1(4)
+        integer :: i, j
         g1 = [-1.0_dp, 1.0_dp, 1.0_dp, -1.0_dp]
-        if (.not. la_finite(a)) then
+        if (.not. all(ieee_is_finite(a))) then
             mono = 0.0_dp
             info = CM_NONFINITE
             return
         end if
-        lu = a
-        ! x = A^-1 (G1 A): solve A x = G1 A
-        do j = 1, 4
-            x(:, j) = g1*a(:, j)
-        end do
-        call dgesv(4, 4, lu, 4, ipiv, x, 4, info)
-        if (info /= 0) then
-            info = CM_SINGULAR
-            return
-        end if
+        w = reshape([0.0_dp, 2.0_dp*m, -1.0_dp, 0.0_dp, -2.0_dp*m, 0.0_dp, 0.0_dp, -1.0_dp, &
+                     1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp], [4, 4])
+        wi = reshape([0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, &
+                      -1.0_dp, 0.0_dp, 0.0_dp, 2.0_dp*m, 0.0_dp, -1.0_dp, -2.0_dp*m, 0.0_dp], &
+                     [4, 4])
+        ainv = matmul(wi, matmul(transpose(a), w))
+        ! G1 A^-1 G1
         do j = 1, 4
             do i = 1, 4
-                b(i, j) = g1(i)*x(i, j)
+                ainv(i, j) = g1(i)*g1(j)*ainv(i, j)
             end do
         end do
+        b = matmul(ainv, a)
         mono = matmul(b, b)
         info = CM_SUCCESS
     end subroutine monodromy_from_quarter
