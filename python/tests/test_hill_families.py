@@ -1,0 +1,91 @@
+"""Families of Hénon's classification of Hill's problem (Hénon 1969, A&A 1, 223), in his
+units, continued by the general pseudo-arclength continuation from closed-form starts
+(no initial condition from Hénon's tables: they were not available to us)."""
+import numpy as np
+import pytest
+
+import conmech
+from conmech import hill, hill_families as hf, stability
+
+
+def _closure(y0, period):
+    r = conmech.solve_ivp(hf.system(), (0, period), y0, method="VERNER98", rtol=1e-13,
+                          atol=1e-13)
+    return float(np.max(np.abs(r.y[:, -1] - y0)))
+
+
+def _henon_potential(q):
+    """V = -(3/2) x^2 - 1/r (Hénon's units; the rotating frame is omega = -1)."""
+    x, y = q
+    r = np.hypot(x, y)
+    v = -1.5*x*x - 1.0/r
+    g = np.array([-3*x + x/r**3, y/r**3])
+    h = np.array([[-3 + 1/r**3 - 3*x*x/r**5, -3*x*y/r**5],
+                  [-3*x*y/r**5, 1/r**3 - 3*y*y/r**5]])
+    return v, g, h
+
+
+def test_lyapunov_family_of_l2_limits():
+    """The orbits about L2 tend, as the amplitude a -> 0, to the linear oscillation: period
+    2 pi/sqrt(2 sqrt 7 - 1), Gamma = 3^(4/3), stability index cosh(lambda T) with
+    lambda^2 = 1 + 2 sqrt 7 (closed forms of the linearisation at L2). The corrections
+    start at a^2 (the energy above L2 is O(a^2)): a fit c0 + c2 a^2 + c3 a^3 through three
+    amplitudes extrapolates to a = 0 with an O(a^4) error."""
+    amps = np.array([1e-3, 2e-3, 3e-3])
+    orbs = [hf.lyapunov_orbit(a) for a in amps]
+    w = np.linalg.solve(np.stack([np.ones(3), amps**2, amps**3]), [1.0, 0.0, 0.0])
+    T0 = w @ [o.period for o in orbs]
+    G0 = w @ [hf.gamma(o.y0) for o in orbs]
+    S0 = w @ [o.stability_index for o in orbs]
+    o1 = orbs[1]
+    assert T0 == pytest.approx(hf.PERIOD_L, abs=1e-8)    # at a = 1e-3 off by 5e-6
+    assert G0 == pytest.approx(hf.GAMMA_L, abs=1e-8)     # at a = 1e-3 off by 3.5e-5
+    lam = np.sqrt(1 + 2*np.sqrt(7))
+    assert S0 == pytest.approx(np.cosh(lam*hf.PERIOD_L), rel=1e-7)
+    # the mirror orbit about L1 has the same period
+    assert hf.lyapunov_orbit(2e-3, side=-1).period == pytest.approx(o1.period, rel=1e-12)
+    br = hf.family(o1, max_points=12, ds=0.02)
+    assert br.success and len(br) == 12
+    assert np.all(np.diff(br.energy) < 0)              # Gamma falls away from L2
+    assert np.all(br.stability_index > 1)              # unstable (a saddle direction)
+    k = len(br) - 1
+    assert _closure(br.y0[k], br.p[k]) < 1e-9
+    r = stability.transverse(_henon_potential, br.y0[k], br.p[k], omega=-1.0, rtol=1e-12)
+    assert r["half_trace"] == pytest.approx(br.stability_index[k], rel=1e-7)
+
+
+def test_family_g_loses_stability_where_the_variation_orbits_do():
+    """Family g (direct satellites) continued from the Kepler limit in Hénon's units: S
+    crosses +1 (located as a branch point) at the Hénon period T = 2 pi m* and at the
+    Gamma of Hill's variation orbit at m* = 0.19510399668... located by the independent
+    fast path in Hill's units (conmech.hill)."""
+    o = hf.satellite_orbit(0.1, "g")
+    assert o.period == pytest.approx(2*np.pi/(0.1**-1.5 - 1), rel=1e-2)
+    br = hf.family(o, max_points=40)
+    assert br.success
+    bp = [s for s in br.special if s.kind == "branch point"]
+    assert len(bp) == 1
+    ref = hill.locate_stability_change(0.19, 0.2)
+    assert bp[0].p == pytest.approx(2*np.pi*ref["m"], abs=1e-8)
+    v = hill.variation_orbit(ref["m"])
+    assert hf.gamma(bp[0].y0) == pytest.approx(hill.henon_gamma(ref["m"], v.jacobi),
+                                               abs=1e-7)
+    assert np.all(br.stable[br.p < bp[0].p - 1e-6]) and not br.stable[-1]
+
+
+def test_family_f_retrograde_satellites():
+    """Family f (retrograde satellites) from the Kepler limit: the period tends to
+    2 pi/(n + 1) (n = r^(-3/2); tidal corrections O(r^3)); continued out to Gamma < 0
+    every orbit closes and stays stable (|S| < 1), as Hénon (1969) describes family f."""
+    small = hf.satellite_orbit(0.02, "f")
+    n = 0.02**-1.5
+    assert small.period == pytest.approx(2*np.pi/(n + 1), rel=1e-4)
+    br = hf.family(hf.satellite_orbit(0.1, "f"), max_points=60)
+    assert br.success and br.energy[-1] < 0 < br.energy[0]
+    assert np.all(np.abs(br.stability_index) < 1) and not br.special
+    for k in (0, 30, 59):
+        assert _closure(br.y0[k], br.p[k]) < 1e-9
+    with pytest.raises(ValueError, match="kind"):
+        hf.satellite_orbit(0.1, "h")
+    with pytest.raises(ValueError, match="amplitude"):
+        hf.lyapunov_orbit(0.0)
