@@ -57,6 +57,31 @@ def test_branch_point_switching_pitchfork():
         stability.switch_branch_point(pitchfork_cycle, br, bps[0], free=[0])
 
 
+def transcritical_cycle(t, s, p):
+    """The cycle, coupled to z (x' gets 0.3 z x: the period changes along the new branch),
+    and z' = (p - 2) z - z^2: the branches z = 0 and z = p - 2 cross transversally at
+    p = 2 (a transcritical branch point; closed form by construction)."""
+    x, y, z = s
+    r2 = x*x + y*y
+    return [x*(1 - r2) - y + 0.3*z*x, y*(1 - r2) + x, (p - 2.0)*z - z*z]
+
+
+def test_branch_point_switching_transcritical():
+    """Both sides of the second branch z = p - 2 (not orthogonal to the first in (z, p)):
+    every new orbit on it, p moving both ways from 2, periods off 2 pi."""
+    br = stability.continuation(transcritical_cycle, [1, 0, 0], 6.3, p0=1.5, ds=0.1,
+                                ds_max=0.2, p_range=(0, 2.4))
+    bp = [s for s in br.special if s.kind == "branch point"]
+    assert len(bp) == 1 and bp[0].p == pytest.approx(2.0, abs=1e-8)
+    for d in (1, -1):
+        new = stability.switch_branch_point(transcritical_cycle, br, bp[0], direction=d,
+                                            ds=0.05, max_points=5)
+        assert new.success and new.kernel_ratio < 1e-4
+        assert np.allclose(new.y0[:, 2], new.p - 2, atol=1e-10)
+        assert d*(new.p[-1] - 2) > 0.1 and abs(new.period[-1] - 2*np.pi) > 1e-3
+        assert _closure(transcritical_cycle, new.y0[-1], new.period[-1], new.p[-1]) < 1e-9
+
+
 def ns_cycle(t, s, p, alpha=0.4472135954999579):
     """The cycle and v' = (p - 3 + i alpha) v - |v|^2 v: the pair exp(2 pi (p - 3))
     exp(+-2 pi i alpha) leaves the unit circle at p = 3 (Neimark-Sacker); the radial
