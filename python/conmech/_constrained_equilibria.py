@@ -70,7 +70,10 @@ def _evaluator(system, t):
         if system.n_nh > 0:
             raise ValueError(f"'{system.name}' has non-holonomic constraints: equilibria on "
                              "a constraint manifold need holonomic constraints only")
-        if system.name in _RHEONOMIC_BUILTINS:
+        from .compiled import CompiledConstrained
+        compiled_rheonomic = isinstance(system, CompiledConstrained) and \
+            int(system.spec[4]) != 0       # spec[4]: the rheonomic flag (_make_spec)
+        if system.name in _RHEONOMIC_BUILTINS or compiled_rheonomic:
             raise ValueError(f"'{system.name}' has time-dependent (rheonomic) constraints: "
                              "it has no equilibria")
         n, m = system.n, system.n_hol

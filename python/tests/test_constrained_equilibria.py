@@ -96,3 +96,28 @@ def test_constrained_equilibrium_bad_input():
     # a system without an equilibrium (the Atwood machine with unequal masses accelerates)
     with pytest.raises(RuntimeError, match="Newton|singular"):
         stability.constrained_equilibrium(systems.atwood_xy(), [1.0, 1.0])
+
+
+def test_compiled_constrained_pendulum():
+    """A pendulum derived and compiled by conmech.symbolic: the same equilibria and
+    frequency sqrt(g/l) as the built-in; a rheonomic compiled system is rejected."""
+    sp = pytest.importorskip("sympy")
+    from sympy.physics.mechanics import dynamicsymbols
+    from conmech import symbolic
+    t = sp.Symbol("t")
+    x, y = dynamicsymbols("x y")
+    m, g, l = sp.symbols("m g l")
+    T = m*(x.diff(t)**2 + y.diff(t)**2)/2
+    sys_ = symbolic.constrained_system(T, m*g*y, [x, y],
+                                       holonomic=[(x**2 + y**2 - l**2)/2],
+                                       params=dict(m=1.0, g=9.81, l=0.5))
+    e = stability.constrained_equilibrium(sys_, [0.05, -0.4])
+    assert np.allclose(e.q, [0, -0.5], atol=1e-12) and e.kind == "centre"
+    assert e.frequencies == pytest.approx([np.sqrt(9.81/0.5)], rel=1e-9)
+    assert e.lagrange_dirichlet is True
+    s = sp.sin(t)/10
+    moving = symbolic.constrained_system(T, m*g*y, [x, y],
+                                         holonomic=[((x - s)**2 + y**2 - l**2)/2],
+                                         params=dict(m=1.0, g=9.81, l=0.5))
+    with pytest.raises(ValueError, match="rheonomic"):
+        stability.constrained_equilibrium(moving, [0.05, -0.4])
