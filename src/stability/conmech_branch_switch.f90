@@ -99,8 +99,6 @@ contains
         type(cont_point), intent(in) :: a, b
         logical, intent(in) :: with_period
         real(dp), allocatable :: t(:)
-        integer :: n
-        n = size(a%y0)
         if (with_period) then
             t = [b%y0 - a%y0, b%period - a%period, b%p - a%p]
         else
