@@ -12,16 +12,20 @@ pseudo-arclength continuation of a conservative family (:func:`conmech.stability
 continuation` with ``in_period``: the period is the continued quantity, Gamma a function
 of the point):
 
-- :func:`lyapunov_orbit`: the orbits about the Lagrange points L2 (x = 3^(-1/3)) and L1
-  (their mirror image), which start at Gamma = 3^(4/3) with the period 2 pi/sqrt(2 sqrt 7 -
-  1) of the linearisation (Lyapunov's centre theorem);
+- :func:`lyapunov_orbit`: the orbits about the Lagrange points L1 (x = 3^(-1/3), Hénon's
+  family a) and L2 (x = -3^(-1/3), family c, the mirror image), which start at Gamma =
+  3^(4/3) with the period 2 pi/sqrt(2 sqrt 7 - 1) of the linearisation (Lyapunov's centre
+  theorem);
 - :func:`satellite_orbit`: near-circular retrograde (Hénon's family f) and direct (family
   g, which holds Hill's variation orbits) satellite orbits, from the Kepler limit r -> 0
   (period 2 pi/(n +- 1), n = r^(-3/2));
-- :func:`family`: the continuation of either, with Gamma as the branch's ``energy``.
+- :func:`family`: the continuation of either (or of a published initial condition), with
+  Gamma as the branch's ``energy``; :func:`orbit_at_gamma`: the member of a continued
+  family at a given Gamma, started on the x axis (as the published tables list them).
 
-No initial condition was taken from Hénon's tables (they were not available to us); the
-starts are the closed-form limits above.
+The published families of Batkhin's data set (github.com/abbat06/Hill2D: x(0), p_y(0) =
+y'(0) + x(0), T, C = Gamma and the stability index of Hénon's families a, f, g, ... at
+round values of C) are the tests' reference.
 """
 from __future__ import annotations
 
@@ -29,11 +33,11 @@ import numpy as np
 
 from . import stability, systems
 
-__all__ = ["system", "gamma", "X_L2", "GAMMA_L", "PERIOD_L", "lyapunov_orbit",
-           "satellite_orbit", "family"]
+__all__ = ["system", "gamma", "X_L1", "GAMMA_L", "PERIOD_L", "lyapunov_orbit",
+           "satellite_orbit", "family", "on_axis", "orbit_at_gamma"]
 
-#: x of the Lagrange point L2 (L1 at -X_L2) in Hénon's units
-X_L2 = 3.0**(-1.0/3.0)
+#: x of the Lagrange point L1 (L2 at -X_L1) in Hénon's units
+X_L1 = 3.0**(-1.0/3.0)
 #: Gamma at L1, L2: 3 x^2 + 2/x = 3^(4/3)
 GAMMA_L = 3.0**(4.0/3.0)
 #: the period of the linear oscillation about L1, L2: 2 pi/sqrt(2 sqrt 7 - 1)
@@ -64,18 +68,18 @@ def _symmetric(y0, period, rtol):
 
 
 def lyapunov_orbit(amplitude: float, side: int = 1, rtol: float = 1e-12):
-    """The periodic orbit about L2 (``side`` = +1) or L1 (-1) that crosses the x axis at
-    right angles at x = +-(X_L2 + amplitude), from the linear oscillation (x - x_L =
+    """The periodic orbit about L1 (``side`` = +1) or L2 (-1) that crosses the x axis at
+    right angles at x = +-(X_L1 + amplitude), from the linear oscillation (x - x_L =
     a cos w t, y = -(9 + w^2) a/(2 w) sin w t, w^2 = 2 sqrt 7 - 1) corrected by symmetric
     shooting. Returns a :class:`conmech.stability.PeriodicOrbit`."""
     a = stability._real(amplitude, "amplitude")
     if not 0 < abs(a) < 0.3:
         raise ValueError("amplitude must be non-zero and below 0.3 (the linear start)")
     if side not in (1, -1):
-        raise ValueError("side must be +1 (L2) or -1 (L1)")
+        raise ValueError("side must be +1 (L1) or -1 (L2)")
     w = 2.0*np.pi/PERIOD_L
     vy = -(9.0 + w*w)*a/2.0
-    y0 = side*np.array([X_L2 + a, 0.0, 0.0, vy])
+    y0 = side*np.array([X_L1 + a, 0.0, 0.0, vy])
     return _symmetric(y0, PERIOD_L, rtol)
 
 
@@ -110,3 +114,54 @@ def family(orbit, direction: int = 1, max_points: int = 50, ds: float = 0.05,
                                   conservative=True, direction=direction,
                                   max_points=max_points, ds=ds, ds_max=ds_max, rtol=rtol,
                                   atol=rtol, energy=lambda y, p: gamma(y), **options)
+
+
+def on_axis(y0, period: float, rtol: float = 1e-12) -> np.ndarray:
+    """The state [x0, 0, x', y'] where the periodic orbit through ``y0`` crosses the x axis
+    farthest to the right (for an orbit symmetric about the axis x' = 0 there), from an
+    integration over one period with an event on y."""
+    from ._ivp import solve_ivp
+    y0 = stability._state(y0)
+    if y0.size != 4:
+        raise ValueError("y0 must be [x, y, x', y']")
+    r = solve_ivp(system(), (0.0, float(period)), y0, method="DOP853", rtol=rtol,
+                  atol=rtol, events=lambda t, s: s[1])
+    ys = r.y_events[0] if r.y_events else np.zeros((0, 4))
+    if not r.success or len(ys) == 0:
+        raise RuntimeError("the orbit does not cross the x axis within its period")
+    y = np.array(ys[int(np.argmax(ys[:, 0]))])
+    y[1] = 0.0
+    return y
+
+
+def orbit_at_gamma(branch, target: float, rtol: float = 1e-12, tol: float = 1e-11,
+                   max_iter: int = 30):
+    """The member of the continued family ``branch`` (from :func:`family`) with Gamma =
+    ``target``: between the two branch points whose Gamma brackets it, started on the x
+    axis (:func:`on_axis`), by the secant method on x0 (each x0 corrected by symmetric
+    shooting, y'0 and the half period free) until |Gamma - target| <= tol. Returns the
+    :class:`conmech.stability.PeriodicOrbit` (y0 = [x0, 0, 0, y'0])."""
+    target = stability._real(target, "target")
+    g = np.asarray(branch.energy, dtype=float)
+    k = np.nonzero(np.diff(np.sign(g - target)) != 0)[0]
+    if k.size == 0:
+        raise ValueError(f"Gamma = {target} is not reached on the branch "
+                         f"({g.min():.6g} .. {g.max():.6g})")
+    k = int(k[0])
+    pts = []
+    for j in (k, k + 1):
+        y = on_axis(branch.y0[j], branch.p[j], rtol)
+        o = _symmetric(y, branch.p[j], rtol)
+        pts.append((o.y0[0], gamma(o.y0) - target, o))
+    (xa, fa, oa), (xb, fb, ob) = pts
+    for _ in range(max_iter):
+        if abs(fb) <= tol:
+            return ob
+        if fb == fa:
+            break
+        xc = xb - fb*(xb - xa)/(fb - fa)
+        o = _symmetric([xc, 0.0, 0.0, ob.y0[3]], ob.period, rtol)
+        xa, fa, oa = xb, fb, ob
+        xb, fb, ob = o.y0[0], gamma(o.y0) - target, o
+    raise RuntimeError(f"orbit_at_gamma: the secant iteration did not reach Gamma = "
+                       f"{target} (last |Gamma - target| = {abs(fb):.3g})")
