@@ -1,6 +1,7 @@
-"""Branch switching at a branch point (a multiplier through +1 of a non-conservative
-family: transcritical or symmetry-breaking pitchfork of periodic orbits); see
-conmech_branch_switch. Exported as :func:`conmech.stability.switch_branch_point`."""
+"""Branch switching at a branch point (a multiplier through +1: transcritical or
+symmetry-breaking pitchfork of periodic orbits in a parameter, or S through +1 in a
+conservative family continued in the period); see conmech_branch_switch. Exported as
+:func:`conmech.stability.switch_branch_point`."""
 from __future__ import annotations
 
 from typing import Any
@@ -15,8 +16,9 @@ def switch_branch_point(system: Any, branch, point, param: str | int | None = No
     """The second branch through a located branch point of ``branch``.
 
     ``branch``: a :class:`~conmech.stability.Branch` from
-    :func:`~conmech.stability.continuation` (general shooting, in a parameter, not
-    ``conservative``); ``point``: one of its special points of kind 'branch point'.
+    :func:`~conmech.stability.continuation` by general shooting, in a parameter, or of a
+    conservative family along the period (``in_period``; the new branch is continued the
+    same way); ``point``: one of its special points of kind 'branch point'.
     ``system``/``param`` as for that continuation. At the point the shooting Jacobian has a
     two-dimensional kernel (computed by SVD); the old branch's tangent (the secant of the
     branch points around ``point``) is removed from it and the remaining direction starts
@@ -34,16 +36,18 @@ def switch_branch_point(system: Any, branch, point, param: str | int | None = No
     for bad in ("free", "targets", "p0", "_switch", "_tangent", "in_period", "conservative"):
         if bad in options:
             raise ValueError(f"{bad} is not an option of switch_branch_point (general "
-                             "shooting of a non-conservative family in a parameter)")
-    if branch.conservative or branch.param == "period":
-        raise ValueError("switch_branch_point is for non-conservative families continued "
-                         "in a parameter (in a conservative family use symmetric shooting "
-                         "from the orbit at the point)")
+                             "shooting, the branch's own kind of continuation)")
+    in_period = branch.param == "period"
+    if branch.conservative and not in_period:
+        raise ValueError("switch_branch_point: a conservative family must be continued in "
+                         "the period (in_period=True) for branch switching")
+    if in_period:
+        options.update(in_period=True, conservative=bool(branch.conservative))
     i = point.index
     if not 0 <= i < len(branch) - 1:
         raise ValueError("the branch point's index is outside the branch")
     autonomous = options.get("autonomous", True)
-    with_period = autonomous and not options.get("fixed_period", False)
+    with_period = autonomous and not options.get("fixed_period", False) and not in_period
 
     def x(k):
         parts = [branch.y0[k]]
@@ -54,5 +58,6 @@ def switch_branch_point(system: Any, branch, point, param: str | int | None = No
     t_old = x(i + 1) - x(i)
     if not np.linalg.norm(t_old) > 0:
         raise ValueError("the branch points around the branch point coincide")
-    return continuation(system, point.y0, point.period, param=param, p0=point.p,
+    return continuation(system, point.y0, point.period, param=param,
+                        p0=None if in_period else point.p,
                         _switch=2, _tangent=t_old/np.linalg.norm(t_old), **options)

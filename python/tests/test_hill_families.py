@@ -119,3 +119,29 @@ def test_family_f_retrograde_satellites():
         hf.lyapunov_orbit(0.0)
     with pytest.raises(ValueError, match="not reached"):
         hf.orbit_at_gamma(br, 50.0)
+
+
+def test_family_g_prime_by_branch_switching():
+    """At g's loss of stability (S = +1, Gamma = 4.49998584) the singly symmetric family
+    g' branches off (Hill2D, Satellite/README.md: g' meets g there, is stable on
+    C in (4.271428, 4.499986) and meets the two-orbit family Ha at C = 4.271428, i.e. its
+    S passes -1 there). Branch switching in the conservative family (continued in the
+    period): the new orbits are genuine, stable down to a period doubling located at the
+    published Gamma, and are not family g's (other periods at the same Gamma)."""
+    g = hf.family(hf.satellite_orbit(0.1, "g"), max_points=40)
+    bp = [s for s in g.special if s.kind == "branch point"][0]
+    gp = stability.switch_branch_point(hf.system(), g, bp, direction=-1, ds=0.02,
+                                       ds_max=0.1, max_points=32,
+                                       energy=lambda y, p: hf.gamma(y))
+    assert gp.success and gp.kernel_ratio < 1e-4
+    assert [s.kind for s in gp.special] == ["period doubling"]
+    pd = gp.special[0]
+    assert hf.gamma(pd.y0) == pytest.approx(4.271428, abs=1e-6)
+    before = gp.p < pd.p
+    assert np.all(np.abs(gp.stability_index[before]) < 1 + 1e-9)
+    assert not np.all(np.abs(gp.stability_index[~before]) < 1)
+    k = int(np.argmin(np.abs(gp.p - pd.p)))
+    assert _closure(gp.y0[k], gp.p[k]) < 1e-9
+    # family g at the same Gamma has a much shorter period
+    tg = np.interp(-gp.energy[k], -g.energy, g.p)
+    assert gp.p[k] - tg > 0.5

@@ -8,8 +8,9 @@
 !! pseudo-arclength step leaves the old branch (which the hyperplane t . (X - X*) = ds
 !! excludes) for the new one; `direction` (+1/-1) picks the sign of v.
 !!
-!! Branch switching at a branch point (a real multiplier through +1 in a non-conservative
-!! family: a transcritical or a symmetry-breaking pitchfork bifurcation of periodic orbits):
+!! Branch switching at a branch point (a real multiplier through +1: a transcritical or a
+!! symmetry-breaking pitchfork bifurcation of periodic orbits in a parameter, or in a
+!! conservative family continued in the period, S through +1):
 !! at the point X* = (y*, T*, p*) the Jacobian DG of the general shooting equations (see
 !! conmech_continuation: [Phi - I, f(y(T)), dy(T)/dp; f(y*)^T, 0, 0]) has a two-dimensional
 !! kernel, spanned by the right singular vectors of its two smallest singular values (LAPACK
@@ -136,15 +137,16 @@ contains
             return
         end if
         n = size(sp%point%y0)
-        tfree = o%autonomous .and. .not. o%fixed_period
+        tfree = o%autonomous .and. .not. o%fixed_period .and. .not. o%in_period
         nx = n + 1
         if (tfree) nx = n + 2
         neq = n
         if (o%autonomous) neq = n + 1
-        if (o%in_period .or. o%conservative .or. (o%autonomous .and. o%fixed_period)) then
+        if ((o%conservative .and. .not. o%in_period) .or. &
+            (o%autonomous .and. o%fixed_period)) then
             br%info = CM_BAD_INPUT
-            br%message = "switch_branch_point: for the general shooting of a "// &
-                         "non-conservative family in a parameter"
+            br%message = "switch_branch_point: for the general shooting of a family in a "// &
+                         "parameter, or of a conservative family in the period (in_period)"
             return
         end if
         if (size(t_old) /= nx .or. .not. (norm2(t_old) > 0.0_dp)) then
@@ -166,7 +168,8 @@ contains
             br%message = "switch_branch_point: SVD of the shooting Jacobian failed"
             return
         end if
-        ! kernel of DG (neq = nx - 1 rows): the last two right singular vectors
+        ! kernel of DG (neq = nx - 1 rows, or nx with in_period where the energy integral
+        ! makes one row dependent): the last two right singular vectors
         k1 = vt(nx - 1, :)
         k2 = vt(nx, :)
         rat = sv(nx - 1)/max(sv(nx - 2), tiny(1.0_dp))
@@ -207,15 +210,17 @@ contains
         oo%rtol = o%rtol
         oo%atol = o%atol
         h = o%fd_step*max(1.0_dp, abs(pt%p))
-        call set_param(sys, pt%p + h)
-        yp = pt%y0
-        call ode_integrate(sys, 0.0_dp, pt%period, yp, oo, info, message=msg)
-        if (info < 0) return
-        call set_param(sys, pt%p - h)
-        ym = pt%y0
-        call ode_integrate(sys, 0.0_dp, pt%period, ym, oo, info, message=msg)
-        if (info < 0) return
-        call set_param(sys, pt%p)
+        if (.not. o%in_period) then
+            call set_param(sys, pt%p + h)
+            yp = pt%y0
+            call ode_integrate(sys, 0.0_dp, pt%period, yp, oo, info, message=msg)
+            if (info < 0) return
+            call set_param(sys, pt%p - h)
+            ym = pt%y0
+            call ode_integrate(sys, 0.0_dp, pt%period, ym, oo, info, message=msg)
+            if (info < 0) return
+            call set_param(sys, pt%p)
+        end if
         y = pt%y0
         phi = 0.0_dp
         do j = 1, n
@@ -230,7 +235,11 @@ contains
         end do
         call sys%rhs(pt%period, y, f)
         if (tfree) dg(1:n, n + 1) = f
-        dg(1:n, nx) = (yp - ym)/(2.0_dp*h)
+        if (o%in_period) then
+            dg(1:n, nx) = f                      ! the period is the continued quantity
+        else
+            dg(1:n, nx) = (yp - ym)/(2.0_dp*h)
+        end if
         if (size(dg, 1) > n) then
             call sys%rhs(0.0_dp, pt%y0, f)
             dg(n + 1, 1:n) = f
