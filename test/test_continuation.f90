@@ -130,8 +130,64 @@ contains
         ! u^2 + w^2 = |xi|^2 = p - 1 (closed form), p > 1 (supercritical)
         do k = 1, br%nspecial
             if (br%special(k)%kind == SP_PD) call check_doubled(sys, br%special(k))
+            if (br%special(k)%kind == SP_BP) call check_pitchfork(sys, br, k)
         end do
     end subroutine test_pd_bp_ns
+
+    !> Branch switching at the pitchfork p = 2 of z' = (p - 2) z - z^3 (the symmetry
+    !! z -> -z broken): the new orbits have z^2 = p - 2 (closed form by construction), the
+    !! rest of the state on the old cycle, period 2 pi; each checked by an independent
+    !! integration over its period (true closure error).
+    subroutine check_pitchfork(sys, br, k)
+        type(nf_cycles), intent(inout) :: sys
+        type(branch), intent(in) :: br
+        integer, intent(in) :: k
+        type(branch) :: b2
+        type(cont_options) :: o
+        type(ode_options) :: oo
+        real(dp) :: err, clos, ratio, y(7)
+        integer :: j, i, info
+        logical :: newb
+        i = br%special(k)%index
+        o%ds = 0.05_dp
+        o%ds_max = 0.1_dp
+        o%max_points = 8
+        call switch_branch_point(sys, set_p, br%special(k), &
+                                 branch_secant(br%points(i), br%points(i + 1), .true.), b2, &
+                                 o, ratio)
+        call ts%check(b2%info == CM_SUCCESS .and. b2%npoints == 8, &
+                      "pitchfork branch: "//b2%message)
+        call ts%check_less(ratio, 1.0e-4_dp, "two-dimensional kernel at the branch point")
+        err = 0.0_dp
+        clos = 0.0_dp
+        newb = .true.
+        oo%rtol = 1.0e-12_dp
+        oo%atol = 1.0e-12_dp
+        do j = 2, b2%npoints
+            err = max(err, abs(b2%points(j)%y0(5)**2 - (b2%points(j)%p - 2.0_dp)), &
+                      abs(b2%points(j)%period - 8.0_dp*atan(1.0_dp)))
+            sys%p = b2%points(j)%p
+            y = b2%points(j)%y0
+            call ode_integrate(sys, 0.0_dp, b2%points(j)%period, y, oo, info)
+            clos = max(clos, maxval(abs(y - b2%points(j)%y0)))
+            newb = newb .and. b2%points(j)%p > 2.0_dp .and. &
+                   b2%points(j)%y0(5) > 0.5_dp*sqrt(max(b2%points(j)%p - 2.0_dp, 0.0_dp))
+        end do
+        call ts%check(newb, "new orbits: p > 2, z > 0 (not the old branch z = 0)")
+        call ts%check_less(err, 1.0e-8_dp, "pitchfork orbits: z^2 = p - 2, period 2 pi")
+        call ts%check_less(clos, 1.0e-8_dp, "pitchfork orbits close (true closure error)")
+        ! the other side of the pitchfork: z < 0 (direction -1)
+        o%direction = -1
+        o%max_points = 3
+        call switch_branch_point(sys, set_p, br%special(k), &
+                                 branch_secant(br%points(i), br%points(i + 1), .true.), b2, o)
+        call ts%check(b2%info == CM_SUCCESS .and. b2%points(b2%npoints)%y0(5) < -0.05_dp, &
+                      "direction -1: the mirror branch z < 0")
+        ! not a branch point
+        call switch_branch_point(sys, set_p, br%special(1 + mod(k, br%nspecial)), &
+                                 [1.0_dp], b2, o)
+        call ts%check(b2%info == CM_BAD_INPUT, "switch at a non-BP rejected: "//b2%message)
+    end subroutine check_pitchfork
 
     subroutine check_doubled(sys, sp)
         type(nf_cycles), intent(inout) :: sys

@@ -31,7 +31,8 @@ from .systems import BuiltinSystem
 __all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
            "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
            "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
-           "switch_period_doubling",
+           "switch_period_doubling", "switch_branch_point", "constrained_equilibrium",
+           "constrained_equilibria", "ConstrainedEquilibrium",
            "equilibrium", "lagrange_dirichlet", "stm",
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
 
@@ -495,11 +496,13 @@ class Branch:
     component of the tangent, branch point, period doubling, Neimark-Sacker), residual,
     iterations, energy (if an energy function was given); special (list of SpecialPoint);
     success, status, message (a branch that stopped early keeps its points: success False
-    and the message names the parameter value)."""
+    and the message names the parameter value); kernel_ratio (a branch from
+    :func:`switch_branch_point`: the second smallest singular value of the shooting
+    Jacobian at the branch point over the third, small for a genuine branch point)."""
 
     __slots__ = ("p", "period", "y0", "multipliers", "stability_index", "stable", "tests",
                  "residual", "iterations", "energy", "special", "status", "message",
-                 "param", "conservative")
+                 "param", "conservative", "kernel_ratio")
 
     def __init__(self, **kw):
         for k in self.__slots__:
@@ -536,7 +539,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                  conservative=False, free=None, targets=None, free_time=False,
                  period_factor=2.0, rtol=1e-11, atol=1e-11, tol=1e-10, res_tol=1e-8,
                  max_iter=12, locate=True, locate_tol=1e-11, energy=None, in_period=False,
-                 _switch=False) -> Branch:
+                 _switch=0, _tangent=None) -> Branch:
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -580,11 +583,12 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                      rtol, atol, locate_tol, period_factor], dtype=float)
     iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(autonomous),
                      bool(fixed_period), bool(conservative), bool(locate), sym,
-                     bool(free_time), bool(_switch), bool(in_period)], dtype=np.int32)
+                     bool(free_time), int(_switch), bool(in_period)], dtype=np.int32)
     if in_period and (sym or not autonomous):
         raise ValueError("in_period is for general shooting of autonomous systems")
+    tang = np.zeros(1) if _tangent is None else np.array(_tangent, dtype=float).ravel()
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
-            int(max_points))
+            tang.size if _tangent is not None else 0, tang, int(max_points))
     if isinstance(system, BuiltinSystem):
         if param is None and in_period:
             param = 0
@@ -644,7 +648,8 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                   stability_index=s, stable=stable, tests=np.array(psi[:, k]).T.copy(),
                   residual=np.array(res[k]), iterations=np.array(iters[k], dtype=int),
                   energy=en, special=special, status=int(info), message=_msg(message),
-                  param="period" if in_period else pname, conservative=bool(conservative))
+                  param="period" if in_period else pname, conservative=bool(conservative),
+                  kernel_ratio=float(tang[0]) if _switch == 2 else None)
 
 
 def transverse(potential: Callable[..., Any], y0: ArrayLike, period: float, omega: float = 0.0,
@@ -804,11 +809,11 @@ def switch_period_doubling(system: Any, point: SpecialPoint, param: str | int | 
     for :func:`continuation` (general shooting of an autonomous system)."""
     if not isinstance(point, SpecialPoint) or point.kind != "period doubling":
         raise ValueError("point must be a 'period doubling' SpecialPoint of a Branch")
-    for bad in ("free", "targets", "p0", "_switch"):
+    for bad in ("free", "targets", "p0", "_switch", "_tangent"):
         if bad in options:
             raise ValueError(f"{bad} is not an option of switch_period_doubling")
     return continuation(system, point.y0, point.period, param=param, p0=point.p,
-                        _switch=True, **options)
+                        _switch=1, **options)
 
 
 # --------------------------------------------------------------------------- plots
@@ -863,3 +868,8 @@ def plot_multipliers(branch, ax=None):
     ax.set_ylabel("Im mu")
     ax.set_title("multipliers along the branch")
     return ax
+
+
+from ._branch_switch import switch_branch_point  # noqa: E402 (uses continuation above)
+from ._constrained_equilibria import (  # noqa: E402
+    ConstrainedEquilibrium, constrained_equilibrium, constrained_equilibria)

@@ -156,7 +156,9 @@ contains
             br%npoints = br%npoints + 1
             br%points(br%npoints) = pt
             k = br%npoints
-            if (pb%o%locate) call detect(sys, set_param, pb, br, x, t, ds, k)
+            ! (from a bifurcation point, the test functions of the first point are ~0)
+            if (pb%o%locate .and. .not. (present(tangent0) .and. k == 2)) &
+                call detect(sys, set_param, pb, br, x, t, ds, k)
             x = xn
             t = tn
             if (it <= 3) ds = min(pb%o%ds_max, 1.5_dp*ds)

@@ -434,7 +434,8 @@ end subroutine flat_hill_equation_callback
 !! in arrays of mp points (npts used), the special points (nsp, at most 64).
 subroutine flat_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, period, ropt, &
                                      iopt, nfree, &
-                                     free_idx, ntg, targets, mp, npts, pp, per, ys, mr, mi, &
+                                     free_idx, ntg, targets, ntang, tang, mp, npts, pp, &
+                                     per, ys, mr, mi, &
                                      s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
                                      sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -449,7 +450,8 @@ subroutine flat_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, p
     integer(c_int), intent(in) :: nspec
     integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
+    real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
     real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
     real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
@@ -473,7 +475,8 @@ subroutine flat_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, p
         return
     end if
     call run_continuation(sys, n, y0, period, params(ip), ropt, iopt, nfree, free_idx, ntg, &
-                          targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, &
+                          targets, ntang, tang, mp, npts, pp, per, ys, mr, mi, s, psi, res, &
+                          iters, nsp, &
                           sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, &
                           message)
 end subroutine flat_continuation_builtin
@@ -481,7 +484,8 @@ end subroutine flat_continuation_builtin
 !> As flat_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from the
 !! parameter value p0 (finite-difference Jacobian).
 subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree, free_idx, &
-                                      ntg, targets, mp, npts, pp, per, ys, mr, mi, s, psi, &
+                                      ntg, targets, ntang, tang, mp, npts, pp, per, ys, mr, &
+                                      mi, s, psi, &
                                       res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
                                       sp_mr, sp_mi, sp_s, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -489,7 +493,8 @@ subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree,
     implicit none
     integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
     real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
+    real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
     real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
     real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
@@ -511,7 +516,8 @@ subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree,
     sys%n = n
     sys%p = p0
     call run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, targets, &
-                          mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sp_kind, &
+                          ntang, tang, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, &
+                          sp_kind, &
                           sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
 end subroutine flat_continuation_callback
 

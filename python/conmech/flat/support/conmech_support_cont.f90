@@ -10,8 +10,8 @@ module conmech_support_cont
     use conmech_param_system, only: builtin_param_system, set_builtin_param
     use conmech_shooting, only: set_parameter_proc
     use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &
-                                    SP_PD
-    use conmech_branch_switch, only: switch_period_doubling
+                                    SP_PD, SP_BP
+    use conmech_branch_switch, only: switch_period_doubling, switch_branch_point
     implicit none
     private
     public :: callback_param_system, set_param_any, run_continuation
@@ -53,16 +53,20 @@ contains
     !> Run the continuation and pack the branch. ropt = [ds, ds_min, ds_max, p_min, p_max,
     !! tol, res_tol, rtol, atol, locate_tol, period_factor]; iopt = [max_points, direction,
     !! max_iter, autonomous, fixed_period, conservative, locate, symmetric, free_time,
-    !! switch, in_period]: switch /= 0 starts the doubled-period branch at the
-    !! period-doubling point (p0, y0, period); in_period /= 0 continues in the period.
+    !! switch, in_period]: switch = 1 starts the doubled-period branch at the
+    !! period-doubling point (p0, y0, period), switch = 2 the second branch at the branch
+    !! point (p0, y0, period) whose old tangent is tang(1:ntang) (unknowns [y0, T, p]; its
+    !! singular-value ratio is returned in tang(1)); in_period /= 0 continues in the period.
     subroutine run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, &
-                                targets, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, &
+                                targets, ntang, tang, mp, npts, pp, per, ys, mr, mi, s, &
+                                psi, res, iters, &
                                 nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, &
                                 sp_s, info, message)
         class(ode_system), intent(inout) :: sys
         integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
         real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
-        integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
+        integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
+        real(c_double), intent(inout) :: tang(max(ntang, 1))
         integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(MAX_SPECIAL)
         integer(c_int), intent(out) :: sp_index(MAX_SPECIAL), info
         real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
@@ -74,6 +78,7 @@ contains
         type(cont_options) :: o
         type(branch) :: br
         type(special_point) :: sp
+        real(dp) :: ratio
         integer :: k
         npts = 0
         nsp = 0
@@ -100,7 +105,14 @@ contains
         o%locate = iopt(7) /= 0
         o%in_period = iopt(11) /= 0
         call set_param_any(sys, p0)
-        if (iopt(10) /= 0) then
+        if (iopt(10) == 2) then
+            sp%kind = SP_BP
+            sp%point%p = p0
+            sp%point%y0 = y0
+            sp%point%period = period
+            call switch_branch_point(sys, set_param_any, sp, tang(1:ntang), br, o, ratio)
+            tang(1) = ratio
+        else if (iopt(10) /= 0) then
             sp%kind = SP_PD
             sp%point%p = p0
             sp%point%y0 = y0
