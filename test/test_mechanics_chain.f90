@@ -8,7 +8,7 @@ module test_chain_systems
     use conmech_systems_chain, only: pendulum_chain_xy
     implicit none
     private
-    public :: twice_pendulum, skew_mass, coupled_chain, trailer_chain
+    public :: twice_pendulum, skew_mass, coupled_chain
 
     !> The chain of pendulums with a constant block-diagonal mass (2 x 2 blocks [m c; c m]
     !! per point): M^-1 is banded (bm = 1), kept by prepare_mass for the banded path.
@@ -18,24 +18,6 @@ module test_chain_systems
         procedure :: mass => cc_mass
     end type coupled_chain
 
-    !> N points in the plane (n = 2N), the first pulled by a constant force: rods between
-    !! consecutive points (N - 1 holonomic rows, windows of width 4) and a knife edge at
-    !! each point i >= 2 along its link, perp(p_i - p_{i-1}) . v_i = 0 (N - 1 Pfaffian
-    !! rows, windows of width 2): an N-trailer. Rows of G and A interleave along the chain.
-    type, extends(constrained_system) :: trailer_chain
-        real(dp) :: m = 1.0_dp
-    contains
-        procedure :: mass => tr_mass
-        procedure :: mass_diagonal => tr_mass_diagonal
-        procedure :: forces => tr_forces
-        procedure :: phi => tr_phi
-        procedure :: phi_jac => tr_jac
-        procedure :: phi_jac_band => tr_jac_band
-        procedure :: phi_gamma => tr_gamma
-        procedure :: nh_matrix => tr_nh
-        procedure :: nh_matrix_band => tr_nh_band
-        procedure :: nh_gamma => tr_nh_gamma
-    end type trailer_chain
 
 
     !> A point mass with the same circle constraint twice (redundant: rank 1), with a
@@ -135,126 +117,14 @@ contains
         end do
     end subroutine cc_mass
 
-    subroutine tr_mass(self, t, q, mm)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: mm(:, :)
-        integer :: i
-        mm = 0.0_dp
-        do i = 1, size(q)
-            mm(i, i) = self%m
-        end do
-    end subroutine tr_mass
-    subroutine tr_mass_diagonal(self, t, q, d)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: d(:)
-        d = self%m
-    end subroutine tr_mass_diagonal
-    subroutine tr_forces(self, t, q, v, f)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: f(:)
-        f = 0.0_dp
-        f(1) = 1.0_dp
-        f(2) = 0.3_dp
-    end subroutine tr_forces
-    subroutine tr_phi(self, t, q, c)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: c(:)
-        integer :: i
-        do i = 2, size(q)/2
-            c(i - 1) = 0.5_dp*((q(2*i - 1) - q(2*i - 3))**2 + (q(2*i) - q(2*i - 2))**2 - 1.0_dp)
-        end do
-    end subroutine tr_phi
-    subroutine tr_jac_band(self, t, q, gb, first)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: gb(:, :)
-        integer, intent(out) :: first(:)
-        real(dp) :: dx, dy
-        integer :: i
-        do i = 2, size(q)/2
-            dx = q(2*i - 1) - q(2*i - 3)
-            dy = q(2*i) - q(2*i - 2)
-            first(i - 1) = 2*i - 3
-            gb(i - 1, :) = [-dx, -dy, dx, dy]
-        end do
-    end subroutine tr_jac_band
-    subroutine tr_jac(self, t, q, g)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: g(:, :)
-        real(dp) :: gb(self%n_hol, 4)
-        integer :: first(self%n_hol), i
-        call tr_jac_band(self, t, q, gb, first)
-        g = 0.0_dp
-        do i = 1, self%n_hol
-            g(i, first(i):first(i) + 3) = gb(i, :)
-        end do
-    end subroutine tr_jac
-    subroutine tr_gamma(self, t, q, v, gam)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: gam(:)
-        integer :: i
-        do i = 2, size(q)/2
-            gam(i - 1) = -((v(2*i - 1) - v(2*i - 3))**2 + (v(2*i) - v(2*i - 2))**2)
-        end do
-    end subroutine tr_gamma
-    subroutine tr_nh_band(self, t, q, ab, b, first)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: ab(:, :), b(:)
-        integer, intent(out) :: first(:)
-        integer :: i
-        do i = 2, size(q)/2
-            first(i - 1) = 2*i - 1
-            ab(i - 1, :) = [-(q(2*i) - q(2*i - 2)), q(2*i - 1) - q(2*i - 3)]
-        end do
-        b = 0.0_dp
-    end subroutine tr_nh_band
-    subroutine tr_nh(self, t, q, a, b)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: a(:, :), b(:)
-        real(dp) :: ab(self%n_nh, 2)
-        integer :: first(self%n_nh), i
-        call tr_nh_band(self, t, q, ab, b, first)
-        a = 0.0_dp
-        do i = 1, self%n_nh
-            a(i, first(i):first(i) + 1) = ab(i, :)
-        end do
-    end subroutine tr_nh
-    !> gamma_n = -(dA/dt) v: d/dt of perp(p_i - p_{i-1}) . v_i with v fixed.
-    subroutine tr_nh_gamma(self, t, q, v, gam)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: gam(:)
-        integer :: i
-        do i = 2, size(q)/2
-            gam(i - 1) = (v(2*i) - v(2*i - 2))*v(2*i - 1) - (v(2*i - 1) - v(2*i - 3))*v(2*i)
-        end do
-    end subroutine tr_nh_gamma
-
 end module test_chain_systems
 
 program test_mechanics_chain
     use conmech
     use conmech_systems_chain, only: pendulum_chain_xy
     use conmech_testing, only: test_suite
-    use test_chain_systems, only: twice_pendulum, skew_mass, coupled_chain, trailer_chain
+    use test_chain_systems, only: twice_pendulum, skew_mass, coupled_chain
+    use conmech_systems_trailer, only: trailer_chain, trailer_initial_state
     implicit none
     type(test_suite) :: ts
     class(constrained_system), allocatable :: band, dense, pend
