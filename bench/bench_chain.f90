@@ -8,8 +8,11 @@
 !!
 !! Prints a Markdown table: steps, CPU time per step (best of 3), the growth exponent
 !! between successive N, and the largest residuals max|phi|, max|G v| over the run.
+!! A second table: the N-trailer (conmech_systems_trailer: N - 1 rods and N - 1 knife
+!! edges, the Pfaffian rows interleaved with the holonomic ones), banded vs dense.
 program bench_chain
     use conmech
+    use conmech_systems_trailer, only: trailer_chain, trailer_chain_of, trailer_initial_state
     implicit none
     integer, parameter :: ns(4) = [16, 32, 64, 128]
     real(dp) :: tb(size(ns)), td(size(ns)), rb(size(ns)), rd(size(ns))
@@ -29,6 +32,20 @@ program bench_chain
         call run(ns(i), .false., merge(0.02_dp, merge(0.5_dp, 0.1_dp, ns(i) <= 32), quick), &
                  td(i), sd(i), rd(i))
     end do
+    call table()
+    write (*, '(a)') ""
+    write (*, '(a)') "N-trailer (N - 1 rods + N - 1 knife edges, Pfaffian rows banded):"
+    do i = 1, size(ns)
+        call run(ns(i), .true., merge(2.0_dp, 20.0_dp, quick), tb(i), sb(i), rb(i), .true.)
+        call run(ns(i), .false., merge(0.02_dp, merge(0.5_dp, 0.1_dp, ns(i) <= 32), quick), &
+                 td(i), sd(i), rd(i), .true.)
+    end do
+    call table()
+
+contains
+
+    subroutine table()
+        integer :: i
 
     write (*, '(a)') "| N | banded: steps | us/step | exponent | max residual | "// &
         "dense: steps | us/step | exponent | max residual | dense/banded |"
@@ -48,14 +65,14 @@ program bench_chain
     end do
     write (*, '(a,f0.2,a,f0.2)') "Banded: growth exponent from N = 16 to 128: ", &
         log(tb(size(ns))/tb(1))/log(8.0_dp), "; dense: ", log(td(size(ns))/td(1))/log(8.0_dp)
-
-contains
+    end subroutine table
 
     !> Best CPU time per accepted step over nrep runs on [0, tend] (DOP853, 1e-8).
-    subroutine run(nl, banded, tend, per_step, steps, resid)
+    subroutine run(nl, banded, tend, per_step, steps, resid, trailer)
         integer, intent(in) :: nl
         logical, intent(in) :: banded
         real(dp), intent(in) :: tend
+        logical, intent(in), optional :: trailer
         real(dp), intent(out) :: per_step, resid
         integer, intent(out) :: steps
         class(constrained_system), allocatable :: cs
@@ -65,11 +82,17 @@ contains
         real(dp) :: c0, c1
         integer :: info, rep
         character(len=:), allocatable :: msg
-        call make_constrained("pendulum_chain_xy", [real(nl, dp)], cs, info, msg)
-        call mech_initial_state("pendulum_chain_xy", [real(nl, dp)], q0, v0, info)
+        if (present(trailer)) then
+            allocate (cs, source=trailer_chain_of(nl))
+            call trailer_initial_state(nl, 1.0_dp, q0, v0)
+        else
+            call make_constrained("pendulum_chain_xy", [real(nl, dp)], cs, info, msg)
+            call mech_initial_state("pendulum_chain_xy", [real(nl, dp)], q0, v0, info)
+        end if
         if (.not. banded) then
             cs%diagonal_mass = .false.
             cs%jac_width = 0
+            cs%nh_width = 0
         end if
         opt%ode%method = METHOD_DOP853
         opt%ode%rtol = 1.0e-8_dp

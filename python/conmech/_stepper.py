@@ -1,7 +1,7 @@
 """Step-by-step integration with SciPy's OdeSolver interface.
 
 ``conmech.DOP853(fun, t0, y0, t_bound, rtol=..., atol=..., max_step=..., first_step=...)``
-(and ``RK45``/``DOPRI5``, ``VERNER98``, ``RK4``) advance one accepted step per ``step()``
+(and ``RK45`` (SciPy's step control), ``DOPRI5`` (Hairer's), ``VERNER98``, ``RK4``) advance one accepted step per ``step()``
 call, as ``scipy.integrate.DOP853`` does: attributes ``t``, ``y``, ``t_old``,
 ``t_bound``, ``direction``, ``n``, ``status`` ("running", "finished", "failed"),
 ``step_size``, ``nfev``, ``njev``, ``nlu``; ``dense_output()`` is the continuous
@@ -78,7 +78,8 @@ class RungeKutta:
     rtol, atol : float or array_like of shape (n,)
         Relative and absolute tolerances (SciPy's defaults 1e-3, 1e-6).
     first_step : float or None
-        Initial step size (None: Hairer's heuristic). RK4: its fixed step, required.
+        Initial step size (None: SciPy's heuristic for RK45, Hairer's for the others).
+        RK4: its fixed step, required.
     vectorized : bool
         Accepted for SciPy compatibility, without effect.
     max_steps : int
@@ -264,15 +265,23 @@ class DOP853(RungeKutta):
 
 
 class RK45(RungeKutta):
-    """Dormand-Prince 5(4) (Hairer's DOPRI5: Lund-stabilised control, dense output of order
-    4), SciPy's OdeSolver interface."""
-    _code = 2
+    """Dormand-Prince 5(4) with SciPy's step control and initial step (as
+    ``scipy.integrate.RK45`` and ``conmech.solve_ivp(method="RK45")``: no Lund
+    stabilisation, SciPy's ``select_initial_step``), dense output of order 4; SciPy's
+    OdeSolver interface. ``conmech.DOPRI5`` is the same pair with Hairer's control."""
+    _code = 12
     order = 5
     error_estimator_order = 4
     n_stages = 6
 
 
-DOPRI5 = RK45
+class DOPRI5(RungeKutta):
+    """Dormand-Prince 5(4) as Hairer's DOPRI5 (Lund-stabilised step control, Hairer's
+    initial step, dense output of order 4), SciPy's OdeSolver interface."""
+    _code = 2
+    order = 5
+    error_estimator_order = 4
+    n_stages = 6
 
 
 class VERNER98(RungeKutta):
@@ -291,7 +300,7 @@ class RK4(RungeKutta):
     n_stages = 4
 
 
-_SCIPY_COUNTERPARTS = {"RK45": 2, "DOP853": 3}
+_SCIPY_COUNTERPARTS = {"RK45": 12, "DOP853": 3}
 
 
 def method_code(method):

@@ -114,11 +114,14 @@ def test_zero_interval_finishes_at_once(cls):
 
 
 # ------------------------------------------------ conmech's own properties
-# conmech.RK45 is the class of DOPRI5 (Hairer's control, as in Fortran); the string
-# "RK45" of solve_ivp is SciPy's control (its default method), so the class is compared
-# with "DOPRI5" and with solve_ivp(method=conmech.RK45)
-@pytest.mark.parametrize("cls,name", [(conmech.DOP853, "DOP853"), (conmech.RK45, "DOPRI5"),
+# conmech.RK45 is Dormand-Prince with SciPy's step control and initial step, as the string
+# "RK45" of solve_ivp (SciPy's default method); conmech.DOPRI5 is Hairer's control, as
+# the string "DOPRI5"
+@pytest.mark.parametrize("cls,name", [(conmech.DOP853, "DOP853"), (conmech.RK45, "RK45"),
                                       (conmech.RK45, conmech.RK45),
+                                      (conmech.RK45, si.RK45),
+                                      (conmech.DOPRI5, "DOPRI5"),
+                                      (conmech.DOPRI5, conmech.DOPRI5),
                                       (conmech.VERNER98, "VERNER98")])
 def test_step_loop_is_solve_ivp_bit_for_bit(cls, name):
     y0 = [0.4, 0.0, 0.0, 2.0]
@@ -134,6 +137,48 @@ def test_step_loop_is_solve_ivp_bit_for_bit(cls, name):
     assert np.array_equal(np.array(ys).T, r.y)
     assert s.nfev == r.nfev
     assert s.naccept == r.naccept and s.nreject == r.nreject
+
+
+@pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-9])
+@pytest.mark.parametrize("t_span", [(0.0, 6.0), (6.0, 0.5)])
+def test_rk45_takes_scipys_steps(rtol, t_span):
+    # the same loop drives scipy.integrate.RK45 and conmech.RK45: the same number of
+    # steps at the same times (to round-off), the same states; nfev is SciPy's + 1
+    # (conmech's initial-step heuristic evaluates f(t0, y0) once more)
+    y0 = [0.4, 0.0, 0.0, 2.0]
+    runs = []
+    for cls in (si.RK45, conmech.RK45):
+        s = cls(kepler, t_span[0], y0, t_span[1], rtol=rtol, atol=rtol * 1e-3)
+        ts, ys, hs = [], [], []
+        while s.status == "running":
+            assert s.step() is None
+            ts.append(s.t)
+            ys.append(s.y)
+            hs.append(s.step_size)
+        runs.append((np.array(ts), np.array(ys), np.array(hs), s.nfev))
+    (ta, ya, ha, na), (tb, yb, hb, nb) = runs
+    assert len(ta) == len(tb)
+    # (round-off differences of the two codes grow through the step control: to ~1e-9
+    # relative over the 140 steps at rtol 1e-9)
+    assert_allclose(tb, ta, rtol=1e-8, atol=1e-12)
+    assert_allclose(hb, ha, rtol=1e-6)
+    assert_allclose(yb, ya, rtol=0, atol=1e-8)
+    assert nb == na + 1
+    assert conmech.RK45 is not conmech.DOPRI5
+
+
+def test_dopri5_is_hairers_control():
+    # conmech.DOPRI5 (Lund-stabilised, Hairer's initial step) takes other steps than
+    # conmech.RK45 (SciPy's control) on the same problem
+    y0 = [0.4, 0.0, 0.0, 2.0]
+    counts = []
+    for cls in (conmech.RK45, conmech.DOPRI5):
+        s = cls(kepler, 0.0, y0, 6.0, rtol=1e-6, atol=1e-9)
+        while s.status == "running":
+            s.step()
+        counts.append((s.naccept, s.nfev, s.t))
+    assert counts[0][2] == counts[1][2] == 6.0
+    assert counts[0][:2] != counts[1][:2]
 
 
 def test_builtin_system_steps_like_solve_ivp():

@@ -10,6 +10,10 @@
 !! ab(kd + 1 + i - j, j) = S(i, j) for j - kd <= i <= j. A chain of N links has w = 4,
 !! kd = 1 (S tridiagonal): O(N) per evaluation.
 !!
+!! With a constant mass whose inverse is banded (half-bandwidth bm, stored as
+!! minv(j, k) = M^-1(j, j + k), k = -bm..bm) the same holds with the windows widened by
+!! bm: S = C M^-1 C^T by `band_schur_minv`, O(m (w + 2 bm) (w + kd)).
+!!
 !! Pure routines on arrays (no system types, no saved state): thread-safe.
 module conmech_constrained_band
     use conmech_kinds, only: dp
@@ -17,7 +21,7 @@ module conmech_constrained_band
     private
 
     public :: band_width_of, band_schur, band_gmul, band_gtmul, band_factor, band_solve
-    public :: band_dense
+    public :: band_dense, band_schur_minv, band_minv_mul, band_order
 
     interface
         subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
@@ -41,9 +45,13 @@ contains
 
     !> Superdiagonals kd of S = G D^-1 G^T for row windows of width w starting at `first`;
     !! -1 if `first` is not nondecreasing or a window leaves 1..n (use the dense path).
-    pure integer function band_width_of(first, w, n) result(kd)
+    !! `reach` (default 0): half-bandwidth of a banded M^-1 in place of D^-1.
+    pure integer function band_width_of(first, w, n, reach) result(kd)
         integer, intent(in) :: first(:), w, n
-        integer :: i, k, m
+        integer, intent(in), optional :: reach
+        integer :: i, k, m, ext
+        ext = 0
+        if (present(reach)) ext = reach
         m = size(first)
         kd = 0
         do i = 1, m
@@ -61,7 +69,7 @@ contains
         do i = 1, m
             k = i + 1
             do while (k <= m)
-                if (first(k) > first(i) + w - 1) exit
+                if (first(k) > first(i) + w - 1 + ext) exit
                 k = k + 1
             end do
             kd = max(kd, k - 1 - i)
@@ -91,6 +99,80 @@ contains
             end do
         end do
     end subroutine band_schur
+
+    !> ab = S = C M^-1 C^T in upper band storage (kd superdiagonals) for a banded M^-1
+    !! (minv(j, k) = M^-1(j, j + k), k = -bm..bm): u = M^-1 c_k on its reach, then the
+    !! products with the windows of the rows i = k - kd .. k.
+    pure subroutine band_schur_minv(cb, first, minv, bm, kd, ab)
+        real(dp), intent(in) :: cb(:, :)
+        integer, intent(in) :: first(:), bm, kd
+        real(dp), intent(in) :: minv(:, -bm:)
+        real(dp), intent(out) :: ab(:, :)
+        real(dp) :: u(size(minv, 1)), s, cv
+        integer :: i, k, m, w, n, j, l, lo, hi, jj
+        m = size(cb, 1)
+        w = size(cb, 2)
+        n = size(minv, 1)
+        ab = 0.0_dp
+        do k = 1, m
+            lo = max(1, first(k) - bm)
+            hi = min(n, first(k) + w - 1 + bm)
+            u(lo:hi) = 0.0_dp
+            do jj = 1, w
+                j = first(k) + jj - 1
+                cv = cb(k, jj)
+                do l = max(1, j - bm), min(n, j + bm)
+                    u(l) = u(l) + minv(l, j - l)*cv
+                end do
+            end do
+            do i = max(1, k - kd), k
+                s = 0.0_dp
+                do jj = 1, w
+                    j = first(i) + jj - 1
+                    if (j >= lo .and. j <= hi) s = s + cb(i, jj)*u(j)
+                end do
+                ab(kd + 1 + i - k, k) = s
+            end do
+        end do
+    end subroutine band_schur_minv
+
+    !> z = M^-1 x for a banded M^-1 (minv(j, k) = M^-1(j, j + k), k = -bm..bm).
+    pure subroutine band_minv_mul(minv, bm, x, z)
+        integer, intent(in) :: bm
+        real(dp), intent(in) :: minv(:, -bm:), x(:)
+        real(dp), intent(out) :: z(:)
+        integer :: j, k, n
+        real(dp) :: s
+        n = size(minv, 1)
+        do j = 1, n
+            s = 0.0_dp
+            do k = max(-bm, 1 - j), min(bm, n - j)
+                s = s + minv(j, k)*x(j + k)
+            end do
+            z(j) = s
+        end do
+    end subroutine band_minv_mul
+
+    !> Stable order of rows by their first column (counting sort, O(n + m)): row p of the
+    !! ordered set is row perm(p) of the given one.
+    pure subroutine band_order(first, n, perm)
+        integer, intent(in) :: first(:), n
+        integer, intent(out) :: perm(:)
+        integer :: cnt(0:n + 1), i, k
+        cnt = 0
+        do i = 1, size(first)
+            k = min(max(first(i), 0), n + 1)
+            cnt(k) = cnt(k) + 1
+        end do
+        do k = 1, n + 1
+            cnt(k) = cnt(k) + cnt(k - 1)
+        end do
+        do i = size(first), 1, -1
+            k = min(max(first(i), 0), n + 1)
+            perm(cnt(k)) = i
+            cnt(k) = cnt(k) - 1
+        end do
+    end subroutine band_order
 
     !> y = G x (m) from the row windows.
     pure subroutine band_gmul(gb, first, x, y)

@@ -2,30 +2,23 @@
 !! conmech_constrained_system (see there): the dense paths, with the banded ones of
 !! conmech_constrained_system_band tried first where the system's structure allows.
 submodule(conmech_constrained_system) conmech_constrained_projection
-    use conmech_constrained_band, only: band_width_of, band_gmul, band_gtmul
     implicit none
 
 contains
 
-    !> Reaction force r = C(t, q)^T lam (n): O(n) for a row-window G.
+    !> Reaction force r = C(t, q)^T lam (n): O(n) for row windows.
     module subroutine constraint_reaction(sys, t, q, lam, r)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), lam(:)
         real(dp), intent(out) :: r(:)
         real(dp), allocatable :: c(:, :), c0(:)
+        logical :: ok
         r = 0.0_dp
         if (sys%n_hol + sys%n_nh == 0) return
         if (band_ready(sys)) then
-            block
-                real(dp) :: gb(sys%n_hol, sys%jac_width)
-                integer :: first(sys%n_hol)
-                call sys%phi_jac_band(t, q, gb, first)
-                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
-                    call band_gtmul(gb, first, lam, r)
-                    return
-                end if
-            end block
+            call band_reaction(sys, t, q, lam, r, ok)
+            if (ok) return
         end if
         allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
         call constraint_matrix(sys, t, q, c, c0)
@@ -40,6 +33,7 @@ contains
         real(dp), intent(out) :: rpos, rvel
         real(dp), allocatable :: c(:, :), c0(:)
         real(dp) :: ph(sys%n_hol)
+        logical :: ok
         rpos = 0.0_dp
         rvel = 0.0_dp
         if (sys%n_hol > 0) then
@@ -47,17 +41,8 @@ contains
             rpos = maxval(abs(ph))
         end if
         if (band_ready(sys)) then
-            block
-                real(dp) :: gb(sys%n_hol, sys%jac_width), gv(sys%n_hol), pt(sys%n_hol)
-                integer :: first(sys%n_hol)
-                call sys%phi_jac_band(t, q, gb, first)
-                if (band_width_of(first, sys%jac_width, sys%n) >= 0) then
-                    call band_gmul(gb, first, v, gv)
-                    call sys%phi_t(t, q, pt)
-                    rvel = maxval(abs(gv + pt))
-                    return
-                end if
-            end block
+            call band_velocity_residual(sys, t, q, v, rvel, ok)
+            if (ok) return
         end if
         if (sys%n_hol + sys%n_nh > 0) then
             allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))

@@ -24,15 +24,20 @@
 !! diagonal mass sets it):
 !! - `constant_mass`: M does not depend on (t, q); `prepare_mass` (called by
 !!   constrained_solve on its copy of the system) keeps its Cholesky factor, and the KKT
-!!   solves and projections use it instead of factorising M at every evaluation;
+!!   solves and projections use it instead of factorising M at every evaluation; when
+!!   M^-1 is banded (M block diagonal, e.g. bodies with coupled coordinates) it also keeps
+!!   M^-1 in band form for the banded path below;
 !! - `diagonal_mass`: M is diagonal, given by `mass_diagonal` (default: the diagonal of
 !!   `mass`); M^-1 is a division, no factorisation per evaluation;
-!! - `jac_width` > 0 (with a diagonal mass and holonomic constraints only): row i of G has
-!!   its nonzeros in the jac_width consecutive columns first(i) .. first(i) + jac_width - 1
-!!   given by `phi_jac_band`; then S = G M^-1 G^T is banded (bandwidth detected from
-!!   `first`) and factorised by LAPACK's banded Cholesky (conmech_constrained_band): a chain
-!!   of N links costs O(N) per evaluation and per projection. When the banded S is not
-!!   positive definite (redundant constraints) the dense rank-revealing path above runs.
+!! - `jac_width` > 0: row i of G has its nonzeros in the jac_width consecutive columns
+!!   first(i) .. first(i) + jac_width - 1 given by `phi_jac_band`; `nh_width` > 0: the same
+!!   for the rows of A (`nh_matrix_band`). With a diagonal (or kept banded inverse) mass
+!!   and every constraint row so declared, the rows of C = [G; A] are ordered by their
+!!   first column (a stable counting sort), S = C M^-1 C^T is banded (bandwidth detected)
+!!   and factorised by LAPACK's banded Cholesky (conmech_constrained_band): a chain of N
+!!   links costs O(N) per evaluation and per projection, with or without Pfaffian rows.
+!!   When the banded S is not positive definite (redundant constraints) the dense
+!!   rank-revealing path above runs.
 !!
 !! Users extend `constrained_system` and implement `mass` and `forces`, and, as needed,
 !! `phi` and `phi_jac` (holonomic), `nh_matrix` (non-holonomic). Defaults:
@@ -47,7 +52,8 @@
 module conmech_constrained_system
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrs, dpstrf, dpstf2, dgelsd, la_finite
+    use conmech_lapack, only: dpotrs, la_finite
+    use conmech_schur, only: schur_solve
     use conmech_generalized, only: mass_cholesky
     implicit none
     private
@@ -85,6 +91,10 @@ module conmech_constrained_system
         logical :: constant_mass = .false.  !! M is constant (see prepare_mass)
         real(dp), allocatable :: mass_factor(:, :)  !! Cholesky factor kept by prepare_mass
         integer :: jac_width = 0     !! > 0: row-window width of G (see phi_jac_band)
+        integer :: nh_width = 0      !! > 0: row-window width of A (see nh_matrix_band)
+        !> M^-1 in band form mass_inv_band(j, k) = M^-1(j, j + k), k = -bm..bm, kept by
+        !! prepare_mass for a constant mass whose inverse is banded
+        real(dp), allocatable :: mass_inv_band(:, :)
     contains
         procedure(cs_mass), deferred :: mass
         procedure(cs_forces), deferred :: forces
@@ -96,6 +106,7 @@ module conmech_constrained_system
         procedure :: nh_gamma => cs_fd_nh_gamma
         procedure :: mass_diagonal => cs_mass_diagonal
         procedure :: phi_jac_band => cs_phi_jac_band
+        procedure :: nh_matrix_band => cs_nh_matrix_band
         procedure :: energy => cs_no_energy
         procedure :: has_energy => cs_has_no_energy
     end type constrained_system
@@ -169,7 +180,37 @@ module conmech_constrained_system
     ! when it does not apply (mass not positive, windows not banded, S not positive
     ! definite): the caller then runs the dense path.
     interface
-        !> Diagonal mass, row-window G, holonomic constraints only.
+        !> Default row windows of A (and b) from the dense `nh_matrix`: ab(i, :) =
+        !! A(i, first(i) + 0:w-1) (w = nh_width); a row that does not fit gives first = 0.
+        module subroutine cs_nh_matrix_band(self, t, q, ab, b, first)
+            class(constrained_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:)
+            real(dp), intent(out) :: ab(:, :), b(:)
+            integer, intent(out) :: first(:)
+        end subroutine cs_nh_matrix_band
+        !> Keep M^-1 in band form when it is banded (mm: the Cholesky factor of M).
+        module subroutine keep_mass_inverse(sys, mm)
+            class(constrained_system), intent(inout) :: sys
+            real(dp), intent(in) :: mm(:, :)
+        end subroutine keep_mass_inverse
+        !> r = C^T lam by the row windows.
+        module subroutine band_reaction(sys, t, q, lam, r, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), lam(:)
+            real(dp), intent(out) :: r(:)
+            logical, intent(out) :: ok
+        end subroutine band_reaction
+        !> rvel = max |C v + c0| by the row windows.
+        module subroutine band_velocity_residual(sys, t, q, v, rvel, ok)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:)
+            real(dp), intent(out) :: rvel
+            logical, intent(out) :: ok
+        end subroutine band_velocity_residual
+        !> Diagonal mass (or a kept banded M^-1) and row windows for every constraint row.
         pure module logical function band_ready(sys)
             class(constrained_system), intent(in) :: sys
         end function band_ready
@@ -396,63 +437,10 @@ contains
         if (mn > 0) call sys%nh_matrix(t, q, c(mh + 1:mh + mn, :), c0(mh + 1:mh + mn))
     end subroutine constraint_matrix
 
-    !> Solve S x = r for the symmetric positive semi-definite S (m x m) and k right-hand
-    !! sides: pivoted Cholesky (dpstrf) when S has full rank, else the minimum-norm
-    !! solution by dgelsd. rank = numerical rank (relative tolerance 1e-11).
-    subroutine schur_solve(s, r, rank, info)
-        real(dp), intent(in) :: s(:, :)
-        real(dp), intent(inout) :: r(:, :)
-        integer, intent(out) :: rank, info
-        real(dp) :: f(size(s, 1), size(s, 1)), work(2*size(s, 1)), tmp(size(r, 1), size(r, 2))
-        real(dp) :: sv(size(s, 1)), tol, wq(1)
-        real(dp), allocatable :: wk(:)
-        integer :: piv(size(s, 1)), m, k, lainfo, i, lwork
-        integer, allocatable :: iwork(:)
-        m = size(s, 1)
-        k = size(r, 2)
-        info = CM_SUCCESS
-        rank = 0
-        if (m == 0) return
-        if (.not. (la_finite(s) .and. la_finite(r))) then
-            info = CM_NONFINITE
-            return
-        end if
-        f = s
-        tol = 1.0e-11_dp*maxval([(abs(s(i, i)), i=1, m)])
-        if (m <= 32) then
-            call dpstf2('U', m, f, m, piv, rank, tol, work, lainfo)
-        else
-            call dpstrf('U', m, f, m, piv, rank, tol, work, lainfo)
-        end if
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-            return
-        end if
-        if (rank == m .and. lainfo == 0) then
-            do i = 1, m
-                tmp(i, :) = r(piv(i), :)
-            end do
-            call dpotrs('U', m, k, f, m, tmp, m, lainfo)
-            do i = 1, m
-                r(piv(i), :) = tmp(i, :)
-            end do
-            return
-        end if
-        ! rank deficient: minimum-norm least-squares solution
-        f = s
-        call dgelsd(m, m, k, f, m, r, m, sv, 1.0e-11_dp, rank, wq, -1, piv, lainfo)
-        lwork = max(1, int(wq(1)))
-        allocate (wk(lwork), iwork(max(1, 3*m*max(1, int(log(real(m, dp))/log(2.0_dp)) + 1) &
-                                      + 11*m)))
-        f = s
-        call dgelsd(m, m, k, f, m, r, m, sv, 1.0e-11_dp, rank, wk, lwork, iwork, lainfo)
-        if (lainfo /= 0) info = CM_LAPACK_ERROR
-    end subroutine schur_solve
-
     !> For a system with `constant_mass`: factorise M(t, q) once and keep the factor in
-    !! `mass_factor` (otherwise, or if M is not positive definite, drop it: the
-    !! per-evaluation path then runs and reports). Call it again after changing the
-    !! system's mass parameters.
+    !! `mass_factor`, and M^-1 in band form in `mass_inv_band` when it is banded
+    !! (otherwise, or if M is not positive definite, drop them: the per-evaluation path
+    !! then runs and reports). Call it again after changing the system's mass parameters.
     subroutine prepare_mass(sys, t, q)
         class(constrained_system), intent(inout) :: sys
         real(dp), intent(in) :: t
@@ -460,11 +448,14 @@ contains
         real(dp), allocatable :: mm(:, :)
         integer :: info
         if (allocated(sys%mass_factor)) deallocate (sys%mass_factor)
+        if (allocated(sys%mass_inv_band)) deallocate (sys%mass_inv_band)
         if (.not. sys%constant_mass .or. sys%diagonal_mass .or. size(q) /= sys%n) return
         allocate (mm(sys%n, sys%n))
         call sys%mass(t, q, mm)
         call mass_cholesky(mm, info)
-        if (info == CM_SUCCESS) call move_alloc(mm, sys%mass_factor)
+        if (info /= CM_SUCCESS) return
+        call keep_mass_inverse(sys, mm)
+        call move_alloc(mm, sys%mass_factor)
     end subroutine prepare_mass
 
     !> A constant mass with its factor kept by prepare_mass.

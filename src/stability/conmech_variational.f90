@@ -12,6 +12,7 @@
 !! tolerances are scaled by sqrt(n/(n + n^2)), so that the RMS error norm over z equals the
 !! RMS norm over the state alone: the steps are those of the state's integration.
 module conmech_variational
+    use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
@@ -20,6 +21,20 @@ module conmech_variational
     private
 
     public :: variational_system, integrate_stm
+
+    integer, parameter :: NSMALL = 16   !! largest n with J on the stack
+    integer(int64), parameter :: ONE_BITS = transfer(1.0_dp, 0_int64)  !! bits of 1.0
+
+    interface
+        subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: dp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            real(dp), intent(in) :: alpha, beta
+            real(dp), intent(in) :: a(lda, *), b(ldb, *)
+            real(dp), intent(inout) :: c(ldc, *)
+        end subroutine dgemm
+    end interface
 
     !> z = [y; vec(Phi)], z' = [f(t, y); vec(J(t, y) Phi)].
     type, extends(ode_system) :: variational_system
@@ -32,79 +47,159 @@ module conmech_variational
 contains
 
     !> z' = [f(t, y); vec(J Phi)], f and J from the system's `rhs_jacobian` (one call, so a
-    !! system may share their common work). J lives in a fixed-size stack buffer for
-    !! n <= NSMALL (no allocation per evaluation). The product J Phi is one matrix product
-    !! in column-axpy form, structure-aware for the first-order form of a mechanical system
-    !! (J = [0 I; A B], detected per call: the top half of J Phi is then the bottom half of
-    !! Phi, and only [A B] Phi is computed); loops of constant length for n = 2, 4, 6.
+    !! system may share their common work). No allocation per evaluation for n <= NSMALL:
+    !! J lives in a contiguous local array, and Phi, dPhi are passed as explicit-shape
+    !! n x n matrices (contiguous column sums). The product is structure-aware for the
+    !! first-order form of a mechanical system (J = [0 I; A B], tested per call without
+    !! branches: the top half of J Phi is then the bottom half of Phi, and only [A B] Phi
+    !! is computed); constant-size kernels for n = 2, 4, 6; for n > NSMALL one dgemm.
     subroutine var_rhs(self, t, y, dydt)
         class(variational_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dydt(:)
-        integer, parameter :: NSMALL = 16
-        real(dp) :: jsmall(NSMALL, NSMALL)
-        real(dp), allocatable :: jbig(:, :)
         integer :: n
         n = self%n
-        if (n <= NSMALL) then
-            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jsmall(1:n, 1:n))
-            select case (n)
-            case (2)
-                call product2(NSMALL, jsmall, y, dydt)
-            case (4)
-                call product4(NSMALL, jsmall, y, dydt)
-            case (6)
-                call product6(NSMALL, jsmall, y, dydt)
-            case default
-                call product_n(n, NSMALL, jsmall, y, dydt)
-            end select
-        else
-            allocate (jbig(n, n))
-            call self%base%rhs_jacobian(t, y(1:n), dydt(1:n), jbig)
-            call product_n(n, n, jbig, y, dydt)
-        end if
+        select case (n)
+        case (2)
+            call var_rhs2(self%base, t, y, dydt)
+        case (4)
+            call var_rhs4(self%base, t, y, dydt)
+        case (6)
+            call var_rhs6(self%base, t, y, dydt)
+        case default
+            if (n <= NSMALL) then
+                call var_rhs_small(self%base, n, t, y, dydt)
+            else
+                call var_rhs_big(self%base, n, t, y, dydt)
+            end if
+        end select
     end subroutine var_rhs
 
-    !> dydt(n+1:) = vec(jac(1:n, 1:n) Phi), Phi = reshape(y(n+1:), [n, n]): n = 2, 4, 6, any.
-    pure subroutine product2(ld, jac, y, dydt)
+    subroutine var_rhs2(base, t, y, dydt)
         integer, parameter :: n = 2
-        integer, intent(in) :: ld
-        real(dp), intent(in) :: jac(ld, n), y(:)
-        real(dp), intent(inout) :: dydt(:)
-        integer :: i, j, l, m
-        logical :: mech
+        class(ode_system), intent(in) :: base
+        real(dp), intent(in) :: t, y(n*(n + 1))
+        real(dp), intent(out) :: dydt(n*(n + 1))
+        real(dp) :: jac(n, n)
+        call base%rhs_jacobian(t, y(1:n), dydt(1:n), jac)
+        call product2(jac, y(n + 1:), dydt(n + 1:))
+    end subroutine var_rhs2
+
+    subroutine var_rhs4(base, t, y, dydt)
+        integer, parameter :: n = 4
+        class(ode_system), intent(in) :: base
+        real(dp), intent(in) :: t, y(n*(n + 1))
+        real(dp), intent(out) :: dydt(n*(n + 1))
+        real(dp) :: jac(n, n)
+        call base%rhs_jacobian(t, y(1:n), dydt(1:n), jac)
+        call product4(jac, y(n + 1:), dydt(n + 1:))
+    end subroutine var_rhs4
+
+    subroutine var_rhs6(base, t, y, dydt)
+        integer, parameter :: n = 6
+        class(ode_system), intent(in) :: base
+        real(dp), intent(in) :: t, y(n*(n + 1))
+        real(dp), intent(out) :: dydt(n*(n + 1))
+        real(dp) :: jac(n, n)
+        call base%rhs_jacobian(t, y(1:n), dydt(1:n), jac)
+        call product6(jac, y(n + 1:), dydt(n + 1:))
+    end subroutine var_rhs6
+
+    subroutine var_rhs_small(base, n, t, y, dydt)
+        class(ode_system), intent(in) :: base
+        integer, intent(in) :: n
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp) :: jac(n, n)     ! n <= NSMALL: a small automatic array on the stack
+        call base%rhs_jacobian(t, y(1:n), dydt(1:n), jac)
+        call product_n(n, jac, y(n + 1:n + n*n), dydt(n + 1:n + n*n))
+    end subroutine var_rhs_small
+
+    !> n > NSMALL: J on the heap (its O(n^2) allocation is small beside the O(n^3)
+    !! product), [A B] Phi or J Phi by one dgemm.
+    subroutine var_rhs_big(base, n, t, y, dydt)
+        class(ode_system), intent(in) :: base
+        integer, intent(in) :: n
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp), allocatable :: jac(:, :)
+        allocate (jac(n, n))
+        call base%rhs_jacobian(t, y(1:n), dydt(1:n), jac)
+        call product_blas(n, jac, y(n + 1:n + n*n), dydt(n + 1:n + n*n))
+    end subroutine var_rhs_big
+
+    !> dphi = jac phi (n x n each) for n = 2, 4, 6 (constant loop lengths) and any n.
+    pure subroutine product2(jac, phi, dphi)
+        integer, parameter :: n = 2, m = 1
+        real(dp), intent(in) :: jac(n, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
+        integer :: i, j, l
+        integer(int64) :: dev
         include "conmech_stm_product_body.inc"
     end subroutine product2
 
-    pure subroutine product4(ld, jac, y, dydt)
-        integer, parameter :: n = 4
-        integer, intent(in) :: ld
-        real(dp), intent(in) :: jac(ld, n), y(:)
-        real(dp), intent(inout) :: dydt(:)
-        integer :: i, j, l, m
-        logical :: mech
+    pure subroutine product4(jac, phi, dphi)
+        integer, parameter :: n = 4, m = 2
+        real(dp), intent(in) :: jac(n, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
+        integer :: i, j, l
+        integer(int64) :: dev
         include "conmech_stm_product_body.inc"
     end subroutine product4
 
-    pure subroutine product6(ld, jac, y, dydt)
-        integer, parameter :: n = 6
-        integer, intent(in) :: ld
-        real(dp), intent(in) :: jac(ld, n), y(:)
-        real(dp), intent(inout) :: dydt(:)
-        integer :: i, j, l, m
-        logical :: mech
+    pure subroutine product6(jac, phi, dphi)
+        integer, parameter :: n = 6, m = 3
+        real(dp), intent(in) :: jac(n, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
+        integer :: i, j, l
+        integer(int64) :: dev
         include "conmech_stm_product_body.inc"
     end subroutine product6
 
-    pure subroutine product_n(n, ld, jac, y, dydt)
-        integer, intent(in) :: n, ld
-        real(dp), intent(in) :: jac(ld, n), y(:)
-        real(dp), intent(inout) :: dydt(:)
+    pure subroutine product_n(n, jac, phi, dphi)
+        integer, intent(in) :: n
+        real(dp), intent(in) :: jac(n, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
         integer :: i, j, l, m
-        logical :: mech
+        integer(int64) :: dev
+        m = n/2
         include "conmech_stm_product_body.inc"
     end subroutine product_n
+
+    !> dphi = jac phi by dgemm; for J = [0 I; A B] the top half is copied and only
+    !! [A B] phi is multiplied.
+    subroutine product_blas(n, jac, phi, dphi)
+        integer, intent(in) :: n
+        real(dp), intent(in) :: jac(n, n), phi(n, n)
+        real(dp), intent(out) :: dphi(n, n)
+        integer :: m, j
+        m = n/2
+        if (is_mech(n, m, jac)) then
+            do j = 1, n
+                dphi(1:m, j) = phi(m + 1:n, j)
+            end do
+            call dgemm('N', 'N', n - m, n, n, 1.0_dp, jac(m + 1, 1), n, phi, n, 0.0_dp, &
+                       dphi(m + 1, 1), n)
+        else
+            call dgemm('N', 'N', n, n, n, 1.0_dp, jac, n, phi, n, 0.0_dp, dphi, n)
+        end if
+    end subroutine product_blas
+
+    !> J = [0 I; A B] (n = 2m): the top m rows are exactly [0 I] (a NaN there gives
+    !! .false.).
+    pure logical function is_mech(n, m, jac)
+        integer, intent(in) :: n, m
+        real(dp), intent(in) :: jac(n, n)
+        integer :: i, j
+        is_mech = 2*m == n
+        do j = 1, m
+            do i = 1, m
+                is_mech = is_mech .and. jac(i, j) == 0.0_dp .and. &
+                          jac(i, m + j) == merge(1.0_dp, 0.0_dp, i == j)
+            end do
+        end do
+    end function is_mech
 
     !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
     !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.

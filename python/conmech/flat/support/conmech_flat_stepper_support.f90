@@ -15,6 +15,7 @@ module conmech_flat_stepper_support
         METHOD_VERNER98
     use conmech_rk_tableaus, only: dopri5_tableau, dop853_tableau, verner98_tableau
     use conmech_rk_stepper, only: rk_stepper, rk_init, rk_start, rk_step
+    use conmech_flat_ode_support, only: METHOD_RK45_SCIPY, scipy_first_step
     implicit none
     private
     public :: NR_STATE, NI_STATE, NW_STATE, stepper_pack, stepper_unpack, stepper_action
@@ -94,6 +95,9 @@ contains
     !> One action on a packed stepper: 0 init (rk_init + rk_start at t0, y0), 1 one
     !! accepted step towards t_bound, 2 dense coefficients of the last step (w's fc
     !! columns). info: CM_SUCCESS or the failure; the state is written back in every case.
+    !! method METHOD_RK45_SCIPY (12): DOPRI5 with SciPy's step control (no Lund
+    !! stabilisation) and, without first_step, SciPy's initial step (its two evaluations
+    !! counted in nfev), as solve_ivp(method="RK45") runs it.
     subroutine stepper_action(sys, action, n, t0, t_bound, y0, method, rtol, atol, &
                               first_step, max_step, max_steps, r, iv, w, info, message)
         class(ode_system), intent(in) :: sys
@@ -108,6 +112,7 @@ contains
         type(ode_options) :: opt
         character(len=:), allocatable :: msg
         integer :: inf
+        integer(c_int) :: nfev0
         msg = "success"
         select case (action)
         case (0)
@@ -117,8 +122,20 @@ contains
             opt%first_step = first_step
             opt%max_step = max_step
             opt%max_steps = max_steps
+            nfev0 = 0
+            if (method == METHOD_RK45_SCIPY) then
+                opt%method = METHOD_DOPRI5
+                opt%beta = 0.0_dp
+                if (.not. first_step > 0.0_c_double .and. t_bound /= t0 .and. &
+                    all(y0 == y0) .and. all(abs(y0) <= huge(1.0_dp))) then
+                    call scipy_first_step(sys, [t0, t_bound], y0, &
+                                          max(rtol, 100.0_dp*epsilon(1.0_dp)), atol, &
+                                          max_step, 4, opt%first_step, nfev0)
+                end if
+            end if
             call rk_init(s, t0, t_bound, y0, opt, inf, msg, allow_inf=.true.)
             if (inf == CM_SUCCESS .and. t_bound /= t0) call rk_start(s, sys, inf, msg)
+            if (allocated(s%y)) s%st%nfev = s%st%nfev + nfev0
             if (inf == CM_SUCCESS .or. allocated(s%y)) call stepper_pack(s, n, r, iv, w)
         case (1)
             call stepper_unpack(s, n, r, iv, w)
