@@ -12,6 +12,9 @@ program test_radau
     real(dp) :: ref(2), y(2), yi(2)
     integer :: info, m
     type(ode_stats) :: st
+    type(radau_stepper) :: rs
+    integer :: k
+    logical :: same
     character(len=:), allocatable :: msg
 
     ts%name = "test_radau"
@@ -47,6 +50,19 @@ program test_radau
     call ts%check(info == CM_TOO_MANY_STEPS .and. index(msg, "t =") > 0 .and. &
                   all(yi /= [2.0_dp, -0.66_dp]), "ode_integrate Radau failure: "//msg)
     opt%max_steps = 100000
+    ! the step-by-step integration makes the steps of radau_solve, bit for bit
+    call radau_stepper_init(rs, f, 0.0_dp, 2.0_dp, [2.0_dp, -0.66_dp], opt, info, msg)
+    call ts%check(info == CM_SUCCESS, "radau_stepper_init: "//msg)
+    same = .true.
+    do k = 2, r%nt
+        call radau_stepper_step(rs, f, opt, info, msg)
+        if (info /= CM_SUCCESS) exit
+        same = same .and. rs%r(RADAU_RT) == r%t(k) .and. all(rs%w(:, RADAU_WY) == r%y(:, k))
+    end do
+    call ts%check(info == CM_SUCCESS .and. same .and. rs%r(RADAU_RT) == 2.0_dp .and. &
+                  all(rs%iv(RADAU_IFEV:RADAU_IFEV + 4) == [r%stats%nfev, r%stats%njev, &
+                  r%stats%nlu, r%stats%naccept, r%stats%nreject]), &
+                  "radau_stepper: the steps and counters of radau_solve: "//msg)
     f%f => osc
     do m = METHOD_GAUSS4, METHOD_GAUSS6
         opt%method = m
