@@ -131,3 +131,46 @@ def test_failures_and_bad_input():
     msg = s.step()
     assert_equal(s.status, "failed")
     assert "singular iteration matrix" in msg
+
+
+def kepler(t, y):
+    r3 = np.hypot(y[0], y[1]) ** 3
+    return [y[2], y[3], -y[0] / r3, -y[1] / r3]
+
+
+@pytest.mark.parametrize("cls,name", [(conmech.Gauss4, "GAUSS4"), (conmech.Gauss6, "GAUSS6")])
+def test_gauss_step_loop_is_solve_ivp_bit_for_bit(cls, name):
+    y0 = [0.4, 0.0, 0.0, 2.0]          # Kepler, e = 0.6
+    ref = conmech.solve_ivp(kepler, (0, 7), y0, method=name, first_step=0.05,
+                            dense_output=True)
+    s = cls(kepler, 0.0, y0, 7.0, first_step=0.05)
+    t, y = run_steps(s)
+    assert_equal(s.status, "finished")
+    assert_equal(t, ref.t)
+    assert_equal(y, ref.y)
+    assert s.nfev == ref.nfev and s.naccept == t.size - 1 and (s.njev, s.nlu) == (0, 0)
+    tm = np.linspace(s.t_old, s.t, 5)
+    assert_allclose(s.dense_output()(tm), ref.sol(tm), rtol=1e-13, atol=1e-14)
+    b = conmech.solve_ivp(kepler, (0, 7), y0, method=cls, first_step=0.05)
+    assert_equal(b.y, ref.y)
+    # angular momentum, a quadratic invariant, to round-off
+    L = y[0] * y[3] - y[1] * y[2]
+    assert np.abs(L - L[0]).max() < 1e-13
+
+
+def test_gauss_builtin_and_bad_input():
+    k = conmech.systems.kepler()
+    y0 = [0.4, 0.0, 0.0, 2.0]
+    ref = conmech.solve_ivp(k, (0, 3), y0, method="GAUSS6", first_step=0.1)
+    t, y = run_steps(conmech.Gauss6(k, 0.0, y0, 3.0, first_step=0.1))
+    assert_equal(t, ref.t)
+    assert_equal(y, ref.y)
+    with pytest.raises(ValueError, match="first_step is required"):
+        conmech.Gauss6(kepler, 0.0, y0, 1.0)
+    with pytest.raises(ValueError, match="finite"):
+        conmech.Gauss4(kepler, 0.0, y0, np.inf, first_step=0.1)
+    # a stiff system and a large step: the iteration does not converge, failed with the time
+    s = conmech.Gauss4(lambda t, y: -1e4 * y, 0.0, [1.0], 1.0, first_step=0.1)
+    msg = s.step()
+    assert_equal(s.status, "failed")
+    assert "did not converge at t =" in msg
