@@ -18,6 +18,7 @@ module conmech
     use conmech_rattle
     use conmech_rattle_dae
     use conmech_radau
+    use conmech_radau_stepper
     use conmech_gauss
     use conmech_systems_generalized
     use conmech_systems_constrained

@@ -7,9 +7,10 @@ program test_gauss
     type(test_suite) :: ts
     type(ode_function) :: f
     type(ode_options) :: opt
-    type(ode_result) :: r
-    real(dp) :: err(2), tf
-    integer :: m, k
+    type(ode_result) :: r, r2
+    real(dp) :: err(2), tf, rs(GAUSS_NR), ws(2, GAUSS_NW)
+    integer :: m, k, is(GAUSS_NI)
+    logical :: same
 
     ts%name = "test_gauss"
     f%f => osc
@@ -31,6 +32,22 @@ program test_gauss
         call ts%check_close(log(err(1)/err(2))/log(2.0_dp), real(2*(m - 4), dp), 0.3_dp, &
                             "observed order")
     end do
+    ! step by step (packed state, action 0 then 1 per step): the steps of the whole run
+    opt%method = METHOD_GAUSS6
+    opt%first_step = 0.3_dp
+    opt%save_steps = .true.
+    call ode_solve(f, [0.0_dp, 10.0_dp], [1.0_dp, 0.0_dp], opt, r)
+    call gauss_solve(f, 3, [0.0_dp, 10.0_dp], [1.0_dp, 0.0_dp], opt, r2, r_state=rs, &
+                     i_state=is, w_state=ws, action=0)
+    same = r2%status == CM_SUCCESS
+    do k = 2, r%nt
+        call gauss_solve(f, 3, [0.0_dp, 10.0_dp], [1.0_dp, 0.0_dp], opt, r2, r_state=rs, &
+                         i_state=is, w_state=ws, action=1)
+        same = same .and. r2%status == CM_SUCCESS .and. rs(3) == r%t(k) .and. &
+               all(ws(:, 1) == r%y(:, k))
+    end do
+    call ts%check(same .and. is(5) == r%stats%nfev .and. is(6) == r%stats%naccept, &
+                  "Gauss step by step = the whole run, bit for bit")
     opt%first_step = 0.0_dp
     call ode_solve(f, [0.0_dp, 1.0_dp], [1.0_dp, 0.0_dp], opt, r)
     call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "first_step") > 0, &

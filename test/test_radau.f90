@@ -1,5 +1,6 @@
 !> Radau IIA (order 5) through ode_solve: Hairer's scaled Van der Pol (eps = 1e-6) against
-!! a tight reference, counters, dense output, bad input.
+!! a tight reference, counters, dense output, bad input; ode_integrate with the implicit
+!! methods (the end point of ode_solve, bit for bit; its failure with the time).
 program test_radau
     use conmech
     use conmech_testing, only: test_suite
@@ -8,7 +9,13 @@ program test_radau
     type(ode_function) :: f
     type(ode_options) :: opt
     type(ode_result) :: r
-    real(dp) :: ref(2), y(2)
+    real(dp) :: ref(2), y(2), yi(2)
+    integer :: info, m
+    type(ode_stats) :: st
+    type(radau_stepper) :: rs
+    integer :: k
+    logical :: same
+    character(len=:), allocatable :: msg
 
     ts%name = "test_radau"
     f%f => vdp
@@ -29,6 +36,47 @@ program test_radau
     call ts%check_less(maxval(abs(y - r%y(:, r%nt))), 1.0e-12_dp, "dense output at the end")
     call r%sol%eval(1.0_dp, y)
     call ts%check(abs(y(1)) < 2.1_dp .and. abs(y(1)) > 1.0_dp, "dense output inside")
+
+    ! ode_integrate dispatches the implicit methods: the end point of ode_solve exactly
+    opt%dense_output = .false.
+    yi = [2.0_dp, -0.66_dp]
+    call ode_integrate(f, 0.0_dp, 2.0_dp, yi, opt, info, st, msg)
+    call ts%check(info == CM_SUCCESS, "ode_integrate Radau: "//msg)
+    call ts%check(all(yi == r%y(:, r%nt)) .and. st%naccept == r%stats%naccept .and. &
+                  st%nlu == r%stats%nlu, "ode_integrate Radau = ode_solve, bit for bit")
+    opt%max_steps = 20
+    yi = [2.0_dp, -0.66_dp]
+    call ode_integrate(f, 0.0_dp, 2.0_dp, yi, opt, info, st, msg)
+    call ts%check(info == CM_TOO_MANY_STEPS .and. index(msg, "t =") > 0 .and. &
+                  all(yi /= [2.0_dp, -0.66_dp]), "ode_integrate Radau failure: "//msg)
+    opt%max_steps = 100000
+    ! the step-by-step integration makes the steps of radau_solve, bit for bit
+    call radau_stepper_init(rs, f, 0.0_dp, 2.0_dp, [2.0_dp, -0.66_dp], opt, info, msg)
+    call ts%check(info == CM_SUCCESS, "radau_stepper_init: "//msg)
+    same = .true.
+    do k = 2, r%nt
+        call radau_stepper_step(rs, f, opt, info, msg)
+        if (info /= CM_SUCCESS) exit
+        same = same .and. rs%r(RADAU_RT) == r%t(k) .and. all(rs%w(:, RADAU_WY) == r%y(:, k))
+    end do
+    call ts%check(info == CM_SUCCESS .and. same .and. rs%r(RADAU_RT) == 2.0_dp .and. &
+                  all(rs%iv(RADAU_IFEV:RADAU_IFEV + 4) == [r%stats%nfev, r%stats%njev, &
+                  r%stats%nlu, r%stats%naccept, r%stats%nreject]), &
+                  "radau_stepper: the steps and counters of radau_solve: "//msg)
+    f%f => osc
+    do m = METHOD_GAUSS4, METHOD_GAUSS6
+        opt%method = m
+        opt%first_step = 0.01_dp
+        yi = [1.0_dp, 0.0_dp]
+        call ode_integrate(f, 0.0_dp, 1.0_dp, yi, opt, info, st, msg)
+        call ts%check(info == CM_SUCCESS .and. st%naccept == 100, "ode_integrate Gauss: "//msg)
+        call ts%check_less(maxval(abs(yi - [cos(1.0_dp), -sin(1.0_dp)])), 1.0e-9_dp, &
+                           "ode_integrate Gauss: y(1)")
+    end do
+    f%f => vdp
+    opt%method = METHOD_RADAU5
+    opt%first_step = 0.0_dp
+    opt%dense_output = .true.
 
     ! the same with the finite-difference Jacobian
     f%jac => null()
@@ -78,6 +126,13 @@ contains
         real(dp), intent(out) :: dydt(:)
         dydt = [y(2), y(2) + y(1)]
     end subroutine dae
+
+    subroutine osc(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt = [y(2), -y(1)]
+    end subroutine osc
 
     subroutine vdp_jac(t, y, dfdy)
         real(dp), intent(in) :: t

@@ -13,6 +13,9 @@
 !!   does not random-walk the invariants.
 !! - Outputs: every step, or t_eval on the collocation polynomial (degree s); dense
 !!   output and events on the same polynomial (power basis).
+!! - Step by step (SciPy's OdeSolver use, conmech.Gauss4 / Gauss6): `gauss_solve` with the
+!!   packed state (r_state(GAUSS_NR), i_state(GAUSS_NI), w_state(n, GAUSS_NW)) and
+!!   action 0 (start) or 1 (one step): the steps of the whole run, bit for bit.
 module conmech_gauss
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
@@ -26,6 +29,11 @@ module conmech_gauss
     public :: gauss_solve, gauss_tableau
 
     integer, parameter :: MAX_ITER = 50
+    !> Sizes of the packed state of a step-by-step run: reals (t0, tf, t, h, t_old),
+    !! integers (n, s, steps done, steps, nfev, naccept, polynomial known, started),
+    !! columns (y, the compensation of the summation, the polynomial fc(:, 0:s) of the
+    !! last step in x = (t - t_old)/h).
+    integer, parameter, public :: GAUSS_NR = 8, GAUSS_NI = 8, GAUSS_NW = 6
 
 contains
 
@@ -53,7 +61,8 @@ contains
     !> Solve y' = f(t, y) on t_span with the s-stage Gauss method (s = 2: opt%method =
     !! METHOD_GAUSS4, s = 3: METHOD_GAUSS6), fixed step opt%first_step; outputs as
     !! `ode_solve`.
-    subroutine gauss_solve(sys, s, t_span, y0, opt, res, t_eval, events)
+    subroutine gauss_solve(sys, s, t_span, y0, opt, res, t_eval, events, r_state, i_state, &
+                           w_state, action)
         class(ode_system), intent(in) :: sys
         integer, intent(in) :: s
         real(dp), intent(in) :: t_span(2)
@@ -62,14 +71,20 @@ contains
         type(ode_result), intent(inout) :: res
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
+        !> step-by-step use: the packed state and the action (0: start, 1: one step)
+        real(dp), intent(inout), optional :: r_state(:)
+        integer, intent(inout), optional :: i_state(:)
+        real(dp), intent(inout), optional :: w_state(:, :)
+        integer, intent(in), optional :: action
 
         type(step_output) :: o
         real(dp) :: a(s, s), b(s), c(s), pmat(s, s), h, t0, tf, t, tnew, tstop, xi
         real(dp), allocatable :: y(:), comp(:), z(:, :), znew(:, :), f(:, :), fc(:, :)
         real(dp), allocatable :: ynew(:), ystop(:), incr(:), tmp(:)
         real(dp) :: dyno, dynold, scale
-        integer :: n, nsteps, k, i, j, it
-        logical :: converged, stop_now, have_poly
+        integer :: n, nsteps, k, i, j, it, kstart, kdone
+        logical :: converged, stop_now, have_poly, stepping, resume
+        real(dp) :: t_prev
         character(len=:), allocatable :: m2
         character(len=32) :: buf
 
@@ -96,6 +111,23 @@ contains
             call check_t_eval(t_span, t_eval, res%status, m2)
             if (res%status /= CM_SUCCESS) res%message = m2
         end if
+        stepping = present(action) .and. present(r_state) .and. present(i_state) .and. &
+                   present(w_state)
+        resume = .false.
+        if (stepping) resume = action == 1
+        if (res%status == CM_SUCCESS .and. stepping) then
+            if (present(t_eval) .or. present(events) .or. size(r_state) < GAUSS_NR .or. &
+                size(i_state) < GAUSS_NI .or. size(w_state, 1) /= n .or. &
+                size(w_state, 2) < GAUSS_NW) then
+                res%status = CM_BAD_INPUT
+                res%message = "bad input: the packed Gauss state has the wrong size (or "// &
+                              "t_eval, events given to a step-by-step integration)"
+            else if (resume .and. (i_state(1) /= n .or. i_state(2) /= s .or. &
+                                   i_state(8) /= 1)) then
+                res%status = CM_BAD_INPUT
+                res%message = "bad input: the Gauss state was not started (action 0 first)"
+            end if
+        end if
         if (res%status /= CM_SUCCESS) return
 
         call gauss_tableau(s, a, b, c)
@@ -105,7 +137,10 @@ contains
         y = y0
         comp = 0.0_dp
         t = t0
-        call out_init(o, res, opt, t0, tf, y0, s, t_eval, events)
+        t_prev = t0
+        kdone = 0
+        fc = 0.0_dp
+        if (.not. stepping) call out_init(o, res, opt, t0, tf, y0, s, t_eval, events)
         nsteps = 0
         if (tf /= t0) nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step*(1.0_dp - 1.0e-12_dp)))
         if (nsteps > opt%max_steps) then
@@ -118,8 +153,16 @@ contains
         if (nsteps > 0) h = (tf - t0)/real(nsteps, dp)
         have_poly = .false.
         z = 0.0_dp
+        kstart = 1
+        if (resume) then
+            call load_state()
+            kstart = kdone + 1
+        else if (stepping) then
+            call finish(CM_SUCCESS, "success")
+            return
+        end if
 
-        do k = 1, nsteps
+        do k = kstart, nsteps
             ! starting values: the previous collocation polynomial, u(1 + c_i) - u(1)
             if (have_poly) then
                 do i = 1, s
@@ -178,9 +221,12 @@ contains
             else
                 tnew = t0 + real(k, dp)*h
             end if
-            call out_step(o, res, t, tnew - t, fc, ynew, stop_now, tstop, ystop, t_eval, &
-                          events)
+            stop_now = .false.
+            if (.not. stepping) call out_step(o, res, t, tnew - t, fc, ynew, stop_now, &
+                                              tstop, ystop, t_eval, events)
             res%stats%naccept = res%stats%naccept + 1
+            kdone = k
+            t_prev = t
             if (stop_now) then
                 t = tstop
                 y = ystop
@@ -189,6 +235,7 @@ contains
             end if
             y = ynew
             t = tnew
+            if (stepping) exit           ! one step per call
         end do
         call finish(CM_SUCCESS, "success")
 
@@ -201,8 +248,29 @@ contains
             res%message = text
             res%success = code >= 0
             res%stats%h_next = h
-            call out_finish(o, res, t, y)
+            if (stepping) then
+                r_state(1:GAUSS_NR) = [t0, tf, t, h, t_prev, 0.0_dp, 0.0_dp, 0.0_dp]
+                i_state(1:GAUSS_NI) = [n, s, kdone, nsteps, res%stats%nfev, &
+                                       res%stats%naccept, merge(1, 0, have_poly), 1]
+                w_state(:, 1) = y
+                w_state(:, 2) = comp
+                w_state(:, 3:3 + s) = fc
+            else
+                call out_finish(o, res, t, y)
+            end if
         end subroutine finish
+
+        subroutine load_state()
+            t = r_state(3)
+            t_prev = r_state(5)
+            kdone = i_state(3)
+            res%stats%nfev = i_state(5)
+            res%stats%naccept = i_state(6)
+            have_poly = i_state(7) /= 0
+            y = w_state(:, 1)
+            comp = w_state(:, 2)
+            fc = w_state(:, 3:3 + s)
+        end subroutine load_state
 
     end subroutine gauss_solve
 

@@ -114,6 +114,9 @@ contains
     end subroutine ode_solve
 
     !> Advance y from t0 to t1 in place, storing nothing. Fast path for shooting.
+    !! The implicit methods (METHOD_RADAU5, METHOD_GAUSS4, METHOD_GAUSS6) run through
+    !! `ode_solve`'s implicit driver keeping the end point only (no step hook: CM_BAD_INPUT);
+    !! on failure y is the state where the integration stopped (its time in `message`).
     subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
@@ -125,9 +128,34 @@ contains
         class(ode_step_hook), intent(inout), optional :: hook
         type(ode_stats) :: st
         character(len=:), allocatable :: msg
-        call drive(sys, t0, t1, y, options, st, info, msg, hook=hook)
+        if (options%method >= METHOD_RADAU5) then
+            call integrate_implicit()
+        else
+            call drive(sys, t0, t1, y, options, st, info, msg, hook=hook)
+        end if
         if (present(stats)) stats = st
         if (present(message)) message = msg
+
+    contains
+
+        subroutine integrate_implicit()
+            type(ode_options) :: oo
+            type(ode_result) :: r
+            if (present(hook)) then
+                info = CM_BAD_INPUT
+                msg = "bad input: step hooks need an explicit method"
+                return
+            end if
+            oo = options
+            oo%save_steps = .false.
+            oo%dense_output = .false.
+            call implicit_solve(sys, [t0, t1], y, oo, r)
+            info = r%status
+            msg = "success"
+            if (allocated(r%message)) msg = r%message
+            st = r%stats
+            if (size(r%t) > 0 .and. size(r%y, 1) == size(y)) y = r%y(:, size(r%t))
+        end subroutine integrate_implicit
     end subroutine ode_integrate
 
     subroutine fail(res, info, msg)

@@ -50,6 +50,21 @@ module conmech_radau
     private
 
     public :: radau_solve
+    public :: RADAU_NR, RADAU_NI, RADAU_NW
+
+    !> Sizes of the packed state of a step-by-step integration (radau_solve with r_state,
+    !! i_state, w_state and action; conmech_radau_stepper): r(RADAU_NR) reals,
+    !! iv(RADAU_NI + 2 n) integers (the last 2 n: LU pivots), w(n, RADAU_NW + 4 n) columns
+    !! (y, f(t, y), scale, rtol, atol, the collocation polynomial of the last step
+    !! fc(:, 0:3) in x = (s - t_old)/h_old, then J, the real LU, the complex LU's real and
+    !! imaginary parts).
+    integer, parameter :: RADAU_NR = 20, RADAU_NI = 20, RADAU_NW = 9
+    !> Positions in the packed state read by the callers (r: t, t_old, h_old; w: y, fc).
+    integer, parameter, public :: RADAU_RT = 3, RADAU_RTOLD = 18, RADAU_RHOLD = 13
+    integer, parameter, public :: RADAU_WY = 1, RADAU_WFC = 6
+    !> Positions of the counters in iv: nfev, njev, nlu, naccept, nreject.
+    integer, parameter, public :: RADAU_IFEV = 5
+
 
     interface
         subroutine zgetrf(m, n, a, lda, ipiv, info)
@@ -106,7 +121,8 @@ contains
     !> Solve y' = f(t, y) on t_span with Radau IIA (order 5); outputs as `ode_solve`
     !! (every accepted step, or t_eval interpolated on the collocation polynomial; dense
     !! output; events). res%stats counts nfev, njev, nlu, naccept, nreject.
-    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events, mass, index2)
+    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events, mass, index2, &
+                           r_state, i_state, w_state, action)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: y0(:)
@@ -118,6 +134,12 @@ contains
         real(dp), intent(in), optional :: mass(:, :)
         !> the index-2 algebraic components (their error is scaled by h, as RADAU5)
         logical, intent(in), optional :: index2(:)
+        !> step-by-step use (radau_stepper_*): the packed state and the action (0: start
+        !! at (t_span(1), y0), 1: one accepted step); outputs in res are then not kept
+        real(dp), intent(inout), optional :: r_state(:)
+        integer, intent(inout), optional :: i_state(:)
+        real(dp), intent(inout), optional :: w_state(:, :)
+        integer, intent(in), optional :: action
 
         type(step_output) :: o
         real(dp), allocatable :: y(:), f0(:), jac(:, :), e1(:, :), z1(:), z2(:), z3(:)
@@ -132,22 +154,52 @@ contains
         real(dp) :: pmat(3, 3), cvec(3)
         integer :: n, newt, nsteps, nsing, nfail, lainfo, i, j
         logical :: first, reject, last, caljac, need_jac, need_lu, converged, stop_now
-        logical :: newton_failed, have_cont
+        logical :: newton_failed, have_cont, stepping, resume
+        real(dp) :: t_prev
         character(len=32) :: buf
 
         n = size(y0)
         t0 = t_span(1)
         tf = t_span(2)
         h = 0.0_dp
+        stop_now = .false.
+        t_prev = t0
+        stepping = present(action) .and. present(r_state) .and. present(i_state) .and. &
+                   present(w_state)
+        resume = .false.
+        if (stepping) resume = action == 1
+        if (stepping) then
+            if (present(mass) .or. present(t_eval) .or. present(events) .or. &
+                size(r_state) < RADAU_NR .or. size(i_state) < RADAU_NI + 2*n .or. &
+                size(w_state, 1) /= n .or. size(w_state, 2) < RADAU_NW + 4*n) then
+                res%status = CM_BAD_INPUT
+                res%message = "bad input: the packed Radau state has the wrong size (or "// &
+                              "mass, t_eval, events given to a step-by-step integration)"
+                return
+            end if
+        end if
+        if (resume) then
+            allocate (y(n), f0(n), jac(n, n), e1(n, n), z1(n), z2(n), z3(n), w1(n), w2(n), &
+                      w3(n), a1(n), a2(n), a3(n), scal(n), cont(n), fc(n, 0:3), ynew(n), &
+                      ystop(n), e2(n, n), zc(n), ip1(n), ip2(n), scal0(n), b1(n), b2(n), &
+                      b3(n), rtolv(n), atolv(n))
+            call load_state()
+            if (res%status /= CM_SUCCESS) return
+        else
         call validate()
         if (res%status /= CM_SUCCESS) return
         allocate (y(n), f0(n), jac(n, n), e1(n, n), z1(n), z2(n), z3(n), w1(n), w2(n), &
                   w3(n), a1(n), a2(n), a3(n), scal(n), cont(n), fc(n, 0:3), ynew(n), &
                   ystop(n), e2(n, n), zc(n), ip1(n), ip2(n), scal0(n), b1(n), b2(n), b3(n))
         y = y0
+        jac = 0.0_dp
+        e1 = 0.0_dp
+        e2 = 0.0_dp
+        ip1 = 0
+        ip2 = 0
         t = t0
-        call out_init(o, res, opt, t0, tf, y0, 3, t_eval, events)
-        if (tf == t0) then
+        if (.not. stepping) call out_init(o, res, opt, t0, tf, y0, 3, t_eval, events)
+        if (tf == t0 .and. .not. stepping) then
             call finish(CM_SUCCESS, "success")
             return
         end if
@@ -197,6 +249,12 @@ contains
         nsing = 0
         nfail = 0
         newton_failed = .false.
+        fc = 0.0_dp
+        if (stepping) then           ! action 0: the state at the start, no step
+            call finish(CM_SUCCESS, "success")
+            return
+        end if
+        end if
         ! ------------------------------------------------------------------ main loop
         do
             if (0.1_dp*abs(h) <= abs(t)*uround .or. abs(h) < tiny(1.0_dp)) then
@@ -291,8 +349,10 @@ contains
                 end do
                 have_cont = .true.
                 ynew = y + z3
-                call out_step(o, res, t, h, fc, ynew, stop_now, tstop, ystop, t_eval, events)
+                if (.not. stepping) call out_step(o, res, t, h, fc, ynew, stop_now, tstop, &
+                                                  ystop, t_eval, events)
                 hold = h
+                t_prev = t
                 if (stop_now) then
                     t = tstop
                     y = ystop
@@ -330,6 +390,7 @@ contains
                         need_lu = .true.
                     end if
                 end if
+                if (stepping) exit       ! one accepted step per call
             else
                 ! ---------------------------------------------------- rejected step
                 reject = .true.
@@ -416,8 +477,79 @@ contains
             res%message = text
             res%success = code >= 0
             res%stats%h_next = h
-            if (allocated(o%g_old) .or. o%n > 0) call out_finish(o, res, t, y)
+            if (stepping) then
+                call save_state()
+            else if (allocated(o%g_old) .or. o%n > 0) then
+                call out_finish(o, res, t, y)
+            end if
         end subroutine finish
+
+        !> Pack the state of the integration into (r_state, i_state, w_state).
+        subroutine save_state()
+            r_state = 0.0_dp
+            r_state(1:RADAU_NR) = [t0, tf, t, h, hmax, posneg, uround, fnewt, faccon, &
+                                   theta, hacc, erracc, hold, safe, facl, facr, cfac, &
+                                   t_prev, 0.0_dp, 0.0_dp]
+            i_state(1:RADAU_NI) = [n, nsteps, nsing, nfail, res%stats%nfev, &
+                                   res%stats%njev, res%stats%nlu, res%stats%naccept, &
+                                   res%stats%nreject, l2i(first), l2i(reject), l2i(last), &
+                                   l2i(caljac), l2i(need_jac), l2i(need_lu), &
+                                   l2i(have_cont), l2i(newton_failed), 1, 0, 0]
+            i_state(RADAU_NI + 1:RADAU_NI + n) = ip1
+            i_state(RADAU_NI + n + 1:RADAU_NI + 2*n) = ip2
+            w_state(:, 1) = y
+            w_state(:, 2) = f0
+            w_state(:, 3) = scal0
+            w_state(:, 4) = rtolv
+            w_state(:, 5) = atolv
+            w_state(:, 6:9) = fc
+            w_state(:, RADAU_NW + 1:RADAU_NW + n) = jac
+            w_state(:, RADAU_NW + n + 1:RADAU_NW + 2*n) = e1
+            w_state(:, RADAU_NW + 2*n + 1:RADAU_NW + 3*n) = real(e2, dp)
+            w_state(:, RADAU_NW + 3*n + 1:RADAU_NW + 4*n) = aimag(e2)
+        end subroutine save_state
+
+        !> Unpack the state written by save_state (action 1).
+        subroutine load_state()
+            if (i_state(1) /= n .or. i_state(18) /= 1) then
+                res%status = CM_BAD_INPUT
+                res%message = "bad input: the Radau state was not started (action 0 first)"
+                return
+            end if
+            res%status = CM_SUCCESS
+            t0 = r_state(1); tf = r_state(2); t = r_state(3); h = r_state(4)
+            hmax = r_state(5); posneg = r_state(6); uround = r_state(7); fnewt = r_state(8)
+            faccon = r_state(9); theta = r_state(10); hacc = r_state(11)
+            erracc = r_state(12); hold = r_state(13); safe = r_state(14); facl = r_state(15)
+            facr = r_state(16); cfac = r_state(17); t_prev = r_state(18)
+            nsteps = i_state(2); nsing = i_state(3); nfail = i_state(4)
+            res%stats%nfev = i_state(5); res%stats%njev = i_state(6)
+            res%stats%nlu = i_state(7); res%stats%naccept = i_state(8)
+            res%stats%nreject = i_state(9)
+            first = i_state(10) /= 0; reject = i_state(11) /= 0; last = i_state(12) /= 0
+            caljac = i_state(13) /= 0; need_jac = i_state(14) /= 0
+            need_lu = i_state(15) /= 0; have_cont = i_state(16) /= 0
+            newton_failed = i_state(17) /= 0
+            ip1 = i_state(RADAU_NI + 1:RADAU_NI + n)
+            ip2 = i_state(RADAU_NI + n + 1:RADAU_NI + 2*n)
+            y = w_state(:, 1)
+            f0 = w_state(:, 2)
+            scal0 = w_state(:, 3)
+            rtolv = w_state(:, 4)
+            atolv = w_state(:, 5)
+            fc = w_state(:, 6:9)
+            jac = w_state(:, RADAU_NW + 1:RADAU_NW + n)
+            e1 = w_state(:, RADAU_NW + n + 1:RADAU_NW + 2*n)
+            e2 = cmplx(w_state(:, RADAU_NW + 2*n + 1:RADAU_NW + 3*n), &
+                       w_state(:, RADAU_NW + 3*n + 1:RADAU_NW + 4*n), kind=dp)
+            cvec = [C1, C2, 1.0_dp]
+            pmat = power_basis_matrix(cvec)
+        end subroutine load_state
+
+        integer function l2i(l)
+            logical, intent(in) :: l
+            l2i = merge(1, 0, l)
+        end function l2i
 
         subroutine rhs(tt, yy, ff)
             real(dp), intent(in) :: tt, yy(:)
@@ -623,5 +755,4 @@ contains
         end subroutine estimate_error
 
     end subroutine radau_solve
-
 end module conmech_radau
