@@ -16,7 +16,10 @@
 !!   max|phi| <= proj_tol or the correction is below the round-off of q.
 !! - Velocity constraints: one linear solve with G_{n+1} M_{n+1}^{-1} G_{n+1}^T.
 !! - Mass matrix: M(q_n) in the first half kick and the position solve, M(q_{n+1}) in
-!!   the second (the standard variant). For a constant mass matrix this is RATTLE
+!!   the second (the standard variant). A `diagonal_mass` system costs a division per
+!!   coordinate, a `constant_mass` one is inverted once per run; otherwise M is
+!!   factorised (Cholesky) and inverted at every grid point. One constraint (n_hol = 1)
+!!   needs no factorisation at all (a scalar division). For a constant mass matrix this is RATTLE
 !!   exactly; for a configuration-dependent one the method stays symmetric and of order
 !!   2, but is not symplectic.
 !! - Velocity-dependent forces: Q_{n+1} = Q(t_{n+1}, q_{n+1}, v_{n+1}) makes the second
@@ -46,6 +49,8 @@ module conmech_rattle
 
     public :: rattle_solve
 
+    integer, parameter :: MASS_GENERAL = 0, MASS_DIAGONAL = 1, MASS_CONSTANT = 2
+
     interface
         !> Unblocked LU (no block-size query: fast for the small constraint matrices).
         subroutine dgetf2(m, n, a, lda, ipiv, info)
@@ -69,7 +74,8 @@ module conmech_rattle
         real(dp) :: t = 0.0_dp
         real(dp), allocatable :: q(:), v(:)
         real(dp), allocatable :: f(:)       !! Q(t, q, v)
-        real(dp), allocatable :: mc(:, :)   !! M(t, q)^{-1} (from its Cholesky factor)
+        real(dp), allocatable :: mc(:, :)   !! M(t, q)^{-1} (general mass only)
+        real(dp), allocatable :: d(:)       !! 1 / diag M(t, q) (diagonal mass only)
         real(dp), allocatable :: x(:, :)    !! M^{-1} G^T (n x n_hol)
         real(dp), allocatable :: g(:, :)    !! G (n_hol x n)
     end type rattle_state
@@ -89,7 +95,12 @@ contains
         real(dp), intent(in), optional :: t_eval(:)
 
         type(rattle_state) :: st(2), side
-        integer :: cur
+        integer :: cur, mkind
+        real(dp), allocatable :: minv(:, :)
+        ! work arrays of the step (allocated once: gfortran puts automatic arrays on the heap)
+        real(dp), allocatable :: afree(:), vhalf(:), ph(:), gt(:, :), dq(:), dqsum(:), w(:)
+        real(dp), allocatable :: r(:), vprev(:), pt(:, :), sm(:, :), cv(:)
+        integer, allocatable :: ipiv(:)
         real(dp), allocatable :: tout(:), qout(:, :), vout(:, :), q(:), v(:), acc(:), lam(:)
         real(dp) :: h, t0, tf, posneg
         integer :: n, m, nsteps, k, nout, n_eval, i_eval, info, iters, j
@@ -145,6 +156,8 @@ contains
         if (nsteps > 0) h = (tf - t0)/real(nsteps, dp)
 
         allocate (q(n), v(n), acc(n), lam(m))
+        allocate (afree(n), vhalf(n), ph(m), gt(m, n), dq(n), dqsum(n), w(n), r(m), &
+                  vprev(n), pt(m, n), sm(m, m), cv(m), ipiv(m))
         q = q0
         v = v0
         if (options%project_initial) then
@@ -161,6 +174,24 @@ contains
         if (info /= CM_SUCCESS) then
             call fail(info, msg)
             return
+        end if
+        mkind = MASS_GENERAL
+        if (sys%diagonal_mass) then
+            mkind = MASS_DIAGONAL
+        else if (sys%constant_mass) then
+            ! M^{-1} once, kept for the run
+            allocate (minv(n, n))
+            call sys%mass(t0, q, minv)
+            call mass_cholesky(minv, info, msg)
+            if (info /= CM_SUCCESS) then
+                call fail(info, msg)
+                return
+            end if
+            call dpotri('U', n, minv, n, info)
+            do j = 1, n - 1
+                minv(j + 1:n, j) = minv(j, j + 1:n)
+            end do
+            mkind = MASS_CONSTANT
         end if
         cur = 1
         call prepare(st(1), t0, q, v, info, msg)
@@ -309,41 +340,112 @@ contains
             res%power(jj) = dot_product(res%reaction(:, jj), vout(:, jj))
         end subroutine store
 
+        subroutine allocate_state(st)
+            type(rattle_state), intent(inout) :: st
+            allocate (st%q(n), st%v(n), st%f(n), st%x(n, m), st%g(m, n))
+            if (mkind == MASS_GENERAL) allocate (st%mc(n, n))
+            if (mkind == MASS_DIAGONAL) allocate (st%d(n))
+        end subroutine allocate_state
+
         !> Fill a state at (tt, qq, vv): forces, Cholesky of M, G and M^{-1} G^T.
         subroutine prepare(st, tt, qq, vv, inf, mg)
             type(rattle_state), intent(inout) :: st
             real(dp), intent(in) :: tt, qq(:), vv(:)
             integer, intent(out) :: inf
             character(len=:), allocatable, intent(out) :: mg
+            if (.not. allocated(st%f)) call allocate_state(st)
             st%t = tt
             st%q = qq
             st%v = vv
-            if (.not. allocated(st%f)) allocate (st%f(n), st%mc(n, n), st%x(n, m), st%g(m, n))
             call sys%forces(tt, qq, vv, st%f)
             res%nfev = res%nfev + 1
             call factor_mass(st, inf, mg)
         end subroutine prepare
 
+        !> M^{-1} (or 1/diag M) and M^{-1} G^T at st%t, st%q.
         subroutine factor_mass(st, inf, mg)
             type(rattle_state), intent(inout) :: st
             integer, intent(out) :: inf
             character(len=:), allocatable, intent(out) :: mg
             integer :: lainfo, jj
-            call sys%mass(st%t, st%q, st%mc)
-            call mass_cholesky(st%mc, inf, mg)
-            if (inf /= CM_SUCCESS) return
-            ! the explicit inverse (small matrices: one LAPACK call per step instead of a
-            ! triangular solve per right-hand side)
-            call dpotri('U', n, st%mc, n, lainfo)
-            do jj = 1, n - 1
-                st%mc(jj + 1:n, jj) = st%mc(jj, jj + 1:n)
-            end do
+            inf = CM_SUCCESS
+            select case (mkind)
+            case (MASS_DIAGONAL)
+                call sys%mass_diagonal(st%t, st%q, st%d)
+                if (.not. all(st%d > 0.0_dp .and. st%d < huge(1.0_dp))) then
+                    inf = CM_SINGULAR
+                    mg = "the diagonal mass matrix has a non-positive or non-finite entry"
+                    return
+                end if
+                st%d = 1.0_dp/st%d
+            case (MASS_GENERAL)
+                call sys%mass(st%t, st%q, st%mc)
+                call mass_cholesky(st%mc, inf, mg)
+                if (inf /= CM_SUCCESS) return
+                ! the explicit inverse (small matrices: one LAPACK call per step instead
+                ! of a triangular solve per right-hand side)
+                call dpotri('U', n, st%mc, n, lainfo)
+                do jj = 1, n - 1
+                    st%mc(jj + 1:n, jj) = st%mc(jj, jj + 1:n)
+                end do
+            end select
             if (m > 0) then
                 call sys%phi_jac(st%t, st%q, st%g)
-                st%x = matmul(st%mc, transpose(st%g))
+                select case (mkind)
+                case (MASS_DIAGONAL)
+                    do jj = 1, m
+                        st%x(:, jj) = st%d*st%g(jj, :)
+                    end do
+                case (MASS_CONSTANT)
+                    st%x = matmul(minv, transpose(st%g))
+                case default
+                    st%x = matmul(st%mc, transpose(st%g))
+                end select
             end if
-            mg = "success"
         end subroutine factor_mass
+
+        !> M(st)^{-1} f.
+        subroutine minv_times(st, f, y)
+            type(rattle_state), intent(in) :: st
+            real(dp), intent(in) :: f(:)
+            real(dp), intent(out) :: y(:)
+            select case (mkind)
+            case (MASS_DIAGONAL)
+                y = st%d*f
+            case (MASS_CONSTANT)
+                y = matmul(minv, f)
+            case default
+                y = matmul(st%mc, f)
+            end select
+        end subroutine minv_times
+
+        !> pt = S^{-T} X^T (m x n) for S = gg X (m x m, LU by dgetf2; one constraint: a
+        !! division). inf = CM_SINGULAR when S is singular.
+        subroutine schur_rows(gg, xx, pt, inf)
+            real(dp), intent(in) :: gg(:, :), xx(:, :)
+            real(dp), intent(out) :: pt(:, :)
+            integer, intent(out) :: inf
+            real(dp) :: s1
+            integer :: lainfo
+            inf = CM_SUCCESS
+            if (m == 1) then
+                s1 = dot_product(gg(1, :), xx(:, 1))
+                if (.not. (abs(s1) > 0.0_dp .and. abs(s1) < huge(1.0_dp))) then
+                    inf = CM_SINGULAR
+                    return
+                end if
+                pt(1, :) = xx(:, 1)/s1
+                return
+            end if
+            sm = matmul(gg, xx)
+            call dgetf2(m, m, sm, m, ipiv, lainfo)
+            if (lainfo /= 0) then
+                inf = CM_SINGULAR
+                return
+            end if
+            pt = transpose(xx)
+            call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
+        end subroutine schur_rows
 
         !> One RATTLE step of length hs from st to s2 (s2 prepared for the next step).
         subroutine step(st, hs, s2, inf, mg)
@@ -352,31 +454,24 @@ contains
             type(rattle_state), intent(inout) :: s2
             integer, intent(out) :: inf
             character(len=:), allocatable, intent(out) :: mg
-            real(dp) :: afree(n), vhalf(n), qt(n), ph(m), sm(m, m), gt(m, n), dq(n)
-            real(dp) :: dqsum(n), w(n), r(m), vprev(n), t1, rnorm, pt(m, n)
-            integer :: ipiv(m), lainfo, it, kk
+            real(dp) :: t1, rnorm
+            integer :: it, kk, i
             character(len=32) :: b2
             t1 = st%t + hs
-            if (.not. allocated(s2%f)) allocate (s2%q(n), s2%v(n), s2%f(n), s2%mc(n, n), &
-                                                 s2%x(n, m), s2%g(m, n))
+            if (.not. allocated(s2%f)) call allocate_state(s2)
             ! first half kick without the constraint force, unconstrained predictor
-            afree = matmul(st%mc, st%f)
-            qt = st%q + hs*st%v + (0.5_dp*hs*hs)*afree
+            call minv_times(st, st%f, afree)
+            s2%q = st%q + hs*st%v + (0.5_dp*hs*hs)*afree
             dqsum = 0.0_dp
-            s2%q = qt
             if (m > 0) then
-                call sys%phi_jac(t1, qt, gt)
-                sm = matmul(gt, st%x)
-                call dgetf2(m, m, sm, m, ipiv, lainfo)
-                if (lainfo /= 0) then
-                    inf = CM_SINGULAR
+                call sys%phi_jac(t1, s2%q, gt)
+                ! pk = X S^{-1} (n x m) from S^T pk^T = X^T, S = G(q~) X
+                call schur_rows(gt, st%x, pt, inf)
+                if (inf /= CM_SUCCESS) then
                     mg = "singular constraint matrix G M^-1 G^T in the position solve " &
                          //"(redundant constraints?)"
                     return
                 end if
-                ! pk = X S^{-1} (n x m) from S^T pk^T = X^T
-                pt = transpose(st%x)
-                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
                 inf = CM_NO_CONVERGENCE
                 do it = 1, options%proj_max_iter + 1
                     call sys%phi(t1, s2%q, ph)
@@ -387,7 +482,10 @@ contains
                         exit
                     end if
                     if (it > options%proj_max_iter) exit
-                    dq = matmul(ph, pt)
+                    dq = 0.0_dp
+                    do i = 1, m
+                        dq = dq + ph(i)*pt(i, :)
+                    end do
                     dqsum = dqsum + dq
                     s2%q = s2%q - dq
                     if (maxval(abs(dq)) <= 4.0_dp*epsilon(1.0_dp)*maxval(abs(s2%q))) then
@@ -412,28 +510,29 @@ contains
             call factor_mass(s2, inf, mg)
             if (inf /= CM_SUCCESS) return
             if (m > 0) then
-                sm = matmul(s2%g, s2%x)
-                call dgetf2(m, m, sm, m, ipiv, lainfo)
-                if (lainfo /= 0) then
-                    inf = CM_SINGULAR
+                call schur_rows(s2%g, s2%x, pt, inf)
+                if (inf /= CM_SUCCESS) then
                     mg = "singular constraint matrix G M^-1 G^T in the velocity solve"
                     return
                 end if
-                pt = transpose(s2%x)
-                call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
             end if
+            r = 0.0_dp
+            if (m > 0) call sys%phi_t(t1, s2%q, r)
             s2%v = 2.0_dp*vhalf - st%v
             inf = CM_NO_CONVERGENCE
             do kk = 1, 50
                 call sys%forces(t1, s2%q, s2%v, s2%f)
                 res%nfev = res%nfev + 1
                 if (.not. all(ieee_is_finite(s2%f))) exit
-                w = vhalf + (0.5_dp*hs)*matmul(s2%mc, s2%f)
-                if (m > 0) then
-                    call sys%phi_t(t1, s2%q, r)
-                    r = -(matmul(s2%g, w) + r)
-                    w = w + matmul(r, pt)
-                end if
+                call minv_times(s2, s2%f, w)
+                w = vhalf + (0.5_dp*hs)*w
+                ! w - (G w + phi_t) S^{-1} G M^{-1} (all rows from the same w)
+                do i = 1, m
+                    cv(i) = dot_product(s2%g(i, :), w) + r(i)
+                end do
+                do i = 1, m
+                    w = w - cv(i)*pt(i, :)
+                end do
                 vprev = s2%v
                 s2%v = w
                 if (kk > 1 .and. maxval(abs(s2%v - vprev)) <= 4.0_dp*epsilon(1.0_dp)* &
