@@ -30,7 +30,14 @@
 !!   RATTLE side step of the remaining length from the grid point before it (so every
 !!   output is on the constraint manifold to round-off; the trajectory itself is not
 !!   altered). Without t_eval every grid point is an output (or only the ends, without
-!!   save_steps). Events are not supported.
+!!   save_steps).
+!! - Events (`events`, functions g(t, y) of y = [q; v], `ode_events`): a sign change of g
+!!   between grid points (with the event's direction) is located by Brent's method on the
+!!   RATTLE side step of length tau from the grid point before it (a continuous extension
+!!   of the step whose states are on the constraint manifold to round-off; its local
+!!   error is O(h^3), so event times have the method's second order). Events of one step
+!!   are reported in time order; a terminal one ends the run there (status
+!!   CM_EVENT_STOP), its state the last output (without t_eval).
 !! Multipliers, reactions, residuals, energy and power at the outputs come from the
 !! acceleration-level KKT system, as in `constrained_solve`; only holonomic constraints
 !! (n_nh = 0).
@@ -44,6 +51,8 @@ module conmech_rattle
         constraint_matrix, constraint_residuals
     use conmech_constrained_solver, only: constrained_options, constrained_result, &
         consistent_initial
+    use conmech_ode_system, only: ode_events
+    use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
 
@@ -86,13 +95,15 @@ contains
     !! fixed step options%ode%first_step (see the module documentation). Result and
     !! options as `constrained_solve` (projection, rtol, atol are not used; proj_tol and
     !! proj_max_iter control the position solve; max_steps bounds the number of steps).
-    subroutine rattle_solve(sys, t_span, q0, v0, options, res, t_eval)
+    subroutine rattle_solve(sys, t_span, q0, v0, options, res, t_eval, events)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: q0(:), v0(:)
         type(constrained_options), intent(in) :: options
         type(constrained_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
+        !> event functions of (t, [q; v]) (see the module documentation)
+        class(ode_events), intent(in), optional :: events
 
         type(rattle_state) :: st(2), side
         integer :: cur, mkind
@@ -101,6 +112,13 @@ contains
         real(dp), allocatable :: afree(:), vhalf(:), ph(:), gt(:, :), dq(:), dqsum(:), w(:)
         real(dp), allocatable :: r(:), vprev(:), pt(:, :), sm(:, :), cv(:)
         integer, allocatable :: ipiv(:)
+        ! events: g at the current grid point, the events found, their states
+        real(dp), allocatable :: g_old(:), g_new(:), yev(:), gv(:), evt(:), evq(:, :)
+        real(dp), allocatable :: evv(:, :)
+        integer, allocatable :: evid(:)
+        integer :: ne, nev
+        logical :: stopped
+        real(dp) :: t_stop, tk
         real(dp), allocatable :: tout(:), qout(:, :), vout(:, :), q(:), v(:), acc(:), lam(:)
         real(dp) :: h, t0, tf, posneg
         integer :: n, m, nsteps, k, nout, n_eval, i_eval, info, iters, j
@@ -113,6 +131,9 @@ contains
         tf = t_span(2)
         n_eval = 0
         if (present(t_eval)) n_eval = size(t_eval)
+        ne = 0
+        if (present(events)) ne = events%n_events()
+        nev = 0
         res%message = "bad input"
         res%status = CM_BAD_INPUT
         if (n < 1 .or. sys%n_hol < 0) then
@@ -132,6 +153,9 @@ contains
                           //"first_step > 0"
         else if (options%proj_max_iter < 1 .or. .not. options%proj_tol > 0.0_dp) then
             res%message = "bad input: proj_max_iter and proj_tol must be positive"
+        else if (.not. events_ok()) then
+            res%message = "bad input: the events need direction and terminal arrays of " &
+                          //"n_events elements"
         else if (.not. t_eval_ok()) then
             res%message = "bad input: t_eval must lie in t_span, sorted in the direction " &
                           //"of integration"
@@ -140,6 +164,8 @@ contains
         end if
         if (res%status /= CM_SUCCESS) then
             call allocate_outputs(0)
+            allocate (res%ev_t(0), res%ev_q(max(n, 0), 0), res%ev_v(max(n, 0), 0), &
+                      res%ev_id(0))
             return
         end if
         posneg = sign(1.0_dp, tf - t0)
@@ -200,6 +226,9 @@ contains
             return
         end if
 
+        allocate (g_old(ne), g_new(ne), yev(2*n), gv(ne), evt(8), evq(n, 8), evv(n, 8), evid(8))
+        if (ne > 0) call events%eval(t0, [q, v], g_old)
+
         ! ------------------------------------------------------------ outputs at t0
         allocate (tout(16), qout(n, 16), vout(n, 16))
         nout = 0
@@ -215,25 +244,40 @@ contains
         end if
 
         ! ------------------------------------------------------------ the grid
+        stopped = .false.
+        t_stop = tf
         do k = 1, nsteps
-            ! t_eval points strictly inside (t_{k-1}, t_k): a side step from t_{k-1}
+            call step(st(cur), h, st(3 - cur), info, msg)
+            if (info /= CM_SUCCESS) exit
+            tk = t0 + k*h
+            if (k == nsteps) tk = tf
+            st(3 - cur)%t = tk
+            if (ne > 0) then
+                call find_events(st(cur), st(3 - cur), h, info, msg)
+                if (info /= CM_SUCCESS) exit
+            end if
+            ! t_eval points strictly inside (t_{k-1}, t_k) (up to t_stop after a terminal
+            ! event): a side step from t_{k-1}
             do while (i_eval <= n_eval)
-                if ((t_eval(i_eval) - (t0 + k*h))*posneg >= 0.0_dp) exit
+                if (stopped) then
+                    if ((t_eval(i_eval) - t_stop)*posneg > 0.0_dp) exit
+                else
+                    if ((t_eval(i_eval) - tk)*posneg >= 0.0_dp) exit
+                end if
                 call step(st(cur), t_eval(i_eval) - st(cur)%t, side, info, msg)
                 if (info /= CM_SUCCESS) exit
                 call push(t_eval(i_eval), side%q, side%v)
                 i_eval = i_eval + 1
             end do
             if (info /= CM_SUCCESS) exit
-            call step(st(cur), h, st(3 - cur), info, msg)
-            if (info /= CM_SUCCESS) exit
-            cur = 3 - cur
-            if (k == nsteps) then
-                st(cur)%t = tf
-            else
-                st(cur)%t = t0 + k*h
-            end if
             res%naccept = res%naccept + 1
+            if (stopped) then
+                ! the state at the terminal event is the last output without t_eval
+                if (n_eval == 0) call push(t_stop, evq(:, nev), evv(:, nev))
+                cur = 3 - cur
+                exit
+            end if
+            cur = 3 - cur
             if (n_eval == 0) then
                 if (options%save_steps .or. k == nsteps) &
                     call push(st(cur)%t, st(cur)%q, st(cur)%v)
@@ -250,12 +294,20 @@ contains
             write (buf, '(es14.6)') st(cur)%t
             res%status = info
             res%message = msg//" (RATTLE step from t ="//trim(buf)//")"
+        else if (stopped) then
+            res%status = CM_EVENT_STOP
+            res%message = "a terminal event occurred"
         else
             res%status = CM_SUCCESS
             res%message = "success"
         end if
 
         ! ------------------------------------------------------------ diagnostics
+        res%nev = nev
+        res%ev_t = evt(1:nev)
+        res%ev_q = evq(:, 1:nev)
+        res%ev_v = evv(:, 1:nev)
+        res%ev_id = evid(1:nev)
         call allocate_outputs(nout)
         do j = 1, nout
             call store(j)
@@ -283,6 +335,7 @@ contains
             res%message = text
             res%success = .false.
             call allocate_outputs(0)
+            allocate (res%ev_t(0), res%ev_q(n, 0), res%ev_v(n, 0), res%ev_id(0))
         end subroutine fail
 
         subroutine allocate_outputs(nt)
@@ -339,6 +392,108 @@ contains
             if (sys%has_energy()) res%energy(jj) = sys%energy(tt, qout(:, jj), vout(:, jj))
             res%power(jj) = dot_product(res%reaction(:, jj), vout(:, jj))
         end subroutine store
+
+        logical function events_ok()
+            events_ok = .true.
+            if (ne == 0) return
+            if (.not. (allocated(events%direction) .and. allocated(events%terminal))) then
+                events_ok = .false.
+            else
+                events_ok = size(events%direction) == ne .and. size(events%terminal) == ne
+            end if
+        end function events_ok
+
+        !> Sign changes of the event functions between s0 and s1 (a step of length hs),
+        !! each root by Brent's method on the side step from s0; events recorded in time
+        !! order up to the first terminal one (then stopped, t_stop).
+        subroutine find_events(s0, s1, hs, inf, mg)
+            type(rattle_state), intent(in) :: s0, s1
+            real(dp), intent(in) :: hs
+            integer, intent(out) :: inf
+            character(len=:), allocatable, intent(out) :: mg
+            real(dp) :: times(ne)
+            integer :: ids(ne), nf, i, j, jj, it
+            logical :: cross, done
+            type(brent_state) :: bs
+            inf = CM_SUCCESS
+            yev(1:n) = s1%q
+            yev(n + 1:) = s1%v
+            call events%eval(s1%t, yev, g_new)
+            nf = 0
+            do i = 1, ne
+                cross = (g_old(i) < 0.0_dp .and. g_new(i) >= 0.0_dp .and. &
+                         events%direction(i) >= 0) .or. &
+                        (g_old(i) > 0.0_dp .and. g_new(i) <= 0.0_dp .and. &
+                         events%direction(i) <= 0)
+                if (.not. cross) cycle
+                nf = nf + 1
+                ids(nf) = i
+                times(nf) = s1%t
+                if (g_new(i) == 0.0_dp) cycle
+                call brent_init(bs, g_old(i), g_new(i), s0%t, hs)
+                do it = 1, 200
+                    call brent_step(bs, done)
+                    if (done) exit
+                    call step(s0, bs%b*hs, side, inf, mg)
+                    if (inf /= CM_SUCCESS) return
+                    yev(1:n) = side%q
+                    yev(n + 1:) = side%v
+                    call events%eval(side%t, yev, gv)
+                    call brent_take(bs, gv(i))
+                end do
+                times(nf) = s0%t + bs%b*hs
+            end do
+            g_old = g_new
+            ! time order (insertion sort, few events)
+            do i = 2, nf
+                j = i
+                do while (j > 1)
+                    if ((times(j) - times(j - 1))*posneg >= 0.0_dp) exit
+                    times(j - 1:j) = [times(j), times(j - 1)]
+                    ids(j - 1:j) = [ids(j), ids(j - 1)]
+                    j = j - 1
+                end do
+            end do
+            do jj = 1, nf
+                if (stopped .and. (times(jj) - t_stop)*posneg > 0.0_dp) exit
+                if (times(jj) == s1%t) then
+                    call push_event(times(jj), s1%q, s1%v, ids(jj))
+                else
+                    call step(s0, times(jj) - s0%t, side, inf, mg)
+                    if (inf /= CM_SUCCESS) return
+                    call push_event(times(jj), side%q, side%v, ids(jj))
+                end if
+                if (events%terminal(ids(jj)) .and. .not. stopped) then
+                    stopped = .true.
+                    t_stop = times(jj)
+                end if
+            end do
+        end subroutine find_events
+
+        subroutine push_event(tt, qq, vv, id)
+            real(dp), intent(in) :: tt, qq(:), vv(:)
+            integer, intent(in) :: id
+            real(dp), allocatable :: t2(:), q2(:, :), v2(:, :)
+            integer, allocatable :: i2(:)
+            integer :: cap
+            cap = size(evt)
+            if (nev >= cap) then
+                allocate (t2(2*cap), q2(n, 2*cap), v2(n, 2*cap), i2(2*cap))
+                t2(1:nev) = evt(1:nev)
+                q2(:, 1:nev) = evq(:, 1:nev)
+                v2(:, 1:nev) = evv(:, 1:nev)
+                i2(1:nev) = evid(1:nev)
+                call move_alloc(t2, evt)
+                call move_alloc(q2, evq)
+                call move_alloc(v2, evv)
+                call move_alloc(i2, evid)
+            end if
+            nev = nev + 1
+            evt(nev) = tt
+            evq(:, nev) = qq
+            evv(:, nev) = vv
+            evid(nev) = id
+        end subroutine push_event
 
         subroutine allocate_state(st)
             type(rattle_state), intent(inout) :: st
