@@ -1,7 +1,10 @@
 !> Cost of one RATTLE step on the built-in pendulum_xy and double_pendulum_xy (no
 !! stored steps): wall time per step, for callgrind or gprof profiles.
 !!
-!!     fpm run --example rattle_step --profile release -- [NSTEPS]
+!!     fpm run --example rattle_step --profile release -- [NSTEPS [1|2]]
+!!
+!! (the second argument: only pendulum_xy (1) or only double_pendulum_xy (2); for
+!! `valgrind --tool=callgrind`, instruction counts per step of one system)
 program rattle_step
     use conmech_kinds, only: dp
     use conmech_constrained_system, only: constrained_system
@@ -15,7 +18,7 @@ program rattle_step
     real(dp), allocatable :: q0(:), v0(:)
     character(len=:), allocatable :: msg
     character(len=32) :: arg
-    integer :: nsteps, info, k
+    integer :: nsteps, info, k, only
     integer(8) :: c0, c1, rate
     character(len=20), parameter :: names(2) = [character(len=20) :: "pendulum_xy", &
                                                 "double_pendulum_xy"]
@@ -24,7 +27,13 @@ program rattle_step
         call get_command_argument(1, arg)
         read (arg, *) nsteps
     end if
+    only = 0
+    if (command_argument_count() >= 2) then
+        call get_command_argument(2, arg)
+        read (arg, *) only
+    end if
     do k = 1, 2
+        if (only /= 0 .and. k /= only) cycle
         call make_constrained(trim(names(k)), [real(dp) ::], sys, info, msg)
         if (k == 1) then
             q0 = [sin(1.0_dp), -cos(1.0_dp)]
