@@ -120,6 +120,19 @@ def cmd_plot(a):
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(a.o, dpi=110)
+    print()
+    print("max dE over decades of t (the trend at log scale):")
+    print()
+    for d in data:
+        for key in ("rattle", "dop853"):
+            t, de = d[key + "_t"], d[key + "_de"]
+            edges = 10.0 ** np.arange(np.floor(np.log10(t[1])), np.log10(t[-1]) + 1)
+            cells = []
+            for lo, hi in zip(edges[:-1], edges[1:]):
+                sel = (t >= lo) & (t < hi)
+                if sel.any():
+                    cells.append(f"[{lo:.0e}, {hi:.0e}): {de[sel].max():.1e}")
+            print(f"- {str(d['name']).split(' ')[0]} {key}: " + "; ".join(cells))
     print("wrote", a.o)
 
 
