@@ -581,7 +581,7 @@ contains
             real(dp), intent(out) :: pt(:, :)
             integer, intent(out) :: inf
             real(dp) :: s1
-            integer :: lainfo
+            integer :: lainfo, i2, j2
             inf = CM_SUCCESS
             if (m == 1) then
                 s1 = dot_product(gg(1, :), xx(:, 1))
@@ -592,7 +592,12 @@ contains
                 pt(1, :) = xx(:, 1)/s1
                 return
             end if
-            sm = matmul(gg, xx)
+            ! (loops: the library matmul costs more than the product of tiny matrices)
+            do j2 = 1, m
+                do i2 = 1, m
+                    sm(i2, j2) = dot_product(gg(i2, :), xx(:, j2))
+                end do
+            end do
             call dgetf2(m, m, sm, m, ipiv, lainfo)
             if (lainfo /= 0) then
                 inf = CM_SINGULAR
