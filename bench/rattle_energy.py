@@ -1,31 +1,33 @@
 """RATTLE against projected DOP853 at the same cost (force evaluations): energy error of
 the Cartesian pendulum and double pendulum over long runs, constraint residuals.
 
-    python bench/rattle_energy.py [--periods N] [--double-periods M] [out.png]
+    python bench/rattle_energy.py run pendulum [--periods N] [--steps S] -o P.npz
+    python bench/rattle_energy.py run double [--periods N] [--steps S] -o D.npz
+    python bench/rattle_energy.py plot P.npz D.npz [-o out.png]
 
-Defaults: 1e6 periods of pendulum_xy (theta0 = 1, h = T/100: 1e8 RATTLE steps, several
-minutes) and 1e4 periods (2 pi sqrt(l/g)) of double_pendulum_xy (h = T/400). DOP853 with
-position+velocity projection gets the rtol whose force evaluations per period are closest
-to RATTLE's (calibrated on a short run). Writes the PNG (default
-bench/results/rattle_energy.png) and prints a Markdown table.
+`run` integrates one system with RATTLE (h = T/S) and with DOP853 + position/velocity
+projection at the rtol whose force evaluations per period are closest to RATTLE's
+(calibrated on 50 periods), keeps the energy error at 20001 output points, and saves them
+(the two systems can run in parallel processes). pendulum: pendulum_xy, theta0 = 1, T the
+exact period (default 1e6 periods, S = 100); double: double_pendulum_xy from its default
+state, T = 2 pi sqrt(l/g) (default 1e6 periods, S = 100). `plot` writes the PNG (default
+bench/results/rattle_energy.png) and prints the Markdown table with a least-squares fit
+dE_max ~ t^p of the maximum error over the ten tenths of the run (p ~ 0: bounded, p ~ 1:
+linear growth).
 """
 import argparse
 import time
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from scipy.special import ellipk  # noqa: E402
-
-from conmech import constrained  # noqa: E402
+from conmech import constrained
 
 G = 9.81
+N_OUT = 20001
 
 
-def run(system, q0, v0, tf, n_out, method, **kw):
+def run(system, q0, v0, tf, method, n_out=N_OUT, **kw):
     t0 = time.perf_counter()
     r = constrained.solve(system, (0, tf), q0, v0, method=method,
                           t_eval=np.linspace(0, tf, n_out), max_steps=2**31 - 1, **kw)
@@ -38,8 +40,9 @@ def run(system, q0, v0, tf, n_out, method, **kw):
 def matched_rtol(system, q0, v0, period, nfev_per_period):
     """rtol of projected DOP853 whose nfev per period is closest to the target."""
     best = None
-    for rtol in 10.0 ** -np.arange(3.0, 11.0, 0.5):
-        r = run(system, q0, v0, 50 * period, 3, "DOP853", rtol=rtol, atol=rtol)
+    for rtol in 10.0 ** -np.arange(3.0, 12.0, 0.25):
+        # (3 outputs: the steps of DOP853 hit every t_eval point)
+        r = run(system, q0, v0, 50 * period, "DOP853", n_out=3, rtol=rtol, atol=rtol)
         cost = r.nfev / 50
         if best is None or abs(np.log(cost / nfev_per_period)) < abs(np.log(best[1] /
                                                                           nfev_per_period)):
@@ -47,61 +50,105 @@ def matched_rtol(system, q0, v0, period, nfev_per_period):
     return best[0]
 
 
-def compare(name, system, q0, v0, period, periods, steps_per_period, energy):
-    tf = periods * period
-    n_out = 20001
-    rr = run(system, q0, v0, tf, n_out, "RATTLE", first_step=period / steps_per_period)
-    rtol = matched_rtol(system, q0, v0, period, rr.nfev / periods)
-    rd = run(system, q0, v0, tf, n_out, "DOP853", rtol=rtol, atol=rtol)
-    rows = []
-    for label, r in (("RATTLE h = T/%d" % steps_per_period, rr),
-                     ("DOP853 + projection, rtol %.0e" % rtol, rd)):
-        e = energy(r)
-        de = np.abs(e - e[0])
-        k = de.size // 10
-        rows.append(dict(label=label, r=r, de=de, first=de[:k].max(), last=de[-k:].max(),
-                         nfev=r.nfev, seconds=r.seconds,
-                         res=max(np.abs(r.res_pos).max(), np.abs(r.res_vel).max())))
-    return name, tf, rows
+def setup(which):
+    if which == "pendulum":
+        from scipy.special import ellipk
+        th0 = 1.0
+        period = 4 * np.sqrt(1.0 / G) * ellipk(np.sin(th0 / 2) ** 2)
+        sysm = constrained.builtin("pendulum_xy")
+        return ("pendulum_xy (theta0 = 1, T exact)", sysm,
+                np.array([np.sin(th0), -np.cos(th0)]), np.zeros(2), period)
+    sysm = constrained.builtin("double_pendulum_xy")
+    q0, v0 = sysm.initial_state()
+    return ("double_pendulum_xy (default state, T = 2 pi sqrt(l/g))", sysm, q0, v0,
+            2 * np.pi * np.sqrt(1.0 / G))
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--periods", type=float, default=1e6)
-    ap.add_argument("--double-periods", type=float, default=1e4)
-    ap.add_argument("out", nargs="?",
-                    default=str(Path(__file__).parent / "results" / "rattle_energy.png"))
-    a = ap.parse_args()
+def cmd_run(a):
+    name, sysm, q0, v0, period = setup(a.system)
+    tf = a.periods * period
+    rr = run(sysm, q0, v0, tf, "RATTLE", first_step=period / a.steps)
+    print(f"RATTLE done: {rr.seconds:.1f} s, nfev {rr.nfev}", flush=True)
+    rtol = matched_rtol(sysm, q0, v0, period, rr.nfev / a.periods)
+    print(f"DOP853 rtol {rtol:.1e}", flush=True)
+    rd = run(sysm, q0, v0, tf, "DOP853", rtol=rtol, atol=rtol)
+    print(f"DOP853 done: {rd.seconds:.1f} s, nfev {rd.nfev}", flush=True)
+    out = dict(name=name, periods=a.periods, tf=tf, steps=a.steps, rtol=rtol)
+    for key, r in (("rattle", rr), ("dop853", rd)):
+        out[key + "_t"] = r.t
+        out[key + "_de"] = np.abs(r.energy - r.energy[0])
+        out[key + "_res_pos"] = r.res_pos
+        out[key + "_res_vel"] = r.res_vel
+        out[key + "_nfev"] = r.nfev
+        out[key + "_seconds"] = r.seconds
+    np.savez(a.o, **out)
+    print("wrote", a.o)
 
-    th0 = 1.0
-    T = 4 * np.sqrt(1.0 / G) * ellipk(np.sin(th0 / 2) ** 2)
-    e1 = lambda r: 0.5 * (r.v ** 2).sum(axis=0) + G * r.q[1]
-    cases = [compare("pendulum_xy (theta0 = 1)", "pendulum_xy",
-                     [np.sin(th0), -np.cos(th0)], [0.0, 0.0], T, a.periods, 100, e1)]
-    dsys = constrained.builtin("double_pendulum_xy")
-    q0, v0 = dsys.initial_state()
-    cases.append(compare("double_pendulum_xy (default state)", dsys, q0, v0,
-                         2 * np.pi * np.sqrt(1.0 / G), a.double_periods, 400,
-                         lambda r: r.energy))
 
-    fig, axes = plt.subplots(1, len(cases), figsize=(13, 4.5))
-    print("| system | method | span | force evals | time (s) | max dE first 10 % | "
-          "max dE last 10 % | max residual |")
-    print("|---|---|---|---|---|---|---|---|")
-    for ax, (name, tf, rows) in zip(axes, cases):
-        for row in rows:
-            r = row["r"]
-            ax.loglog(r.t[1:], np.maximum(row["de"][1:], 1e-17), lw=0.6, label=row["label"])
-            print(f"| {name} | {row['label']} | t = {tf:.4g} | "
-                  f"{row['nfev']} | {row['seconds']:.1f} | {row['first']:.2e} | "
-                  f"{row['last']:.2e} | {row['res']:.1e} |")
-        ax.set_title(name)
+def growth(t, de):
+    """Maximum of de over each tenth of the run and the exponent p of max ~ t^p."""
+    k = de.size // 10
+    tm = np.array([t[i * k:(i + 1) * k].mean() for i in range(10)])
+    mx = np.array([de[i * k:(i + 1) * k].max() for i in range(10)])
+    p = np.polyfit(np.log(tm), np.log(np.maximum(mx, 1e-300)), 1)[0]
+    return mx, p
+
+
+def cmd_plot(a):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    data = [np.load(f, allow_pickle=False) for f in a.files]
+    fig, axes = plt.subplots(1, len(data), figsize=(6.5 * len(data), 4.5), squeeze=False)
+    print("| system | method | periods | force evals | time (s) | max dE first 10 % | "
+          "max dE last 10 % | fit dE ~ t^p | max res_pos | max res_vel |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for ax, d in zip(axes[0], data):
+        name = str(d["name"])
+        for key, label in (("rattle", "RATTLE h = T/%d" % int(d["steps"])),
+                           ("dop853", "DOP853 + projection, rtol %.0e" % float(d["rtol"]))):
+            t, de = d[key + "_t"], d[key + "_de"]
+            mx, p = growth(t[1:], de[1:])
+            ax.loglog(t[1:], np.maximum(de[1:], 1e-17), lw=0.5, label=label)
+            print(f"| {name} | {label} | {float(d['periods']):.0e} | {int(d[key + '_nfev'])} "
+                  f"| {float(d[key + '_seconds']):.0f} | {mx[0]:.2e} | {mx[-1]:.2e} | "
+                  f"p = {p:.2f} | {d[key + '_res_pos'].max():.1e} | "
+                  f"{d[key + '_res_vel'].max():.1e} |")
+        ax.set_title(name, fontsize=9)
         ax.set_xlabel("t")
         ax.set_ylabel("|E(t) - E(0)|")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(a.out, dpi=110)
-    print("wrote", a.out)
+    fig.savefig(a.o, dpi=110)
+    print()
+    print("max dE over decades of t (the trend at log scale):")
+    print()
+    for d in data:
+        for key in ("rattle", "dop853"):
+            t, de = d[key + "_t"], d[key + "_de"]
+            edges = 10.0 ** np.arange(np.floor(np.log10(t[1])), np.log10(t[-1]) + 1)
+            cells = []
+            for lo, hi in zip(edges[:-1], edges[1:]):
+                sel = (t >= lo) & (t < hi)
+                if sel.any():
+                    cells.append(f"[{lo:.0e}, {hi:.0e}): {de[sel].max():.1e}")
+            print(f"- {str(d['name']).split(' ')[0]} {key}: " + "; ".join(cells))
+    print("wrote", a.o)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("system", choices=("pendulum", "double"))
+    r.add_argument("--periods", type=float, default=1e6)
+    r.add_argument("--steps", type=int, default=100)
+    r.add_argument("-o", required=True)
+    p = sub.add_parser("plot")
+    p.add_argument("files", nargs="+")
+    p.add_argument("-o", default=str(Path(__file__).parent / "results" / "rattle_energy.png"))
+    a = ap.parse_args()
+    cmd_run(a) if a.cmd == "run" else cmd_plot(a)
 
 
 if __name__ == "__main__":

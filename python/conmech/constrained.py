@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
-from ._callback import Guard, message_text
+from ._callback import Guard, as_result, message_text
 from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
@@ -52,8 +52,9 @@ class ConstrainedResult(dict):
     ``power`` (nt,) of the reactions, ``nfev``, ``naccept``, ``nreject``, ``nproj``,
     ``proj_iter`` (total simplified Newton iterations), ``proj_iter_max``, ``rank`` (of
     the constraints; < m when redundant), ``dq0``, ``dv0`` (how far the initial state was
-    moved), ``status`` (0 success, -1 failure),
-    ``message``, ``success``.
+    moved), ``status`` (0 success, 1 a terminal event, -1 failure),
+    ``message``, ``success``; with ``events``: ``t_events``, ``q_events``, ``v_events``
+    (one array per event function; states (k, n)).
     """
 
     def __getattr__(self, name):
@@ -222,7 +223,9 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
           rtol: float = 1e-8, atol: float = 1e-10, params: Sequence[float] = (),
           first_step: float | None = None, max_step: float = np.inf, max_steps: int = 1000000,
           every: int = 1, alpha: float = 5.0, beta: float = 5.0, proj_tol: float = 1e-14,
-          proj_max_iter: int = 10) -> ConstrainedResult:
+          proj_max_iter: int = 10,
+          events: Callable[..., float] | Sequence[Callable[..., float]] | None = None
+          ) -> ConstrainedResult:
     """Integrate a constrained mechanical system.
 
     Parameters
@@ -252,6 +255,14 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
         Baumgarte parameters.
     proj_tol, proj_max_iter :
         Position projection: target max |phi| and simplified Newton iterations.
+    events : callable ``event(t, q, v) -> float`` or a list of them, optional
+        RATTLE and Radau only. Zero crossings are located (SciPy's conventions: attributes
+        ``terminal`` (bool) and ``direction``); the result gets ``t_events``,
+        ``q_events``, ``v_events`` (lists per event) and, after a terminal event,
+        ``status`` 1 with the run ending at the event. RATTLE locates a crossing by
+        Brent's method on its side step from the grid point before it (event states on
+        the constraints to round-off, event times of the method's order 2); Radau on its
+        dense output (to the tolerance).
 
     Returns
     -------
@@ -334,6 +345,40 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
         if np.any(d <= 0):
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
+    from ._ivp import _event_settings
+    settings = _event_settings(events)
+    ne = len(settings)
+    if ne and method not in ("RATTLE", "Radau", "RADAU5"):
+        raise ValueError(f"events on a constrained system need method 'RATTLE' or 'Radau', "
+                         f"got {method!r}")
+    for i, (_, count, _) in enumerate(settings):
+        if count > 1:
+            raise ValueError(f"events[{i}].terminal: constrained.solve stops at the first "
+                             "occurrence (terminal must be a boolean)")
+    ev_dir = np.array([d for _, _, d in settings] or [0], dtype=np.intc)
+    ev_term = np.array([int(c > 0) for _, c, _ in settings] or [0], dtype=np.intc)
+    ev_guard = Guard()
+    ev_out = {}
+
+    def events_cb(t, y):
+        g = np.zeros(max(ne, 1))
+        if ev_guard.failed:
+            return g * np.nan
+        try:
+            for i, (fun, _, _) in enumerate(settings):
+                r = fun(t, y[:n].copy(), y[n:].copy())
+                if r is None:
+                    raise ValueError(f"events[{i}] returned None; expected a number")
+                g[i] = float(as_result(r, (), f"events[{i}]"))
+        except Exception as exc:  # kept and re-raised after the Fortran run
+            ev_guard.fail(exc)
+            return g * np.nan
+        return g
+
+    def evstore(ev_t, ev_q, ev_v, ev_id, n_, nev):
+        ev_out.update(t=np.array(ev_t), q=np.array(ev_q), v=np.array(ev_v),
+                      id=np.array(ev_id))
+
     iopt = np.array([PROJECTIONS[projection], int(every), int(proj_max_iter), int(max_steps)],
                     dtype=np.intc)
     mstep = float(max_step) if np.isfinite(max_step) else np.finfo(float).max
@@ -348,18 +393,21 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
 
     common = dict(n=n, t_span=np.array([t0, tf]), q0=q0, v0=v0, method=_METHODS[method],
                   rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
-                  neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD)
+                  neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD, ne=ne,
+                  ev_dir=ev_dir, ev_term=ev_term)
     if isinstance(system, BuiltinConstrained):
         stats, moved, info, message = _conmech.flat_constrained_builtin(
-            *system._flat_args(), store, **common)
+            *system._flat_args(), store, events_cb, evstore, **common)
     else:
         guard = Guard()
         cb = system._callbacks(guard)
         stats, moved, info, message = _conmech.flat_constrained_callback(
             cb[0], cb[1], cb[2], cb[3], cb[4], cb[5], cb[6], int(system.jac is not None),
             int(system.gamma is not None), int(system.nh_gamma is not None),
-            int(system.rheonomic), system.n_hol, system.n_nh, store, **common)
+            int(system.rheonomic), system.n_hol, system.n_nh, store, events_cb, evstore,
+            **common)
         guard.check()
+    ev_guard.check()
     message = message_text(message)
     info = int(info)
     if info == _CM_BAD_INPUT:
@@ -380,6 +428,16 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
                proj_iter_max=int(stats[6]),
                dq0=float(moved[0]), dv0=float(moved[1]), status=0 if info >= 0 else -1,
                message=message, success=info >= 0, info=info)
+    if ne:
+        ids = ev_out.get("id", np.zeros(0, dtype=int))
+        sel = [ids == k + 1 for k in range(ne)]
+        res.update(t_events=[ev_out["t"][s_] if ev_out else np.zeros(0) for s_ in sel],
+                   q_events=[ev_out["q"][:, s_].T if ev_out else np.zeros((0, n))
+                             for s_ in sel],
+                   v_events=[ev_out["v"][:, s_].T if ev_out else np.zeros((0, n))
+                             for s_ in sel])
+        if info == 1:
+            res["status"] = 1
     return res
 
 

@@ -94,6 +94,11 @@ module conmech_constrained_solver
         integer :: proj_iter_max = 0               !! largest iteration count of one
         real(dp) :: dq0 = 0.0_dp                   !! |q0 moved| by the initial projection
         real(dp) :: dv0 = 0.0_dp                   !! |v0 moved| by the initial projection
+        ! events (RATTLE and Radau; event functions of [q; v])
+        integer :: nev = 0                         !! number of events found
+        real(dp), allocatable :: ev_t(:)           !! (nev) event times
+        real(dp), allocatable :: ev_q(:, :), ev_v(:, :)  !! (n, nev) states at the events
+        integer, allocatable :: ev_id(:)           !! (nev) which event function
     end type constrained_result
 
 contains

@@ -13,13 +13,15 @@
 !! projection. Solved by `radau_solve` with the block-diagonal mass matrix
 !! diag(I, M, 0, 0), lambda and mu as index-2 components, a finite-difference Jacobian.
 !! The mass matrix must be constant (it is checked at every output); t_eval points come
-!! from the collocation polynomial. Result: `constrained_result`, diagnostics from the
+!! from the collocation polynomial. Events are functions of (t, [q; v]), located by
+!! `radau_solve` on its dense output (so event states are on the constraints to the
+!! tolerance, not to round-off). Result: `constrained_result`, diagnostics from the
 !! KKT system at the outputs as `constrained_solve`.
 module conmech_rattle_dae
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system
+    use conmech_ode_system, only: ode_system, ode_events
     use conmech_ode_solver, only: ode_options, ode_result, METHOD_RADAU5
     use conmech_radau, only: radau_solve
     use conmech_constrained_system, only: constrained_system, constrained_accel, &
@@ -38,7 +40,23 @@ module conmech_rattle_dae
         procedure :: rhs => ggl_rhs
     end type ggl_system
 
+    !> Events of (t, [q; v]) seen from y = [q, v, lambda, mu].
+    type, extends(ode_events) :: ggl_events
+        class(ode_events), allocatable :: inner
+        integer :: n = 0
+    contains
+        procedure :: eval => ggl_event_eval
+    end type ggl_events
+
 contains
+
+    subroutine ggl_event_eval(self, t, y, g)
+        class(ggl_events), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: g(:)
+        call self%inner%eval(t, y(1:2*self%n), g)
+    end subroutine ggl_event_eval
 
     subroutine ggl_rhs(self, t, y, dydt)
         class(ggl_system), intent(in) :: self
@@ -64,17 +82,20 @@ contains
     !> Integrate a constrained system with Radau IIA (order 5, adaptive: options%ode%rtol,
     !! atol, first_step, max_step, max_steps) in the stabilised index-2 form (see the
     !! module documentation). The projection options are not used.
-    subroutine radau_constrained_solve(sys, t_span, q0, v0, options, res, t_eval)
+    subroutine radau_constrained_solve(sys, t_span, q0, v0, options, res, t_eval, events)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: q0(:), v0(:)
         type(constrained_options), intent(in) :: options
         type(constrained_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
+        !> event functions of (t, [q; v])
+        class(ode_events), intent(in), optional :: events
 
         type(ggl_system) :: f
         type(ode_options) :: opt
         type(ode_result) :: ores
+        type(ggl_events) :: gev
         real(dp), allocatable :: q(:), v(:), acc(:), lam(:), y0(:), mass(:, :), m0(:, :)
         real(dp), allocatable :: mt(:, :)
         logical, allocatable :: idx2(:)
@@ -139,7 +160,23 @@ contains
         opt%save_steps = options%save_steps
         if (allocated(opt%rtol_vec)) deallocate (opt%rtol_vec)
         if (allocated(opt%atol_vec)) deallocate (opt%atol_vec)
-        call radau_solve(f, t_span, y0, opt, ores, t_eval=t_eval, mass=mass, index2=idx2)
+        if (present(events)) then
+            allocate (gev%inner, source=events)
+            gev%n = n
+            if (allocated(events%direction)) gev%direction = events%direction
+            if (allocated(events%terminal)) gev%terminal = events%terminal
+            call radau_solve(f, t_span, y0, opt, ores, t_eval=t_eval, events=gev, &
+                             mass=mass, index2=idx2)
+        else
+            call radau_solve(f, t_span, y0, opt, ores, t_eval=t_eval, mass=mass, index2=idx2)
+        end if
+        res%nev = ores%nev
+        if (ores%nev > 0) then
+            res%ev_t = ores%ev_t(1:ores%nev)
+            res%ev_q = ores%ev_y(1:n, 1:ores%nev)
+            res%ev_v = ores%ev_y(n + 1:2*n, 1:ores%nev)
+            res%ev_id = ores%ev_id(1:ores%nev)
+        end if
         res%status = ores%status
         res%message = ores%message
         res%nfev = ores%stats%nfev

@@ -80,10 +80,10 @@ end subroutine flat_mech_initial_state
 !! iopt = [projection, every, proj_max_iter, max_steps]; ropt = [first_step, max_step,
 !! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank,
 !! proj_iter_max]; moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
-subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, n, t_span, q0, v0, &
-                                    method, &
-                                    rtol, atol, iopt, ropt, neval, t_eval, stats, moved, &
-                                    info, message)
+subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events, evstore, &
+                                    n, t_span, q0, v0, method, &
+                                    rtol, atol, iopt, ropt, neval, t_eval, ne, ev_dir, &
+                                    ev_term, stats, moved, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
@@ -105,12 +105,28 @@ subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, n, t_s
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(in) :: ne
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: stats(7)
     real(c_double), intent(out) :: moved(2)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
-!f2py external store
+!f2py external store, events, evstore
     interface
+        subroutine events(t, y, g, n2, ne)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n2, ne
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n2)
+            real(c_double), intent(out) :: g(ne)
+        end subroutine events
+        subroutine evstore(ev_t, ev_q, ev_v, ev_id, n, nev)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, nev
+            real(c_double), intent(in) :: ev_t(nev)
+            real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
+            integer(c_int), intent(in) :: ev_id(nev)
+        end subroutine evstore
         subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
@@ -131,16 +147,18 @@ subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, n, t_s
         return
     end if
     call run_constrained(cs, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
-                         t_eval, store, stats, moved, info, message)
+                         t_eval, store, stats, moved, info, message, ne, ev_dir, ev_term, &
+                         events, evstore)
 end subroutine flat_constrained_builtin
 
 !> Solve a constrained system given by Python callables (see conmech_flat_mech_support
 !! for their conventions). has_jac, has_gamma, has_nh_gamma, rheonomic: 0 or 1; without
 !! an analytic Jacobian or acceleration term the documented finite differences are used.
 subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma, has_jac, &
-                                     has_gamma, has_nh_gamma, rheonomic, mh, mn, store, n, &
+                                     has_gamma, has_nh_gamma, rheonomic, mh, mn, store, &
+                                     events, evstore, n, &
                                      t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
-                                     t_eval, stats, moved, info, message)
+                                     t_eval, ne, ev_dir, ev_term, stats, moved, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_BAD_INPUT
     use conmech_flat_ode_support, only: copy_message
@@ -155,11 +173,13 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(in) :: ne
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: stats(7)
     real(c_double), intent(out) :: moved(2)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
-!f2py external mass, forces, phi, jac, gamma, nh, nhgamma, store
+!f2py external mass, forces, phi, jac, gamma, nh, nhgamma, store, events, evstore
     interface
         subroutine mass(t, q, mm, n)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -210,6 +230,20 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
             real(c_double), intent(in) :: q(n), v(n)
             real(c_double), intent(out) :: gam(mn)
         end subroutine nhgamma
+        subroutine events(t, y, g, n2, ne)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n2, ne
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n2)
+            real(c_double), intent(out) :: g(ne)
+        end subroutine events
+        subroutine evstore(ev_t, ev_q, ev_v, ev_id, n, nev)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n, nev
+            real(c_double), intent(in) :: ev_t(nev)
+            real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
+            integer(c_int), intent(in) :: ev_id(nev)
+        end subroutine evstore
         subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
@@ -243,5 +277,6 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
     sys%fnh => nh
     sys%fnhgamma => nhgamma
     call run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
-                         t_eval, store, stats, moved, info, message)
+                         t_eval, store, stats, moved, info, message, ne, ev_dir, ev_term, &
+                         events, evstore)
 end subroutine flat_constrained_callback

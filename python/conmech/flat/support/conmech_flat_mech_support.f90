@@ -23,7 +23,7 @@ module conmech_flat_mech_support
     use conmech_ode_solver, only: METHOD_RATTLE, METHOD_RADAU5
     use conmech_rattle, only: rattle_solve
     use conmech_rattle_dae, only: radau_constrained_solve
-    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_ode_support, only: copy_message, callback_events
     implicit none
     private
     public :: callback_constrained, run_constrained
@@ -141,9 +141,12 @@ contains
     !! [projection, every, proj_max_iter, max_steps]; ropt(1:5) = [first_step, max_step,
     !! alpha, beta, proj_tol]. stats(1:7) = [nfev, naccept, nreject, nproj, proj_iter, rank,
     !! proj_iter_max];
-    !! moved(1:2) = [dq0, dv0].
+    !! moved(1:2) = [dq0, dv0]. Optional events (RATTLE and Radau only): ne functions of
+    !! (t, [q; v]) by events(t, y, g, 2n, ne), ev_dir (+1, -1, 0), ev_term (/= 0:
+    !! terminal); the events found go to evstore(ev_t, ev_q, ev_v, ev_id, n, nev).
     subroutine run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, &
-                               neval, t_eval, store, stats, moved, info, message)
+                               neval, t_eval, store, stats, moved, info, message, ne, &
+                               ev_dir, ev_term, events, evstore)
         class(constrained_system), intent(in) :: sys
         integer(c_int), intent(in) :: n
         real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
@@ -158,7 +161,13 @@ contains
         real(c_double), intent(out) :: moved(2)
         integer(c_int), intent(out) :: info
         character(len=*), intent(out) :: message
+        integer(c_int), intent(in), optional :: ne
+        integer(c_int), intent(in), optional :: ev_dir(:), ev_term(:)
+        external :: events, evstore
+        optional :: events, evstore
         type(constrained_options) :: opt
+        type(callback_events) :: ev
+        integer(c_int) :: nev_fun
         type(constrained_result) :: r
         real(dp), allocatable :: lam(:, :)
         integer(c_int) :: m, mm, nt, nn
@@ -182,7 +191,35 @@ contains
         opt%alpha = ropt(3)
         opt%beta = ropt(4)
         opt%proj_tol = ropt(5)
-        if (method == METHOD_RADAU5) then
+        nev_fun = 0
+        if (present(ne)) nev_fun = ne
+        if (nev_fun > 0) then
+            if (method /= METHOD_RADAU5 .and. method /= METHOD_RATTLE) then
+                info = CM_BAD_INPUT
+                call copy_message("bad input: events on a constrained system need method " &
+                                  //"RATTLE or Radau", message)
+                return
+            end if
+            ev%g => events
+            ev%n = 2*n
+            ev%ne = nev_fun
+            ev%direction = ev_dir(1:nev_fun)
+            ev%terminal = ev_term(1:nev_fun) /= 0
+            if (method == METHOD_RADAU5) then
+                if (neval > 0) then
+                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, &
+                                                 t_eval(1:neval), events=ev)
+                else
+                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, events=ev)
+                end if
+            else
+                if (neval > 0) then
+                    call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), events=ev)
+                else
+                    call rattle_solve(sys, t_span, q0, v0, opt, r, events=ev)
+                end if
+            end if
+        else if (method == METHOD_RADAU5) then
             if (neval > 0) then
                 call radau_constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
             else
@@ -212,6 +249,8 @@ contains
         if (m > 0 .and. nt > 0) lam(1:m, 1:nt) = r%lam
         if (nt > 0) call store(r%t, r%q, r%v, lam, r%reaction, r%res_pos, r%res_vel, &
                                r%energy, r%power, nn, mm, nt)
+        if (nev_fun > 0 .and. r%nev > 0) call evstore(r%ev_t, r%ev_q, r%ev_v, r%ev_id, nn, &
+                                                      int(r%nev, c_int))
     end subroutine run_constrained
 
 end module conmech_flat_mech_support

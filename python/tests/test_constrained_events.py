@@ -1,0 +1,124 @@
+"""Events of conmech.constrained.solve with RATTLE and Radau: the crossings of theta = 0
+by pendulum_xy (released at rest from theta0 = 1) at (2k+1) T/4, T from the complete
+elliptic integral; terminal events; t_eval with events; bad input."""
+import numpy as np
+import pytest
+from scipy.special import ellipk
+
+from conmech import constrained
+
+G, L, TH0 = 9.81, 1.0, 1.0
+T = 4 * np.sqrt(L / G) * ellipk(np.sin(TH0 / 2) ** 2)
+Q0 = [L * np.sin(TH0), -L * np.cos(TH0)]
+V0 = [0.0, 0.0]
+
+
+def x_cross(t, q, v):
+    return q[0]
+
+
+def falling_terminal(t, q, v):
+    return q[0]
+
+
+falling_terminal.terminal = True
+falling_terminal.direction = -1
+
+
+def test_rattle_crossings_order_two():
+    # all crossings in two periods, event states on the circle to round-off; the errors of
+    # the first crossing time fall as h^2
+    errs = []
+    for k in (40, 80, 160):
+        r = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="RATTLE",
+                              first_step=T / k, events=x_cross)
+        assert r.success and r.status == 0
+        te = r.t_events[0]
+        assert te.size == 4
+        assert np.all(np.abs(te - np.array([1, 3, 5, 7]) * T / 4) < 50 / k ** 2)
+        qe = r.q_events[0]
+        assert qe.shape == (4, 2) and r.v_events[0].shape == (4, 2)
+        assert np.abs(qe[:, 0]).max() < 1e-13
+        assert np.abs(np.hypot(qe[:, 0], qe[:, 1]) - L).max() < 1e-14
+        # velocity constraint q . v = 0 at the events
+        assert np.abs((qe * r.v_events[0]).sum(axis=1)).max() < 1e-13
+        errs.append(abs(te[0] - T / 4))
+    p = np.log2(np.array(errs[:-1]) / errs[1:])
+    assert np.all(np.abs(p - 2) < 0.2), p
+
+
+def test_rattle_terminal_event_and_t_eval():
+    r = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="RATTLE",
+                          first_step=T / 200, events=[x_cross, falling_terminal])
+    assert r.success and r.status == 1
+    # the first crossing is falling (the bob swings from x > 0 through x = 0): both
+    # events there, the run ends at it
+    assert r.t_events[0].size == 1 and r.t_events[1].size == 1
+    assert r.t_events[1][0] == r.t[-1] and abs(r.t[-1] - T / 4) < 1e-3
+    assert np.array_equal(r.q[:, -1], r.q_events[1][0])
+    assert r.res_pos[-1] < 1e-14
+    te = np.linspace(0, 2 * T, 21)
+    r2 = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="RATTLE",
+                           first_step=T / 200, events=falling_terminal, t_eval=te)
+    assert r2.status == 1 and np.array_equal(r2.t, te[te <= r.t[-1]])
+    assert r2.t_events[0][0] == r.t_events[1][0]
+
+
+def test_radau_events_and_t_eval():
+    # Radau IIA on the index-2 DAE: event times to the tolerance, t_eval exact
+    te = np.linspace(0, 2 * T, 11)
+    r = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="Radau", rtol=1e-10,
+                          atol=1e-10, events=x_cross, t_eval=te)
+    assert r.success and r.status == 0 and np.array_equal(r.t, te)
+    assert np.abs(r.t_events[0] - np.array([1, 3, 5, 7]) * T / 4).max() < 1e-7
+    assert np.abs(r.q_events[0][:, 0]).max() < 1e-9
+    assert np.abs(np.hypot(*r.q_events[0].T) - L).max() < 1e-8
+    r2 = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="Radau", rtol=1e-10,
+                           atol=1e-10, events=falling_terminal, t_eval=te)
+    assert r2.status == 1 and np.array_equal(r2.t, te[te <= T / 4])
+    assert abs(r2.t_events[0][0] - T / 4) < 1e-7
+    # RATTLE's event time agrees with Radau's to the RATTLE order (h^2)
+    h = T / 400
+    r3 = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="RATTLE",
+                           first_step=h, events=falling_terminal)
+    assert abs(r3.t_events[0][0] - r2.t_events[0][0]) < 5 * h ** 2
+
+
+def test_events_on_a_user_system():
+    # the same pendulum as Python callables (the general-mass RATTLE path)
+    s = constrained.ConstrainedSystem(
+        2, mass=lambda t, q: np.eye(2), forces=lambda t, q, v: np.array([0.0, -G]),
+        phi=lambda t, q: np.array([0.5 * (q @ q - L ** 2)]),
+        jac=lambda t, q: q.reshape(1, 2), n_hol=1)
+    r = constrained.solve(s, (0, 2 * T), Q0, V0, method="RATTLE", first_step=T / 200,
+                          events=x_cross)
+    rb = constrained.solve("pendulum_xy", (0, 2 * T), Q0, V0, method="RATTLE",
+                           first_step=T / 200, events=x_cross)
+    assert np.allclose(r.t_events[0], rb.t_events[0], rtol=0, atol=1e-12)
+
+
+def test_events_bad_input():
+    with pytest.raises(ValueError, match="RATTLE' or 'Radau"):
+        constrained.solve("pendulum_xy", (0, 1), Q0, V0, method="DOP853", events=x_cross)
+
+    def twice(t, q, v):
+        return q[0]
+    twice.terminal = 2
+    with pytest.raises(ValueError, match="terminal"):
+        constrained.solve("pendulum_xy", (0, 1), Q0, V0, method="RATTLE", first_step=0.01,
+                          events=twice)
+    with pytest.raises(TypeError, match="callable"):
+        constrained.solve("pendulum_xy", (0, 1), Q0, V0, method="RATTLE", first_step=0.01,
+                          events=[1.0])
+
+    def broken(t, q, v):
+        raise RuntimeError("boom")
+    with pytest.raises(RuntimeError, match="boom"):
+        constrained.solve("pendulum_xy", (0, 1), Q0, V0, method="RATTLE", first_step=0.01,
+                          events=broken)
+
+    def vector(t, q, v):
+        return q
+    with pytest.raises(ValueError, match="events"):
+        constrained.solve("pendulum_xy", (0, 1), Q0, V0, method="RATTLE", first_step=0.01,
+                          events=vector)
