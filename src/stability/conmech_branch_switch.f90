@@ -114,8 +114,9 @@ contains
     !! exclude the asymmetric branch of a symmetry-breaking pitchfork). `t_old`: the old
     !! branch's tangent at the point in the unknowns [y0, T, p] (T absent for a fixed
     !! period; [y0, T] with `in_period`), e.g. `branch_secant` of the points around it.
-    !! `options` as for continue_orbits (`direction` picks the side of the new branch). `ratio` (optional):
-    !! the second smallest singular value of DG over the third (small at a branch point).
+    !! `options` as for continue_orbits (`direction` picks the side of the new branch).
+    !! `ratio` (optional): the second smallest singular value of DG over the third (small
+    !! at a branch point).
     subroutine switch_branch_point(sys, set_param, sp, t_old, br, options, ratio)
         class(ode_system), intent(inout) :: sys
         procedure(set_parameter_proc) :: set_param
