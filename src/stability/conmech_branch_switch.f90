@@ -109,12 +109,14 @@ contains
     end function branch_secant
 
     !> The second branch through the branch point `sp` (kind SP_BP, general shooting: the
-    !! period an unknown for autonomous systems, fixed otherwise; not symmetric shooting,
-    !! whose equations exclude the asymmetric branch of a symmetry-breaking pitchfork).
-    !! `t_old`: the old branch's tangent at the point in the unknowns [y0, T, p] (T absent
-    !! for a fixed period), e.g. `branch_secant` of the points around it. `options` as for
-    !! continue_orbits (`direction` picks the side of the new branch). `ratio` (optional):
-    !! the second smallest singular value of DG over the third (small at a branch point).
+    !! period an unknown for autonomous systems, fixed otherwise, or the continued quantity
+    !! of a conservative family with `in_period`; not symmetric shooting, whose equations
+    !! exclude the asymmetric branch of a symmetry-breaking pitchfork). `t_old`: the old
+    !! branch's tangent at the point in the unknowns [y0, T, p] (T absent for a fixed
+    !! period; [y0, T] with `in_period`), e.g. `branch_secant` of the points around it.
+    !! `options` as for continue_orbits (`direction` picks the side of the new branch).
+    !! `ratio` (optional): the second smallest singular value of DG over the third (small
+    !! at a branch point).
     subroutine switch_branch_point(sys, set_param, sp, t_old, br, options, ratio)
         class(ode_system), intent(inout) :: sys
         procedure(set_parameter_proc) :: set_param
