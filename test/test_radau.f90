@@ -73,6 +73,7 @@ program test_radau
         call ts%check_less(maxval(abs(yi - [cos(1.0_dp), -sin(1.0_dp)])), 1.0e-9_dp, &
                            "ode_integrate Gauss: y(1)")
     end do
+    deallocate (msg)     ! (a main program's allocatables are not freed at its end)
     f%f => vdp
     opt%method = METHOD_RADAU5
     opt%first_step = 0.0_dp
