@@ -1,6 +1,8 @@
 !> Radau IIA (order 5) through ode_solve: Hairer's scaled Van der Pol (eps = 1e-6) against
 !! a tight reference, counters, dense output, bad input; ode_integrate with the implicit
-!! methods (the end point of ode_solve, bit for bit; its failure with the time).
+!! methods (the end point of ode_solve, bit for bit; its failure with the time); Newton
+!! failure (step reduced to the minimum, the time in the message) and a singular iteration
+!! matrix (its message).
 program test_radau
     use conmech
     use conmech_testing, only: test_suite
@@ -10,6 +12,7 @@ program test_radau
     type(ode_options) :: opt
     type(ode_result) :: r
     real(dp) :: ref(2), y(2), yi(2)
+    real(dp), parameter :: HS = 0.01_dp, GAM0 = 3.6378342527444957322_dp
     integer :: info, m
     type(ode_stats) :: st
     type(radau_stepper) :: rs
@@ -73,6 +76,7 @@ program test_radau
         call ts%check_less(maxval(abs(yi - [cos(1.0_dp), -sin(1.0_dp)])), 1.0e-9_dp, &
                            "ode_integrate Gauss: y(1)")
     end do
+    deallocate (msg)     ! (a main program's allocatables are not freed at its end)
     f%f => vdp
     opt%method = METHOD_RADAU5
     opt%first_step = 0.0_dp
@@ -96,6 +100,27 @@ program test_radau
     call ts%check_less(maxval(abs(r%y(1, :) + r%y(2, :))), 1.0e-12_dp, &
                        "DAE: algebraic equation at every step")
     f%f => vdp
+
+    ! y' = y^2, y(0) = 1 blows up at t = 1: Newton stops converging, the step shrinks to the
+    ! minimum, the run ends (CM_STEP_TOO_SMALL) near t = 1 with the time in the message
+    f%f => blowup
+    f%jac => blowup_jac
+    opt%rtol = 1.0e-8_dp
+    opt%atol = 1.0e-8_dp
+    call ode_solve(f, [0.0_dp, 2.0_dp], [1.0_dp], opt, r)
+    call ts%check(.not. r%success .and. r%status == CM_STEP_TOO_SMALL .and. &
+                  index(r%message, "at t =") > 0, "y' = y^2: "//r%message)
+    call ts%check_less(abs(r%t(r%nt) - 1.0_dp), 1.0e-3_dp, "y' = y^2: stops near t = 1")
+    ! eigenvalues of J at gamma/h 2^k, k = 0..4: gamma/h I - J singular for h, h/2, ..., h/16
+    f%f => lin5
+    f%jac => lin5_jac
+    opt%first_step = HS
+    call ode_solve(f, [0.0_dp, 1.0_dp], [1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], opt, r)
+    call ts%check(.not. r%success .and. r%status == CM_SINGULAR .and. &
+                  index(r%message, "singular iteration matrix") > 0, "singular: "//r%message)
+    opt%first_step = 0.0_dp
+    f%f => vdp
+    f%jac => vdp_jac
 
     ! bad input
     opt%rtol = -1.0_dp
@@ -126,6 +151,41 @@ contains
         real(dp), intent(out) :: dydt(:)
         dydt = [y(2), y(2) + y(1)]
     end subroutine dae
+
+    subroutine blowup(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        dydt = y**2
+    end subroutine blowup
+
+    subroutine blowup_jac(t, y, dfdy)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        dfdy(1, 1) = 2.0_dp*y(1)
+    end subroutine blowup_jac
+
+    subroutine lin5(t, y, dydt)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        integer :: i
+        do i = 1, 5
+            dydt(i) = GAM0/HS*2.0_dp**(i - 1)*y(i)
+        end do
+    end subroutine lin5
+
+    subroutine lin5_jac(t, y, dfdy)
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        integer :: i
+        dfdy = 0.0_dp
+        do i = 1, 5
+            dfdy(i, i) = GAM0/HS*2.0_dp**(i - 1)
+        end do
+    end subroutine lin5_jac
 
     subroutine osc(t, y, dydt)
         real(dp), intent(in) :: t

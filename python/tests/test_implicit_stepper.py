@@ -73,6 +73,23 @@ def test_solve_ivp_with_the_class_and_scipy_driving_it():
     assert_allclose(r.y, d.y[:, -1], rtol=1e-4, atol=1e-9)
 
 
+def test_unbounded_t_bound():
+    # SciPy's OdeSolver pattern: t_bound = inf, step a while, the polynomial at both ends
+    s = conmech.Radau(rober, 0.0, [1.0, 0.0, 0.0], np.inf, rtol=1e-6, atol=1e-10)
+    assert_equal(s.t_bound, np.inf)
+    assert s.step_size is None
+    for _ in range(30):
+        assert s.step() is None
+    assert_equal(s.status, "running")
+    assert s.t > 0 and s.step_size > 0 and s.njev >= 1 and s.nlu >= 2
+    ref = conmech.solve_ivp(rober, (0, s.t), [1.0, 0.0, 0.0], method="Radau", rtol=1e-6,
+                            atol=1e-10)
+    assert_allclose(s.y, ref.y[:, -1], rtol=1e-5, atol=1e-12)
+    d = s.dense_output()
+    assert_allclose(d(s.t), s.y, rtol=1e-12, atol=1e-18)
+    assert_allclose(d(s.t_old).sum(), 1.0, rtol=1e-12)     # mass conservation
+
+
 def test_builtin_system_and_backwards():
     sysv = conmech.systems.vanderpol(mu=5.0)
     ref = conmech.solve_ivp(sysv, (0, 3), [2.0, 0.0], method="Radau", rtol=1e-8,

@@ -129,34 +129,43 @@ contains
         type(ode_stats) :: st
         character(len=:), allocatable :: msg
         if (options%method >= METHOD_RADAU5) then
-            call integrate_implicit()
+            if (present(hook)) then
+                info = CM_BAD_INPUT
+                msg = "bad input: step hooks need an explicit method"
+            else
+                call integrate_implicit(sys, t0, t1, y, options, info, st, msg)
+            end if
         else
             call drive(sys, t0, t1, y, options, st, info, msg, hook=hook)
         end if
         if (present(stats)) stats = st
         if (present(message)) message = msg
-
-    contains
-
-        subroutine integrate_implicit()
-            type(ode_options) :: oo
-            type(ode_result) :: r
-            if (present(hook)) then
-                info = CM_BAD_INPUT
-                msg = "bad input: step hooks need an explicit method"
-                return
-            end if
-            oo = options
-            oo%save_steps = .false.
-            oo%dense_output = .false.
-            call implicit_solve(sys, [t0, t1], y, oo, r)
-            info = r%status
-            msg = "success"
-            if (allocated(r%message)) msg = r%message
-            st = r%stats
-            if (size(r%t) > 0 .and. size(r%y, 1) == size(y)) y = r%y(:, size(r%t))
-        end subroutine integrate_implicit
     end subroutine ode_integrate
+
+    !> ode_integrate with an implicit method: ode_solve's implicit driver, end point only.
+    subroutine integrate_implicit(sys, t0, t1, y, options, info, st, msg)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t0, t1
+        real(dp), intent(inout) :: y(:)
+        type(ode_options), intent(in) :: options
+        integer, intent(out) :: info
+        type(ode_stats), intent(out) :: st
+        character(len=:), allocatable, intent(out) :: msg
+        type(ode_options) :: oo
+        type(ode_result) :: r
+        oo = options
+        oo%save_steps = .false.
+        oo%dense_output = .false.
+        call implicit_solve(sys, [t0, t1], y, oo, r)
+        info = r%status
+        if (allocated(r%message)) then
+            msg = r%message
+        else
+            msg = "success"
+        end if
+        st = r%stats
+        if (size(r%t) > 0 .and. size(r%y, 1) == size(y)) y = r%y(:, size(r%t))
+    end subroutine integrate_implicit
 
     subroutine fail(res, info, msg)
         type(ode_result), intent(inout) :: res

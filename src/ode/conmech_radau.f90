@@ -39,7 +39,7 @@
 !!   conmech_rattle_dae (the stabilised index-2 formulation).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
 module conmech_radau
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_lapack, only: dgetrf, dgetrs
@@ -416,7 +416,9 @@ contains
                 res%message = "bad input: y0 is empty"
             else if (.not. all(ieee_is_finite(y0))) then
                 res%message = "bad input: y0 contains NaN or Inf"
-            else if (.not. (ieee_is_finite(t0) .and. ieee_is_finite(tf))) then
+            else if (.not. ieee_is_finite(t0) .or. ieee_is_nan(tf) .or. &
+                     (.not. ieee_is_finite(tf) .and. .not. stepping)) then
+                ! (a step-by-step integration may run towards t_bound = +-inf)
                 res%message = "bad input: t_span must be finite"
             else if (.not. opt%max_step > 0.0_dp) then
                 res%message = "bad input: max_step must be positive"
