@@ -40,13 +40,16 @@ module conmech_variational
     type, extends(ode_system) :: variational_system
         class(ode_system), allocatable :: base   !! the underlying system
         integer :: n = 0                         !! its dimension
+        logical :: product = .false.             !! base has a structure-aware J x
     contains
         procedure :: rhs => var_rhs
     end type variational_system
 
 contains
 
-    !> z' = [f(t, y); vec(J Phi)], f and J from the system's `rhs_jacobian` (one call, so a
+    !> z' = [f(t, y); vec(J Phi)]. A system with `has_jacobian_product` gives f and J Phi
+    !! in one `rhs_jacobian_product` call (J never formed, its structure exploited by the
+    !! system). Otherwise f and J come from the system's `rhs_jacobian` (one call, so a
     !! system may share their common work). No allocation per evaluation for n <= NSMALL:
     !! J lives in a contiguous local array, and Phi, dPhi are passed as explicit-shape
     !! n x n matrices (contiguous column sums). The product is structure-aware for the
@@ -60,6 +63,10 @@ contains
         real(dp), intent(out) :: dydt(:)
         integer :: n
         n = self%n
+        if (self%product) then
+            call var_rhs_product(self%base, n, t, y, dydt)
+            return
+        end if
         select case (n)
         case (2)
             call var_rhs2(self%base, t, y, dydt)
@@ -75,6 +82,15 @@ contains
             end if
         end select
     end subroutine var_rhs
+
+    !> f and J Phi from the system's own product (explicit shapes: contiguous, no copy).
+    subroutine var_rhs_product(base, n, t, y, dydt)
+        class(ode_system), intent(in) :: base
+        integer, intent(in) :: n
+        real(dp), intent(in) :: t, y(n*(n + 1))
+        real(dp), intent(out) :: dydt(n*(n + 1))
+        call base%rhs_jacobian_product(t, n, n, y(1:n), dydt(1:n), y(n + 1:), dydt(n + 1:))
+    end subroutine var_rhs_product
 
     subroutine var_rhs2(base, t, y, dydt)
         integer, parameter :: n = 2
@@ -231,6 +247,7 @@ contains
         if (present(state_only)) only = state_only
         allocate (vs%base, source=sys)
         vs%n = n
+        vs%product = sys%has_jacobian_product()
         opt = options
         if (only .or. allocated(options%atol_vec) .or. allocated(options%rtol_vec)) then
             allocate (opt%atol_vec(nz), opt%rtol_vec(nz))
