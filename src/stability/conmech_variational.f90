@@ -20,7 +20,7 @@ module conmech_variational
     implicit none
     private
 
-    public :: variational_system, integrate_stm
+    public :: variational_system, variational_product_system, integrate_stm
 
     integer, parameter :: NSMALL = 16   !! largest n with J on the stack
     integer(int64), parameter :: ONE_BITS = transfer(1.0_dp, 0_int64)  !! bits of 1.0
@@ -40,16 +40,21 @@ module conmech_variational
     type, extends(ode_system) :: variational_system
         class(ode_system), allocatable :: base   !! the underlying system
         integer :: n = 0                         !! its dimension
-        logical :: product = .false.             !! base has a structure-aware J x
     contains
         procedure :: rhs => var_rhs
     end type variational_system
 
+    !> The same z' through the base system's own `rhs_jacobian_product` (J never formed):
+    !! `integrate_stm` uses it when the system has one. A type of its own, so that its
+    !! `rhs` is a small routine (no test, no frame of the dense kernels).
+    type, extends(variational_system) :: variational_product_system
+    contains
+        procedure :: rhs => var_rhs_product
+    end type variational_product_system
+
 contains
 
-    !> z' = [f(t, y); vec(J Phi)]. A system with `has_jacobian_product` gives f and J Phi
-    !! in one `rhs_jacobian_product` call (J never formed, its structure exploited by the
-    !! system). Otherwise f and J come from the system's `rhs_jacobian` (one call, so a
+    !> z' = [f(t, y); vec(J Phi)], f and J from the system's `rhs_jacobian` (one call, so a
     !! system may share their common work). No allocation per evaluation for n <= NSMALL:
     !! J lives in a contiguous local array, and Phi, dPhi are passed as explicit-shape
     !! n x n matrices (contiguous column sums). The product is structure-aware for the
@@ -63,10 +68,6 @@ contains
         real(dp), intent(out) :: dydt(:)
         integer :: n
         n = self%n
-        if (self%product) then
-            call var_rhs_product(self%base, n, t, y, dydt)
-            return
-        end if
         select case (n)
         case (2)
             call var_rhs2(self%base, t, y, dydt)
@@ -83,14 +84,23 @@ contains
         end select
     end subroutine var_rhs
 
-    !> f and J Phi from the system's own product (explicit shapes: contiguous, no copy).
-    subroutine var_rhs_product(base, n, t, y, dydt)
+    !> z' = [f(t, y); vec(J Phi)] in one call of the system's `rhs_jacobian_product`.
+    subroutine var_rhs_product(self, t, y, dydt)
+        class(variational_product_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        call product_call(self%base, self%n, t, y, dydt)
+    end subroutine var_rhs_product
+
+    !> Explicit shapes: the state and Phi reach the system contiguous, without descriptors.
+    subroutine product_call(base, n, t, y, dydt)
         class(ode_system), intent(in) :: base
         integer, intent(in) :: n
         real(dp), intent(in) :: t, y(n*(n + 1))
         real(dp), intent(out) :: dydt(n*(n + 1))
         call base%rhs_jacobian_product(t, n, n, y(1:n), dydt(1:n), y(n + 1:), dydt(n + 1:))
-    end subroutine var_rhs_product
+    end subroutine product_call
 
     subroutine var_rhs2(base, t, y, dydt)
         integer, parameter :: n = 2
@@ -229,7 +239,7 @@ contains
         character(len=:), allocatable, intent(out), optional :: message
         type(ode_stats), intent(out), optional :: stats
         logical, intent(in), optional :: state_only
-        type(variational_system) :: vs
+        class(variational_system), allocatable :: vs
         type(ode_options) :: opt
         real(dp), allocatable :: z(:)
         character(len=:), allocatable :: msg
@@ -245,9 +255,13 @@ contains
         end if
         only = .false.
         if (present(state_only)) only = state_only
+        if (sys%has_jacobian_product()) then
+            allocate (variational_product_system :: vs)
+        else
+            allocate (variational_system :: vs)
+        end if
         allocate (vs%base, source=sys)
         vs%n = n
-        vs%product = sys%has_jacobian_product()
         opt = options
         if (only .or. allocated(options%atol_vec) .or. allocated(options%rtol_vec)) then
             allocate (opt%atol_vec(nz), opt%rtol_vec(nz))

@@ -128,8 +128,21 @@ contains
         dydt(3) = 2.0_dp*self%m*y(4) + fx
         dydt(4) = -2.0_dp*self%m*y(3) + fy
         call hill_hess_f(self%m, self%kappa, y(1), y(2), fxx, fxy, fyy)
-        call rotating_frame_product(k, fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+        if (n == 4 .and. k == 4) then
+            call hill_stm_product(fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+        else
+            call rotating_frame_product(k, fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+        end if
     end subroutine hill_rhs_jac_prod
+
+    !> J x for the 4 x 4 STM (constant sizes, inline).
+    pure subroutine hill_stm_product(uxx, uxy, uyy, c, x, jx)
+        integer, parameter :: k = 4
+        real(dp), intent(in) :: uxx, uxy, uyy, c, x(4, k)
+        real(dp), intent(out) :: jx(4, k)
+        integer :: j
+        include "conmech_rotating_frame_product.inc"
+    end subroutine hill_stm_product
 
     logical function hill_has_jac(self)
         class(hill_problem), intent(in) :: self

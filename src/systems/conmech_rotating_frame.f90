@@ -8,8 +8,10 @@
 !!         [ Uxy  Uyy -c  0 ],
 !!
 !! so J x copies two rows and folds the constant entries: 6 multiplications and 4
-!! additions per column instead of a dense 4 x 4 product. Written once, used by the
-!! built-ins' `jacobian_product` / `rhs_jacobian_product` and their dense `jacobian`.
+!! additions per column instead of a dense 4 x 4 product. The loop is written once
+!! (conmech_rotating_frame_product.inc): `rotating_frame_product` includes it for any k,
+!! and a built-in's `rhs_jacobian_product` includes it for k = 4 (the STM), where the
+!! compiler unrolls it and no call is made.
 module conmech_rotating_frame
     use conmech_kinds, only: dp
     implicit none
@@ -25,12 +27,7 @@ contains
         real(dp), intent(in) :: x(4, k)
         real(dp), intent(out) :: jx(4, k)
         integer :: j
-        do j = 1, k
-            jx(1, j) = x(3, j)
-            jx(2, j) = x(4, j)
-            jx(3, j) = uxx*x(1, j) + uxy*x(2, j) + c*x(4, j)
-            jx(4, j) = uxy*x(1, j) + uyy*x(2, j) - c*x(3, j)
-        end do
+        include "conmech_rotating_frame_product.inc"
     end subroutine rotating_frame_product
 
     !> The dense 4 x 4 J (same entries).

@@ -231,9 +231,25 @@ contains
         real(dp), intent(in) :: y(n), x(n, k)
         real(dp), intent(out) :: dydt(n), jx(n, k)
         real(dp) :: uxx, uxy, uyy
-        call are_parts(self%mu, y, dydt, uxx, uxy, uyy)
-        call rotating_frame_product(k, uxx, uxy, uyy, 2.0_dp, x, jx)
+        if (n == 4 .and. k == 4) then
+            call are_rhs_stm(self%mu, y, dydt, x, jx)
+        else
+            call are_parts(self%mu, y, dydt, uxx, uxy, uyy)
+            call rotating_frame_product(k, uxx, uxy, uyy, 2.0_dp, x, jx)
+        end if
     end subroutine are_rhs_jac_prod
+
+    !> f and J Phi for the 4 x 4 STM (constant sizes, the product inline).
+    pure subroutine are_rhs_stm(mu, y, dydt, x, jx)
+        integer, parameter :: k = 4
+        real(dp), parameter :: c = 2.0_dp
+        real(dp), intent(in) :: mu, y(4), x(4, k)
+        real(dp), intent(out) :: dydt(4), jx(4, k)
+        real(dp) :: uxx, uxy, uyy
+        integer :: j
+        call are_parts(mu, y, dydt, uxx, uxy, uyy)
+        include "conmech_rotating_frame_product.inc"
+    end subroutine are_rhs_stm
 
     subroutine vdp_rhs(self, t, y, dydt)
         class(van_der_pol), intent(in) :: self
