@@ -27,7 +27,7 @@ module conmech_ode_system
     private
 
     public :: ode_system, ode_function, ode_events, ode_step_hook, rhs_proc, jac_proc
-    public :: ode_fd_jacobian
+    public :: ode_fd_jacobian, ode_jacobian_product
 
     type, abstract :: ode_system
     contains
