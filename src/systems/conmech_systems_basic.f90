@@ -194,10 +194,10 @@ contains
         f(2) = y(4)
         f(3) = y(1) + 2.0_dp*y(4) - mp*x1/d1 - mu*x2/d2
         f(4) = y(2) - 2.0_dp*y(3) - mp*y(2)/d1 - mu*y(2)/d2
-        i13 = 1.0_dp/d1
-        i23 = 1.0_dp/d2
-        i15 = i13/s1
-        i25 = i23/s2
+        i15 = 1.0_dp/(d1*s1)     ! 1/r^5: one division per body, 1/r^3 from it
+        i25 = 1.0_dp/(d2*s2)
+        i13 = i15*s1
+        i23 = i25*s2
         uxx = 1.0_dp - mp*(i13 - 3.0_dp*x1*x1*i15) - mu*(i23 - 3.0_dp*x2*x2*i25)
         uxy = 3.0_dp*y(2)*(mp*x1*i15 + mu*x2*i25)
         uyy = 1.0_dp - mp*(i13 - 3.0_dp*y(2)*y(2)*i15) - mu*(i23 - 3.0_dp*y(2)*y(2)*i25)
