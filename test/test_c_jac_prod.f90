@@ -63,58 +63,65 @@ program test_c_jac_prod
     real(dp), parameter :: y0(4) = [0.994_dp, 0.0_dp, 0.0_dp, &
                                     -2.00158510637908252240537862224_dp]
     type(test_suite) :: ts
-    type(c_ode_system) :: cs
-    type(arenstorf) :: are
-    type(ode_options) :: opt
-    type(ode_stats) :: st1, st2
-    real(dp) :: y(4), x(4, 3), jx(4, 3), ref(4, 3), y1(4), y2(4), p1(4, 4), p2(4, 4)
-    integer :: info, info1, info2, i
-    character(len=:), allocatable :: msg
 
     ts%name = "test_c_jac_prod"
-    call make_c_ode(4, c_funloc(are_c_rhs), c_null_funptr, [are%mu], cs, info, msg)
-    call ts%check(info == CM_SUCCESS .and. .not. cs%has_jacobian_product(), &
-                  "make_c_ode: no product without jac_prod")
-    call set_c_jac_prod(cs, c_funloc(are_c_jac_prod))
-    call ts%check(cs%has_jacobian_product(), "set_c_jac_prod: has_jacobian_product")
-    y = [0.5_dp, 0.3_dp, 0.1_dp, -0.2_dp]
-    x = reshape([(sin(1.3_dp*i), i=1, 12)], [4, 3])
-    call cs%jacobian_product(0.0_dp, 4, 3, y, x, jx)
-    call are%jacobian_product(0.0_dp, 4, 3, y, x, ref)
-    call ts%check_less(maxval(abs(jx - ref))/maxval(abs(ref)), 1.0e-14_dp, &
-                       "C jac_prod = built-in J x")
-
-    opt%method = METHOD_DOP853
-    opt%rtol = 1.0e-10_dp
-    opt%atol = 1.0e-10_dp
-    y1 = y0; y2 = y0
-    p1 = 0.0_dp
-    do i = 1, 4
-        p1(i, i) = 1.0_dp
-    end do
-    p2 = p1
-    call integrate_stm(cs, 0.0_dp, period, y1, p1, opt, info1, stats=st1)
-    call integrate_stm(are, 0.0_dp, period, y2, p2, opt, info2, stats=st2)
-    call ts%check(info1 == CM_SUCCESS .and. info2 == CM_SUCCESS .and. &
-                  st1%nfev == st2%nfev, "integrate_stm through jac_prod: success, same nfev")
-    ! the STM's rounding differs (other formulas), and it is under error control: the steps
-    ! differ at round-off, the results by about the tolerance times the orbit's sensitivity
-    call ts%check_less(maxval(abs(y1 - y2)), 1.0e-8_dp, &
-                       "integrate_stm through jac_prod: the built-in's state")
-    call ts%check_less(maxval(abs(p1 - p2))/maxval(abs(p2)), 1.0e-8_dp, &
-                       "integrate_stm through jac_prod: the built-in's STM")
-
-    ! without the product: the finite-difference Jacobian path, STM to ~1e-6
-    call set_c_jac_prod(cs, c_null_funptr)
-    y1 = y0
-    p1 = 0.0_dp
-    do i = 1, 4
-        p1(i, i) = 1.0_dp
-    end do
-    call integrate_stm(cs, 0.0_dp, period, y1, p1, opt, info1)
-    call ts%check(info1 == CM_SUCCESS .and. .not. cs%has_jacobian_product(), &
-                  "set_c_jac_prod(null): the default path")
-    call ts%check_less(maxval(abs(p1 - p2))/maxval(abs(p2)), 1.0e-4_dp, &
-                       "finite-difference STM near the exact one")
+    call run()    ! locals of a procedure are freed on return (LeakSanitizer)
     call ts%finish()
+
+contains
+
+    subroutine run()
+        type(c_ode_system) :: cs
+        type(arenstorf) :: are
+        type(ode_options) :: opt
+        type(ode_stats) :: st1, st2
+        real(dp) :: y(4), x(4, 3), jx(4, 3), ref(4, 3), y1(4), y2(4), p1(4, 4), p2(4, 4)
+        integer :: info, info1, info2, i
+        character(len=:), allocatable :: msg
+        call make_c_ode(4, c_funloc(are_c_rhs), c_null_funptr, [are%mu], cs, info, msg)
+        call ts%check(info == CM_SUCCESS .and. .not. cs%has_jacobian_product(), &
+                      "make_c_ode: no product without jac_prod")
+        call set_c_jac_prod(cs, c_funloc(are_c_jac_prod))
+        call ts%check(cs%has_jacobian_product(), "set_c_jac_prod: has_jacobian_product")
+        y = [0.5_dp, 0.3_dp, 0.1_dp, -0.2_dp]
+        x = reshape([(sin(1.3_dp*i), i=1, 12)], [4, 3])
+        call cs%jacobian_product(0.0_dp, 4, 3, y, x, jx)
+        call are%jacobian_product(0.0_dp, 4, 3, y, x, ref)
+        call ts%check_less(maxval(abs(jx - ref))/maxval(abs(ref)), 1.0e-14_dp, &
+                           "C jac_prod = built-in J x")
+
+        opt%method = METHOD_DOP853
+        opt%rtol = 1.0e-10_dp
+        opt%atol = 1.0e-10_dp
+        y1 = y0; y2 = y0
+        p1 = 0.0_dp
+        do i = 1, 4
+            p1(i, i) = 1.0_dp
+        end do
+        p2 = p1
+        call integrate_stm(cs, 0.0_dp, period, y1, p1, opt, info1, stats=st1)
+        call integrate_stm(are, 0.0_dp, period, y2, p2, opt, info2, stats=st2)
+        call ts%check(info1 == CM_SUCCESS .and. info2 == CM_SUCCESS .and. &
+                      st1%nfev == st2%nfev, "integrate_stm through jac_prod: success, same nfev")
+        ! the STM's rounding differs (other formulas), and it is under error control: the steps
+        ! differ at round-off, the results by about the tolerance times the orbit's sensitivity
+        call ts%check_less(maxval(abs(y1 - y2)), 1.0e-8_dp, &
+                           "integrate_stm through jac_prod: the built-in's state")
+        call ts%check_less(maxval(abs(p1 - p2))/maxval(abs(p2)), 1.0e-8_dp, &
+                           "integrate_stm through jac_prod: the built-in's STM")
+
+        ! without the product: the finite-difference Jacobian path, STM to ~1e-6
+        call set_c_jac_prod(cs, c_null_funptr)
+        y1 = y0
+        p1 = 0.0_dp
+        do i = 1, 4
+            p1(i, i) = 1.0_dp
+        end do
+        call integrate_stm(cs, 0.0_dp, period, y1, p1, opt, info1)
+        call ts%check(info1 == CM_SUCCESS .and. .not. cs%has_jacobian_product(), &
+                      "set_c_jac_prod(null): the default path")
+        call ts%check_less(maxval(abs(p1 - p2))/maxval(abs(p2)), 1.0e-4_dp, &
+                           "finite-difference STM near the exact one")
+    end subroutine run
+
 end program test_c_jac_prod
