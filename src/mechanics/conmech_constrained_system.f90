@@ -189,7 +189,8 @@ module conmech_constrained_system
             real(dp), intent(out) :: ab(:, :), b(:)
             integer, intent(out) :: first(:)
         end subroutine cs_nh_matrix_band
-        !> Keep M^-1 in band form when it is banded (mm: the Cholesky factor of M).
+        !> Keep M^-1 in band form when it is banded and every constraint row has a declared
+        !! window (mm: the Cholesky factor of M).
         module subroutine keep_mass_inverse(sys, mm)
             class(constrained_system), intent(inout) :: sys
             real(dp), intent(in) :: mm(:, :)

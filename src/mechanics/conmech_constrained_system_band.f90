@@ -83,6 +83,10 @@ contains
         real(dp), allocatable :: x(:, :)
         integer :: n, i, j, bm, lainfo
         n = sys%n
+        ! only where the banded path can use it (every row with a declared window)
+        if (sys%n_hol > 0 .and. sys%jac_width <= 0) return
+        if (sys%n_nh > 0 .and. sys%nh_width <= 0) return
+        if (sys%n_hol + sys%n_nh == 0) return
         allocate (x(n, n))
         x = 0.0_dp
         do i = 1, n

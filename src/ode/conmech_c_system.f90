@@ -6,22 +6,27 @@
 !!
 !!     void rhs(double t, const double *y, double *dydt, const double *p);   /* n     */
 !!     void jac(double t, const double *y, double *dfdy, const double *p);   /* n x n */
+!!     /* optional: jx = J(t, y) x for an n x k block x (column-major) */
+!!     void jac_prod(double t, const double *y, int k, const double *x, double *jx,
+!!                   const double *p);
 !!
 !! `c_ode_system` holds the function pointers and the parameters; it is an `ode_system`,
 !! so every integrator and every stability routine runs on it with no Python in the loop.
-!! Without `jac` the finite-difference default of `ode_system` is used. A Fortran user
-!! builds one from `c_funloc` of bind(C) procedures with `make_c_ode`.
+!! Without `jac` the finite-difference default of `ode_system` is used. With `jac_prod`
+!! (set by `set_c_jac_prod`) the system has a Jacobian product: `integrate_stm` calls it
+!! for J Phi instead of forming J (a generated product can fold J's constant entries).
+!! A Fortran user builds one from `c_funloc` of bind(C) procedures with `make_c_ode`.
 module conmech_c_system
-    use, intrinsic :: iso_c_binding, only: c_double, c_funptr, c_associated, &
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_funptr, c_associated, &
                                            c_f_procpointer
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
-    use conmech_ode_system, only: ode_system, ode_fd_jacobian
+    use conmech_ode_system, only: ode_system, ode_fd_jacobian, ode_jacobian_product
     implicit none
     private
 
-    public :: c_ode_system, make_c_ode
-    public :: c_rhs_fn, c_jac_fn
+    public :: c_ode_system, make_c_ode, set_c_jac_prod
+    public :: c_rhs_fn, c_jac_fn, c_jac_prod_fn
 
     abstract interface
         !> dydt = f(t, y; p), the C right-hand side.
@@ -40,6 +45,16 @@ module conmech_c_system
             real(c_double), intent(out) :: dfdy(*)
             real(c_double), intent(in) :: p(*)
         end subroutine c_jac_fn
+        !> jx = J(t, y) x (n x k, column-major), the C Jacobian product.
+        subroutine c_jac_prod_fn(t, y, k, x, jx, p) bind(c)
+            import :: c_double, c_int
+            real(c_double), value :: t
+            real(c_double), intent(in) :: y(*)
+            integer(c_int), value :: k
+            real(c_double), intent(in) :: x(*)
+            real(c_double), intent(out) :: jx(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_jac_prod_fn
     end interface
 
     !> A system y' = f(t, y; p) whose f (and optionally df/dy) are compiled C functions.
@@ -48,10 +63,13 @@ module conmech_c_system
         real(dp), allocatable :: p(:)                      !! parameters (at least 1 entry)
         procedure(c_rhs_fn), pointer, nopass :: f => null()
         procedure(c_jac_fn), pointer, nopass :: jac => null()
+        procedure(c_jac_prod_fn), pointer, nopass :: jp => null()
     contains
         procedure :: rhs => c_ode_rhs
         procedure :: jacobian => c_ode_jacobian
         procedure :: has_jacobian => c_ode_has_jacobian
+        procedure :: jacobian_product => c_ode_jacobian_product
+        procedure :: has_jacobian_product => c_ode_has_jacobian_product
     end type c_ode_system
 
 contains
@@ -85,6 +103,17 @@ contains
         msg = "success"
     end subroutine make_c_ode
 
+    !> Give a `c_ode_system` the C Jacobian product `jac_prod` (c_null_funptr removes it).
+    subroutine set_c_jac_prod(sys, jac_prod)
+        type(c_ode_system), intent(inout) :: sys
+        type(c_funptr), intent(in) :: jac_prod
+        if (c_associated(jac_prod)) then
+            call c_f_procpointer(jac_prod, sys%jp)
+        else
+            sys%jp => null()
+        end if
+    end subroutine set_c_jac_prod
+
     subroutine c_ode_rhs(self, t, y, dydt)
         class(c_ode_system), intent(in) :: self
         real(dp), intent(in) :: t
@@ -109,5 +138,24 @@ contains
         class(c_ode_system), intent(in) :: self
         c_ode_has_jacobian = associated(self%jac)
     end function c_ode_has_jacobian
+
+    !> jx = J x through the C `jac_prod`, else the default (J formed, then multiplied).
+    subroutine c_ode_jacobian_product(self, t, n, k, y, x, jx)
+        class(c_ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: jx(n, k)
+        if (associated(self%jp)) then
+            call self%jp(t, y, int(k, c_int), x, jx, self%p)
+        else
+            call ode_jacobian_product(self, t, n, k, y, x, jx)
+        end if
+    end subroutine c_ode_jacobian_product
+
+    logical function c_ode_has_jacobian_product(self)
+        class(c_ode_system), intent(in) :: self
+        c_ode_has_jacobian_product = associated(self%jp)
+    end function c_ode_has_jacobian_product
 
 end module conmech_c_system

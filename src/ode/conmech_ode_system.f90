@@ -8,6 +8,13 @@
 !! `rhs_jacobian` gives both at once (used by the variational equations); its default calls
 !! `rhs` and `jacobian`, a system may override it to share their common work.
 !!
+!! `jacobian_product` gives jx = J(t, y) x for an n x k block x (explicit shapes, so the
+!! arrays are contiguous and passed without descriptors), `rhs_jacobian_product` gives f
+!! and J x at once. Their defaults form the dense J (`jacobian`) and multiply; a system
+!! that knows J's structure (constant entries, zero blocks) overrides both and
+!! `has_jacobian_product` (default .false.): `integrate_stm` then evaluates
+!! z' = [f; J Phi] through one `rhs_jacobian_product` call, never forming J.
+!!
 !! For simple use, `ode_function` wraps a plain procedure `f(t, y, dydt)` (and optionally
 !! `jac(t, y, dfdy)`) without a derived type of one's own.
 !!
@@ -20,7 +27,7 @@ module conmech_ode_system
     private
 
     public :: ode_system, ode_function, ode_events, ode_step_hook, rhs_proc, jac_proc
-    public :: ode_fd_jacobian
+    public :: ode_fd_jacobian, ode_jacobian_product
 
     type, abstract :: ode_system
     contains
@@ -28,6 +35,9 @@ module conmech_ode_system
         procedure :: jacobian => ode_fd_jacobian
         procedure :: has_jacobian => ode_no_jacobian
         procedure :: rhs_jacobian => ode_rhs_jacobian
+        procedure :: has_jacobian_product => ode_no_jacobian_product
+        procedure :: jacobian_product => ode_jacobian_product
+        procedure :: rhs_jacobian_product => ode_rhs_jacobian_product
     end type ode_system
 
     abstract interface
@@ -139,6 +149,42 @@ contains
         call self%rhs(t, y, dydt)
         call self%jacobian(t, y, dfdy)
     end subroutine ode_rhs_jacobian
+
+    !> jx = J(t, y) x for an n x k block x (default: the dense J from `jacobian`, times x).
+    subroutine ode_jacobian_product(self, t, n, k, y, x, jx)
+        class(ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: jx(n, k)
+        real(dp), allocatable :: jac(:, :)
+        integer :: j, l
+        allocate (jac(n, n))
+        call self%jacobian(t, y, jac)
+        do j = 1, k
+            jx(:, j) = 0.0_dp
+            do l = 1, n
+                jx(:, j) = jx(:, j) + jac(:, l)*x(l, j)
+            end do
+        end do
+    end subroutine ode_jacobian_product
+
+    !> f(t, y) and jx = J(t, y) x at one point (default: `rhs`, then `jacobian_product`).
+    subroutine ode_rhs_jacobian_product(self, t, n, k, y, dydt, x, jx)
+        class(ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: dydt(n), jx(n, k)
+        call self%rhs(t, y, dydt)
+        call self%jacobian_product(t, n, k, y, x, jx)
+    end subroutine ode_rhs_jacobian_product
+
+    !> Default: no structure-aware product (`integrate_stm` forms J and multiplies).
+    logical function ode_no_jacobian_product(self)
+        class(ode_system), intent(in) :: self
+        ode_no_jacobian_product = .false.
+    end function ode_no_jacobian_product
 
     logical function ode_no_jacobian(self)
         class(ode_system), intent(in) :: self

@@ -20,7 +20,7 @@ module conmech_variational
     implicit none
     private
 
-    public :: variational_system, integrate_stm
+    public :: variational_system, variational_product_system, integrate_stm
 
     integer, parameter :: NSMALL = 16   !! largest n with J on the stack
     integer(int64), parameter :: ONE_BITS = transfer(1.0_dp, 0_int64)  !! bits of 1.0
@@ -43,6 +43,14 @@ module conmech_variational
     contains
         procedure :: rhs => var_rhs
     end type variational_system
+
+    !> The same z' through the base system's own `rhs_jacobian_product` (J never formed):
+    !! `integrate_stm` uses it when the system has one. A type of its own, so that its
+    !! `rhs` is a small routine (no test, no frame of the dense kernels).
+    type, extends(variational_system) :: variational_product_system
+    contains
+        procedure :: rhs => var_rhs_product
+    end type variational_product_system
 
 contains
 
@@ -75,6 +83,24 @@ contains
             end if
         end select
     end subroutine var_rhs
+
+    !> z' = [f(t, y); vec(J Phi)] in one call of the system's `rhs_jacobian_product`.
+    subroutine var_rhs_product(self, t, y, dydt)
+        class(variational_product_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        call product_call(self%base, self%n, t, y, dydt)
+    end subroutine var_rhs_product
+
+    !> Explicit shapes: the state and Phi reach the system contiguous, without descriptors.
+    subroutine product_call(base, n, t, y, dydt)
+        class(ode_system), intent(in) :: base
+        integer, intent(in) :: n
+        real(dp), intent(in) :: t, y(n*(n + 1))
+        real(dp), intent(out) :: dydt(n*(n + 1))
+        call base%rhs_jacobian_product(t, n, n, y(1:n), dydt(1:n), y(n + 1:), dydt(n + 1:))
+    end subroutine product_call
 
     subroutine var_rhs2(base, t, y, dydt)
         integer, parameter :: n = 2
@@ -213,7 +239,7 @@ contains
         character(len=:), allocatable, intent(out), optional :: message
         type(ode_stats), intent(out), optional :: stats
         logical, intent(in), optional :: state_only
-        type(variational_system) :: vs
+        class(variational_system), allocatable :: vs
         type(ode_options) :: opt
         real(dp), allocatable :: z(:)
         character(len=:), allocatable :: msg
@@ -229,6 +255,11 @@ contains
         end if
         only = .false.
         if (present(state_only)) only = state_only
+        if (sys%has_jacobian_product()) then
+            allocate (variational_product_system :: vs)
+        else
+            allocate (variational_system :: vs)
+        end if
         allocate (vs%base, source=sys)
         vs%n = n
         opt = options

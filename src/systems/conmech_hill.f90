@@ -8,6 +8,7 @@
 module conmech_hill
     use conmech_kinds, only: dp
     use conmech_ode_system, only: ode_system
+    use conmech_rotating_frame, only: rotating_frame_product
     implicit none
     private
     public :: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f, hill_equilibrium_x
@@ -19,6 +20,9 @@ module conmech_hill
         procedure :: rhs => hill_rhs
         procedure :: jacobian => hill_jac
         procedure :: has_jacobian => hill_has_jac
+        procedure :: has_jacobian_product => hill_has_jac
+        procedure :: jacobian_product => hill_jac_prod
+        procedure :: rhs_jacobian_product => hill_rhs_jac_prod
         procedure :: jacobi => hill_jacobi_tbp
     end type hill_problem
 
@@ -97,6 +101,48 @@ contains
         dfdy(3, 4) = 2.0_dp*self%m
         dfdy(4, 3) = -2.0_dp*self%m
     end subroutine hill_jac
+
+    !> jx = J x for a 4 x k block (two rows copied, constant entries folded).
+    subroutine hill_jac_prod(self, t, n, k, y, x, jx)
+        class(hill_problem), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: jx(n, k)
+        real(dp) :: fxx, fxy, fyy
+        call hill_hess_f(self%m, self%kappa, y(1), y(2), fxx, fxy, fyy)
+        call rotating_frame_product(k, fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+    end subroutine hill_jac_prod
+
+    !> f (as `hill_rhs`) and J x together.
+    subroutine hill_rhs_jac_prod(self, t, n, k, y, dydt, x, jx)
+        class(hill_problem), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: dydt(n), jx(n, k)
+        real(dp) :: fx, fy, fxx, fxy, fyy
+        call hill_grad_f(self%m, self%kappa, y(1), y(2), fx, fy)
+        dydt(1) = y(3)
+        dydt(2) = y(4)
+        dydt(3) = 2.0_dp*self%m*y(4) + fx
+        dydt(4) = -2.0_dp*self%m*y(3) + fy
+        call hill_hess_f(self%m, self%kappa, y(1), y(2), fxx, fxy, fyy)
+        if (n == 4 .and. k == 4) then
+            call hill_stm_product(fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+        else
+            call rotating_frame_product(k, fxx, fxy, fyy, 2.0_dp*self%m, x, jx)
+        end if
+    end subroutine hill_rhs_jac_prod
+
+    !> J x for the 4 x 4 STM (constant sizes, inline).
+    pure subroutine hill_stm_product(uxx, uxy, uyy, c, x, jx)
+        integer, parameter :: k = 4
+        real(dp), intent(in) :: uxx, uxy, uyy, c, x(4, k)
+        real(dp), intent(out) :: jx(4, k)
+        integer :: j
+        include "conmech_rotating_frame_product.inc"
+    end subroutine hill_stm_product
 
     logical function hill_has_jac(self)
         class(hill_problem), intent(in) :: self

@@ -1,9 +1,10 @@
 !> An N-trailer: the scaling test of constrained systems with Pfaffian constraints.
 !!
 !! N points in the plane, q = [x1, y1, ..., xN, yN], mass m each; the first is pulled by
-!! a rotating force f (cos w t, sin w t) (the train winds along a curve); rods of length l join consecutive points (N - 1 holonomic
-!! constraints phi_i = (|p_i - p_{i-1}|^2 - l^2)/2, i = 2..N) and each point i >= 2 rides
-!! on a knife edge along its rod: perp(p_i - p_{i-1}) . v_i = 0 (N - 1 Pfaffian
+!! a rotating force f (cos w t, sin w t) (the train winds along a curve); rods of length
+!! l join consecutive points (N - 1 holonomic constraints
+!! phi_i = (|p_i - p_{i-1}|^2 - l^2)/2, i = 2..N) and each point i >= 2 rides on a knife
+!! edge along its rod: perp(p_i - p_{i-1}) . v_i = 0 (N - 1 Pfaffian
 !! constraints, b = 0). Row i of G has its nonzeros in the columns 2i-3 .. 2i (width 4),
 !! row i of A in 2i-1 .. 2i (width 2): the system declares `diagonal_mass`, `jac_width`
 !! = 4 and `nh_width` = 2, the rows of G and A interleave along the chain, and the
