@@ -121,7 +121,7 @@ def cmd_plot(a):
                   f"| {float(d[key + '_seconds']):.0f} | {mx[0]:.2e} | {mx[-1]:.2e} | "
                   f"p = {p:.2f} | {d[key + '_res_pos'].max():.1e} | "
                   f"{d[key + '_res_vel'].max():.1e} |")
-        ax.set_title(name, fontsize=9)
+        ax.set_title(f"{name}, {float(d['periods']):.0e} periods", fontsize=9)
         ax.set_xlabel("t")
         ax.set_ylabel("|E(t) - E(0)|")
         ax.legend(fontsize=8)
