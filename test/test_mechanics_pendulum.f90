@@ -205,6 +205,36 @@ program test_mechanics_pendulum
         call ts%check_less(worst, 1.0e-13_dp, "hook: residuals at the steps")
     end block
 
+    ! constrained_solve with events: x = 0 at T/4 (falling) and 3T/4 (rising); direction -1
+    ! and terminal: the run ends at the projected event state T/4
+    block
+        type(bottom_crossing) :: ev
+        real(dp) :: rp, rv
+        ev%direction = [0]
+        ev%terminal = [.false.]
+        call constrained_solve(cs, [0.0_dp, period], [l*sin(th0), -l*cos(th0)], &
+                               [0.0_dp, 0.0_dp], copt, cr2, events=ev)
+        call ts%check(cr2%success .and. cr2%nev == 2, "solve: two events per period")
+        if (cr2%nev == 2) then
+            call ts%check_less(maxval(abs(cr2%ev_t - [0.25_dp, 0.75_dp]*period)), 1.0e-10_dp, &
+                               "solve: events at T/4, 3T/4")
+            call constraint_residuals(cs, cr2%ev_t(2), cr2%ev_q(:, 2), cr2%ev_v(:, 2), rp, rv)
+            call ts%check_less(max(rp, rv), 5.0e-14_dp, "solve: event state projected")
+        end if
+        ev%direction = [-1]
+        ev%terminal = [.true.]
+        call constrained_solve(cs, [0.0_dp, period], [l*sin(th0), -l*cos(th0)], &
+                               [0.0_dp, 0.0_dp], copt, cr2, events=ev)
+        call ts%check(cr2%status == CM_EVENT_STOP .and. cr2%nev == 1 .and. cr2%nt > 1, &
+                      "solve: terminal event, "//cr2%message)
+        if (cr2%nev == 1 .and. cr2%nt > 1) then
+            call ts%check(cr2%t(cr2%nt) == cr2%ev_t(1) .and. all(cr2%q(:, cr2%nt) == &
+                          cr2%ev_q(:, 1)), "solve: the run ends at the event state")
+            call ts%check_less(max(cr2%res_pos(cr2%nt), cr2%res_vel(cr2%nt)), 1.0e-14_dp, &
+                               "solve: final state on the constraints")
+        end if
+    end block
+
     ! ---------------------------------------------------------------- redundant constraints
     block
         type(pendulum_twice) :: tw

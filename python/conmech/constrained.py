@@ -256,10 +256,14 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
     proj_tol, proj_max_iter :
         Position projection: target max |phi| and simplified Newton iterations.
     events : callable ``event(t, q, v) -> float`` or a list of them, optional
-        RATTLE and Radau only. Zero crossings are located (SciPy's conventions: attributes
-        ``terminal`` (bool) and ``direction``); the result gets ``t_events``,
-        ``q_events``, ``v_events`` (lists per event) and, after a terminal event,
-        ``status`` 1 with the run ending at the event. RATTLE locates a crossing by
+        Zero crossings are located (SciPy's conventions: attributes ``terminal`` (bool)
+        and ``direction``); the result gets ``t_events``, ``q_events``, ``v_events``
+        (lists per event) and, after a terminal event, ``status`` 1 with the run ending
+        at the event (t_eval points after it are dropped). The explicit methods locate a
+        crossing by Brent's method on the dense output of the step, then project the
+        event state like the steps (with "position+velocity" or "velocity"; not with
+        "none" or "baumgarte"): event states on the constraints to ``proj_tol``, the event
+        function zero there to the integration tolerance. RATTLE locates a crossing by
         Brent's method on its side step from the grid point before it (event states on
         the constraints to round-off, event times of the method's order 2); Radau on its
         dense output (to the tolerance).
@@ -348,9 +352,6 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
     from ._ivp import _event_settings
     settings = _event_settings(events)
     ne = len(settings)
-    if ne and method not in ("RATTLE", "Radau", "RADAU5"):
-        raise ValueError(f"events on a constrained system need method 'RATTLE' or 'Radau', "
-                         f"got {method!r}")
     for i, (_, count, _) in enumerate(settings):
         if count > 1:
             raise ValueError(f"events[{i}].terminal: constrained.solve stops at the first "
@@ -370,6 +371,9 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
                 if r is None:
                     raise ValueError(f"events[{i}] returned None; expected a number")
                 g[i] = float(as_result(r, (), f"events[{i}]"))
+                if not np.isfinite(g[i]):
+                    raise ValueError(f"events[{i}] returned {g[i]} at t = {t}; expected a "
+                                     "finite number")
         except Exception as exc:  # kept and re-raised after the Fortran run
             ev_guard.fail(exc)
             return g * np.nan

@@ -12,11 +12,16 @@
 !! Outputs are the accepted steps, or the points of `t_eval`, which the steps hit exactly
 !! (`hit_t_eval`: every output point is a projected point). The initial state is made
 !! consistent first (position then velocity projection; the distances moved are reported).
+!! Events (functions of (t, [q; v])) are located by `ode_solve` on the dense output of the
+!! steps (Brent's method); the located states are then projected like the steps
+!! (position+velocity or velocity; not with "none" or Baumgarte), so event states are on
+!! the constraints to `proj_tol` and the event functions vanish there to the integration
+!! tolerance. A terminal event ends the run at the (projected) event state.
 module conmech_constrained_solver
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system, ode_step_hook
+    use conmech_ode_system, only: ode_system, ode_step_hook, ode_events
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     use conmech_constrained_system
     implicit none
@@ -28,7 +33,7 @@ module conmech_constrained_solver
     integer, parameter, public :: PROJ_BAUMGARTE = 3          !! Baumgarte stabilisation
 
     public :: constrained_ode, constrained_options, constrained_result, projection_hook
-    public :: constrained_solve, consistent_initial, projection_from_name
+    public :: constrained_solve, consistent_initial, projection_from_name, take_events
 
     !> First-order form y = [q, v] of a constrained system (index-1 / Baumgarte).
     !! NaN accelerations when the KKT solve fails (singular mass matrix).
@@ -94,7 +99,7 @@ module conmech_constrained_solver
         integer :: proj_iter_max = 0               !! largest iteration count of one
         real(dp) :: dq0 = 0.0_dp                   !! |q0 moved| by the initial projection
         real(dp) :: dv0 = 0.0_dp                   !! |v0 moved| by the initial projection
-        ! events (RATTLE and Radau; event functions of [q; v])
+        ! events (event functions of [q; v])
         integer :: nev = 0                         !! number of events found
         real(dp), allocatable :: ev_t(:)           !! (nev) event times
         real(dp), allocatable :: ev_q(:, :), ev_v(:, :)  !! (n, nev) states at the events
@@ -148,10 +153,6 @@ contains
         real(dp), intent(inout) :: y(:)
         logical, intent(out) :: changed
         integer, intent(out) :: info
-        real(dp) :: q(self%mech%n), v(self%mech%n)
-        integer :: n, it
-        character(len=:), allocatable :: msg
-        character(len=32) :: buf
         changed = .false.
         info = CM_SUCCESS
         self%since = self%since + 1
@@ -159,6 +160,22 @@ contains
         if (self%projection /= PROJ_VELOCITY .and. &
             self%projection /= PROJ_POSITION_VELOCITY) return
         self%since = 0
+        call project_state(self, t, y, info)
+        changed = info == CM_SUCCESS
+    end subroutine hook_project
+
+    !> Project y = [q, v] at t by the hook's projection (position+velocity or velocity),
+    !! counting the projection and its iterations; y unchanged on failure (message set).
+    subroutine project_state(self, t, y, info)
+        class(projection_hook), intent(inout) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: y(:)
+        integer, intent(out) :: info
+        real(dp) :: q(self%mech%n), v(self%mech%n)
+        integer :: n, it
+        character(len=:), allocatable :: msg
+        character(len=32) :: buf
+        info = CM_SUCCESS
         n = self%mech%n
         q = y(1:n)
         v = y(n + 1:2*n)
@@ -177,8 +194,22 @@ contains
         self%nproj = self%nproj + 1
         y(1:n) = q
         y(n + 1:2*n) = v
-        changed = .true.
-    end subroutine hook_project
+    end subroutine project_state
+
+    !> Copy the events of a core result (states y = [q, v, ...]) into `res`.
+    subroutine take_events(ores, n, res)
+        type(ode_result), intent(in) :: ores
+        integer, intent(in) :: n
+        type(constrained_result), intent(inout) :: res
+        integer :: k
+        k = ores%nev
+        res%nev = k
+        if (k == 0) return
+        res%ev_t = ores%ev_t(1:k)
+        res%ev_q = ores%ev_y(1:n, 1:k)
+        res%ev_v = ores%ev_y(n + 1:2*n, 1:k)
+        res%ev_id = ores%ev_id(1:k)
+    end subroutine take_events
 
     !> Make (q, v) consistent at t: position projection (if holonomic constraints) then
     !! velocity projection. dq, dv: Euclidean distances moved.
@@ -217,13 +248,15 @@ contains
     !! `projection_hook` and `hit_t_eval`: the steps land on the t_eval points, so every
     !! output is a projected step end, and the diagnostics (multipliers, reactions,
     !! residuals, energy, reaction power) are evaluated there.
-    subroutine constrained_solve(sys, t_span, q0, v0, options, res, t_eval)
+    subroutine constrained_solve(sys, t_span, q0, v0, options, res, t_eval, events)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: q0(:), v0(:)
         type(constrained_options), intent(in) :: options
         type(constrained_result), intent(out) :: res
         real(dp), intent(in), optional :: t_eval(:)
+        !> event functions of (t, [q; v]) (see the module documentation)
+        class(ode_events), intent(in), optional :: events
 
         type(constrained_ode) :: f
         type(projection_hook) :: hk
@@ -300,13 +333,11 @@ contains
         opt%hit_t_eval = .true.
         opt%dense_output = .false.
         opt%save_steps = options%save_steps
-        if (present(t_eval)) then
-            call ode_solve(f, t_span, [q, v], opt, ores, t_eval=t_eval, hook=hk)
-        else
-            call ode_solve(f, t_span, [q, v], opt, ores, hook=hk)
-        end if
+        call ode_solve(f, t_span, [q, v], opt, ores, t_eval=t_eval, events=events, hook=hk)
         res%status = ores%status
         res%message = ores%message
+        if (ores%nev > 0) call project_events()
+        call take_events(ores, n, res)
         if (ores%status == CM_NONFINITE) res%message = ores%message// &
             " (a singular mass matrix or KKT system gives NaN accelerations)"
         res%nfev = ores%stats%nfev
@@ -324,6 +355,25 @@ contains
         res%success = res%status >= 0
 
     contains
+
+        !> Project the located event states (and the final state of a terminal stop, the
+        !! dense-output state at the last event) like the steps.
+        subroutine project_events()
+            integer :: k, inf2
+            if (options%projection /= PROJ_VELOCITY .and. &
+                options%projection /= PROJ_POSITION_VELOCITY) return
+            do k = 1, ores%nev
+                call project_state(hk, ores%ev_t(k), ores%ev_y(:, k), inf2)
+                if (inf2 /= CM_SUCCESS .and. res%status >= 0) then
+                    res%status = inf2
+                    res%message = "event state: "//hk%message
+                end if
+            end do
+            if (ores%status == CM_EVENT_STOP .and. ores%nt > 0) then
+                if (ores%t(ores%nt) == ores%ev_t(ores%nev)) &
+                    ores%y(:, ores%nt) = ores%ev_y(:, ores%nev)
+            end if
+        end subroutine project_events
 
         subroutine fail(code, text)
             integer, intent(in) :: code

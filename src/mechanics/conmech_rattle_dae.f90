@@ -27,7 +27,7 @@ module conmech_rattle_dae
     use conmech_constrained_system, only: constrained_system, constrained_accel, &
         constraint_matrix, constraint_residuals
     use conmech_constrained_solver, only: constrained_options, constrained_result, &
-        consistent_initial
+        consistent_initial, take_events
     implicit none
     private
 
@@ -170,13 +170,7 @@ contains
         else
             call radau_solve(f, t_span, y0, opt, ores, t_eval=t_eval, mass=mass, index2=idx2)
         end if
-        res%nev = ores%nev
-        if (ores%nev > 0) then
-            res%ev_t = ores%ev_t(1:ores%nev)
-            res%ev_q = ores%ev_y(1:n, 1:ores%nev)
-            res%ev_v = ores%ev_y(n + 1:2*n, 1:ores%nev)
-            res%ev_id = ores%ev_id(1:ores%nev)
-        end if
+        call take_events(ores, n, res)
         res%status = ores%status
         res%message = ores%message
         res%nfev = ores%stats%nfev

@@ -21,6 +21,7 @@ module conmech_flat_mech_support
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_ode_solver, only: METHOD_RATTLE, METHOD_RADAU5
+    use conmech_ode_system, only: ode_events
     use conmech_rattle, only: rattle_solve
     use conmech_rattle_dae, only: radau_constrained_solve
     use conmech_flat_ode_support, only: copy_message, callback_events
@@ -141,7 +142,7 @@ contains
     !! [projection, every, proj_max_iter, max_steps]; ropt(1:5) = [first_step, max_step,
     !! alpha, beta, proj_tol]. stats(1:7) = [nfev, naccept, nreject, nproj, proj_iter, rank,
     !! proj_iter_max];
-    !! moved(1:2) = [dq0, dv0]. Optional events (RATTLE and Radau only): ne functions of
+    !! moved(1:2) = [dq0, dv0]. Optional events (every method): ne functions of
     !! (t, [q; v]) by events(t, y, g, 2n, ne), ev_dir (+1, -1, 0), ev_term (/= 0:
     !! terminal); the events found go to evstore(ev_t, ev_q, ev_v, ev_id, n, nev).
     subroutine run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, &
@@ -194,47 +195,14 @@ contains
         nev_fun = 0
         if (present(ne)) nev_fun = ne
         if (nev_fun > 0) then
-            if (method /= METHOD_RADAU5 .and. method /= METHOD_RATTLE) then
-                info = CM_BAD_INPUT
-                call copy_message("bad input: events on a constrained system need method " &
-                                  //"RATTLE or Radau", message)
-                return
-            end if
             ev%g => events
             ev%n = 2*n
             ev%ne = nev_fun
             ev%direction = ev_dir(1:nev_fun)
             ev%terminal = ev_term(1:nev_fun) /= 0
-            if (method == METHOD_RADAU5) then
-                if (neval > 0) then
-                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, &
-                                                 t_eval(1:neval), events=ev)
-                else
-                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, events=ev)
-                end if
-            else
-                if (neval > 0) then
-                    call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), events=ev)
-                else
-                    call rattle_solve(sys, t_span, q0, v0, opt, r, events=ev)
-                end if
-            end if
-        else if (method == METHOD_RADAU5) then
-            if (neval > 0) then
-                call radau_constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
-            else
-                call radau_constrained_solve(sys, t_span, q0, v0, opt, r)
-            end if
-        else if (method == METHOD_RATTLE) then
-            if (neval > 0) then
-                call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
-            else
-                call rattle_solve(sys, t_span, q0, v0, opt, r)
-            end if
-        else if (neval > 0) then
-            call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval))
+            call dispatch(ev)
         else
-            call constrained_solve(sys, t_span, q0, v0, opt, r)
+            call dispatch()
         end if
         info = r%status
         call copy_message(r%message, message)
@@ -251,6 +219,33 @@ contains
                                r%energy, r%power, nn, mm, nt)
         if (nev_fun > 0 .and. r%nev > 0) call evstore(r%ev_t, r%ev_q, r%ev_v, r%ev_id, nn, &
                                                       int(r%nev, c_int))
+
+    contains
+
+        !> The solver of `method`, with t_eval if given and the events if present.
+        subroutine dispatch(evs)
+            class(ode_events), intent(in), optional :: evs
+            if (method == METHOD_RADAU5) then
+                if (neval > 0) then
+                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, &
+                                                 t_eval(1:neval), events=evs)
+                else
+                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, events=evs)
+                end if
+            else if (method == METHOD_RATTLE) then
+                if (neval > 0) then
+                    call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), events=evs)
+                else
+                    call rattle_solve(sys, t_span, q0, v0, opt, r, events=evs)
+                end if
+            else if (neval > 0) then
+                call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), &
+                                       events=evs)
+            else
+                call constrained_solve(sys, t_span, q0, v0, opt, r, events=evs)
+            end if
+        end subroutine dispatch
+
     end subroutine run_constrained
 
 end module conmech_flat_mech_support
