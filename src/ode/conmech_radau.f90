@@ -38,6 +38,11 @@
 !!   the initial step is then 1e-6 unless given. The constrained layer uses it through
 !!   conmech_rattle_dae (the stabilised index-2 formulation).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
+!! This module holds the driver (input checks, set-up, the step loop, the outputs); the
+!! parts: conmech_radau_coefficients (constants), conmech_radau_state (the state type and
+!! its packing for the step-by-step use), conmech_radau_newton (Jacobian, LU, Newton),
+!! conmech_radau_control (initial step, error estimate, step-size control),
+!! conmech_radau_collocation (the collocation polynomial), conmech_radau_common (outputs).
 module conmech_radau
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use conmech_kinds, only: dp

@@ -26,8 +26,8 @@ contains
     !! stage increments z1, z2, z3.
     pure subroutine radau_collocation_update(pmat, y, z1, z2, z3, fc)
         real(dp), intent(in) :: pmat(3, 3)
-        real(dp), intent(in) :: y(:), z1(:), z2(:), z3(:)
-        real(dp), intent(inout) :: fc(:, 0:)
+        real(dp), contiguous, intent(in) :: y(:), z1(:), z2(:), z3(:)
+        real(dp), contiguous, intent(inout) :: fc(:, 0:)
         integer :: j
         fc(:, 0) = y
         do j = 1, 3
@@ -38,10 +38,10 @@ contains
     !> Starting stage increments of the next step (ratio = h_new/h_old): u(xi) - u(1) at
     !! xi = 1 + c_i ratio, the previous polynomial extrapolated.
     pure subroutine radau_extrapolate(fc, cvec, ratio, z1, z2, z3)
-        real(dp), intent(in) :: fc(:, 0:)
+        real(dp), contiguous, intent(in) :: fc(:, 0:)
         real(dp), intent(in) :: cvec(3)
         real(dp), intent(in) :: ratio
-        real(dp), intent(inout) :: z1(:), z2(:), z3(:)
+        real(dp), contiguous, intent(inout) :: z1(:), z2(:), z3(:)
         real(dp) :: xi
         xi = 1.0_dp + cvec(1)*ratio
         z1 = fc(:, 1)*(xi - 1.0_dp) + fc(:, 2)*(xi**2 - 1.0_dp) + fc(:, 3)*(xi**3 - 1.0_dp)
