@@ -1,6 +1,6 @@
 !> Radau IIA step by step (SciPy's OdeSolver use; conmech.Radau in Python): a
 !! `radau_stepper` holds the whole state of a `radau_solve` integration in plain arrays
-!! (layout: conmech_radau, RADAU_NR, RADAU_NI, RADAU_NW), `radau_stepper_init` starts at
+!! (layout: conmech_radau_state, RADAU_NR, RADAU_NI, RADAU_NW), `radau_stepper_init` starts at
 !! (t0, y0), each `radau_stepper_step` makes one accepted step: the steps of `radau_solve`,
 !! bit for bit. No state outside the object (thread-safe for distinct objects).
 module conmech_radau_stepper
