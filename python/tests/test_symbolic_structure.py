@@ -165,3 +165,17 @@ def test_time_dependent_mass_and_gyroscopic_terms_match_the_expanded_form():
         assert np.max(np.abs(mod.call("forces", tt, qq, vv) - Q)) < 1e-13*np.max(np.abs(Q))
         Rc = mod.call("forces_jac", tt, qq, vv, aa)
         assert np.max(np.abs(Rc - R)) < 1e-13*np.max(np.abs(R))
+
+
+def test_derivation_cache_hit_reads_the_expressions_only_when_used():
+    L, q, params = chain_textbook(5)
+    first = symbolic.lagrangian_system(L, q, params, model_only=True)
+    again = symbolic.lagrangian_system(L, q, params, model_only=True)
+    assert again.times["derive"] == 0.0 and "derived_cache" in again.times
+    d = again.derived
+    assert "_heavy" in d.__dict__ and "M" not in d.__dict__     # not unpickled yet
+    qq, vv = np.linspace(0.1, 0.9, 5), np.linspace(-1, 1, 5)
+    np.testing.assert_array_equal(again.call("forces", 0.0, qq, vv),
+                                  first.call("forces", 0.0, qq, vv))
+    assert d.M == first.derived.M and len(d.struct["dM"]) == 20     # read back on use
+    assert "_heavy" not in d.__dict__
