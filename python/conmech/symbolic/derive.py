@@ -100,12 +100,13 @@ class Derived:
         self.__dict__.update(state)
 
     def __getattr__(self, name):
-        heavy = self.__dict__.get("_heavy")
-        if heavy is None or name.startswith("__"):
-            raise AttributeError(name)
-        del self.__dict__["_heavy"]
-        self.__dict__.update(pickle.loads(heavy))
-        return getattr(self, name)
+        heavy = None if name.startswith("__") else self.__dict__.pop("_heavy", None)
+        if heavy is not None:
+            self.__dict__.update(pickle.loads(heavy))
+        try:
+            return self.__dict__[name]
+        except KeyError:
+            raise AttributeError(name) from None
 
     @property
     def Q(self):
