@@ -134,3 +134,48 @@ def test_trig_split_values_and_no_gain_case():
     # one sum of two terms that appear nowhere else: no gain, unchanged
     same, none = trig_split([sp.cos(a - b)])
     assert none == [] and same == [sp.cos(a - b)]
+
+
+def test_time_dependent_mass_and_gyroscopic_terms_match_the_expanded_form():
+    """M depends on t and q, terms linear in the velocities depend on t and q (a particle in
+    a frame turning at a varying rate, with a pulsating mass and a pendulum on it)."""
+    x, y, th = dynamicsymbols("x y th")
+    m, w, e, g, ln = sp.symbols("m w e g l")
+    mt = m*(1 + e*sp.sin(t))
+    om = w*(1 + e*sp.cos(2*t))
+    vx, vy = x.diff(t) - om*y, y.diff(t) + om*x
+    px, py = x + ln*sp.sin(th), y - ln*sp.cos(th)
+    T = mt*(vx**2 + vy**2)/2 + m*(px.diff(t)**2 + py.diff(t)**2)/2
+    U = m*g*py + (x**2 + y**2)/2
+    params = {m: 1.3, w: 0.7, e: 0.2, g: 9.81, ln: 0.8}
+    d = derive_lagrangian(T - U, [x, y, th], params)
+    assert d.struct is not None and d.struct["QL"][0].has(d.t)
+    mod = symbolic.compile_model(d)
+    args = [d.t] + list(d.coords) + list(d.speeds) + list(d.accels) + list(d.params)
+    fQ = sp.lambdify(args, d.Q, modules="numpy")
+    fR = sp.lambdify(args, d.R, modules="numpy")
+    rng = np.random.default_rng(3)
+    p = np.array(d.param_values)
+    for _ in range(10):
+        tt = rng.uniform(0, 3)
+        qq, vv, aa = rng.uniform(-2, 2, 3), rng.normal(size=3), rng.normal(size=3)
+        vals = [tt, *qq, *vv, *aa, *p]
+        Q = np.ravel(fQ(*vals))
+        R = np.array(fR(*vals), float)
+        assert np.max(np.abs(mod.call("forces", tt, qq, vv) - Q)) < 1e-13*np.max(np.abs(Q))
+        Rc = mod.call("forces_jac", tt, qq, vv, aa)
+        assert np.max(np.abs(Rc - R)) < 1e-13*np.max(np.abs(R))
+
+
+def test_derivation_cache_hit_reads_the_expressions_only_when_used():
+    L, q, params = chain_textbook(5)
+    first = symbolic.lagrangian_system(L, q, params, model_only=True)
+    again = symbolic.lagrangian_system(L, q, params, model_only=True)
+    assert again.times["derive"] == 0.0 and "derived_cache" in again.times
+    d = again.derived
+    assert "_heavy" in d.__dict__ and "M" not in d.__dict__     # not unpickled yet
+    qq, vv = np.linspace(0.1, 0.9, 5), np.linspace(-1, 1, 5)
+    np.testing.assert_array_equal(again.call("forces", 0.0, qq, vv),
+                                  first.call("forces", 0.0, qq, vv))
+    assert d.M == first.derived.M and len(d.struct["dM"]) == 20     # read back on use
+    assert "_heavy" not in d.__dict__

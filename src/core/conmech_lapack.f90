@@ -22,6 +22,7 @@ module conmech_lapack
         module procedure la_finite_1, la_finite_2
     end interface la_finite
     public :: dpotf2, dpstf2   ! unblocked forms: no ilaenv call, fast for tiny matrices
+    public :: dtrsv   ! BLAS triangular solve, one right-hand side
 
     interface
         subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
@@ -145,6 +146,13 @@ module conmech_lapack
 
     ! Unblocked Cholesky factorisations (for the small matrices of mechanical systems).
     interface
+        subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+            import :: dp
+            character(len=1), intent(in) :: uplo, trans, diag
+            integer, intent(in) :: n, lda, incx
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: x(*)
+        end subroutine dtrsv
         subroutine dpotf2(uplo, n, a, lda, info)
             import :: dp
             character(len=1), intent(in) :: uplo

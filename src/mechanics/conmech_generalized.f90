@@ -6,16 +6,19 @@
 !! equations). `energy` is optional (`has_energy` says whether it is defined).
 !!
 !! `generalized_ode` wraps such a system as a first-order `ode_system` with y = [q, q']:
-!! the accelerations come from a Cholesky factorisation of M (LAPACK dpotrf/dpotrs). The
+!! the accelerations come from a Cholesky factorisation of M (LAPACK dpotf2, or dpotrf
+!! above 32 coordinates; solve with two BLAS dtrsv calls: the fastest of the LAPACK/BLAS
+!! forms at small n, see bench/results/symbolic_pydy.md; M of up to 32 coordinates lives on
+!! the stack, so a right-hand side evaluation allocates nothing). The
 !! ODE interface has no status argument, so a mass matrix that is not positive definite
 !! makes the right-hand side NaN (the integrators then stop with CM_NONFINITE);
 !! `generalized_accel` and `generalized_solve` check M first and return CM_SINGULAR with a
 !! message instead.
 module conmech_generalized
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dpotrf, dpotf2, dpotrs, la_finite
+    use conmech_lapack, only: dpotrf, dpotf2, dpotrs, dtrsv, la_finite
     use conmech_ode_system, only: ode_system, ode_events, ode_fd_jacobian
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     implicit none
@@ -23,6 +26,9 @@ module conmech_generalized
 
     public :: generalized_system, generalized_ode, generalized_accel, generalized_solve
     public :: mass_cholesky
+
+    !> Mass matrices up to this order are factorised in a stack buffer (no allocation).
+    integer, parameter :: SMALL_NDOF = 32
 
     !> A system M(t, q) q'' = Q(t, q, q') with `ndof` generalized coordinates.
     type, abstract :: generalized_system
@@ -113,12 +119,16 @@ contains
             if (present(msg)) msg = "bad input: the mass matrix is not square"
             return
         end if
-        if (.not. la_finite(mm)) then
-            info = CM_NONFINITE
-            if (present(msg)) msg = "non-finite entries (NaN or Inf) in the mass matrix"
-            return
+        ! a finite sum means every entry is finite (a NaN or Inf entry makes it NaN or
+        ! Inf); only when it is not (or overflows) are the entries tested one by one
+        if (.not. ieee_is_finite(sum(mm))) then
+            if (.not. la_finite(mm)) then
+                info = CM_NONFINITE
+                if (present(msg)) msg = "non-finite entries (NaN or Inf) in the mass matrix"
+                return
+            end if
         end if
-        if (n <= 32) then
+        if (n <= SMALL_NDOF) then
             call dpotf2('U', n, mm, n, lainfo)   ! unblocked: no ilaenv overhead
         else
             call dpotrf('U', n, mm, n, lainfo)
@@ -152,28 +162,63 @@ contains
         real(dp), intent(out) :: a(:)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out), optional :: msg
-        real(dp) :: mm(mech%ndof, mech%ndof)
-        integer :: n, lainfo
+        real(dp) :: small(SMALL_NDOF*SMALL_NDOF)
+        real(dp), allocatable :: big(:)
         character(len=:), allocatable :: m2
+        integer :: n
         n = mech%ndof
         if (n < 1 .or. size(q) /= n .or. size(v) /= n .or. size(a) /= n) then
             info = CM_BAD_INPUT
             if (present(msg)) msg = "bad input: q, v and a must have ndof elements (ndof >= 1)"
             return
         end if
+        if (n > SMALL_NDOF) allocate (big(n*n))
+        ! (a local string: passing the optional deferred-length msg straight through
+        ! loses its length with gfortran)
+        if (n <= SMALL_NDOF .and. present(msg)) then
+            call accel_in(mech, n, t, q, v, a, small, info, m2)
+        else if (n <= SMALL_NDOF) then
+            call accel_in(mech, n, t, q, v, a, small, info)
+        else if (present(msg)) then
+            call accel_in(mech, n, t, q, v, a, big, info, m2)
+        else
+            call accel_in(mech, n, t, q, v, a, big, info)
+        end if
+        if (present(msg)) msg = m2
+    end subroutine generalized_accel
+
+    !> generalized_accel with the mass matrix in the caller's buffer mm (n x n).
+    subroutine accel_in(mech, n, t, q, v, a, mm, info, msg)
+        class(generalized_system), intent(in) :: mech
+        integer, intent(in) :: n
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:)
+        real(dp), intent(out) :: mm(n, n)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out), optional :: msg
+        character(len=:), allocatable :: m2
         call mech%mass(t, q, mm)
         call mech%forces(t, q, v, a)
         if (present(msg)) then
-            ! (a local string: passing the optional deferred-length msg straight through
-            ! loses its length with gfortran)
             call mass_cholesky(mm, info, m2)
             msg = m2
         else
             call mass_cholesky(mm, info)
         end if
         if (info /= CM_SUCCESS) return
-        call dpotrs('U', n, 1, mm, n, a, n, lainfo)
-    end subroutine generalized_accel
+        call chol_solve1(n, mm, a)
+    end subroutine accel_in
+
+    !> Solve U^T U x = b in place (U from mass_cholesky): two BLAS dtrsv calls, cheaper
+    !! than dpotrs (dtrsm) for one right-hand side.
+    subroutine chol_solve1(n, u, b)
+        integer, intent(in) :: n
+        real(dp), intent(in) :: u(n, n)
+        real(dp), intent(inout) :: b(:)
+        call dtrsv('U', 'T', 'N', n, u, n, b, 1)
+        call dtrsv('U', 'N', 'N', n, u, n, b, 1)
+    end subroutine chol_solve1
 
     subroutine genode_rhs(self, t, y, dydt)
         class(generalized_ode), intent(in) :: self
@@ -213,7 +258,7 @@ contains
             dfdy(n + 1:2*n, :) = ieee_value(1.0_dp, ieee_quiet_nan)
             return
         end if
-        call dpotrs('U', n, 1, mm, n, a, n, info)
+        call chol_solve1(n, mm, a)
         call self%mech%forces_jacobian(t, y(1:n), y(n + 1:2*n), a, r)
         call dpotrs('U', n, 2*n, mm, n, r, n, info)
         dfdy(n + 1:2*n, :) = r

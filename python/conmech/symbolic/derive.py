@@ -49,6 +49,7 @@ n_hol, n_nh    numbers of constraints; ``rheonomic``: phi depends explicitly on 
 
 ``Derived.values(**kw)`` returns the parameter vector with some values replaced by name.
 """
+import pickle
 import random
 
 import numpy as np
@@ -79,6 +80,33 @@ class Derived:
         self.with_jacobian = True
         for k, v in kw.items():
             setattr(self, k, v)
+
+    # the attributes a compiled system needs; the expressions (large for long chains) are
+    # pickled as one blob and read back only when first used (fast derivation-cache hits)
+    _LIGHT = frozenset(("kind", "t", "coords", "coord_names", "speeds", "accels", "params",
+                        "param_names", "param_values", "n_hol", "n_nh", "rheonomic",
+                        "with_jacobian"))
+
+    def __getstate__(self):
+        state = {k: v for k, v in self.__dict__.items() if k in self._LIGHT}
+        if "_heavy" in self.__dict__:          # expressions not read back yet
+            state["_heavy"] = self.__dict__["_heavy"]
+        else:
+            heavy = {k: v for k, v in self.__dict__.items() if k not in self._LIGHT}
+            state["_heavy"] = pickle.dumps(heavy, protocol=pickle.HIGHEST_PROTOCOL)
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+
+    def __getattr__(self, name):
+        heavy = None if name.startswith("__") else self.__dict__.pop("_heavy", None)
+        if heavy is not None:
+            self.__dict__.update(pickle.loads(heavy))
+        try:
+            return self.__dict__[name]
+        except KeyError:
+            raise AttributeError(name) from None
 
     @property
     def Q(self):
