@@ -300,11 +300,11 @@ class RK4(RungeKutta):
     n_stages = 4
 
 
-_SCIPY_COUNTERPARTS = {"RK45": 12, "DOP853": 3}
+_SCIPY_COUNTERPARTS = {"RK45": 12, "DOP853": 3, "Radau": 5}   # 5: conmech.Radau
 
 
 def method_code(method):
-    """Method code of a stepper class (conmech's, or SciPy's RK45/DOP853); 0 if none."""
+    """Method code of a stepper class (conmech's, or SciPy's RK45/DOP853/Radau); 0 if none."""
     if isinstance(method, type):
         if issubclass(method, RungeKutta):
             return method._code
