@@ -44,11 +44,15 @@ module conmech_radau_state
         real(dp) :: pmat(3, 3) = 0, cvec(3) = 0   !! collocation basis (nodes, power basis)
         integer :: newt = 0                   !! Newton iterations of the last step
         integer :: nsteps = 0, nsing = 0, nfail = 0   !! steps, singular LUs, Newton failures
-        logical :: first = .true., reject = .false., last = .false.
+        logical :: first = .true.             !! no step accepted yet
+        logical :: reject = .false.           !! the last attempt was rejected
+        logical :: last = .false.             !! the step ends at tf
         logical :: caljac = .false.           !! the Jacobian is current
-        logical :: need_jac = .true., need_lu = .true.
+        logical :: need_jac = .true.          !! evaluate the Jacobian before the step
+        logical :: need_lu = .true.           !! factorise before the step
         logical :: have_cont = .false.        !! fc holds a polynomial
-        logical :: newton_failed = .false., converged = .false.
+        logical :: newton_failed = .false.    !! the last Newton iteration failed
+        logical :: converged = .false.        !! the last Newton iteration converged
         real(dp), allocatable :: y(:), f0(:), scal(:), scal0(:), rtolv(:), atolv(:)
         real(dp), allocatable :: jac(:, :), e1(:, :)    !! J and the LU of gamma/h M - J
         complex(dp), allocatable :: e2(:, :)            !! LU of (alpha + i beta)/h M - J
