@@ -179,3 +179,42 @@ def test_derivation_cache_hit_reads_the_expressions_only_when_used():
                                   first.call("forces", 0.0, qq, vv))
     assert d.M == first.derived.M and len(d.struct["dM"]) == 20     # read back on use
     assert "_heavy" not in d.__dict__
+
+
+def test_mass_forces_in_one_call_equals_the_separate_calls():
+    """conmech_mass_forces (one common-subexpression elimination over M and Q, used by the
+    right-hand side) gives the same M and Q as conmech_mass and conmech_forces, has no more
+    trigonometric calls than either alone, and the integration with it equals the one
+    through the separate calls (the old path, mass_forces absent) to round-off."""
+    import conmech
+    from conmech import compiled
+    n = 4
+    L, q, params, forces = shaken_chain(n)
+    mod = symbolic.lagrangian_system(L, q, params, forces, model_only=True)
+    assert "mass_forces" in mod.addresses
+    src = mod.source
+    body = src[src.index("subroutine conmech_mass_forces("):
+               src.index("end subroutine conmech_mass_forces")]
+    assert len(re.findall(r"\b(sin|cos)\(", body)) <= 2*n + 2   # + sin, cos of w t
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        tt, qq, vv = rng.uniform(0, 3), rng.uniform(-2, 2, n), rng.normal(size=n)
+        Mb, Qb = mod.call("mass_forces", tt, qq, vv)
+        Ms, Qs = mod.call("mass", tt, qq), mod.call("forces", tt, qq, vv)
+        assert np.max(np.abs(Mb - Ms)) <= 1e-15*np.max(np.abs(Ms))
+        assert np.max(np.abs(Qb - Qs)) <= 1e-14*np.max(np.abs(Qs))
+    y0 = np.concatenate([np.linspace(0.9, 0.3, n), np.zeros(n)])
+    both = symbolic._system(mod)
+    d, a = mod.derived, mod.addresses
+    sep = compiled.generalized_system(n, a["mass"], a["forces"], params=tuple(d.param_values),
+                                      param_names=tuple(d.param_names), keep=mod)
+    kw = dict(method="DOP853", rtol=1e-10, atol=1e-10)
+    r1 = conmech.solve_ivp(both, (0, 2), y0, **kw)
+    r2 = conmech.solve_ivp(sep, (0, 2), y0, **kw)
+    assert r1.success and r2.success and r1.nfev == r2.nfev
+    assert np.max(np.abs(r1.y[:, -1] - r2.y[:, -1])) < 1e-12
+    # a NULL mass_forces address is the old path; a bad one is refused like the others
+    with pytest.raises((TypeError, ValueError)):
+        compiled.generalized_system(n, a["mass"], a["forces"], mass_forces="x",
+                                    params=tuple(d.param_values),
+                                    param_names=tuple(d.param_names))

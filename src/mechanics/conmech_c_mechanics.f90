@@ -14,12 +14,15 @@
 !!     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
 !!     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
 !!     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+!!     /* optional, generalized systems: M and Q in one call (shared subexpressions) */
+!!     void mass_forces(double t, const double *q, const double *v, double *M, double *Q,
+!!                      const double *p);
 !!
 !! Only `mass` and `forces` are required; a missing optional function falls back to the
 !! finite-difference default of the parent type (see conmech_constrained_system).
 module conmech_c_mechanics
     use, intrinsic :: iso_c_binding, only: c_double, c_funptr, c_associated, &
-                                           c_f_procpointer
+                                           c_f_procpointer, c_null_funptr
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_generalized, only: generalized_system
@@ -46,6 +49,13 @@ module conmech_c_mechanics
             real(c_double), intent(out) :: f(*)
             real(c_double), intent(in) :: p(*)
         end subroutine c_qv_fn
+        subroutine c_mf_fn(t, q, v, m, f, p) bind(c)   ! mass_forces
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*), v(*)
+            real(c_double), intent(out) :: m(*), f(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_mf_fn
         subroutine c_fjac_fn(t, q, v, a, r, p) bind(c)
             import :: c_double
             real(c_double), value :: t
@@ -73,6 +83,8 @@ module conmech_c_mechanics
     type :: c_mech_pointers
         type(c_funptr) :: mass, forces, forces_jac, energy
         type(c_funptr) :: phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma
+        !> optional: M and Q in one call (generalized systems)
+        type(c_funptr) :: mass_forces = c_null_funptr
     end type c_mech_pointers
 
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
@@ -82,8 +94,10 @@ module conmech_c_mechanics
         procedure(c_qv_fn), pointer, nopass :: forces_f => null()
         procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
+        procedure(c_mf_fn), pointer, nopass :: mf_f => null()
     contains
         procedure :: mass => cg_mass
+        procedure :: mass_forces => cg_mass_forces
         procedure :: forces => cg_forces
         procedure :: energy => cg_energy
         procedure :: has_energy => cg_has_energy
@@ -149,6 +163,7 @@ contains
         call c_f_procpointer(fp%forces, sys%forces_f)
         if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
         if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
+        if (c_associated(fp%mass_forces)) call c_f_procpointer(fp%mass_forces, sys%mf_f)
         call set_params(sys%p, params)
         info = CM_SUCCESS
         msg = "success"
@@ -210,6 +225,19 @@ contains
         real(dp), intent(out) :: mm(:, :)
         call self%mass_f(t, q, mm, self%p)
     end subroutine cg_mass
+
+    subroutine cg_mass_forces(self, t, q, v, mm, f)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: mm(:, :), f(:)
+        if (associated(self%mf_f)) then
+            call self%mf_f(t, q, v, mm, f, self%p)
+        else
+            call self%mass_f(t, q, mm, self%p)
+            call self%forces_f(t, q, v, f, self%p)
+        end if
+    end subroutine cg_mass_forces
 
     subroutine cg_forces(self, t, q, v, f)
         class(c_generalized_system), intent(in) :: self

@@ -39,6 +39,7 @@ module conmech_generalized
         procedure :: energy => gen_no_energy
         procedure :: has_energy => gen_has_no_energy
         procedure :: forces_jacobian => gen_no_forces_jacobian
+        procedure :: mass_forces => gen_mass_forces
         procedure :: has_forces_jacobian => gen_has_no_forces_jacobian
     end type generalized_system
 
@@ -101,6 +102,19 @@ contains
         class(generalized_system), intent(in) :: self
         gen_has_no_forces_jacobian = .false.
     end function gen_has_no_forces_jacobian
+
+    !> mm = M(t, q) and f = Q(t, q, v) in one call (what the right-hand side needs). The
+    !! default calls `mass` and `forces`; a system that computes both faster together
+    !! (shared subexpressions, e.g. compiled systems with a `mass_forces` function)
+    !! overrides it.
+    subroutine gen_mass_forces(self, t, q, v, mm, f)
+        class(generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: mm(:, :), f(:)
+        call self%mass(t, q, mm)
+        call self%forces(t, q, v, f)
+    end subroutine gen_mass_forces
 
     !> Cholesky factor (upper, in place) of an SPD matrix, with a clear status:
     !! CM_SINGULAR if dpotrf fails or the factor's diagonal ratio squared is below 1e-14
@@ -198,8 +212,7 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out), optional :: msg
         character(len=:), allocatable :: m2
-        call mech%mass(t, q, mm)
-        call mech%forces(t, q, v, a)
+        call mech%mass_forces(t, q, v, mm, a)
         if (present(msg)) then
             call mass_cholesky(mm, info, m2)
             msg = m2

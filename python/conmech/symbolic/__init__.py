@@ -53,7 +53,7 @@ _SIG = {
     "mass": ("in1", "out1"), "forces": ("in2", "out1"), "forces_jac": ("in3", "out1"),
     "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
-    "nh_gamma": ("in2", "out1"),
+    "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"),
 }
 
 
@@ -81,7 +81,8 @@ class CompiledModel:
         return {"rhs": [(n,)], "jac": [(n, n)], "mass": [(n, n)], "forces": [(n,)],
                 "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
-                "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)]}[entry]
+                "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
+                "mass_forces": [(n, n), (n,)]}[entry]
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
@@ -180,7 +181,8 @@ def _system(model):
     if d.kind == "generalized":
         return compiled.generalized_system(d.n, a["mass"], a["forces"],
                                            forces_jac=a.get("forces_jac"),
-                                           energy=a.get("energy"), **common)
+                                           energy=a.get("energy"),
+                                           mass_forces=a.get("mass_forces"), **common)
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),

@@ -39,14 +39,15 @@ __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prep
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
     "ode": ["rhs", "jac"],
-    "generalized": ["mass", "forces", "forces_jac", "energy"],
+    "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces"],
     "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
                     "nh_matrix", "nh_gamma"],
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "3"   # 2: conmech_* entry names, model-library description;
-#                         3: structured forces / Jacobian, sin and cos by angle addition
+CODEGEN_VERSION = "4"   # 2: conmech_* entry names, model-library description;
+#                         3: structured forces / Jacobian, sin and cos by angle addition;
+#                         4: conmech_mass_forces (M and Q in one call, shared subexpressions)
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -435,6 +436,15 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                 [("f", sp.Matrix(st["Q"]) if st else d.Q, False)],
                                 defs=st["defs_Q"] if st else ()))
         entries += ["mass", "forces"]
+        if d.kind == "generalized":
+            # M and Q in one function: one common-subexpression elimination over both (the
+            # sines and cosines of the coordinates once); the right-hand side calls this
+            procs.append(_procedure(pr, "conmech_mass_forces", ["t", "q", "v", "mm", "f", "p"],
+                                    QV + [arr("mm", [n, n], "out"), arr("f", [n], "out"), P],
+                                    [("mm", d.M, True),
+                                     ("f", sp.Matrix(st["Q"]) if st else d.Q, False)],
+                                    defs=st["defs_Q"] if st else ()))
+            entries.append("mass_forces")
         if st is not None and "R" in st:
             procs.append(_procedure(pr, "conmech_forces_jac", ["t", "q", "v", "a", "r", "p"],
                                     QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],

@@ -12,6 +12,7 @@
 !!         generalized:  6 mass, 7 forces, 8 forces_jac, 9 energy
 !!         constrained:  6 mass, 7 forces, 8 (unused), 9 energy, 10 phi, 11 phi_jac,
 !!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
+!!     spec(16) (optional, generalized) mass_forces: M and Q in one call
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -68,6 +69,7 @@ contains
         fp%phi_gamma = fptr(spec(13))
         fp%nh_matrix = fptr(spec(14))
         fp%nh_gamma = fptr(spec(15))
+        if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
