@@ -122,220 +122,34 @@ contains
     !> The state and three STM columns, z = [x, y, x', y', A e1, A e3, A e4], from t = 0 to
     !! t1 in n DOP853 steps (z holds the initial values on entry). nfev += 12 n.
     pure subroutine hill_kernel_var(m, kappa, t1, n, z, nfev)
+        integer, parameter :: nz = 16
         real(dp), intent(in) :: m, kappa, t1
         integer, intent(in) :: n
-        real(dp), intent(inout) :: z(16)
+        real(dp), intent(inout) :: z(nz)
         integer, intent(inout) :: nfev
-        real(dp) :: k(16, 12), zt(16), h
-        real(dp) :: ha2_1, ha3_1, ha3_2, ha4_1, ha4_3, ha5_1, ha5_3, ha5_4, ha6_1, ha6_4, &
-            ha6_5, ha7_1, ha7_4, ha7_5, ha7_6, ha8_1, ha8_4, ha8_5, ha8_6, ha8_7, ha9_1, &
-            ha9_4, ha9_5, ha9_6, ha9_7, ha9_8, ha10_1, ha10_4, ha10_5, ha10_6, ha10_7, &
-            ha10_8, ha10_9, ha11_1, ha11_4, ha11_5, ha11_6, ha11_7, ha11_8, ha11_9, ha11_10, &
-            ha12_1, ha12_4, ha12_5, ha12_6, ha12_7, ha12_8, ha12_9, ha12_10, ha12_11, hb1, &
-            hb6, hb7, hb8, hb9, hb10, hb11, hb12
-        integer :: istep
-        h = t1/n
-        ha2_1 = h*a2_1
-        ha3_1 = h*a3_1
-        ha3_2 = h*a3_2
-        ha4_1 = h*a4_1
-        ha4_3 = h*a4_3
-        ha5_1 = h*a5_1
-        ha5_3 = h*a5_3
-        ha5_4 = h*a5_4
-        ha6_1 = h*a6_1
-        ha6_4 = h*a6_4
-        ha6_5 = h*a6_5
-        ha7_1 = h*a7_1
-        ha7_4 = h*a7_4
-        ha7_5 = h*a7_5
-        ha7_6 = h*a7_6
-        ha8_1 = h*a8_1
-        ha8_4 = h*a8_4
-        ha8_5 = h*a8_5
-        ha8_6 = h*a8_6
-        ha8_7 = h*a8_7
-        ha9_1 = h*a9_1
-        ha9_4 = h*a9_4
-        ha9_5 = h*a9_5
-        ha9_6 = h*a9_6
-        ha9_7 = h*a9_7
-        ha9_8 = h*a9_8
-        ha10_1 = h*a10_1
-        ha10_4 = h*a10_4
-        ha10_5 = h*a10_5
-        ha10_6 = h*a10_6
-        ha10_7 = h*a10_7
-        ha10_8 = h*a10_8
-        ha10_9 = h*a10_9
-        ha11_1 = h*a11_1
-        ha11_4 = h*a11_4
-        ha11_5 = h*a11_5
-        ha11_6 = h*a11_6
-        ha11_7 = h*a11_7
-        ha11_8 = h*a11_8
-        ha11_9 = h*a11_9
-        ha11_10 = h*a11_10
-        ha12_1 = h*a12_1
-        ha12_4 = h*a12_4
-        ha12_5 = h*a12_5
-        ha12_6 = h*a12_6
-        ha12_7 = h*a12_7
-        ha12_8 = h*a12_8
-        ha12_9 = h*a12_9
-        ha12_10 = h*a12_10
-        ha12_11 = h*a12_11
-        hb1 = h*b1
-        hb6 = h*b6
-        hb7 = h*b7
-        hb8 = h*b8
-        hb9 = h*b9
-        hb10 = h*b10
-        hb11 = h*b11
-        hb12 = h*b12
-        do istep = 1, n
-            call var_rhs16(m, kappa, z, k(:, 1))
-            zt = z + (ha2_1*k(:, 1))
-            call var_rhs16(m, kappa, zt, k(:, 2))
-            zt = z + (ha3_1*k(:, 1) + ha3_2*k(:, 2))
-            call var_rhs16(m, kappa, zt, k(:, 3))
-            zt = z + (ha4_1*k(:, 1) + ha4_3*k(:, 3))
-            call var_rhs16(m, kappa, zt, k(:, 4))
-            zt = z + (ha5_1*k(:, 1) + ha5_3*k(:, 3) + ha5_4*k(:, 4))
-            call var_rhs16(m, kappa, zt, k(:, 5))
-            zt = z + (ha6_1*k(:, 1) + ha6_4*k(:, 4) + ha6_5*k(:, 5))
-            call var_rhs16(m, kappa, zt, k(:, 6))
-            zt = z + (ha7_1*k(:, 1) + ha7_4*k(:, 4) + ha7_5*k(:, 5) + ha7_6*k(:, 6))
-            call var_rhs16(m, kappa, zt, k(:, 7))
-            zt = z + (ha8_1*k(:, 1) + ha8_4*k(:, 4) + ha8_5*k(:, 5) + ha8_6*k(:, 6) + &
-                ha8_7*k(:, 7))
-            call var_rhs16(m, kappa, zt, k(:, 8))
-            zt = z + (ha9_1*k(:, 1) + ha9_4*k(:, 4) + ha9_5*k(:, 5) + ha9_6*k(:, 6) + &
-                ha9_7*k(:, 7) + ha9_8*k(:, 8))
-            call var_rhs16(m, kappa, zt, k(:, 9))
-            zt = z + (ha10_1*k(:, 1) + ha10_4*k(:, 4) + ha10_5*k(:, 5) + ha10_6*k(:, 6) + &
-                ha10_7*k(:, 7) + ha10_8*k(:, 8) + ha10_9*k(:, 9))
-            call var_rhs16(m, kappa, zt, k(:, 10))
-            zt = z + (ha11_1*k(:, 1) + ha11_4*k(:, 4) + ha11_5*k(:, 5) + ha11_6*k(:, 6) + &
-                ha11_7*k(:, 7) + ha11_8*k(:, 8) + ha11_9*k(:, 9) + ha11_10*k(:, 10))
-            call var_rhs16(m, kappa, zt, k(:, 11))
-            zt = z + (ha12_1*k(:, 1) + ha12_4*k(:, 4) + ha12_5*k(:, 5) + ha12_6*k(:, 6) + &
-                ha12_7*k(:, 7) + ha12_8*k(:, 8) + ha12_9*k(:, 9) + ha12_10*k(:, 10) + &
-                ha12_11*k(:, 11))
-            call var_rhs16(m, kappa, zt, k(:, 12))
-            z = z + (hb1*k(:, 1) + hb6*k(:, 6) + hb7*k(:, 7) + hb8*k(:, 8) + hb9*k(:, 9) + &
-                hb10*k(:, 10) + hb11*k(:, 11) + hb12*k(:, 12))
-        end do
-        nfev = nfev + 12*n
+        include "conmech_hill_kernel_body.inc"
+    contains
+        pure subroutine rhs_of(s, ds)
+            real(dp), intent(in) :: s(nz)
+            real(dp), intent(out) :: ds(nz)
+            call var_rhs16(m, kappa, s, ds)
+        end subroutine rhs_of
     end subroutine hill_kernel_var
 
     !> The state s = [x, y, x', y'] from t = 0 to t1 in n DOP853 steps. nfev += 12 n.
     pure subroutine hill_kernel_state(m, kappa, t1, n, z, nfev)
+        integer, parameter :: nz = 4
         real(dp), intent(in) :: m, kappa, t1
         integer, intent(in) :: n
-        real(dp), intent(inout) :: z(4)
+        real(dp), intent(inout) :: z(nz)
         integer, intent(inout) :: nfev
-        real(dp) :: k(4, 12), zt(4), h
-        real(dp) :: ha2_1, ha3_1, ha3_2, ha4_1, ha4_3, ha5_1, ha5_3, ha5_4, ha6_1, ha6_4, &
-            ha6_5, ha7_1, ha7_4, ha7_5, ha7_6, ha8_1, ha8_4, ha8_5, ha8_6, ha8_7, ha9_1, &
-            ha9_4, ha9_5, ha9_6, ha9_7, ha9_8, ha10_1, ha10_4, ha10_5, ha10_6, ha10_7, &
-            ha10_8, ha10_9, ha11_1, ha11_4, ha11_5, ha11_6, ha11_7, ha11_8, ha11_9, ha11_10, &
-            ha12_1, ha12_4, ha12_5, ha12_6, ha12_7, ha12_8, ha12_9, ha12_10, ha12_11, hb1, &
-            hb6, hb7, hb8, hb9, hb10, hb11, hb12
-        integer :: istep
-        h = t1/n
-        ha2_1 = h*a2_1
-        ha3_1 = h*a3_1
-        ha3_2 = h*a3_2
-        ha4_1 = h*a4_1
-        ha4_3 = h*a4_3
-        ha5_1 = h*a5_1
-        ha5_3 = h*a5_3
-        ha5_4 = h*a5_4
-        ha6_1 = h*a6_1
-        ha6_4 = h*a6_4
-        ha6_5 = h*a6_5
-        ha7_1 = h*a7_1
-        ha7_4 = h*a7_4
-        ha7_5 = h*a7_5
-        ha7_6 = h*a7_6
-        ha8_1 = h*a8_1
-        ha8_4 = h*a8_4
-        ha8_5 = h*a8_5
-        ha8_6 = h*a8_6
-        ha8_7 = h*a8_7
-        ha9_1 = h*a9_1
-        ha9_4 = h*a9_4
-        ha9_5 = h*a9_5
-        ha9_6 = h*a9_6
-        ha9_7 = h*a9_7
-        ha9_8 = h*a9_8
-        ha10_1 = h*a10_1
-        ha10_4 = h*a10_4
-        ha10_5 = h*a10_5
-        ha10_6 = h*a10_6
-        ha10_7 = h*a10_7
-        ha10_8 = h*a10_8
-        ha10_9 = h*a10_9
-        ha11_1 = h*a11_1
-        ha11_4 = h*a11_4
-        ha11_5 = h*a11_5
-        ha11_6 = h*a11_6
-        ha11_7 = h*a11_7
-        ha11_8 = h*a11_8
-        ha11_9 = h*a11_9
-        ha11_10 = h*a11_10
-        ha12_1 = h*a12_1
-        ha12_4 = h*a12_4
-        ha12_5 = h*a12_5
-        ha12_6 = h*a12_6
-        ha12_7 = h*a12_7
-        ha12_8 = h*a12_8
-        ha12_9 = h*a12_9
-        ha12_10 = h*a12_10
-        ha12_11 = h*a12_11
-        hb1 = h*b1
-        hb6 = h*b6
-        hb7 = h*b7
-        hb8 = h*b8
-        hb9 = h*b9
-        hb10 = h*b10
-        hb11 = h*b11
-        hb12 = h*b12
-        do istep = 1, n
-            call state_rhs(m, kappa, z, k(:, 1))
-            zt = z + (ha2_1*k(:, 1))
-            call state_rhs(m, kappa, zt, k(:, 2))
-            zt = z + (ha3_1*k(:, 1) + ha3_2*k(:, 2))
-            call state_rhs(m, kappa, zt, k(:, 3))
-            zt = z + (ha4_1*k(:, 1) + ha4_3*k(:, 3))
-            call state_rhs(m, kappa, zt, k(:, 4))
-            zt = z + (ha5_1*k(:, 1) + ha5_3*k(:, 3) + ha5_4*k(:, 4))
-            call state_rhs(m, kappa, zt, k(:, 5))
-            zt = z + (ha6_1*k(:, 1) + ha6_4*k(:, 4) + ha6_5*k(:, 5))
-            call state_rhs(m, kappa, zt, k(:, 6))
-            zt = z + (ha7_1*k(:, 1) + ha7_4*k(:, 4) + ha7_5*k(:, 5) + ha7_6*k(:, 6))
-            call state_rhs(m, kappa, zt, k(:, 7))
-            zt = z + (ha8_1*k(:, 1) + ha8_4*k(:, 4) + ha8_5*k(:, 5) + ha8_6*k(:, 6) + &
-                ha8_7*k(:, 7))
-            call state_rhs(m, kappa, zt, k(:, 8))
-            zt = z + (ha9_1*k(:, 1) + ha9_4*k(:, 4) + ha9_5*k(:, 5) + ha9_6*k(:, 6) + &
-                ha9_7*k(:, 7) + ha9_8*k(:, 8))
-            call state_rhs(m, kappa, zt, k(:, 9))
-            zt = z + (ha10_1*k(:, 1) + ha10_4*k(:, 4) + ha10_5*k(:, 5) + ha10_6*k(:, 6) + &
-                ha10_7*k(:, 7) + ha10_8*k(:, 8) + ha10_9*k(:, 9))
-            call state_rhs(m, kappa, zt, k(:, 10))
-            zt = z + (ha11_1*k(:, 1) + ha11_4*k(:, 4) + ha11_5*k(:, 5) + ha11_6*k(:, 6) + &
-                ha11_7*k(:, 7) + ha11_8*k(:, 8) + ha11_9*k(:, 9) + ha11_10*k(:, 10))
-            call state_rhs(m, kappa, zt, k(:, 11))
-            zt = z + (ha12_1*k(:, 1) + ha12_4*k(:, 4) + ha12_5*k(:, 5) + ha12_6*k(:, 6) + &
-                ha12_7*k(:, 7) + ha12_8*k(:, 8) + ha12_9*k(:, 9) + ha12_10*k(:, 10) + &
-                ha12_11*k(:, 11))
-            call state_rhs(m, kappa, zt, k(:, 12))
-            z = z + (hb1*k(:, 1) + hb6*k(:, 6) + hb7*k(:, 7) + hb8*k(:, 8) + hb9*k(:, 9) + &
-                hb10*k(:, 10) + hb11*k(:, 11) + hb12*k(:, 12))
-        end do
-        nfev = nfev + 12*n
+        include "conmech_hill_kernel_body.inc"
+    contains
+        pure subroutine rhs_of(s, ds)
+            real(dp), intent(in) :: s(nz)
+            real(dp), intent(out) :: ds(nz)
+            call state_rhs(m, kappa, s, ds)
+        end subroutine rhs_of
     end subroutine hill_kernel_state
 
 end module conmech_hill_kernel
