@@ -9,7 +9,8 @@ subroutine flat_solve_implicit_callback(fun, jac, events, store, n, t_span, y0, 
                                         max_steps, dense, neval, t_eval, ne, ev_dir, &
                                         ev_term, counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_implicit_support, only: callback_jac_system, run_implicit
+    use conmech_flat_ode_support, only: callback_jac_system
+    use conmech_flat_implicit_support, only: run_implicit
     implicit none
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
@@ -62,9 +63,8 @@ subroutine flat_solve_implicit_callback(fun, jac, events, store, n, t_span, y0, 
     type(callback_jac_system) :: sys
 
     sys%f => fun
-    sys%fjac => jac
     sys%n = n
-    sys%has_jac = has_jac /= 0
+    if (has_jac /= 0) sys%jac => jac
     call run_implicit(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                       max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
                       counts, dense_form, info, message)

@@ -24,7 +24,7 @@ subroutine flat_radau_stepper_callback(fun, jac, action, n, t0, t_bound, y0, has
                                        atol, first_step, max_step, max_steps, r, iv, w, &
                                        info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_implicit_support, only: callback_jac_system
+    use conmech_flat_ode_support, only: callback_jac_system
     use conmech_flat_implicit_stepper_support, only: radau_action
     implicit none
     integer(c_int), intent(in) :: action, n, has_jac, max_steps
@@ -53,9 +53,8 @@ subroutine flat_radau_stepper_callback(fun, jac, action, n, t0, t_bound, y0, has
     end interface
     type(callback_jac_system) :: sys
     sys%f => fun
-    sys%fjac => jac
     sys%n = n
-    sys%has_jac = has_jac /= 0
+    if (has_jac /= 0) sys%jac => jac
     call radau_action(sys, action, n, t0, t_bound, y0, rtol, atol, first_step, max_step, &
                       max_steps, r, iv, w, info, message)
 end subroutine flat_radau_stepper_callback

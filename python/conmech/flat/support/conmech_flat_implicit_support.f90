@@ -1,13 +1,13 @@
 !> Support of the flat f2py layer for the implicit integrators (Radau IIA, Gauss): a
-!! callback system with an optional Jacobian callback, and `run_implicit`, which runs
+!! `run_implicit`, which runs
 !! `ode_solve` with an implicit method and hands the result, with the Jacobian and LU
 !! counts, to a `store` procedure (conventions of conmech_flat_ode_support).
 !!
 !!     fun(t, y, dydt, n)         real(c_double) t, y(n), dydt(n)
-!!     jac(t, y, dfdy, n)         real(c_double) t, y(n), dfdy(n, n)   (if has_jac)
+!!     jac(t, y, dfdy, n)         real(c_double) t, y(n), dfdy(n, n)   (if associated)
+!! (the systems are conmech_flat_ode_support's callback_system / callback_jac_system)
 module conmech_flat_implicit_support
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_kinds, only: dp
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_RADAU5, &
@@ -15,42 +15,9 @@ module conmech_flat_implicit_support
     use conmech_flat_ode_support, only: callback_events, copy_message
     implicit none
     private
-    public :: callback_jac_system, run_implicit
-
-    !> A system whose right-hand side (and Jacobian, if has_jac) are external procedures.
-    type, extends(ode_system) :: callback_jac_system
-        procedure(), pointer, nopass :: f => null()
-        procedure(), pointer, nopass :: fjac => null()
-        integer(c_int) :: n = 0
-        logical :: has_jac = .false.
-    contains
-        procedure :: rhs => cj_rhs
-        procedure :: jacobian => cj_jacobian
-        procedure :: has_jacobian => cj_has_jacobian
-    end type callback_jac_system
+    public :: run_implicit
 
 contains
-
-    subroutine cj_rhs(self, t, y, dydt)
-        class(callback_jac_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        call self%f(t, y, dydt, self%n)
-    end subroutine cj_rhs
-
-    subroutine cj_jacobian(self, t, y, dfdy)
-        class(callback_jac_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        call self%fjac(t, y, dfdy, self%n)
-    end subroutine cj_jacobian
-
-    logical function cj_has_jacobian(self)
-        class(callback_jac_system), intent(in) :: self
-        cj_has_jacobian = self%has_jac
-    end function cj_has_jacobian
 
     !> Run `ode_solve` with an implicit method from plain arguments (see run_solve of
     !! conmech_flat_ode_support); counts(1:5) = [nfev, njev, nlu, naccept, nreject].
