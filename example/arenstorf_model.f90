@@ -18,6 +18,9 @@ module arenstorf_model
         procedure :: rhs => arenstorf_sym_rhs
         procedure :: jacobian => arenstorf_sym_jacobian
         procedure :: has_jacobian => arenstorf_sym_has_jacobian
+        procedure :: jacobian_product => arenstorf_sym_jacobian_product
+        procedure :: rhs_jacobian_product => arenstorf_sym_rhs_jacobian_product
+        procedure :: has_jacobian_product => arenstorf_sym_has_jacobian_product
     end type arenstorf_sym
 
 contains
@@ -86,5 +89,94 @@ contains
         class(arenstorf_sym), intent(in) :: self
         arenstorf_sym_has_jacobian = .true.
     end function arenstorf_sym_has_jacobian
+
+    !> jx = J(t, y) x for an n x k block x (no J formed).
+    subroutine arenstorf_sym_jacobian_product(self, t, n, k, y, x, jx)
+        class(arenstorf_sym), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n)
+        real(dp), intent(in) :: x(n, k)
+        real(dp), intent(out) :: jx(n, k)
+        integer :: c
+        real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9, w10
+        real(dp) :: w11, w12, w13, w14, w15, w16, jv1, jv2, jv3, jv4
+        w1 = self%mu + y(1)
+        w2 = y(2)**2
+        w3 = sqrt(w1**2 + w2)
+        w4 = 1.0_dp - self%mu
+        w5 = w4/w3**3
+        w6 = w1 + (-1.0_dp)
+        w7 = sqrt(w2 + w6**2)
+        w8 = self%mu/w7**3
+        w9 = 3.0_dp*self%mu
+        w10 = 3.0_dp*y(1) + w9
+        w11 = w4/w3**5
+        w12 = -w11*w10
+        w13 = 1.0_dp/w7**5
+        w14 = w13*w6
+        w15 = self%mu*(3.0_dp - w10)
+        w16 = 3.0_dp*w11
+        jv1 = -w1*w12 - w14*w15 - w5 - w8 + 1.0_dp
+        jv2 = y(2)*w1*w16 + y(2)*w14*w9
+        jv3 = -y(2)*w12 - y(2)*w13*w15
+        jv4 = w2*w13*w9 + w2*w16 - w5 - w8 + 1.0_dp
+        do c = 1, k
+            jx(1, c) = x(3, c)
+            jx(2, c) = x(4, c)
+            jx(3, c) = jv1*x(1, c) + jv2*x(2, c) + 2.0_dp*x(4, c)
+            jx(4, c) = jv3*x(1, c) + jv4*x(2, c) - 2.0_dp*x(3, c)
+        end do
+    end subroutine arenstorf_sym_jacobian_product
+
+    !> f(t, y) and jx = J(t, y) x at once (one elimination over both).
+    subroutine arenstorf_sym_rhs_jacobian_product(self, t, n, k, y, dydt, x, jx)
+        class(arenstorf_sym), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n)
+        real(dp), intent(in) :: x(n, k)
+        real(dp), intent(out) :: dydt(n)
+        real(dp), intent(out) :: jx(n, k)
+        integer :: c
+        real(dp) :: w1, w2, w3, w4, w5, w6, w7, w8, w9, w10
+        real(dp) :: w11, w12, w13, w14, w15, w16, jv1, jv2, jv3, jv4
+        w1 = self%mu + y(1)
+        w2 = y(2)**2
+        w3 = sqrt(w1**2 + w2)
+        w4 = 1.0_dp - self%mu
+        w5 = w4/w3**3
+        w6 = w1 + (-1.0_dp)
+        w7 = sqrt(w2 + w6**2)
+        w8 = self%mu/w7**3
+        w9 = 3.0_dp*self%mu
+        w10 = 3.0_dp*y(1) + w9
+        w11 = w4/w3**5
+        w12 = -w11*w10
+        w13 = 1.0_dp/w7**5
+        w14 = w13*w6
+        w15 = self%mu*(3.0_dp - w10)
+        w16 = 3.0_dp*w11
+        dydt(1) = y(3)
+        dydt(2) = y(4)
+        dydt(3) = 2.0_dp*y(4) + y(1) - w1*w5 - w6*w8
+        dydt(4) = -2.0_dp*y(3) - y(2)*w5 - y(2)*w8 + y(2)
+        jv1 = -w1*w12 - w14*w15 - w5 - w8 + 1.0_dp
+        jv2 = y(2)*w1*w16 + y(2)*w14*w9
+        jv3 = -y(2)*w12 - y(2)*w13*w15
+        jv4 = w2*w13*w9 + w2*w16 - w5 - w8 + 1.0_dp
+        do c = 1, k
+            jx(1, c) = x(3, c)
+            jx(2, c) = x(4, c)
+            jx(3, c) = jv1*x(1, c) + jv2*x(2, c) + 2.0_dp*x(4, c)
+            jx(4, c) = jv3*x(1, c) + jv4*x(2, c) - 2.0_dp*x(3, c)
+        end do
+    end subroutine arenstorf_sym_rhs_jacobian_product
+
+    !> The Jacobian product is structure-aware (integrate_stm uses it).
+    logical function arenstorf_sym_has_jacobian_product(self)
+        class(arenstorf_sym), intent(in) :: self
+        arenstorf_sym_has_jacobian_product = .true.
+    end function arenstorf_sym_has_jacobian_product
 
 end module arenstorf_model

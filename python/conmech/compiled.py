@@ -7,6 +7,9 @@ compiled function serves every parameter value)::
 
     void rhs(double t, const double *y, double *dydt, const double *p);      /* n       */
     void jac(double t, const double *y, double *dfdy, const double *p);      /* n x n   */
+    /* optional: jx = J(t, y) x for an n x k block x (column-major) */
+    void jac_prod(double t, const double *y, int k, const double *x, double *jx,
+                  const double *p);
     /* M(t, q) q'' = Q(t, q, q'), ndof coordinates */
     void mass(double t, const double *q, double *M, const double *p);        /* nd x nd */
     void forces(double t, const double *q, const double *v, double *Q, const double *p);
@@ -48,10 +51,10 @@ __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSy
            "CompiledConstrained", "evaluate", "function_address", "load_model"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 16
+_SPEC_SIZE = 18
 _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
           "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
-          "nh_gamma": 15, "mass_forces": 16}
+          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18}
 
 
 def function_address(f, what: str = "function") -> int:
@@ -205,16 +208,22 @@ class CompiledConstrained(BuiltinConstrained):
 
 def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
                param_names: Sequence[str] = (), keep=None,
-               name: str = "compiled") -> CompiledSystem:
+               name: str = "compiled", *, jac_prod=None) -> CompiledSystem:
     """A first-order system y' = rhs(t, y; p) of dimension ``n`` from compiled functions
     (``jac``: the exact Jacobian df/dy, column-major; None: finite differences).
-    ``params``: a sequence (names from ``param_names``) or a dict name -> value."""
+    ``params``: a sequence (names from ``param_names``) or a dict name -> value.
+    ``jac_prod`` (optional), ``void jac_prod(double t, const double *y, int k, const double
+    *x, double *jx, const double *p)``, gives jx = J(t, y) x for an n x k block x
+    (column-major): the variational equations (:func:`conmech.stability.stm`,
+    ``monodromy``, shooting) then evaluate J Phi through it without forming J. It must
+    agree with ``jac``."""
     n = _count(n, "n", 1)
     values, names = _params(params, param_names)
-    spec = _make_spec(_KIND_ODE, n, 0, 0, False, {"rhs": rhs, "jac": jac})
+    spec = _make_spec(_KIND_ODE, n, 0, 0, False, {"rhs": rhs, "jac": jac,
+                                                  "jac_prod": jac_prod})
     if spec[_SLOTS["rhs"] - 1] == 0:
         raise ValueError("rhs is required")
-    return CompiledSystem(str(name), "ode", spec, values, names, (keep, rhs, jac))
+    return CompiledSystem(str(name), "ode", spec, values, names, (keep, rhs, jac, jac_prod))
 
 
 def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
@@ -326,7 +335,8 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     functions of its kind named ``conmech_rhs``, ``conmech_jac``, ``conmech_mass``,
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
-    ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``). The Fortran programs load the same libraries (``sweep --model``,
+    ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_jac_prod``).
+    The Fortran programs load the same libraries (``sweep --model``,
     conmech_model_library)."""
     try:
         lib = ctypes.CDLL(str(path))
@@ -353,7 +363,8 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     fn = {k: getattr(lib, "conmech_" + k, None) for k in _SLOTS}
     name = name or str(path)
     if kind == _KIND_ODE:
-        return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name)
+        return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name,
+                          jac_prod=fn["jac_prod"])
     if kind == _KIND_GEN:
         return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
                                   params=params, keep=lib, name=name,

@@ -86,10 +86,13 @@ class CompiledModel:
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
-        (y; q; q, v; q, v, a), with the model's parameters or `params`."""
+        (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
+        parameters or `params`."""
         if entry not in self.addresses:
             raise ValueError(f"this model has no entry point '{entry}' "
                              f"(has: {', '.join(self.addresses)})")
+        if entry == "jac_prod":
+            return self._call_jac_prod(t, *arrays, params=params)
         p = np.ascontiguousarray(self.derived.param_values if params is None else params,
                                  dtype=float)
         if p.ndim != 1 or p.size != len(self.derived.param_names):
@@ -115,6 +118,29 @@ class CompiledModel:
         if kind == "ret":
             return float(r)
         return outs[0] if len(outs) == 1 else tuple(outs)
+
+
+    def _call_jac_prod(self, t, y, x, params=None):
+        """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
+        n = self.derived.n
+        p = np.ascontiguousarray(self.derived.param_values if params is None else params,
+                                 dtype=float)
+        if p.ndim != 1 or p.size != len(self.derived.param_names):
+            raise ValueError(f"params must have {len(self.derived.param_names)} values")
+        if p.size == 0:
+            p = np.zeros(1)
+        y = np.ascontiguousarray(y, dtype=float)
+        x = np.asarray(x, dtype=float)
+        vec = x.ndim == 1
+        x = np.asfortranarray(x.reshape(n, -1) if vec else x)
+        if y.shape != (n,) or x.ndim != 2 or x.shape[0] != n or x.shape[1] < 1:
+            raise ValueError(f"jac_prod needs y of shape ({n},) and x of shape ({n}, k)")
+        jx = np.zeros(x.shape, order="F")
+        fn = ctypes.CFUNCTYPE(None, _D, _P, ctypes.c_int, _P, _P, _P)(
+            self.addresses["jac_prod"])
+        fn(float(t), y.ctypes.data_as(_P), x.shape[1], x.ctypes.data_as(_P),
+           jx.ctypes.data_as(_P), p.ctypes.data_as(_P))
+        return jx.ravel() if vec else jx
 
 
 def compile_model(derived, flags=None):
@@ -177,7 +203,8 @@ def _system(model):
     common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model,
                   name="symbolic")
     if d.kind == "ode":
-        return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], **common)
+        return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
+                                   **common)
     if d.kind == "generalized":
         return compiled.generalized_system(d.n, a["mass"], a["forces"],
                                            forces_jac=a.get("forces_jac"),

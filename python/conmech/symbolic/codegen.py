@@ -5,7 +5,8 @@ of one free-form Fortran module whose procedures have the C signatures of conmec
 compiled systems (``value`` for t, explicit-shape arrays, column-major matrices, the
 parameter array ``p`` last)::
 
-    ode:          cm_rhs(t, y, dydt, p), cm_jac(t, y, dfdy, p)
+    ode:          cm_rhs(t, y, dydt, p), cm_jac(t, y, dfdy, p),
+                  cm_jac_prod(t, y, k, x, jx, p)   (jx = J x, x an n x k block)
     generalized:  cm_mass(t, q, M, p), cm_forces(t, q, v, Q, p),
                   cm_forces_jac(t, q, v, a, R, p), real cm_energy(t, q, v, p)
     constrained:  cm_mass, cm_forces, cm_energy, and as present cm_phi(t, q, c, p),
@@ -34,20 +35,21 @@ import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
 __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
-           "trig_split", "ENTRY_POINTS"]
+           "trig_split", "ENTRY_POINTS", "product_terms", "product_lines"]
 
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
-    "ode": ["rhs", "jac"],
+    "ode": ["rhs", "jac", "jac_prod"],
     "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces"],
     "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
                     "nh_matrix", "nh_gamma"],
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "4"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "5"   # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
-#                         4: conmech_mass_forces (M and Q in one call, shared subexpressions)
+#                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
+#                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed)
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -348,6 +350,87 @@ def _procedure(printer, cname, args, decls, outputs, result=None, defs=(), trig=
             + lines0 + lines1 + lines + [tail, ""])
 
 
+def product_terms(jac, printer):
+    """Row-wise terms of the product J x for a Jacobian `jac` (sympy Matrix): for each row
+    i, a list of (column j, sign "+" or "-", coefficient) over the structurally nonzero
+    entries, where the coefficient is None for +-1, the printed literal of the magnitude of
+    a constant entry, or the index into the returned list of variable entries (expressions
+    of t, y, p). Returns (rows, variable entries)."""
+    rows, var = [], []
+    for i in range(jac.shape[0]):
+        terms = []
+        for j in range(jac.shape[1]):
+            e = sp.sympify(jac[i, j])
+            if e == 0:
+                continue
+            if e.is_number and e.is_real:
+                sign = "-" if e < 0 else "+"
+                mag = abs(e)
+                terms.append((j, sign, None if mag == 1 else printer._print(mag)))
+            else:
+                terms.append((j, "+", len(var)))
+                var.append(e)
+        rows.append(terms)
+    return rows, var
+
+
+def product_lines(rows, entry_names, x, jx, col, indent):
+    """Statements jx(i, col) = sum_j J_ij x(j, col) for :func:`product_terms`' rows
+    (`entry_names`: the Fortran names of the variable entries)."""
+    out = []
+    for i, terms in enumerate(rows):
+        parts = []
+        for j, sign, c in terms:
+            xv = f"{x}({j + 1}, {col})"
+            if c is None:
+                parts.append((sign, xv))
+            elif isinstance(c, int):
+                parts.append((sign, f"{entry_names[c]}*{xv}"))
+            else:
+                parts.append((sign, f"{c}*{xv}"))
+        if not parts:
+            rhs = "0.0_dp"
+        else:
+            rhs = ("-" if parts[0][0] == "-" else "") + parts[0][1]
+            rhs += "".join(f" {sg} {t}" for sg, t in parts[1:])
+        out += _wrap(f"{jx}({i + 1}, {col}) = {rhs}", indent)
+    return out
+
+
+def _jac_prod_procedure(printer, d):
+    """cm_jac_prod(t, y, k, x, jx, p): jx = J x for an n x k block x. The variable entries
+    of J are evaluated once (one common-subexpression elimination), then each column of x
+    is multiplied over the structurally nonzero entries only (constant entries folded)."""
+    n, npar = d.n, max(len(d.params), 1)
+    ind = "        "
+    rows, var = product_terms(d.jac, printer)
+    allx, tdefs = trig_split([sp.sympify(e) for e in var])
+    extra = {s_: f"tg{k + 1}" for k, (s_, _) in enumerate(tdefs)}
+    ent = [f"jv{k + 1}" for k in range(len(var))]
+    saved = printer.names
+    printer.names = {**saved, **extra}
+    try:
+        lines0 = []
+        for s_, e in tdefs:
+            lines0 += _wrap(f"{extra[s_]} = {printer._print(prepare(e))}", ind)
+        temps, lines = assignments(ent, allx, printer, ind) if var else ([], [])
+    finally:
+        printer.names = saved
+    name = "conmech_jac_prod"
+    head = [f"    subroutine {name}(t, y, k, x, jx, p) bind(C, name=\"{name}\")",
+            f"{ind}real(dp), value, intent(in) :: t",
+            f"{ind}real(dp), intent(in) :: y({n})",
+            f"{ind}integer(c_int), value, intent(in) :: k",
+            f"{ind}real(dp), intent(in) :: x({n}, k)",
+            f"{ind}real(dp), intent(out) :: jx({n}, k)",
+            f"{ind}real(dp), intent(in) :: p({npar})",
+            f"{ind}integer :: c"]
+    loop = ([f"{ind}do c = 1, k"] + product_lines(rows, ent, "x", "jx", "c", ind + "    ")
+            + [f"{ind}end do"])
+    return (head + _decl_temps(list(extra.values()) + temps + ent, ind) + lines0 + lines
+            + loop + [f"    end subroutine {name}", ""])
+
+
 def _names(d):
     names = {d.t: "t"}
     for i, s in enumerate(d.coords):
@@ -424,7 +507,8 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
         procs.append(_procedure(pr, "conmech_jac", ["t", "y", "dfdy", "p"],
                                 [T, arr("y", [n]), arr("dfdy", [n, n], "out"), P],
                                 [("dfdy", d.jac, True)]))
-        entries = ["rhs", "jac"]
+        procs.append(_jac_prod_procedure(pr, d))
+        entries = ["rhs", "jac", "jac_prod"]
     else:
         Q1 = [T, arr("q", [n])]
         QV = Q1 + [arr("v", [n])]

@@ -4,8 +4,10 @@
 self-contained Fortran module that needs only ``use conmech`` (no Python, no C ABI, no
 shared library): the parameters are components of the type with their values as defaults.
 
-- ode (``derive_ode``): ``type, extends(ode_system) :: NAME`` with ``rhs`` and the exact
-  ``jacobian`` (``has_jacobian`` true).
+- ode (``derive_ode``): ``type, extends(ode_system) :: NAME`` with ``rhs``, the exact
+  ``jacobian`` (``has_jacobian`` true) and the Jacobian product ``jacobian_product`` /
+  ``rhs_jacobian_product`` (``has_jacobian_product`` true: ``integrate_stm`` evaluates
+  z' = [f; J Phi] in one call over J's structurally nonzero entries, never forming J).
 - generalized (``derive_lagrangian``): ``type, extends(generalized_system) :: NAME_mech``
   (mass, forces, energy: for ``generalized_solve``) and ``type, extends(ode_system) ::
   NAME`` with y = [q, v]: ``rhs`` solves M a = Q by Cholesky (LAPACK dpotrf/dpotrs through
@@ -43,7 +45,7 @@ import re
 
 import sympy as sp
 
-from .codegen import FortranPrinter, assignments
+from .codegen import FortranPrinter, assignments, product_lines, product_terms
 
 __all__ = ["emit", "fortran_name_check"]
 
@@ -51,7 +53,8 @@ __all__ = ["emit", "fortran_name_check"]
 # generated type, always referenced as self%name) may not take these names
 _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energy",
              "has_energy", "phi", "phi_jac", "phi_t", "phi_gamma", "nh_matrix", "nh_gamma",
-             "rhs", "jacobian", "has_jacobian", "self", "dp"}
+             "rhs", "jacobian", "has_jacobian", "self", "dp", "jacobian_product",
+             "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian"}
 _IND = "        "
 
 
@@ -242,6 +245,9 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
                   f"        procedure :: jacobian => {name}_jacobian",
                   f"        procedure :: has_jacobian => {name}_has_jacobian",
+                  f"        procedure :: jacobian_product => {name}_jacobian_product",
+                  f"        procedure :: rhs_jacobian_product => {name}_rhs_jacobian_product",
+                  f"        procedure :: has_jacobian_product => {name}_has_jacobian_product",
                   f"    end type {name}", ""]
         pr = em.printer()
         body += _ctor(name, name, [], d)
@@ -252,6 +258,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                         [_decl("t"), _decl("y", [":"]), _decl("dfdy", [":", ":"], "out")],
                         pr, [("dfdy", d.jac, True)], "dfdy = df/dy (exact, from sympy).")
         body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
+        body += _ode_products(name, pr, d)
     elif d.kind == "generalized":
         mech = f"{name}_mech"
         lines += [f"    public :: {name}, {mech}", f"    public :: new_{name}, new_{mech}",
@@ -368,6 +375,39 @@ def _ctor(tname, fname, sets, d):
     lines += [f"{_IND}s%{pn} = {_lit(pv)}" for pn, pv in zip(d.param_names, d.param_values)]
     lines += [f"    end function new_{fname}", ""]
     return lines
+
+
+def _ode_products(name, pr, d):
+    """jacobian_product (jx = J x) and rhs_jacobian_product (f and J x, one common-
+    subexpression elimination over f and J's variable entries) of an ode type: only the
+    structurally nonzero entries of J enter, constant ones folded into the products."""
+    rows, var = product_terms(d.jac, pr)
+    ent = [f"jv{k + 1}" for k in range(len(var))]
+    out = []
+    for proc, with_f in ((f"{name}_jacobian_product", False),
+                         (f"{name}_rhs_jacobian_product", True)):
+        targets = ([f"dydt({i + 1})" for i in range(d.n)] if with_f else []) + ent
+        exprs = (list(d.f) if with_f else []) + var
+        temps, lines = assignments(targets, exprs, pr, _IND) if exprs else ([], [])
+        temps = temps + ent
+        args = ["t", "n", "k", "y", "dydt", "x", "jx"] if with_f else ["t", "n", "k", "y",
+                                                                       "x", "jx"]
+        doc = ("f(t, y) and jx = J(t, y) x at once (one elimination over both)." if with_f
+               else "jx = J(t, y) x for an n x k block x (no J formed).")
+        out += [f"    !> {doc}", f"    subroutine {proc}(self, {', '.join(args)})",
+                f"{_IND}class({name}), intent(in) :: self", _decl("t"),
+                f"{_IND}integer, intent(in) :: n, k", _decl("y", ["n"]), _decl("x", ["n", "k"])]
+        if with_f:
+            out.append(_decl("dydt", ["n"], "out"))
+        out += [_decl("jx", ["n", "k"], "out"), f"{_IND}integer :: c"]
+        out += [f"{_IND}real(dp) :: " + ", ".join(temps[i:i + 10])
+                for i in range(0, len(temps), 10)]
+        out += lines + [f"{_IND}do c = 1, k"]
+        out += product_lines(rows, ent, "x", "jx", "c", _IND + "    ")
+        out += [f"{_IND}end do", f"    end subroutine {proc}", ""]
+    out += _logical_true(name, f"{name}_has_jacobian_product",
+                         "The Jacobian product is structure-aware (integrate_stm uses it).")
+    return out
 
 
 def _mass_solve(n, nrhs, rhs_name):

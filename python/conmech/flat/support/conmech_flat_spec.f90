@@ -13,6 +13,8 @@
 !!         constrained:  6 mass, 7 forces, 8 (unused), 9 energy, 10 phi, 11 phi_jac,
 !!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
+!!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
+!!     spec(18) (optional, ode) jac_prod: J x for an n x k block x (set_c_jac_prod)
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -25,7 +27,7 @@ module conmech_flat_spec
     use conmech_systems_mech, only: make_constrained, make_generalized
     use conmech_generalized, only: generalized_system, generalized_ode
     use conmech_constrained_system, only: constrained_system
-    use conmech_c_system, only: c_ode_system, make_c_ode
+    use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
     implicit none
@@ -106,6 +108,7 @@ contains
                 type(c_ode_system) :: s
                 call make_c_ode(int(spec(2)), fptr(spec(6)), fptr(spec(7)), params, s, &
                                 info, msg)
+                if (size(spec) >= 18) call set_c_jac_prod(s, fptr(spec(18)))
                 if (info == CM_SUCCESS) allocate (sys, source=s)
             end block
         case (KIND_GENERALIZED)
