@@ -14,8 +14,12 @@
 !! conmech_c_mechanics, named conmech_rhs, conmech_jac (ode); conmech_mass,
 !! conmech_forces, conmech_forces_jac, conmech_energy (generalized and constrained);
 !! conmech_phi, conmech_phi_jac, conmech_phi_t, conmech_phi_gamma, conmech_nh_matrix,
-!! conmech_nh_gamma (constrained). Missing optional functions fall back to finite
-!! differences. The library stays loaded for the life of the process.
+!! conmech_nh_gamma (constrained). Optional fast entries: conmech_jac_prod (ode: J x for a
+!! block x, `set_c_jac_prod`, used by `integrate_stm`), conmech_mass_forces (M and Q in
+!! one call) and conmech_accel (a = M^-1 Q, `void accel(double t, const double *q, const
+!! double *v, double *a, const double *p)`) for generalized models. Missing optional
+!! functions fall back to finite differences (or to mass + forces). The library stays
+!! loaded for the life of the process.
 module conmech_model_library
     use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_char, c_int, c_double, &
                                            c_null_char, c_associated, &
@@ -25,7 +29,7 @@ module conmech_model_library
     use conmech_ode_system, only: ode_system
     use conmech_generalized, only: generalized_ode
     use conmech_constrained_system, only: constrained_system
-    use conmech_c_system, only: c_ode_system, make_c_ode
+    use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
     implicit none
@@ -45,6 +49,8 @@ module conmech_model_library
         real(dp), allocatable :: defaults(:)         !! default parameter values
         character(len=:), allocatable :: param_names !! blank-separated names
         type(c_funptr) :: rhs, jac
+        type(c_funptr) :: jac_prod      !! optional Jacobian product (ode models)
+        type(c_funptr) :: accel         !! optional a = M^-1 Q (generalized models)
         type(c_mech_pointers) :: fp
     end type model_library
 
@@ -174,6 +180,9 @@ contains
         end if
         lib%rhs = symbol(h, "conmech_rhs")
         lib%jac = symbol(h, "conmech_jac")
+        lib%jac_prod = symbol(h, "conmech_jac_prod")
+        lib%accel = symbol(h, "conmech_accel")
+        lib%fp%mass_forces = symbol(h, "conmech_mass_forces")
         lib%fp%mass = symbol(h, "conmech_mass")
         lib%fp%forces = symbol(h, "conmech_forces")
         lib%fp%forces_jac = symbol(h, "conmech_forces_jac")
@@ -202,6 +211,7 @@ contains
             block
                 type(c_ode_system) :: s
                 call make_c_ode(lib%n, lib%rhs, lib%jac, params, s, info, msg)
+                call set_c_jac_prod(s, lib%jac_prod)
                 if (info == CM_SUCCESS) allocate (sys, source=s)
             end block
         case (MODEL_KIND_GENERALIZED)
