@@ -251,3 +251,29 @@ def hill_lagrangian():
     m, kappa = sp.symbols("m kappa")
     F = kappa/sp.sqrt(x**2 + y**2) + sp.Rational(3, 2)*m**2*x**2
     return (D(x)**2 + D(y)**2)/2 + m*(x*D(y) - y*D(x)) + F, [x, y]
+
+
+# ------------------------------------------------------------------ first-order systems
+
+def arenstorf_ode():
+    """Arenstorf's equations (restricted three-body problem, rotating frame) as formulas
+    for conmech.symbolic.ode_system: (f, [x, y, u, v], the parameter symbol mu)."""
+    x, y, u, v, mu = sp.symbols("x y u v mu")
+    mp = 1 - mu
+    r1 = sp.sqrt((x + mu)**2 + y**2)
+    r2 = sp.sqrt((x - mp)**2 + y**2)
+    f = [u, v, x + 2*v - mp*(x + mu)/r1**3 - mu*(x - mp)/r2**3,
+         y - 2*u - mp*y/r1**3 - mu*y/r2**3]
+    return f, [x, y, u, v], mu
+
+
+def use_test_cache(base):
+    """Point CONMECH_CACHE at the test session's compile cache (created under `base` by
+    the first test module that asks; shared by every module of the session)."""
+    import os
+    d = os.environ.get("_CONMECH_TEST_CACHE")
+    if not d:
+        d = os.path.join(str(base), "conmech_cache")
+        os.environ["_CONMECH_TEST_CACHE"] = d
+    os.environ["CONMECH_CACHE"] = d
+    return d

@@ -15,6 +15,7 @@ from conmech import compiled, stability
 
 sp = pytest.importorskip("sympy")
 from conmech import symbolic  # noqa: E402
+import symbolic_seeds as seeds  # noqa: E402
 
 HERE = os.path.dirname(__file__)
 MU = 0.012277471
@@ -22,19 +23,19 @@ Y0 = [0.994, 0.0, 0.0, -2.00158510637908252240537862224]
 T = 17.0652165601579625588917206249
 
 
-def arenstorf_model():
-    x, y, u, v, mu = sp.symbols("x y u v mu")
-    mp = 1 - mu
-    r1 = sp.sqrt((x + mu)**2 + y**2)
-    r2 = sp.sqrt((x - mp)**2 + y**2)
-    f = [u, v, x + 2*v - mp*(x + mu)/r1**3 - mu*(x - mp)/r2**3,
-         y - 2*u - mp*y/r1**3 - mu*y/r2**3]
-    return symbolic.ode_system(f, [x, y, u, v], params={mu: MU}, model_only=True)
+@pytest.fixture(scope="session", autouse=True)
+def symbolic_cache_jac_prod(tmp_path_factory):
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
+
+
+def _inputs():
+    f, y, mu = seeds.arenstorf_ode()
+    return f, y, {mu: MU}
 
 
 @pytest.fixture(scope="module")
 def aren():
-    return arenstorf_model()
+    return symbolic.ode_system(*_inputs(), model_only=True)
 
 
 def without_product(model):
@@ -96,16 +97,6 @@ def test_symbolic_system_passes_the_product(aren):
     s = symbolic.ode_system(*_inputs())
     assert s.spec[17] != 0 and s.spec.size == 18
     assert without_product(aren).spec[17] == 0
-
-
-def _inputs():
-    x, y, u, v, mu = sp.symbols("x y u v mu")
-    mp = 1 - mu
-    r1 = sp.sqrt((x + mu)**2 + y**2)
-    r2 = sp.sqrt((x - mp)**2 + y**2)
-    f = [u, v, x + 2*v - mp*(x + mu)/r1**3 - mu*(x - mp)/r2**3,
-         y - 2*u - mp*y/r1**3 - mu*y/r2**3]
-    return f, [x, y, u, v], {mu: MU}
 
 
 def test_arenstorf_stm_and_monodromy_with_and_without_product(aren):

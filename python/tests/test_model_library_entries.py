@@ -17,11 +17,17 @@ sp = pytest.importorskip("sympy")
 from conmech import symbolic  # noqa: E402
 from conmech.symbolic.build import compile_source  # noqa: E402
 from conmech.symbolic.codegen import generate  # noqa: E402
+import symbolic_seeds as seeds  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 GRID = ["--vary", "y0:1", "--from", "0.2", "--to", "1.0", "--count", "3", "--t-end", "3",
         "--rtol", "1e-11", "--atol", "1e-11", "--quiet"]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def symbolic_cache_models(tmp_path_factory):
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
 
 
 @pytest.fixture(scope="module")
@@ -74,19 +80,9 @@ def test_sweep_uses_the_fast_entries_of_a_generalized_model(sweep, tmp_path):
         np.testing.assert_allclose(row[2:4], r.y[:, -1], rtol=1e-12, atol=1e-13)
 
 
-def cart_pendulum():
-    t = sp.Symbol("t")
-    x, th = sp.Function("x")(t), sp.Function("theta")(t)
-    M, m, l, g = sp.symbols("M m l g")
-    T = (M + m)*x.diff(t)**2/2 + m*l*sp.cos(th)*x.diff(t)*th.diff(t) \
-        + m*l**2*th.diff(t)**2/2
-    U = m*g*l*sp.cos(th)
-    return symbolic.lagrangian_system(T - U, [x, th], params={M: 1.0, m: 0.5, l: 1.0,
-                                                              g: 9.81})
-
-
 def test_sweep_of_a_symbolic_model_with_and_without_mass_forces(sweep, tmp_path):
-    s = cart_pendulum()
+    L, q = seeds.cart_pendulum()
+    s = symbolic.lagrangian_system(L, q, params=dict(M=1.0, m=0.5, l=1.0, g=9.81))
     lib = symbolic.save_model(s, tmp_path / "cart.so")
     d = symbolic.model_of(s).derived
     src, entries = generate(d, model_values=list(s.params))
@@ -110,13 +106,8 @@ def test_sweep_of_a_symbolic_model_with_and_without_mass_forces(sweep, tmp_path)
 
 def test_sweep_of_a_symbolic_ode_model_with_jac_prod(sweep, tmp_path):
     # an ode model exports conmech_jac_prod; sweep (explicit DOP853) runs it as before
-    x, y, u, v, mu = sp.symbols("x y u v mu")
-    mp = 1 - mu
-    r1 = sp.sqrt((x + mu)**2 + y**2)
-    r2 = sp.sqrt((x - mp)**2 + y**2)
-    f = [u, v, x + 2*v - mp*(x + mu)/r1**3 - mu*(x - mp)/r2**3,
-         y - 2*u - mp*y/r1**3 - mu*y/r2**3]
-    s = symbolic.ode_system(f, [x, y, u, v], params={mu: 0.012277471})
+    f, y, mu = seeds.arenstorf_ode()
+    s = symbolic.ode_system(f, y, params={mu: 0.012277471})
     lib = symbolic.save_model(s, tmp_path / "aren.so")
     a = run_sweep(sweep, lib, "0.994,0,0,-2.00158510637908252240537862224", tmp_path)
     for row in a:

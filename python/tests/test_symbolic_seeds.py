@@ -140,13 +140,8 @@ def test_hill_formulas_and_rotating_lagrangian_match_builtin():
 # ------------------------------------------------------------------ stability, events
 
 def arenstorf():
-    x, y, u, v, mu = sp.symbols("x y u v mu")
-    mp = 1 - mu
-    r1 = sp.sqrt((x + mu)**2 + y**2)
-    r2 = sp.sqrt((x - mp)**2 + y**2)
-    f = [u, v, x + 2*v - mp*(x + mu)/r1**3 - mu*(x - mp)/r2**3,
-         y - 2*u - mp*y/r1**3 - mu*y/r2**3]
-    return symbolic.ode_system(f, [x, y, u, v], params={mu: 0.012277471})
+    f, y, mu = seeds.arenstorf_ode()
+    return symbolic.ode_system(f, y, params={mu: 0.012277471})
 
 
 def arenstorf_numpy(mu=0.012277471):

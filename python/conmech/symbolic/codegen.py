@@ -298,6 +298,23 @@ def trig_split(exprs):
     return [e.xreplace(rep) for e in exprs], defs
 
 
+def _trig_defs(printer, exprs, local, ind):
+    """:func:`trig_split` over exprs: (exprs with the sines and cosines replaced, {symbol:
+    Fortran name tg<k>}, the statements defining them). `local`: further {symbol: name}
+    the definitions may refer to."""
+    exprs, tdefs = trig_split(exprs)
+    extra = {s_: f"tg{k + 1}" for k, (s_, _) in enumerate(tdefs)}
+    saved = printer.names
+    printer.names = {**saved, **extra, **local}
+    try:
+        lines = []
+        for s_, e in tdefs:
+            lines += _wrap(f"{extra[s_]} = {printer._print(prepare(e))}", ind)
+    finally:
+        printer.names = saved
+    return exprs, extra, lines
+
+
 def _procedure(printer, cname, args, decls, outputs, result=None, defs=(), trig=True):
     """One bind(C) subroutine (or a real(dp) function when `result` is an expression).
     `defs` [(Symbol, expr)]: local values computed first (their own common-subexpression
@@ -319,17 +336,12 @@ def _procedure(printer, cname, args, decls, outputs, result=None, defs=(), trig=
     defs = list(defs)
     nd = len(defs)
     allx = [sp.sympify(e) for _, e in defs] + [sp.sympify(e) for e in exprs]
-    tdefs = []
-    if trig:
-        allx, tdefs = trig_split(allx)
-    extra = {s: f"tg{k + 1}" for k, (s, _) in enumerate(tdefs)}
-    extra.update({s: f"dd{k + 1}" for k, (s, _) in enumerate(defs)})
+    local = {s: f"dd{k + 1}" for k, (s, _) in enumerate(defs)}
+    allx, extra, lines0 = _trig_defs(printer, allx, local, ind) if trig else (allx, {}, [])
+    extra.update(local)
     saved = printer.names
     printer.names = {**saved, **extra}
     try:
-        lines0 = []
-        for s_, e in tdefs:
-            lines0 += _wrap(f"{extra[s_]} = {printer._print(prepare(e))}", ind)
         temps1, lines1 = ([], [])
         if nd:
             temps1, lines1 = assignments([extra[s_] for s_, _ in defs], allx[:nd], printer,
@@ -404,15 +416,11 @@ def _jac_prod_procedure(printer, d):
     n, npar = d.n, max(len(d.params), 1)
     ind = "        "
     rows, var = product_terms(d.jac, printer)
-    allx, tdefs = trig_split([sp.sympify(e) for e in var])
-    extra = {s_: f"tg{k + 1}" for k, (s_, _) in enumerate(tdefs)}
+    allx, extra, lines0 = _trig_defs(printer, [sp.sympify(e) for e in var], {}, ind)
     ent = [f"jv{k + 1}" for k in range(len(var))]
     saved = printer.names
     printer.names = {**saved, **extra}
     try:
-        lines0 = []
-        for s_, e in tdefs:
-            lines0 += _wrap(f"{extra[s_]} = {printer._print(prepare(e))}", ind)
         temps, lines = assignments(ent, allx, printer, ind) if var else ([], [])
     finally:
         printer.names = saved
