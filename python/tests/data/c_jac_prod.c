@@ -20,3 +20,10 @@ void kepler_jac_prod(double t, const double *y, int k, const double *x, double *
     }
 }
 long kepler_jac_prod_calls(void) { return kepler_jp_calls; }
+
+/* the model-library name of the product (c_model_kepler.c + this file = a Kepler model
+   library with conmech_jac_prod) */
+void conmech_jac_prod(double t, const double *y, int k, const double *x, double *jx,
+                      const double *p) {
+    kepler_jac_prod(t, y, k, x, jx, p);
+}
