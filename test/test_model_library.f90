@@ -35,7 +35,7 @@ contains
         class(ode_system), allocatable :: s_jp, s_plain, ref, gs_fast, gs_plain
         type(ode_options) :: opt
         real(dp) :: y(4), p1(4, 4), p2(4, 4), p3(4, 4), y1(4), y2(4), y3(4), x(4, 2), &
-                    jx(4, 2), jref(4, 2), f1(2), f2(2)
+                    jx(4, 2), jref(4, 2), f1(2), f2(2), fy(4), fy2(4)
         real(dp), parameter :: pi = acos(-1.0_dp)
         integer :: info, i
         character(len=:), allocatable :: msg
@@ -63,6 +63,15 @@ contains
         call ref%jacobian_product(0.0_dp, 4, 2, y, x, jref)
         call ts%check_less(maxval(abs(jx - jref))/maxval(abs(jref)), 1.0e-14_dp, &
                            "conmech_jac_prod = the built-in kepler's J x")
+        ! f and J x in one call (c_ode_system's rhs_jacobian_product): the same values as
+        ! rhs and jacobian_product apart; without the C product, the default (J, then J x)
+        call s_jp%rhs(0.0_dp, y, fy)
+        call s_jp%rhs_jacobian_product(0.0_dp, 4, 2, y, fy2, x, jx)
+        call ts%check(all(fy2 == fy) .and. maxval(abs(jx - jref)) <= 1.0e-14_dp* &
+                      maxval(abs(jref)), "rhs_jacobian_product through the C entries")
+        call s_plain%rhs_jacobian_product(0.0_dp, 4, 2, y, fy2, x, jx)
+        call ts%check(all(fy2 == fy) .and. maxval(abs(jx - jref)) <= 1.0e-6_dp* &
+                      maxval(abs(jref)), "rhs_jacobian_product without jac_prod: the default")
         ! the STM of the circular orbit (period 2 pi) through the library's product equals
         ! the built-in's (analytic J) at the tolerance; the plain library's (finite
         ! differences) is close too (1.4e-10 measured)

@@ -69,6 +69,7 @@ module conmech_c_system
         procedure :: jacobian => c_ode_jacobian
         procedure :: has_jacobian => c_ode_has_jacobian
         procedure :: jacobian_product => c_ode_jacobian_product
+        procedure :: rhs_jacobian_product => c_ode_rhs_jacobian_product
         procedure :: has_jacobian_product => c_ode_has_jacobian_product
     end type c_ode_system
 
@@ -152,6 +153,22 @@ contains
             call ode_jacobian_product(self, t, n, k, y, x, jx)
         end if
     end subroutine c_ode_jacobian_product
+
+    !> f and jx = J x: the C `rhs` and `jac_prod` called directly (explicit shapes, no
+    !! array descriptors or packing), else the default.
+    subroutine c_ode_rhs_jacobian_product(self, t, n, k, y, dydt, x, jx)
+        class(c_ode_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: dydt(n), jx(n, k)
+        call self%f(t, y, dydt, self%p)
+        if (associated(self%jp)) then
+            call self%jp(t, y, int(k, c_int), x, jx, self%p)
+        else
+            call ode_jacobian_product(self, t, n, k, y, x, jx)
+        end if
+    end subroutine c_ode_rhs_jacobian_product
 
     logical function c_ode_has_jacobian_product(self)
         class(c_ode_system), intent(in) :: self
