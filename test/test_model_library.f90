@@ -107,7 +107,9 @@ contains
         call model_system(g_plain, [1.0_dp, 0.8_dp, 9.81_dp], gs_plain, info, msg)
         call gs_fast%rhs(0.0_dp, [0.6_dp, 0.2_dp], f1)
         call gs_plain%rhs(0.0_dp, [0.6_dp, 0.2_dp], f2)
-        call ts%check_less(maxval(abs(f1 - f2)), 1.0e-15_dp, "fast and plain entries agree")
+        ! (accel's a = -g sin(q)/l and the solve of M a = Q may differ in the last bits)
+        call ts%check_less(maxval(abs(f1 - f2)), 1.0e-14_dp*maxval(abs(f2)), &
+                           "fast and plain entries agree")
         call ts%check_close(f2(2), -9.81_dp*sin(0.6_dp)/0.8_dp, 1.0e-14_dp, &
                             "pendulum acceleration -g sin(q)/l")
     end subroutine run
