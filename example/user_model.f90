@@ -21,7 +21,7 @@ program user_model
     type(ode_options) :: opt
     type(ode_result) :: res, gres
     real(dp) :: y0(4), y(4), phi(4, 4), jex(4, 4), jfd(4, 4), p0, e0, de, dp_max
-    real(dp) :: m0(2, 2), m1(2, 2)
+    real(dp) :: m0(2, 2), m1(2, 2), fa(4), fb(4)
     integer :: info, i
     character(len=:), allocatable :: msg
 
@@ -76,6 +76,15 @@ program user_model
 
     ! the Arenstorf orbit: one period, and its monodromy matrix with the exact Jacobian
     aren = new_arenstorf_sym()
+    ! its Jacobian product (integrate_stm's path: f and J Phi in one call, J not formed)
+    ! against the dense Jacobian times the same block
+    y = [0.7_dp, -0.4_dp, 0.3_dp, 0.9_dp]
+    phi = reshape([(sin(0.9_dp*i), i=1, 16)], [4, 4])
+    call aren%jacobian(0.0_dp, y, jex)
+    call aren%rhs_jacobian_product(0.0_dp, 4, 4, y, fa, phi, jfd)
+    call aren%rhs(0.0_dp, y, fb)
+    write (*, '(a, 2es10.2)') "arenstorf J x vs dense J times x, f vs rhs: ", &
+        maxval(abs(jfd - matmul(jex, phi)))/maxval(abs(jfd)), maxval(abs(fa - fb))
     y = [0.994_dp, 0.0_dp, 0.0_dp, -2.00158510637908252240537862224_dp]
     y0 = y
     phi = 0.0_dp

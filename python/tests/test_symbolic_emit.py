@@ -163,6 +163,8 @@ def test_fpm_example_user_model_agrees_with_builtins():
     assert abs(value(out, "Liouville det(STM) det M(q1)/det M(q0) - 1:")[0]) < 1e-10
     # Arenstorf: closed orbit, volume-preserving monodromy whose trace agrees with the
     # built-in's (finite-difference Jacobian, ~1e-6 relative)
+    # the emitted product (integrate_stm's path) against the emitted dense Jacobian
+    assert max(value(out, "arenstorf J x vs dense J times x, f vs rhs:", 2)) < 1e-14
     assert value(out, "arenstorf closure |y(T) - y(0)|:")[0] < 1e-8
     assert abs(value(out, "arenstorf det(monodromy) - 1:")[0]) < 1e-6
     tr = value(out, "arenstorf monodromy trace:")[0]
