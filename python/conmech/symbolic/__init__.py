@@ -119,7 +119,6 @@ class CompiledModel:
             return float(r)
         return outs[0] if len(outs) == 1 else tuple(outs)
 
-
     def _call_jac_prod(self, t, y, x, params=None):
         """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
         n = self.derived.n
