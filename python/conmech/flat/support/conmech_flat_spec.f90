@@ -13,6 +13,8 @@
 !!         constrained:  6 mass, 7 forces, 8 (unused), 9 energy, 10 phi, 11 phi_jac,
 !!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
+!!     spec(17) (optional, generalized) accel: a = M^-1 Q directly
+!!     spec(18) (optional, ode) jac_prod
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -70,6 +72,7 @@ contains
         fp%nh_matrix = fptr(spec(14))
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
+        if (size(spec) >= 17) fp%accel = fptr(spec(17))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
