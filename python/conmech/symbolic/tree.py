@@ -266,6 +266,8 @@ def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
         c = kb["c"]
         uD = L(u*Dinv)
         pa = [pA[r] + sum(Ia[r, j]*c[j] for j in range(3)) + U[r]*uD for r in range(3)]
+        if b.joint == "revolute":   # exactly: pA_0 + D u / D = tau
+            pa[0] = tau[b.name]
         pa = [L(x) for x in pa]
         bx, by, E = kb["X"]
         Xm = sp.Matrix([[1, 0, 0], [bx, E[0][0], E[0][1]], [by, E[1][0], E[1][1]]])
