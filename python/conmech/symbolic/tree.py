@@ -24,11 +24,11 @@ chains).
 Algorithm (Featherstone, Rigid Body Dynamics Algorithms, ch. 7, with planar spatial vectors
 [omega, v_x, v_y]): a forward pass for the velocities and bias accelerations, a backward
 pass for the articulated inertias IA_i and bias forces pA_i (D_i = S_i^T IA_i S_i, the
-articulated inertia of joint i, is checked positive: otherwise the output is NaN and the
-integration stops with success=False), a forward pass for the accelerations; gravity enters
-as the acceleration of the ground. For absolute coordinates the relative rates are
-q'_i - q'_k (k the nearest revolute ancestor), the generalized forces are mapped by
-tau_rel = L^-T Q (subtree sums) and the accelerations accumulated in the last pass.
+articulated inertia of joint i, is checked positive: otherwise the output is not finite
+and the integration stops with success=False), a forward pass for the accelerations;
+gravity enters as the acceleration of the ground. For absolute coordinates the relative
+rates are q'_i - q'_k (k the nearest revolute ancestor), the generalized forces are mapped
+by tau_rel = L^-T Q (subtree sums) and the accelerations accumulated in the last pass.
 """
 import sympy as sp
 from sympy.core.function import AppliedUndef
@@ -513,7 +513,8 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
 def accel_procedure(printer, d, cname="conmech_accel"):
     """Fortran lines of the bind(C) subroutine ``cname(t, q, v, a, p)`` that evaluates the
     straight-line articulated-body code ``d.aba`` (defs, accelerations); a pivot that is
-    not positive (or NaN) becomes NaN, so that the output is not finite."""
+    not positive (or NaN) is set to 0, so that its inverse and every acceleration is
+    infinite or NaN (the compiled system then reports non-finite accelerations)."""
     defs, acc = d.aba
     n = d.n
     npar = max(len(d.params), 1)
@@ -528,8 +529,9 @@ def accel_procedure(printer, d, cname="conmech_accel"):
         for s, e in defs:
             if isinstance(e, str):      # "positive": the pivot check
                 nm = names[s]
-                body.append(f"{ind}if (.not. ({nm} > 0.0_dp)) {nm} = "
-                            f"ieee_value({nm}, ieee_quiet_nan)")
+                # (a zero pivot divides to Inf: every output below is then Inf or NaN;
+                # no ieee_arithmetic, whose procedure entry/exit costs ~90 instructions)
+                body.append(f"{ind}if (.not. ({nm} > 0.0_dp)) {nm} = 0.0_dp")
             else:
                 body += _wrap(f"{names[s]} = {printer._print(prepare(e))}", ind)
         for i, e in enumerate(acc):
@@ -537,7 +539,6 @@ def accel_procedure(printer, d, cname="conmech_accel"):
     finally:
         printer.names = saved
     head = [f'    subroutine {cname}(t, q, v, a, p) bind(C, name="{cname}")',
-            f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
             f"{ind}real(dp), value, intent(in) :: t",
             f"{ind}real(dp), intent(in) :: q({n}), v({n})",
             f"{ind}real(dp), intent(out) :: a({n})",
