@@ -33,7 +33,7 @@ by tau_rel = L^-T Q (subtree sums) and the accelerations accumulated in the last
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["Body", "planar_tree", "build_tree"]
+__all__ = ["Body", "planar_tree", "build_tree", "derive_tree"]
 
 _JOINTS = ("revolute", "prismatic")
 
@@ -427,6 +427,46 @@ def _check_leaves(order, data, params):
                                  "and zero inertia): the mass matrix would be singular")
 
 
+def _derive(parts, params, simplify, jacobian):
+    """The Derived record of the tree's Lagrangian with the ABA code attached (d.aba)."""
+    from .derive import derive_lagrangian
+    d = derive_lagrangian(parts["L"], parts["q"], params, parts["forces"], None, simplify,
+                          bool(jacobian))
+    n = d.n
+    qs = [sp.Dummy(f"q{i}", real=True) for i in range(n)]
+    vs = [sp.Dummy(f"v{i}", real=True) for i in range(n)]
+    defs, acc = parts["aba"](qs, vs)
+    sub = {**dict(zip(qs, d.coords)), **dict(zip(vs, d.speeds))}
+    byname = dict(zip(d.param_names, d.params))
+    known = set(d.coords) | set(d.speeds) | {d.t} | {s for s, _ in defs}
+    exprs = [e for _, e in defs if not isinstance(e, str)] + acc
+    for s in set().union(*[sp.sympify(e).free_symbols for e in exprs]):
+        if s in sub or s in known:
+            continue
+        if s.name in byname:
+            sub[s] = byname[s.name]
+        elif s.name == d.t.name:
+            sub[s] = d.t
+        else:
+            raise ValueError(f"unknown symbol '{s}': neither t, a coordinate nor a "
+                             "parameter with a value")
+    d.aba = ([(s, e if isinstance(e, str) else sp.sympify(e).xreplace(sub))
+              for s, e in defs], [sp.sympify(e).xreplace(sub) for e in acc])
+    return d
+
+
+def derive_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="relative",
+                simplify="auto", jacobian=True):
+    """The derived record (:class:`~conmech.symbolic.derive.Derived`) of a planar tree,
+    without compiling: what :func:`planar_tree` compiles, and what
+    ``python -m conmech.symbolic emit`` writes as a standalone Fortran module (whose
+    right-hand side is then the articulated-body algorithm). Arguments as
+    :func:`planar_tree`."""
+    parts = build_tree(bodies, gravity, forces, coordinates)
+    _check_leaves(parts["order"], parts["data"], params)
+    return _derive(parts, params, simplify, jacobian)
+
+
 def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="relative", *,
                 simplify="auto", jacobian=True, flags=None, model_only=False):
     """A compiled planar multibody tree (see the module docstring for frames and
@@ -470,35 +510,12 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
                           coordinates="absolute")
     """
     from . import _construct, _tup
-    from .derive import derive_lagrangian
     parts = build_tree(bodies, gravity, forces, coordinates)
     _check_leaves(parts["order"], parts["data"], params)
     q = parts["q"]
 
     def derive():
-        d = derive_lagrangian(parts["L"], q, params, parts["forces"], None, simplify,
-                              bool(jacobian))
-        n = d.n
-        qs = [sp.Dummy(f"q{i}", real=True) for i in range(n)]
-        vs = [sp.Dummy(f"v{i}", real=True) for i in range(n)]
-        defs, acc = parts["aba"](qs, vs)
-        sub = {**dict(zip(qs, d.coords)), **dict(zip(vs, d.speeds))}
-        byname = dict(zip(d.param_names, d.params))
-        known = set(d.coords) | set(d.speeds) | {d.t} | {s for s, _ in defs}
-        exprs = [e for _, e in defs if not isinstance(e, str)] + acc
-        for s in set().union(*[sp.sympify(e).free_symbols for e in exprs]):
-            if s in sub or s in known:
-                continue
-            if s.name in byname:
-                sub[s] = byname[s.name]
-            elif s.name == d.t.name:
-                sub[s] = d.t
-            else:
-                raise ValueError(f"unknown symbol '{s}': neither t, a coordinate nor a "
-                                 "parameter with a value")
-        d.aba = ([(s, e if isinstance(e, str) else sp.sympify(e).xreplace(sub))
-                  for s, e in defs], [sp.sympify(e).xreplace(sub) for e in acc])
-        return d
+        return _derive(parts, params, simplify, jacobian)
 
     body_key = sp.Tuple(*[sp.Tuple(*parts["data"][b.name][0], *parts["data"][b.name][1],
                                    parts["data"][b.name][2], *parts["data"][b.name][3],
@@ -510,18 +527,17 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
                       model_only)
 
 
-def accel_procedure(printer, d, cname="conmech_accel"):
-    """Fortran lines of the bind(C) subroutine ``cname(t, q, v, a, p)`` that evaluates the
-    straight-line articulated-body code ``d.aba`` (defs, accelerations); a pivot that is
-    not positive (or NaN) is set to 0, so that its inverse and every acceleration is
-    infinite or NaN (the compiled system then reports non-finite accelerations)."""
+def aba_lines(printer, d, target="a", ind="        "):
+    """(declarations, statements) of the straight-line articulated-body code ``d.aba``
+    assigning the accelerations to ``target(1..n)``, printed with `printer` (whose names
+    map the coordinates, velocities and parameters). A pivot that is not positive (or NaN)
+    is set to 0, so that its inverse and the accelerations are infinite or NaN (the
+    integrators then stop with a non-finite status); no ieee_arithmetic (its procedure
+    entry and exit would cost ~90 instructions per call)."""
+    from .codegen import _decl_temps, _wrap, prepare
     defs, acc = d.aba
-    n = d.n
-    npar = max(len(d.params), 1)
-    ind = "        "
     names = {s: f"b{k + 1}" for k, (s, e) in enumerate(
         (s, e) for s, e in defs if not isinstance(e, str))}
-    from .codegen import _decl_temps, _wrap, prepare
     saved = printer.names
     printer.names = {**saved, **names}
     body = []
@@ -529,19 +545,27 @@ def accel_procedure(printer, d, cname="conmech_accel"):
         for s, e in defs:
             if isinstance(e, str):      # "positive": the pivot check
                 nm = names[s]
-                # (a zero pivot divides to Inf: every output below is then Inf or NaN;
-                # no ieee_arithmetic, whose procedure entry/exit costs ~90 instructions)
                 body.append(f"{ind}if (.not. ({nm} > 0.0_dp)) {nm} = 0.0_dp")
             else:
                 body += _wrap(f"{names[s]} = {printer._print(prepare(e))}", ind)
         for i, e in enumerate(acc):
-            body += _wrap(f"a({i + 1}) = {printer._print(prepare(sp.sympify(e)))}", ind)
+            body += _wrap(f"{target}({i + 1}) = {printer._print(prepare(sp.sympify(e)))}",
+                          ind)
     finally:
         printer.names = saved
+    return _decl_temps(list(names.values()), ind), body
+
+
+def accel_procedure(printer, d, cname="conmech_accel"):
+    """Fortran lines of the bind(C) subroutine ``cname(t, q, v, a, p)`` that evaluates the
+    articulated-body accelerations (:func:`aba_lines`)."""
+    n = d.n
+    npar = max(len(d.params), 1)
+    ind = "        "
+    decl, body = aba_lines(printer, d, "a", ind)
     head = [f'    subroutine {cname}(t, q, v, a, p) bind(C, name="{cname}")',
             f"{ind}real(dp), value, intent(in) :: t",
             f"{ind}real(dp), intent(in) :: q({n}), v({n})",
             f"{ind}real(dp), intent(out) :: a({n})",
             f"{ind}real(dp), intent(in) :: p({npar})"]
-    return head + _decl_temps(list(names.values()), ind) + body + [f"    end subroutine {cname}",
-                                                                   ""]
+    return head + decl + body + [f"    end subroutine {cname}", ""]
