@@ -356,28 +356,35 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative"):
         if len(fl) != n:
             raise ValueError(f"forces has {len(fl)} components for {n} coordinates")
     absolute = coordinates == "absolute"
-    # positions and orientations -> T, U
-    pose = {}
+    # positions -> T, U in the compact form: a point's position is sum_phi R(phi) W_phi
+    # over the distinct frame angles phi on its path (W_phi: the offsets in that frame),
+    # so |r'|^2 = sum |U_phi|^2 + 2 sum_{phi<psi} [cos(psi - phi) U_phi.U_psi
+    # - sin(psi - phi) U_phi x U_psi] with U_phi = phi' J W_phi + W_phi' (J: +90 deg):
+    # the cosines of angle differences directly, as the lecture notes write T
+    pose, acc = {}, {}
     T = U = sp.Integer(0)
     for b in order:
         at, axis, m, com, inertia = data[b.name]
-        th_p, ox, oy = (sp.Integer(0),)*3 if b.parent is None else pose[b.parent]
+        th_p, segs = (sp.Integer(0), {}) if b.parent is None else pose[b.parent]
+        segs = dict(segs)
         q = b.q
-        if b.joint == "revolute":
-            dx, dy = _rot(th_p, *at)
-            th = q if absolute else th_p + q
-        else:
-            dx, dy = _rot(th_p, at[0] + q*axis[0], at[1] + q*axis[1])
-            th = th_p
-        ox, oy = ox + dx, oy + dy
-        pose[b.name] = (th, ox, oy)
-        cx, cy = _rot(th, *com)
-        rx, ry = ox + cx, oy + cy
+        off = at if b.joint == "revolute" else [at[0] + q*axis[0], at[1] + q*axis[1]]
+        w = segs.get(th_p, (0, 0))
+        segs[th_p] = (w[0] + off[0], w[1] + off[1])
+        th = (q if absolute else th_p + q) if b.joint == "revolute" else th_p
+        pose[b.name] = (th, segs)
         if m != 0:
-            T += m*(rx.diff(t)**2 + ry.diff(t)**2)/2
-            U -= m*(g[0]*rx + g[1]*ry)
+            pts = dict(segs)
+            w = pts.get(th, (0, 0))
+            pts[th] = (w[0] + com[0], w[1] + com[1])
+            _speed2(pts, t, m, acc)
+            for phi, (wx, wy) in pts.items():
+                c, s_ = sp.cos(phi), sp.sin(phi)
+                # g . R(phi) W = cos(phi) g.W - sin(phi) g x W
+                U -= m*(c*(g[0]*wx + g[1]*wy) - s_*(g[0]*wy - g[1]*wx))
         if inertia != 0:
             T += inertia*th.diff(t)**2/2
+    T += _kinetic(acc)
 
     def aba(qs, vs):
         sub = {}
@@ -393,6 +400,36 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative"):
         return _aba(order, index, data, qs, vs, tau, g, absolute)
 
     return dict(L=T - U, T=T, U=U, q=coords, forces=fl, aba=aba, order=order, data=data)
+
+
+def _speed2(pts, t, m, acc):
+    """Add the terms of m |r'|^2 of r = sum_phi R(phi) W_phi (`pts`: {phi: (W_x, W_y)}) to
+    `acc` ({(phi, psi): [terms of cos(psi - phi)], [terms of sin(psi - phi)]}, with the
+    squares under (phi, phi)); the sums are built once at the end (fast for long chains)."""
+    items = sorted(pts.items(), key=lambda kv: sp.default_sort_key(kv[0]))
+    us = []
+    for phi, (wx, wy) in items:
+        wx, wy = sp.sympify(wx), sp.sympify(wy)
+        phid = sp.sympify(phi).diff(t)
+        us.append((phi, -phid*wy + wx.diff(t), phid*wx + wy.diff(t)))
+    for i, (phi, ax, ay) in enumerate(us):
+        acc.setdefault((phi, phi), ([], []))[0].append(m*(ax**2 + ay**2))
+        for psi, bx, by in us[i + 1:]:
+            c, s_ = acc.setdefault((phi, psi), ([], []))
+            c.append(2*m*(ax*bx + ay*by))
+            s_.append(-2*m*(ax*by - ay*bx))
+
+
+def _kinetic(acc):
+    """sum over `acc` (see _speed2) of cos(psi - phi) (sum) + sin(psi - phi) (sum), / 2."""
+    out = []
+    for (phi, psi), (c, s_) in acc.items():
+        if phi == psi:
+            out.append(sp.Add(*c)/2)
+        else:
+            d = psi - phi
+            out.append(sp.cos(d)*sp.Add(*c)/2 + sp.sin(d)*sp.Add(*s_)/2)
+    return sp.Add(*out)
 
 
 def _check_leaves(order, data, params):
