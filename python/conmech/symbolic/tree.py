@@ -307,12 +307,13 @@ def _xtf(X, f):
     return (n_ + bx*fx + by*fy, E[0][0]*fx + E[1][0]*fy, E[0][1]*fx + E[1][1]*fy)
 
 
-def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative"):
-    """The pieces of a planar tree without compiling: a dict with ``L`` (T - U in the
-    dynamicsymbols), ``q`` (coordinates in the order of ``bodies``), ``forces`` (one
-    generalized force per coordinate), and ``aba(qs, vs)``, a function that returns the
-    articulated-body algorithm's straight-line code (defs, accelerations) in plain symbols
-    qs, vs (one per coordinate). Used by :func:`planar_tree`; useful to inspect T and U."""
+def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy=False):
+    """The pieces of a planar tree without compiling: a dict with ``L``, ``T``, ``U`` (in
+    the dynamicsymbols; with ``lazy`` None, computed by ``energies()`` when needed), ``q``
+    (coordinates in the order of ``bodies``), ``forces`` (one generalized force per
+    coordinate), and ``aba(qs, vs)``, a function that returns the articulated-body
+    algorithm's straight-line code (defs, accelerations) in plain symbols qs, vs (one per
+    coordinate). Used by :func:`planar_tree`; useful to inspect T and U."""
     if coordinates not in ("relative", "absolute"):
         raise ValueError(f"coordinates must be 'relative' or 'absolute', got {coordinates!r}")
     from sympy.physics.mechanics import dynamicsymbols
@@ -361,30 +362,32 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative"):
     # so |r'|^2 = sum |U_phi|^2 + 2 sum_{phi<psi} [cos(psi - phi) U_phi.U_psi
     # - sin(psi - phi) U_phi x U_psi] with U_phi = phi' J W_phi + W_phi' (J: +90 deg):
     # the cosines of angle differences directly, as the lecture notes write T
-    pose, acc = {}, {}
-    T = U = sp.Integer(0)
-    for b in order:
-        at, axis, m, com, inertia = data[b.name]
-        th_p, segs = (sp.Integer(0), {}) if b.parent is None else pose[b.parent]
-        segs = dict(segs)
-        q = b.q
-        off = at if b.joint == "revolute" else [at[0] + q*axis[0], at[1] + q*axis[1]]
-        w = segs.get(th_p, (0, 0))
-        segs[th_p] = (w[0] + off[0], w[1] + off[1])
-        th = (q if absolute else th_p + q) if b.joint == "revolute" else th_p
-        pose[b.name] = (th, segs)
-        if m != 0:
-            pts = dict(segs)
-            w = pts.get(th, (0, 0))
-            pts[th] = (w[0] + com[0], w[1] + com[1])
-            _speed2(pts, t, m, acc)
-            for phi, (wx, wy) in pts.items():
-                c, s_ = sp.cos(phi), sp.sin(phi)
-                # g . R(phi) W = cos(phi) g.W - sin(phi) g x W
-                U -= m*(c*(g[0]*wx + g[1]*wy) - s_*(g[0]*wy - g[1]*wx))
-        if inertia != 0:
-            T += inertia*th.diff(t)**2/2
-    T += _kinetic(acc)
+    def energies():
+        pose, acc = {}, {}
+        T = U = sp.Integer(0)
+        for b in order:
+            at, axis, m, com, inertia = data[b.name]
+            th_p, segs = (sp.Integer(0), {}) if b.parent is None else pose[b.parent]
+            segs = dict(segs)
+            q = b.q
+            off = at if b.joint == "revolute" else [at[0] + q*axis[0], at[1] + q*axis[1]]
+            w = segs.get(th_p, (0, 0))
+            segs[th_p] = (w[0] + off[0], w[1] + off[1])
+            th = (q if absolute else th_p + q) if b.joint == "revolute" else th_p
+            pose[b.name] = (th, segs)
+            if m != 0:
+                pts = dict(segs)
+                w = pts.get(th, (0, 0))
+                pts[th] = (w[0] + com[0], w[1] + com[1])
+                _speed2(pts, t, m, acc)
+                for phi, (wx, wy) in pts.items():
+                    c, s_ = sp.cos(phi), sp.sin(phi)
+                    # g . R(phi) W = cos(phi) g.W - sin(phi) g x W
+                    U -= m*(c*(g[0]*wx + g[1]*wy) - s_*(g[0]*wy - g[1]*wx))
+            if inertia != 0:
+                T += inertia*th.diff(t)**2/2
+        T += _kinetic(acc)
+        return T, U
 
     def aba(qs, vs):
         sub = {}
@@ -399,7 +402,11 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative"):
                                  "coordinate (or on an acceleration)")
         return _aba(order, index, data, qs, vs, tau, g, absolute)
 
-    return dict(L=T - U, T=T, U=U, q=coords, forces=fl, aba=aba, order=order, data=data)
+    T = U = None
+    if not lazy:
+        T, U = energies()
+    return dict(L=None if lazy else T - U, T=T, U=U, energies=energies, q=coords, forces=fl,
+                aba=aba, order=order, data=data, gravity=g)
 
 
 def _speed2(pts, t, m, acc):
@@ -467,7 +474,11 @@ def _check_leaves(order, data, params):
 def _derive(parts, params, simplify, jacobian):
     """The Derived record of the tree's Lagrangian with the ABA code attached (d.aba)."""
     from .derive import derive_lagrangian
-    d = derive_lagrangian(parts["L"], parts["q"], params, parts["forces"], None, simplify,
+    L = parts["L"]
+    if L is None:
+        T, U = parts["energies"]()
+        L = T - U
+    d = derive_lagrangian(L, parts["q"], params, parts["forces"], None, simplify,
                           bool(jacobian))
     n = d.n
     qs = [sp.Dummy(f"q{i}", real=True) for i in range(n)]
@@ -547,7 +558,7 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
                           coordinates="absolute")
     """
     from . import _construct, _tup
-    parts = build_tree(bodies, gravity, forces, coordinates)
+    parts = build_tree(bodies, gravity, forces, coordinates, lazy=True)
     _check_leaves(parts["order"], parts["data"], params)
     q = parts["q"]
 
@@ -558,7 +569,8 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
                                    parts["data"][b.name][2], *parts["data"][b.name][3],
                                    parts["data"][b.name][4]) for b in parts["order"]])
     topo = tuple((b.name, b.parent, b.joint) for b in parts["order"])
-    return _construct("tree", [parts["L"], _tup(q), _tup(parts["forces"]), _tup(gravity),
+    # the key: the description (T and U follow from it; built only on a cache miss)
+    return _construct("tree", [_tup(q), _tup(parts["forces"]), _tup(parts["gravity"]),
                                body_key], params,
                       (coordinates, simplify, bool(jacobian), topo), derive, flags,
                       model_only)
