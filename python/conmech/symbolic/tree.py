@@ -190,10 +190,6 @@ def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
             p = byname[p].parent
         return p
     kin = {}
-    children = {b.name: [] for b in order}
-    for b in order:
-        if b.parent is not None:
-            children[b.parent].append(b.name)
     # ---- pass 1: transforms, velocities, bias terms
     for b in order:
         i = index[b.name]
