@@ -28,8 +28,9 @@ recompiling. Example (the cart pendulum of seed 000)::
     cart = symbolic.lagrangian_system(T - U, [x, th], params={M: 1, m: 1, l: 1, g: 9.81})
 
 Layout: ``derive.py`` (pure sympy, the :class:`~conmech.symbolic.derive.Derived` record),
-``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), this file (the
-public constructors).
+``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), ``tree.py`` (planar
+multibody trees: T and U from the bodies, the articulated-body accelerations), this file
+(the public constructors).
 """
 import ctypes
 import hashlib
