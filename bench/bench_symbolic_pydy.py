@@ -12,7 +12,11 @@ Both tools derive it from its kinematics:
              by conmech.solve_ivp(DOP853), with T written two ways:
              "positions": T = sum m_i |r_i'|^2 / 2 of the same positions as PyDy's,
              "textbook":  T = 1/2 sum_ij (sum_{k >= max(i,j)} m_k) l_i l_j cos(th_i - th_j)
-                          th_i' th_j' (the chain's kinetic energy as the notes write it).
+                          th_i' th_j' (the chain's kinetic energy as the notes write it);
+             or as a multibody description like PyDy's:
+             "tree":      conmech.symbolic.planar_tree (bodies on revolute joints, absolute
+                          angles, point masses on massless rods, the frames as PyDy's);
+                          its right-hand side is the articulated-body algorithm, O(N).
 Same tolerance (rtol = atol = --tol) over [0, --tf]; both endpoints are compared with a tight
 reference (conmech, rtol = atol = 1e-13) so that they are shown to reach the same accuracy.
 Reported: integration wall time (best of --repeat) and the ratio PyDy/conmech, and the
@@ -22,6 +26,7 @@ construction costs: derivation, code generation + first compile, and a second co
 This is a benchmark, not a test: it needs `pip install pydy cython` (not a dependency).
 
 Usage:  python bench/bench_symbolic_pydy.py [--n 2 4 8 16] [--tol 1e-10] [--tf 10]
+                                           [--forms positions textbook tree]
                                            [--repeat 3] [--out bench/results/symbolic_pydy.md]
 """
 import argparse
@@ -70,13 +75,26 @@ def build_conmech(N, form):
             for j in range(i + 1, N):
                 T += sum(m[j:]) * l[i] * l[j] * sympy.cos(q[i] - q[j]) * qd[i] * qd[j]
     params = {**{s: 1.0 for s in syms["m"]}, **{s: 1.0 for s in syms["l"]}, g: 9.81}
+    if form == "tree":
+        # body i hangs from the end of link i - 1 (point (0, -l) of its frame), the mass at
+        # (0, -l_i) of its own frame, the frame rotated by th_i from the ground: PyDy's chain
+        bodies = [symbolic.Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute",
+                                q[i], at=(0, 0) if i == 0 else (0, -l[i - 1]), mass=m[i],
+                                com=(0, -l[i])) for i in range(N)]
+
+        def construct(**kw):
+            return symbolic.planar_tree(bodies, params, gravity=(0, -g),
+                                        coordinates="absolute", **kw)
+    else:
+        def construct(**kw):
+            return symbolic.lagrangian_system(T - U, q, params, **kw)
     t0 = time.perf_counter()
-    model = symbolic.lagrangian_system(T - U, q, params, model_only=True)
+    model = construct(model_only=True)
     total = time.perf_counter() - t0
     system = symbolic._system(model)
     times = dict(model.times)
     times["total"] = total
-    return system, times, (T - U, q, params)
+    return system, times, construct
 
 
 def build_pydy(N):
@@ -148,11 +166,10 @@ def run(N, form, args, pydy_cache):
     res = {"N": N, "form": form}
     with tempfile.TemporaryDirectory() as cache:
         os.environ["CONMECH_CACHE"] = cache
-        sysc, tc, inputs = build_conmech(N, form)
+        sysc, tc, construct = build_conmech(N, form)
         # a second construction of the same system: cache hit (same process)
-        from conmech import symbolic
         t0 = time.perf_counter()
-        symbolic.lagrangian_system(*inputs)
+        construct()
         res["conmech_hit"] = time.perf_counter() - t0
     res["conmech_times"] = tc
     if N not in pydy_cache:
@@ -204,7 +221,7 @@ def main():
     ap.add_argument("--tf", type=float, default=10.0)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--forms", nargs="+", default=["positions", "textbook"],
-                    choices=["positions", "textbook"])
+                    choices=["positions", "textbook", "tree"])
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     rows, pydy_cache = [], {}

@@ -99,10 +99,10 @@ contains
         ! generalized model: conmech_mass_forces and conmech_accel looked up when present
         call load_model("build/cm_test_spy_fast.so", g_fast, info, msg)
         call ts%check(info == CM_SUCCESS .and. c_associated(g_fast%fp%mass_forces) .and. &
-                      c_associated(g_fast%accel), "load_model finds mass_forces and accel")
+                      c_associated(g_fast%fp%accel), "load_model finds mass_forces and accel")
         call load_model("build/cm_test_spy.so", g_plain, info, msg)
         call ts%check(info == CM_SUCCESS .and. .not. c_associated(g_plain%fp%mass_forces) &
-                      .and. .not. c_associated(g_plain%accel), "plain library: neither")
+                      .and. .not. c_associated(g_plain%fp%accel), "plain library: neither")
         call model_system(g_fast, [1.0_dp, 0.8_dp, 9.81_dp], gs_fast, info, msg)
         call model_system(g_plain, [1.0_dp, 0.8_dp, 9.81_dp], gs_plain, info, msg)
         call gs_fast%rhs(0.0_dp, [0.6_dp, 0.2_dp], f1)

@@ -229,14 +229,18 @@ def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
 def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
                        keep=None, name: str = "compiled", *,
-                       mass_forces=None) -> CompiledSystem:
+                       mass_forces=None, accel=None) -> CompiledSystem:
     """M(t, q) q'' = Q(t, q, q') with ``ndof`` coordinates from compiled functions; the
     state is y = [q, q']. ``forces_jac`` gives the exact Jacobian of the accelerations
     (see the module's signatures); without it the Jacobian is a finite difference.
     ``mass_forces`` (optional), ``void mass_forces(double t, const double *q, const double
     *v, double *M, double *Q, const double *p)``, computes M and Q in one call (the
     right-hand side then uses it instead of ``mass`` + ``forces``); it must give the same
-    values as the two."""
+    values as the two. ``accel`` (optional), ``void accel(double t, const double *q, const
+    double *v, double *a, const double *p)``, computes the accelerations a = M^-1 Q directly
+    (e.g. by the articulated-body algorithm of :func:`conmech.symbolic.planar_tree`); the
+    right-hand side then uses it instead of factorising M (non-finite output, e.g. where
+    M is not positive definite, stops the integration with success=False)."""
     ndof = _count(ndof, "ndof", 1)
     values, names = _params(params, param_names)
     if mass is None or forces is None:
@@ -244,9 +248,10 @@ def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
     spec = _make_spec(_KIND_GEN, ndof, 0, 0, False, {"mass": mass, "forces": forces,
                                                      "forces_jac": forces_jac,
                                                      "energy": energy,
-                                                     "mass_forces": mass_forces})
+                                                     "mass_forces": mass_forces,
+                                                     "accel": accel})
     return CompiledSystem(str(name), "generalized", spec, values, names,
-                          (keep, mass, forces, forces_jac, energy, mass_forces))
+                          (keep, mass, forces, forces_jac, energy, mass_forces, accel))
 
 
 def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=None,
@@ -335,8 +340,8 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     functions of its kind named ``conmech_rhs``, ``conmech_jac``, ``conmech_mass``,
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
-    ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_jac_prod``).
-    The Fortran programs load the same libraries (``sweep --model``,
+    ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_accel``,
+    ``conmech_jac_prod``). The Fortran programs load the same libraries (``sweep --model``,
     conmech_model_library)."""
     try:
         lib = ctypes.CDLL(str(path))
@@ -368,7 +373,7 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     if kind == _KIND_GEN:
         return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
                                   params=params, keep=lib, name=name,
-                                  mass_forces=fn["mass_forces"])
+                                  mass_forces=fn["mass_forces"], accel=fn["accel"])
     return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
                               fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
                               fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,

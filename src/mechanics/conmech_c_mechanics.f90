@@ -17,6 +17,9 @@
 !!     /* optional, generalized systems: M and Q in one call (shared subexpressions) */
 !!     void mass_forces(double t, const double *q, const double *v, double *M, double *Q,
 !!                      const double *p);
+!!     /* optional, generalized systems: the accelerations a = M^-1 Q directly (e.g. by the
+!!        articulated-body algorithm); non-finite entries where M is not positive definite */
+!!     void accel(double t, const double *q, const double *v, double *a, const double *p);
 !!
 !! Only `mass` and `forces` are required; a missing optional function falls back to the
 !! finite-difference default of the parent type (see conmech_constrained_system).
@@ -85,6 +88,8 @@ module conmech_c_mechanics
         type(c_funptr) :: phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma
         !> optional: M and Q in one call (generalized systems)
         type(c_funptr) :: mass_forces = c_null_funptr
+        !> optional: the accelerations a = M^-1 Q (generalized systems)
+        type(c_funptr) :: accel = c_null_funptr
     end type c_mech_pointers
 
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
@@ -95,8 +100,11 @@ module conmech_c_mechanics
         procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
         procedure(c_mf_fn), pointer, nopass :: mf_f => null()
+        procedure(c_qv_fn), pointer, nopass :: accel_f => null()
     contains
         procedure :: mass => cg_mass
+        procedure :: accelerations => cg_accelerations
+        procedure :: has_accelerations => cg_has_accelerations
         procedure :: mass_forces => cg_mass_forces
         procedure :: forces => cg_forces
         procedure :: energy => cg_energy
@@ -164,6 +172,7 @@ contains
         if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
         if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
         if (c_associated(fp%mass_forces)) call c_f_procpointer(fp%mass_forces, sys%mf_f)
+        if (c_associated(fp%accel)) call c_f_procpointer(fp%accel, sys%accel_f)
         call set_params(sys%p, params)
         info = CM_SUCCESS
         msg = "success"
@@ -238,6 +247,19 @@ contains
             call self%forces_f(t, q, v, f, self%p)
         end if
     end subroutine cg_mass_forces
+
+    subroutine cg_accelerations(self, t, q, v, a)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:)
+        call self%accel_f(t, q, v, a, self%p)
+    end subroutine cg_accelerations
+
+    logical function cg_has_accelerations(self)
+        class(c_generalized_system), intent(in) :: self
+        cg_has_accelerations = associated(self%accel_f)
+    end function cg_has_accelerations
 
     subroutine cg_forces(self, t, q, v, f)
         class(c_generalized_system), intent(in) :: self

@@ -14,6 +14,11 @@
 !! makes the right-hand side NaN (the integrators then stop with CM_NONFINITE);
 !! `generalized_accel` and `generalized_solve` check M first and return CM_SINGULAR with a
 !! message instead.
+!!
+!! A system that computes a = M^{-1} Q directly (e.g. a kinematic tree by the
+!! articulated-body algorithm, O(n) without a matrix) overrides `accelerations` and
+!! `has_accelerations`; `generalized_accel` (and with it the right-hand side) then calls it
+!! instead of `mass_forces` and the Cholesky solve, and checks that the result is finite.
 module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
@@ -41,6 +46,8 @@ module conmech_generalized
         procedure :: forces_jacobian => gen_no_forces_jacobian
         procedure :: mass_forces => gen_mass_forces
         procedure :: has_forces_jacobian => gen_has_no_forces_jacobian
+        procedure :: accelerations => gen_no_accelerations
+        procedure :: has_accelerations => gen_has_no_accelerations
     end type generalized_system
 
     abstract interface
@@ -102,6 +109,23 @@ contains
         class(generalized_system), intent(in) :: self
         gen_has_no_forces_jacobian = .false.
     end function gen_has_no_forces_jacobian
+
+    !> Accelerations a = M^{-1} Q computed directly, optional (`has_accelerations`). The
+    !! default is not defined (a = 0; `generalized_accel` factorises M instead). An
+    !! override returns non-finite entries where it cannot compute a (e.g. a
+    !! non-positive articulated inertia: M not positive definite).
+    subroutine gen_no_accelerations(self, t, q, v, a)
+        class(generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:)
+        a = 0.0_dp
+    end subroutine gen_no_accelerations
+
+    logical function gen_has_no_accelerations(self)
+        class(generalized_system), intent(in) :: self
+        gen_has_no_accelerations = .false.
+    end function gen_has_no_accelerations
 
     !> mm = M(t, q) and f = Q(t, q, v) in one call (what the right-hand side needs). The
     !! default calls `mass` and `forces`; a system that computes both faster together
@@ -168,7 +192,9 @@ contains
         if (present(msg)) msg = "success"
     end subroutine mass_cholesky
 
-    !> Accelerations a = M(t, q)^{-1} Q(t, q, v), with a status.
+    !> Accelerations a = M(t, q)^{-1} Q(t, q, v), with a status: from the system's own
+    !! `accelerations` when it has them (CM_NONFINITE if they are not finite), else by a
+    !! Cholesky factorisation of M (CM_SINGULAR if M is not positive definite).
     subroutine generalized_accel(mech, t, q, v, a, info, msg)
         class(generalized_system), intent(in) :: mech
         real(dp), intent(in) :: t
@@ -184,6 +210,19 @@ contains
         if (n < 1 .or. size(q) /= n .or. size(v) /= n .or. size(a) /= n) then
             info = CM_BAD_INPUT
             if (present(msg)) msg = "bad input: q, v and a must have ndof elements (ndof >= 1)"
+            return
+        end if
+        if (mech%has_accelerations()) then
+            call mech%accelerations(t, q, v, a)
+            if (ieee_is_finite(sum(a))) then
+                info = CM_SUCCESS
+                if (present(msg)) msg = "success"
+            else
+                info = CM_NONFINITE
+                if (present(msg)) msg = "non-finite accelerations from the system's " &
+                    //"accelerations (mass matrix not positive definite, e.g. a zero or " &
+                    //"negative articulated inertia, or non-finite forces)"
+            end if
             return
         end if
         if (n > SMALL_NDOF) allocate (big(n*n))

@@ -50,7 +50,6 @@ module conmech_model_library
         character(len=:), allocatable :: param_names !! blank-separated names
         type(c_funptr) :: rhs, jac
         type(c_funptr) :: jac_prod      !! optional Jacobian product (ode models)
-        type(c_funptr) :: accel         !! optional a = M^-1 Q (generalized models)
         type(c_mech_pointers) :: fp
     end type model_library
 
@@ -181,7 +180,7 @@ contains
         lib%rhs = symbol(h, "conmech_rhs")
         lib%jac = symbol(h, "conmech_jac")
         lib%jac_prod = symbol(h, "conmech_jac_prod")
-        lib%accel = symbol(h, "conmech_accel")
+        lib%fp%accel = symbol(h, "conmech_accel")
         lib%fp%mass_forces = symbol(h, "conmech_mass_forces")
         lib%fp%mass = symbol(h, "conmech_mass")
         lib%fp%forces = symbol(h, "conmech_forces")

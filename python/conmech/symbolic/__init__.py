@@ -9,7 +9,10 @@ it; the result runs in :func:`conmech.solve_ivp`, ``conmech.stability.*`` and (c
 - :func:`ode_system` (y' = f(t, y, p), exact df/dy),
 - :func:`lagrangian_system` (generalized coordinates, L = T - U, optional forces),
 - :func:`constrained_system` (excessive coordinates, T, U, holonomic and Pfaffian
-  constraints, rheonomic detected).
+  constraints, rheonomic detected),
+- :func:`planar_tree` (a planar multibody tree of :class:`Body` records: revolute and
+  prismatic joints, relative or absolute angles; its right-hand side is the O(n)
+  articulated-body algorithm).
 
 Parameters are run-time values: ``system.with_params(m=2.0)`` gives a copy without
 recompiling. Example (the cart pendulum of seed 000)::
@@ -25,8 +28,9 @@ recompiling. Example (the cart pendulum of seed 000)::
     cart = symbolic.lagrangian_system(T - U, [x, th], params={M: 1, m: 1, l: 1, g: 9.81})
 
 Layout: ``derive.py`` (pure sympy, the :class:`~conmech.symbolic.derive.Derived` record),
-``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), this file (the
-public constructors).
+``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), ``tree.py`` (planar
+multibody trees: T and U from the bodies, the articulated-body accelerations), this file
+(the public constructors).
 """
 import ctypes
 import hashlib
@@ -53,7 +57,7 @@ _SIG = {
     "mass": ("in1", "out1"), "forces": ("in2", "out1"), "forces_jac": ("in3", "out1"),
     "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
-    "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"),
+    "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
 }
 
 
@@ -82,7 +86,7 @@ class CompiledModel:
                 "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
-                "mass_forces": [(n, n), (n,)]}[entry]
+                "mass_forces": [(n, n), (n,)], "accel": [(n,)]}[entry]
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
@@ -208,7 +212,8 @@ def _system(model):
         return compiled.generalized_system(d.n, a["mass"], a["forces"],
                                            forces_jac=a.get("forces_jac"),
                                            energy=a.get("energy"),
-                                           mass_forces=a.get("mass_forces"), **common)
+                                           mass_forces=a.get("mass_forces"),
+                                           accel=a.get("accel"), **common)
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
@@ -401,5 +406,9 @@ def _tup(x):
 from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: E402
                        pfaffian_from_velocities, pfaffian_of, pfaffian_system)
 
+# planar multibody trees (articulated-body algorithm)
+from .tree import Body, planar_tree  # noqa: E402
+
+__all__ += ["Body", "planar_tree"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]

@@ -8,7 +8,9 @@ parameter array ``p`` last)::
     ode:          cm_rhs(t, y, dydt, p), cm_jac(t, y, dfdy, p),
                   cm_jac_prod(t, y, k, x, jx, p)   (jx = J x, x an n x k block)
     generalized:  cm_mass(t, q, M, p), cm_forces(t, q, v, Q, p),
-                  cm_forces_jac(t, q, v, a, R, p), real cm_energy(t, q, v, p)
+                  cm_forces_jac(t, q, v, a, R, p), real cm_energy(t, q, v, p),
+                  cm_mass_forces(t, q, v, M, Q, p), and for planar trees
+                  cm_accel(t, q, v, a, p) (see conmech.symbolic.tree)
     constrained:  cm_mass, cm_forces, cm_energy, and as present cm_phi(t, q, c, p),
                   cm_phi_jac(t, q, G, p), cm_phi_t(t, q, pt, p),
                   cm_phi_gamma(t, q, v, g, p), cm_nh_matrix(t, q, A, b, p),
@@ -40,16 +42,17 @@ __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prep
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
     "ode": ["rhs", "jac", "jac_prod"],
-    "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces"],
+    "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces", "accel"],
     "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
                     "nh_matrix", "nh_gamma"],
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "5"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "6"   # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
 #                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
-#                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed)
+#                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed);
+#                         6: conmech_accel of planar trees (articulated-body algorithm)
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -547,6 +550,12 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                     QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],
                                     [("r", d.R, True)]))
             entries.append("forces_jac")
+        if d.kind == "generalized" and getattr(d, "aba", None) is not None:
+            # a planar tree (conmech.symbolic.tree): a = M^-1 Q by the articulated-body
+            # algorithm, straight-line O(n) code
+            from .tree import accel_procedure
+            procs.append(accel_procedure(pr, d))
+            entries.append("accel")
         if d.energy is not None:
             procs.append(_procedure(pr, "conmech_energy", ["t", "q", "v", "p"], QV + [P], [],
                                     result=d.energy))

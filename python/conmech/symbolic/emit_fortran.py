@@ -11,7 +11,8 @@ shared library): the parameters are components of the type with their values as 
 - generalized (``derive_lagrangian``): ``type, extends(generalized_system) :: NAME_mech``
   (mass, forces, energy: for ``generalized_solve``) and ``type, extends(ode_system) ::
   NAME`` with y = [q, v]: ``rhs`` solves M a = Q by Cholesky (LAPACK dpotrf/dpotrs through
-  conmech's ``mass_cholesky``), ``jacobian`` is exact: d a/d[q, v] = M^-1 R with
+  conmech's ``mass_cholesky``; for a planar tree, :func:`conmech.symbolic.planar_tree`, it
+  is the articulated-body algorithm instead, O(n)), ``jacobian`` is exact: d a/d[q, v] = M^-1 R with
   R = [dQ/dq - d(M a)/dq |a fixed, dQ/dv]. A mass matrix that is not positive definite makes
   the right-hand side NaN, so conmech's integrators stop with a non-finite status (as
   conmech's own ``generalized_ode``).
@@ -423,6 +424,19 @@ def _mass_solve(n, nrhs, rhs_name):
 
 def _gen_rhs(em, name, pry, d):
     n = d.n
+    if getattr(d, "aba", None) is not None:
+        # a planar tree (conmech.symbolic.planar_tree): the articulated-body algorithm
+        from .tree import aba_lines
+        decl, lines = aba_lines(pry, d, "a", _IND)
+        return (["    !> y' = [v, a], a = M^-1 Q by the articulated-body algorithm (O(n), no "
+                 "matrix;", "    !! non-finite if M is not positive definite).",
+                 f"    subroutine {name}_rhs(self, t, y, dydt)",
+                 f"{_IND}class({name}), intent(in) :: self",
+                 _decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out"),
+                 f"{_IND}real(dp) :: a({n})"]
+                + decl + lines
+                + [f"{_IND}dydt(1:{n}) = y({n + 1}:{2 * n})",
+                   f"{_IND}dydt({n + 1}:{2 * n}) = a", f"    end subroutine {name}_rhs", ""])
     decl, lines = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)])
     return (["    !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).",
              f"    subroutine {name}_rhs(self, t, y, dydt)",

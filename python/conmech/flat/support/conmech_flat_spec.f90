@@ -72,6 +72,7 @@ contains
         fp%nh_matrix = fptr(spec(14))
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
+        if (size(spec) >= 17) fp%accel = fptr(spec(17))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
