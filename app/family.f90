@@ -48,8 +48,11 @@ program family
         "--switch-special (default switched_special.csv). General shooting only (not"//nl// &
         "with --free/--targets, --conservative, --fixed-period); no resume: an existing"//nl// &
         "--out or --switch-out needs --force."//nl// &
+        "--input FILE.nml: the options from a namelist &family ... / (names as the"//nl// &
+        "options, '-' -> '_'; switch = K; see jobs/family.nml); the command line"//nl// &
+        "overrides them."//nl// &
         "Exit: 0 done, 1 stopped early or no K-th bifurcation point, 2 bad input."//nl// &
-        "Example (Hill's variation orbits in m, the loss of stability at m = 0.195...):"//nl// &
+        "Example: Hill's variation orbits in m, the loss of stability at m = 0.195..."//nl// &
         "  family --system hill --params 0.15,1 --param 1 --y0 0.8,0,0,1"//nl// &
         "         --period 6.283185307179586 --free 1,4 --targets 1,4 --period-factor 4"//nl// &
         "         --conservative --p-max 0.25"
@@ -83,6 +86,7 @@ program family
     force_ = .false.
     tfree = .false.
     allocate (params(0), y0(0), freer(0), targr(0))
+    if (len(cli%input) > 0) call read_input(params, y0, period)
     do while (cli%next(key))
         select case (key)
         case ("--system"); call cli%get_string(sysname)
@@ -407,5 +411,57 @@ contains
         close (uu)
         if (nrows > 1 .and. prev /= last(1)) direction = merge(1, -1, last(1) > prev)
     end subroutine read_last
+
+    !> The options from a namelist &family ... / (the command line overrides them); the
+    !! dummies are the host's params, y0, period (their names are the namelist's here).
+    subroutine read_input(params_h, y0_h, period_h)
+        real(dp), allocatable, intent(inout) :: params_h(:), y0_h(:)
+        real(dp), intent(inout) :: period_h
+        character(len=64) :: system
+        character(len=1024) :: model, out, special, switch_out, switch_special
+        real(dp) :: params(64), y0(64), free(64), targets(64)
+        real(dp) :: period, period_factor, ds, ds_min, ds_max, p_min, p_max, rtol
+        integer :: param, max_points, direction, switch, switch_direction, switch_points
+        logical :: free_time, conservative, fixed_period, non_autonomous, force
+        integer :: uu, ios
+        character(len=512) :: iomsg_
+        namelist /family/ system, model, params, param, y0, period, free, targets, &
+            period_factor, free_time, conservative, fixed_period, non_autonomous, ds, &
+            ds_min, ds_max, p_min, p_max, max_points, direction, rtol, out, special, force, &
+            switch, switch_direction, switch_points, switch_out, switch_special
+        system = sysname; model = model_path; out = out_file; special = sp_file
+        switch_out = sw_file; switch_special = sw_sp_file
+        params = unset; y0 = unset; free = unset; targets = unset
+        param = ipar; period = period_h; period_factor = pf; free_time = tfree
+        conservative = o%conservative; fixed_period = o%fixed_period
+        non_autonomous = .not. o%autonomous; ds = o%ds; ds_min = o%ds_min
+        ds_max = o%ds_max; p_min = o%p_min; p_max = o%p_max; max_points = o%max_points
+        direction = o%direction; rtol = o%rtol; force = force_; switch = kswitch
+        switch_direction = sw_dir; switch_points = sw_points
+        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, &
+              iomsg=iomsg_)
+        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(iomsg_))
+        read (uu, nml=family, iostat=ios, iomsg=iomsg_)
+        if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &family: "// &
+                                    trim(iomsg_))
+        close (uu)
+        if (switch < 0) call cli%fail("--input "//cli%input//": switch must be >= 1 "// &
+                                      "(0 or absent: no switching)")
+        if (switch_direction /= sw_dir .or. switch_points /= sw_points .or. &
+            switch_out /= sw_file .or. switch_special /= sw_sp_file) &
+            sw_opt = "switch_* of --input "//cli%input
+        sysname = system; model_path = model; out_file = out; sp_file = special
+        sw_file = switch_out; sw_sp_file = switch_special
+        params_h = nml_list(cli, params, "params")
+        y0_h = nml_list(cli, y0, "y0")
+        freer = nml_list(cli, free, "free")
+        targr = nml_list(cli, targets, "targets")
+        ipar = param; period_h = period; pf = period_factor; tfree = free_time
+        o%conservative = conservative; o%fixed_period = fixed_period
+        o%autonomous = .not. non_autonomous; o%ds = ds; o%ds_min = ds_min
+        o%ds_max = ds_max; o%p_min = p_min; o%p_max = p_max; o%max_points = max_points
+        o%direction = direction; o%rtol = rtol; o%atol = rtol; force_ = force
+        kswitch = switch; sw_dir = switch_direction; sw_points = switch_points
+    end subroutine read_input
 
 end program family

@@ -165,3 +165,29 @@ def test_existing_output_needs_force(family, tmp_path):
     r = subprocess.run([exe, "--model", "nope.so", *START], cwd=tmp_path,
                        capture_output=True, text=True)
     assert r.returncode == 2 and "--model:" in r.stderr
+
+
+def test_namelist_switching_and_its_errors(family, tmp_path):
+    """--input FILE.nml: the same switching from a namelist &family (the pitchfork's
+    z < 0 side); a switch option without switch, and a negative switch, exit 2."""
+    _, lib = family
+    (tmp_path / "s.nml").write_text(
+        f"&family model = '{lib}', y0 = 1,0,0,0,0,0,0, period = 6, ds = 0.05,\n"
+        "  ds_max = 0.1, p_max = 2.6, max_points = 100, switch = 2,\n"
+        "  switch_direction = -1, switch_points = 4, switch_out = 'z.csv' /\n")
+    exe, _ = family
+    r = subprocess.run([exe, "--input", "s.nml"], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    _, new = table(tmp_path / "z.csv")
+    assert new.shape[0] == 4 and np.all(new[1:, 11] < 0)
+    assert np.allclose(new[1:, 11]**2, new[1:, 1] - 2, atol=1e-9)
+    assert closure(new[-1]) < 1e-8
+    (tmp_path / "bad.nml").write_text(f"&family model = '{lib}', switch_points = 4 /\n")
+    r = subprocess.run([exe, "--input", "bad.nml", *START], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "switch_* of --input bad.nml needs --switch K" in r.stderr
+    (tmp_path / "neg.nml").write_text(f"&family model = '{lib}', switch = -1 /\n")
+    r = subprocess.run([exe, "--input", "neg.nml", *START], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "switch must be >= 1" in r.stderr
