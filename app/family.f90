@@ -187,8 +187,28 @@ program family
     write (*, '(a, i0, a)') "family: ", br%npoints, " points, "//br%message
     if (kswitch > 0) call switch_branch(br)
     if (br%info /= CM_SUCCESS) stop 1, quiet=.true.
+    call release()
 
 contains
+
+    !> Free what the program holds before its normal end (it ends valgrind-clean).
+    subroutine release()
+        call cli%clear()
+        deallocate (params, y0, freer, targr)
+        if (allocated(last)) deallocate (last)
+        if (allocated(key)) deallocate (key)
+        if (allocated(msg)) deallocate (msg)
+        if (allocated(sw_opt)) deallocate (sw_opt)
+        if (allocated(sys%inner)) deallocate (sys%inner)
+        if (allocated(sys%name)) deallocate (sys%name)
+        if (allocated(sys%params)) deallocate (sys%params)
+        if (allocated(br%points)) deallocate (br%points)
+        if (allocated(br%special)) deallocate (br%special)
+        if (allocated(br%message)) deallocate (br%message)
+        if (allocated(model%path)) deallocate (model%path)
+        if (allocated(model%defaults)) deallocate (model%defaults)
+        if (allocated(model%param_names)) deallocate (model%param_names)
+    end subroutine release
 
     !> The options of branch switching, checked before any computation.
     subroutine check_switch()

@@ -234,7 +234,9 @@ def test_programs_valgrind_clean(exes, tmp_path):
             (["sweep", "--system", "harmonic", "--params", "1", "--y0", "1e-150,0", "--vary",
               "y0:1", "--from", "1e-150", "--to", "1e150", "--count", "2", "--t-end", "1"],
              (0, 1)),
-            (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,))]:
+            (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,)),
+            (["family", "--system", "vanderpol", "--params", "1", "--y0", "2,0", "--period",
+              "6.6", "--p-max", "1.2"], (0,))]:
         r = run([*vg, exes[args[0]], *args[1:]], tmp_path)
         assert r.returncode in want and "==" not in r.stderr, (args, r.stderr)
 
