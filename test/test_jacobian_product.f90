@@ -5,15 +5,22 @@
 module jacobian_product_test_systems
     use conmech_kinds, only: dp
     use conmech_systems_basic, only: arenstorf
+    use conmech_param_system, only: builtin_param_system
     implicit none
     private
-    public :: arenstorf_dense
+    public :: arenstorf_dense, param_dense
 
     !> Arenstorf without its product: integrate_stm forms J and multiplies.
     type, extends(arenstorf) :: arenstorf_dense
     contains
         procedure :: has_jacobian_product => dense_no
     end type arenstorf_dense
+
+    !> A parameter-continuation wrapper that hides the wrapped product (the dense path).
+    type, extends(builtin_param_system) :: param_dense
+    contains
+        procedure :: has_jacobian_product => param_dense_no
+    end type param_dense
 
 contains
 
@@ -22,12 +29,17 @@ contains
         dense_no = .false.
     end function dense_no
 
+    logical function param_dense_no(self)
+        class(param_dense), intent(in) :: self
+        param_dense_no = .false.
+    end function param_dense_no
+
 end module jacobian_product_test_systems
 
 program test_jacobian_product
     use conmech
     use conmech_testing, only: test_suite
-    use jacobian_product_test_systems, only: arenstorf_dense
+    use jacobian_product_test_systems, only: arenstorf_dense, param_dense
     implicit none
     type(test_suite) :: ts
     type(arenstorf) :: are
@@ -42,6 +54,7 @@ program test_jacobian_product
     call check_products(kep, "kepler (default product)")
     call check_fd(are, "arenstorf")
     call check_stm()
+    call check_param_system()
     call ts%finish()
 
 contains
@@ -121,5 +134,48 @@ contains
                            "integrate_stm (arenstorf): product STM = generic STM")
         call ts%check_less(maxval(abs(y1 - y0)), 1.0e-6_dp, "arenstorf orbit closes")
     end subroutine check_stm
+
+    !> builtin_param_system forwards the wrapped product: it reports it, the products agree
+    !! with the wrapped system's bit for bit, and the continuation of Hill's variation
+    !! orbits in m (symmetric shooting) gives the same branch through the product path
+    !! as through the dense path (J formed), to round-off.
+    subroutine check_param_system()
+        type(builtin_param_system) :: ps
+        type(param_dense) :: pd
+        type(cont_options) :: o
+        type(branch) :: b1, b2
+        real(dp) :: y(4), x(4, 4), jx(4, 4), jx2(4, 4), f(4), f2(4), err
+        real(dp), parameter :: y0(4) = [0.8_dp, 0.0_dp, 0.0_dp, 1.0_dp]
+        integer :: info, i
+        character(len=:), allocatable :: msg
+        call make_param_system("hill", [0.15_dp, 1.0_dp], 1, ps, info, msg)
+        call make_param_system("hill", [0.15_dp, 1.0_dp], 1, pd%builtin_param_system, &
+                               info, msg)
+        call ts%check(info == CM_SUCCESS .and. ps%has_jacobian_product() .and. &
+                      .not. pd%has_jacobian_product(), "param system forwards the product")
+        y = [0.7_dp, 0.2_dp, -0.1_dp, 0.9_dp]
+        call random_number(x)
+        call ps%rhs_jacobian_product(0.0_dp, 4, 4, y, f, x, jx)
+        call ps%inner%rhs_jacobian_product(0.0_dp, 4, 4, y, f2, x, jx2)
+        call ts%check(all(jx == jx2) .and. all(f == f2), &
+                      "param system: f and J x = the wrapped system's (bit for bit)")
+        o%conservative = .true.
+        o%p_max = 0.25_dp
+        o%max_points = 6
+        call continue_orbits(ps, set_builtin_param, 0.15_dp, y0, 8.0_dp*atan(1.0_dp), b1, &
+                             o, [1, 4], [1, 4], .false., 4.0_dp)
+        call continue_orbits(pd, set_builtin_param, 0.15_dp, y0, 8.0_dp*atan(1.0_dp), b2, &
+                             o, [1, 4], [1, 4], .false., 4.0_dp)
+        call ts%check(b1%info == CM_SUCCESS .and. b2%info == CM_SUCCESS .and. &
+                      b1%npoints == 6 .and. b2%npoints == 6, "hill family on both paths")
+        err = 0.0_dp
+        do i = 1, min(b1%npoints, b2%npoints)
+            err = max(err, abs(b1%points(i)%p - b2%points(i)%p), &
+                      abs(b1%points(i)%period - b2%points(i)%period), &
+                      maxval(abs(b1%points(i)%y0 - b2%points(i)%y0)), &
+                      abs(b1%points(i)%stability_index - b2%points(i)%stability_index))
+        end do
+        call ts%check_less(err, 1.0e-9_dp, "hill family: product path = dense path")
+    end subroutine check_param_system
 
 end program test_jacobian_product

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-PROGRAMS = ["hill", "hill_family", "seed", "sweep", "tour"]
+PROGRAMS = ["family", "hill", "hill_family", "seed", "sweep", "tour"]
 MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 # one job = a long integration of the harmonic oscillator at tight tolerances (tens of ms)
 SWEEP = ["--system", "harmonic", "--params", "1", "--y0", "1,0", "--vary", "param:1",
@@ -122,7 +122,7 @@ def serial(exes, tmp_path_factory):
 
 # ------------------------------------------------------------------ the command lines
 
-BAD_VALUES = {"hill": ["--m", "abc"], "hill_family": ["--n", "1,2"],
+BAD_VALUES = {"family": ["--switch", "1,2"], "hill": ["--m", "abc"], "hill_family": ["--n", "1,2"],
               "seed": ["--system", "pendulum_xy", "--params", "1,,1"],
               "sweep": ["--t-end", "/"], "tour": ["--m", "abc"]}
 
@@ -234,7 +234,9 @@ def test_programs_valgrind_clean(exes, tmp_path):
             (["sweep", "--system", "harmonic", "--params", "1", "--y0", "1e-150,0", "--vary",
               "y0:1", "--from", "1e-150", "--to", "1e150", "--count", "2", "--t-end", "1"],
              (0, 1)),
-            (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,))]:
+            (["seed", "--system", "pendulum_xy", "--params", "1,,1"], (2,)),
+            (["family", "--system", "vanderpol", "--params", "1", "--y0", "2,0", "--period",
+              "6.6", "--p-max", "1.2"], (0,))]:
         r = run([*vg, exes[args[0]], *args[1:]], tmp_path)
         assert r.returncode in want and "==" not in r.stderr, (args, r.stderr)
 

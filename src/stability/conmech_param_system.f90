@@ -24,6 +24,10 @@ module conmech_param_system
         procedure :: rhs => bp_rhs
         procedure :: jacobian => bp_jac
         procedure :: has_jacobian => bp_has_jac
+        procedure :: rhs_jacobian => bp_rhs_jac
+        procedure :: has_jacobian_product => bp_has_jac_prod
+        procedure :: jacobian_product => bp_jac_prod
+        procedure :: rhs_jacobian_product => bp_rhs_jac_prod
     end type builtin_param_system
 
 contains
@@ -119,14 +123,52 @@ contains
         bp_has_jac = self%inner%has_jacobian()
     end function bp_has_jac
 
-    !> set_param of a builtin_param_system (other systems are left unchanged).
+    !> f and J of the wrapped system (its own shared-work version, if any).
+    subroutine bp_rhs_jac(self, t, y, dydt, dfdy)
+        class(builtin_param_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dydt(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        call self%inner%rhs_jacobian(t, y, dydt, dfdy)
+    end subroutine bp_rhs_jac
+
+    !> Whether the wrapped system has a structure-aware J x (then `integrate_stm` uses it).
+    logical function bp_has_jac_prod(self)
+        class(builtin_param_system), intent(in) :: self
+        bp_has_jac_prod = self%inner%has_jacobian_product()
+    end function bp_has_jac_prod
+
+    !> jx = J x of the wrapped system (the state is not extended: the parameter enters
+    !! only through the wrapped system's own parameters).
+    subroutine bp_jac_prod(self, t, n, k, y, x, jx)
+        class(builtin_param_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: jx(n, k)
+        call self%inner%jacobian_product(t, n, k, y, x, jx)
+    end subroutine bp_jac_prod
+
+    !> f and J x of the wrapped system at once.
+    subroutine bp_rhs_jac_prod(self, t, n, k, y, dydt, x, jx)
+        class(builtin_param_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n, k
+        real(dp), intent(in) :: y(n), x(n, k)
+        real(dp), intent(out) :: dydt(n), jx(n, k)
+        call self%inner%rhs_jacobian_product(t, n, k, y, dydt, x, jx)
+    end subroutine bp_rhs_jac_prod
+
+    !> set_param of a builtin_param_system or an extension of it (other systems are left
+    !! unchanged).
     subroutine set_builtin_param(sys, p)
         class(ode_system), intent(inout) :: sys
         real(dp), intent(in) :: p
         integer :: info
         character(len=:), allocatable :: msg
         select type (sys)
-        type is (builtin_param_system)
+        class is (builtin_param_system)
             sys%params(sys%ip) = p
             if (len(sys%name) == 0) then
                 if (.not. set_compiled(sys%inner, sys%ip, p)) return
