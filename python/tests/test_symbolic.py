@@ -20,13 +20,8 @@ t = dynamicsymbols._t
 
 @pytest.fixture(scope="session", autouse=True)
 def symbolic_cache(tmp_path_factory):
-    """One compile cache for the whole test session (shared with test_symbolic_seeds)."""
-    d = os.environ.get("_CONMECH_TEST_CACHE")
-    if not d:
-        d = str(tmp_path_factory.getbasetemp() / "conmech_cache")
-        os.environ["_CONMECH_TEST_CACHE"] = d
-    os.environ["CONMECH_CACHE"] = d
-    return d
+    """The test session's one compile cache (symbolic_seeds.use_test_cache)."""
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
 
 
 arenstorf_formulas = seeds.arenstorf_ode

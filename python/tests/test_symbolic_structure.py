@@ -2,7 +2,6 @@
 coefficients) and the sines and cosines of sums by angle addition agree with the expanded
 Euler-Lagrange derivation (two independent derivations of the same system), and the code of
 a chain needs 2n trigonometric calls, not n^2."""
-import os
 import re
 
 import numpy as np
@@ -12,6 +11,7 @@ sp = pytest.importorskip("sympy")
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 
 from conmech import symbolic  # noqa: E402
+import symbolic_seeds as seeds  # noqa: E402
 from conmech.symbolic.codegen import trig_split  # noqa: E402
 from conmech.symbolic.derive import derive_lagrangian  # noqa: E402
 
@@ -20,12 +20,8 @@ t = dynamicsymbols._t
 
 @pytest.fixture(scope="module", autouse=True)
 def symbolic_cache(tmp_path_factory):
-    d = os.environ.get("_CONMECH_TEST_CACHE")
-    if not d:
-        d = str(tmp_path_factory.getbasetemp() / "conmech_cache")
-        os.environ["_CONMECH_TEST_CACHE"] = d
-    os.environ["CONMECH_CACHE"] = d
-    return d
+    """The test session's one compile cache (symbolic_seeds.use_test_cache)."""
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
 
 
 def shaken_chain(n):

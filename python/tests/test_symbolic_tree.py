@@ -1,7 +1,6 @@
 """conmech.symbolic.planar_tree: the articulated-body accelerations (conmech_accel) against
 M^-1 Q of the same tree's Lagrangian, trajectories against lagrangian_system of the same
 T and U, run-time parameters, a stability function, bad input."""
-import os
 
 import numpy as np
 import pytest
@@ -12,19 +11,15 @@ from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import conmech  # noqa: E402
 from conmech import compiled, symbolic  # noqa: E402
 from conmech.symbolic import Body, planar_tree  # noqa: E402
+import symbolic_seeds as seeds  # noqa: E402
 
 t = dynamicsymbols._t
 
 
 @pytest.fixture(scope="session", autouse=True)
 def symbolic_cache(tmp_path_factory):
-    """One compile cache for the whole test session (shared with the other symbolic tests)."""
-    d = os.environ.get("_CONMECH_TEST_CACHE")
-    if not d:
-        d = str(tmp_path_factory.getbasetemp() / "conmech_cache")
-        os.environ["_CONMECH_TEST_CACHE"] = d
-    os.environ["CONMECH_CACHE"] = d
-    return d
+    """The test session's one compile cache (symbolic_seeds.use_test_cache)."""
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
 
 
 def rel(a, b):
