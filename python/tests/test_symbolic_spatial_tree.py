@@ -77,13 +77,14 @@ ARM_JOINTS = 6
 
 
 def arm(n=ARM_JOINTS):
-    """A robot arm: revolute joints about z, y, y, x, a tilted axis, one prismatic joint
-    (the third), offsets between the joints, COM offsets, full inertia tensors."""
+    """A robot arm: revolute joints about z, y, x, y, x, one prismatic joint (the third,
+    along z), offsets between the joints, COM offsets, full inertia tensors (products of
+    inertia). Coordinate axes: with a tilted axis among six joints the derivation of M and
+    Q takes ~90 s instead of ~25 s (tilted axes: the double pendulum, the branched tree)."""
     qs = dynamicsymbols(f"j1:{n + 1}")
     g = sp.Symbol("g")
     rng = np.random.default_rng(5)
-    axes = [(0, 0, 1), (0, 1, 0), (0, 0, 1), (1, 0, 0),
-            (0, sp.Rational(3, 5), sp.Rational(4, 5)), (0, 1, 0)]
+    axes = [(0, 0, 1), (0, 1, 0), (0, 0, 1), (1, 0, 0), (0, 1, 0), (1, 0, 0)]
     bodies = []
     for i in range(n):
         com = tuple(sp.Rational(str(round(x, 3))) for x in rng.normal(size=3) * 0.1)
