@@ -265,6 +265,9 @@ def test_bad_input():
         spatial_tree([SpatialBody("a", None, "revolute", q1, axis=(1, 0), mass=1)], {})
     with pytest.raises(ValueError, match="3x3"):
         spatial_tree([SpatialBody("a", None, "revolute", q1, mass=1, inertia=[[1, 0]])], {})
+    with pytest.raises(TypeError, match="rot must be a 3x3"):
+        spatial_tree([SpatialBody("a", None, "revolute", q1, mass=1, com=(1, 0, 0), rot=0)],
+                     {})
     with pytest.raises(ValueError, match="unknown joint"):
         spatial_tree([SpatialBody("a", None, "ball", q1, mass=1)], {})
     with pytest.raises(TypeError, match="SpatialBody"):

@@ -90,9 +90,10 @@ def _vec3(x, what):
     return sp.Matrix([_expr(e, what) for e in seq])
 
 
-def _mat3(x, what, default):
-    if x is None or (not hasattr(x, "__len__") and not isinstance(x, sp.MatrixBase)
-                     and _expr(x, what) == 0):
+def _mat3(x, what, default, zero_ok=False):
+    """A 3x3 matrix of expressions; None (or 0 where `zero_ok`): `default`."""
+    if x is None or (zero_ok and not hasattr(x, "__len__")
+                     and not isinstance(x, sp.MatrixBase) and _expr(x, what) == 0):
         return default
     try:
         M = sp.Matrix(x)
@@ -198,7 +199,7 @@ def build_spatial_tree(bodies, gravity=(0, 0, 0), forces=None, lazy=False):
         nm = f"body '{b.name}'"
         d = (_vec3(b.at, f"{nm}: at"), _mat3(b.rot, f"{nm}: rot", sp.eye(3)),
              _vec3(b.axis, f"{nm}: axis"), _expr(b.mass, f"{nm}: mass"),
-             _vec3(b.com, f"{nm}: com"), _mat3(b.inertia, f"{nm}: inertia", sp.zeros(3, 3)))
+             _vec3(b.com, f"{nm}: com"), _mat3(b.inertia, f"{nm}: inertia", sp.zeros(3, 3), True))
         data[b.name] = d
         for e in [*d[0], *d[1], *d[2], d[3], *d[4], *d[5]]:
             if e.has(t) or e.atoms(AppliedUndef):
