@@ -80,7 +80,8 @@ def arm(n=ARM_JOINTS):
     """A robot arm: revolute joints about z, y, x, y, x, one prismatic joint (the third,
     along z), offsets between the joints, COM offsets, full inertia tensors (products of
     inertia). Coordinate axes: with a tilted axis among six joints the derivation of M and
-    Q takes ~90 s instead of ~25 s (tilted axes: the double pendulum, the branched tree)."""
+    Q takes minutes instead of ~25 s (tilted axes: the double pendulum, the branched
+    tree)."""
     qs = dynamicsymbols(f"j1:{n + 1}")
     g = sp.Symbol("g")
     rng = np.random.default_rng(5)
@@ -138,6 +139,24 @@ def test_branched_tree_accel_matches_lagrangian():
     rng = np.random.default_rng(7)
     for t0 in (0.0, 0.9, 2.3):       # the motor torque depends on t
         assert accel_vs_lagrangian(model, 4, rng, k=2, t0=t0) <= 1e-12
+
+
+def test_compact_kinetic_energy_equals_the_plain_one():
+    """T in the compact form (column products in the deeper joint's frame) is the plain
+    sum of (m |v_c|^2 + omega . I omega)/2 of the recursive body velocities; same U."""
+    rng = np.random.default_rng(8)
+    for bodies, params, *_ in (arm(4), branched()):
+        parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -sp.Symbol("g")),
+                                                    lazy=True)
+        T1, U1 = parts["energies"]()
+        T0, U0 = parts["energies_naive"]()
+        psub = {s: params.get(s, 1.3) for s in (T0 + U0).free_symbols if s.name != "t"}
+        for _ in range(3):
+            sub = {q.diff(t): rng.uniform(-2, 2) for q in parts["q"]}
+            sub.update({q: rng.uniform(-2, 2) for q in parts["q"]})
+            for a, b in ((T1, T0), (U1, U0)):
+                a, b = float(a.subs(sub).subs(psub)), float(b.subs(sub).subs(psub))
+                assert abs(a - b) <= 1e-13 * max(abs(b), 1.0)
 
 
 def test_planar_tree_as_spatial_tree():

@@ -213,8 +213,24 @@ def build_spatial_tree(bodies, gravity=(0, 0, 0), forces=None, lazy=False):
     fl = _force_list(forces, coords, index)
 
     def energies():
+        """T and U: T in the compact form of :func:`_kinetic_compact` (no products of a
+        rotation with its own transpose), U from the positions in ground coordinates."""
+        T, U = _kinetic_compact(order, data, t), sp.Integer(0)
+        R, p = {}, {}
+        for b in order:
+            at, rot, k, m, com, Ic = data[b.name]
+            Rp, pp = (sp.eye(3), sp.zeros(3, 1)) if b.parent is None else (R[b.parent],
+                                                                          p[b.parent])
+            Erel, r = _joint(b, data[b.name], sp.cos(b.q), sp.sin(b.q))
+            R[b.name], p[b.name] = Rp*Erel, pp + Rp*r
+            if m != 0:
+                U -= m*g.dot(p[b.name] + R[b.name]*com)
+        return T, U
+
+    def energies_naive():
         """T and U from the poses: omega and the origin's velocity in body coordinates
-        (recursively, parent to child), the positions in ground coordinates."""
+        (recursively, parent to child), the positions in ground coordinates (the plain
+        form: expanded, it is much longer than the compact one; kept to check it)."""
         kin = {}
         T = U = sp.Integer(0)
         for b in order:
@@ -258,8 +274,70 @@ def build_spatial_tree(bodies, gravity=(0, 0, 0), forces=None, lazy=False):
     T = U = None
     if not lazy:
         T, U = energies()
-    return dict(L=None if lazy else T - U, T=T, U=U, energies=energies, q=coords, forces=fl,
+    return dict(L=None if lazy else T - U, T=T, U=U, energies=energies,
+                energies_naive=energies_naive, q=coords, forces=fl,
                 aba=aba, order=order, data=data, gravity=g)
+
+
+def _joint(b, d, c, s):
+    """(E, r): the body's axes in its parent's frame and its origin there."""
+    at, rot, k = d[0], d[1], d[2]
+    if b.joint == "revolute":
+        return rot*_rodrigues(k, c, s), at
+    return rot, at + rot*k*b.q
+
+
+def _dot_cols(u1, u2, rho, n2):
+    """(h1 + a1 x rho) . (h2 + a2 x rho) with |rho|^2 = n2 given (not expanded from rho)."""
+    h1, a1 = u1
+    h2, a2 = u2
+    return (h1.dot(h2) + h1.dot(_cross(a2, rho)) + h2.dot(_cross(a1, rho))
+            + a1.dot(a2)*n2 - a1.dot(rho)*a2.dot(rho))
+
+
+def _kinetic_compact(order, data, t):
+    """T = sum_i (m_i |v_c,i|^2 + omega_i . I_i omega_i)/2 written so that its expanded
+    form stays short: the velocity of a point due to joint j is h + a x rho (a: joint j's
+    axis, h: the velocity of the frame-l origin, rho: the point from that origin, all in
+    the frame l of the deeper of the two joints of a product), the products of two such
+    columns are taken in that frame, with |rho|^2 propagated as a sum (not as rho . rho,
+    whose expansion would carry E E^T = 1 unsimplified through every joint)."""
+    cols, E, r = {}, {}, {}
+    byname = {b.name: b for b in order}
+    T = []
+    for b in order:
+        at, rot, k, m, com, Ic = data[b.name]
+        Eb, rb = _joint(b, data[b.name], sp.cos(b.q), sp.sin(b.q))
+        E[b.name], r[b.name] = Eb, rb
+        mine = {}
+        if b.parent is not None:
+            for j, (h, a) in cols[b.parent].items():
+                mine[j] = (Eb.T*(h + _cross(a, rb)), Eb.T*a)
+        z = sp.zeros(3, 1)
+        mine[b.name] = (z, k) if b.joint == "revolute" else (k, z)
+        cols[b.name] = mine
+        qd = {j: byname[j].q.diff(t) for j in mine}
+        if any(e != 0 for e in Ic):
+            w = sum((a*qd[j] for j, (h, a) in mine.items()), sp.zeros(3, 1))
+            T.append(w.dot(Ic*w)/2)
+        if m == 0:
+            continue
+        # up the path: rho (COM from the origin of l, in frame l) and |rho|^2
+        rho, n2, lname = com, com.dot(com), b.name
+        while True:
+            ul = cols[lname][lname]
+            T.append(m*qd[lname]**2*_dot_cols(ul, ul, rho, n2)/2)
+            for j, uj in cols[lname].items():
+                if j != lname:
+                    T.append(m*qd[j]*qd[lname]*_dot_cols(uj, ul, rho, n2))
+            par = byname[lname].parent
+            if par is None:
+                break
+            El, rl = E[lname], r[lname]
+            Er = El*rho
+            rho, n2 = rl + Er, rl.dot(rl) + 2*rl.dot(Er) + n2
+            lname = par
+    return sp.Add(*T)
 
 
 def _spatial_aba(order, index, data, qs, vs, tau, g):
