@@ -195,9 +195,10 @@ def test_planar_tree_as_spatial_tree():
             <= 1e-12 * abs(mp.call("energy", 0.0, q, v))
 
 
-def test_trajectory_and_energy_of_the_double_pendulum():
+def test_trajectories_match_lagrangian_system_and_energy_is_conserved():
     """The ABA right-hand side and the Cholesky right-hand side of lagrangian_system(T - U)
-    give the same trajectory to 1e-10 over several swings; the energy is conserved."""
+    give the same trajectory to 1e-10 (the double pendulum over several swings, the
+    branched tree with forces); the double pendulum's energy is conserved."""
     bodies, params, q, g = double_pendulum()
     tree = spatial_tree(bodies, params, gravity=(0, 0, -g))
     parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -g))
@@ -211,6 +212,16 @@ def test_trajectory_and_energy_of_the_double_pendulum():
     model = symbolic.model_of(tree)
     E = [model.call("energy", 0.0, y[:2], y[2:]) for y in r1.y.T]
     assert np.max(np.abs(np.array(E) - E[0])) <= 1e-10 * abs(E[0])
+    # the branched tree with springs, dampers and a time-dependent motor
+    bodies, params, forces, g = branched()
+    tree = spatial_tree(bodies, params, gravity=(0, 0, -g), forces=forces)
+    parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -g), forces)
+    ref = symbolic.lagrangian_system(parts["L"], parts["q"], params, forces=parts["forces"])
+    y0 = [0.1, 0.5, -0.4, 0.3, 0.0, 0.2, 0.0, -0.1]
+    r1 = conmech.solve_ivp(tree, (0, 5), y0, **kw)
+    r2 = conmech.solve_ivp(ref, (0, 5), y0, **kw)
+    assert r1.success and r2.success
+    assert rel(r1.y[:, -1], r2.y[:, -1]) <= 1e-10
 
 
 def test_hanging_double_pendulum_is_a_centre():
