@@ -3,6 +3,8 @@ against M^-1 Q of the same tree's Lagrangian, a planar tree written as a spatial
 against planar_tree, a trajectory against lagrangian_system of the same T and U, energy
 conservation, a stability function, bad input."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -104,6 +106,13 @@ def test_arm_accel_matches_lagrangian():
     model = spatial_tree(bodies, params, gravity=(0, 0, -g), forces=damp, jacobian=False,
                          model_only=True)
     assert accel_vs_lagrangian(model, len(bodies), np.random.default_rng(2)) <= 1e-12
+    # straight-line code: one sine and cosine per revolute joint, one division per joint
+    src = model.source[model.source.find("subroutine conmech_accel"):]
+    src = src[:src.find("end subroutine")]
+    assert src.count("sin(") == 5 and src.count("cos(") == 5
+    # (at most: the leaf's pivot is a constant here)
+    assert len(re.findall(r"= 1\.0_dp/b\d+$", src, re.M)) <= len(bodies)
+    assert src.count("/") - len(re.findall(r"_dp/[0-9]", src)) <= len(bodies)
 
 
 def branched():
