@@ -315,3 +315,17 @@ def test_bad_input():
         spatial_tree([SpatialBody("a", None, "revolute", q1, mass=1, com=(q2, 0, 0))], {})
     with pytest.raises(ValueError, match="'g' has no value|unknown symbol.*'g'"):
         spatial_tree([ok], {m: 1}, gravity=(0, 0, -g))
+
+
+def test_emitted_module_uses_the_articulated_body_algorithm():
+    """The standalone Fortran module of `python -m conmech.symbolic emit` (a model file
+    returning derive_spatial_tree(...)): its right-hand side is the spatial ABA, no
+    factorisation of M (compiling it is covered for planar trees by the user_tree
+    example)."""
+    from conmech.symbolic.emit_fortran import emit
+    bodies, params, q, g = double_pendulum()
+    d = symbolic.spatial.derive_spatial_tree(bodies, params, gravity=(0, 0, -g))
+    src = emit(d, "sdp_sym", module="sdp_model")
+    rhs = src[src.find("subroutine sdp_sym_rhs"):src.find("end subroutine sdp_sym_rhs")]
+    assert rhs and "mass_cholesky" not in rhs
+    assert rhs.count("sin(") == 2 and rhs.count("cos(") == 2
