@@ -81,8 +81,8 @@ ARM_JOINTS = 6
 def arm(n=ARM_JOINTS):
     """A robot arm: revolute joints about z, y, x, y, x, one prismatic joint (the third,
     along z), offsets between the joints, COM offsets, full inertia tensors (products of
-    inertia). Coordinate axes: with a tilted axis among six joints the derivation of M and
-    Q takes minutes instead of ~25 s (tilted axes: the double pendulum, the branched
+    inertia). Coordinate axes: with a tilted axis among six joints the construction (M
+    and Q) takes ~65 s instead of ~25 s (tilted axes: the double pendulum, the branched
     tree)."""
     qs = dynamicsymbols(f"j1:{n + 1}")
     g = sp.Symbol("g")
