@@ -12,6 +12,9 @@ it; the result runs in :func:`conmech.solve_ivp`, ``conmech.stability.*`` and (c
   constraints, rheonomic detected),
 - :func:`planar_tree` (a planar multibody tree of :class:`Body` records: revolute and
   prismatic joints, relative or absolute angles; its right-hand side is the O(n)
+  articulated-body algorithm),
+- :func:`spatial_tree` (the same in 3-D with :class:`SpatialBody` records: revolute and
+  prismatic joints about unit axes, inertia tensors, relative coordinates; the spatial
   articulated-body algorithm).
 
 Parameters are run-time values: ``system.with_params(m=2.0)`` gives a copy without
@@ -29,7 +32,8 @@ recompiling. Example (the cart pendulum of seed 000)::
 
 Layout: ``derive.py`` (pure sympy, the :class:`~conmech.symbolic.derive.Derived` record),
 ``codegen.py`` (bind(C) Fortran), ``build.py`` (compile, cache, load), ``tree.py`` (planar
-multibody trees: T and U from the bodies, the articulated-body accelerations), this file
+multibody trees: T and U from the bodies, the articulated-body accelerations),
+``spatial.py`` (the same for spatial trees), this file
 (the public constructors).
 """
 import ctypes
@@ -410,5 +414,10 @@ from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,  # noqa: 
 from .tree import Body, planar_tree  # noqa: E402
 
 __all__ += ["Body", "planar_tree"]
+
+# spatial (3-D) multibody trees (spatial articulated-body algorithm)
+from .spatial import SpatialBody, spatial_tree  # noqa: E402
+
+__all__ += ["SpatialBody", "spatial_tree"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]

@@ -93,18 +93,19 @@ def _expr(e, what):
         raise TypeError(f"{what}: {e!r} is not a sympy expression or a number") from None
 
 
-def _check_tree(bodies, t):
-    """Validated bodies in topological order (parents first) and the coordinate list in the
-    given order."""
-    if isinstance(bodies, Body):
+def _check_tree(bodies, t, cls=None):
+    """Validated bodies (records of class `cls`, default Body) in topological order (parents
+    first) and the coordinate list in the given order."""
+    cls = Body if cls is None else cls
+    if isinstance(bodies, cls):
         bodies = [bodies]
     bodies = list(bodies)
     if not bodies:
         raise ValueError("a tree needs at least one body")
     names, coords = {}, []
     for b in bodies:
-        if not isinstance(b, Body):
-            raise TypeError(f"bodies must be conmech.symbolic.Body records, got "
+        if not isinstance(b, cls):
+            raise TypeError(f"bodies must be conmech.symbolic.{cls.__name__} records, got "
                             f"{type(b).__name__}")
         if not isinstance(b.name, str) or not b.name:
             raise TypeError("a body's name must be a non-empty string")
@@ -335,23 +336,7 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy
     for e in g:
         if e.has(t) or e.atoms(AppliedUndef):
             raise ValueError(f"gravity must depend on parameters only, got {e}")
-    n = len(coords)
-    if forces is None:
-        fl = [sp.Integer(0)]*n
-    elif isinstance(forces, dict):
-        fl = [sp.Integer(0)]*n
-        for key, val in forces.items():
-            if isinstance(key, str) and key in index:
-                i = index[key]
-            elif key in coords:
-                i = coords.index(key)
-            else:
-                raise ValueError(f"forces: {key!r} is neither a body name nor a coordinate")
-            fl[i] = fl[i] + _expr(val, "forces")
-    else:
-        fl = [_expr(e, "forces") for e in forces]
-        if len(fl) != n:
-            raise ValueError(f"forces has {len(fl)} components for {n} coordinates")
+    fl = _force_list(forces, coords, index)
     absolute = coordinates == "absolute"
     # positions -> T, U in the compact form: a point's position is sum_phi R(phi) W_phi
     # over the distinct frame angles phi on its path (W_phi: the offsets in that frame),
@@ -403,6 +388,29 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy
         T, U = energies()
     return dict(L=None if lazy else T - U, T=T, U=U, energies=energies, q=coords, forces=fl,
                 aba=aba, order=order, data=data, gravity=g)
+
+
+def _force_list(forces, coords, index):
+    """One generalized force per coordinate from a list or a dict {body name or coordinate:
+    force} (None: no forces)."""
+    n = len(coords)
+    if forces is None:
+        fl = [sp.Integer(0)]*n
+    elif isinstance(forces, dict):
+        fl = [sp.Integer(0)]*n
+        for key, val in forces.items():
+            if isinstance(key, str) and key in index:
+                i = index[key]
+            elif key in coords:
+                i = coords.index(key)
+            else:
+                raise ValueError(f"forces: {key!r} is neither a body name nor a coordinate")
+            fl[i] = fl[i] + _expr(val, "forces")
+    else:
+        fl = [_expr(e, "forces") for e in forces]
+        if len(fl) != n:
+            raise ValueError(f"forces has {len(fl)} components for {n} coordinates")
+    return fl
 
 
 def _speed2(pts, t, m, acc):
