@@ -277,3 +277,10 @@ def use_test_cache(base):
         os.environ["_CONMECH_TEST_CACHE"] = d
     os.environ["CONMECH_CACHE"] = d
     return d
+
+
+def rel(a, b):
+    """max |a - b| / max |b| (the relative difference the symbolic tests compare with)."""
+    import numpy as np
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300)

@@ -31,7 +31,7 @@ acceleration of the ground.
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from .tree import _Code, _check_tree, _derive, _expr, _force_list
+from .tree import _Code, _check_tree, _derive, _expr, _force_list, _forces_at
 
 __all__ = ["SpatialBody", "spatial_tree", "build_spatial_tree", "derive_spatial_tree"]
 
@@ -259,16 +259,7 @@ def build_spatial_tree(bodies, gravity=(0, 0, 0), forces=None, lazy=False):
         return T, U
 
     def aba(qs, vs):
-        sub = {}
-        for i, qi in enumerate(coords):
-            sub[qi.diff(t)] = vs[i]
-        for i, qi in enumerate(coords):
-            sub[qi] = qs[i]
-        tau = [e.subs(sub) for e in fl]
-        for e in tau:
-            if e.atoms(AppliedUndef) or e.atoms(sp.Derivative):
-                raise ValueError(f"forces: {e} depends on a function of t that is not a "
-                                 "coordinate (or on an acceleration)")
+        tau = _forces_at(fl, coords, qs, vs)
         return _spatial_aba(order, index, data, qs, vs, tau, g)
 
     T = U = None

@@ -371,16 +371,7 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy
         return T, U
 
     def aba(qs, vs):
-        sub = {}
-        for i, qi in enumerate(coords):
-            sub[qi.diff(t)] = vs[i]
-        for i, qi in enumerate(coords):
-            sub[qi] = qs[i]
-        tau = [e.subs(sub) for e in fl]
-        for e in tau:
-            if e.atoms(AppliedUndef) or e.atoms(sp.Derivative):
-                raise ValueError(f"forces: {e} depends on a function of t that is not a "
-                                 "coordinate (or on an acceleration)")
+        tau = _forces_at(fl, coords, qs, vs)
         return _aba(order, index, data, qs, vs, tau, g, absolute)
 
     T = U = None
@@ -388,6 +379,22 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy
         T, U = energies()
     return dict(L=None if lazy else T - U, T=T, U=U, energies=energies, q=coords, forces=fl,
                 aba=aba, order=order, data=data, gravity=g)
+
+
+def _forces_at(fl, coords, qs, vs):
+    """The generalized forces `fl` with the coordinates and their rates replaced by the
+    symbols `qs`, `vs` of the generated code (a force that still depends on another
+    function of t, or on an acceleration, is refused)."""
+    from sympy.physics.mechanics import dynamicsymbols
+    t = dynamicsymbols._t
+    sub = {qi.diff(t): vs[i] for i, qi in enumerate(coords)}
+    sub.update({qi: qs[i] for i, qi in enumerate(coords)})
+    tau = [e.subs(sub) for e in fl]
+    for e in tau:
+        if e.atoms(AppliedUndef) or e.atoms(sp.Derivative):
+            raise ValueError(f"forces: {e} depends on a function of t that is not a "
+                             "coordinate (or on an acceleration)")
+    return tau
 
 
 def _force_list(forces, coords, index):
