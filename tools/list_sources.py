@@ -7,6 +7,7 @@ src/ (or python/conmech/flat/) is picked up at the next configure without editin
     python3 tools/list_sources.py src                      # src/**/*.f90 and *.F90 (fpm's)
     python3 tools/list_sources.py python/conmech/flat --flat           # flat/*.f90 only
     python3 tools/list_sources.py python/conmech --flat --ext py       # conmech/*.py only
+    python3 tools/list_sources.py python/conmech --packages    # stability, symbolic, ...
 
 Paths are relative to the current directory, with forward slashes.
 """
@@ -19,6 +20,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("directory")
     parser.add_argument("--flat", action="store_true", help="do not descend into subfolders")
+    parser.add_argument("--packages", action="store_true",
+                        help="list the Python subpackage folders below DIRECTORY (those "
+                             "with an __init__.py, flat/ excluded), relative to it")
     parser.add_argument("--ext", action="append",
                         help="file extension without the dot (repeatable; default: f90 and "
                              "F90, the free-form Fortran sources fpm compiles)")
@@ -27,6 +31,13 @@ def main(argv=None):
     if not root.is_dir():
         sys.stderr.write(f"list_sources.py: no directory {root}\n")
         return 1
+    if args.packages:
+        pkgs = sorted(p.parent.relative_to(root).as_posix()
+                      for p in root.glob("**/__init__.py")
+                      if p.parent != root and "flat" not in p.parent.relative_to(root).parts
+                      and "__pycache__" not in p.parts)
+        sys.stdout.write("".join(f + "\n" for f in pkgs))
+        return 0
     exts = args.ext or ["f90", "F90"]
     prefix = "" if args.flat else "**/"
     files = sorted({p.as_posix() for ext in exts for p in root.glob(prefix + "*." + ext)

@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from .continuation import Branch, SpecialPoint, continuation
+
 __all__ = ["switch_branch_point"]
 
 
@@ -26,7 +28,7 @@ def switch_branch_point(system: Any, branch, point, param: str | int | None = No
     :func:`~conmech.stability.continuation`). The result's ``kernel_ratio`` (second smallest
     singular value over the third) is small at a genuine branch point.
     """
-    from .stability import Branch, SpecialPoint, continuation
+
     if not isinstance(branch, Branch):
         raise TypeError("branch must be the Branch on which the branch point was located")
     if not isinstance(point, SpecialPoint) or point.kind != "branch point":

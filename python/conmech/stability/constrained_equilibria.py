@@ -1,4 +1,4 @@
-"""Equilibria of holonomically constrained systems on their constraint manifold (issue 9).
+"""Equilibria of holonomically constrained systems on their constraint manifold .
 
 The system M(q) q'' = Q(t, q, q') + G(q)^T lambda, phi(q) = 0 (excessive coordinates; see
 :mod:`conmech.constrained`) is at rest at q* when
@@ -24,6 +24,11 @@ from __future__ import annotations
 from typing import Any, Callable
 
 import numpy as np
+
+from ..compiled import CompiledConstrained, evaluate
+from ..constrained import BuiltinConstrained, ConstrainedSystem, builtin
+from .equilibria import equilibrium, lagrange_dirichlet, potential_hessian
+from ._validate import _real, _state
 
 __all__ = ["ConstrainedEquilibrium", "constrained_equilibrium", "constrained_equilibria"]
 
@@ -61,16 +66,12 @@ class ConstrainedEquilibrium:
 
 def _evaluator(system, t):
     """(n, m, fun(q, v) -> (M, Q, phi, G), energy(q) or None) of a constrained system."""
-    from .constrained import BuiltinConstrained, ConstrainedSystem
     if isinstance(system, str):
-        from .constrained import builtin
         system = builtin(system)
     if isinstance(system, BuiltinConstrained):
-        from .compiled import evaluate
         if system.n_nh > 0:
             raise ValueError(f"'{system.name}' has non-holonomic constraints: equilibria on "
                              "a constraint manifold need holonomic constraints only")
-        from .compiled import CompiledConstrained
         compiled_rheonomic = isinstance(system, CompiledConstrained) and \
             int(system.spec[4]) != 0       # spec[4]: the rheonomic flag (_make_spec)
         if system.name in _RHEONOMIC_BUILTINS or compiled_rheonomic:
@@ -168,7 +169,6 @@ def constrained_equilibrium(system: Any, guess, t: float = 0.0,
     the manifold (see the module notes). Raises ValueError on bad input (non-holonomic or
     rheonomic systems, wrong shapes) and RuntimeError when Newton fails or the point found
     does not satisfy the equations to the tolerance."""
-    from .stability import _real, _state, equilibrium, lagrange_dirichlet, potential_hessian
     t = _real(t, "t")
     tol = _real(tol, "tol", 0.0, 1.0, low_open=True)
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) \

@@ -1,0 +1,44 @@
+"""Stability of equilibria and periodic motions, for built-in systems
+(:mod:`conmech.systems`, run entirely in Fortran), compiled and symbolic systems, or Python
+callables ``fun(t, y)`` (finite-difference Jacobian in Fortran).
+
+- :func:`equilibrium`: linearisation, eigenvalues (LAPACK) and classification;
+  :func:`find_equilibrium`, :func:`equilibria` (from a :func:`grid` of guesses,
+  deduplicated); :func:`lagrange_dirichlet`, :func:`lagrange_dirichlet_potential`
+  (Hessian exact or by differences); :func:`constrained_equilibrium` on a constraint
+  manifold (``equilibria.py``, ``constrained_equilibria.py``);
+- :func:`stm`: state and state transition matrix (variational equations);
+  :func:`monodromy`, :func:`floquet` (``variational.py``);
+- :func:`periodic_orbit`, :func:`symmetric_orbit`: Newton shooting, with the monodromy
+  matrix and Floquet multipliers (``orbits.py``);
+- :func:`hill_equation`: N'' + Phi(t) N = 0 with Phi a callable or periodic samples;
+- :func:`continuation`: pseudo-arclength continuation of periodic orbits in a parameter,
+  with folds, branch points, period doublings and Neimark-Sacker points located
+  (:class:`Branch`, :class:`SpecialPoint`); :func:`switch_period_doubling`,
+  :func:`switch_branch_point` (``continuation.py``, ``branch_switch.py``);
+- :func:`plot_branch`, :func:`plot_multipliers` (``plots.py``);
+- :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
+  of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``).
+"""
+from .equilibria import (EQUILIBRIUM_RTOL, Equilibrium, equilibria, equilibrium,
+                         find_equilibrium, grid, lagrange_dirichlet,
+                         lagrange_dirichlet_potential, potential_hessian)
+from .variational import floquet, monodromy, stm
+from .orbits import ORBIT_RESIDUAL_TOL, PeriodicOrbit, periodic_orbit, symmetric_orbit
+from .hill_equation import HillEquationResult, hill_equation
+from .continuation import Branch, SpecialPoint, continuation, switch_period_doubling
+from .branch_switch import switch_branch_point
+from .constrained_equilibria import (ConstrainedEquilibrium, constrained_equilibria,
+                                     constrained_equilibrium)
+from .transverse import transverse
+from .plots import plot_branch, plot_multipliers
+# validators used by sibling modules (hill_families)
+from ._validate import _real, _state  # noqa: F401
+
+__all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
+           "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
+           "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
+           "switch_period_doubling", "switch_branch_point", "constrained_equilibrium",
+           "constrained_equilibria", "ConstrainedEquilibrium",
+           "equilibrium", "lagrange_dirichlet", "stm",
+           "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]

@@ -1,0 +1,78 @@
+"""The state transition matrix (variational equations), the monodromy matrix and its
+Floquet multipliers."""
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
+
+from numpy.typing import ArrayLike  # noqa: F401 (annotations)
+import numpy as np
+
+from .. import _conmech
+from ..systems import BuiltinSystem
+from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state, _tols
+
+def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
+        atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
+        full_output: bool = False) -> tuple:
+    """(y(t1), Phi(t1)) of the state and its state transition matrix from t0 to t1
+    (DOP853 with the same step control on the state and the STM).
+
+    ``jac``: exact Jacobian jac(t, y) -> (n, n) of a Python system (SciPy's name; default:
+    central finite differences, accurate to ~1e-6 relative). With ``full_output`` a third
+    item, a dict {nfev, njev}, is returned."""
+    y0 = _state(y0)
+    _check_dim(system, y0)
+    try:
+        t0, t1 = t_span
+    except (TypeError, ValueError):
+        raise ValueError("t_span must be a pair (t0, t1)") from None
+    t0, t1 = _real(t0, "t_span[0]"), _real(t1, "t_span[1]")
+    rtol, atol = _tols(rtol, atol)
+    _no_jac_for_builtin(system, jac)
+    njev = 0
+    if isinstance(system, BuiltinSystem):
+        y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
+            *system._flat_args(), y0, t0, t1, rtol, atol)
+    else:
+        g, rhs, dfdy = _callback(system, y0.size, y0, t0, jac)
+        if dfdy is None:
+            y1, phi, nfev, info, message = _conmech.flat_stm_callback(
+                rhs, y0, t0, t1, rtol, atol)
+        else:
+            y1, phi, nfev, info, message = _conmech.flat_stm_callback_jac(
+                rhs, dfdy, y0, t0, t1, rtol, atol)
+        g.check()
+        njev = g.count("jac")
+    if info < 0:
+        _raise(info, message)
+    if full_output:
+        return np.array(y1), np.array(phi), {"nfev": int(nfev), "njev": njev}
+    return np.array(y1), np.array(phi)
+
+
+def monodromy(system: Any, y0: ArrayLike, period: float, rtol: float = 1e-12,
+              atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None) -> np.ndarray:
+    """Monodromy matrix Phi(period) of the orbit through y0 (``jac`` as in :func:`stm`)."""
+    period = _real(period, "period", 0.0, low_open=True)
+    return stm(system, (0.0, period), y0, rtol, atol, jac=jac)[1]
+
+
+def floquet(m: ArrayLike, period: float) -> dict:
+    """Multipliers (eigenvalues of m), Floquet exponents log(mu)/period and, for a 4 x 4
+    monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict."""
+    m = np.asarray(m)
+    if m.dtype.kind not in "biuf":
+        raise TypeError("m must be a real matrix")
+    m = m.astype(float)
+    if m.ndim != 2 or m.shape[0] != m.shape[1] or m.size == 0:
+        raise ValueError("m must be a non-empty square matrix")
+    if not np.all(np.isfinite(m)):
+        raise ValueError("m must be finite")
+    period = _real(period, "period", 0.0, low_open=True)
+    mu = np.linalg.eigvals(m)
+    with np.errstate(divide="ignore", invalid="ignore"):   # a zero multiplier: -inf
+        expo = np.log(mu.astype(complex))/period
+    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m))}
+    if m.shape == (4, 4):
+        out["stability_index"] = 0.5*(np.trace(m) - 2.0)
+    return out
