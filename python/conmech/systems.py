@@ -101,6 +101,14 @@ class BuiltinSystem:
         names = self.param_names or tuple(f"p{i}" for i in range(self.params.size))
         return dict(zip(names, self.params.tolist()))
 
+    @property
+    def degrees_of_freedom(self):
+        """The number of generalized coordinates of a mechanical system in generalized
+        coordinates (its holonomic constraints eliminated); None for a first-order system
+        without mechanical structure."""
+        kind, n, mh, mn, info, _ = _conmech.flat_mech_info(*self._flat_args())
+        return int(n) if info == 0 and kind == 2 else None
+
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
         return f"conmech.systems.{self.name}({args})"
