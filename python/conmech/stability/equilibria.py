@@ -8,7 +8,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import BuiltinSystem
+from ..systems import STATE_NAMES, BuiltinSystem
 from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate",
@@ -90,7 +90,9 @@ class RelativeEquilibrium:
 
 def _state_names(system, n):
     """Names of the state components: a symbolic system's coordinates (and velocities,
-    primed), else y[i]."""
+    primed), a built-in's documented coordinates, else y[i]."""
+    if type(system) is BuiltinSystem and len(STATE_NAMES.get(system.name, ())) == n:
+        return list(STATE_NAMES[system.name])
     keep = getattr(system, "_keep", None)
     model = keep[0] if isinstance(keep, tuple) and keep else None
     d = getattr(model, "derived", None)
