@@ -159,3 +159,24 @@ def test_not_a_symbolic_lagrangian_system():
                               [sp.Symbol("x"), sp.Symbol("v")])
     with pytest.raises(TypeError):
         symbolic.momenta(ode)
+
+
+def test_planar_tree_cart_pole():
+    """A cart-pole described as bodies (a prismatic cart, a revolute pole): the cart's
+    coordinate is cyclic, its momentum conserved, and the reduction and the equilibrium
+    structure work on the tree as on the Lagrangian."""
+    from conmech import stability
+    x, th = dynamicsymbols("x theta")
+    M, m, l, g = sp.symbols("M m l g")
+    bodies = [symbolic.Body("cart", None, "prismatic", x, axis=(1, 0), mass=M),
+              symbolic.Body("pole", "cart", "revolute", th, mass=m, com=(0, l))]
+    tree = symbolic.planar_tree(bodies, {M: 1.0, m: 1.0, l: 1.0, g: 9.81}, gravity=(0, -g))
+    assert tree.cyclic_coordinates == (0,)
+    r = conmech.solve_ivp(tree, (0, 10), [0.0, 0.3, 0.2, 0.0], rtol=1e-12, atol=1e-12)
+    assert tree.first_integrals.check(r)["p_x"] <= 1e-10
+    red = symbolic.reduce(tree, cyclic=[x])
+    e = stability.equilibrium(red, [np.pi, 0.0])
+    assert e.kind == "centre"
+    assert np.allclose(np.abs(e.eigenvalues.imag), np.sqrt(2*9.81), atol=1e-10)
+    full = stability.equilibrium(tree, [0.0, np.pi, 0.0, 0.0])
+    assert full.kind == "unstable (secular drift along x)" and full.relative.kind == "centre"

@@ -202,6 +202,9 @@ def _integral_data(system, y, t, integrals):
         return fi.names, fi.gradients(y, t), fi.energy_hessian(y, t)
     if callable(integrals):
         integrals = [integrals]
+    if not isinstance(integrals, (list, tuple)):
+        raise TypeError("integrals must be 'auto', None, a callable I(y) or a list of them "
+                        f"(or of (name, I, grad) triples), got {type(integrals).__name__}")
     names, grads = [], []
     for k, item in enumerate(integrals):
         if isinstance(item, tuple) and len(item) == 3:

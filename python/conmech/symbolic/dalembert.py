@@ -286,18 +286,29 @@ def dalembert_system(mapping, masses, forces=None, q=None, params=None, *, angle
     """A compiled system in generalized coordinates from D'Alembert's principle (see the
     module notes).
 
-    mapping : the particles' positions u_k(q, t): a list of vectors (1 to 3 components
-        each) or a D x N Matrix with one column per particle (the notes' mapping U).
-    masses : one mass per particle (expressions of the parameters).
-    forces : the applied forces X_k (same shapes as mapping; any expressions in t, q, q'
-        and the parameters), or None.
-    q : the generalized coordinates (dynamicsymbols, or Symbols with ``velocities=``).
-    params : {Symbol or name: value}.
-    angles, inertias, torques : planar rigid bodies: the angle phi_k(q, t) of body k (whose
-        centre of mass is particle k), its central moment of inertia, the applied torque.
+    Parameters
+    ----------
+    mapping : list or Matrix
+        The particles' positions u_k(q, t): a list of vectors (1 to 3 components each) or a
+        D x N Matrix with one column per particle (the notes' mapping U).
+    masses : list
+        One mass per particle (expressions of the parameters).
+    forces : list or Matrix, optional
+        The applied forces X_k (same shapes as mapping; any expressions in t, q, q' and
+        the parameters).
+    q : list
+        The generalized coordinates (dynamicsymbols, or Symbols with ``velocities=``).
+    params : dict
+        {Symbol or name: value}.
+    angles, inertias, torques : list, optional
+        Planar rigid bodies: the angle phi_k(q, t) of body k (whose centre of mass is
+        particle k), its central moment of inertia, the applied torque.
 
-    Returns a :class:`DAlembertSystem` (with ``generalized_forces``, ``mass_matrix``,
-    ``implicit_constraints``, ``degrees_of_freedom``), which runs wherever a system runs.
+    Returns
+    -------
+    DAlembertSystem
+        With ``generalized_forces``, ``mass_matrix``, ``implicit_constraints``,
+        ``degrees_of_freedom``; it runs wherever a system runs.
     """
     if q is None:
         raise ValueError("q: give the generalized coordinates")

@@ -152,19 +152,27 @@ def _resolve(items, names, what):
 def reduce(system, cyclic=None, momenta=None, *, flags=None):
     """Routh reduction of a symbolic Lagrangian system (see the module notes).
 
-    system : a system from :func:`conmech.symbolic.lagrangian_system` (or a tree).
-    cyclic : the cyclic coordinates to eliminate (indices, names or dynamicsymbols;
-        default: all of ``system.cyclic_coordinates``). A coordinate that is not cyclic
-        (L depends on it, or a non-conservative force acts on it) is a ValueError naming it.
-    momenta : {coordinate: value} of the conserved momenta (default 0 for each); the values
-        are run-time parameters ``p_<name>`` of the reduced system.
+    Parameters
+    ----------
+    system : LagrangianSystem
+        A system from :func:`conmech.symbolic.lagrangian_system` (or a tree).
+    cyclic : list, optional
+        The cyclic coordinates to eliminate (indices, names or dynamicsymbols; default: all
+        of ``system.cyclic_coordinates``). A coordinate that is not cyclic (L depends on
+        it, or a non-conservative force acts on it) is a ValueError naming it.
+    momenta : dict, optional
+        {coordinate: value} of the conserved momenta (default 0 for each); the values are
+        run-time parameters ``p_<name>`` of the reduced system.
 
-    Returns a :class:`ReducedSystem` (state [q_r, q_r']) with ``reduction``
-    (:class:`Reduction`: Routhian, reduced mass, amended potential, reduced energy,
-    cyclic velocity and its closed-form integral) and :meth:`~ReducedSystem.reconstruct`.
-    A singular d p_c / d v_c (M_cc identically singular: the cyclic velocity cannot be
-    solved for) and a non-finite momentum are ValueErrors naming them; a nonzero momentum
-    where det M_cc vanishes is reported when a state there is evaluated.
+    Returns
+    -------
+    ReducedSystem
+        State [q_r, q_r'], with ``reduction`` (:class:`Reduction`: Routhian, reduced mass,
+        amended potential, reduced energy, cyclic velocity and its closed-form integral)
+        and :meth:`~ReducedSystem.reconstruct`. A singular d p_c / d v_c (M_cc identically
+        singular: the cyclic velocity cannot be solved for) and a non-finite momentum are
+        ValueErrors naming them; a nonzero momentum where det M_cc vanishes is reported
+        when a state there is evaluated.
     """
     a = analysis(system)
     d = a.d
