@@ -196,3 +196,26 @@ def test_degrees_of_freedom_symbolic_and_redundant():
         == 1
     with pytest.raises(ValueError, match="q must have 2"):
         degrees_of_freedom(s, q=[1.0])
+
+
+def test_virtual_work_of_a_link_and_of_a_spring():
+    """Seed 002: two particles A, B with coordinates (x_A, y_A, phi) and a rigid link: the
+    link's internal forces +-R along AB do no virtual work (Q = 0); with a spring instead
+    (coordinates x_A, y_A, L, phi) only L is worked on: Q_L = -k (L - L0)."""
+    xA, yA, L, ph = dynamicsymbols("x_A y_A L phi")
+    R, k, L0, l = sp.symbols("R k L0 l")
+    A = sp.Matrix([xA, yA])
+    e = sp.Matrix([sp.cos(ph), sp.sin(ph)])
+    link = symbolic.dalembert_system([A, A + l*e], [1, 1], [-R*e, R*e], [xA, yA, ph],
+                                     {R: 2.5, l: 1.0})
+    assert all(q == 0 for q in map(sp.simplify, link.generalized_forces))
+    assert link.implicit_constraints == 1                  # 4 - 3: the link's length
+    spring = symbolic.dalembert_system([A, A + L*e], [1, 1],
+                                       [k*(L - L0)*e, -k*(L - L0)*e], [xA, yA, L, ph],
+                                       {k: 40.0, L0: 1.0})
+    Q = [sp.simplify(q) for q in spring.generalized_forces]
+    assert Q[0] == 0 and Q[1] == 0 and Q[3] == 0
+    assert _same(Q[2], -k*(L - L0))
+    assert spring.implicit_constraints == 0 and spring.degrees_of_freedom == 4
+    # conservative: V = k (L - L0)^2 / 2 up to a constant
+    assert _same(sp.diff(spring.potential, L), k*(L - L0))
