@@ -119,3 +119,25 @@ def test_readme_example_wording():
     assert down.relative.kind == "centre"
     w = np.sqrt(9.81*(1.3 + 0.7)/(1.3*0.9))
     assert np.allclose(np.abs(down.relative.eigenvalues.imag), w, atol=1e-10)
+
+
+def test_curved_family_of_a_symmetry():
+    """A particle in the 'Mexican hat' V = (x^2 + y^2 - 1)^2/4: a circle of equilibria (the
+    rotational symmetry), found with its dimension; along the circle the particle drifts
+    (a Jordan block); relative to the angular momentum x y' - y x' (and the circle) it is a
+    centre with the radial frequency sqrt(V''(1)) = sqrt(2)."""
+    def f(t, s):
+        x, y, vx, vy = s
+        c = x*x + y*y - 1.0
+        return [vx, vy, -c*x, -c*y]
+    a = 0.7
+    y0 = [np.cos(a), np.sin(a), 0.0, 0.0]
+    e = stability.equilibrium(f, y0, integrals=[lambda s: s[0]*s[3] - s[1]*s[2]])
+    assert e.family_dim == 1
+    assert abs(abs(e.family[:, 0] @ [-np.sin(a), np.cos(a), 0, 0]) - 1) <= 1e-6
+    assert e.kind.startswith("unstable (secular drift along")
+    assert e.relative.kind == "centre"
+    assert np.allclose(np.abs(e.relative.eigenvalues.imag), np.sqrt(2), atol=1e-6)
+    # Newton from off the circle lands on it
+    r = stability.find_equilibrium(f, [1.3, 0.4, 0.1, 0.0])
+    assert abs(np.hypot(r.y[0], r.y[1]) - 1) <= 1e-12 and r.family_dim == 1
