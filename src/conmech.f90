@@ -27,6 +27,9 @@ module conmech
     use conmech_systems_ball
     use conmech_hill
     use conmech_equilibria
+    use conmech_jordan
+    use conmech_relative_equilibria
+    use conmech_degrees_of_freedom
     use conmech_variational
     use conmech_floquet
     use conmech_shooting

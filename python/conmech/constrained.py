@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
+from . import degrees_of_freedom as _dof
 from ._callback import Guard, as_result, message_text
 from .systems import _NO_SPEC
 
@@ -103,6 +104,13 @@ class BuiltinConstrained:
         p = self.params if self.params.size else _PAD
         nspec = self.spec.size if self.spec is not _NO_SPEC else 0
         return self.name, self.params.size, p, nspec, self.spec
+
+    @property
+    def degrees_of_freedom(self):
+        """n minus the independent holonomic constraints, at the default consistent state
+        (:func:`conmech.degrees_of_freedom.degrees_of_freedom` gives the whole report:
+        independent velocities, redundant constraints)."""
+        return _dof.degrees_of_freedom(self).dof
 
     def initial_state(self):
         """Default consistent initial state (q0, v0)."""

@@ -37,6 +37,17 @@ POSITIVE_PARAMS = {
     "yoyo": {0: "m", 1: "r", 2: "I"}, "skate": {0: "m", 1: "I"},
     "rolling_disk": {0: "m", 1: "R", 2: "I_roll", 3: "I_turn"},
 }
+#: Names of the state components of the built-in first-order and generalized systems (for
+#: reports such as the direction of a secular drift): coordinates, then velocities.
+_COORDS = {"pendulum_angle": ("theta",), "cart_pendulum": ("x", "theta"),
+           "double_pendulum": ("theta1", "theta2"), "atwood": ("y1",),
+           "spring_pendulum": ("r", "theta"), "double_spring_pendulum": ("x1", "y1", "x2", "y2"),
+           "three_springs": ("x1", "y1", "x2", "y2", "x3", "y3"), "bead_hoop": ("theta",),
+           "polar_particle": ("r", "theta"), "pendulum_moving": ("theta",),
+           "yoyo_angle": ("y",), "harmonic": ("x",), "pendulum": ("theta",),
+           "vanderpol": ("x",), "kepler": ("x", "y"), "arenstorf": ("x", "y"),
+           "hill": ("x", "y")}
+STATE_NAMES = {k: v + tuple(c + "'" for c in v) for k, v in _COORDS.items()}
 #: Parameters that must lie in a closed interval.
 RANGE_PARAMS = {"arenstorf": {0: ("mu", 0.0, 1.0)}, "hill": {0: ("m", 0.0, np.inf)}}
 
@@ -100,6 +111,14 @@ class BuiltinSystem:
         """The parameters as a dict (name -> value)."""
         names = self.param_names or tuple(f"p{i}" for i in range(self.params.size))
         return dict(zip(names, self.params.tolist()))
+
+    @property
+    def degrees_of_freedom(self):
+        """The number of generalized coordinates of a mechanical system in generalized
+        coordinates (its holonomic constraints eliminated); None for a first-order system
+        without mechanical structure."""
+        kind, n, mh, mn, info, _ = _conmech.flat_mech_info(*self._flat_args())
+        return int(n) if info == 0 and kind == 2 else None
 
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())

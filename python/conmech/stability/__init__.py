@@ -20,8 +20,8 @@ callables ``fun(t, y)`` (finite-difference Jacobian in Fortran).
 - :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
   of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``).
 """
-from .equilibria import (EQUILIBRIUM_RTOL, Equilibrium, equilibria, equilibrium,
-                         find_equilibrium, grid, lagrange_dirichlet,
+from .equilibria import (EQUILIBRIUM_RTOL, Equilibrium, RelativeEquilibrium, equilibria,
+                         equilibrium, find_equilibrium, grid, lagrange_dirichlet,
                          lagrange_dirichlet_potential, potential_hessian)
 from .variational import floquet, monodromy, stm
 from .orbits import ORBIT_RESIDUAL_TOL, PeriodicOrbit, periodic_orbit, symmetric_orbit
@@ -35,7 +35,7 @@ from .plots import plot_branch, plot_multipliers
 # validators used by sibling modules (hill_families)
 from ._validate import _real, _state  # noqa: F401
 
-__all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
+__all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
            "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
            "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
            "switch_period_doubling", "switch_branch_point", "constrained_equilibrium",

@@ -49,9 +49,12 @@ import sympy as sp
 from .build import CompileError, _conmech_version, cache_dir, compile_source, load
 from .codegen import CODEGEN_VERSION, generate
 from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
+from .momenta import (FirstIntegrals, LagrangianSystem, Momenta, as_lagrangian_system,
+                      first_integrals, momenta)
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
-           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model"]
+           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model",
+           "momenta", "first_integrals", "Momenta", "FirstIntegrals", "LagrangianSystem"]
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
@@ -213,11 +216,10 @@ def _system(model):
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
                                    **common)
     if d.kind == "generalized":
-        return compiled.generalized_system(d.n, a["mass"], a["forces"],
-                                           forces_jac=a.get("forces_jac"),
-                                           energy=a.get("energy"),
-                                           mass_forces=a.get("mass_forces"),
-                                           accel=a.get("accel"), **common)
+        return as_lagrangian_system(compiled.generalized_system(
+            d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
+            energy=a.get("energy"), mass_forces=a.get("mass_forces"), accel=a.get("accel"),
+            **common))
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
@@ -421,3 +423,18 @@ from .spatial import SpatialBody, spatial_tree  # noqa: E402
 __all__ += ["SpatialBody", "spatial_tree"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]
+
+# Routh reduction (cyclic coordinates eliminated for given momenta)
+from .reduction import Reduction, ReducedSystem, reduce  # noqa: E402
+
+__all__ += ["reduce", "Reduction", "ReducedSystem"]
+
+# D'Alembert's route (positions, applied forces, generalized forces)
+from .dalembert import DAlembertSystem, dalembert_system  # noqa: E402
+
+# Hamilton's principle along computed motions
+from .action import (Variation, action, check_stationary, first_variation,  # noqa: E402
+                     second_variation)
+
+__all__ += ["dalembert_system", "DAlembertSystem", "action", "first_variation",
+            "second_variation", "check_stationary", "Variation"]
