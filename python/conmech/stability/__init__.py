@@ -23,7 +23,8 @@ callables ``fun(t, y)`` (finite-difference Jacobian in Fortran).
 - :func:`normal_modes` of an equilibrium of a conservative system and
   :func:`lyapunov_family`, the family of periodic orbits born at one of them, continued
   with its energy (``lyapunov_family.py``);
-- :func:`plot_branch`, :func:`plot_multipliers` (``plots.py``);
+- :func:`plot_branch`, :func:`plot_multipliers`, :func:`plot_orbits`,
+  :func:`stable_orbits` (``plots.py``);
 - :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
   of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``).
 """
@@ -42,7 +43,7 @@ from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoin
                                        HopfNormalForm, equilibrium_continuation,
                                        first_lyapunov_coefficient, hopf_orbits)
 from .lyapunov_family import LyapunovFamily, NormalModes, lyapunov_family, normal_modes
-from .plots import plot_branch, plot_multipliers
+from .plots import plot_branch, plot_multipliers, plot_orbits, stable_orbits
 # validators used by sibling modules (hill_families)
 from ._validate import _real, _state  # noqa: F401
 
@@ -55,4 +56,5 @@ __all__ = ["Equilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuati
            "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation",
            "EquilibriumBranch", "EquilibriumSpecialPoint", "HopfNormalForm",
            "equilibrium_continuation", "first_lyapunov_coefficient", "hopf_orbits",
-           "LyapunovFamily", "NormalModes", "lyapunov_family", "normal_modes"]
+           "LyapunovFamily", "NormalModes", "lyapunov_family", "normal_modes",
+           "plot_orbits", "stable_orbits"]

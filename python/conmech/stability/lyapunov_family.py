@@ -8,7 +8,7 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
-from ..compiled import evaluate
+from ..compiled import CompiledSystem, evaluate
 from ..systems import BuiltinSystem
 from ._validate import _count, _real, _state
 from .continuation import Branch, continuation
@@ -118,14 +118,15 @@ def normal_modes(system: Any, q_eq: ArrayLike, jac=None) -> NormalModes:
         v = v/np.linalg.norm(v)
         j = int(np.argmin(np.abs(wl - w[i])))
         u = np.conj(vl[:, j])
-        u = u/np.conj(np.vdot(u, v))                  # u^H v = 1
+        with np.errstate(divide="ignore", invalid="ignore"):    # (a 1:1 resonance)
+            u = u/np.conj(np.vdot(u, v))              # u^H v = 1
         vectors[:, c] = v
         left[:, c] = u
         notes = []
         others = np.delete(lam, [int(np.argmin(np.abs(lam - w[i]))),
                                  int(np.argmin(np.abs(lam - np.conj(w[i]))))])
         for lj in others:
-            ratio = lj/(1j*w[i])
+            ratio = lj/(1j*w[i].imag)
             nr = np.round(ratio.real)
             if abs(ratio - nr) <= RESONANCE_TOL:
                 notes.append("a zero eigenvalue" if nr == 0 else
@@ -233,7 +234,13 @@ def lyapunov_family(system: Any, q_eq: ArrayLike, mode: int = 0, *, amplitude: f
                          "family cannot be continued in the period (a linear or isochronous "
                          "mode)")
     if isinstance(system, BuiltinSystem):
-        br = continuation(system, ya, ta, in_period=True, conservative=True,
+        csys = system
+        if system.params.size == 0 and isinstance(system, CompiledSystem):
+            # continuation() needs a parameter slot even when it continues in the period
+            # (it never sets it): a compiled system without parameters gets an unused one
+            csys = CompiledSystem(system.name, system.kind, system.spec, np.zeros(1),
+                                  ("unused",), system._keep)
+        br = continuation(csys, ya, ta, in_period=True, conservative=True,
                           direction=1 if tb > ta else -1, rtol=rtol, atol=rtol,
                           energy=lambda y, p: efun(y), **options)
     else:
