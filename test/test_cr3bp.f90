@@ -7,6 +7,7 @@ program test_cr3bp
     use conmech_testing
     implicit none
     type(test_suite) :: ts
+    ts%name = "test_cr3bp"
     call test_libration(ts)
     call test_jacobians(ts)
     call test_jacobi_conserved(ts)

@@ -107,6 +107,7 @@ program test_equilibrium_continuation
     use eqc_test_systems
     implicit none
     type(test_suite) :: ts
+    ts%name = "test_equilibrium_continuation"
     call test_brusselator(ts)
     call test_folds(ts)
     call test_normal_form(ts)
