@@ -281,12 +281,14 @@ def hopf_orbits(system: Any, branch: EquilibriumBranch, point: EquilibriumSpecia
 
     The first orbit comes from the normal form: with mu(p) the real part of the critical
     pair (its slope mu' from the branch points around the Hopf point) and l1 the first
-    Lyapunov coefficient, the cycle of amplitude rho (``amplitude``; in the normal-form
-    coordinate z = <p, y - y_H>, <q, q> = 1) lies at p - p_H = -l1 omega rho^2 / mu' and is
+    Lyapunov coefficient, the cycle of amplitude rho (``amplitude`` times max(1, |y_H|); in
+    the normal-form coordinate z = <p, y - y_H>, <q, q> = 1) lies at
+    p - p_H = -l1 omega rho^2 / mu' and is
     y_H + 2 rho Re(q e^(i omega t)) to first order, with the period 2 pi / omega. From that
     guess :func:`~conmech.stability.continuation` corrects the orbit at that parameter and
-    continues it away from the Hopf point (general shooting of an autonomous system; the
-    other options as for continuation). Raises ValueError at a degenerate Hopf point (l1
+    continues it away from the Hopf point (general shooting of an autonomous system;
+    ``param`` defaults to the branch's parameter; the other options as for continuation).
+    Raises ValueError at a degenerate Hopf point (l1
     not distinguishable from 0: the side on which the cycles exist is not decided by the
     normal form) or a point that is not a located Hopf point."""
     if not isinstance(branch, EquilibriumBranch):
@@ -307,6 +309,9 @@ def hopf_orbits(system: Any, branch: EquilibriumBranch, point: EquilibriumSpecia
                          f"{point.l1_error:.3g}); the normal form does not decide on which "
                          "side of the point the cycles exist")
     amplitude = _real(amplitude, "amplitude", 0.0, low_open=True)
+    amplitude *= max(1.0, float(np.max(np.abs(point.y))))
+    if param is None and isinstance(system, BuiltinSystem):
+        param = branch.param
     for bad in ("p0", "free", "targets", "in_period", "conservative", "_switch", "_tangent",
                 "fixed_period", "autonomous", "direction"):
         if bad in options:

@@ -359,9 +359,11 @@ def plot_orbits(system, branch, ax=None, coords=(0, 1), n_orbits=15, indices=Non
         ax.set_aspect("equal", adjustable="datalim")
         mappable = lc
     else:
+        # the legend entry goes with the strongest colour of the map
+        strong = int(np.argmax(np.abs(np.asarray([norm(cv[k]) for k in indices]) - 0.5)))
         for i, (c, k) in enumerate(zip(curves, indices)):
             ax.plot(c[0], c[1], c[2], color=cm(norm(cv[k])), lw=0.9,
-                    label=label if i == len(curves) - 1 else None)
+                    label=label if i == strong else None)
         mappable = plt.cm.ScalarMappable(norm=norm, cmap=cm)
         mappable.set_array(cv[indices])
         # equal scales on the three axes (the orbits' true shape)
