@@ -40,6 +40,11 @@ module conmech
     use conmech_transverse
     use conmech_param_system
     use conmech_branch_switch
+    use conmech_cr3bp
+    use conmech_hill_spatial
+    use conmech_system_energy
+    use conmech_hopf
+    use conmech_equilibrium_continuation
     implicit none
     public
 end module conmech

@@ -16,7 +16,15 @@ callables ``fun(t, y)`` (finite-difference Jacobian in Fortran).
   with folds, branch points, period doublings and Neimark-Sacker points located
   (:class:`Branch`, :class:`SpecialPoint`); :func:`switch_period_doubling`,
   :func:`switch_branch_point` (``continuation.py``, ``branch_switch.py``);
-- :func:`plot_branch`, :func:`plot_multipliers` (``plots.py``);
+- :func:`equilibrium_continuation`: continuation of equilibria in a parameter, folds and
+  Hopf points located, the first Lyapunov coefficient (:func:`first_lyapunov_coefficient`)
+  at each Hopf point, and :func:`hopf_orbits`, the periodic branch born there
+  (``equilibrium_continuation.py``);
+- :func:`normal_modes` of an equilibrium of a conservative system and
+  :func:`lyapunov_family`, the family of periodic orbits born at one of them, continued
+  with its energy (``lyapunov_family.py``);
+- :func:`plot_branch`, :func:`plot_multipliers`, :func:`plot_orbits`,
+  :func:`stable_orbits` (``plots.py``);
 - :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
   of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``).
 """
@@ -31,7 +39,11 @@ from .branch_switch import switch_branch_point
 from .constrained_equilibria import (ConstrainedEquilibrium, constrained_equilibria,
                                      constrained_equilibrium)
 from .transverse import transverse
-from .plots import plot_branch, plot_multipliers
+from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoint,
+                                       HopfNormalForm, equilibrium_continuation,
+                                       first_lyapunov_coefficient, hopf_orbits)
+from .lyapunov_family import LyapunovFamily, NormalModes, lyapunov_family, normal_modes
+from .plots import plot_branch, plot_multipliers, plot_orbits, stable_orbits
 # validators used by sibling modules (hill_families)
 from ._validate import _real, _state  # noqa: F401
 
@@ -41,4 +53,8 @@ __all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "Spe
            "switch_period_doubling", "switch_branch_point", "constrained_equilibrium",
            "constrained_equilibria", "ConstrainedEquilibrium",
            "equilibrium", "lagrange_dirichlet", "stm",
-           "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation"]
+           "monodromy", "periodic_orbit", "symmetric_orbit", "floquet", "hill_equation",
+           "EquilibriumBranch", "EquilibriumSpecialPoint", "HopfNormalForm",
+           "equilibrium_continuation", "first_lyapunov_coefficient", "hopf_orbits",
+           "LyapunovFamily", "NormalModes", "lyapunov_family", "normal_modes",
+           "plot_orbits", "stable_orbits"]
