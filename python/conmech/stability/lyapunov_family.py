@@ -116,6 +116,9 @@ def normal_modes(system: Any, q_eq: ArrayLike, jac=None) -> NormalModes:
         v = vr[:, i]
         v = v*np.exp(-0.5j*np.angle(np.sum(v*v)))    # the largest real part
         v = v/np.linalg.norm(v)
+        # the sign of an eigenvector is arbitrary (LAPACK's choice): fix it, so that a
+        # family always starts on the same side of the equilibrium
+        v = v if v.real[int(np.argmax(np.abs(v.real)))] >= 0 else -v
         j = int(np.argmin(np.abs(wl - w[i])))
         u = np.conj(vl[:, j])
         with np.errstate(divide="ignore", invalid="ignore"):    # (a 1:1 resonance)
