@@ -163,9 +163,12 @@ contains
                 exit
             end if
 
+            changed = .false.
+            hinfo = 0
+            if (present(hook)) call hook%after_step(stp%t, stp%y, changed, hinfo)
+            ! f at the step's end where the method deferred it (or the hook changed y)
+            if (changed .or. stp%f_stale) call stp%refresh_f(sys)
             if (present(hook)) then
-                call hook%after_step(stp%t, stp%y, changed, hinfo)
-                if (changed .or. stp%f_stale) call stp%refresh_f(sys)
                 if (hinfo /= 0) then
                     if (store_steps) call push_point(res, t, stp%y)
                     if (hinfo < 0) then

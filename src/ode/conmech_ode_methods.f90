@@ -9,6 +9,7 @@ module conmech_ode_methods
     use conmech_ode_options
     use conmech_ode_stepper, only: ode_stepper
     use conmech_rk_stepper, only: rk_stepper
+    use conmech_radau_stepper, only: radau_stepper
     implicit none
     private
 
@@ -51,6 +52,7 @@ contains
             if (present(stp)) allocate (rk_stepper :: stp)
         case (METHOD_RADAU5)
             info = method_info(code, "RADAU5", "RADAU", 5, uses_jacobian=.true.)
+            if (present(stp)) allocate (radau_stepper :: stp)
         case (METHOD_GAUSS4)
             info = method_info(code, "GAUSS4", "", 4, fixed_step=.true.)
         case (METHOD_GAUSS6)

@@ -23,7 +23,8 @@ module conmech_ode_solver
         METHOD_RATTLE
     use conmech_ode_dense, only: dense_solution
     use conmech_ode_result, only: ode_result
-    use conmech_ode_stepper, only: ode_stepper
+    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack
+    use conmech_state_packer, only: state_packer
     use conmech_ode_methods, only: method_from_name, new_stepper, method_info, method_entry
     use conmech_ode_driver, only: ode_drive
     use conmech_rk_stepper, only: rk_stepper, rk_init, rk_start, rk_step
@@ -34,7 +35,7 @@ module conmech_ode_solver
     public :: METHOD_RADAU5, METHOD_GAUSS4, METHOD_GAUSS6, METHOD_RATTLE
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name, method_info, method_entry
-    public :: ode_stepper, ode_drive
+    public :: ode_stepper, ode_drive, stepper_pack, stepper_unpack, state_packer
     public :: rk_stepper, rk_init, rk_start, rk_step     ! the stepper, for step-by-step use
 
     interface
@@ -79,7 +80,8 @@ contains
 
         allocate (res%t(0), res%y(size(y0), 0), res%ev_t(0), res%ev_y(size(y0), 0), &
                   res%ev_id(0))
-        if (.not. present(stepper) .and. options%method >= METHOD_RADAU5) then
+        if (.not. present(stepper) .and. (options%method == METHOD_GAUSS4 .or. &
+                                          options%method == METHOD_GAUSS6)) then
             if (present(hook)) then
                 call fail(res, CM_BAD_INPUT, "bad input: step hooks need an explicit method")
             else
@@ -119,7 +121,7 @@ contains
         type(ode_stats) :: st
         class(ode_stepper), allocatable :: stp
         character(len=:), allocatable :: msg
-        if (options%method >= METHOD_RADAU5) then
+        if (options%method == METHOD_GAUSS4 .or. options%method == METHOD_GAUSS6) then
             if (present(hook)) then
                 info = CM_BAD_INPUT
                 msg = "bad input: step hooks need an explicit method"

@@ -7,7 +7,7 @@
 module conmech_flat_stepper_support
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NONFINITE
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_DOPRI5
     use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack
@@ -50,6 +50,7 @@ contains
         character(len=:), allocatable :: msg
         integer :: inf, code
         integer(c_int) :: nfev0
+        character(len=32) :: buf
 
         sizes = 0
         code = method
@@ -101,6 +102,13 @@ contains
             if (inf == CM_SUCCESS) then
                 if (action == ACTION_STEP) then
                     call s%step(sys, s%tf, inf, msg)
+                    if (inf == CM_SUCCESS .and. s%f_stale) call s%refresh_f(sys)
+                    ! a step that ends where f is not finite fails, as in the driver
+                    if (inf == CM_SUCCESS .and. .not. s%f_finite()) then
+                        inf = CM_NONFINITE
+                        write (buf, '(es14.6)') s%t
+                        msg = "non-finite right-hand side at t ="//trim(buf)
+                    end if
                 else
                     call s%dense(sys)
                 end if
