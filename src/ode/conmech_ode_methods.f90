@@ -10,6 +10,7 @@ module conmech_ode_methods
     use conmech_ode_stepper, only: ode_stepper
     use conmech_rk_stepper, only: rk_stepper
     use conmech_radau_stepper, only: radau_stepper
+    use conmech_gauss_stepper, only: gauss_stepper
     implicit none
     private
 
@@ -55,8 +56,10 @@ contains
             if (present(stp)) allocate (radau_stepper :: stp)
         case (METHOD_GAUSS4)
             info = method_info(code, "GAUSS4", "", 4, fixed_step=.true.)
+            if (present(stp)) allocate (gauss_stepper :: stp)
         case (METHOD_GAUSS6)
             info = method_info(code, "GAUSS6", "", 6, fixed_step=.true.)
+            if (present(stp)) allocate (gauss_stepper :: stp)
         case (METHOD_RATTLE)
             info = method_info(code, "RATTLE", "", 2, fixed_step=.true., &
                                constrained_only=.true.)
