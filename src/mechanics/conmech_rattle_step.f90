@@ -32,10 +32,12 @@ module conmech_rattle_step
     use conmech_lapack, only: dgetrs
     use conmech_generalized, only: mass_cholesky
     use conmech_constrained_system, only: constrained_system
+    use conmech_state_packer, only: state_packer
     implicit none
     private
 
     public :: rattle_state, rattle_work, rattle_work_init, rattle_prepare, rattle_step
+    public :: rattle_state_transfer
 
     integer, parameter :: MASS_GENERAL = 0, MASS_DIAGONAL = 1, MASS_CONSTANT = 2
 
@@ -247,6 +249,24 @@ contains
                  //"converge (or are not finite)"
         end if
     end subroutine rattle_step
+
+    !> Pack or unpack one grid state (conmech_state_packer), allocated for the run of wk.
+    subroutine rattle_state_transfer(wk, st, p)
+        type(rattle_work), intent(in) :: wk
+        type(rattle_state), intent(inout) :: st
+        type(state_packer), intent(inout) :: p
+        integer :: n, m
+        n = wk%n
+        m = wk%m
+        call p%item(st%t)
+        call p%reals(st%q, n)
+        call p%reals(st%v, n)
+        call p%reals(st%f, n)
+        call p%real_matrix(st%x, n, m)
+        call p%real_matrix(st%g, m, n)
+        if (wk%mkind == MASS_GENERAL) call p%real_matrix(st%mc, n, n)
+        if (wk%mkind == MASS_DIAGONAL) call p%reals(st%d, n)
+    end subroutine rattle_state_transfer
 
     subroutine allocate_state(wk, st)
         type(rattle_work), intent(in) :: wk

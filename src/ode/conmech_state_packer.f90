@@ -7,6 +7,8 @@
 !!     call p%columns(self%fc, 0, self%nf) ! an (n, lo:hi) matrix: hi - lo + 1 columns
 !!     call p%ints(self%ipiv, self%n)      ! an integer vector of length m
 !!     call p%complex_columns(self%e2, self%n)   ! an (n, m) complex matrix: 2 m columns
+!!     call p%reals(self%q, m)             ! a real vector of any length m: into r
+!!     call p%real_matrix(self%g, m1, m2)  ! an (m1, m2) real matrix: into r
 !!
 !! The same list writes (mode PACK_WRITE: the packer's arrays grow as needed) and reads
 !! (mode PACK_READ: from arrays given to `packer_read`; allocatable targets are allocated
@@ -42,6 +44,8 @@ module conmech_state_packer
         procedure :: columns => pack_columns
         procedure :: ints => pack_ints
         procedure :: complex_columns => pack_complex_columns
+        procedure :: reals => pack_reals
+        procedure :: real_matrix => pack_real_matrix
         procedure :: reading => packer_reading
     end type state_packer
 
@@ -233,5 +237,41 @@ contains
         end if
         p%nw = p%nw + 2*m
     end subroutine pack_complex_columns
+
+    !> A real vector of length m (any m) into r.
+    subroutine pack_reals(p, a, m)
+        class(state_packer), intent(inout) :: p
+        real(dp), allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: m
+        if (.not. room_r(p, m)) return
+        if (p%mode == PACK_READ) then
+            if (allocated(a)) then
+                if (size(a) /= m) deallocate (a)
+            end if
+            if (.not. allocated(a)) allocate (a(m))
+            a = p%r(p%nr + 1:p%nr + m)
+        else
+            p%r(p%nr + 1:p%nr + m) = a(1:m)
+        end if
+        p%nr = p%nr + m
+    end subroutine pack_reals
+
+    !> A real (m1, m2) matrix into r (column by column).
+    subroutine pack_real_matrix(p, a, m1, m2)
+        class(state_packer), intent(inout) :: p
+        real(dp), allocatable, intent(inout) :: a(:, :)
+        integer, intent(in) :: m1, m2
+        if (.not. room_r(p, m1*m2)) return
+        if (p%mode == PACK_READ) then
+            if (allocated(a)) then
+                if (size(a, 1) /= m1 .or. size(a, 2) /= m2) deallocate (a)
+            end if
+            if (.not. allocated(a)) allocate (a(m1, m2))
+            a = reshape(p%r(p%nr + 1:p%nr + m1*m2), [m1, m2])
+        else
+            p%r(p%nr + 1:p%nr + m1*m2) = reshape(a(1:m1, 1:m2), [m1*m2])
+        end if
+        p%nr = p%nr + m1*m2
+    end subroutine pack_real_matrix
 
 end module conmech_state_packer
