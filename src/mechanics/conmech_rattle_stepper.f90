@@ -19,7 +19,7 @@ module conmech_rattle_stepper
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_RATTLE
-    use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
+    use conmech_ode_stepper, only: ode_stepper, check_first_step
     use conmech_state_packer, only: state_packer
     use conmech_constrained_system, only: constrained_system
     use conmech_rattle_step, only: rattle_state, rattle_work, rattle_work_init, &
@@ -44,7 +44,7 @@ module conmech_rattle_stepper
         type(rattle_state) :: grid(2)       !! the states at t_old and t
         type(rattle_state) :: side          !! scratch of the side steps
     contains
-        procedure :: init => rattle_init
+        procedure :: setup => rattle_setup
         procedure :: start => rattle_start
         procedure :: step => rattle_stepper_step
         procedure :: eval => rattle_eval
@@ -55,16 +55,13 @@ module conmech_rattle_stepper
 
 contains
 
-    !> The options and the grid (y0 = [q0; v0]); CM_TOO_MANY_STEPS when the grid has more
-    !! steps than max_steps. No evaluation.
-    subroutine rattle_init(self, t0, tf, y0, opt, info, msg, allow_inf)
+    !> The method's part of init: the system, the step option and the grid (y = [q0; v0]);
+    !! CM_TOO_MANY_STEPS when the grid has more steps than max_steps. No evaluation.
+    subroutine rattle_setup(self, opt, info, msg)
         class(rattle_stepper), intent(inout) :: self
-        real(dp), intent(in) :: t0, tf
-        real(dp), intent(in) :: y0(:)
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: allow_inf
         character(len=32) :: buf
         info = CM_BAD_INPUT
         if (.not. allocated(self%mech)) then
@@ -73,17 +70,17 @@ contains
         else if (self%mech%n_nh /= 0) then
             msg = "bad input: RATTLE handles holonomic constraints only (n_nh = 0)"
             return
-        else if (size(y0) /= 2*self%mech%n) then
+        else if (self%n /= 2*self%mech%n) then
             msg = "bad input: y0 must be [q0; v0] of the system's 2 n elements"
             return
         end if
-        call check_interval(t0, tf, y0, opt, info, msg, fixed="RATTLE")
+        call check_first_step(self, opt, info, msg, fixed="RATTLE")
         if (info /= CM_SUCCESS) return
         self%ncoord = self%mech%n
-        self%t_start = t0
+        self%t_start = self%t
         self%nsteps = 0
-        if (tf /= t0) self%nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step &
-                                                   *(1.0_dp - 1.0e-12_dp)))
+        if (self%tf /= self%t) self%nsteps = max(1, ceiling(abs(self%tf - self%t) &
+                                                            /opt%first_step*(1.0_dp - 1.0e-12_dp)))
         if (self%nsteps > opt%max_steps) then
             write (buf, '(i0)') self%nsteps
             info = CM_TOO_MANY_STEPS
@@ -91,14 +88,14 @@ contains
                   //"more than max_steps"
             return
         end if
-        call self%setup_base(METHOD_RATTLE, t0, tf, y0, 0, FORM_POWER)
+        self%method = METHOD_RATTLE
         self%lands_on_target = .false.
         self%hg = 0.0_dp
-        if (self%nsteps > 0) self%hg = (tf - t0)/real(self%nsteps, dp)
+        if (self%nsteps > 0) self%hg = (self%tf - self%t)/real(self%nsteps, dp)
         self%h = self%hg
         self%kdone = 0
         self%cur = 1
-    end subroutine rattle_init
+    end subroutine rattle_setup
 
     !> The work of the run (M^{-1} once for a constant mass) and the state at t0 (forces,
     !! mass factor, G and M^{-1} G^T).

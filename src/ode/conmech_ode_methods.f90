@@ -10,7 +10,7 @@ module conmech_ode_methods
     use conmech_ode_stepper, only: ode_stepper
     use conmech_rk_stepper, only: rk_stepper
     use conmech_radau_stepper, only: radau_stepper
-    use conmech_gauss_stepper, only: gauss_stepper
+    use conmech_gauss, only: gauss_stepper
     implicit none
     private
 

@@ -8,7 +8,7 @@
 !! (conmech_ode_stepper's contract); a caller's own stepper type runs through the same loop
 !! when given as `stepper`. The pieces: options, counters and method codes
 !! (conmech_ode_options), the method table (conmech_ode_methods), the steppers
-!! (conmech_rk_stepper, conmech_radau_stepper, conmech_gauss_stepper), event location on the last
+!! (conmech_rk_stepper, conmech_radau_stepper, conmech_gauss), event location on the last
 !! step (conmech_ode_event_locate), the dense solution (conmech_ode_dense) and the result
 !! (conmech_ode_result). This module re-exports their public names, so
 !! `use conmech_ode_solver` gives the whole integrator API.
