@@ -238,8 +238,12 @@ contains
         type(rattle_state), intent(inout) :: st
         type(state_packer), intent(inout) :: p
         integer :: n, m
+        logical :: prepared
         n = wk%n
         m = wk%m
+        prepared = allocated(st%f)              ! (the second state before the first step)
+        call p%item(prepared)
+        if (.not. prepared) return
         call p%item(st%t)
         call p%reals(st%q, n)
         call p%reals(st%v, n)

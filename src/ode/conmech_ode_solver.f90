@@ -23,7 +23,8 @@ module conmech_ode_solver
         METHOD_RATTLE
     use conmech_ode_dense, only: dense_solution
     use conmech_ode_result, only: ode_result
-    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack
+    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack, &
+        check_first_step, check_interval, tolerance_vectors, FORM_HAIRER, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_ode_methods, only: method_from_name, new_stepper, method_info, method_entry
     use conmech_ode_driver, only: ode_drive
@@ -36,6 +37,7 @@ module conmech_ode_solver
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name, method_info, method_entry
     public :: ode_stepper, ode_drive, stepper_pack, stepper_unpack, state_packer
+    public :: check_first_step, check_interval, tolerance_vectors, FORM_HAIRER, FORM_POWER
     public :: rk_stepper, rk_init, rk_start, rk_step     ! the stepper, for step-by-step use
 
 contains
