@@ -222,6 +222,8 @@ program test_add_integrator
     call ts%check(k == r%nt + 1 .and. h1%last .and. h1%st%nfev == r%stats%nfev, &
                   "packed and unpacked at every step: ode_solve's steps, bit for bit")
     call ts%finish()
+    deallocate (h1)         ! (main-program allocatables are not freed at exit)
+    if (allocated(msg)) deallocate (msg)
 
 contains
 

@@ -65,6 +65,7 @@ program test_gauss
     call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "first_step") > 0, &
                   "no step: "//r%message)
     call ts%finish()
+    deallocate (gs)         ! (main-program allocatables are not freed at exit)
 
 contains
 

@@ -149,6 +149,7 @@ program test_radau
     call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "constrained") > 0, &
                   "RATTLE in ode_solve: "//r%message)
     call ts%finish()
+    deallocate (rs)         ! (main-program allocatables are not freed at exit)
 
 contains
 

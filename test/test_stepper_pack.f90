@@ -89,6 +89,7 @@ program test_stepper_pack
     call ts%check(same .and. ra%last .and. ra%st%nfev == r%stats%nfev, &
                   "RATTLE packed at every step = ode_solve, bit for bit")
     call ts%finish()
+    deallocate (ra, rk2, cs)   ! (main-program allocatables are not freed at exit)
     if (allocated(msg)) deallocate (msg)
 
 end program test_stepper_pack
