@@ -32,6 +32,8 @@ module conmech_systems_generalized
         procedure :: forces => cp_forces
         procedure :: energy => cp_energy
         procedure :: has_energy => yes_energy_cp
+        procedure :: forces_jacobian => cp_forces_jacobian
+        procedure :: has_forces_jacobian => yes_forces_jacobian_cp
     end type cart_pendulum
 
     !> Double pendulum, q = [theta1, theta2] (absolute angles from downward).
@@ -42,6 +44,8 @@ module conmech_systems_generalized
         procedure :: forces => dp_forces
         procedure :: energy => dp_energy
         procedure :: has_energy => yes_energy_dp
+        procedure :: forces_jacobian => dp_forces_jacobian
+        procedure :: has_forces_jacobian => yes_forces_jacobian_dp
     end type gen_double_pendulum
 
     !> Atwood machine, q = [y1] (downward): (m1 + m2) y1'' = (m1 - m2) g.
@@ -213,7 +217,52 @@ contains
                     + self%m*self%l**2*v(2)**2) + self%m*self%g*self%l*cos(q(2))
     end function cp_energy
 
+    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv] (the variational equations and the transverse
+    !! linearisation then need no finite differences).
+    subroutine cp_forces_jacobian(self, t, q, v, a, r)
+        class(cart_pendulum), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        real(dp) :: ml, s, c
+        ml = self%m*self%l
+        s = sin(q(2))
+        c = cos(q(2))
+        r = 0.0_dp
+        r(1, 2) = ml*c*v(2)**2 + ml*s*a(2)
+        r(2, 2) = ml*self%g*c + ml*s*a(1)
+        r(1, 4) = 2.0_dp*ml*s*v(2)
+    end subroutine cp_forces_jacobian
+    logical function yes_forces_jacobian_cp(self)
+        class(cart_pendulum), intent(in) :: self
+        yes_forces_jacobian_cp = .true.
+    end function yes_forces_jacobian_cp
+
     ! ---------------------------------------------------------------- double pendulum
+    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv] (see cp_forces_jacobian).
+    subroutine dp_forces_jacobian(self, t, q, v, a, r)
+        class(gen_double_pendulum), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        real(dp) :: k, s, c
+        k = self%m2*self%l1*self%l2
+        s = sin(q(1) - q(2))
+        c = cos(q(1) - q(2))
+        r(1, 1) = -k*c*v(2)**2 - (self%m1 + self%m2)*self%g*self%l1*cos(q(1)) + k*s*a(2)
+        r(1, 2) = k*c*v(2)**2 - k*s*a(2)
+        r(2, 1) = k*c*v(1)**2 + k*s*a(1)
+        r(2, 2) = -k*c*v(1)**2 - self%m2*self%g*self%l2*cos(q(2)) - k*s*a(1)
+        r(1, 3) = 0.0_dp
+        r(1, 4) = -2.0_dp*k*s*v(2)
+        r(2, 3) = 2.0_dp*k*s*v(1)
+        r(2, 4) = 0.0_dp
+    end subroutine dp_forces_jacobian
+    logical function yes_forces_jacobian_dp(self)
+        class(gen_double_pendulum), intent(in) :: self
+        yes_forces_jacobian_dp = .true.
+    end function yes_forces_jacobian_dp
+
     subroutine dp_mass(self, t, q, mm)
         class(gen_double_pendulum), intent(in) :: self
         real(dp), intent(in) :: t
