@@ -122,7 +122,7 @@ contains
         real(dp) :: w(fo%n, fo%ny + 1), wdq(fo%ny + 1, fo%k), wq(fo%ny + 1, fo%k)
         real(dp) :: gm(fo%ny + 1, fo%ny + 1)
         integer :: p, lainfo
-        call fo%sys%rhs_jacobian(t, x, f, a)
+        call jacobian_fd6(fo%sys, t, x, f, a)
         p = fo%ny + 1
         if (fo%ny > 0) then
             dy = -matmul(y, a)
@@ -151,6 +151,38 @@ contains
         dq = -matmul(w, wdq)
         if (fo%m > 0) call fo%model%input_matrix(t, x, bx)
     end subroutine frame_derivative
+
+    !> f and A = df/dx: the system's own Jacobian when it has one, else sixth-order
+    !! central differences (step eps^(1/7) max(|x_j|, 1), error ~1e-13 relative). The
+    !! construction relies on f' = A f and on the adjoint of the same A carrying the
+    !! invariant covectors; the second-order default differences (~1e-10) would make the
+    !! transverse and the full multipliers disagree at that level.
+    subroutine jacobian_fd6(sys, t, x, f, a)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t, x(:)
+        real(dp), intent(out) :: f(:), a(:, :)
+        real(dp), parameter :: off(6) = [3.0_dp, 2.0_dp, 1.0_dp, -1.0_dp, -2.0_dp, -3.0_dp]
+        real(dp), parameter :: wt(6) = [1.0_dp, -9.0_dp, 45.0_dp, -45.0_dp, 9.0_dp, -1.0_dp]
+        real(dp) :: xp(size(x)), fp(size(x)), h
+        integer :: j, i
+        if (sys%has_jacobian()) then
+            call sys%rhs_jacobian(t, x, f, a)
+            return
+        end if
+        call sys%rhs(t, x, f)
+        xp = x
+        do j = 1, size(x)
+            h = epsilon(1.0_dp)**(1.0_dp/7.0_dp)*max(abs(x(j)), 1.0_dp)
+            a(:, j) = 0.0_dp
+            do i = 1, 6
+                xp(j) = x(j) + off(i)*h
+                call sys%rhs(t, xp, fp)
+                a(:, j) = a(:, j) + wt(i)*fp
+            end do
+            a(:, j) = a(:, j)/(60.0_dp*h)
+            xp(j) = x(j)
+        end do
+    end subroutine jacobian_fd6
 
     subroutine fo_rhs(self, t, y, dydt)
         class(frame_ode), intent(in) :: self
@@ -236,7 +268,22 @@ contains
         oo%atol = opt%atol
         oo%max_steps = opt%max_steps
 
-        ! ---- the orbit alone: closure, the vector field, conservation of the energy
+        if (opt%energy == ENERGY_REQUIRED .and. .not. model%has_energy()) then
+            call fail(CM_BAD_INPUT, "transverse: the system has no energy to reduce by")
+            return
+        end if
+        ! ---- on the invariant manifold; the orbit alone: closure, the vector field,
+        !      conservation of the energy
+        if (nc > 0) then
+            defect = model%manifold_residual(0.0_dp, y0)
+            tol = max(1.0e-10_dp, 1.0e2_dp*opt%atol)*max(1.0_dp, maxval(abs(y0)))
+            if (.not. defect <= tol) then
+                write (b1, '(es10.3)') defect
+                call fail(CM_BAD_INPUT, "transverse: y0 is not on the constraints "// &
+                          "(max |phi|, |C v| = "//trim(adjustl(b1))//")")
+                return
+            end if
+        end if
         call check_orbit(info)
         if (info /= CM_SUCCESS) return
         k = n - 1 - nc
@@ -502,47 +549,49 @@ contains
         if (fr%m > 0) bp(:, 1:fr%m) = matmul(transpose(e), matmul(transpose(qs), bx(:, 1:fr%m)))
     end subroutine transverse_eval
 
-    !> For a two-degree-of-freedom system in second-order form x = [q, q'] with the energy
-    !! removed (N = 4, k = 2): the normal deviation N = n . dq (n the unit normal to q' in
-    !! the configuration plane, turned +90 degrees) of isoenergetic perturbations obeys
-    !! N'' + psi(t) N' + phi(t) N = 0. With r0 = [n; 0], r1 = [n'; n] and
-    !! r2 = [n'' + a_q^T n; 2 n' + a_v^T n] (A = [0 I; a_q a_v]), N^(i) = r_i . dx along the
-    !! variational flow; on the transverse space (dx = Qp xi) r2 = -phi r0 - psi r1 gives
-    !! (phi, psi). For q'' = -grad V + 2 omega J q' (identity mass) psi = 0 and phi is
-    !! Hill's coefficient n^T V'' n + 3 (turn - omega)^2 + omega^2.
+    !> For a two-degree-of-freedom system in second-order form x = [q, v] (v = dq/dt) with
+    !! the energy removed (N = 4, k = 2): the normal deviation N = n . dq (n the unit normal
+    !! to v in the configuration plane, turned +90 degrees) of isoenergetic perturbations
+    !! obeys N'' + psi(t) N' + phi(t) N = 0. With r0 = [n; 0], r1 = [dn; n] and
+    !! r2 = [ddn + a_q^T n; 2 dn + a_v^T n] (A = [0 I; a_q a_v], dn and ddn the first and
+    !! second time derivatives of n), the i-th derivative of N is r_i . dx along the
+    !! variational flow; on the isoenergetic section {f . dx = 0, grad H . dx = 0}
+    !! r2 = -phi r0 - psi r1, i.e. r2 + phi r0 + psi r1 = alpha f + beta grad H (a 4 x 4
+    !! solve at the orbit point with the model's grad H: no frame enters). For
+    !! dv/dt = -grad V + 2 omega J v (identity mass) psi = 0 and phi is Hill's coefficient
+    !! n^T V'' n + 3 (turn - omega)^2 + omega^2.
     subroutine transverse_hill(fr, t, phi, psi, info)
         type(transverse_frame), intent(in) :: fr
         real(dp), intent(in) :: t
         real(dp), intent(out) :: phi, psi
         integer, intent(out) :: info
-        real(dp) :: z(fr%sol%n), x(4), q(4, 2), f(4), a(4, 4), dq(4, 2), bx(4, 1), af(4)
-        real(dp) :: cv(1, 4), dcv(1, 4), qs(4, 2)
-        real(dp) :: e(2, 2), qp(4, 2), v1(2), v2(2), v3(2), nn(2), n1(2), n2(2)
-        real(dp) :: s, s1, s2, r0(4), r1(4), r2(4), mat(2, 2), rhs(2, 1), sol(2, 1), tt
+        real(dp) :: z(fr%sol%n), x(4), f(4), a(4, 4), af(4), g(4)
+        real(dp) :: v1(2), v2(2), v3(2), nn(2), n1(2), n2(2)
+        real(dp) :: s, s1, s2, r0(4), r1(4), r2(4), mat(4, 4), rhs(4, 1), sol(4, 1), tt
         phi = 0.0_dp
         psi = 0.0_dp
-        if (fr%info /= CM_SUCCESS .or. fr%n /= 4 .or. fr%k /= 2) then
+        if (fr%info /= CM_SUCCESS .or. fr%n /= 4 .or. fr%k /= 2 .or. .not. fr%reduced) then
             info = CM_BAD_INPUT
             return
         end if
         tt = modulo(t, fr%period)
         call fr%sol%eval(tt, z)
         x = z(1:4)
-        cv(1, :) = z(5:8)
-        q = reshape(z(9:16), [4, 2])
-        call frame_derivative(fr%ode, tt, x, cv, q, f, a, qs, dq, dcv, bx, info)
-        if (info /= CM_SUCCESS) return
+        call jacobian_fd6(fr%ode%sys, tt, x, f, a)
         if (maxval(abs(f(1:2) - x(3:4))) > 1.0e-10_dp*max(1.0_dp, maxval(abs(x(3:4))))) then
-            info = CM_BAD_INPUT    ! not in second-order form x = [q, q']
+            info = CM_BAD_INPUT    ! not in second-order form x = [q, v]
             return
         end if
-        call fr%hlog%power(-tt/fr%period, e)
-        qp = matmul(qs, e)
+        call fr%ode%model%energy_gradient(tt, x, g)
         af = matmul(a, f)
-        v1 = x(3:4)         ! q'
-        v2 = f(3:4)         ! q''
-        v3 = af(3:4)        ! q'''
+        v1 = x(3:4)         ! velocity
+        v2 = f(3:4)         ! acceleration
+        v3 = af(3:4)        ! its time derivative
         s = norm2(v1)
+        if (.not. s > 0.0_dp) then
+            info = CM_SINGULAR   ! v = 0: no normal
+            return
+        end if
         s1 = dot_product(v1, v2)/s
         s2 = (dot_product(v2, v2) + dot_product(v1, v3))/s - s1**2/s
         nn = rot90(v1)/s
@@ -551,9 +600,11 @@ contains
         r0 = [nn, 0.0_dp, 0.0_dp]
         r1 = [n1, nn]
         r2 = [n2 + matmul(nn, a(3:4, 1:2)), 2.0_dp*n1 + matmul(nn, a(3:4, 3:4))]
-        mat(:, 1) = matmul(r0, qp)
-        mat(:, 2) = matmul(r1, qp)
-        rhs(:, 1) = -matmul(r2, qp)
+        mat(:, 1) = r0
+        mat(:, 2) = r1
+        mat(:, 3) = -f/norm2(f)
+        mat(:, 4) = -g/norm2(g)
+        rhs(:, 1) = -r2
         call la_solve(mat, rhs, sol, info)
         if (info /= CM_SUCCESS) return
         phi = sol(1, 1)

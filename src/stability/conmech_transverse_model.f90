@@ -3,9 +3,9 @@
 !! energy, and an input matrix dF/du for control.
 !!
 !! The base type has none of them; extensions override what they have. The energy
-!! gradient defaults to fourth-order central differences of `energy`,
-!! g_j = (-H(x + 2h) + 8 H(x + h) - 8 H(x - h) + H(x - 2h))/(12 h),
-!! h = eps^(1/5) max(|x_j|, 1): error ~ h^4 + eps/h ~ 1e-13 relative, so that the energy
+!! gradient defaults to sixth-order central differences of `energy`,
+!! g_j = (H(x+3h) - 9 H(x+2h) + 45 H(x+h) - 45 H(x-h) + 9 H(x-2h) - H(x-3h))/(60 h),
+!! h = eps^(1/7) max(|x_j|, 1): error ~ h^6 + eps/h ~ 1e-14 relative, so that the energy
 !! level used by the reduction is exact to well below the integration tolerance.
 module conmech_transverse_model
     use conmech_kinds, only: dp
@@ -19,6 +19,7 @@ module conmech_transverse_model
     contains
         procedure :: n_normals => tm_n_normals
         procedure :: normals => tm_normals
+        procedure :: manifold_residual => tm_manifold_residual
         procedure :: has_energy => tm_has_energy
         procedure :: energy => tm_energy
         procedure :: energy_gradient => tm_energy_gradient
@@ -40,6 +41,13 @@ contains
         real(dp), intent(out) :: c(:, :)
         c = 0.0_dp
     end subroutine tm_normals
+
+    !> How far x is from the invariant manifold (0 without one).
+    real(dp) function tm_manifold_residual(self, t, x) result(r)
+        class(transverse_model), intent(in) :: self
+        real(dp), intent(in) :: t, x(:)
+        r = 0.0_dp
+    end function tm_manifold_residual
 
     logical function tm_has_energy(self)
         class(transverse_model), intent(in) :: self
@@ -69,26 +77,25 @@ contains
         bx = 0.0_dp
     end subroutine tm_input_matrix
 
-    !> Fourth-order central differences of self%energy (see the module notes).
+    !> Sixth-order central differences of self%energy (see the module notes).
     subroutine fd_energy_gradient(self, t, x, g)
         class(transverse_model), intent(in) :: self
         real(dp), intent(in) :: t, x(:)
         real(dp), intent(out) :: g(:)
-        real(dp) :: xp(size(x)), h, e1, e2, e3, e4
-        integer :: j
+        real(dp), parameter :: off(6) = [3.0_dp, 2.0_dp, 1.0_dp, -1.0_dp, -2.0_dp, -3.0_dp]
+        real(dp), parameter :: wt(6) = [1.0_dp, -9.0_dp, 45.0_dp, -45.0_dp, 9.0_dp, -1.0_dp]
+        real(dp) :: xp(size(x)), h
+        integer :: j, i
         xp = x
         do j = 1, size(x)
-            h = epsilon(1.0_dp)**0.2_dp*max(abs(x(j)), 1.0_dp)
-            xp(j) = x(j) + 2.0_dp*h
-            e1 = self%energy(t, xp)
-            xp(j) = x(j) + h
-            e2 = self%energy(t, xp)
-            xp(j) = x(j) - h
-            e3 = self%energy(t, xp)
-            xp(j) = x(j) - 2.0_dp*h
-            e4 = self%energy(t, xp)
+            h = epsilon(1.0_dp)**(1.0_dp/7.0_dp)*max(abs(x(j)), 1.0_dp)
+            g(j) = 0.0_dp
+            do i = 1, 6
+                xp(j) = x(j) + off(i)*h
+                g(j) = g(j) + wt(i)*self%energy(t, xp)
+            end do
+            g(j) = g(j)/(60.0_dp*h)
             xp(j) = x(j)
-            g(j) = (-e1 + 8.0_dp*e2 - 8.0_dp*e3 + e4)/(12.0_dp*h)
         end do
     end subroutine fd_energy_gradient
 

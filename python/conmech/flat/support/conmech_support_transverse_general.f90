@@ -12,15 +12,26 @@ module conmech_support_transverse_general
     use conmech_ode_system, only: ode_system
     use conmech_generalized, only: generalized_system, generalized_ode
     use conmech_constrained_system, only: constrained_system
-    use conmech_constrained_solver, only: constrained_ode
     use conmech_flat_spec, only: spec_kind, spec_system, spec_generalized, spec_constrained, &
                                  KIND_BUILTIN, KIND_ODE, KIND_GENERALIZED, KIND_CONSTRAINED
     use conmech_transverse_model, only: transverse_model
-    use conmech_transverse_mech, only: generalized_model, constrained_model
+    use conmech_hill, only: hill_problem, hill_grad_f
+    use conmech_systems_basic, only: kepler_2d
+    use conmech_transverse_mech, only: generalized_model, constrained_model, constrained_index1
     use conmech_transverse_general, only: transverse_frame, transverse_eval, transverse_hill
     implicit none
     private
     public :: callback_energy_model, system_and_model, pack_frame
+
+    !> The conserved quantity of a built-in first-order system: Hill's Jacobi integral,
+    !! the Kepler energy.
+    type, extends(transverse_model) :: builtin_energy_model
+        class(ode_system), allocatable :: sys
+    contains
+        procedure :: has_energy => bem_has_energy
+        procedure :: energy => bem_energy
+        procedure :: energy_gradient => bem_energy_gradient
+    end type builtin_energy_model
 
     !> A model whose energy gradient is an external procedure egrad(t, y, g, n).
     type, extends(transverse_model) :: callback_energy_model
@@ -33,6 +44,46 @@ module conmech_support_transverse_general
     end type callback_energy_model
 
 contains
+
+    logical function bem_has_energy(self)
+        class(builtin_energy_model), intent(in) :: self
+        bem_has_energy = .false.
+        select type (s => self%sys)
+        type is (hill_problem)
+            bem_has_energy = .true.
+        type is (kepler_2d)
+            bem_has_energy = .true.
+        end select
+    end function bem_has_energy
+
+    real(dp) function bem_energy(self, t, x) result(e)
+        class(builtin_energy_model), intent(in) :: self
+        real(dp), intent(in) :: t, x(:)
+        e = 0.0_dp
+        select type (s => self%sys)
+        type is (hill_problem)
+            e = s%jacobi(x)
+        type is (kepler_2d)
+            e = s%energy(x)
+        end select
+    end function bem_energy
+
+    !> The exact gradient (Hill: C = |v|^2 - 2 F; Kepler: E = |v|^2/2 - mu/r).
+    subroutine bem_energy_gradient(self, t, x, g)
+        class(builtin_energy_model), intent(in) :: self
+        real(dp), intent(in) :: t, x(:)
+        real(dp), intent(out) :: g(:)
+        real(dp) :: fx, fy, r3
+        g = 0.0_dp
+        select type (s => self%sys)
+        type is (hill_problem)
+            call hill_grad_f(s%m, s%kappa, x(1), x(2), fx, fy)
+            g = [-2.0_dp*fx, -2.0_dp*fy, 2.0_dp*x(3), 2.0_dp*x(4)]
+        type is (kepler_2d)
+            r3 = sqrt(x(1)**2 + x(2)**2)**3
+            g = [s%mu*x(1)/r3, s%mu*x(2)/r3, x(3), x(4)]
+        end select
+    end subroutine bem_energy_gradient
 
     logical function cem_has_energy(self)
         class(callback_energy_model), intent(in) :: self
@@ -95,7 +146,7 @@ contains
                     return
                 end if
                 block
-                    type(constrained_ode) :: w
+                    type(constrained_index1) :: w
                     type(constrained_model) :: cm
                     allocate (cm%mech, source=cs)
                     call move_alloc(cs, w%mech)
@@ -108,7 +159,11 @@ contains
         if (sk == KIND_BUILTIN .or. sk == KIND_ODE) then
             call spec_system(name, params, nspec, spec, sys, info, msg)
             if (info == CM_SUCCESS) then
-                allocate (transverse_model :: model)
+                block
+                    type(builtin_energy_model) :: bm
+                    allocate (bm%sys, source=sys)
+                    allocate (model, source=bm)
+                end block
                 return
             end if
         end if
