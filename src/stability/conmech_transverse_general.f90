@@ -48,7 +48,7 @@ module conmech_transverse_general
     private
 
     public :: transverse_options, transverse_frame, transverse_build, transverse_eval
-    public :: transverse_hill, ENERGY_NONE, ENERGY_AUTO, ENERGY_REQUIRED
+    public :: transverse_hill, transverse_jacobian, ENERGY_NONE, ENERGY_AUTO, ENERGY_REQUIRED
 
     integer, parameter :: ENERGY_NONE = 0      !! do not reduce by an energy
     integer, parameter :: ENERGY_AUTO = 1      !! reduce if the model's energy is conserved
@@ -122,7 +122,7 @@ contains
         real(dp) :: w(fo%n, fo%ny + 1), wdq(fo%ny + 1, fo%k), wq(fo%ny + 1, fo%k)
         real(dp) :: gm(fo%ny + 1, fo%ny + 1)
         integer :: p, lainfo
-        call jacobian_fd6(fo%sys, t, x, f, a)
+        call transverse_jacobian(fo%sys, t, x, f, a)
         p = fo%ny + 1
         if (fo%ny > 0) then
             dy = -matmul(y, a)
@@ -157,7 +157,7 @@ contains
     !! construction relies on f' = A f and on the adjoint of the same A carrying the
     !! invariant covectors; the second-order default differences (~1e-10) would make the
     !! transverse and the full multipliers disagree at that level.
-    subroutine jacobian_fd6(sys, t, x, f, a)
+    subroutine transverse_jacobian(sys, t, x, f, a)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t, x(:)
         real(dp), intent(out) :: f(:), a(:, :)
@@ -182,7 +182,7 @@ contains
             a(:, j) = a(:, j)/(60.0_dp*h)
             xp(j) = x(j)
         end do
-    end subroutine jacobian_fd6
+    end subroutine transverse_jacobian
 
     subroutine fo_rhs(self, t, y, dydt)
         class(frame_ode), intent(in) :: self
@@ -516,12 +516,13 @@ contains
     end subroutine transverse_build
 
     !> The orbit point x, the periodic frame qp (N x k), A_perp (k x k) and, with inputs,
-    !! B_perp (k x m) at time t (taken modulo the period).
-    subroutine transverse_eval(fr, t, x, qp, ap, bp, info)
+    !! B_perp (k x m) at time t (taken modulo the period); optionally dqp = qp'.
+    subroutine transverse_eval(fr, t, x, qp, ap, bp, info, dqp)
         type(transverse_frame), intent(in) :: fr
         real(dp), intent(in) :: t
         real(dp), intent(out) :: x(:), qp(:, :), ap(:, :), bp(:, :)
         integer, intent(out) :: info
+        real(dp), intent(out), optional :: dqp(:, :)
         real(dp) :: z(fr%sol%n), q(fr%n, fr%k), f(fr%n), a(fr%n, fr%n), dq(fr%n, fr%k)
         real(dp) :: bx(fr%n, max(fr%m, 1)), e(fr%k, fr%k), l(fr%k, fr%k), tt
         real(dp) :: cv(max(fr%ode%ny, 1), fr%n), dcv(max(fr%ode%ny, 1), fr%n), qs(fr%n, fr%k)
@@ -547,6 +548,7 @@ contains
         ap = matmul(transpose(e), matmul(matmul(transpose(qs), matmul(a, qs) - dq), e)) + &
              l/fr%period
         if (fr%m > 0) bp(:, 1:fr%m) = matmul(transpose(e), matmul(transpose(qs), bx(:, 1:fr%m)))
+        if (present(dqp)) dqp = matmul(dq, e) - matmul(qs, matmul(l, e))/fr%period
     end subroutine transverse_eval
 
     !> For a two-degree-of-freedom system in second-order form x = [q, v] (v = dq/dt) with
@@ -577,7 +579,7 @@ contains
         tt = modulo(t, fr%period)
         call fr%sol%eval(tt, z)
         x = z(1:4)
-        call jacobian_fd6(fr%ode%sys, tt, x, f, a)
+        call transverse_jacobian(fr%ode%sys, tt, x, f, a)
         if (maxval(abs(f(1:2) - x(3:4))) > 1.0e-10_dp*max(1.0_dp, maxval(abs(x(3:4))))) then
             info = CM_BAD_INPUT    ! not in second-order form x = [q, v]
             return
