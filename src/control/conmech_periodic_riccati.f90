@@ -13,13 +13,17 @@
 !! Hamiltonian monodromy Psi for its multipliers inside the unit circle (k of them, the
 !! closed-loop multipliers; the other k are their reciprocals). An ordered real Schur form
 !! of Psi (LAPACK dgees, eigenvalues |mu| < 1 first) gives that subspace [X; Y] and
-!! P(0) = Y X^-1 directly, with no convergence to wait for however close to the unit
-!! circle the closed loop is. Psi has condition ~ max|mu|/min|mu|, so P(0) is then
-!! refined by integrating the Riccati equation backwards over whole periods from
-!! P(T) = P(0): the stabilising solution attracts backward integration, each period
-!! contracting the error by the squares of the closed-loop multipliers, until
-!! P(0) returns to itself (relative change below `periodic_tol`). The last backward pass
-!! is kept as dense output: P(t) and K(t) at any t.
+!! P(0) = Y X^-1, with no convergence to wait for however close to the unit circle the
+!! closed loop is. But Psi has condition ~ max|mu|/min|mu| (1e11 for a loop that damps
+!! fast modes by 1e-6 a period), so this is only the start: the backward pass
+!! F: P(T) -> P(0) of the Riccati equation (integrated with Phi = Phi_cl(T, 0), the
+!! closed loop's transition matrix, alongside) is then driven to its fixed point by
+!! Newton's method, P(T) <- P(T) + D with D - Phi^T D Phi = F(P(T)) - P(T) (a Stein
+!! equation, k^2 x k^2), once the closed loop of the pass is stable; plain passes before
+!! that (the stabilising solution attracts backward integration from any positive
+!! semi-definite start, which is also the start, P(T) = 0, when the Schur form fails).
+!! Converged when P(0) returns to P(T) (relative change below `periodic_tol`); the last
+!! pass is kept as dense output: P(t) and K(t) at any t.
 !!
 !! Failures, each with a message: multipliers of Psi on the unit circle (no stabilising
 !! periodic solution: (A, B) not stabilisable or (A, Q) not detectable), X singular, a
@@ -154,12 +158,18 @@ contains
             dydt = ieee_value(1.0_dp, ieee_quiet_nan)
             return
         end if
-        p = reshape(y, [k, k])
+        p = reshape(y(1:k*k), [k, k])
         p = 0.5_dp*(p + transpose(p))
         pb = matmul(p, b)
         d = matmul(transpose(a), p)
         d = d + transpose(d) - matmul(pb, matmul(self%rinv, transpose(pb))) + self%qw
-        dydt = -reshape(d, [k*k])
+        dydt(1:k*k) = -reshape(d, [k*k])
+        if (size(y) > k*k) then
+            ! Psi(t) = Phi_cl(T, t): dPsi/dt = -Psi (A - S P)
+            d = a - matmul(b, matmul(self%rinv, transpose(pb)))
+            dydt(k*k + 1:2*k*k) = -reshape(matmul(reshape(y(k*k + 1:2*k*k), [k, k]), d), &
+                                           [k*k])
+        end if
     end subroutine ric_rhs
 
     subroutine cl_rhs(self, t, y, dydt)
@@ -212,9 +222,11 @@ contains
         type(ode_result) :: rr
         real(dp), allocatable :: z(:), psi(:, :), vs(:, :), wr(:), wi(:), work(:), p(:, :)
         real(dp), allocatable :: pnew(:, :), xt(:, :), yt(:, :), ev(:), rc(:, :), xi(:)
+        real(dp), allocatable :: phi(:, :), stein(:, :), rhs(:, :), dvec(:, :), z0(:)
+        real(dp) :: ev2r(lq%k), ev2i(lq%k)
         logical, allocatable :: bwork(:)
         real(dp) :: wq(1), dist, t, change
-        integer :: k, m, sdim, lainfo, info, j, pass
+        integer :: k, m, sdim, lainfo, info, j, i, pass
         character(len=:), allocatable :: msg
         character(len=24) :: b1, b2
 
@@ -281,13 +293,10 @@ contains
                    size(work), bwork, lainfo)
         res%hmr = wr
         res%hmi = wi
-        if (lainfo /= 0 .and. lainfo /= 2*k + 2) then
-            call fail(CM_NO_CONVERGENCE, "riccati: the Schur form of the Hamiltonian "// &
-                      "monodromy failed")
-            return
-        end if
+        if (lainfo /= 0 .and. lainfo /= 2*k + 2) sdim = -1   ! no usable start from it
+        allocate (z0(2*k*k))
         dist = minval(abs(sqrt(wr**2 + wi**2) - 1.0_dp))
-        if (dist < opt%unit_circle_tol .or. sdim /= k) then
+        if (dist < opt%unit_circle_tol .and. maxval(wr**2 + wi**2) < 1.0e16_dp) then
             write (b1, '(es10.3)') dist
             call fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: the "// &
                       "Hamiltonian monodromy has multipliers on the unit circle (min ||mu| - 1| "// &
@@ -296,43 +305,70 @@ contains
             return
         end if
         allocate (xt(k, k), yt(k, k), p(k, k), pnew(k, k))
-        xt = transpose(vs(1:k, 1:k))
-        yt = transpose(vs(k + 1:2*k, 1:k))
-        call la_solve(xt, yt, p, info, rcond_min=1.0e-13_dp)
-        if (info /= CM_SUCCESS) then
-            call fail(CM_SINGULAR, "riccati: no stabilising periodic solution: the stable "// &
-                      "subspace of the Hamiltonian monodromy is not a graph (X singular)")
-            return
+        p = 0.0_dp
+        if (sdim == k) then
+            xt = transpose(vs(1:k, 1:k))
+            yt = transpose(vs(k + 1:2*k, 1:k))
+            call la_solve(xt, yt, pnew, info, rcond_min=1.0e-13_dp)
+            if (info == CM_SUCCESS) then
+                p = transpose(pnew)
+                p = 0.5_dp*(p + transpose(p))
+            end if
         end if
-        p = transpose(p)
-        p = 0.5_dp*(p + transpose(p))
 
-        ! ---- backward refinement over whole periods; the last pass is kept (dense)
+        ! ---- backward passes driven to the fixed point (Newton on the Stein equation)
         allocate (rs%lq, source=lq)
         rs%qw = hs%qw
         rs%rinv = res%rinv
         oo%dense_output = .true.
         oo%save_steps = .false.
         change = huge(1.0_dp)
+        allocate (phi(k, k), stein(k*k, k*k), rhs(k*k, 1), dvec(k*k, 1))
         do pass = 1, opt%max_passes
-            call ode_solve(rs, [lq%period, 0.0_dp], reshape(p, [k*k]), oo, rr)
+            z0 = 0.0_dp
+            z0(1:k*k) = reshape(p, [k*k])
+            do j = 1, k
+                z0(k*k + (j - 1)*k + j) = 1.0_dp
+            end do
+            call ode_solve(rs, [lq%period, 0.0_dp], z0, oo, rr)
             if (rr%status /= CM_SUCCESS) then
                 msg = "riccati: the backward integration failed"
                 if (allocated(rr%message)) msg = msg//": "//rr%message
                 call fail(rr%status, msg)
                 return
             end if
-            pnew = reshape(rr%y(:, rr%nt), [k, k])
+            pnew = reshape(rr%y(1:k*k, rr%nt), [k, k])
             pnew = 0.5_dp*(pnew + transpose(pnew))
-            change = maxval(abs(pnew - p))/max(maxval(abs(p)), tiny(1.0_dp))
+            phi = reshape(rr%y(k*k + 1:2*k*k, rr%nt), [k, k])
+            change = maxval(abs(pnew - p))/max(maxval(abs(pnew)), tiny(1.0_dp))
             res%passes = pass
             if (change <= opt%periodic_tol) exit
+            call la_eig(phi, ev2r, ev2i, info)
+            if (info == CM_SUCCESS .and. maxval(ev2r**2 + ev2i**2) < 1.0_dp .and. &
+                change < 1.0e-1_dp) then
+                ! Newton: D - Phi^T D Phi = F(P) - P, vec(Phi^T D Phi) = (Phi^T x Phi^T) vec D
+                do j = 1, k
+                    do i = 1, k
+                        stein((j - 1)*k + 1:j*k, (i - 1)*k + 1:i*k) = -phi(i, j)*transpose(phi)
+                    end do
+                end do
+                do j = 1, k*k
+                    stein(j, j) = stein(j, j) + 1.0_dp
+                end do
+                rhs(:, 1) = reshape(pnew - p, [k*k])
+                call la_solve(stein, rhs, dvec, info)
+                if (info == CM_SUCCESS) then
+                    p = p + reshape(dvec(:, 1), [k, k])
+                    p = 0.5_dp*(p + transpose(p))
+                    cycle
+                end if
+            end if
             p = pnew
         end do
         res%periodicity = change
         if (.not. change <= opt%periodic_tol) then
             write (b1, '(es10.3)') change
-            call fail(CM_NO_CONVERGENCE, "riccati: the backward refinement did not return "// &
+            call fail(CM_NO_CONVERGENCE, "riccati: the backward passes did not return "// &
                       "to P(0) (relative change "//trim(adjustl(b1))//"): no stabilising "// &
                       "periodic solution")
             return
@@ -340,13 +376,13 @@ contains
         res%p0 = pnew
         call move_alloc(rr%sol%ts, res%sol%ts)
         call move_alloc(rr%sol%hs, res%sol%hs)
-        call move_alloc(rr%sol%coef, res%sol%coef)
-        res%sol%n = rr%sol%n
+        res%sol%n = k*k
         res%sol%nseg = rr%sol%nseg
         res%sol%nf = rr%sol%nf
         res%sol%form = rr%sol%form
         res%sol%t_first = rr%sol%t_first
         res%sol%t_last = rr%sol%t_last
+        res%sol%coef = rr%sol%coef(1:k*k, :, 1:rr%sol%nseg)
 
         ! ---- P positive definite along the period
         res%min_eig = huge(1.0_dp)

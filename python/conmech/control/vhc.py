@@ -387,7 +387,7 @@ class ReducedDynamics:
             out.append((z, "centre" if dg/al > 0 else "saddle", float(np.sqrt(abs(dg/al)))))
         return out
 
-    def periodic_orbit(self, theta0: float, *, nodes: int = 64, rtol: float = 1e-13,
+    def periodic_orbit(self, theta0: float, *, nodes: int = 32, rtol: float = 1e-13,
                        atol: float = 1e-13, max_swing: float = 2*np.pi) -> ReducedOrbit:
         """The oscillation through the turning point (theta0, theta' = 0): the other
         turning point from E(theta) = 0, the period by quadrature and by integration
@@ -440,18 +440,34 @@ class ReducedDynamics:
                             constraint=self.constraint)
 
     def _period_quadrature(self, ta, tb, nodes, rtol, atol):
+        """2 int_ta^tb dtheta/sqrt(E) with theta = mid - half cos(phi) (the integrand
+        half sin(phi)/sqrt(E) is smooth: E vanishes linearly at both turning points).
+        E is integrated from each turning point towards the middle (E = 0 there exactly,
+        and its small values near the ends keep their relative accuracy: atol 1e-18):
+        one branch from ta alone would reach tb as a difference of large numbers, and the
+        quadrature nodes next to tb would see that error amplified by 1/sqrt(E)."""
+        mid, half = 0.5*(ta + tb), 0.5*(tb - ta)
+        tiny = 1e-18
+
         def quad(nn):
             x, w = np.polynomial.legendre.leggauss(nn)
             phi = 0.5*np.pi*(x + 1)
             wphi = 0.5*np.pi*w
-            mid, half = 0.5*(ta + tb), 0.5*(tb - ta)
             th = mid - half*np.cos(phi)          # from ta (phi = 0) to tb (phi = pi)
-            order = np.argsort((th - ta)*np.sign(tb - ta))
             e = np.empty(nn)
-            e[order] = self.energy(th[order], ta, 0.0, rtol, atol)
+            first = phi < 0.5*np.pi
+            for sel, start in ((first, ta), (~first, tb)):
+                idx = np.nonzero(sel)[0]
+                order = idx[np.argsort(np.abs(th[idx] - start))]
+                e[order] = self.energy(th[order], start, 0.0, rtol, tiny)
             if np.any(e <= 0):
                 raise RuntimeError("E vanishes inside the orbit: not an oscillation")
             return 2*np.sum(wphi*abs(half)*np.sin(phi)/np.sqrt(e))
+        ea = self.energy([mid], ta, 0.0, rtol, tiny)[0]
+        eb = self.energy([mid], tb, 0.0, rtol, tiny)[0]
+        if abs(ea - eb) > 1e-8*max(abs(ea), abs(eb)):
+            raise RuntimeError(f"the turning points do not bound one orbit (E from either "
+                               f"end differs by {abs(ea - eb):.2e} in the middle)")
         t1, t2 = quad(nodes), quad(2*nodes)
         return float(t2), float(abs(t2 - t1))
 
