@@ -402,20 +402,27 @@ class ReducedDynamics:
         if acc == 0:
             raise ValueError(f"theta0 = {theta0} is an equilibrium of the reduced dynamics")
         direction = 1.0 if acc > 0 else -1.0
-        # E from theta0 towards the motion; the turning point where E returns to 0
-        far = theta0 + direction*max_swing
+        # E from theta0 towards the motion, up to where alpha changes sign (there the
+        # reduced dynamics is singular); the turning point where E returns to 0
         grid = theta0 + direction*np.linspace(0, max_swing, 4001)[1:]
         al_grid = self.constraint.coefficients(grid)[0]
-        bad = np.nonzero(np.sign(al_grid) != np.sign(al0))[0]
-        es, tz = self.energy(grid, theta0, 0.0, rtol, atol, stop_at_zero=True)
+        bad = np.nonzero((np.sign(al_grid) != np.sign(al0)) |
+                         (np.abs(al_grid) <= 1e-10*abs(al0)))[0]
+        upto = grid[:bad[0]] if bad.size else grid
+        tz = None
+        if upto.size:
+            try:
+                es, tz = self.energy(upto, theta0, 0.0, rtol, atol, stop_at_zero=True)
+            except RuntimeError:
+                tz = None
         if tz is None:
+            if bad.size:
+                raise ValueError(f"the constraint is not regular along the orbit: "
+                                 f"alpha(theta) crosses zero near theta = {grid[bad[0]]:.6g} "
+                                 f"before the motion from theta0 = {theta0:.6g} turns back")
             raise ValueError(f"no oscillation through theta0 = {theta0}: theta' does not "
                              f"return to 0 within {max_swing:.3g} rad (a rotation, or an "
                              "unbounded motion)")
-        if bad.size and (grid[bad[0]] - tz)*direction < 0:
-            raise ValueError(f"the constraint is not regular along the orbit: alpha(theta) "
-                             f"crosses zero near theta = {grid[bad[0]]:.6g}, between the "
-                             f"turning points {theta0:.6g} and {tz:.6g}")
         lo, hi = sorted((theta0, tz))
         ths = np.linspace(lo, hi, 801)
         al = self.constraint.coefficients(ths)[0]
