@@ -88,8 +88,8 @@ def periodic_riccati(A: Callable, B: Callable, period: float, Q: ArrayLike | Non
     g = Guard()
     fa = g.wrap(A, 1, (k, k), "A")
     fb = g.wrap(B, 1, (k, m), "B")
-    out = _conmech.flat_control_riccati(lambda s: fa(s), lambda s: fb(s), k, m, period, q, r,
-                                        float(rtol), float(atol), tt)
+    out = _conmech.flat_control_riccati(afun=fa, bfun=fb, period=period, qw=q, rw=r,
+                                        rtol=float(rtol), atol=float(atol), t=tt)
     g.check()
     (ps, ks, hmr, hmi, cmr, cmi, clm, periodicity, min_eig, passes, info, message) = out
     if info != 0:

@@ -133,15 +133,19 @@ class VirtualConstraint:
         fs = [sp.lambdify(th, e, "numpy") for e in exprs]
         d1 = [sp.lambdify(th, sp.diff(e, th), "numpy") for e in exprs]
         d2 = [sp.lambdify(th, sp.diff(e, th, 2), "numpy") for e in exprs]
-        npts = 96
-        xk = np.cos(np.pi*(np.arange(npts) + 0.5)/npts)
-        tk = 0.5*(a + b) + 0.5*(b - a)*xk
         cheb = np.polynomial.chebyshev
         rows = []
+        from scipy.fft import dct
+        npts = 128
+        xk = np.cos(np.pi*(np.arange(npts) + 0.5)/npts)
         for f in fs:
-            vals = np.broadcast_to(np.asarray(f(tk), dtype=float), tk.shape)
-            c = cheb.chebfit(xk, vals, npts - 1)
-            keep = np.nonzero(np.abs(c) > 1e-17*max(np.max(np.abs(c)), 1e-300))[0]
+            # interpolation at the Chebyshev points by the DCT (stable), then the tail
+            # below round-off dropped (it would only add noise to the derivatives)
+            vals = np.broadcast_to(np.asarray(f(0.5*(a + b) + 0.5*(b - a)*xk), dtype=float),
+                                   xk.shape)
+            c = dct(vals, type=2)/npts
+            c[0] *= 0.5
+            keep = np.nonzero(np.abs(c) > 1e-15*max(np.max(np.abs(c)), 1e-300))[0]
             rows.append(c[:keep[-1] + 1] if keep.size else c[:1])
         d = max(r.size for r in rows)
         c = np.zeros((nd - 1, d))
@@ -434,12 +438,14 @@ class ReducedDynamics:
         tq, err = self._period_quadrature(theta0, tz, nodes, rtol, atol)
         # period by integration: the second return to theta' = 0
         t_end = 1.25*tq
-        t, st, evt, evy = self.solve([theta0, 0.0], (0.0, t_end), np.linspace(0, tq, 257),
-                                     rtol=rtol, atol=atol, events=True)
+        _, _, evt, evy = self.solve([theta0, 0.0], (0.0, t_end), [0.0, t_end], rtol=rtol,
+                                    atol=atol, events=True)
         ret = evt[evt > 1e-6*tq]
         if ret.size < 2:
             raise RuntimeError("the reduced solution did not return to theta' = 0 twice")
         period = float(ret[1])
+        t, st = self.solve([theta0, 0.0], (0.0, period), np.linspace(0, period, 257),
+                           rtol=rtol, atol=atol)
         x0 = self.constraint.state(theta0, 0.0)
         return ReducedOrbit(theta0=theta0, theta_min=lo, theta_max=hi, period=period,
                             period_quadrature=tq, quadrature_error=err,
