@@ -313,6 +313,12 @@ contains
             if (info == CM_SUCCESS) then
                 p = transpose(pnew)
                 p = 0.5_dp*(p + transpose(p))
+            else if (maxval(wr**2 + wi**2) < 1.0e16_dp) then
+                ! a well-conditioned monodromy whose stable subspace is not a graph over x
+                call fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: "// &
+                          "the stable subspace of the Hamiltonian monodromy is not a graph "// &
+                          "(X singular): the system is not stabilisable")
+                return
             end if
         end if
 
