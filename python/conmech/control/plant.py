@@ -41,9 +41,10 @@ class ControlledSystem:
     actuated : indices of the actuated coordinates (one input each: B = their columns of
         the identity, e.g. the force on a cart, the torque at a joint), or
     B : a constant input matrix (ndof x m), or
-    input_matrix : a compiled function ``void B(double t, const double *q, double *b,
-        const double *p)`` (column-major ndof x m; an address, ctypes function, numba cfunc
-        or LowLevelCallable) with ``n_inputs`` = m and its parameters ``input_params``.
+    input_matrix : a compiled function with the C signature
+        ``void B(double t, const double *q, double *b, const double *p)``
+        (column-major ndof x m; an address, ctypes function, numba cfunc or
+        LowLevelCallable) with ``n_inputs`` = m and its parameters ``input_params``.
 
     Attributes: ``system``, ``ndof``, ``n_inputs``, ``B`` (constant case),
     ``passive`` (the coordinates without an input, for selection matrices).
@@ -172,8 +173,9 @@ class PythonLaw(FeedbackLaw):
 
 
 class CompiledLaw(FeedbackLaw):
-    """u from a compiled function ``void law(double t, const double *x, double *u,
-    const double *p)`` (an address, ctypes function, numba cfunc or LowLevelCallable)
+    """u from a compiled function with the C signature
+    ``void law(double t, const double *x, double *u, const double *p)``
+    (an address, ctypes function, numba cfunc or LowLevelCallable)
     with parameters ``params``: no Python in the loop."""
 
     def __init__(self, fun, n_inputs, params=(), keep=None):

@@ -71,18 +71,19 @@ def perturbed_runs(controller, n_starts=20, size=0.02, periods=30, seed=2026,
 
 def plot_convergence(controller, t, dist, ax=None, xi=None):
     """The orbital distance (and |xi|) against t/T from the perturbed starts (log scale)."""
-    ax = _axes(ax)
+    ax = _axes(ax, (7, 4.2))
     T = controller.period
-    for d in dist:
-        ax.semilogy(t/T, d, color="C0", lw=0.8, alpha=0.7)
+    for i, d in enumerate(dist):
+        ax.semilogy(t/T, d, color="C0", lw=0.8, label="|x - x*(tau)|" if i == 0 else None)
     if xi is not None:
-        for x in xi:
-            ax.semilogy(t/T, x, color="C1", lw=0.6, alpha=0.4)
+        for i, x in enumerate(xi):
+            ax.semilogy(t/T, x, color="C1", lw=0.5, alpha=0.6,
+                        label="|xi|" if i == 0 else None)
     rate = np.max(np.abs(controller.multipliers))
     ax.semilogy(t/T, np.median(dist[:, 0])*rate**(t/T), "k--", lw=1.2,
                 label=f"largest multiplier^(t/T), {rate:.3g}")
     ax.set_xlabel("t / T")
-    ax.set_ylabel("orbital distance |x - x*(tau)|" + (" (and |xi|)" if xi is not None else ""))
+    ax.set_ylabel("orbital distance")
     ax.legend(fontsize=8)
     return ax
 

@@ -509,8 +509,8 @@ class ReducedDynamics:
             ax.plot(z, 0, "o" if kind == "centre" else "x", color="k", ms=6)
         th = np.linspace(a, b, 2001)
         al = self.constraint.coefficients(th)[0]
-        for i in np.nonzero(np.sign(al[:-1]) != np.sign(al[1:]))[0]:
-            ax.axvline(th[i], color="C0", ls="--", lw=1, label="alpha = 0")
+        for j, i in enumerate(np.nonzero(np.sign(al[:-1]) != np.sign(al[1:]))[0]):
+            ax.axvline(th[i], color="C0", ls="--", lw=1, label="alpha = 0" if j == 0 else None)
         ax.set_xlim(a, b)
         ax.set_xlabel("theta")
         ax.set_ylabel("theta'")
