@@ -254,3 +254,32 @@ def test_bad_input(dp_orbit):
     with pytest.raises(ValueError, match="no energy"):       # required, but none given
         stability.transverse_linearisation(_hh, ([0, 0.2, 0.25, 0], 6.0), energy="required",
                                            rtol=1e-6, atol=1e-6)
+
+
+def test_symbolic_constrained_system_and_rheonomic_refused(dp_orbit):
+    """The Cartesian double pendulum from conmech.symbolic.constrained_system (compiled,
+    excessive coordinates): k = 2 and the multipliers in angles; a rheonomic constraint
+    (a moving suspension) has no periodic orbits in this sense: refused."""
+    t = dynamicsymbols._t
+    x1, y1, x2, y2 = dynamicsymbols("x1 y1 x2 y2")
+    g = sp.Symbol("g")
+    T = (x1.diff(t)**2 + y1.diff(t)**2 + x2.diff(t)**2 + y2.diff(t)**2)/2
+    c = symbolic.constrained_system(T, g*(y1 + y2), [x1, y1, x2, y2],
+                                    holonomic=[(x1**2 + y1**2 - 1)/2,
+                                               ((x2 - x1)**2 + (y2 - y1)**2 - 1)/2],
+                                    params={g: G})
+    s, o = dp_orbit
+    a, b, va, vb = o.y0
+    q = [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)]
+    v = [np.cos(a)*va, np.sin(a)*va, np.cos(a)*va + np.cos(b)*vb, np.sin(a)*va + np.sin(b)*vb]
+    tl = stability.transverse_linearisation(c, (np.r_[q, v], o.period))
+    assert tl.kind == "constrained" and tl.dimension == 2 and tl.agreement <= 1e-10
+    ref = stability.transverse_linearisation(s, o)
+    assert _match(tl.multipliers, ref.multipliers) <= 1e-10
+    x, y = dynamicsymbols("x y")
+    w = sp.Symbol("w")
+    moving = symbolic.constrained_system((x.diff(t)**2 + y.diff(t)**2)/2, g*y, [x, y],
+                                         holonomic=[((x - 0.1*sp.sin(w*t))**2 + y**2 - 1)/2],
+                                         params={g: G, w: 3.0})
+    with pytest.raises(ValueError, match="rheonomic"):
+        stability.transverse_linearisation(moving, ([0, -1, 0.3, 0], 2.0))

@@ -299,9 +299,9 @@ contains
         if (dist < opt%unit_circle_tol .and. maxval(wr**2 + wi**2) < 1.0e16_dp) then
             write (b1, '(es10.3)') dist
             call fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: the "// &
-                      "Hamiltonian monodromy has multipliers on the unit circle (min ||mu| - 1| "// &
-                      "= "//trim(adjustl(b1))//"): the system is not stabilisable, or not "// &
-                      "detectable through Q")
+                      "Hamiltonian monodromy has multipliers on the unit circle "// &
+                      "(min ||mu| - 1| = "//trim(adjustl(b1))//"): the system is not "// &
+                      "stabilisable, or not detectable through Q")
             return
         end if
         allocate (xt(k, k), yt(k, k), p(k, k), pnew(k, k))

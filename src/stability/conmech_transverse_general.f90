@@ -16,23 +16,34 @@
 !! multipliers of the orbit; the N - k trivial ones (flow direction, energy, constraints)
 !! are 1.
 !!
-!! The frame is transported without rotation inside S: with W = [C^T, f, grad H] (its
-!! columns span the complement of S), Q' = -W (W^T W)^-1 (W'^T Q), which keeps Q
-!! orthonormal and in S; W'^T Q needs only first derivatives, because on S
-!! d/dt (C) Q = -C A Q (the manifold is invariant), f' = A f and d/dt grad H = -A^T grad H
-!! (H conserved). Then Q^T Q' = 0 and A_red = Q^T A Q. After one period Q(T) = Q(0) R with R
-!! a rotation (the holonomy); the periodic frame Qp(t) = Q(t) R^(-t/T) gives the periodic
-!! coefficient matrix
+!! The invariant covectors (the rows of C and grad H) are evaluated once, at x*(0), and
+!! carried along by the adjoint equation y' = -y A: then y dx is conserved by the
+!! variational flow exactly as the invariants are, consistently with the A integrated
+!! (grad H evaluated at every point instead would differ from the transported one by its
+!! own round-off, and that difference, fed through the coupling of the energy direction,
+!! costs two digits). The frame is transported without rotation inside S: with W = [y^T, f]
+!! (its columns span the complement of S), Q' = -W (W^T W)^-1 (W'^T Q), W'^T Q =
+!! [-y A Q; (A f)^T Q], which keeps Q orthonormal and in S; the integrated Q drifts off S
+!! by the integration error, so every evaluation first projects it onto S. Then
+!! Q^T Q' = 0 and A_red = Q^T A Q. After one period Q(T) = Q(0) R with R a rotation (the
+!! holonomy); the periodic frame Qp(t) = Q(t) R^(-t/T) gives the periodic coefficient
+!! matrix
 !!
 !!     A_perp(t) = E^T A_red E + log(R)/T,   E = R^(-t/T),
 !!
 !! and B_perp(t) = E^T Q^T B(t) for a system with an input matrix B = dF/du. The transverse
 !! monodromy in the periodic frame is R Phi_red(T).
 !!
+!! A system without an analytic Jacobian gets sixth-order central differences here: the
+!! identities the construction rests on (f' = A f, the adjoint of the same A) make the
+!! transverse and the full multipliers differ by the Jacobian's error.
+!!
 !! `transverse_build` integrates the orbit, the covectors, the frame, Phi_red (and
-!! optionally the full N x N monodromy, and with inputs the controllability Gramian) in one
-!! run with dense output (Verner 9(8) by default); `transverse_eval` then gives x*, Qp, A_perp, B_perp at any t from the
-!! dense output, and `transverse_hill` the coefficients of the normal deviation's equation
+!! optionally the full N x N monodromy, and with inputs the controllability Gramian) in
+!! one run with dense output (Verner 9(8) by default: on the double pendulum ten times
+!! more accurate than DOP853 at the same tolerance, with fewer evaluations);
+!! `transverse_eval` then gives x*, Qp, A_perp, B_perp at any t from the dense output,
+!! and `transverse_hill` the coefficients of the normal deviation's equation
 !! N'' + psi N' + Phi N = 0 of a two-degree-of-freedom system.
 module conmech_transverse_general
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
@@ -40,7 +51,7 @@ module conmech_transverse_general
     use conmech_status
     use conmech_lapack, only: dgesvd, dpotrf, dpotrs, la_eig, la_finite, la_solve
     use conmech_ode_system, only: ode_system
-    use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOP853, METHOD_VERNER98
+    use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_VERNER98
     use conmech_ode_dense, only: dense_solution
     use conmech_rotation_log, only: rotation_log, rotation_log_init, nearest_rotation
     use conmech_transverse_model, only: transverse_model

@@ -32,8 +32,6 @@ module conmech_systems_generalized
         procedure :: forces => cp_forces
         procedure :: energy => cp_energy
         procedure :: has_energy => yes_energy_cp
-        procedure :: forces_jacobian => cp_forces_jacobian
-        procedure :: has_forces_jacobian => yes_forces_jacobian_cp
     end type cart_pendulum
 
     !> Double pendulum, q = [theta1, theta2] (absolute angles from downward).
@@ -217,29 +215,9 @@ contains
                     + self%m*self%l**2*v(2)**2) + self%m*self%g*self%l*cos(q(2))
     end function cp_energy
 
-    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv] (the variational equations and the transverse
-    !! linearisation then need no finite differences).
-    subroutine cp_forces_jacobian(self, t, q, v, a, r)
-        class(cart_pendulum), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:), a(:)
-        real(dp), intent(out) :: r(:, :)
-        real(dp) :: ml, s, c
-        ml = self%m*self%l
-        s = sin(q(2))
-        c = cos(q(2))
-        r = 0.0_dp
-        r(1, 2) = ml*c*v(2)**2 + ml*s*a(2)
-        r(2, 2) = ml*self%g*c + ml*s*a(1)
-        r(1, 4) = 2.0_dp*ml*s*v(2)
-    end subroutine cp_forces_jacobian
-    logical function yes_forces_jacobian_cp(self)
-        class(cart_pendulum), intent(in) :: self
-        yes_forces_jacobian_cp = .true.
-    end function yes_forces_jacobian_cp
-
     ! ---------------------------------------------------------------- double pendulum
-    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv] (see cp_forces_jacobian).
+    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv]: the variational equations (monodromy,
+    !! transverse linearisation) then need no difference quotients (~1e-10 accurate).
     subroutine dp_forces_jacobian(self, t, q, v, a, r)
         class(gen_double_pendulum), intent(in) :: self
         real(dp), intent(in) :: t

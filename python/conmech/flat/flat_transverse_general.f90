@@ -12,10 +12,11 @@
 !! N'' + psi N' + phi N = 0 (NaN when the state is not [q, q']).
 
 !> A built-in or compiled system (name, params, spec).
-subroutine flat_transverse_general_system(name, np, params, nspec, spec, n, y0, period, rtol, atol, &
-                                  energy_mode, full, nt, t, kmax, k, reduced, closure, drift, &
-                                  defect, mono, mr, mi, fmono, fr_re, fr_im, holo, xs, qs, as, &
-                                  phis, psis, nfev, kind, info, message)
+subroutine flat_transverse_general_system(name, np, params, nspec, spec, n, y0, period, &
+                                          rtol, atol, energy_mode, full, nt, t, kmax, k, &
+                                          reduced, closure, drift, defect, mono, mr, mi, &
+                                          fmono, fr_re, fr_im, holo, xs, qs, as, phis, psis, &
+                                          nfev, kind, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -68,10 +69,11 @@ end subroutine flat_transverse_general_system
 
 !> A Python right-hand side fun(t, y) with an optional Jacobian (has_jac) and an optional
 !! energy gradient egrad(t, y) (has_energy).
-subroutine flat_transverse_general_callback(fun, jac, egrad, n, has_jac, has_energy, y0, period, &
-                                    rtol, atol, energy_mode, full, nt, t, kmax, k, reduced, &
-                                    closure, drift, defect, mono, mr, mi, fmono, fr_re, fr_im, &
-                                    holo, xs, qs, as, phis, psis, nfev, info, message)
+subroutine flat_transverse_general_callback(fun, jac, egrad, n, has_jac, has_energy, y0, &
+                                            period, rtol, atol, energy_mode, full, nt, t, &
+                                            kmax, k, reduced, closure, drift, defect, mono, &
+                                            mr, mi, fmono, fr_re, fr_im, holo, xs, qs, as, &
+                                            phis, psis, nfev, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_flat_ode_support, only: callback_system, callback_jac_system
     use conmech_transverse_general, only: transverse_options, transverse_frame, transverse_build

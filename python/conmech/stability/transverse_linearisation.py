@@ -35,8 +35,9 @@ class TransverseLinearisation:
     monodromy : (k, k) the transverse monodromy (of xi' = A_perp(t) xi over a period);
         ``multipliers`` its eigenvalues.
     full_monodromy, full_multipliers : the N x N monodromy of the orbit (same run).
-    nontrivial : the N - k... the full multipliers that are not trivial (the k farthest
-        from 1), ordered to match ``multipliers``; ``agreement`` = max |difference|.
+    nontrivial : the k full multipliers that are not trivial (the k farthest from 1; the
+        other N - k belong to the flow direction, the energy and the constraints), ordered
+        to match ``multipliers``; ``agreement`` = max |difference|.
     holonomy : (k, k) the rotation R = Q(0)^T Q(T) of the transported frame.
     closure : max |x(T) - x(0)| of the orbit; ``energy_drift``: max |grad H . f| /
         (|grad H| |f|) along it (how well the energy is conserved; 0 if none).
