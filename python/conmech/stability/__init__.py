@@ -26,7 +26,11 @@ callables ``fun(t, y)`` (finite-difference Jacobian in Fortran).
 - :func:`plot_branch`, :func:`plot_multipliers`, :func:`plot_orbits`,
   :func:`stable_orbits` (``plots.py``);
 - :func:`transverse`: transverse linearisation (Hill's equation of the normal deviation)
-  of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``).
+  of a periodic orbit of any planar natural (+ gyroscopic) system (``transverse.py``);
+- :func:`transverse_linearisation`: the transverse linearisation of a periodic orbit of
+  any system (built-in, compiled, symbolic, Python; generalized or excessive coordinates):
+  the periodic A_perp(t), its monodromy (energy and constraints removed) and the check
+  against the full monodromy (``transverse_linearisation.py``).
 """
 from .equilibria import (EQUILIBRIUM_RTOL, Equilibrium, RelativeEquilibrium, equilibria,
                          equilibrium, find_equilibrium, grid, lagrange_dirichlet,
@@ -43,12 +47,15 @@ from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoin
                                        HopfNormalForm, equilibrium_continuation,
                                        first_lyapunov_coefficient, hopf_orbits)
 from .lyapunov_family import LyapunovFamily, NormalModes, lyapunov_family, normal_modes
+from .transverse_linearisation import (TransverseLinearisation, nontrivial_multipliers,
+                                       transverse_linearisation)
 from .plots import plot_branch, plot_multipliers, plot_orbits, stable_orbits
 # validators used by sibling modules (hill_families)
 from ._validate import _real, _state  # noqa: F401
 
-__all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "SpecialPoint", "continuation",
-           "transverse", "find_equilibrium", "equilibria", "grid", "potential_hessian",
+__all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "SpecialPoint",
+           "continuation", "transverse", "transverse_linearisation", "TransverseLinearisation",
+           "nontrivial_multipliers", "find_equilibrium", "equilibria", "grid", "potential_hessian",
            "lagrange_dirichlet_potential", "plot_branch", "plot_multipliers",
            "switch_period_doubling", "switch_branch_point", "constrained_equilibrium",
            "constrained_equilibria", "ConstrainedEquilibrium",
