@@ -332,6 +332,7 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     type(closed_loop) :: cl
     type(mech_plant) :: plant
     character(len=:), allocatable :: msg
+    integer(c_int) :: counts(5)
     nfev = 0
     naccept = 0
     nreject = 0
@@ -346,8 +347,11 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     allocate (cl%plant, source=plant)
     cl%n_inputs = m
     call run_solve(cl, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
-                   nreject, dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
+                   dense_form, info, message)
+    nfev = counts(1)        ! counts: nfev, njev, nlu, naccept, nreject
+    naccept = counts(4)
+    nreject = counts(5)
 end subroutine flat_control_solve
 
 !> The phase tau, the transverse coordinates xi (k, nx) and the orbital distance of nx
