@@ -83,7 +83,7 @@ contains
         real(dp), allocatable :: x(:), t(:), xn(:), tn(:)
         type(cont_point) :: pt
         type(cconstraint) :: con
-        real(dp) :: ds, f(size(y0))
+        real(dp) :: ds, f(size(y0)), fx(size(y0)), tend, per, p
         integer :: info, it, k, dir
         logical :: ended
         character(len=:), allocatable :: msg
@@ -131,6 +131,18 @@ contains
             br%info = info
             br%message = "continuation: the start is not a periodic orbit: "//msg
             return
+        end if
+        if (pb%o%autonomous .and. .not. present(tangent0)) then
+            ! Newton at a fixed period can end on an equilibrium (periodic with any period)
+            call cp_unpack(pb, x, f, tend, per, p)
+            call sys%rhs(0.0_dp, f, fx)
+            if (norm2(fx)*per <= 1.0e-10_dp*max(1.0_dp, maxval(abs(f)))) then
+                br%info = CM_BAD_INPUT
+                br%message = "continuation: the start converged to an equilibrium (a "// &
+                             "periodic solution of any period): start from the orbit's "// &
+                             "own period, e.g. found by symmetric_orbit with the time free"
+                return
+            end if
         end if
         ! the first tangent: the null vector of DG with t_p of sign `direction`
         dir = pb%o%direction
