@@ -30,7 +30,6 @@ def test_fold_located_with_its_test_value_and_closure():
     assert f.p == pytest.approx(-0.25, abs=1e-10)
     assert abs(f.test) < 1e-8                  # the p-component of the tangent
     assert f.residual < 1e-9                   # |y(T) - y0| by an independent integration
-    assert f.p_bracket[0] <= f.p <= f.p_bracket[1]
 
 
 def test_a_corrector_that_must_fail_gives_not_located():

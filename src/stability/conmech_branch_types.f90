@@ -74,7 +74,8 @@ module conmech_branch_types
     !! orbit nearer the sign change (a true orbit, never an interpolated state) and
     !! `message` says why. `test` is the test function at `point`, `closure` the point's
     !! true closure (an independent integration of the state alone), `p_bracket` the
-    !! parameter values around the sign change.
+    !! parameter values at the ends of the final bracket (around the sign change; both on
+    !! one side of a fold).
     type :: special_point
         integer :: kind = 0                   !! SP_FOLD, SP_BP, SP_PD, SP_NS
         integer :: index = 0                  !! between points index and index + 1

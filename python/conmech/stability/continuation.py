@@ -55,7 +55,8 @@ class SpecialPoint:
     sign change, never an interpolated state), test (the test function at the point),
     residual (the closure of its orbit by an independent integration: |y(T) - y0| for
     single shooting, the largest miss of a node for multiple shooting and collocation),
-    p_bracket (the parameter interval around the sign change), message."""
+    p_bracket (the parameter at the ends of the final bracket around the sign change;
+    both on one side of a fold), message."""
 
     __slots__ = ("kind", "index", "p", "period", "y0", "multipliers", "stability_index",
                  "located", "test", "residual", "p_bracket", "message")
