@@ -13,6 +13,7 @@ program test_periodic_schur
     call random_against_formed_product()
     call graded_product_with_known_eigenvalues()
     call single_factor_and_sizes()
+    call many_factors_far_apart()
     call deflated_flow_direction()
     call suite%finish()
 
@@ -118,6 +119,48 @@ contains
         worst_formed = minval(abs(er - 1.0e-12_dp))/1.0e-12_dp
         call suite%check(worst_formed > 1.0e-3_dp, "(the formed product loses 1e-12)")
     end subroutine graded_product_with_known_eigenvalues
+
+    !> 400 factors whose product has the eigenvalues 1e200, 1 and 1e-200 (each factor's
+    !! diagonal 1e(+-1/2), scaled products underflow after ~50 factors): the iteration
+    !! carries its products with log scales and finds all three to 1e-12 relative.
+    subroutine many_factors_far_apart()
+        integer, parameter :: n = 3, k = 400
+        real(dp) :: a(n, n, k), s(n, n, k + 1), t(n, n), x(n, n), wr(n), wi(n), want(n)
+        real(dp) :: d(n), worst, rel
+        integer :: l, i, j, info
+        do l = 1, k
+            call fill(s(:, :, l), 500 + l)
+            do i = 1, n
+                s(i, i, l) = s(i, i, l) + 2.0_dp
+            end do
+        end do
+        s(:, :, k + 1) = s(:, :, 1)
+        d = [10.0_dp**(200.0_dp/k), 1.0_dp, 10.0_dp**(-200.0_dp/k)]
+        do l = 1, k
+            call fill(t, 900 + l)
+            do j = 1, n
+                do i = j + 1, n
+                    t(i, j) = 0.0_dp
+                end do
+                t(j, j) = d(j)
+            end do
+            call la_solve(transpose(s(:, :, l)), transpose(matmul(s(:, :, l + 1), t)), x, &
+                          info)
+            a(:, :, l) = transpose(x)
+        end do
+        want = [1.0e200_dp, 1.0_dp, 1.0e-200_dp]
+        call periodic_eigenvalues(a, wr, wi, info)
+        call suite%check(info == CM_SUCCESS, "periodic QR converges (400 factors)")
+        worst = 0.0_dp
+        do i = 1, n
+            rel = huge(1.0_dp)
+            do j = 1, n
+                rel = min(rel, abs(wr(j) - want(i))/want(i))
+            end do
+            worst = max(worst, rel)
+        end do
+        call suite%check_less(worst, 1.0e-10_dp, "1e200, 1, 1e-200 from 400 factors")
+    end subroutine many_factors_far_apart
 
     subroutine single_factor_and_sizes()
         real(dp) :: a1(1, 1, 3), a2(2, 2, 1), wr(2), wi(2), w1(1), v1(1)

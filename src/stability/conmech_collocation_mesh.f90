@@ -15,7 +15,7 @@ module conmech_collocation_mesh
     implicit none
     private
 
-    public :: co_adapt, co_evaluate_polynomial
+    public :: co_adapt, co_evaluate_polynomial, co_new_mesh, co_remesh
 
 contains
 
@@ -49,14 +49,25 @@ contains
         real(dp), intent(in) :: x(:)
         real(dp), intent(out) :: xn(:)
         real(dp), intent(out) :: ratio
+        real(dp) :: newmesh(bvp%k + 1)
+        call co_new_mesh(bvp, tab, x, newmesh, ratio)
+        call co_remesh(bvp, tab, newmesh, x, xn)
+        bvp%mesh = newmesh
+    end subroutine co_adapt
+
+    !> The mesh equidistributing the error monitor of X (see the module notes).
+    subroutine co_new_mesh(bvp, tab, x, newmesh, ratio)
+        type(orbit_bvp), intent(in) :: bvp
+        type(gauss_tableau), intent(in) :: tab
+        real(dp), intent(in) :: x(:)
+        real(dp), intent(out) :: newmesh(:)
+        real(dp), intent(out) :: ratio
         real(dp) :: dm(bvp%n, bvp%k), del(bvp%k), phi(bvp%k), cum(0:bvp%k), yv(bvp%n, 0:bvp%m)
-        real(dp) :: newmesh(bvp%k + 1), h(bvp%k), target, s, mean
-        type(orbit_bvp) :: old
-        integer :: n, m, k, j, i, q, o
-        n = bvp%n
+        real(dp) :: h(bvp%k), target, mean
+        integer :: m, k, j, i, q
         m = bvp%m
         k = bvp%k
-        xn = x
+        newmesh = bvp%mesh
         ratio = 1.0_dp
         if (k < 3) return
         h = bvp%mesh(2:) - bvp%mesh(:k)
@@ -102,23 +113,32 @@ contains
             end do
             newmesh(q + 1) = bvp%mesh(j) + (target - cum(j - 1))/phi(j)
         end do
-        ! carry the solution over (the old mesh and sizes are all co_evaluate_polynomial
-        ! reads)
-        old%n = n
-        old%k = k
-        old%m = m
-        old%mesh = bvp%mesh
-        bvp%mesh = newmesh
+    end subroutine co_new_mesh
+
+    !> v (nodes, stages and border values of X's layout on bvp%mesh) carried to newmesh
+    !! by evaluating its collocation polynomials (linear in v: solutions and tangents
+    !! alike); the border values are copied.
+    subroutine co_remesh(bvp, tab, newmesh, v, vn)
+        type(orbit_bvp), intent(in) :: bvp
+        type(gauss_tableau), intent(in) :: tab
+        real(dp), intent(in) :: newmesh(:), v(:)
+        real(dp), intent(out) :: vn(:)
+        real(dp) :: s
+        integer :: n, m, k, j, i, o
+        n = bvp%n
+        m = bvp%m
+        k = bvp%k
+        vn = v
         do j = 1, k
             o = (j - 1)*n
-            xn(o + 1:o + n) = co_evaluate_polynomial(old, tab, x, newmesh(j))
+            vn(o + 1:o + n) = co_evaluate_polynomial(bvp, tab, v, newmesh(j))
             do i = 1, m
                 s = newmesh(j) + tab%c(i)*(newmesh(j + 1) - newmesh(j))
                 o = n*(k + 1) + ((j - 1)*m + (i - 1))*n
-                xn(o + 1:o + n) = co_evaluate_polynomial(old, tab, x, s)
+                vn(o + 1:o + n) = co_evaluate_polynomial(bvp, tab, v, s)
             end do
         end do
-        xn(k*n + 1:(k + 1)*n) = bvp_z(old, x, k + 1)
-    end subroutine co_adapt
+        vn(k*n + 1:(k + 1)*n) = bvp_z(bvp, v, k + 1)
+    end subroutine co_remesh
 
 end module conmech_collocation_mesh

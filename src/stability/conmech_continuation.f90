@@ -30,6 +30,11 @@
 !! branch's reach, max_points ds_max (a family born at an equilibrium is followed away
 !! from it, not into it).
 !!
+!! Collocation: the mesh is adapted (equidistribution, conmech_collocation_mesh) every
+!! third point, solution and tangent carried over; every point's nodes are checked by
+!! independent integrations, and the branch stops with a message where the mesh no longer
+!! resolves the orbit.
+!!
 !! Ranges: p_range (p_min, p_max), and the period and the energy (an `energy(y, p)`
 !! function) ranges. A step that leaves a range is replaced by the orbit exactly on the
 !! bound (Newton with the bound as the extra equation, from the interpolation of the two
@@ -44,7 +49,9 @@ module conmech_continuation
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
-    use conmech_orbit_types, only: set_parameter_proc
+    use conmech_orbit_types, only: set_parameter_proc, ORBIT_COLLOCATION
+    use conmech_orbit_newton, only: bvp_closure_tol
+    use conmech_collocation_mesh, only: co_new_mesh, co_remesh
     use conmech_branch_types
     use conmech_cont_problem
     use conmech_cont_locate, only: detect_special
@@ -83,11 +90,13 @@ contains
         real(dp), allocatable :: x(:), t(:), xn(:), tn(:)
         type(cont_point) :: pt
         type(cconstraint) :: con
-        real(dp) :: ds, f(size(y0)), fx(size(y0)), tend, per, p
+        real(dp) :: ds, f(size(y0)), fx(size(y0)), tend, per, p, clos, ratio
+        real(dp), allocatable :: newmesh(:)
         integer :: info, it, k, dir
         logical :: ended
         character(len=:), allocatable :: msg
         character(len=32) :: buf
+        character(len=64) :: b2
         if (present(options)) pb%o = options
         call cp_setup(pb, y0, period, p0, free, targets, free_time, period_factor, info, msg)
         if (info /= CM_SUCCESS) then
@@ -109,6 +118,7 @@ contains
         end if
         allocate (br%points(pb%o%max_points), br%special(64))
         allocate (x(pb%nx), t(pb%nx), xn(pb%nx), tn(pb%nx))
+        if (pb%o%discretisation == ORBIT_COLLOCATION) allocate (newmesh(pb%bvp%k + 1))
         if (.not. pb%o%in_period) call set_param(sys, p0)
         call cp_pack_start(sys, pb, y0, period, p0, x, info, msg)
         if (info /= CM_SUCCESS) then
@@ -183,8 +193,10 @@ contains
             con%b = dot_product(con%a, xn)
             call cp_correct(sys, set_param, pb, xn, con, .false., it, info, msg)
             tn = t
-            if (info == CM_SUCCESS) call cp_make_point(sys, set_param, pb, xn, tn, it, ds, &
-                                                        pt, info)
+            if (info == CM_SUCCESS) then
+                call cp_make_point(sys, set_param, pb, xn, tn, it, ds, pt, info)
+                if (info /= CM_SUCCESS) msg = "the tangent or the multipliers failed"
+            end if
             if (info /= CM_SUCCESS) then
                 ds = 0.5_dp*ds
                 if (ds < pb%o%ds_min) then
@@ -202,6 +214,21 @@ contains
                 br%message = msg
                 exit
             end if
+            if (pb%o%discretisation == ORBIT_COLLOCATION) then
+                ! the discrete orbit must still be the orbit: independent integrations
+                call cp_closure(sys, set_param, pb, xn, clos, info)
+                if (info < 0 .or. .not. (clos <= bvp_closure_tol(pb%bvp, xn))) then
+                    write (buf, '(es23.15)') pt%p
+                    write (b2, '(i0,a,i0,a,es9.2)') pb%bvp%k, " intervals of degree ", &
+                        pb%bvp%m, "; closure ", clos
+                    br%info = CM_NO_CONVERGENCE
+                    br%message = "continuation stopped at p = "//trim(adjustl(buf))// &
+                                 ": the collocation mesh ("//trim(b2)//") does not "// &
+                                 "resolve the orbit there (use more intervals or a higher "// &
+                                 "degree)"
+                    exit
+                end if
+            end if
             br%npoints = br%npoints + 1
             br%points(br%npoints) = pt
             k = br%npoints
@@ -211,6 +238,15 @@ contains
                                     cp_rdot(pb, reduced(pb, t), xn - x), k)
             x = xn
             t = tn
+            if (pb%o%discretisation == ORBIT_COLLOCATION .and. mod(br%npoints, 3) == 0) then
+                ! the mesh follows the orbit (equidistribution, as AUTO every 3 steps)
+                call co_new_mesh(pb%bvp, pb%bvp%tab, x, newmesh, ratio)
+                call co_remesh(pb%bvp, pb%bvp%tab, newmesh, x, xn)
+                call co_remesh(pb%bvp, pb%bvp%tab, newmesh, t, tn)
+                pb%bvp%mesh = newmesh
+                x = xn
+                t = tn/cp_rnorm(pb, tn)
+            end if
             if (ended) then
                 br%message = msg
                 exit

@@ -18,7 +18,8 @@
 !! applied to the columns of the next, and the triangular factors are re-triangularised
 !! by two reflectors per bulge position. Shifts and the first column of
 !! (P - s1)(P - s2) e1 come from the leading and trailing 2 x 2/3 x 3 blocks of the
-!! factors, each scaled by its norm (no overflow however large the product). A
+!! factors, multiplied as running products renormalised after every factor with their log
+!! scales kept (no overflow or underflow however many factors, however spread). A
 !! subdiagonal entry of H_K below eps times its neighbours is set to zero (deflation);
 !! converged 1 x 1 blocks give the eigenvalue as the product of the diagonal entries, 2 x 2
 !! blocks from the product of the 2 x 2 blocks, the smaller of a real pair as det/larger
@@ -153,7 +154,7 @@ contains
         real(dp), intent(out) :: wr(:), wi(:)
         integer, intent(out) :: info
         real(dp), parameter :: eps = epsilon(1.0_dp)
-        real(dp) :: s(k), x(3), v(3), tau, tr, dt, b(2, 2), r, tst
+        real(dp) :: x(3), v(3), tau, tr, dt, b(2, 2), r, tst, lb
         integer :: ilo, ihi, l, j, nr, iter, its, c, lf
         info = CM_SUCCESS
         ihi = n
@@ -191,12 +192,8 @@ contains
                 info = CM_NO_CONVERGENCE
                 return
             end if
-            ! scales: each factor's norm over the active window
-            do l = 1, k
-                s(l) = maxval(abs(h(ilo:ihi, ilo:ihi, l)))
-                if (.not. (s(l) > 0.0_dp)) s(l) = 1.0_dp
-            end do
-            call trailing_product(h, k, s, ihi, b)
+            ! the trailing 2 x 2 block of the product as e^lb b (shifts: its eigenvalues)
+            call trailing_product(h, k, ihi, b, lb)
             tr = b(1, 1) + b(2, 2)
             dt = b(1, 1)*b(2, 2) - b(1, 2)*b(2, 1)
             if (mod(iter, 10) == 0) then
@@ -205,7 +202,7 @@ contains
                 tr = 1.5_dp*r
                 dt = r*r
             end if
-            call first_column(h, k, s, ilo, tr, dt, x)
+            call first_column(h, k, ilo, tr, dt, lb, x)
             do j = ilo, ihi - 1
                 nr = min(3, ihi - j + 1)
                 if (j == ilo) then
@@ -237,12 +234,13 @@ contains
         end do
     end subroutine periodic_qr
 
-    !> The trailing 2 x 2 block (rows/columns ihi-1..ihi) of the scaled product
-    !! (H_k/s_k) ... (H_1/s_1); ihi >= 3.
-    pure subroutine trailing_product(h, k, s, ihi, b)
-        real(dp), intent(in) :: h(:, :, :), s(:)
+    !> The trailing 2 x 2 block (rows/columns ihi-1..ihi) of the product H_k ... H_1 as
+    !! e^lscale b, max |b| = 1 (the running product renormalised after every factor: no
+    !! overflow or underflow however many factors); ihi >= 3.
+    pure subroutine trailing_product(h, k, ihi, b, lscale)
+        real(dp), intent(in) :: h(:, :, :)
         integer, intent(in) :: k, ihi
-        real(dp), intent(out) :: b(2, 2)
+        real(dp), intent(out) :: b(2, 2), lscale
         real(dp) :: t(3, 3), u(3, 3)
         integer :: l, i0
         i0 = ihi - 2
@@ -250,37 +248,89 @@ contains
         t(1, 1) = 1.0_dp
         t(2, 2) = 1.0_dp
         t(3, 3) = 1.0_dp
+        lscale = 0.0_dp
         do l = 1, k - 1
-            u = h(i0:ihi, i0:ihi, l)/s(l)
+            u = h(i0:ihi, i0:ihi, l)
             u(2, 1) = 0.0_dp
             u(3, 1) = 0.0_dp
             u(3, 2) = 0.0_dp
             t = matmul(u, t)
+            call renormalise(t, lscale)
         end do
-        b = matmul(h(ihi - 1:ihi, i0:ihi, k)/s(k), t(:, 2:3))
+        b = matmul(h(ihi - 1:ihi, i0:ihi, k), t(:, 2:3))
+        call renormalise(b, lscale)
     end subroutine trailing_product
 
-    !> First three entries of (P - s1)(P - s2) e_ilo for the scaled product P, with
-    !! s1 + s2 = tr and s1 s2 = dt.
-    pure subroutine first_column(h, k, s, ilo, tr, dt, x)
-        real(dp), intent(in) :: h(:, :, :), s(:), tr, dt
+    !> a = a/max|a| (unless zero), lscale += log(max|a|).
+    pure subroutine renormalise(a, lscale)
+        real(dp), intent(inout) :: a(:, :), lscale
+        real(dp) :: c
+        c = maxval(abs(a))
+        if (c > 0.0_dp) then
+            a = a/c
+            lscale = lscale + log(c)
+        end if
+    end subroutine renormalise
+
+    !> The direction of the first three entries of (P - s1)(P - s2) e_ilo for the product
+    !! P, with s1 + s2 = tr e^lb and s1 s2 = dt e^(2 lb). P e and P^2 e are carried with
+    !! their own log scales; the three terms are added after scaling by the largest, so that
+    !! nothing overflows and a term far below the others underflows harmlessly to zero.
+    pure subroutine first_column(h, k, ilo, tr, dt, lb, x)
+        real(dp), intent(in) :: h(:, :, :), tr, dt, lb
         integer, intent(in) :: k, ilo
         real(dp), intent(out) :: x(3)
-        real(dp) :: t2(2, 2), u(2), pe(2), b(2, 2)
+        real(dp) :: t2(2, 2), u(2), pe(2), c(2, 2), v2(3), lt, l1, l2, c1, c2, e1, e2, e3, em
+        real(dp) :: w(2, 2)
         integer :: l, i
         i = ilo
         t2 = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2])
+        lt = 0.0_dp
         do l = 1, k - 1
-            b = h(i:i + 1, i:i + 1, l)/s(l)
-            b(2, 1) = 0.0_dp
-            t2 = matmul(b, t2)
+            c = h(i:i + 1, i:i + 1, l)
+            c(2, 1) = 0.0_dp
+            t2 = matmul(c, t2)
+            call renormalise(t2, lt)
         end do
-        ! P e_i = H_k (T e_i) = t2(1,1) H_k(:, i): rows i, i+1
-        pe = t2(1, 1)*h(i:i + 1, i, k)/s(k)
-        u = matmul(t2, pe)
-        x = matmul(h(i:i + 2, i:i + 1, k)/s(k), u)
-        x(1:2) = x(1:2) - tr*pe
-        x(1) = x(1) + dt
+        ! P e_i = e^lt t2(1, 1) H_k(i:i+1, i)
+        pe = t2(1, 1)*h(i:i + 1, i, k)
+        c1 = maxval(abs(pe))
+        x = 0.0_dp
+        if (.not. (c1 > 0.0_dp)) then
+            x(1) = 1.0_dp
+            return
+        end if
+        pe = pe/c1
+        l1 = lt + log(c1)
+        ! P^2 e_i = H_k(i:i+2, i:i+1) (e^lt t2) (e^l1 pe)
+        w = t2
+        u = matmul(w, pe)
+        v2 = matmul(h(i:i + 2, i:i + 1, k), u)
+        c2 = maxval(abs(v2))
+        if (c2 > 0.0_dp) then
+            v2 = v2/c2
+            l2 = lt + l1 + log(c2)
+        else
+            l2 = -huge(1.0_dp)
+        end if
+        e1 = l2
+        e2 = -huge(1.0_dp)
+        if (tr /= 0.0_dp) e2 = lb + l1 + log(abs(tr))
+        e3 = -huge(1.0_dp)
+        if (dt /= 0.0_dp) e3 = 2.0_dp*lb + log(abs(dt))
+        em = max(e1, e2, e3)
+        x = scale_exp(e1 - em)*v2
+        if (tr /= 0.0_dp) x(1:2) = x(1:2) - sign(scale_exp(e2 - em), tr)*pe
+        if (dt /= 0.0_dp) x(1) = x(1) + sign(scale_exp(e3 - em), dt)
+    contains
+        pure real(dp) function scale_exp(d) result(y)
+            real(dp), intent(in) :: d
+            if (d < log(tiny(1.0_dp))) then
+                y = 0.0_dp
+            else
+                y = exp(min(d, 0.0_dp))
+            end if
+        end function scale_exp
     end subroutine first_column
 
     !> The eigenvalue of a converged 1 x 1 block: the product of the diagonal entries.
@@ -331,6 +381,7 @@ contains
             end if
             b = matmul(c/sc, b)
             lscale = lscale + log(sc)
+            call renormalise(b, lscale)
         end do
         tr = b(1, 1) + b(2, 2)
         if (sdet == 0.0_dp) then
