@@ -11,7 +11,8 @@ conservative), 1,000 points (ds 0.05, ds_max 0.2, special points located):
 For each discretisation: wall time (provisional: a shared, loaded machine), points reached,
 where the family ended (T per lap, Gamma), the largest multiplier, the worst
 |mu_min mu_max - 1| over the branch (for this Hamiltonian system exactly 0: the accuracy of
-the multipliers), the status and message. Writes bench/results/orbit_methods.md.
+the multipliers) beside the worst accuracy the multipliers report themselves (their
+largest error estimate relative to max(1, |mu|)), the status and message. Writes bench/results/orbit_methods.md.
 
     python bench/bench_orbit_methods.py [--points 1000] [--repeat 1]
 """
@@ -41,7 +42,8 @@ def run(laps, method, points, **extra):
     recip = np.abs(a[:, 0]*a[:, -1] - 1.0)
     return dict(method=method, laps=laps, time=el, points=len(br), T=br.p[-1]/laps,
                 gamma=br.energy[-1], mu_max=float(a[:, -1].max()),
-                recip=float(recip.max()), special=len(br.special),
+                recip=float(recip.max()), acc=float(np.max(br.accuracy)),
+                special=len(br.special),
                 located=sum(s.located for s in br.special), message=br.message)
 
 
@@ -73,17 +75,17 @@ def main():
              f"other work (load average {load:.1f} at the end); machine {platform.machine()}.",
              "",
              "| laps | method | options | time (s) | points | T/lap at the end | Gamma at "
-             "the end | max mu_max | worst mu_min mu_max - 1 | special (located) | "
-             "message |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "the end | max mu_max | worst mu_min mu_max - 1 | worst reported accuracy | "
+             "special (located) | message |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if r["points"] == 0:
             lines.append(f"| {r['laps']} | {r['method']} | {r['opts']} | {r['time']:.1f} | "
-                         f"0 | - | - | - | - | - | {r['message']} |")
+                         f"0 | - | - | - | - | - | - | {r['message']} |")
             continue
         lines.append(f"| {r['laps']} | {r['method']} | {r['opts']} | {r['time']:.1f} | "
                      f"{r['points']} | {r['T']:.6f} | {r['gamma']:.6g} | "
-                     f"{r['mu_max']:.3g} | {r['recip']:.1e} | {r['special']} "
+                     f"{r['mu_max']:.3g} | {r['recip']:.1e} | {r['acc']:.1e} | {r['special']} "
                      f"({r['located']}) | {r['message']} |")
     with open(args.out, "w") as fh:
         fh.write("\n".join(lines) + "\n")

@@ -229,6 +229,9 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
         raise ValueError("in_period is for autonomous systems")
     if in_period and sym and free_time:
         raise ValueError("in_period continues in the time itself: free_time must be False")
+    if _tangent is not None and not _switch:
+        # start at a known solution with a given first tangent ([y0, T, p], T if free)
+        _switch = 3
     ropt = np.array([ds, ds_min, ds_max, lo, hi, tol, res_tol, rtol, atol, locate_tol,
                      period_factor, tlo, thi, elo, ehi], dtype=float)
     iopt = np.array([max_points, dirn, max_iter, bool(autonomous),

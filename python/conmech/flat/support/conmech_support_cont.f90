@@ -78,7 +78,10 @@ contains
     !! doubled-period branch at the period-doubling point (p0, y0, period), switch = 2 the
     !! second branch at the branch point (p0, y0, period) whose old tangent is
     !! tang(1:ntang) (unknowns [y0, T, p]; its singular-value ratio is returned in
-    !! tang(1)); in_period /= 0 continues in the period. `en`: the energy (has_energy /= 0).
+    !! tang(1)); switch = 3 starts at the solution (p0, y0, period) with the first tangent
+    !! tang(1:ntang) in the unknowns of single shooting ([y0, T, p], T only if free; the
+    !! reduced [z_1, T, p] for multiple shooting and collocation); in_period /= 0
+    !! continues in the period. `en`: the energy (has_energy /= 0).
     !! Per point: multipliers with their error estimates (merr) and accuracy; per special
     !! point: located (1/0) + 10 * the reason the location stopped (SPR_*), the test
     !! function, the true closure and the p bracket.
@@ -155,6 +158,13 @@ contains
             sp%point%period = period
             call switch_branch_point(sys, set_param_any, sp, tang(1:ntang), br, o, ratio)
             tang(1) = ratio
+        else if (iopt(10) == 3 .and. sym) then
+            call continue_orbits(sys, set_param_any, p0, y0, period, br, o, &
+                                 free_idx(1:nfree), targets(1:ntg), iopt(9) /= 0, ropt(11), &
+                                 tangent0=tang(1:ntang))
+        else if (iopt(10) == 3) then
+            call continue_orbits(sys, set_param_any, p0, y0, period, br, o, &
+                                 tangent0=tang(1:ntang))
         else if (iopt(10) /= 0) then
             sp%kind = SP_PD
             sp%point%p = p0
