@@ -12,7 +12,8 @@ For each discretisation: wall time (provisional: a shared, loaded machine), poin
 where the family ended (T per lap, Gamma), the largest multiplier, the worst
 |mu_min mu_max - 1| over the branch (for this Hamiltonian system exactly 0: the accuracy of
 the multipliers) beside the worst accuracy the multipliers report themselves (their
-largest error estimate relative to max(1, |mu|)), the status and message. Writes bench/results/orbit_methods.md.
+largest error estimate relative to max(1, |mu|)), the status and message. Writes
+bench/results/orbit_methods.md.
 
     python bench/bench_orbit_methods.py [--points 1000] [--repeat 1]
 """

@@ -67,6 +67,10 @@ def test_three_lap_henon_a_orbit_keeps_its_small_multiplier():
     assert r.multiplier_error[imin] < 1e-3*a[0]
     formed = np.sort(np.abs(np.linalg.eigvals(r.monodromy)))
     assert abs(formed[0]*formed[-1] - 1) > 1e-2
+    # floquet() of the formed matrix says so: its estimate for mu_min exceeds mu_min
+    fl = stability.floquet(r.monodromy, r.period, rel_error=1e-12)
+    jmin = int(np.argmin(np.abs(fl["multipliers"])))
+    assert fl["multiplier_error"][jmin] > a[0]
 
 
 @pytest.mark.parametrize("method", ["multiple", "collocation"])

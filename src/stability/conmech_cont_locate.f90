@@ -9,16 +9,18 @@
 !! correction from that start exceeds a hundredth of the bracket (it left the branch), or
 !! whose corrector fails, ends the location. At a branch point itself Newton's matrix is
 !! singular and the iteration cannot meet its step tolerance; the trial is then the
-!! interpolant if a fresh evaluation there meets the corrector's residual tolerance
-!! (its closure is checked independently like every special point's). The special point is `located` when the
-!! bracket in sigma shrank below locate_tol (or a test function vanished exactly), or when
-!! the trials stopped with the bracket's parameter interval already below
-!! 10 locate_tol max(1, |p|). Otherwise it is "not located": its orbit is the bracket end
-!! with the smaller test function (a corrected orbit, never an interpolated state) and the
-!! message says why. Every special point carries its test-function value and the
-!! closure of its orbit by an independent integration. A sign change of the branch-point
-!! test at a fold is the fold itself and is not reported twice; a Neimark-Sacker test that
-!! vanishes for a real pair mu, 1/mu (a neutral saddle) is not reported.
+!! interpolant only if a fresh evaluation there meets the corrector's residual tolerance
+!! (a checked orbit; its tangent is the interpolant's derivative).
+!!
+!! The special point is `located` when the bracket in sigma shrank below locate_tol (or
+!! a test function vanished exactly), or when the trials stopped with the bracket's
+!! parameter interval already below 10 locate_tol max(1, |p|). Otherwise it is "not
+!! located": its orbit is the bracket end with the smaller test function (a checked
+!! orbit, never an unchecked interpolated state) and the message says why. Every special
+!! point carries its test-function value and the closure of its orbit by an independent
+!! integration. A sign change of the branch-point test at a fold is the fold itself and
+!! is not reported twice; a Neimark-Sacker test that vanishes for a real pair mu, 1/mu (a
+!! neutral saddle) is not reported.
 module conmech_cont_locate
     use conmech_kinds, only: dp
     use conmech_status

@@ -221,7 +221,7 @@ contains
             orbit%message = "find_symmetric_orbit: bad input (indices, tau > 0, finite y0)"
             return
         end if
-        msg = symmetric_count_message(nf, ft_free, ntg)
+        msg = symmetric_count_message(nf, ft_free, ntg, opt%discretisation /= ORBIT_SINGLE)
         if (len(msg) > 0) then
             orbit%info = CM_BAD_INPUT
             orbit%message = "find_symmetric_orbit: "//msg
@@ -341,17 +341,20 @@ contains
         end if
     end subroutine orbit_monodromy
 
-    !> "" if nfree free components (and the time, if free_time) match ntg targets, else a
-    !! message naming both counts.
-    pure function symmetric_count_message(nfree, free_time, ntg) result(msg)
+    !> "" if nfree free components (and the time, if free_time) can meet ntg targets, else
+    !! a message naming both counts: fewer unknowns than targets is an overdetermined
+    !! system Newton cannot solve in general; more unknowns than targets (a family, e.g.
+    !! an isochronous oscillator: single shooting's minimum-norm Gauss-Newton step picks a
+    !! member) is refused only with `exact` (multiple shooting and collocation).
+    pure function symmetric_count_message(nfree, free_time, ntg, exact) result(msg)
         integer, intent(in) :: nfree, ntg
-        logical, intent(in) :: free_time
+        logical, intent(in) :: free_time, exact
         character(len=:), allocatable :: msg
         character(len=64) :: a, b
         integer :: nun
         nun = nfree + merge(1, 0, free_time)
         msg = ""
-        if (nun == ntg) return
+        if (nun == ntg .or. (nun > ntg .and. .not. exact)) return
         write (a, '(i0,a,i0,a)') nun, " unknowns (", nfree, " free components"
         if (free_time) a = trim(a)//" + the time"
         write (b, '(i0,a)') ntg, " targets"

@@ -96,7 +96,8 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
         raise ValueError("free and targets must not be empty")
     if kind == 2 and len(set(fr.tolist())) != nfree:
         raise ValueError("free must not repeat an index")
-    if kind == 2 and nfree + bool(free_time) != ntg:
+    nun = nfree + bool(free_time)
+    if kind == 2 and (nun < ntg or (nun > ntg and method != "single")):
         raise ValueError(
             f"symmetric_orbit: {nfree + bool(free_time)} unknowns ({nfree} free components"
             f"{' + the time' if free_time else ''}) for {ntg} targets: symmetric shooting "
@@ -217,8 +218,10 @@ def symmetric_orbit(system: Any, y0: ArrayLike, free: Sequence[int], targets: Se
     components ``free`` (0-based) unknown, the components ``targets`` of the state at
     tau = period/period_factor must vanish (2: half period, 4: quarter period for two
     perpendicular symmetry lines); tau is unknown too if ``free_time``. The unknowns
-    (free components, and tau if free) must be as many as the targets (a ValueError names
-    both counts). ``jac``: exact Jacobian of a Python system. The multipliers are those of
+    (free components, and tau if free) must be at least as many as the targets, and as
+    many for multiple shooting and collocation (a ValueError names both counts; more
+    unknowns than targets is a family, of which single shooting's minimum-norm Newton
+    step picks a member). ``jac``: exact Jacobian of a Python system. The multipliers are those of
     the full period (the rest of it integrated from the end of the shooting span).
     """
     return _orbit(system, y0, period, 2, 1, free, targets, free_time, period_factor, rtol,
