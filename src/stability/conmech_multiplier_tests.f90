@@ -10,9 +10,12 @@
 !! multiplier of a conservative system, `nontrivial_multipliers` drops the multipliers
 !! nearest to 1. From the others (mu_i):
 !! - branch point / period-preserving bifurcation (a real multiplier through +1):
-!!   psi_bp = prod over real mu_i of (mu_i - 1);
-!! - period doubling (a real multiplier through -1): psi_pd = prod over real mu_i of
-!!   (mu_i + 1);
+!!   psi_bp = prod over the non-trivial mu_i of (mu_i - 1), real (a complex pair gives
+!!   |mu - 1|^2 > 0) and continuous where a pair on the unit circle meets at +1 and
+!!   leaves it along the real axis (mu, 1/mu: a negative factor), as at the halo
+!!   bifurcation of a conservative family;
+!! - period doubling (a real multiplier through -1): psi_pd = prod over the non-trivial
+!!   mu_i of (mu_i + 1), likewise;
 !! - Neimark-Sacker (a complex pair through the unit circle): psi_ns = prod over i < j of
 !!   (mu_i mu_j - 1) (the eigenvalues of the bialternate product, Kuznetsov 2004, sec.
 !!   10.2); it also vanishes at a neutral saddle (real mu, 1/mu), which the caller tells
@@ -42,7 +45,7 @@ contains
         real(dp), intent(out) :: psi(3), s
         integer, intent(out) :: info
         real(dp), allocatable :: nr(:), ni(:)
-        integer :: n, k, i
+        integer :: n, k
         psi = 0.0_dp
         s = 0.0_dp
         info = ms%info
@@ -61,13 +64,8 @@ contains
             psi(3) = 1.0_dp
             return
         end if
-        psi(1:2) = 1.0_dp
-        do i = 1, k
-            if (ni(i) == 0.0_dp) then
-                psi(1) = psi(1)*(nr(i) - 1.0_dp)
-                psi(2) = psi(2)*(nr(i) + 1.0_dp)
-            end if
-        end do
+        psi(1) = real(product(cmplx(nr(1:k) - 1.0_dp, ni(1:k), dp)), dp)
+        psi(2) = real(product(cmplx(nr(1:k) + 1.0_dp, ni(1:k), dp)), dp)
         psi(3) = ns_product(nr(1:k), ni(1:k))
         if (conservative) psi(3) = 1.0_dp
         s = 0.0_dp
