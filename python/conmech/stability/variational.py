@@ -57,9 +57,16 @@ def monodromy(system: Any, y0: ArrayLike, period: float, rtol: float = 1e-12,
     return stm(system, (0.0, period), y0, rtol, atol, jac=jac)[1]
 
 
-def floquet(m: ArrayLike, period: float) -> dict:
+def floquet(m: ArrayLike, period: float, rel_error: float = 0.0) -> dict:
     """Multipliers (eigenvalues of m), Floquet exponents log(mu)/period and, for a 4 x 4
-    monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict."""
+    monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict, with
+    ``multiplier_error``: an estimate of each multiplier's absolute error for an m known to
+    the relative accuracy ``rel_error`` (at least 10 eps; e.g. the integrator's rtol), by
+    the statistical condition estimate of conmech_periodic_multipliers (three seeded
+    random perturbations of that size, three times the largest change), and ``accuracy``
+    (the largest error relative to max(1, |mu|)). For multipliers that keep their digits
+    use :func:`periodic_orbit` (method="multiple"): eig of a formed monodromy of an
+    unstable orbit loses the small multipliers, and the estimate says so."""
     m = np.asarray(m)
     if m.dtype.kind not in "biuf":
         raise TypeError("m must be a real matrix")
@@ -69,10 +76,23 @@ def floquet(m: ArrayLike, period: float) -> dict:
     if not np.all(np.isfinite(m)):
         raise ValueError("m must be finite")
     period = _real(period, "period", 0.0, low_open=True)
+    rel_error = max(_real(rel_error, "rel_error", 0.0), 10*np.finfo(float).eps)
     mu = np.linalg.eigvals(m)
     with np.errstate(divide="ignore", invalid="ignore"):   # a zero multiplier: -inf
         expo = np.log(mu.astype(complex))/period
-    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m))}
+    rng = np.random.default_rng(12345)
+    change = np.zeros(mu.size)
+    for _ in range(3):
+        z = rng.standard_normal(m.shape)
+        z *= rel_error*np.linalg.norm(m)/np.linalg.norm(z)
+        pert = list(np.linalg.eigvals(m + z))
+        for i, v in enumerate(mu):
+            j = int(np.argmin(np.abs(np.asarray(pert) - v)))
+            change[i] = max(change[i], abs(pert.pop(j) - v))
+    err = 3.0*change
+    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m)),
+           "multiplier_error": err,
+           "accuracy": float(np.max(err/np.maximum(1.0, np.abs(mu))))}
     if m.shape == (4, 4):
         out["stability_index"] = 0.5*(np.trace(m) - 2.0)
     return out
