@@ -25,6 +25,7 @@ import numpy as np
 
 from . import _conmech
 from ._callback import Guard, as_result, message_text
+from ._checks import event_settings
 from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
@@ -349,8 +350,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
         if np.any(d <= 0):
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
-    from ._ivp import _event_settings
-    settings = _event_settings(events)
+    settings = event_settings(events)
     ne = len(settings)
     for i, (_, count, _) in enumerate(settings):
         if count > 1:

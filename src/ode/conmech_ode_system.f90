@@ -109,10 +109,14 @@ module conmech_ode_system
     !! evaluation) before the next step. `info` < 0 stops the integration with that
     !! status and the hook's `message`; `info` > 0 stops it as a success (like a terminal
     !! event, status CM_EVENT_STOP).
+    !! `at_event` is called with every located event state before it is stored (default:
+    !! nothing): a projection hook puts it on the manifold like the step ends; `info` < 0
+    !! stops the integration with the hook's `message`.
     type, abstract :: ode_step_hook
         character(len=:), allocatable :: message   !! set by the hook when it fails
     contains
         procedure(hook_after_step), deferred :: after_step
+        procedure :: at_event => hook_no_event_action
     end type ode_step_hook
 
     abstract interface
@@ -127,6 +131,15 @@ module conmech_ode_system
     end interface
 
 contains
+
+    !> Default: event states are stored as located.
+    subroutine hook_no_event_action(self, t, y, info)
+        class(ode_step_hook), intent(inout) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: y(:)
+        integer, intent(out) :: info
+        info = 0
+    end subroutine hook_no_event_action
 
     !> Central finite-difference Jacobian, step h_j = eps^(1/3) max(|y_j|, 1).
     subroutine ode_fd_jacobian(self, t, y, dfdy)

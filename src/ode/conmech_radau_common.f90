@@ -13,7 +13,7 @@ module conmech_radau_common
     use conmech_ode_system, only: ode_events
     use conmech_ode_solver, only: ode_options, ode_result, dense_solution
     use conmech_ode_result, only: push_point, push_event
-    use conmech_ode_dense, only: dense_push
+    use conmech_ode_dense, only: dense_push, power_basis_matrix
     use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
@@ -21,7 +21,8 @@ module conmech_radau_common
     integer, parameter, public :: FORM_POWER_BASIS = 2  !! dense_solution%form of the power basis
 
     public :: step_output, out_init, out_step, out_finish, poly_eval, check_t_eval
-    public :: tolerance_vectors, power_basis_matrix
+    public :: power_basis_matrix
+    public :: tolerance_vectors
 
     !> State of the outputs during one integration.
     type :: step_output
@@ -95,33 +96,6 @@ contains
         info = CM_SUCCESS
         msg = "success"
     end subroutine tolerance_vectors
-
-    !> Matrix P (s x s) of the interpolation in the power basis through the origin: the
-    !! polynomial u with u(0) = 0 and u(c_i) = z_i is u(x) = sum_j x^j sum_i P(j, i) z_i
-    !! (expanded Lagrange basis x/c_i prod_{k /= i} (x - c_k)/(c_i - c_k); nodes distinct
-    !! and non-zero).
-    pure function power_basis_matrix(c) result(p)
-        real(dp), intent(in) :: c(:)
-        real(dp) :: p(size(c), size(c))
-        real(dp) :: poly(0:size(c)), den
-        integer :: i, k, j, s
-        s = size(c)
-        do i = 1, s
-            ! poly = x * prod_{k /= i} (x - c_k), coefficients of x^0..x^s
-            poly = 0.0_dp
-            poly(1) = 1.0_dp
-            den = c(i)
-            do k = 1, s
-                if (k == i) cycle
-                do j = s, 1, -1
-                    poly(j) = poly(j - 1) - c(k)*poly(j)
-                end do
-                poly(0) = -c(k)*poly(0)
-                den = den*(c(i) - c(k))
-            end do
-            p(:, i) = poly(1:s)/den
-        end do
-    end function power_basis_matrix
 
     !> u(x) = fc(:, 0) + x fc(:, 1) + ... + x^nf fc(:, nf) (Horner).
     pure subroutine poly_eval(fc, x, u)

@@ -3,7 +3,6 @@
 !! `ode_solve` dispatches to them) that routes METHOD_RADAU5 to `radau_solve` and
 !! METHOD_GAUSS4 / METHOD_GAUSS6 to `gauss_solve`.
 submodule(conmech_ode_solver) conmech_radau_dispatch
-    use conmech_radau, only: radau_solve
     use conmech_gauss, only: gauss_solve
     implicit none
 
@@ -18,8 +17,6 @@ contains
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
         select case (options%method)
-        case (METHOD_RADAU5)
-            call radau_solve(sys, t_span, y0, options, res, t_eval, events)
         case (METHOD_GAUSS4)
             call gauss_solve(sys, 2, t_span, y0, options, res, t_eval, events)
         case (METHOD_GAUSS6)
