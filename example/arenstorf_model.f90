@@ -214,7 +214,7 @@ contains
         real(dp) :: tc1, tc2
         real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
         real(dp) :: h11, iv1, iv2
-        real(dp) :: fj, fk, rk, rk1
+        real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
         tc1 = self%mu
@@ -256,7 +256,6 @@ contains
             h10 = 0.0_dp
             h11 = 0.0_dp
             do j = 1, k - 1
-                fj = real(j, dp)
                 h1 = h1 + w(j, 2)*w(k - j, 2)
                 h2 = h2 + w(j, 6)*w(k - j, 6)
                 h3 = h3 + w(j, 8)*w(k - j, 9)
@@ -305,7 +304,7 @@ contains
         real(dp) :: h21, h22, h23, h24, h25, h26, h27, h28, h29, h30
         real(dp) :: h31, h32, h33, h34, h35, h36, h37, h38, h39, h40
         real(dp) :: h41, h42, h43, iv1, iv2, iv3, iv4
-        real(dp) :: fj, fk, rk, rk1
+        real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
         tc1 = self%mu
@@ -439,7 +438,6 @@ contains
             h42 = 0.0_dp
             h43 = 0.0_dp
             do j = 1, k - 1
-                fj = real(j, dp)
                 h1 = h1 + w(j, 2)*w(k - j, 2)
                 h2 = h2 + w(j, 22)*w(k - j, 22)
                 h3 = h3 + w(j, 24)*w(k - j, 25)

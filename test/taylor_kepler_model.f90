@@ -176,7 +176,7 @@ contains
         real(dp), intent(inout) :: w(0:order, 12)
         real(dp) :: tc1
         real(dp) :: h1, h2, h3, h4, h5, h6, iv1
-        real(dp) :: fj, fk, rk, rk1
+        real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
         tc1 = self%mu
@@ -203,7 +203,6 @@ contains
             h5 = 0.0_dp
             h6 = 0.0_dp
             do j = 1, k - 1
-                fj = real(j, dp)
                 h1 = h1 + w(j, 1)*w(k - j, 1)
                 h2 = h2 + w(j, 2)*w(k - j, 2)
                 h3 = h3 + w(j, 7)*w(k - j, 8)
@@ -235,7 +234,7 @@ contains
         real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
         real(dp) :: h11, h12, h13, h14, h15, h16, h17, h18, h19, h20
         real(dp) :: h21, h22, h23, h24, h25, h26, h27, h28, iv1, iv2
-        real(dp) :: fj, fk, rk, rk1
+        real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
         tc1 = self%mu
@@ -326,7 +325,6 @@ contains
             h27 = 0.0_dp
             h28 = 0.0_dp
             do j = 1, k - 1
-                fj = real(j, dp)
                 h1 = h1 + w(j, 1)*w(k - j, 1)
                 h2 = h2 + w(j, 2)*w(k - j, 2)
                 h3 = h3 + w(j, 23)*w(k - j, 24)

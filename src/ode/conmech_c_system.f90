@@ -33,7 +33,7 @@ module conmech_c_system
     implicit none
     private
 
-    public :: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor
+    public :: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor, set_c_taylor_fixed
     public :: c_rhs_fn, c_jac_fn, c_jac_prod_fn, c_taylor_fn
 
     abstract interface
@@ -83,6 +83,10 @@ module conmech_c_system
         procedure(c_taylor_fn), pointer, nopass :: tj => null()    !! Taylor coefficients
         procedure(c_taylor_fn), pointer, nopass :: tjv => null()   !! ... variational
         integer :: nw_taylor = 0, nw_taylor_var = 0                !! their work columns
+        !> the same written out for one order (no loops; used when the order matches)
+        procedure(c_taylor_fn), pointer, nopass :: tjf => null()
+        procedure(c_taylor_fn), pointer, nopass :: tjvf => null()
+        integer :: order_fixed = -1, order_fixed_var = -1
     contains
         procedure :: rhs => c_ode_rhs
         procedure :: jacobian => c_ode_jacobian
@@ -156,6 +160,27 @@ contains
         end if
     end subroutine set_c_taylor
 
+    !> Give a `c_ode_system` Taylor routines written out for one order each (same work
+    !! columns as those of `set_c_taylor`; c_null_funptr: none): used when the order of a
+    !! call matches.
+    subroutine set_c_taylor_fixed(sys, taylor, order, taylor_var, order_var)
+        type(c_ode_system), intent(inout) :: sys
+        type(c_funptr), intent(in) :: taylor, taylor_var
+        integer, intent(in) :: order, order_var
+        sys%tjf => null()
+        sys%tjvf => null()
+        sys%order_fixed = -1
+        sys%order_fixed_var = -1
+        if (c_associated(taylor) .and. associated(sys%tj)) then
+            call c_f_procpointer(taylor, sys%tjf)
+            sys%order_fixed = order
+        end if
+        if (c_associated(taylor_var) .and. associated(sys%tjv)) then
+            call c_f_procpointer(taylor_var, sys%tjvf)
+            sys%order_fixed_var = order_var
+        end if
+    end subroutine set_c_taylor_fixed
+
     integer function c_ode_taylor_size(self, kind)
         class(c_ode_system), intent(in) :: self
         integer, intent(in) :: kind
@@ -169,8 +194,13 @@ contains
         integer, intent(in) :: kind, order, nw
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: w(0:order, nw)
-        if (kind == 0 .and. associated(self%tj) .and. nw >= self%nw_taylor) then
+        if (kind == 0 .and. order == self%order_fixed .and. nw >= self%nw_taylor) then
+            call self%tjf(t, int(order, c_int), w, self%p)
+        else if (kind == 0 .and. associated(self%tj) .and. nw >= self%nw_taylor) then
             call self%tj(t, int(order, c_int), w, self%p)
+        else if (kind == 1 .and. order == self%order_fixed_var .and. &
+                 nw >= self%nw_taylor_var) then
+            call self%tjvf(t, int(order, c_int), w, self%p)
         else if (kind == 1 .and. associated(self%tjv) .and. nw >= self%nw_taylor_var) then
             call self%tjv(t, int(order, c_int), w, self%p)
         else

@@ -29,42 +29,42 @@ module conmech_taylor_stepper
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
-    use conmech_ode_options, only: ode_options, ode_stats
+    use conmech_ode_options, only: ode_options, ode_stats, METHOD_TAYLOR
+    use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
+    use conmech_state_packer, only: state_packer
     implicit none
     private
 
-    public :: taylor_stepper, taylor_order, taylor_init, taylor_start, taylor_step
-    public :: taylor_propagate
+    public :: taylor_stepper, taylor_order, taylor_propagate
 
     real(dp), parameter :: CHECK_MAX = 10.0_dp   !! rejected above 10 x the tolerance
 
-    !> State of a Taylor integration (the common fields of conmech's steppers, and the two
-    !! expansions: at the current point and at the start of the last step).
-    type :: taylor_stepper
-        integer :: n = 0                  !! dimension of y (n + n**2 for kind 1)
-        integer :: nblock = 0             !! first block of y (the state; the rest: Phi)
+    !> State of a Taylor integration beyond the contract's common state: the two
+    !! expansions (at the current point, and at the start of the last step: its polynomial).
+    !! Set `kind` = 1 before `init` to integrate the variational system (y0 = [y; Phi]).
+    type, extends(ode_stepper) :: taylor_stepper
         integer :: kind = 0               !! 0 the system, 1 its variational system
+        integer :: nblock = 0             !! first block of y (the state; the rest: Phi)
         integer :: order = 0              !! p
-        integer :: nw = 0                 !! columns of the work arrays
-        integer :: nf = 0                 !! degree of the continuous extension (p)
-        real(dp) :: t = 0.0_dp, t_old = 0.0_dp, tf = 0.0_dp, posneg = 1.0_dp
+        integer :: nw = 0                 !! columns of the work arrays (from the system)
         real(dp) :: t_lo = 0.0_dp         !! t + t_lo: the time in double length
-        real(dp) :: h = 0.0_dp            !! step proposed from the current expansion
-        real(dp) :: h_done = 0.0_dp       !! last accepted step (signed)
         real(dp) :: hmax = huge(1.0_dp)
         real(dp) :: first_step = 0.0_dp
         real(dp) :: eps = 0.0_dp          !! tolerance that set the order
+        real(dp) :: decay = 0.0_dp        !! exp(-2 - 0.7/(p - 1)), Jorba and Zou's factor
         real(dp) :: err = 0.0_dp          !! safety-check ratio of the last accepted step
         integer :: nsteps = 0, max_steps = 100000
-        logical :: last = .false., hit = .false., dense_ready = .false.
-        type(ode_stats) :: st
-        real(dp), allocatable :: y(:), y_old(:), rtol(:), atol(:), dy(:)
+        real(dp), allocatable :: rtol(:), atol(:), dy(:), ynew(:), e(:)
         real(dp), allocatable :: jet(:, :)    !! (0:p, nw) expansion at (t, y)
         real(dp), allocatable :: jold(:, :)   !! (0:p, nw) expansion at (t_old, y_old)
-        real(dp), allocatable :: fc(:, :)     !! (n, 0:p) extension, power form
     contains
+        procedure :: init => taylor_init
+        procedure :: start => taylor_start
+        procedure :: step => taylor_step
+        procedure :: transfer_state => taylor_transfer
         procedure :: dense => taylor_dense
         procedure :: eval => taylor_eval
+        procedure :: eval_unit => taylor_eval_unit
         procedure :: refresh_f => taylor_refresh
         procedure :: f_finite => taylor_f_finite
     end type taylor_stepper
@@ -77,56 +77,59 @@ contains
         taylor_order = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
     end function taylor_order
 
-    !> Check the options and set up at (t0, y0) on [t0, tf]; kind 0 integrates the system,
-    !! kind 1 its variational system (y0 of length n + n**2: the state, then Phi
-    !! column-major). No evaluation yet. A system without Taylor coefficients is
-    !! CM_BAD_INPUT with a message saying so.
-    subroutine taylor_init(self, sys, t0, tf, y0, opt, info, msg, kind, allow_inf)
-        type(taylor_stepper), intent(out) :: self
-        class(ode_system), intent(in) :: sys
-        real(dp), intent(in) :: t0, tf, y0(:)
+    !> Check the options and set up at (t0, y0) on [t0, tf] (no evaluation: the system's
+    !! Taylor code is looked up in `start`). rtol may go down to the unit round-off.
+    subroutine taylor_init(self, t0, tf, y0, opt, info, msg, allow_inf)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: t0, tf
+        real(dp), intent(in) :: y0(:)
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        integer, intent(in), optional :: kind
         logical, intent(in), optional :: allow_inf
-        integer :: n, k
-        logical :: inf_ok
-        real(dp) :: rmin, amin
-        k = 0
-        if (present(kind)) k = kind
-        inf_ok = .false.
-        if (present(allow_inf)) inf_ok = allow_inf
+        integer :: n
         n = size(y0)
-        info = CM_BAD_INPUT
-        if (n < 1) then
-            msg = "bad input: y0 is empty"
-        else if (.not. all(ieee_is_finite(y0))) then
-            msg = "bad input: y0 contains NaN or Inf"
-        else if (.not. (ieee_is_finite(t0) .and. (ieee_is_finite(tf) .or. &
-                                                  (inf_ok .and. tf == tf)))) then
-            msg = "bad input: t_span must be finite"
-        else if (sys%taylor_size(k) < n) then
-            msg = "bad input: the system has no Taylor coefficients (method TAYLOR needs a "// &
-                  "system from conmech.symbolic with smooth right-hand side, or a type "// &
-                  "that overrides taylor_size and taylor_jet)"
-        else if (.not. opt%max_step > 0.0_dp) then
-            msg = "bad input: max_step must be positive"
-        else if (.not. opt%first_step >= 0.0_dp) then
-            msg = "bad input: first_step must be positive"
-        else if (opt%first_step > abs(tf - t0) .and. tf /= t0) then
-            msg = "bad input: first_step exceeds the length of t_span"
-        else if (opt%max_steps < 1) then
-            msg = "bad input: max_steps must be positive"
-        else
-            info = CM_SUCCESS
-            msg = "success"
-        end if
+        call check_interval(t0, tf, y0, opt, info, msg, allow_inf=allow_inf)
         if (info /= CM_SUCCESS) return
+        call tolerances(self, opt, n, info, msg)
+        if (info /= CM_SUCCESS) return
+        self%eps = max(minval(self%rtol), minval(self%atol))
+        self%order = taylor_order(self%eps)
+        self%decay = exp(-2.0_dp - 0.7_dp/real(self%order - 1, dp))
+        call self%setup_base(METHOD_TAYLOR, t0, tf, y0, self%order, FORM_POWER)
+        self%nblock = n
+        if (self%kind == 1) self%nblock = nint((sqrt(4.0_dp*n + 1.0_dp) - 1.0_dp)/2.0_dp)
+        if (self%kind == 1 .and. self%nblock*(self%nblock + 1) /= n) then
+            info = CM_BAD_INPUT
+            msg = "bad input: the variational system's state must have n + n**2 components"
+            return
+        end if
+        self%t_lo = 0.0_dp
+        self%hmax = min(abs(opt%max_step), abs(tf - t0))
+        if (.not. ieee_is_finite(self%hmax)) self%hmax = huge(1.0_dp)
+        self%first_step = opt%first_step
+        self%max_steps = opt%max_steps
+        self%nsteps = 0
+        self%err = 0.0_dp
+        self%nw = 0
+        if (allocated(self%jet)) deallocate (self%jet)
+        if (allocated(self%jold)) deallocate (self%jold)
+        if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+        allocate (self%dy(n), self%ynew(n), self%e(n))
+    end subroutine taylor_init
+
+    !> Per-component tolerances (non-negative; rtol at least the unit round-off).
+    subroutine tolerances(self, opt, n, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        type(ode_options), intent(in) :: opt
+        integer, intent(in) :: n
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        if (allocated(self%rtol)) deallocate (self%rtol, self%atol)
         allocate (self%rtol(n), self%atol(n))
+        info = CM_BAD_INPUT
         if (allocated(opt%rtol_vec)) then
             if (size(opt%rtol_vec) /= n) then
-                info = CM_BAD_INPUT
                 msg = "bad input: rtol must be a scalar or have the size of y0"
                 return
             end if
@@ -136,7 +139,6 @@ contains
         end if
         if (allocated(opt%atol_vec)) then
             if (size(opt%atol_vec) /= n) then
-                info = CM_BAD_INPUT
                 msg = "bad input: atol must be a scalar or have the size of y0"
                 return
             end if
@@ -145,49 +147,42 @@ contains
             self%atol = opt%atol
         end if
         if (.not. (all(self%rtol >= 0.0_dp) .and. all(self%atol >= 0.0_dp))) then
-            info = CM_BAD_INPUT
             msg = "bad input: rtol and atol must be non-negative"
             return
         end if
-        ! Taylor's method reaches round-off: rtol may go down to the unit round-off
         self%rtol = max(self%rtol, epsilon(1.0_dp))
-        rmin = minval(self%rtol)
-        amin = minval(self%atol)
-        self%eps = max(rmin, amin)
-        self%order = taylor_order(self%eps)
-        self%kind = k
-        self%n = n
-        self%nblock = n
-        if (k == 1) self%nblock = nint((sqrt(4.0_dp*n + 1.0_dp) - 1.0_dp)/2.0_dp)
-        self%nw = sys%taylor_size(k)
-        self%nf = self%order
-        self%t = t0
-        self%t_old = t0
-        self%tf = tf
-        self%posneg = sign(1.0_dp, tf - t0)
-        self%hmax = min(abs(opt%max_step), abs(tf - t0))
-        if (.not. ieee_is_finite(self%hmax)) self%hmax = huge(1.0_dp)
-        self%first_step = opt%first_step
-        self%max_steps = opt%max_steps
-        allocate (self%y(n), self%y_old(n), self%dy(n), self%fc(n, 0:self%order))
-        allocate (self%jet(0:self%order, self%nw), self%jold(0:self%order, self%nw))
-        self%y = y0
-        self%y_old = y0
-        self%jet = 0.0_dp
-        self%jold = 0.0_dp
-        self%fc = 0.0_dp
-    end subroutine taylor_init
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine tolerances
 
-    !> The expansion at the initial point and the first step.
+    !> The expansion at the initial point and the first step. A system without Taylor
+    !! coefficients is CM_BAD_INPUT with a message saying so.
     subroutine taylor_start(self, sys, info, msg)
-        type(taylor_stepper), intent(inout) :: self
+        class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         info = CM_SUCCESS
         msg = "success"
+        self%nw = sys%taylor_size(self%kind)
+        if (self%nw < self%n) then
+            info = CM_BAD_INPUT
+            if (self%kind == 1) then
+                msg = "bad input: the system has no Taylor coefficients of its variational "// &
+                      "system (method TAYLOR)"
+            else
+                msg = "bad input: the system has no Taylor coefficients (method TAYLOR "// &
+                      "needs a system from conmech.symbolic with a smooth right-hand "// &
+                      "side, or a type that overrides taylor_size and taylor_jet)"
+            end if
+            return
+        end if
+        if (allocated(self%jet)) deallocate (self%jet, self%jold)
+        allocate (self%jet(0:self%order, self%nw), self%jold(0:self%order, self%nw))
+        self%jet = 0.0_dp
+        self%jold = 0.0_dp
         call expand(self, sys, self%jet, self%t, self%y)
-        if (.not. all(ieee_is_finite(self%jet(1, 1:self%n)))) then
+        if (.not. self%f_finite()) then
             info = CM_NONFINITE
             msg = "the right-hand side is not finite at the initial point"
             return
@@ -197,10 +192,10 @@ contains
     end subroutine taylor_start
 
     subroutine expand(self, sys, w, t, y)
-        type(taylor_stepper), intent(inout) :: self
+        class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
-        real(dp), intent(inout) :: w(0:, :)
-        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(inout) :: w(0:self%order, self%nw)
+        real(dp), intent(in) :: t, y(self%n)
         w(0, 1:self%n) = y
         call sys%taylor_jet(self%kind, t, self%order, self%nw, w)
         self%st%nfev = self%st%nfev + 1
@@ -209,7 +204,7 @@ contains
     !> The tolerance scale E_i = max(atol_i, rtol_i ||y||_inf) (per block: state, Phi):
     !! Jorba and Zou's absolute control for small states, relative for large ones.
     pure subroutine scales(self, y, e)
-        type(taylor_stepper), intent(in) :: self
+        class(taylor_stepper), intent(in) :: self
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: e(:)
         real(dp) :: y1, y2
@@ -224,36 +219,34 @@ contains
         e = max(e, tiny(1.0_dp))
     end subroutine scales
 
-    !> Jorba and Zou's step from the current expansion (unsigned, at most hmax).
+    !> Jorba and Zou's step from the current expansion (signed, at most hmax).
     subroutine propose(self)
-        type(taylor_stepper), intent(inout) :: self
-        real(dp) :: e(self%n), s1, s2, rho
+        class(taylor_stepper), intent(inout) :: self
+        real(dp) :: s1, s2, rho
         integer :: p, i
         p = self%order
-        call scales(self, self%y, e)
+        call scales(self, self%y, self%e)
         s1 = 0.0_dp
         s2 = 0.0_dp
         do i = 1, self%n
-            s1 = max(s1, abs(self%jet(p - 1, i))/e(i))
-            s2 = max(s2, abs(self%jet(p, i))/e(i))
+            s1 = max(s1, abs(self%jet(p - 1, i))/self%e(i))
+            s2 = max(s2, abs(self%jet(p, i))/self%e(i))
         end do
-        s1 = s1*self%eps
-        s2 = s2*self%eps
         rho = huge(1.0_dp)
-        if (s1 > 0.0_dp) rho = s1**(-1.0_dp/real(p - 1, dp))
-        if (s2 > 0.0_dp) rho = min(rho, s2**(-1.0_dp/real(p, dp)))
-        if (rho < huge(1.0_dp)) rho = rho*exp(-2.0_dp - 0.7_dp/real(p - 1, dp))
+        if (s1 > 0.0_dp) rho = exp(-log(s1*self%eps)/real(p - 1, dp))
+        if (s2 > 0.0_dp) rho = min(rho, exp(-log(s2*self%eps)/real(p, dp)))
+        if (rho < huge(1.0_dp)) rho = rho*self%decay
         self%h = min(rho, self%hmax)*self%posneg
     end subroutine propose
 
     !> One accepted step towards `target` (landing on it if the step would pass it).
     subroutine taylor_step(self, sys, target, info, msg)
-        type(taylor_stepper), intent(inout) :: self
+        class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: target
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        real(dp) :: h, ynew(self%n), e(self%n), err, d
+        real(dp) :: h, err, d, c
         integer :: i, k, p
         character(len=32) :: buf
         real(dp), allocatable :: tmp(:, :)
@@ -261,9 +254,8 @@ contains
         msg = "success"
         p = self%order
         h = self%h
-        self%hit = .false.
         self%last = .false.
-        call scales(self, self%y, e)
+        c = 16.0_dp*epsilon(1.0_dp)
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
@@ -271,7 +263,7 @@ contains
                 msg = "more than max_steps steps, at t ="//trim(buf)
                 return
             end if
-            if (0.1_dp*abs(h) <= abs(self%t)*epsilon(1.0_dp) .or. h == 0.0_dp) then
+            if (.not. (0.1_dp*abs(h) > abs(self%t)*epsilon(1.0_dp))) then
                 info = CM_STEP_TOO_SMALL
                 write (buf, '(es14.6)') self%t
                 msg = "step size too small at t ="//trim(buf)
@@ -285,22 +277,22 @@ contains
             self%nsteps = self%nsteps + 1
             ! y(t + h) and the polynomial's derivative there (Horner)
             do i = 1, self%n
-                ynew(i) = self%jet(p, i)
+                self%ynew(i) = self%jet(p, i)
                 self%dy(i) = real(p, dp)*self%jet(p, i)
                 do k = p - 1, 1, -1
-                    ynew(i) = self%jet(k, i) + h*ynew(i)
+                    self%ynew(i) = self%jet(k, i) + h*self%ynew(i)
                     self%dy(i) = real(k, dp)*self%jet(k, i) + h*self%dy(i)
                 end do
-                ynew(i) = self%jet(0, i) + h*ynew(i)
+                self%ynew(i) = self%jet(0, i) + h*self%ynew(i)
             end do
-            call expand(self, sys, self%jold, self%t + h, ynew)
+            call expand(self, sys, self%jold, self%t + h, self%ynew)
             ! safety check: h (P'(h) - f(t + h, P(h))) ~ (p + 1) x local error
             err = 0.0_dp
             do i = 1, self%n
                 d = abs(h*(self%dy(i) - self%jold(1, i)))
-                err = max(err, d/(real(p + 1, dp)*(e(i) + 16.0_dp*epsilon(1.0_dp)* &
-                                                   (abs(ynew(i)) + abs(h*self%dy(i))))))
+                err = max(err, d/(self%e(i) + c*(abs(self%ynew(i)) + abs(h*self%dy(i)))))
             end do
+            err = err/real(p + 1, dp)
             if (err <= CHECK_MAX) exit
             ! rejected (or not finite): a shorter step from the same expansion
             self%st%nreject = self%st%nreject + 1
@@ -324,7 +316,7 @@ contains
         else
             call add_time(self%t, self%t_lo, h)
         end if
-        self%y = ynew
+        self%y = self%ynew
         self%h_done = h
         self%dense_ready = .false.
         self%last = self%hit .and. target == self%tf
@@ -362,10 +354,12 @@ contains
     end subroutine taylor_dense
 
     !> The last step's Taylor polynomial at tt (in [t_old, t]).
-    subroutine taylor_eval(self, tt, yout)
+    subroutine taylor_eval(self, tt, yout, info, msg)
         class(taylor_stepper), intent(inout) :: self
         real(dp), intent(in) :: tt
         real(dp), intent(out) :: yout(:)
+        integer, intent(out), optional :: info
+        character(len=:), allocatable, intent(inout), optional :: msg
         real(dp) :: s
         integer :: i, k
         s = tt - self%t_old
@@ -375,7 +369,18 @@ contains
                 yout(i) = self%jold(k, i) + s*yout(i)
             end do
         end do
+        if (present(info)) info = CM_SUCCESS
     end subroutine taylor_eval
+
+    !> The same at x = (s - t_old)/h_done in [0, 1].
+    subroutine taylor_eval_unit(self, x, yout, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: x
+        real(dp), intent(out) :: yout(:)
+        integer, intent(out), optional :: info
+        character(len=:), allocatable, intent(inout), optional :: msg
+        call taylor_eval(self, self%t_old + x*self%h_done, yout, info, msg)
+    end subroutine taylor_eval_unit
 
     !> After a hook changed y: the expansion at the new point (and a new step).
     subroutine taylor_refresh(self, sys)
@@ -383,15 +388,58 @@ contains
         class(ode_system), intent(in) :: sys
         call expand(self, sys, self%jet, self%t, self%y)
         call propose(self)
+        self%f_stale = .false.
     end subroutine taylor_refresh
 
     logical function taylor_f_finite(self)
         class(taylor_stepper), intent(in) :: self
-        taylor_f_finite = all(ieee_is_finite(self%jet(1, 1:self%n)))
+        taylor_f_finite = .false.
+        if (allocated(self%jet)) taylor_f_finite = all(ieee_is_finite(self%jet(1, 1:self%n)))
     end function taylor_f_finite
 
+    !> The whole state, for step-by-step use (the state parts of both expansions; the
+    !! operations' columns are scratch, recomputed by the next expansion).
+    subroutine taylor_transfer(self, p)
+        class(taylor_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        real(dp), allocatable :: a(:, :), b(:, :)
+        call self%transfer_base(p)
+        call p%item(self%kind)
+        call p%item(self%nblock)
+        call p%item(self%order)
+        call p%item(self%nw)
+        call p%item(self%t_lo)
+        call p%item(self%hmax)
+        call p%item(self%first_step)
+        call p%item(self%eps)
+        call p%item(self%decay)
+        call p%item(self%err)
+        call p%item(self%nsteps)
+        call p%item(self%max_steps)
+        call p%column(self%rtol)
+        call p%column(self%atol)
+        if (.not. p%reading()) then
+            a = transpose(self%jet(:, 1:self%n))
+            b = transpose(self%jold(:, 1:self%n))
+        end if
+        call p%columns(a, 0, self%order)
+        call p%columns(b, 0, self%order)
+        if (p%reading()) then
+            if (allocated(self%jet)) deallocate (self%jet, self%jold)
+            allocate (self%jet(0:self%order, max(self%nw, self%n)), &
+                      self%jold(0:self%order, max(self%nw, self%n)))
+            self%jet = 0.0_dp
+            self%jold = 0.0_dp
+            if (allocated(a)) self%jet(:, 1:self%n) = transpose(a)
+            if (allocated(b)) self%jold(:, 1:self%n) = transpose(b)
+            if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+            allocate (self%dy(self%n), self%ynew(self%n), self%e(self%n))
+        end if
+    end subroutine taylor_transfer
+
     !> Advance y from t0 to t1 in place by Taylor's method (kind 0: the system, kind 1: its
-    !! variational system), storing nothing: the lean path for shooting and ensembles.
+    !! variational system, y = [y; Phi]), storing nothing: the lean path for shooting and
+    !! ensembles.
     subroutine taylor_propagate(sys, t0, t1, y, opt, info, stats, msg, kind)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
@@ -404,15 +452,16 @@ contains
         type(taylor_stepper) :: stp
         character(len=32) :: buf
         stats = ode_stats()
-        call taylor_init(stp, sys, t0, t1, y, opt, info, msg, kind)
+        if (present(kind)) stp%kind = kind
+        call stp%init(t0, t1, y, opt, info, msg)
         if (info /= CM_SUCCESS .or. t1 == t0) return
-        call taylor_start(stp, sys, info, msg)
+        call stp%start(sys, info, msg)
         if (info /= CM_SUCCESS) then
             stats = stp%st
             return
         end if
         do
-            call taylor_step(stp, sys, t1, info, msg)
+            call stp%step(sys, t1, info, msg)
             if (info /= CM_SUCCESS) exit
             if (.not. stp%f_finite()) then
                 info = CM_NONFINITE

@@ -211,7 +211,7 @@ def _system(model):
                   name="symbolic")
     if d.kind == "ode":
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
-                                   **common)
+                                   taylor=compiled.library_taylor(model.lib), **common)
     if d.kind == "generalized":
         return compiled.generalized_system(d.n, a["mass"], a["forces"],
                                            forces_jac=a.get("forces_jac"),

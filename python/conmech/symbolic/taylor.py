@@ -408,8 +408,13 @@ class _Printer:
         self.pr = cls(names, kind_suffix="_" + kind)
         self.const_names = {s: f"tc{k + 1}" for k, (s, _) in enumerate(dec.consts)}
         self.pr.names.update(self.const_names)
+        self.scalars = None      # written-out code: the coefficients as scalars s<c>_<k>
 
     def w(self, k, c):
+        if self.scalars is not None and isinstance(k, int):
+            name = f"s{c}_{k}"
+            self.scalars.add(name)
+            return name
         return f"w(:, {k}, {c})" if self.batch else f"w({k}, {c})"
 
     def num(self, x):
@@ -461,135 +466,156 @@ def _wrap(line, ind):
     return w(line, ind)
 
 
-def _body(pp, order_name="order", given=False):
-    """Declarations and statements computing the coefficients (see the module docstring).
-    given: the state columns are inputs of orders 0..order, the operations are computed up
-    to `order` (events along a given polynomial); else the ODE recursion."""
-    d = pp.d
-    K = pp.kind
-    ind = "        "
-    decl, s0, hist, cur = [], [], [], []
-    accs, invs = [], []
-    one = pp.real(1)
+class _Recipe:
+    """The statements of one decomposition, independent of how the orders are run: the
+    order-0 statements, the history terms (accumulator, left column, right column: the
+    term w(j, left) w(k - j, right), j = 1 .. k - 1) and the current-order statements
+    (functions of E: the order index k, its real fk and reciprocal rk as Fortran text)."""
 
-    def W(k, c):
-        return pp.w(k, c)
+    def __init__(self, pp, given=False, order_name="order"):
+        self.pp = pp
+        d = pp.d
+        K = pp.kind
+        W = pp.w
+        one = pp.real(1)
+        self.consts = [(pp.const_names[s], pp.pr._print(e)) for s, e in d.consts]
+        s0, hist, cur, accs, invs = [], [], [], [], []
 
-    def JW(k, c):
-        return pp.w(k, d.jcol[c])
+        def JC(c):
+            return d.jcol[c]
 
-    def jset(c, where, k="k"):
-        """Append jw(k, c) = k w(k, c) (the j-weighted copy) after c's coefficient."""
-        if c in d.jcol:
-            where.append(f"{JW(k, c)} = {'fk' if k == 'k' else pp.real(k)}*{W(k, c)}")
-    # constants
-    cl = []
-    for s, e in d.consts:
-        cl += _wrap(f"{pp.const_names[s]} = {pp.pr._print(e)}", ind)
-    if d.t_col is not None:
-        c = d.t_col
-        s0.append(f"{W(0, c)} = t")
-        s0.append(f"if ({order_name} >= 1) {W(1, c)} = {one}")
-        s0.append(f"if ({order_name} >= 2) {W(f'2:{order_name}', c)} = 0.0_{K}")
-    for op in d.ops:
-        if op.kind == "time":
-            continue
-        o = op.out[0]
-        a = op.args[0] if op.args else None
-        kind = op.kind
-        if kind == "lin":
-            lin = op.data["lin"]
-            s0.append(f"{W(0, o)} = {pp.lin_at(lin, 0, True)}")
-            cur.append(f"{W('k', o)} = {pp.lin_at(lin, 'k', False)}")
-            jset(o, cur)
-            continue
-        h = f"h{len(accs) + 1}"
-        if kind == "mul":
-            b = op.args[1]
-            s0.append(f"{W(0, o)} = {W(0, a)}*{W(0, b)}")
+        def jset(c):
+            if c in d.jcol:
+                cur.append(lambda E, c=c: f"{W(E['k'], JC(c))} = {E['fk']}*{W(E['k'], c)}")
+        if d.t_col is not None and isinstance(order_name, int):     # written out
+            c = d.t_col
+            s0.append(f"{W(0, c)} = t")
+            for cc in [c] + ([JC(c)] if c in d.jcol else []):
+                s0 += [f"{W(k, cc)} = {one if k == 1 else '0.0_' + K}"
+                       for k in range(1, order_name + 1)]
+        elif d.t_col is not None:
+            c = d.t_col
+            s0.append(f"{W(0, c)} = t")
+            s0.append(f"if ({order_name} >= 1) {W(1, c)} = {one}")
+            s0.append(f"if ({order_name} >= 2) {W(f'2:{order_name}', c)} = 0.0_{K}")
+            if c in d.jcol:
+                s0.append(f"if ({order_name} >= 1) {W(1, JC(c))} = {one}")
+                s0.append(f"if ({order_name} >= 2) {W(f'2:{order_name}', JC(c))} = 0.0_{K}")
+
+        def acc():
+            h = f"h{len(accs) + 1}"
             accs.append(h)
-            hist.append(f"{h} = {h} + {W('j', a)}*{W('k - j', b)}")
-            cur.append(f"{W('k', o)} = {h} + {W(0, a)}*{W('k', b)} + {W('k', a)}*{W(0, b)}")
-        elif kind == "sq":
-            s0.append(f"{W(0, o)} = {W(0, a)}**2")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {W('j', a)}*{W('k - j', a)}")
-            cur.append(f"{W('k', o)} = {h} + {pp.real(2)}*{W(0, a)}*{W('k', a)}")
-        elif kind in ("div", "recip"):
-            b = op.args[1] if kind == "div" else op.args[0]
-            iv = f"iv{len(invs) + 1}"
-            invs.append(iv)
-            s0.append(f"{iv} = {one}/{W(0, b)}")
-            num0 = W(0, a) if kind == "div" else pp.num(op.data["c"])
-            s0.append(f"{W(0, o)} = {num0}*{iv}")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {W('j', b)}*{W('k - j', o)}")
-            numk = f"{W('k', a)} - " if kind == "div" else "-"
-            cur.append(f"{W('k', o)} = ({numk}{h} - {W('k', b)}*{W(0, o)})*{iv}")
-        elif kind == "sqrt":
-            iv = f"iv{len(invs) + 1}"
-            invs.append(iv)
-            s0.append(f"{W(0, o)} = sqrt({W(0, a)})")
-            s0.append(f"{iv} = {pp.real(0.5)}/{W(0, o)}")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {W('j', o)}*{W('k - j', o)}")
-            cur.append(f"{W('k', o)} = ({W('k', a)} - {h})*{iv}")
-        elif kind == "pow":
-            r = op.data["r"]
-            iv = f"iv{len(invs) + 1}"
-            invs.append(iv)
-            s0.append(f"{W(0, o)} = {pp.pow_order0(W(0, a), r)}")
-            s0.append(f"{iv} = {one}/{W(0, a)}")
-            rs = pp.num(r)
-            rp1 = pp.num(sp.sympify(r) + 1) if sp.sympify(r).is_Number else f"({rs} + {one})"
-            h2 = f"h{len(accs) + 2}"
-            accs += [h, h2]
-            hist.append(f"{h} = {h} + {W('j', a)}*{W('k - j', o)}")
-            hist.append(f"{h2} = {h2} + {JW('j', a)}*{W('k - j', o)}")
-            cur.append(f"{W('k', o)} = (({rp1}*{h2} - fk*{h})*rk + "
-                       f"{rs}*{W('k', a)}*{W(0, o)})*{iv}")
-        elif kind == "exp":
-            s0.append(f"{W(0, o)} = exp({W(0, a)})")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {JW('j', a)}*{W('k - j', o)}")
-            cur.append(f"{W('k', o)} = {h}*rk + {W('k', a)}*{W(0, o)}")
-        elif kind in ("sincos", "sinhcosh"):
-            s, c = op.out
-            hy = kind == "sinhcosh"
-            h2 = f"h{len(accs) + 2}"
-            s0.append(f"{W(0, s)} = {'sinh' if hy else 'sin'}({W(0, a)})")
-            s0.append(f"{W(0, c)} = {'cosh' if hy else 'cos'}({W(0, a)})")
-            accs += [h, h2]
-            hist.append(f"{h} = {h} + {JW('j', a)}*{W('k - j', c)}")
-            hist.append(f"{h2} = {h2} + {JW('j', a)}*{W('k - j', s)}")
-            cur.append(f"{W('k', s)} = {h}*rk + {W('k', a)}*{W(0, c)}")
-            sg = "" if hy else "-"
-            cur.append(f"{W('k', c)} = {sg}({h2}*rk + {W('k', a)}*{W(0, s)})")
-        elif kind in ("tan", "tanh"):
-            g = op.args[1]
-            s0.append(f"{W(0, o)} = {kind}({W(0, a)})")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {JW('j', a)}*{W('k - j', g)}")
-            cur.append(f"{W('k', o)} = {h}*rk + {W('k', a)}*{W(0, g)}")
-        elif kind.startswith("inv_"):
-            u = op.args[1]
-            fn = kind[4:]
-            iv = f"iv{len(invs) + 1}"
-            invs.append(iv)
-            s0.append(f"{W(0, o)} = {fn}({W(0, a)})")
-            s0.append(f"{iv} = {one}/{W(0, u)}")
-            accs.append(h)
-            hist.append(f"{h} = {h} + {JW('j', o)}*{W('k - j', u)}")
-            cur.append(f"{W('k', o)} = ({W('k', a)} - {h}*rk)*{iv}")
-        else:
-            raise TaylorUnsupported(f"unknown operation {kind}")
-        for c in op.out:
-            jset(c, cur)
-    if d.t_col is not None and d.t_col in d.jcol:
-        c = d.t_col
-        s0.append(f"if ({order_name} >= 1) {JW(1, c)} = {one}")
-        s0.append(f"if ({order_name} >= 2) {JW(f'2:{order_name}', c)} = 0.0_{K}")
-    return cl, s0, accs, invs, hist, cur
+            return h
+
+        def inv():
+            v = f"iv{len(invs) + 1}"
+            invs.append(v)
+            return v
+        for op in d.ops:
+            kind = op.kind
+            if kind == "time":
+                continue
+            o = op.out[0]
+            a = op.args[0] if op.args else None
+            if kind == "lin":
+                lin = op.data["lin"]
+                s0.append(f"{W(0, o)} = {pp.lin_at(lin, 0, True)}")
+                cur.append(lambda E, o=o, lin=lin: f"{W(E['k'], o)} = "
+                           f"{pp.lin_at(lin, E['k'], False)}")
+            elif kind == "mul":
+                b = op.args[1]
+                h = acc()
+                s0.append(f"{W(0, o)} = {W(0, a)}*{W(0, b)}")
+                hist.append((h, a, b))
+                cur.append(lambda E, o=o, a=a, b=b, h=h: f"{W(E['k'], o)} = {h} + "
+                           f"{W(0, a)}*{W(E['k'], b)} + {W(E['k'], a)}*{W(0, b)}")
+            elif kind == "sq":
+                h = acc()
+                s0.append(f"{W(0, o)} = {W(0, a)}**2")
+                hist.append((h, a, a))
+                two = pp.real(2)
+                cur.append(lambda E, o=o, a=a, h=h, two=two: f"{W(E['k'], o)} = {h} + "
+                           f"{two}*{W(0, a)}*{W(E['k'], a)}")
+            elif kind in ("div", "recip"):
+                b = op.args[1] if kind == "div" else op.args[0]
+                h, iv = acc(), inv()
+                s0.append(f"{iv} = {one}/{W(0, b)}")
+                num0 = W(0, a) if kind == "div" else pp.num(op.data["c"])
+                s0.append(f"{W(0, o)} = {num0}*{iv}")
+                hist.append((h, b, o))
+                cur.append(lambda E, o=o, a=a, b=b, h=h, iv=iv, dv=kind == "div":
+                           f"{W(E['k'], o)} = ({W(E['k'], a) + ' - ' if dv else '-'}{h} - "
+                           f"{W(E['k'], b)}*{W(0, o)})*{iv}")
+            elif kind == "sqrt":
+                h, iv = acc(), inv()
+                s0.append(f"{W(0, o)} = sqrt({W(0, a)})")
+                s0.append(f"{iv} = {pp.real(0.5)}/{W(0, o)}")
+                hist.append((h, o, o))
+                cur.append(lambda E, o=o, a=a, h=h, iv=iv:
+                           f"{W(E['k'], o)} = ({W(E['k'], a)} - {h})*{iv}")
+            elif kind == "pow":
+                r = op.data["r"]
+                h, h2, iv = acc(), acc(), inv()
+                s0.append(f"{W(0, o)} = {pp.pow_order0(W(0, a), r)}")
+                s0.append(f"{iv} = {one}/{W(0, a)}")
+                rs = pp.num(r)
+                rp1 = pp.num(sp.sympify(r) + 1) if sp.sympify(r).is_Number else \
+                    f"({rs} + {one})"
+                hist += [(h, a, o), (h2, JC(a), o)]
+                cur.append(lambda E, o=o, a=a, h=h, h2=h2, iv=iv, rs=rs, rp1=rp1:
+                           f"{W(E['k'], o)} = (({rp1}*{h2} - {E['fk']}*{h})*{E['rk']} + "
+                           f"{rs}*{W(E['k'], a)}*{W(0, o)})*{iv}")
+            elif kind == "exp":
+                h = acc()
+                s0.append(f"{W(0, o)} = exp({W(0, a)})")
+                hist.append((h, JC(a), o))
+                cur.append(lambda E, o=o, a=a, h=h: f"{W(E['k'], o)} = {h}*{E['rk']} + "
+                           f"{W(E['k'], a)}*{W(0, o)}")
+            elif kind in ("sincos", "sinhcosh"):
+                sn, cs = op.out
+                hy = kind == "sinhcosh"
+                h, h2 = acc(), acc()
+                s0.append(f"{W(0, sn)} = {'sinh' if hy else 'sin'}({W(0, a)})")
+                s0.append(f"{W(0, cs)} = {'cosh' if hy else 'cos'}({W(0, a)})")
+                hist += [(h, JC(a), cs), (h2, JC(a), sn)]
+                sg = "" if hy else "-"
+                cur.append(lambda E, sn=sn, cs=cs, a=a, h=h: f"{W(E['k'], sn)} = "
+                           f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, cs)}")
+                cur.append(lambda E, sn=sn, cs=cs, a=a, h2=h2, sg=sg: f"{W(E['k'], cs)} = "
+                           f"{sg}({h2}*{E['rk']} + {W(E['k'], a)}*{W(0, sn)})")
+            elif kind in ("tan", "tanh"):
+                g = op.args[1]
+                h = acc()
+                s0.append(f"{W(0, o)} = {kind}({W(0, a)})")
+                hist.append((h, JC(a), g))
+                cur.append(lambda E, o=o, a=a, g=g, h=h: f"{W(E['k'], o)} = "
+                           f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, g)}")
+            elif kind.startswith("inv_"):
+                u = op.args[1]
+                h, iv = acc(), inv()
+                s0.append(f"{W(0, o)} = {kind[4:]}({W(0, a)})")
+                s0.append(f"{iv} = {one}/{W(0, u)}")
+                hist.append((h, JC(o), u))
+                cur.append(lambda E, o=o, a=a, h=h, iv=iv: f"{W(E['k'], o)} = "
+                           f"({W(E['k'], a)} - {h}*{E['rk']})*{iv}")
+            else:
+                raise TaylorUnsupported(f"unknown operation {kind}")
+            for c in op.out:
+                jset(c)
+        self.s0, self.hist, self.cur, self.accs, self.invs = s0, hist, cur, accs, invs
+
+
+def _sum_tree(terms, zero):
+    """A balanced sum of the terms (shorter dependency chains than left to right)."""
+    if not terms:
+        return zero
+    while len(terms) > 1:
+        nxt = [f"({terms[i]} + {terms[i + 1]})" for i in range(0, len(terms) - 1, 2)]
+        if len(terms) % 2:
+            nxt.append(terms[-1])
+        terms = nxt
+    t = terms[0]
+    return t[1:-1] if t.startswith("(") and t.endswith(")") else t
 
 
 def _decls(names, typ, ind):
@@ -599,59 +625,93 @@ def _decls(names, typ, ind):
     return out
 
 
-def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        "):
+def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixed=None):
     """(declarations, statements) computing the coefficients in w (see the module
     docstring), for a procedure that declares t, order, w and the names the printer maps
     the parameters to. kind "dp" or "qp"; batch > 0: w(batch, 0:order, nw), t(batch);
     given: the state columns are inputs of orders 0..order and the operations are computed
-    up to `order` (the outputs as columns ``dec.out_cols``), else the ODE recursion."""
+    up to `order` (the outputs as columns ``dec.out_cols``), else the ODE recursion.
+    fixed: an order p to write out (no loops, literal indices and constants, the history
+    sums as balanced trees); the procedure must then be called with order = p."""
     pp = _Printer(dec, names, batch > 0, kind)
-    cl, s0, accs, invs, hist, cur = _body(pp, given=given)
+    if fixed is not None:
+        pp.scalars = set()
+    rc = _Recipe(pp, given, "order" if fixed is None else fixed)
     W = pp.w
     vec = f"({batch})" if batch else ""
     one = pp.real(1)
-    decl = _decls(list(pp.const_names.values()), f"real({kind})", ind)
-    decl += _decls([f"{x}{vec}" for x in accs + invs], f"real({kind})", ind)
-    decl += [f"{ind}real({kind}) :: fj, fk, rk, rk1", f"{ind}integer :: k, j"]
+    zero = f"0.0_{kind}"
+    decl = _decls([c for c, _ in rc.consts], f"real({kind})", ind)
+    decl += _decls([f"{x}{vec}" for x in rc.accs + rc.invs], f"real({kind})", ind)
     body = [f"{ind}if (order < {0 if given else 1}) return"]
-    body += cl
+    if fixed is not None:
+        body = [f"{ind}if (order /= {fixed}) return"]
+    for c, e in rc.consts:
+        body += _wrap(f"{c} = {e}", ind)
     jstate = [i + 1 for i in range(dec.n) if i + 1 in dec.jcol]
     if given and jstate:      # the given state's j-weighted coefficients, all orders
-        body.append(f"{ind}do k = 1, order")
-        body += [f"{ind}    {W('k', dec.jcol[c])} = real(k, {kind})*{W('k', c)}"
+        decl += [f"{ind}integer :: kk"]
+        body.append(f"{ind}do kk = 1, order")
+        body += [f"{ind}    {W('kk', dec.jcol[c])} = real(kk, {kind})*{W('kk', c)}"
                  for c in jstate]
         body.append(f"{ind}end do")
-    for x in s0:
+    for x in rc.s0:
         body += _wrap(x, ind)
     if not given:
         for i, o in enumerate(dec.outputs):
             body += _wrap(f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}", ind)
         body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
-    loop = [f"{ind}do k = 1, {'order' if given else 'order - 1'}",
-            f"{ind}    fk = real(k, {kind})",
-            f"{ind}    rk = {one}/fk",
-            f"{ind}    rk1 = {one}/(fk + {one})"]
-    loop += [f"{ind}    {h} = 0.0_{kind}" for h in accs]
-    if hist:
-        loop += [f"{ind}    do j = 1, k - 1", f"{ind}        fj = real(j, {kind})"]
-        for x in hist:
-            loop += _wrap(x, ind + "        ")
-        loop.append(f"{ind}    end do")
-    for x in cur:
-        loop += _wrap(x, ind + "    ")
-    if not given:
-        for i, o in enumerate(dec.outputs):
-            loop += _wrap(f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})",
-                          ind + "    ")
-        loop += [f"{ind}    {W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}"
-                 for c in jstate]
-    loop.append(f"{ind}end do")
-    return decl, body + loop
+    if fixed is None:
+        decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j"]
+        E = {"k": "k", "fk": "fk", "rk": "rk"}
+        loop = [f"{ind}do k = 1, {'order' if given else 'order - 1'}",
+                f"{ind}    fk = real(k, {kind})",
+                f"{ind}    rk = {one}/fk",
+                f"{ind}    rk1 = {one}/(fk + {one})"]
+        loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
+        if rc.hist:
+            loop.append(f"{ind}    do j = 1, k - 1")
+            for h, lft, rgt in rc.hist:
+                loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', rgt)}", ind + "        ")
+            loop.append(f"{ind}    end do")
+        for f in rc.cur:
+            loop += _wrap(f(E), ind + "    ")
+        if not given:
+            for i, o in enumerate(dec.outputs):
+                loop += _wrap(f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})",
+                              ind + "    ")
+            loop += [f"{ind}    {W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}"
+                     for c in jstate]
+        loop.append(f"{ind}end do")
+        return decl, body + loop
+    last = fixed if given else fixed - 1
+    state_in = [f"{ind}{W(k, c)} = w({k}, {c})" for c in range(1, dec.n + 1)
+                for k in (range(0, fixed + 1) if given else [0])]
+    body = body[:1] + state_in + body[1:]
+    for k in range(1, last + 1):
+        E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
+        for h, lft, rgt in rc.hist:
+            terms = [f"{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)]
+            body += _wrap(f"{h} = {_sum_tree(terms, zero)}", ind)
+        for f in rc.cur:
+            body += _wrap(f(E), ind)
+        if not given:
+            for i, o in enumerate(dec.outputs):
+                body += _wrap(f"{W(k + 1, i + 1)} = ({one}/{pp.real(k + 1)})*("
+                              f"{pp.lin_at(o, k, False)})", ind)
+            body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
+                     for c in jstate]
+    outs = dec.out_cols if given else range(1, dec.n + 1)
+    body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in outs
+             for k in range(0 if given else 1, fixed + 1)]
+    names_s = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
+    decl += _decls(names_s, f"real({kind})", ind)
+    return decl, body
 
 
-def c_routine(dec, names, cname, batch=0, given=False):
+def c_routine(dec, names, cname, batch=0, given=False, fixed=None):
     """The bind(C) routine ``cname(t, order, w, p)`` (double precision; batch > 0: t and w
-    with a leading member dimension)."""
+    with a leading member dimension; fixed: written out for that order only)."""
     ind = "        "
     nw = dec.ncol
     npar = max(len(dec.params), 1)
@@ -662,7 +722,7 @@ def c_routine(dec, names, cname, batch=0, given=False):
             f"{ind}real(dp), intent(inout) :: w({f'{batch}, ' if batch else ''}"
             f"0:order, {nw})",
             f"{ind}real(dp), intent(in) :: p({npar})"]
-    decl, body = body_lines(dec, names, "dp", batch, given, ind)
+    decl, body = body_lines(dec, names, "dp", batch, given, ind, fixed)
     return head + decl + body + [f"    end subroutine {cname}", ""]
 
 
@@ -785,3 +845,28 @@ def emitted_taylor(tname, d, names):
                   f"{ind}real(dp), intent(inout) :: w(0:order, {dd.ncol})"]
         procs += decl + body + [f"    end subroutine {tname}_taylor{k}", ""]
     return binds, procs, None
+
+
+def fixed_order_source(d, order, variational=True):
+    """Fortran source of a module with the Taylor routines of the ode record `d` written out
+    for one order (``conmech_taylor_fixed``, and ``conmech_taylor_var_fixed`` with
+    `variational`): no loops, so the compiler schedules every multiply-add of the expansion
+    at once. Same signature and work columns as ``conmech_taylor`` (called with order =
+    `order` only)."""
+    from .codegen import _names
+    dec, vdec, why = ode_decompositions(d, variational)
+    if dec is None:
+        raise TaylorUnsupported(why)
+    names = _names(d)
+    lines = c_routine(dec, names, "conmech_taylor_fixed", fixed=order)
+    if vdec is not None:
+        lines += c_routine(vdec, names, "conmech_taylor_var_fixed", fixed=order)
+    head = ["!> Generated by conmech.symbolic.taylor: Taylor coefficients written out for "
+            f"order {order}. Do not edit.",
+            "module conmech_symbolic_taylor_fixed",
+            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
+            "    implicit none",
+            "    integer, parameter :: dp = c_double",
+            "    public",
+            "contains", ""]
+    return "\n".join(head + lines + ["end module conmech_symbolic_taylor_fixed", ""])
