@@ -32,6 +32,7 @@ module conmech_taylor_stepper
     use conmech_ode_options, only: ode_options, ode_stats, METHOD_TAYLOR
     use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
     use conmech_state_packer, only: state_packer
+    use conmech_taylor_events, only: taylor_events, limit_step
     implicit none
     private
 
@@ -57,6 +58,8 @@ module conmech_taylor_stepper
         real(dp), allocatable :: rtol(:), atol(:), dy(:), ynew(:), e(:)
         real(dp), allocatable :: jet(:, :)    !! (0:p, nw) expansion at (t, y)
         real(dp), allocatable :: jold(:, :)   !! (0:p, nw) expansion at (t_old, y_old)
+        !> compiled events: steps are shortened so that none holds two roots of one event
+        class(taylor_events), pointer :: ev => null()
     contains
         procedure :: init => taylor_init
         procedure :: start => taylor_start
@@ -273,6 +276,11 @@ contains
             if ((self%t + h - target)*self%posneg >= 0.0_dp) then
                 h = (target - self%t) - self%t_lo
                 self%hit = .true.
+            end if
+            if (associated(self%ev)) then
+                d = h
+                call limit_step(self%ev, self%t, p, self%jet, h)
+                if (h /= d) self%hit = .false.
             end if
             self%nsteps = self%nsteps + 1
             ! y(t + h) and the polynomial's derivative there (Horner)

@@ -419,5 +419,10 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
+from .taylor_events import Event, event  # noqa: E402
+
+__all__ += ["Event", "event"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]
