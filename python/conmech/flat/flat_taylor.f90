@@ -72,3 +72,49 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
                           real(params(1:max(np, 1)), dp), ne, ev_dir, ev_term, ev_zero, store, &
                           counts, dense_form, info, message)
 end subroutine flat_solve_taylor
+
+!> State and STM by Taylor's method on the variational system's own recurrences (a
+!! compiled system whose spec has taylor_var); as flat_stm_builtin otherwise.
+subroutine flat_stm_taylor(name, np, params, nspec, spec, n, y0, t0, t1, rtol, atol, y1, phi, &
+                           nfev, naccept, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: METHOD_TAYLOR
+    use conmech_ode_solver, only: ode_options, ode_stats
+    use conmech_flat_spec, only: spec_system
+    use conmech_flat_ode_support, only: copy_message
+    use conmech_variational, only: integrate_stm
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), t0, t1, rtol, atol
+    real(c_double), intent(out) :: y1(n), phi(n, n)
+    integer(c_int), intent(out) :: nfev, naccept, info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    type(ode_options) :: opt
+    type(ode_stats) :: st
+    integer :: i
+    nfev = 0
+    naccept = 0
+    y1 = y0
+    phi = 0.0_c_double
+    do i = 1, n
+        phi(i, i) = 1.0_c_double
+    end do
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    if (info /= 0) then
+        call copy_message(msg, message)
+        return
+    end if
+    opt%method = METHOD_TAYLOR
+    opt%rtol = rtol
+    opt%atol = atol
+    call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
+    nfev = st%nfev
+    naccept = st%naccept
+    call copy_message(msg, message)
+end subroutine flat_stm_taylor
