@@ -33,12 +33,12 @@ module conmech_taylor_stepper
     use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_taylor_events, only: taylor_events, limit_step
+    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_rho, &
+        taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
     implicit none
     private
 
     public :: taylor_stepper, taylor_order, taylor_propagate
-
-    real(dp), parameter :: CHECK_MAX = 10.0_dp   !! rejected above 10 x the tolerance
 
     !> State of a Taylor integration beyond the contract's common state: the two
     !! expansions (at the current point, and at the start of the last step: its polynomial).
@@ -73,12 +73,6 @@ module conmech_taylor_stepper
     end type taylor_stepper
 
 contains
-
-    !> Jorba and Zou's order for the tolerance eps: ceil(-ln(eps)/2 + 1), at least 2.
-    pure integer function taylor_order(eps)
-        real(dp), intent(in) :: eps
-        taylor_order = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
-    end function taylor_order
 
     !> Check the options and set up at (t0, y0) on [t0, tf] (no evaluation: the system's
     !! Taylor code is looked up in `start`). rtol may go down to the unit round-off.
@@ -204,42 +198,13 @@ contains
         self%st%nfev = self%st%nfev + 1
     end subroutine expand
 
-    !> The tolerance scale E_i = max(atol_i, rtol_i ||y||_inf) (per block: state, Phi):
-    !! Jorba and Zou's absolute control for small states, relative for large ones.
-    pure subroutine scales(self, y, e)
-        class(taylor_stepper), intent(in) :: self
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: e(:)
-        real(dp) :: y1, y2
-        integer :: nb
-        nb = self%nblock
-        y1 = maxval(abs(y(1:nb)))
-        e(1:nb) = max(self%atol(1:nb), self%rtol(1:nb)*y1)
-        if (self%n > nb) then
-            y2 = maxval(abs(y(nb + 1:)))
-            e(nb + 1:) = max(self%atol(nb + 1:), self%rtol(nb + 1:)*y2)
-        end if
-        e = max(e, tiny(1.0_dp))
-    end subroutine scales
-
-    !> Jorba and Zou's step from the current expansion (signed, at most hmax).
+    !> Jorba and Zou's step from the current expansion (signed, at most hmax); the scales
+    !! E_i at the current point are kept for the step's safety check.
     subroutine propose(self)
         class(taylor_stepper), intent(inout) :: self
-        real(dp) :: s1, s2, rho
-        integer :: p, i
-        p = self%order
-        call scales(self, self%y, self%e)
-        s1 = 0.0_dp
-        s2 = 0.0_dp
-        do i = 1, self%n
-            s1 = max(s1, abs(self%jet(p - 1, i))/self%e(i))
-            s2 = max(s2, abs(self%jet(p, i))/self%e(i))
-        end do
-        rho = huge(1.0_dp)
-        if (s1 > 0.0_dp) rho = exp(-log(s1*self%eps)/real(p - 1, dp))
-        if (s2 > 0.0_dp) rho = min(rho, exp(-log(s2*self%eps)/real(p, dp)))
-        if (rho < huge(1.0_dp)) rho = rho*self%decay
-        self%h = min(rho, self%hmax)*self%posneg
+        call taylor_scales(self%n, self%nblock, self%y, self%rtol, self%atol, self%e)
+        self%h = min(taylor_rho(self%n, self%order, self%jet, self%e, self%eps, self%decay), &
+                     self%hmax)*self%posneg
     end subroutine propose
 
     !> One accepted step towards `target` (landing on it if the step would pass it).
@@ -249,8 +214,8 @@ contains
         real(dp), intent(in) :: target
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        real(dp) :: h, err, d, c
-        integer :: i, k, p
+        real(dp) :: h, err, d
+        integer :: p
         character(len=32) :: buf
         real(dp), allocatable :: tmp(:, :)
         info = CM_SUCCESS
@@ -258,7 +223,6 @@ contains
         p = self%order
         h = self%h
         self%last = .false.
-        c = 16.0_dp*epsilon(1.0_dp)
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
@@ -283,32 +247,14 @@ contains
                 if (h /= d) self%hit = .false.
             end if
             self%nsteps = self%nsteps + 1
-            ! y(t + h) and the polynomial's derivative there (Horner)
-            do i = 1, self%n
-                self%ynew(i) = self%jet(p, i)
-                self%dy(i) = real(p, dp)*self%jet(p, i)
-                do k = p - 1, 1, -1
-                    self%ynew(i) = self%jet(k, i) + h*self%ynew(i)
-                    self%dy(i) = real(k, dp)*self%jet(k, i) + h*self%dy(i)
-                end do
-                self%ynew(i) = self%jet(0, i) + h*self%ynew(i)
-            end do
+            call taylor_eval_step(self%n, p, self%jet, h, self%ynew, self%dy)
             call expand(self, sys, self%jold, self%t + h, self%ynew)
-            ! safety check: h (P'(h) - f(t + h, P(h))) ~ (p + 1) x local error
-            err = 0.0_dp
-            do i = 1, self%n
-                d = abs(h*(self%dy(i) - self%jold(1, i)))
-                err = max(err, d/(self%e(i) + c*(abs(self%ynew(i)) + abs(h*self%dy(i)))))
-            end do
-            err = err/real(p + 1, dp)
-            if (err <= CHECK_MAX) exit
+            err = taylor_check(self%n, p, h, self%ynew, self%dy, self%jold(1, 1:self%n), &
+                               self%e)
+            if (err <= TAYLOR_CHECK_MAX) exit
             ! rejected (or not finite): a shorter step from the same expansion
             self%st%nreject = self%st%nreject + 1
-            if (err == err .and. err <= huge(1.0_dp)) then
-                h = h*max(0.1_dp, min(0.5_dp, 0.8_dp*(CHECK_MAX/err)**(1.0_dp/real(p + 1, dp))))
-            else
-                h = 0.1_dp*h
-            end if
+            h = taylor_shrink(h, err, p)
         end do
         ! accept: the new expansion becomes the current one, the old the step's polynomial
         self%err = err
@@ -322,7 +268,7 @@ contains
             self%t = target
             self%t_lo = 0.0_dp
         else
-            call add_time(self%t, self%t_lo, h)
+            call taylor_add_time(self%t, self%t_lo, h)
         end if
         self%y = self%ynew
         self%h_done = h
@@ -331,20 +277,6 @@ contains
         call propose(self)
         self%st%h_next = self%h
     end subroutine taylor_step
-
-    !> (t, t_lo) += h in double length (Knuth's TwoSum): the time of a long run keeps its
-    !! last bits, so the state (propagated by the exact sum of the steps) and t agree.
-    pure subroutine add_time(t, t_lo, h)
-        real(dp), intent(inout) :: t, t_lo
-        real(dp), intent(in) :: h
-        real(dp) :: s, bb, lo
-        s = t + h
-        bb = s - t
-        lo = (t - (s - bb)) + (h - bb)
-        lo = lo + t_lo
-        t = s + lo
-        t_lo = lo - (t - s)
-    end subroutine add_time
 
     !> The continuous extension of the last step: fc(:, k) = y^[k] h^k (power form in
     !! x = (s - t_old)/h_done).

@@ -118,3 +118,70 @@ subroutine flat_stm_taylor(name, np, params, nspec, spec, n, y0, t0, t1, rtol, a
     naccept = st%naccept
     call copy_message(msg, message)
 end subroutine flat_stm_taylor
+
+!> Ensemble of m members of one compiled system by Taylor's method in batches: the batch
+!! routine at address fnaddr computes `width` members' coefficients at once (nw work
+!! columns, shared parameters params); batches run in OpenMP threads (threads = 0: the
+!! default number). Each member takes exactly the steps of its own integration. Outputs per
+!! member: y_final(:, j), t_final(j), status (conmech_status codes), naccept, nreject;
+!! nfev(j) counts the expansions of its batch.
+subroutine flat_taylor_ensemble(fnaddr, width, nw, np, params, n, m, y0, t_span, rtol, atol, &
+                                max_step, max_steps, threads, y_final, t_final, status, &
+                                nfev, naccept, nreject, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_intptr_t, &
+                                           c_funptr, c_null_funptr, c_f_procpointer
+    !$ use omp_lib, only: omp_get_max_threads
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_taylor_batch, only: taylor_batch_fn, taylor_batch_propagate
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    integer(8), intent(in) :: fnaddr
+    integer(c_int), intent(in) :: width, nw, np, n, m, max_steps, threads
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n, m), t_span(2), rtol(n), atol(n)
+    real(c_double), intent(in) :: max_step
+    real(c_double), intent(out) :: y_final(n, m), t_final(m)
+    integer(c_int), intent(out) :: status(m), nfev(m), naccept(m), nreject(m), info
+    character(len=256), intent(out) :: message
+    procedure(taylor_batch_fn), pointer :: fn
+    type(c_funptr) :: fp
+    integer :: b, nb, j0, nm, nthr, nfb
+    integer :: st(width), na(width), nr(width)
+    real(dp) :: te(width)
+    info = CM_BAD_INPUT
+    status = CM_BAD_INPUT
+    nfev = 0
+    naccept = 0
+    nreject = 0
+    y_final = y0
+    t_final = t_span(1)
+    if (fnaddr == 0 .or. width < 1 .or. nw < n .or. n < 1 .or. m < 1) then
+        call copy_message("bad input: invalid batch Taylor routine or sizes", message)
+        return
+    end if
+    fp = transfer(int(fnaddr, c_intptr_t), c_null_funptr)
+    call c_f_procpointer(fp, fn)
+    nb = (m + width - 1)/width
+    nthr = 1
+    !$ nthr = omp_get_max_threads()
+    if (threads > 0) nthr = threads
+    !$omp parallel do num_threads(nthr) schedule(dynamic, 1) default(shared) &
+    !$omp private(b, j0, nm, st, na, nr, te, nfb)
+    do b = 1, nb
+        j0 = (b - 1)*width + 1
+        nm = min(width, m - j0 + 1)
+        call taylor_batch_propagate(fn, width, nw, real(params(1:max(np, 1)), dp), n, nm, &
+                                    t_span(1), t_span(2), y_final(:, j0:j0 + nm - 1), rtol, &
+                                    atol, max_step, max_steps, st(1:nm), te(1:nm), nfb, &
+                                    na(1:nm), nr(1:nm))
+        status(j0:j0 + nm - 1) = st(1:nm)
+        t_final(j0:j0 + nm - 1) = te(1:nm)
+        naccept(j0:j0 + nm - 1) = na(1:nm)
+        nreject(j0:j0 + nm - 1) = nr(1:nm)
+        nfev(j0:j0 + nm - 1) = nfb
+    end do
+    !$omp end parallel do
+    info = CM_SUCCESS
+    if (any(status < 0)) info = minval(status)
+    call copy_message("success", message)
+end subroutine flat_taylor_ensemble
