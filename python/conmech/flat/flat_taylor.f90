@@ -185,3 +185,55 @@ subroutine flat_taylor_ensemble(fnaddr, width, nw, np, params, n, m, y0, t_span,
     if (any(status < 0)) info = minval(status)
     call copy_message("success", message)
 end subroutine flat_taylor_ensemble
+
+!> Taylor's method in quadruple precision for a reference solution: the generated
+!! real128 routine at fnaddr (nw work columns); y0, the parameters, t0, tf and tol as pairs
+!! of doubles (hi, lo: the value hi + lo), the final state y1 likewise; nsteps accepted
+!! steps at order `order`.
+subroutine flat_taylor_quad(fnaddr, nw, np, params, n, y0, t_span, tol, max_steps, y1, &
+                            nsteps, order, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_intptr_t, c_funptr, &
+                                           c_null_funptr, c_f_procpointer
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, status_message
+    use conmech_taylor_quad, only: qp, taylor_qp_fn, taylor_propagate_qp
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    integer(8), intent(in) :: fnaddr
+    integer(c_int), intent(in) :: nw, np, n, max_steps
+    real(c_double), intent(in) :: params(2, max(np, 1)), y0(2, n), t_span(2, 2), tol(2)
+    real(c_double), intent(out) :: y1(2, n)
+    integer(c_int), intent(out) :: nsteps, order, info
+    character(len=256), intent(out) :: message
+    procedure(taylor_qp_fn), pointer :: fn
+    type(c_funptr) :: fp
+    real(qp) :: y(n), p(max(np, 1)), yq
+    integer :: i, ns, ord, inf
+    y1 = y0
+    nsteps = 0
+    order = 0
+    if (fnaddr == 0 .or. nw < n .or. n < 1) then
+        info = CM_BAD_INPUT
+        call copy_message("bad input: invalid quadruple-precision Taylor routine", message)
+        return
+    end if
+    fp = transfer(int(fnaddr, c_intptr_t), c_null_funptr)
+    call c_f_procpointer(fp, fn)
+    do i = 1, n
+        y(i) = real(y0(1, i), qp) + real(y0(2, i), qp)
+    end do
+    do i = 1, max(np, 1)
+        p(i) = real(params(1, i), qp) + real(params(2, i), qp)
+    end do
+    call taylor_propagate_qp(fn, n, nw, p, real(t_span(1, 1), qp) + real(t_span(2, 1), qp), &
+                             real(t_span(1, 2), qp) + real(t_span(2, 2), qp), y, &
+                             real(tol(1), qp) + real(tol(2), qp), max_steps, inf, ns, ord)
+    do i = 1, n
+        yq = y(i)
+        y1(1, i) = real(yq, c_double)
+        y1(2, i) = real(yq - real(y1(1, i), qp), c_double)
+    end do
+    nsteps = ns
+    order = ord
+    info = inf
+    call copy_message(status_message(inf), message)
+end subroutine flat_taylor_quad
