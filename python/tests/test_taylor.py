@@ -255,3 +255,16 @@ def test_methods_without_taylor_code_are_refused():
         conmech.solve_ivp(conmech.systems.kepler(), (0, 1), [0.5, 0, 0, 1.7], method="TAYLOR")
     with pytest.raises(ValueError, match="TAYLOR"):
         stability.stm(f, (0, 1), [1.0, 0.0], method="TAYLOR")
+
+
+def test_emitted_kepler_module_is_regenerated_identically():
+    """test/taylor_kepler_model.f90 (used by the Fortran test test_taylor) is the emitted
+    module of example/models/kepler.py."""
+    from pathlib import Path
+    from conmech.symbolic.__main__ import emit_file
+    root = Path(__file__).resolve().parents[2]
+    out = root / "test" / "taylor_kepler_model.f90"
+    src, name, module = emit_file(root / "example" / "models" / "kepler.py", out)
+    assert (name, module) == ("kepler_sym", "taylor_kepler_model")
+    assert src == out.read_text()
+    assert "procedure :: taylor_jet => kepler_sym_taylor_jet" in src
