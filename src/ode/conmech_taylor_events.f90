@@ -154,11 +154,12 @@ contains
         q = a
         if (a(0) == 0.0_dp) q = [a(1:d), 0.0_dp]
         ! Bernstein coefficients on [0, 1]: b_i = sum_k C(i, k)/C(d, k) a_k
-        binom = 0.0_dp
-        do i = 0, d
+        binom = 0.0_dp            ! Pascal's triangle (binom(i - 1, i) = 0)
+        binom(0, 0) = 1.0_dp
+        do i = 1, d
             binom(i, 0) = 1.0_dp
             do k = 1, i
-                binom(i, k) = binom(i - 1, k - 1) + merge(binom(i - 1, k), 0.0_dp, k <= i - 1)
+                binom(i, k) = binom(i - 1, k - 1) + binom(i - 1, k)
             end do
         end do
         do i = 0, d
