@@ -16,7 +16,7 @@ module conmech
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_rattle
-    use conmech_rattle_dae
+    use conmech_rattle_stepper
     use conmech_radau
     use conmech_radau_stepper
     use conmech_gauss

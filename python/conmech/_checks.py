@@ -5,7 +5,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["real_scalar", "tolerance", "event_settings"]
+__all__ = ["real_scalar", "tolerance", "event_settings", "initial_state"]
 
 
 def real_scalar(value, name):
@@ -86,3 +86,26 @@ def event_settings(events):
             raise ValueError(f"events[{i}].direction must be a number")
         settings.append((e, count, int(np.sign(direction))))
     return settings
+
+
+def initial_state(y0, fun, builtin):
+    """y0 as a 1-dimensional float array, checked: real, not empty, finite, and of the
+    system's dimension when ``fun`` is a built-in system."""
+    y0_in = np.asarray(y0)
+    if y0_in.dtype.kind == "c":
+        raise TypeError("y0 must be real: complex states are not supported (split them "
+                        "into real and imaginary parts)")
+    try:
+        y = np.array(y0_in, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("y0 must be an array of real numbers") from None
+    if y.ndim != 1:
+        raise ValueError(f"y0 must be 1-dimensional, got shape {y.shape}")
+    if y.size == 0:
+        raise ValueError("y0 must not be empty")
+    if not np.isfinite(y).all():
+        raise ValueError("y0 contains NaN or Inf")
+    if builtin and y.size != fun.dimension:
+        raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
+                         f"'{fun.name}', got {y.shape}")
+    return y

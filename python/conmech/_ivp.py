@@ -14,8 +14,8 @@ import numpy as np
 
 from . import _conmech
 from ._callback import Guard, as_result, message_text
-from ._checks import event_settings as _event_settings, real_scalar as _real_scalar, \
-    tolerance as _tolerance
+from ._checks import event_settings as _event_settings, initial_state as _initial_state, \
+    real_scalar as _real_scalar, tolerance as _tolerance
 from ._dense import DenseOutput
 from ._implicit import jacobian_callback
 from ._methods import METHODS, RK45_SCIPY, method_info
@@ -253,24 +253,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
     tf = _real_scalar(t_span[1], "t_span[1]")
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
-    y0_in = np.asarray(y0)
-    if y0_in.dtype.kind == "c":
-        raise TypeError("y0 must be real: complex states are not supported (split them "
-                        "into real and imaginary parts)")
-    try:
-        y0 = np.array(y0_in, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError("y0 must be an array of real numbers") from None
-    if y0.ndim != 1:
-        raise ValueError(f"y0 must be 1-dimensional, got shape {y0.shape}")
+    y0 = _initial_state(y0, fun, builtin)
     n = y0.size
-    if n == 0:
-        raise ValueError("y0 must not be empty")
-    if not np.isfinite(y0).all():
-        raise ValueError("y0 contains NaN or Inf")
-    if builtin and n != fun.dimension:
-        raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
-                         f"'{fun.name}', got {y0.shape}")
 
     # ---------------------------------------------------------------- tolerances, steps
     rtol_v = _tolerance(rtol, "rtol", n)

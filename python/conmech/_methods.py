@@ -48,4 +48,4 @@ BY_NAME = {n.upper(): m for m in METHODS.values() for n in (m.name, *m.aliases)}
 
 def method_info(code):
     """The table entry of a method code (RK45_SCIPY: DOPRI5's entry); None if unknown."""
-    return METHODS.get(2 if code == RK45_SCIPY else code)
+    return BY_NAME["DOPRI5"] if code == RK45_SCIPY else METHODS.get(code)

@@ -25,7 +25,7 @@ import numpy as np
 from . import _conmech
 from ._callback import Guard, message_text
 from ._dense import DenseOutput
-from ._checks import real_scalar, tolerance
+from ._checks import initial_state, real_scalar, tolerance
 from ._implicit import jacobian_callback
 from ._methods import BY_NAME, RK45_SCIPY, method_info
 from .systems import BuiltinSystem
@@ -116,6 +116,10 @@ class Stepper:
             code = entry.code
         self._code = code
         info = method_info(code)
+        if info is None:
+            raise TypeError(f"{type(self).__name__} is a base class: use a method's class "
+                            "(conmech.DOP853, conmech.Gauss6, ...) or conmech.Stepper(..., "
+                            "method=NAME)")
         jac = None
         if info.uses_jacobian:
             jac = extraneous.pop("jac", None)
@@ -136,23 +140,8 @@ class Stepper:
             raise ValueError("t0 must be finite")
         if math.isnan(t_bound):
             raise ValueError("t_bound must not be NaN")
-        y0_in = np.asarray(y0)
-        if y0_in.dtype.kind == "c":
-            raise TypeError("y0 must be real: complex states are not supported")
-        try:
-            y = np.array(y0_in, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError("y0 must be an array of real numbers") from None
-        if y.ndim != 1:
-            raise ValueError(f"y0 must be 1-dimensional, got shape {y.shape}")
+        y = initial_state(y0, fun, self._builtin)
         n = y.size
-        if n == 0:
-            raise ValueError("y0 must not be empty")
-        if not np.isfinite(y).all():
-            raise ValueError("y0 contains NaN or Inf")
-        if self._builtin and n != fun.dimension:
-            raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
-                             f"'{fun.name}', got {y.shape}")
         self._rtol = tolerance(rtol, "rtol", n)
         self._atol = tolerance(atol, "atol", n)
         name = type(self).__name__ if type(self) is not Stepper else info.name
@@ -322,7 +311,7 @@ class RungeKutta(Stepper):
 
 class DOP853(RungeKutta):
     """Dormand-Prince 8(5,3) with dense output of order 7 (SciPy's OdeSolver interface)."""
-    _code = 3
+    _code = BY_NAME["DOP853"].code
     order = 8
     error_estimator_order = 7
     n_stages = 12
@@ -342,7 +331,7 @@ class RK45(RungeKutta):
 class DOPRI5(RungeKutta):
     """Dormand-Prince 5(4) as Hairer's DOPRI5 (Lund-stabilised step control, Hairer's
     initial step, dense output of order 4), SciPy's OdeSolver interface."""
-    _code = 2
+    _code = BY_NAME["DOPRI5"].code
     order = 5
     error_estimator_order = 4
     n_stages = 6
@@ -350,7 +339,7 @@ class DOPRI5(RungeKutta):
 
 class VERNER98(RungeKutta):
     """Verner's 9(8) pair with dense output of order 8 (SciPy's OdeSolver interface)."""
-    _code = 4
+    _code = BY_NAME["VERNER98"].code
     order = 9
     error_estimator_order = 8
     n_stages = 16
@@ -358,7 +347,7 @@ class VERNER98(RungeKutta):
 
 class RK4(RungeKutta):
     """Classical fixed-step RK4 (step ``first_step``), SciPy's OdeSolver interface."""
-    _code = 1
+    _code = BY_NAME["RK4"].code
     order = 4
     error_estimator_order = 0
     n_stages = 4
@@ -373,7 +362,7 @@ class Radau(Stepper):
     constant matrix, or None: forward differences counted in nfev; not with a built-in
     system, which has its own) and ``jac_sparsity`` (only None: dense Jacobians).
     """
-    _code = 5
+    _code = BY_NAME["RADAU5"].code
     order = 5
     error_estimator_order = 3
     n_stages = 3
@@ -389,19 +378,19 @@ class Gauss(Stepper):
 
 class Gauss4(Gauss):
     """Gauss-Legendre collocation with 2 stages (order 4, symplectic), fixed step."""
-    _code = 6
+    _code = BY_NAME["GAUSS4"].code
     order = 4
     n_stages = 2
 
 
 class Gauss6(Gauss):
     """Gauss-Legendre collocation with 3 stages (order 6, symplectic), fixed step."""
-    _code = 7
+    _code = BY_NAME["GAUSS6"].code
     order = 6
     n_stages = 3
 
 
-_SCIPY_COUNTERPARTS = {"RK45": RK45_SCIPY, "DOP853": 3, "Radau": 5}
+_SCIPY_COUNTERPARTS = {"RK45": RK45_SCIPY, "DOP853": DOP853._code, "Radau": Radau._code}
 
 
 def method_code(method):

@@ -26,6 +26,7 @@ import numpy as np
 from . import _conmech
 from ._callback import Guard, as_result, message_text
 from ._checks import event_settings
+from ._methods import BY_NAME
 from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
@@ -37,8 +38,9 @@ BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_
                  "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "rolling_ball")
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
-_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
-            "RATTLE": 8, "Radau": 5, "RADAU5": 5}
+# the methods of the Fortran table that constrained_solve runs (codes from the table)
+_METHODS = {name: BY_NAME[name.upper()].code for name in (
+    "RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "RATTLE", "Radau", "RADAU5")}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False

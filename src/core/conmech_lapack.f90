@@ -23,6 +23,8 @@ module conmech_lapack
     end interface la_finite
     public :: dpotf2, dpstf2   ! unblocked forms: no ilaenv call, fast for tiny matrices
     public :: dtrsv   ! BLAS triangular solve, one right-hand side
+    public :: zgetrf, zgetrs   ! complex LU (Radau IIA's complex iteration matrix)
+    public :: dgetf2, dpotri   ! unblocked LU, inverse from the Cholesky factor (RATTLE)
 
     interface
         subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
@@ -169,6 +171,40 @@ module conmech_lapack
             real(dp), intent(in) :: tol
             real(dp), intent(out) :: work(*)
         end subroutine dpstf2
+        !> Unblocked LU (no block-size query: fast for small constraint matrices).
+        subroutine dgetf2(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetf2
+        !> Inverse from the Cholesky factor.
+        subroutine dpotri(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotri
+    end interface
+
+    ! Complex LU factorisation and solve.
+    interface
+        subroutine zgetrf(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            complex(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine zgetrf
+        subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb
+            complex(dp), intent(in) :: a(lda, *)
+            integer, intent(in) :: ipiv(*)
+            complex(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine zgetrs
     end interface
 
 contains

@@ -74,6 +74,11 @@ contains
         end if
         call stp%init(t0, tf, y, opt, info, msg)
         if (info /= CM_SUCCESS) return
+        if (present(res)) then
+            if (.not. allocated(res%t)) allocate (res%t(0), res%y(n, 0))
+            if (.not. allocated(res%ev_t)) allocate (res%ev_t(0), res%ev_y(n, 0), &
+                                                     res%ev_id(0))
+        end if
 
         store_steps = present(res) .and. n_eval == 0
         if (store_steps) store_steps = opt%save_steps

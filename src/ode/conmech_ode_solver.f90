@@ -23,7 +23,8 @@ module conmech_ode_solver
         METHOD_RATTLE
     use conmech_ode_dense, only: dense_solution
     use conmech_ode_result, only: ode_result
-    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack
+    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack, &
+        check_first_step, check_interval, tolerance_vectors, FORM_HAIRER, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_ode_methods, only: method_from_name, new_stepper, method_info, method_entry
     use conmech_ode_driver, only: ode_drive
@@ -36,21 +37,8 @@ module conmech_ode_solver
     public :: ode_options, ode_result, ode_stats, dense_solution
     public :: ode_solve, ode_integrate, method_from_name, method_info, method_entry
     public :: ode_stepper, ode_drive, stepper_pack, stepper_unpack, state_packer
+    public :: check_first_step, check_interval, tolerance_vectors, FORM_HAIRER, FORM_POWER
     public :: rk_stepper, rk_init, rk_start, rk_step     ! the stepper, for step-by-step use
-
-    interface
-        !> The implicit methods (METHOD_RADAU5, METHOD_GAUSS4, METHOD_GAUSS6), implemented
-        !! in the submodule conmech_radau_dispatch; arguments as ode_solve.
-        module subroutine implicit_solve(sys, t_span, y0, options, res, t_eval, events)
-            class(ode_system), intent(in) :: sys
-            real(dp), intent(in) :: t_span(2)
-            real(dp), intent(in) :: y0(:)
-            type(ode_options), intent(in) :: options
-            type(ode_result), intent(out) :: res
-            real(dp), intent(in), optional :: t_eval(:)
-            class(ode_events), intent(in), optional :: events
-        end subroutine implicit_solve
-    end interface
 
 contains
 
@@ -72,7 +60,7 @@ contains
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
         class(ode_step_hook), intent(inout), optional :: hook
-        class(ode_stepper), intent(inout), optional, target :: stepper
+        class(ode_stepper), intent(inout), optional :: stepper
         class(ode_stepper), allocatable :: own
         real(dp), allocatable :: y(:)
         integer :: info
@@ -80,16 +68,6 @@ contains
 
         allocate (res%t(0), res%y(size(y0), 0), res%ev_t(0), res%ev_y(size(y0), 0), &
                   res%ev_id(0))
-        if (.not. present(stepper) .and. (options%method == METHOD_GAUSS4 .or. &
-                                          options%method == METHOD_GAUSS6)) then
-            if (present(hook)) then
-                call fail(res, CM_BAD_INPUT, "bad input: step hooks need an explicit method")
-            else
-                deallocate (res%t, res%y, res%ev_t, res%ev_y, res%ev_id)
-                call implicit_solve(sys, t_span, y0, options, res, t_eval, events)
-            end if
-            return
-        end if
         y = y0
         if (present(stepper)) then
             call ode_drive(stepper, sys, t_span(1), t_span(2), y, options, res%stats, &
@@ -107,8 +85,9 @@ contains
         res%success = res%status >= 0
     end subroutine ode_solve
 
-    !> Advance y from t0 to t1 in place, storing nothing. Fast path for shooting.
-    !! On failure y is the state where the integration stopped (its time in `message`).
+    !> Advance y from t0 to t1 in place, storing nothing: the lean path for shooting,
+    !! variational equations and sweeps (any method of the table). On failure y is the
+    !! state where the integration stopped (its time in `message`).
     subroutine ode_integrate(sys, t0, t1, y, options, info, stats, message, hook)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
@@ -121,46 +100,12 @@ contains
         type(ode_stats) :: st
         class(ode_stepper), allocatable :: stp
         character(len=:), allocatable :: msg
-        if (options%method == METHOD_GAUSS4 .or. options%method == METHOD_GAUSS6) then
-            if (present(hook)) then
-                info = CM_BAD_INPUT
-                msg = "bad input: step hooks need an explicit method"
-            else
-                call integrate_implicit(sys, t0, t1, y, options, info, st, msg)
-            end if
-        else
-            call new_stepper(options%method, stp, info, msg)
-            if (info == CM_SUCCESS) call ode_drive(stp, sys, t0, t1, y, options, st, info, &
-                                                   msg, hook=hook)
-        end if
+        call new_stepper(options%method, stp, info, msg)
+        if (info == CM_SUCCESS) call ode_drive(stp, sys, t0, t1, y, options, st, info, msg, &
+                                               hook=hook)
         if (present(stats)) stats = st
         if (present(message)) message = msg
     end subroutine ode_integrate
-
-    !> ode_integrate with an implicit method: ode_solve's implicit driver, end point only.
-    subroutine integrate_implicit(sys, t0, t1, y, options, info, st, msg)
-        class(ode_system), intent(in) :: sys
-        real(dp), intent(in) :: t0, t1
-        real(dp), intent(inout) :: y(:)
-        type(ode_options), intent(in) :: options
-        integer, intent(out) :: info
-        type(ode_stats), intent(out) :: st
-        character(len=:), allocatable, intent(out) :: msg
-        type(ode_options) :: oo
-        type(ode_result) :: r
-        oo = options
-        oo%save_steps = .false.
-        oo%dense_output = .false.
-        call implicit_solve(sys, [t0, t1], y, oo, r)
-        info = r%status
-        if (allocated(r%message)) then
-            msg = r%message
-        else
-            msg = "success"
-        end if
-        st = r%stats
-        if (size(r%t) > 0 .and. size(r%y, 1) == size(y)) y = r%y(:, size(r%t))
-    end subroutine integrate_implicit
 
     subroutine fail(res, info, msg)
         type(ode_result), intent(inout) :: res

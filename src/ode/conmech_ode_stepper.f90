@@ -6,7 +6,8 @@
 !!
 !! Life of a stepper, as the driver (or a user stepping by hand) calls it:
 !!
-!!     call stp%init(t0, tf, y0, opt, info, msg)  ! check the options; no evaluation of f
+!!     call stp%init(t0, tf, y0, opt, info, msg)  ! check the options (setup: the method's
+!!                                                 ! part); no evaluation of f
 !!     call stp%start(sys, info, msg)             ! f at t0, the initial step
 !!     do
 !!         call stp%step(sys, target, info, msg)  ! one ACCEPTED step (its own control)
@@ -27,9 +28,10 @@
 !! arrays, so nothing is kept in Fortran between calls. Its common part (`transfer_base`)
 !! comes first, at fixed positions for every method (PACK_* below).
 !!
-!! A new method is one type extending `ode_stepper` (init, start, step, transfer_state;
-!! dense, eval, refresh_f, f_finite when the defaults do not fit) and one entry in the
-!! method table (conmech_ode_methods); docs/guide/adding_an_integrator.rst walks through it.
+!! A new method is one type extending `ode_stepper` (setup (or init), start, step,
+!! transfer_state; dense, eval, refresh_f, f_finite when the defaults do not fit) and one
+!! entry in the method table (conmech_ode_methods); docs/guide/adding_an_integrator.rst
+!! walks through it.
 !! Everything is in the object: distinct steppers may run in distinct threads.
 module conmech_ode_stepper
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
@@ -38,12 +40,12 @@ module conmech_ode_stepper
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, ode_stats
     use conmech_ode_dense, only: FORM_HAIRER, FORM_POWER, interp
-    use conmech_state_packer, only: state_packer, packer_write, packer_read
+    use conmech_state_packer, only: state_packer, packer_write, packer_ready, packer_read
     implicit none
     private
 
-    public :: ode_stepper, check_interval, tolerance_vectors, check_t_eval
-    public :: stepper_pack, stepper_unpack
+    public :: ode_stepper, check_interval, check_first_step, tolerance_vectors, check_t_eval
+    public :: stepper_pack, stepper_unpack, stepper_init
     public :: FORM_HAIRER, FORM_POWER
 
     !> Fixed positions of the common part of a packed state (1-based): reals r(PACK_R_*),
@@ -85,8 +87,14 @@ module conmech_ode_stepper
     contains
         !> Check the options and set the stepper up at (t0, y0) for [t0, tf]: no
         !! evaluation of f. Problem data a caller set on the object before (Radau's mass
-        !! matrix) is kept. allow_inf: tf may be infinite (stepping by hand).
-        procedure(stepper_init), deferred :: init
+        !! matrix) is kept. allow_inf: tf may be infinite (stepping by hand). The default
+        !! makes the checks every method makes (`check_interval`), sets the common state
+        !! and calls `setup` for the method's part; a method overrides `setup` (or `init`).
+        procedure :: init => stepper_init
+        !> The method's part of `init`, called with the common state set (t, tf, posneg,
+        !! n, y; nf = 0): its own checks (`check_first_step`, tolerances), constants, nf and
+        !! form of its extension, arrays. info /= CM_SUCCESS with msg on bad input.
+        procedure :: setup => stepper_setup
         !> f at the initial point and the initial step (counted in st%nfev).
         procedure(stepper_start), deferred :: start
         !> Attempt steps with the method's own control until one is accepted, then advance
@@ -122,16 +130,6 @@ module conmech_ode_stepper
     end type ode_stepper
 
     abstract interface
-        subroutine stepper_init(self, t0, tf, y0, opt, info, msg, allow_inf)
-            import :: ode_stepper, ode_options, dp
-            class(ode_stepper), intent(inout) :: self
-            real(dp), intent(in) :: t0, tf
-            real(dp), intent(in) :: y0(:)
-            type(ode_options), intent(in) :: opt
-            integer, intent(out) :: info
-            character(len=:), allocatable, intent(out) :: msg
-            logical, intent(in), optional :: allow_inf
-        end subroutine stepper_init
         subroutine stepper_start(self, sys, info, msg)
             import :: ode_stepper, ode_system
             class(ode_stepper), intent(inout) :: self
@@ -155,6 +153,46 @@ module conmech_ode_stepper
     end interface
 
 contains
+
+    subroutine stepper_init(self, t0, tf, y0, opt, info, msg, allow_inf)
+        class(ode_stepper), intent(inout) :: self
+        real(dp), intent(in) :: t0, tf
+        real(dp), intent(in) :: y0(:)
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        logical, intent(in), optional :: allow_inf
+        call check_common(t0, tf, y0, opt, info, msg, allow_inf)
+        if (info /= CM_SUCCESS) return
+        call self%setup_base(opt%method, t0, tf, y0, 0, FORM_POWER)
+        call self%setup(opt, info, msg)
+        if (info /= CM_SUCCESS) return
+        if (ubound(self%fc, 2) /= self%nf) then
+            deallocate (self%fc)
+            allocate (self%fc(self%n, 0:self%nf))
+            self%fc = 0.0_dp
+        end if
+    end subroutine stepper_init
+
+    subroutine stepper_setup(self, opt, info, msg)
+        class(ode_stepper), intent(inout) :: self
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        msg = "bad input: the stepper overrides neither init nor setup"
+    end subroutine stepper_setup
+
+    !> The step option of a method (for `setup`, with t and tf set): `step_option` on
+    !! [t, tf].
+    subroutine check_first_step(self, opt, info, msg, fixed)
+        class(ode_stepper), intent(in) :: self
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(in), optional :: fixed
+        call step_option(self%t, self%tf, opt, info, msg, fixed)
+    end subroutine check_first_step
 
     subroutine stepper_dense(self, sys)
         class(ode_stepper), intent(inout) :: self
@@ -259,7 +297,9 @@ contains
         class(ode_stepper), intent(inout) :: stp
         type(state_packer), intent(out) :: p
         call packer_write(p, stp%n)
-        call stp%transfer_state(p)
+        call stp%transfer_state(p)          ! count the sizes
+        call packer_ready(p)
+        call stp%transfer_state(p)          ! write
     end subroutine stepper_pack
 
     !> Rebuild stp from a state packed by `stepper_pack` for `method`; CM_BAD_INPUT when
@@ -285,11 +325,9 @@ contains
         msg = "success"
     end subroutine stepper_unpack
 
-    !> The checks every method makes in `init`: y0 non-empty and finite, t0 and tf finite
-    !! (tf may be infinite if allow_inf), max_step > 0, first_step >= 0 and not longer
-    !! than the interval (unless `fixed`, the name of a fixed-step method, is given: then
-    !! first_step is the step, required), max_steps >= 1. info = CM_BAD_INPUT with a
-    !! message naming the argument.
+    !> The checks of `init` with the step option (for a method that overrides `init`):
+    !! `check_common`, then `check_first_step`'s rule on first_step as if t = t0 and
+    !! tf = tf (with `fixed`, the name of a fixed-step method: first_step is the step).
     subroutine check_interval(t0, tf, y0, opt, info, msg, fixed, allow_inf)
         real(dp), intent(in) :: t0, tf, y0(:)
         type(ode_options), intent(in) :: opt
@@ -297,10 +335,23 @@ contains
         character(len=:), allocatable, intent(out) :: msg
         character(len=*), intent(in), optional :: fixed
         logical, intent(in), optional :: allow_inf
-        logical :: inf_ok, fixed_step
+        call check_common(t0, tf, y0, opt, info, msg, allow_inf)
+        if (info /= CM_SUCCESS) return
+        call step_option(t0, tf, opt, info, msg, fixed)
+    end subroutine check_interval
+
+    !> The checks every method makes in `init`: y0 non-empty and finite, t0 and tf finite
+    !! (tf may be infinite if allow_inf), max_step > 0, first_step >= 0, max_steps >= 1.
+    !! info = CM_BAD_INPUT with a message naming the argument.
+    subroutine check_common(t0, tf, y0, opt, info, msg, allow_inf)
+        real(dp), intent(in) :: t0, tf, y0(:)
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        logical, intent(in), optional :: allow_inf
+        logical :: inf_ok
         inf_ok = .false.
         if (present(allow_inf)) inf_ok = allow_inf
-        fixed_step = present(fixed)
         info = CM_BAD_INPUT
         if (size(y0) < 1) then
             msg = "bad input: y0 is empty"
@@ -315,17 +366,38 @@ contains
             msg = "bad input: first_step must be positive"
         else if (opt%max_steps < 1) then
             msg = "bad input: max_steps must be positive"
-        else if (fixed_step .and. .not. (opt%first_step > 0.0_dp .and. &
-                                         opt%first_step < huge(1.0_dp))) then
-            msg = "bad input: "//fixed//" is a fixed-step method and needs a step "// &
-                  "(first_step > 0)"
-        else if (.not. fixed_step .and. opt%first_step > abs(tf - t0) .and. tf /= t0) then
-            msg = "bad input: first_step exceeds the length of t_span"
         else
             info = CM_SUCCESS
             msg = "success"
         end if
-    end subroutine check_interval
+    end subroutine check_common
+
+    !> The step option on [t0, tf]: with `fixed` (the method's name) first_step is the
+    !! step, required, and the interval finite; else first_step (0: the method's
+    !! heuristic) is not longer than the interval.
+    subroutine step_option(t0, tf, opt, info, msg, fixed)
+        real(dp), intent(in) :: t0, tf
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(in), optional :: fixed
+        info = CM_BAD_INPUT
+        if (present(fixed)) then
+            if (.not. (opt%first_step > 0.0_dp .and. opt%first_step < huge(1.0_dp))) then
+                msg = "bad input: "//fixed//" is a fixed-step method and needs a step "// &
+                      "(first_step > 0)"
+                return
+            else if (.not. ieee_is_finite(tf)) then
+                msg = "bad input: t_span must be finite"
+                return
+            end if
+        else if (opt%first_step > abs(tf - t0) .and. tf /= t0) then
+            msg = "bad input: first_step exceeds the length of t_span"
+            return
+        end if
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine step_option
 
     !> Per-component tolerances from the options (rtol raised to 100 eps, as SciPy).
     subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg)

@@ -6,7 +6,7 @@
 module conmech_radau_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
-    use conmech_lapack, only: dgetrf, dgetrs
+    use conmech_lapack, only: dgetrf, dgetrs, zgetrf, zgetrs
     use conmech_ode_options, only: ode_stats
     use conmech_ode_system, only: ode_system
     use conmech_radau_coefficients
@@ -16,24 +16,6 @@ module conmech_radau_newton
     private
 
     public :: radau_rhs, radau_jacobian, radau_decompose, radau_newton
-
-    interface
-        subroutine zgetrf(m, n, a, lda, ipiv, info)
-            import :: dp
-            integer, intent(in) :: m, n, lda
-            complex(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine zgetrf
-        subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
-            import :: dp
-            character(len=1), intent(in) :: trans
-            integer, intent(in) :: n, nrhs, lda, ldb
-            complex(dp), intent(in) :: a(lda, *)
-            integer, intent(in) :: ipiv(*)
-            complex(dp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine zgetrs
-    end interface
 
 contains
 

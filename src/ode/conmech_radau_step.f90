@@ -4,7 +4,7 @@
 !! control modules can work on the stepper's type.
 submodule(conmech_radau_stepper) conmech_radau_step
     use conmech_status
-    use conmech_ode_stepper, only: check_interval, tolerance_vectors, FORM_POWER
+    use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER
     use conmech_radau_coefficients, only: NIT, THET
     use conmech_radau_collocation, only: radau_collocation_update
     use conmech_radau_newton, only: radau_rhs, radau_jacobian, radau_decompose, radau_newton
@@ -14,17 +14,10 @@ submodule(conmech_radau_stepper) conmech_radau_step
 
 contains
 
-    module subroutine radau_init(self, t0, tf, y0, opt, info, msg, allow_inf)
-        class(radau_stepper), intent(inout) :: self
-        real(dp), intent(in) :: t0, tf
-        real(dp), intent(in) :: y0(:)
-        type(ode_options), intent(in) :: opt
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: allow_inf
+    module procedure radau_setup
         integer :: n
-        n = size(y0)
-        call check_interval(t0, tf, y0, opt, info, msg, allow_inf=allow_inf)
+        n = self%n
+        call check_first_step(self, opt, info, msg)
         if (info /= CM_SUCCESS) return
         info = CM_BAD_INPUT
         if (allocated(self%mass)) then
@@ -45,7 +38,8 @@ contains
         call tolerance_vectors(opt, n, self%rtolv, self%atolv, info, msg)
         if (info /= CM_SUCCESS) return
 
-        call self%setup_base(opt%method, t0, tf, y0, 3, FORM_POWER)
+        self%nf = 3
+        self%form = FORM_POWER
         if (allocated(self%jac)) deallocate (self%jac, self%e1, self%e2, self%f0, &
                                              self%scal0, self%ip1, self%ip2)
         allocate (self%jac(n, n), self%e1(n, n), self%e2(n, n), self%f0(n), self%scal0(n), &
@@ -57,7 +51,7 @@ contains
         self%ip1 = 0
         self%ip2 = 0
         self%uround = epsilon(1.0_dp)
-        self%hmax = min(abs(opt%max_step), abs(tf - t0))
+        self%hmax = min(abs(opt%max_step), abs(self%tf - self%t))
         self%fnewt = max(10.0_dp*self%uround/minval(self%rtolv), &
                          min(0.03_dp, sqrt(minval(self%rtolv))))
         self%safe = 0.9_dp
@@ -86,13 +80,9 @@ contains
         self%nsteps = 0
         self%nsing = 0
         self%nfail = 0
-    end subroutine radau_init
+    end procedure radau_setup
 
-    module subroutine radau_start(self, sys, info, msg)
-        class(radau_stepper), intent(inout) :: self
-        class(ode_system), intent(in) :: sys
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+    module procedure radau_start
         info = CM_SUCCESS
         msg = "success"
         call radau_rhs(sys, self%st, self%t, self%y, self%f0)
@@ -113,16 +103,11 @@ contains
         self%final_step = (self%t + self%h - self%tf)*self%posneg >= 0.0_dp
         if (self%final_step) self%h = self%tf - self%t
         self%hacc = self%h
-    end subroutine radau_start
+    end procedure radau_start
 
     !> Attempt steps until one is accepted (RADAU5's loop; `target` other than tf is not
     !! used: the step control decides, and the last step lands on tf).
-    module subroutine radau_step(self, sys, target, info, msg)
-        class(radau_stepper), intent(inout) :: self
-        class(ode_system), intent(in) :: sys
-        real(dp), intent(in) :: target
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+    module procedure radau_step
         real(dp) :: quot
         integer :: lainfo
         character(len=32) :: buf
@@ -239,6 +224,6 @@ contains
         ! f(t, y) and the scale of the next step: by refresh_f, after the driver's outputs
         ! (a terminal event ends the run without it, as RADAU5 ends)
         self%f_stale = .true.
-    end subroutine radau_step
+    end procedure radau_step
 
 end submodule conmech_radau_step

@@ -38,7 +38,7 @@
 !!   algebraic systems of index 1 and 2, RADAU5's IMAS = 1): the components `mass` and
 !!   `index2` set before `init` (index-2 components get their error scaled by h, as
 !!   RADAU5's NIND2); the initial step is then 1e-6 unless given. The constrained layer
-!!   uses it for the stabilised index-2 formulation (conmech_rattle_dae).
+!!   uses it for the stabilised index-2 formulation (conmech_constrained_dae).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
 !! This module holds the state and its packing; the step itself is the submodule
 !! conmech_radau_step, on conmech_radau_newton (Jacobian, LU, Newton) and
@@ -97,7 +97,7 @@ module conmech_radau_stepper
         real(dp), allocatable :: a1(:), a2(:), a3(:), b1(:), b2(:), b3(:), cont(:)
         complex(dp), allocatable :: zc(:)
     contains
-        procedure :: init => radau_init
+        procedure :: setup => radau_setup
         procedure :: start => radau_start
         procedure :: step => radau_step
         procedure :: transfer_state => radau_transfer
@@ -106,16 +106,13 @@ module conmech_radau_stepper
     end type radau_stepper
 
     interface
-        !> Check the options (and the mass matrix) and set up at (t0, y0); no evaluation.
-        module subroutine radau_init(self, t0, tf, y0, opt, info, msg, allow_inf)
+        !> The options and the mass matrix checked; constants and arrays (no evaluation).
+        module subroutine radau_setup(self, opt, info, msg)
             class(radau_stepper), intent(inout) :: self
-            real(dp), intent(in) :: t0, tf
-            real(dp), intent(in) :: y0(:)
             type(ode_options), intent(in) :: opt
             integer, intent(out) :: info
             character(len=:), allocatable, intent(out) :: msg
-            logical, intent(in), optional :: allow_inf
-        end subroutine radau_init
+        end subroutine radau_setup
         !> f at t0, the scale and the initial step.
         module subroutine radau_start(self, sys, info, msg)
             class(radau_stepper), intent(inout) :: self

@@ -1,27 +1,10 @@
-!> The explicit Runge-Kutta stepper: one object holds the whole state of an integration
-!! (t, y, the stages, the step size and the controller's memory), advanced one accepted
-!! step at a time. The anchors are FLINT's ERK class and SciPy's OdeSolver:
-!!
-!! - `rk_init`   checks the options and sets up the method (no evaluation of f);
-!! - `rk_start`  evaluates f(t0, y0) and chooses the initial step (Hairer's hinit);
-!! - `rk_step`   attempts steps until one is accepted (Hairer's step control), then
-!!               advances: (t_old, y_old) is the start of that step, (t, y) its end;
-!! - `rk_dense`  builds the continuous extension of the last step (extra stages for
-!!               DOP853 and Verner), `rk_eval` evaluates it;
-!! - `rk_refresh_f` re-evaluates f after a step hook changed y.
-!!
-!! The FSAL stage of an accepted step is moved into k(:, 1) lazily, at the start of the
-!! next step, so that the last step's stages stay available for its dense output.
-!! Step-size control follows Hairer's dopri5.f/dop853.f: safety 0.9, step ratio bounds
-!! [0.2, 10] (DOPRI5, with Lund stabilisation beta = 0.04) and [1/3, 6] (DOP853,
-!! VERNER98), no growth right after a rejection, at most `max_steps` attempted steps,
-!! failure when 0.1|h| <= |t| eps. All state is in the object: thread-safe.
 !> The explicit Runge-Kutta stepper (RK4, DOPRI5, DOP853, VERNER98) on the integrator
 !! contract of conmech_ode_stepper: one object holds the whole state of an integration (t,
 !! y, the stages, the step size and the controller's memory), advanced one accepted step at
 !! a time. The anchors are FLINT's ERK class and SciPy's OdeSolver:
 !!
-!! - `init`      checks the options and sets up the method (no evaluation of f);
+!! - `setup`     (the contract's `init`) checks the options and sets up the method (no
+!!               evaluation of f);
 !! - `start`     evaluates f(t0, y0) and chooses the initial step (Hairer's hinit);
 !! - `step`      attempts steps until one is accepted (Hairer's step control), then
 !!               advances: (t_old, y_old) is the start of that step, (t, y) its end;
@@ -43,8 +26,8 @@ module conmech_rk_stepper
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_RK4, METHOD_DOPRI5, &
         METHOD_DOP853, METHOD_VERNER98
-    use conmech_ode_stepper, only: ode_stepper, check_interval, tolerance_vectors, &
-        FORM_HAIRER, FORM_POWER
+    use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
+        tolerance_vectors, FORM_HAIRER, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
         verner98_tableau
@@ -73,7 +56,7 @@ module conmech_rk_stepper
         real(dp), allocatable :: rtol(:), atol(:)
         real(dp), allocatable :: k(:, :)  !! stages, (n, 21)
     contains
-        procedure :: init => rk_init_impl
+        procedure :: setup => rk_setup
         procedure :: start => rk_start_impl
         procedure :: step => rk_step_impl
         procedure :: transfer_state => rk_transfer
@@ -82,36 +65,41 @@ module conmech_rk_stepper
         procedure :: f_finite => rk_f_finite
     end type rk_stepper
 
+    !> The contract's procedures under the stepper's own names: `rk_init(stp, ...)` is
+    !! `stp%init(...)`, and so on.
+    interface rk_init
+        module procedure stepper_init
+    end interface rk_init
+    interface rk_start
+        module procedure rk_start_impl
+    end interface rk_start
+    interface rk_step
+        module procedure rk_step_impl
+    end interface rk_step
+
 contains
 
-    !> Check the options and set the stepper up at (t0, y0) for the interval [t0, tf]
-    !! (no evaluation of f). An infinite tf is accepted if allow_inf (stepping without end).
-    subroutine rk_init_impl(self, t0, tf, y0, opt, info, msg, allow_inf)
+    !> The method's part of init: its options (tolerances, step control; RK4's fixed step)
+    !! and arrays, at the common state set by the contract's init (no evaluation of f).
+    subroutine rk_setup(self, opt, info, msg)
         class(rk_stepper), intent(inout) :: self
-        real(dp), intent(in) :: t0, tf
-        real(dp), intent(in) :: y0(:)
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: allow_inf
-        integer :: n
-        n = size(y0)
         if (opt%method < METHOD_RK4 .or. opt%method > METHOD_VERNER98) then
             info = CM_BAD_INPUT
             msg = "bad input: unknown method"
             return
         end if
         if (opt%method == METHOD_RK4) then
-            call check_interval(t0, tf, y0, opt, info, msg, fixed="RK4", allow_inf=allow_inf)
+            call check_first_step(self, opt, info, msg, fixed="RK4")
         else
-            call check_interval(t0, tf, y0, opt, info, msg, allow_inf=allow_inf)
+            call check_first_step(self, opt, info, msg)
         end if
         if (info /= CM_SUCCESS) return
-        call tolerance_vectors(opt, n, self%rtol, self%atol, info, msg)
+        call tolerance_vectors(opt, self%n, self%rtol, self%atol, info, msg)
         if (info /= CM_SUCCESS) return
-
         call set_method(self, opt%method)
-        call self%setup_base(opt%method, t0, tf, y0, self%nf, self%form)
         self%safe = 0.9_dp
         self%facold = 1.0e-4_dp
         self%nsteps = 0
@@ -131,12 +119,12 @@ contains
         if (opt%safety > 0.0_dp) self%safe = opt%safety
         if (opt%fac_min > 0.0_dp) self%facc1 = 1.0_dp/opt%fac_min
         if (opt%fac_max > 0.0_dp) self%facc2 = 1.0_dp/opt%fac_max
-        self%hmax = min(abs(opt%max_step), abs(tf - t0))
+        self%hmax = min(abs(opt%max_step), abs(self%tf - self%t))
         self%first_step = opt%first_step
         self%max_steps = opt%max_steps
         call allocate_work(self)
         self%k = 0.0_dp
-    end subroutine rk_init_impl
+    end subroutine rk_setup
 
     !> The method's constants: tableau, dense degree and form, FSAL column, the default
     !! step-ratio bounds and Lund stabilisation (from the method code alone, so that an
@@ -221,35 +209,6 @@ contains
         self%facc2 = facc2
         self%beta = beta
     end subroutine rk_transfer
-
-    !> Compatibility names of the contract's procedures (`rk_init(stp, ...)` is
-    !! `stp%init(...)`, and so on).
-    subroutine rk_init(self, t0, tf, y0, opt, info, msg, allow_inf)
-        type(rk_stepper), intent(inout) :: self
-        real(dp), intent(in) :: t0, tf, y0(:)
-        type(ode_options), intent(in) :: opt
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: allow_inf
-        call self%init(t0, tf, y0, opt, info, msg, allow_inf)
-    end subroutine rk_init
-
-    subroutine rk_start(self, sys, info, msg)
-        type(rk_stepper), intent(inout) :: self
-        class(ode_system), intent(in) :: sys
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        call self%start(sys, info, msg)
-    end subroutine rk_start
-
-    subroutine rk_step(self, sys, target, info, msg)
-        type(rk_stepper), intent(inout) :: self
-        class(ode_system), intent(in) :: sys
-        real(dp), intent(in) :: target
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        call self%step(sys, target, info, msg)
-    end subroutine rk_step
 
     !> Evaluate f at the initial point and choose the first step.
     subroutine rk_start_impl(self, sys, info, msg)

@@ -7,11 +7,13 @@
 !!     call p%columns(self%fc, 0, self%nf) ! an (n, lo:hi) matrix: hi - lo + 1 columns
 !!     call p%ints(self%ipiv, self%n)      ! an integer vector of length m
 !!     call p%complex_columns(self%e2, self%n)   ! an (n, m) complex matrix: 2 m columns
+!!     call p%reals(self%q, m)             ! a real vector of any length m: into r
+!!     call p%real_matrix(self%g, m1, m2)  ! an (m1, m2) real matrix: into r
 !!
-!! The same list writes (mode PACK_WRITE: the packer's arrays grow as needed) and reads
-!! (mode PACK_READ: from arrays given to `packer_read`; allocatable targets are allocated
-!! with the shape named in the call). Packing is therefore its own inverse by
-!! construction, and the sizes of a state are those of one write. The arrays are real
+!! The same list counts the sizes (mode PACK_COUNT), writes (PACK_WRITE, into arrays of
+!! the counted sizes) and reads (PACK_READ: from arrays given to `packer_read`;
+!! allocatable targets are allocated with the shape named in the call). Packing is
+!! therefore its own inverse by construction. The arrays are real
 !! scalars r(:), integers iv(:) (logicals as 0/1) and columns w(n, :) of the state's
 !! dimension n: plain arrays that a caller (the Python stepper objects) keeps between calls,
 !! so that nothing is kept in Fortran.
@@ -21,16 +23,17 @@ module conmech_state_packer
     implicit none
     private
 
+    integer, parameter, public :: PACK_COUNT = 0   !! sizes of the state only
     integer, parameter, public :: PACK_WRITE = 1   !! state -> arrays
     integer, parameter, public :: PACK_READ = 2    !! arrays -> state
 
-    public :: state_packer, packer_write, packer_read
+    public :: state_packer, packer_write, packer_ready, packer_read
 
     !> The arrays of a packed state and the position in them.
     type :: state_packer
-        integer :: mode = PACK_WRITE
+        integer :: mode = PACK_COUNT
         integer :: n = 0                     !! length of the columns of w
-        integer :: nr = 0, ni = 0, nw = 0    !! entries written (or read) so far
+        integer :: nr = 0, ni = 0, nw = 0    !! entries counted, written or read so far
         integer :: info = CM_SUCCESS         !! CM_BAD_INPUT after reading past the end
         real(dp), allocatable :: r(:)        !! real scalars
         integer, allocatable :: iv(:)        !! integers and logicals
@@ -42,20 +45,31 @@ module conmech_state_packer
         procedure :: columns => pack_columns
         procedure :: ints => pack_ints
         procedure :: complex_columns => pack_complex_columns
+        procedure :: reals => pack_reals
+        procedure :: real_matrix => pack_real_matrix
         procedure :: reading => packer_reading
     end type state_packer
 
 contains
 
-    !> A packer that writes a state of column length n (arrays grow as needed; the sizes
-    !! of the state are p%nr, p%ni, p%nw afterwards).
+    !> A packer that counts a state of column length n (p%nr, p%ni, p%nw afterwards):
+    !! `stepper_pack` counts first, then writes into arrays of exactly those sizes.
     subroutine packer_write(p, n)
         type(state_packer), intent(out) :: p
         integer, intent(in) :: n
-        p%mode = PACK_WRITE
+        p%mode = PACK_COUNT
         p%n = n
-        allocate (p%r(32), p%iv(32), p%w(n, 8))
     end subroutine packer_write
+
+    !> After counting: arrays of the counted sizes, positions back to the start, write mode.
+    subroutine packer_ready(p)
+        type(state_packer), intent(inout) :: p
+        allocate (p%r(p%nr), p%iv(p%ni), p%w(p%n, p%nw))
+        p%nr = 0
+        p%ni = 0
+        p%nw = 0
+        p%mode = PACK_WRITE
+    end subroutine packer_ready
 
     !> A packer that reads the state in (r, iv, w) (copied).
     subroutine packer_read(p, r, iv, w)
@@ -75,59 +89,31 @@ contains
         packer_reading = p%mode == PACK_READ
     end function packer_reading
 
-    !> Room for k more reals (write) or k more to read (else info = CM_BAD_INPUT).
-    logical function room_r(p, k)
+    !> Take kr reals, ki integers and kw columns: true when they are there to move (write,
+    !! read); in count mode only counted (false); reading past the end sets info.
+    logical function take(p, kr, ki, kw)
         class(state_packer), intent(inout) :: p
-        integer, intent(in) :: k
-        real(dp), allocatable :: tmp(:)
-        room_r = .true.
-        if (p%nr + k <= size(p%r)) return
+        integer, intent(in) :: kr, ki, kw
+        take = p%mode /= PACK_COUNT
         if (p%mode == PACK_READ) then
-            p%info = CM_BAD_INPUT
-            room_r = .false.
-            return
+            if (p%nr + kr > size(p%r) .or. p%ni + ki > size(p%iv) .or. &
+                p%nw + kw > size(p%w, 2)) then
+                p%info = CM_BAD_INPUT
+                take = .false.
+                return
+            end if
         end if
-        allocate (tmp(max(2*size(p%r), p%nr + k)))
-        tmp(1:p%nr) = p%r(1:p%nr)
-        call move_alloc(tmp, p%r)
-    end function room_r
-
-    logical function room_i(p, k)
-        class(state_packer), intent(inout) :: p
-        integer, intent(in) :: k
-        integer, allocatable :: tmp(:)
-        room_i = .true.
-        if (p%ni + k <= size(p%iv)) return
-        if (p%mode == PACK_READ) then
-            p%info = CM_BAD_INPUT
-            room_i = .false.
-            return
+        if (.not. take) then
+            p%nr = p%nr + kr
+            p%ni = p%ni + ki
+            p%nw = p%nw + kw
         end if
-        allocate (tmp(max(2*size(p%iv), p%ni + k)))
-        tmp(1:p%ni) = p%iv(1:p%ni)
-        call move_alloc(tmp, p%iv)
-    end function room_i
-
-    logical function room_w(p, k)
-        class(state_packer), intent(inout) :: p
-        integer, intent(in) :: k
-        real(dp), allocatable :: tmp(:, :)
-        room_w = .true.
-        if (p%nw + k <= size(p%w, 2)) return
-        if (p%mode == PACK_READ) then
-            p%info = CM_BAD_INPUT
-            room_w = .false.
-            return
-        end if
-        allocate (tmp(p%n, max(2*size(p%w, 2), p%nw + k)))
-        tmp(:, 1:p%nw) = p%w(:, 1:p%nw)
-        call move_alloc(tmp, p%w)
-    end function room_w
+    end function take
 
     subroutine item_real(p, x)
         class(state_packer), intent(inout) :: p
         real(dp), intent(inout) :: x
-        if (.not. room_r(p, 1)) return
+        if (.not. take(p, 1, 0, 0)) return
         p%nr = p%nr + 1
         if (p%mode == PACK_READ) then
             x = p%r(p%nr)
@@ -139,7 +125,7 @@ contains
     subroutine item_int(p, k)
         class(state_packer), intent(inout) :: p
         integer, intent(inout) :: k
-        if (.not. room_i(p, 1)) return
+        if (.not. take(p, 0, 1, 0)) return
         p%ni = p%ni + 1
         if (p%mode == PACK_READ) then
             k = p%iv(p%ni)
@@ -151,7 +137,7 @@ contains
     subroutine item_logical(p, l)
         class(state_packer), intent(inout) :: p
         logical, intent(inout) :: l
-        if (.not. room_i(p, 1)) return
+        if (.not. take(p, 0, 1, 0)) return
         p%ni = p%ni + 1
         if (p%mode == PACK_READ) then
             l = p%iv(p%ni) /= 0
@@ -164,7 +150,7 @@ contains
     subroutine pack_column(p, a)
         class(state_packer), intent(inout) :: p
         real(dp), allocatable, intent(inout) :: a(:)
-        if (.not. room_w(p, 1)) return
+        if (.not. take(p, 0, 0, 1)) return
         p%nw = p%nw + 1
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
@@ -184,7 +170,7 @@ contains
         integer, intent(in) :: lo, hi
         integer :: k
         k = hi - lo + 1
-        if (.not. room_w(p, k)) return
+        if (.not. take(p, 0, 0, k)) return
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
                 if (size(a, 2) /= k .or. lbound(a, 2) /= lo) deallocate (a)
@@ -202,7 +188,7 @@ contains
         class(state_packer), intent(inout) :: p
         integer, allocatable, intent(inout) :: a(:)
         integer, intent(in) :: m
-        if (.not. room_i(p, m)) return
+        if (.not. take(p, 0, m, 0)) return
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
                 if (size(a) /= m) deallocate (a)
@@ -220,7 +206,7 @@ contains
         class(state_packer), intent(inout) :: p
         complex(dp), allocatable, intent(inout) :: a(:, :)
         integer, intent(in) :: m
-        if (.not. room_w(p, 2*m)) return
+        if (.not. take(p, 0, 0, 2*m)) return
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
                 if (size(a, 2) /= m) deallocate (a)
@@ -233,5 +219,41 @@ contains
         end if
         p%nw = p%nw + 2*m
     end subroutine pack_complex_columns
+
+    !> A real vector of length m (any m) into r.
+    subroutine pack_reals(p, a, m)
+        class(state_packer), intent(inout) :: p
+        real(dp), allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: m
+        if (.not. take(p, m, 0, 0)) return
+        if (p%mode == PACK_READ) then
+            if (allocated(a)) then
+                if (size(a) /= m) deallocate (a)
+            end if
+            if (.not. allocated(a)) allocate (a(m))
+            a = p%r(p%nr + 1:p%nr + m)
+        else
+            p%r(p%nr + 1:p%nr + m) = a(1:m)
+        end if
+        p%nr = p%nr + m
+    end subroutine pack_reals
+
+    !> A real (m1, m2) matrix into r (column by column).
+    subroutine pack_real_matrix(p, a, m1, m2)
+        class(state_packer), intent(inout) :: p
+        real(dp), allocatable, intent(inout) :: a(:, :)
+        integer, intent(in) :: m1, m2
+        if (.not. take(p, m1*m2, 0, 0)) return
+        if (p%mode == PACK_READ) then
+            if (allocated(a)) then
+                if (size(a, 1) /= m1 .or. size(a, 2) /= m2) deallocate (a)
+            end if
+            if (.not. allocated(a)) allocate (a(m1, m2))
+            a = reshape(p%r(p%nr + 1:p%nr + m1*m2), [m1, m2])
+        else
+            p%r(p%nr + 1:p%nr + m1*m2) = reshape(a(1:m1, 1:m2), [m1*m2])
+        end if
+        p%nr = p%nr + m1*m2
+    end subroutine pack_real_matrix
 
 end module conmech_state_packer
