@@ -110,6 +110,7 @@ program test_taylor
         call ts%check(info == CM_BAD_INPUT .and. index(msg, "no Taylor") > 0, &
                       "a system without Taylor code: "//msg)
     end block
+    if (allocated(msg)) deallocate (msg)
     call ts%finish()
 
 contains
