@@ -214,7 +214,7 @@ def _system(model):
                   name="symbolic")
     if d.kind == "ode":
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
-                                   **common)
+                                   taylor=compiled.library_taylor(model.lib), **common)
     if d.kind == "generalized":
         return as_lagrangian_system(compiled.generalized_system(
             d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
@@ -429,6 +429,11 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
+from .taylor_events import Event, event  # noqa: E402
+
+__all__ += ["Event", "event"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]
 
