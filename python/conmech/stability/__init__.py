@@ -49,10 +49,14 @@ from .transverse import transverse
 from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoint,
                                        HopfNormalForm, equilibrium_continuation,
                                        first_lyapunov_coefficient, hopf_orbits)
+from .equilibrium_branch_points import equilibrium_branch_points, switch_equilibrium_branch
 from .lyapunov_family import LyapunovFamily, NormalModes, lyapunov_family, normal_modes
 from .transverse_linearisation import (TransverseLinearisation, nontrivial_multipliers,
                                        transverse_linearisation)
 from .plots import plot_branch, plot_multipliers, plot_orbits, stable_orbits
+from .constrained_orbits import (ConstrainedBranch, ConstrainedOrbit, ManifoldChart,
+                                 constrained_continuation, constrained_periodic_orbit,
+                                 constrained_symmetric_orbit)
 # validators used by sibling modules (hill_families)
 from ._validate import _real, _state  # noqa: F401
 
@@ -68,4 +72,7 @@ __all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "Spe
            "EquilibriumBranch", "EquilibriumSpecialPoint", "HopfNormalForm",
            "equilibrium_continuation", "first_lyapunov_coefficient", "hopf_orbits",
            "LyapunovFamily", "NormalModes", "lyapunov_family", "normal_modes",
-           "plot_orbits", "stable_orbits"]
+           "plot_orbits", "stable_orbits", "ManifoldChart", "ConstrainedOrbit",
+           "ConstrainedBranch", "constrained_periodic_orbit", "constrained_symmetric_orbit",
+           "constrained_continuation", "equilibrium_branch_points",
+           "switch_equilibrium_branch"]
