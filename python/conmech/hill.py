@@ -29,6 +29,7 @@ import numpy as np
 
 from . import _conmech
 from ._callback import message_text
+from .stability.continuation import SpecialKind
 from .stability.variational import stm as _stm
 from .systems import hill_spatial as _hill_spatial
 
@@ -217,8 +218,9 @@ class HillFamily:
     the loss of stability, |S| > 1), residual (true closure error of each orbit),
     quarter_state (n, 4) (x'(T/4) = quarter_state[:, 2]), nsteps, status (0 = success),
     iterations, success (bool array), special (list of dicts: the located crossings of
-    S = +1 / -1 between consecutive converged orbits: kind, index (the orbit before it), m,
-    y0, stability_index, c, residual).
+    S = +1 / -1 between consecutive converged orbits: kind ('branch point' / 'period
+    doubling', as the continuation's special points; 'S=+1' / 'S=-1' match too), index
+    (the orbit before it), m, y0, stability_index, c, residual).
     """
 
     __slots__ = ("ms", "kappa", "y0", "jacobi", "monodromy", "stability_index", "c",
@@ -300,7 +302,10 @@ def family(ms: ArrayLike, kappa: float = 1.0, nsteps: int = 0, chunk_size: int =
         a[~ok] = np.nan
     special = []
     if locate:
-        for target, kind in ((1.0, "S=+1"), (-1.0, "S=-1")):
+        # the names of the continuation's special points, the stability-index events
+        # as aliases: kind == "branch point" and kind == "S=+1" both hold
+        for target, kind in ((1.0, SpecialKind("branch point", "S=+1")),
+                             (-1.0, SpecialKind("period doubling", "S=-1"))):
             f = ss - target
             idx = np.nonzero(ok[:-1] & ok[1:] & (f[:-1]*f[1:] <= 0)
                              & ~((f[:-1] == 0) & (f[1:] == 0)))[0]
