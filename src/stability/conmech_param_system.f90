@@ -32,7 +32,9 @@ module conmech_param_system
 
 contains
 
-    !> Build it; info CM_BAD_INPUT for an unknown name or ip out of range.
+    !> Build it; info CM_BAD_INPUT for an unknown name or ip out of range. ip = 0: no
+    !! parameter is continued (a continuation in the period of a system that may have no
+    !! parameter at all); `set_builtin_param` then leaves the system unchanged.
     subroutine make_param_system(name, params, ip, sys, info, msg)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
@@ -40,7 +42,7 @@ contains
         type(builtin_param_system), intent(out) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        if (ip < 1 .or. ip > size(params)) then
+        if (ip < 0 .or. ip > size(params)) then
             info = CM_BAD_INPUT
             msg = "the continuation parameter index is out of range (1.."// &
                   achar(48 + min(9, size(params)))//")"
@@ -54,7 +56,7 @@ contains
 
     !> The same for a compiled system (conmech_c_system / conmech_c_mechanics: its parameter
     !! array p is set in place, no rebuild); info CM_BAD_INPUT for ip out of range or a
-    !! system that is not compiled.
+    !! system that is not compiled. ip = 0: no parameter (as for make_param_system).
     subroutine make_compiled_param_system(inner, params, ip, sys, info, msg)
         class(ode_system), intent(in) :: inner
         real(dp), intent(in) :: params(:)
@@ -63,7 +65,7 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         info = CM_BAD_INPUT
-        if (ip < 1 .or. ip > size(params)) then
+        if (ip < 0 .or. ip > size(params)) then
             msg = "the continuation parameter index is out of range"
             return
         end if
@@ -71,6 +73,11 @@ contains
         sys%params = params
         sys%ip = ip
         allocate (sys%inner, source=inner)
+        if (ip == 0) then
+            info = CM_SUCCESS
+            msg = "success"
+            return
+        end if
         if (.not. set_compiled(sys%inner, ip, params(ip))) then
             msg = "continuation in a parameter needs a built-in or a compiled system"
             return
@@ -169,6 +176,7 @@ contains
         character(len=:), allocatable :: msg
         select type (sys)
         class is (builtin_param_system)
+            if (sys%ip == 0) return
             sys%params(sys%ip) = p
             if (len(sys%name) == 0) then
                 if (.not. set_compiled(sys%inner, sys%ip, p)) return

@@ -63,7 +63,8 @@ subroutine flat_branch_builtin(name, np, params, nspec, spec, ip, n, y0, period,
     end if
     en%f => energy
     en%n = n
-    call run_continuation(sys, n, y0, period, params(ip), ropt, iopt, nfree, free_idx, ntg, &
+    call run_continuation(sys, n, y0, period, params(max(ip, 1)), ropt, iopt, nfree, &
+                          free_idx, ntg, &
                           targets, ntang, tang, mp, en, npts, pp, per, ys, mr, mi, merr, acc, &
                           s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
                           sp_mr, sp_mi, sp_s, sp_located, sp_test, sp_closure, sp_bracket, &

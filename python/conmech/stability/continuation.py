@@ -254,17 +254,23 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             tang.size if _tangent is not None else 0, tang, int(max_points), en)
     if isinstance(system, BuiltinSystem):
         if param is None and in_period:
-            param = 0
-        if param is None:
-            raise ValueError("param (name or index of the continuation parameter) is needed")
-        ip = _param_index(system, param)
+            param = 0 if system.params.size else None
         params = np.array(system.params, dtype=float)
-        if p0 is not None:
-            params[ip] = float(p0)
+        if param is None and in_period:       # no parameter at all: none is continued
+            ip, npar = -1, 0
+            params = np.zeros(1)
+            pname = "period"
+        else:
+            if param is None:
+                raise ValueError("param (name or index of the continuation parameter) is "
+                                 "needed")
+            ip, npar = _param_index(system, param), params.size
+            if p0 is not None:
+                params[ip] = float(p0)
+            pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
         name, _, _, nspec, spec = system._flat_args()
-        out = _conmech.flat_branch_builtin(name, params.size, params, nspec, spec,
+        out = _conmech.flat_branch_builtin(name, npar, params, nspec, spec,
                                            ip + 1, y0, period, *args)
-        pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
     else:
         if not callable(system):
             raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
