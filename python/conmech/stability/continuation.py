@@ -145,7 +145,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                  res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11, energy=None,
                  in_period=False, period_range=(-np.inf, np.inf),
                  energy_range=(-np.inf, np.inf), method="single", segments=8, degree=4,
-                 intervals=40, _switch=0, _tangent=None) -> Branch:
+                 intervals=40, jac=None, _switch=0, _tangent=None) -> Branch:
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -164,6 +164,9 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     (``intervals`` intervals of ``degree`` Gauss points): the same equations discretised
     as a boundary-value problem and solved by a structured Newton; the step ``ds``
     measures the same unknowns (first node, period, parameter) for all three.
+
+    ``jac``: the exact Jacobian df/dy of a callable, ``jac(t, y, p)`` (``jac(t, y)`` with
+    ``in_period``), for the state transition matrices instead of differences.
 
     ``direction``: +1 (towards larger p) or -1; None (default): +1 unless the orbit's
     amplitude shrinks that way to an equilibrium within the branch's reach, then -1 (a
@@ -252,7 +255,12 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             return nan
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
             tang.size if _tangent is not None else 0, tang, int(max_points), en)
+    if jac is not None and not callable(jac):
+        raise TypeError("jac must be a callable jac(t, y, p) (jac(t, y) with in_period) "
+                        "returning df/dy, or None")
     if isinstance(system, BuiltinSystem):
+        if jac is not None:
+            raise ValueError("jac: a built-in or compiled system has its own Jacobian")
         if param is None and in_period:
             param = 0 if system.params.size else None
         params = np.array(system.params, dtype=float)
@@ -290,7 +298,21 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
                 g.fail(exc)
                 return nans
-        out = _conmech.flat_branch_callback(rhs, y0, period, float(p0), *args)
+        if jac is None:
+            out = _conmech.flat_branch_callback(rhs, y0, period, float(p0), *args)
+        else:
+            nanj = np.full((n, n), np.nan)
+
+            def jrhs(t, y, p):
+                if g.failed:
+                    return nanj
+                try:
+                    o = jac(t, y.copy()) if in_period else jac(t, y.copy(), float(p))
+                    return as_result(o, (n, n), "jac")
+                except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
+                    g.fail(exc)
+                    return nanj
+            out = _conmech.flat_branch_callback_jac(rhs, jrhs, y0, period, float(p0), *args)
         pname = param if isinstance(param, str) else "p"
     g.check()
     (npts, pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, sk, si, sp_p, sp_per,

@@ -141,7 +141,7 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
                              tol: float = 1e-12, res_tol: float = 1e-10, max_iter: int = 10,
                              locate: bool = True, locate_tol: float = 1e-12,
                              test_tol: float = 1e-13, l1_tol: float = 1e-6,
-                             t: float = 0.0) -> EquilibriumBranch:
+                             t: float = 0.0, jac=None) -> EquilibriumBranch:
     """Pseudo-arclength continuation of the equilibrium near ``y0`` in a parameter, with
     its folds and Hopf points located and the first Lyapunov coefficient at each Hopf point
     (see conmech_equilibrium_continuation and conmech_hopf).
@@ -150,9 +150,10 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
     it starts from the system's value, or ``p0``) or a callable ``fun(t, y, p)`` (``p0``
     required; finite-difference Jacobian). ``direction``: +1/-1, the first step towards
     larger/smaller p. The branch ends after ``max_points`` points or on the bound of
-    ``p_range`` (the last point is then the equilibrium at the bound). Each point is an
-    equilibrium to ``res_tol`` (max|f|); a special point is ``located`` when its test
-    function met ``test_tol`` (a Hopf point: relative to max(1, |lambda|)) or its bracket
+    ``p_range`` (the last point is then the equilibrium at the bound). ``jac``: the exact
+    Jacobian df/dy of a callable, ``jac(t, y, p)`` (the p-derivative stays a difference).
+    Each point is an equilibrium to ``res_tol`` (max|f|); a special point is ``located``
+    when its test function met ``test_tol`` (a Hopf point: relative to max(1, |lambda|)) or its bracket
     ``locate_tol`` at a corrected equilibrium, else it carries the best corrected
     equilibrium of its bracket and the reason. A Hopf point is ``degenerate`` when |l1| <=
     max(l1_tol * scale, l1_error). Raises ValueError on bad input and RuntimeError when
@@ -180,7 +181,11 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
                      locate_tol, test_tol, l1_tol, _real(t, "t")], dtype=float)
     iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(locate)],
                     dtype=np.int32)
+    if jac is not None and not callable(jac):
+        raise TypeError("jac must be a callable jac(t, y, p) returning df/dy, or None")
     if isinstance(system, BuiltinSystem):
+        if jac is not None:
+            raise ValueError("jac: a built-in or compiled system has its own Jacobian")
         ip, params, pname = _builtin_args(system, param, p0)
         if not lo <= params[ip] <= hi:
             raise ValueError(f"the start value {pname} = {params[ip]:g} is outside p_range")
@@ -194,7 +199,16 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
         if not lo <= p0 <= hi:
             raise ValueError(f"the start value p0 = {p0:g} is outside p_range")
         g, rhs = _param_rhs(system, n, y0, p0)
-        out = _conmech.flat_eq_continuation_callback(rhs, y0, p0, ropt, iopt, max_points)
+        if jac is None:
+            out = _conmech.flat_eq_continuation_callback(rhs, y0, p0, ropt, iopt, max_points)
+        else:
+            as_result(jac(0.0, y0.copy(), float(p0)), (n, n), "jac")
+            cbj = g.wrap(lambda tt, y, pa: jac(tt, y, float(pa[0])), 3, (n, n), "jac")
+
+            def jrhs(tt, y, p):
+                return cbj(tt, y, np.array([p], dtype=float))
+            out = _conmech.flat_eq_continuation_callback_jac(rhs, jrhs, y0, p0, ropt, iopt,
+                                                             max_points)
         g.check()
         pname = param if isinstance(param, str) else "p"
     (npts, pp, ys, wr, wi, psi, nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q,

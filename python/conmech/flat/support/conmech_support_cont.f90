@@ -16,6 +16,7 @@ module conmech_support_cont
     implicit none
     private
     public :: callback_param_system, set_param_any, run_continuation, callback_energy
+    public :: callback_param_jac_system
     public :: MAX_SPECIAL, NROPT, NIOPT
 
     integer, parameter :: MAX_SPECIAL = 64
@@ -38,6 +39,14 @@ module conmech_support_cont
         procedure :: rhs => cp_rhs
     end type callback_param_system
 
+    !> The same with its exact Jacobian df/dy from a Python jac(t, y, p, dfdy, n).
+    type, extends(callback_param_system) :: callback_param_jac_system
+        procedure(), pointer, nopass :: jf => null()
+    contains
+        procedure :: jacobian => cpj_jacobian
+        procedure :: has_jacobian => cpj_has_jacobian
+    end type callback_param_jac_system
+
 contains
 
     function ce_value(self, y, p) result(e)
@@ -58,6 +67,19 @@ contains
         call self%f(t, y, self%p, dydt, self%n)
     end subroutine cp_rhs
 
+    subroutine cpj_jacobian(self, t, y, dfdy)
+        class(callback_param_jac_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: dfdy(:, :)
+        call self%jf(t, y, self%p, dfdy, self%n)
+    end subroutine cpj_jacobian
+
+    logical function cpj_has_jacobian(self)
+        class(callback_param_jac_system), intent(in) :: self
+        cpj_has_jacobian = associated(self%jf)
+    end function cpj_has_jacobian
+
     !> set_param for both wrappers (a built-in system is rebuilt with the new parameter).
     subroutine set_param_any(sys, p)
         class(ode_system), intent(inout) :: sys
@@ -65,7 +87,7 @@ contains
         select type (sys)
         type is (builtin_param_system)
             call set_builtin_param(sys, p)
-        type is (callback_param_system)
+        class is (callback_param_system)
             sys%p = p
         end select
     end subroutine set_param_any
