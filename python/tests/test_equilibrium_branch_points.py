@@ -90,3 +90,21 @@ def test_bad_inputs():
         stability.switch_equilibrium_branch(lorenz, br, bp, side=0)
     with pytest.raises(ValueError, match="direction"):
         stability.switch_equilibrium_branch(lorenz, br, bp, direction=1)
+
+
+def test_bead_on_a_rotating_hoop_builtin():
+    """Built-in bead_hoop (theta from the bottom, hoop spun at omega): the bottom loses
+    stability in a pitchfork at omega^2 = g/R, where the pair cos(theta) = g/(R omega^2)
+    is born (e.g. Strogatz, Nonlinear Dynamics and Chaos, sect. 3.5)."""
+    from conmech import systems
+    s = systems.bead_hoop(R=1.0, omega=2.5, g=9.81)
+    br = stability.equilibrium_continuation(s, [0.0, 0.0], "omega", ds=0.1, max_points=15)
+    bps = stability.equilibrium_branch_points(s, br)
+    assert len(bps) == 1 and bps[0].located
+    assert abs(bps[0].p - np.sqrt(9.81)) < 1e-10
+    assert abs(bps[0].test) < 1e-8
+    new = stability.switch_equilibrium_branch(s, br, bps[0], ds=0.05, max_points=8)
+    assert new.success and np.all(np.abs(new.y[:, 0]) > 1e-3)
+    assert np.max(np.abs(np.cos(new.y[:, 0]) - 9.81/new.p**2)) < 1e-12
+    with pytest.raises(ValueError, match="jac"):
+        stability.equilibrium_branch_points(s, br, jac=lambda t, y, p: np.eye(2))

@@ -9,9 +9,9 @@ the tangent turns in p but the bordered matrix
 stays regular; at a *simple branch point* two branches cross, J loses rank (its kernel
 becomes two-dimensional) and det B changes sign (Keller 1977; Kuznetsov, Elements of
 Applied Bifurcation Theory, 3rd ed., sect. 10.2.2; Allgower and Georg, sect. 8.1). The
-test function is tau(s) = det B(s) with t oriented along the branch (t . dx/ds > 0); it is
-scaled by the product of the column norms of B, so that its size reads as a relative
-distance from singularity.
+test function is tau(s) = det B(s) with t oriented along the branch (t . dx/ds > 0),
+divided by |J|_F^n (t is a unit vector), so that its size reads as a relative distance
+from singularity.
 
 A sign change of tau between two points of a branch is located by the Illinois variant of
 regula falsi in the arclength of the chord between them, each trial point corrected onto
@@ -110,9 +110,11 @@ def _kernel(j):
 
 
 def _tau(j, t):
+    """det [J; t^T] / |J|_F^n: t is a unit vector, so |tau| <= 1, and tau is the product
+    of the singular values of J relative to its size."""
     b = np.vstack([j, t])
-    scale = np.prod(np.linalg.norm(b, axis=0))
-    return float(np.linalg.det(b)/max(scale, 1e-300))
+    scale = max(float(np.linalg.norm(j)), 1e-300)**j.shape[0]
+    return float(np.linalg.det(b)/scale)
 
 
 def _tangent(j, orient):
