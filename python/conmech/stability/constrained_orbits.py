@@ -173,6 +173,7 @@ class ManifoldChart:
         self.k = n - m
         self.q_ref = q_ref.copy()
         self._last = q_ref.copy()
+        self.left_chart = None
 
     def _qfull(self, qi):
         """q with q_I = qi and q_D from phi = 0 by Newton, started at the last solution's
@@ -253,6 +254,17 @@ class ManifoldChart:
         kkt[n:, :n] = g
         a = np.linalg.solve(kkt, np.concatenate([qf, gam]))[:n]
         return np.concatenate([v[self.independent], a[self.independent]])
+
+    def fun_or_nan(self, t, y):
+        """``fun``, but NaN outside the chart (the solvers then cut their step or stop
+        with a message, as at any non-finite value); ``left_chart`` records it."""
+        try:
+            return self.fun(t, y)
+        except RuntimeError as exc:
+            if "leaves the chart" not in str(exc):
+                raise
+            self.left_chart = str(exc)
+            return np.full(2*self.k, np.nan)
 
     def state_index(self, idx, what):
         """Reduced-state indices of excessive-state indices (0..n-1: q, n..2n-1: v),
@@ -399,7 +411,9 @@ def constrained_continuation(system: Any, q0, v0, period: float, *, free=None,
     continued in its period (a conservative system without a parameter:
     :func:`conmech.stability.continuation` with ``in_period=True`` on the chart's system;
     ``free``/``targets`` index [q, v] as in :func:`constrained_symmetric_orbit`; other
-    keywords as there: ``ds``, ``max_points``, ``period_range``, ``method``, ...)."""
+    keywords as there: ``ds``, ``max_points``, ``period_range``, ``method``, ...). Where
+    the family leaves the chart the branch ends with a message saying so (success
+    False), keeping its points."""
     for bad in ("param", "p0", "in_period", "autonomous"):
         if bad in kwargs:
             raise ValueError(f"{bad}: constrained_continuation continues in the period "
@@ -410,7 +424,11 @@ def constrained_continuation(system: Any, q0, v0, period: float, *, free=None,
     if targets is not None:
         kwargs["targets"] = chart.state_index(targets, "targets")
     kwargs.setdefault("conservative", True)
-    br = continuation(chart.fun, y0, period, in_period=True, **kwargs)
+    # outside the chart the field is NaN: the continuation cuts its step there and, if it
+    # cannot go on, ends the branch with a message (completed below)
+    br = continuation(chart.fun_or_nan, y0, period, in_period=True, **kwargs)
+    if br.status != 0 and chart.left_chart is not None:
+        br.message = f"{br.message} (a trial left the chart: {chart.left_chart})"
     lifted = [chart.lift(y) for y in br.y0]
     return ConstrainedBranch(branch=br, q0=np.array([a for a, _ in lifted]),
                              v0=np.array([b for _, b in lifted]), chart=chart)
