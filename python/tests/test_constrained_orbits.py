@@ -106,8 +106,9 @@ def test_libration_family_in_the_period():
     q0, v0 = brake_state(0.5)
     br = stability.constrained_continuation(systems.pendulum_xy(g=G, l=L), q0, v0,
                                             pendulum_period(0.5), free=[0], targets=[2],
-                                            max_points=8, ds=0.05, independent=[0])
-    assert len(br) == 8
+                                            max_points=8, ds=0.05, ds_max=0.05,
+                                            independent=[0])
+    assert len(br) == 8 and br.branch.success
     th = np.arcsin(br.q0[:, 0]/L)
     assert np.max(np.abs(pendulum_period(th) - br.branch.p)) < 1e-9
     assert np.ptp(br.branch.p) > 0.05

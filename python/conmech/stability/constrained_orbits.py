@@ -180,7 +180,13 @@ class ManifoldChart:
         dependent coordinates (Newton converges quadratically: the start changes the
         result by round-off only), and G(q) there. Converged when max|phi| <= tol
         max(1, |q|) at the current q (so that G is evaluated there, in the same call)."""
-        q = self._last.copy()
+        try:
+            return self._newton(self._last, qi)
+        except RuntimeError:        # a start far off: once more from the reference point
+            return self._newton(self.q_ref, qi)
+
+    def _newton(self, start, qi):
+        q = start.copy()
         q[self.independent] = qi
         ind, dep = self.independent, self.dependent
         scale = max(1.0, float(np.max(np.abs(q))))
