@@ -38,7 +38,7 @@ class Radau(RungeKutta):
 
     Parameters
     ----------
-    fun : callable or conmech.systems.BuiltinSystem
+    fun : callable or conmech.systems.NativeSystem (built-in or compiled)
         ``fun(t, y) -> dydt`` (shape (n,)), or a built-in or compiled system (its own
         Jacobian; no Python in the loop).
     t0, y0, t_bound, max_step, rtol, atol, first_step, vectorized, max_steps :

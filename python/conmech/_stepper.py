@@ -23,7 +23,7 @@ import numpy as np
 from . import _conmech
 from ._callback import Guard, message_text
 from ._ivp import DenseOutput, _real_scalar, _tolerance
-from .systems import BuiltinSystem
+from ._native import NativeSystem
 
 __all__ = ["RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "method_code"]
 
@@ -64,7 +64,7 @@ class RungeKutta:
 
     Parameters
     ----------
-    fun : callable or conmech.systems.BuiltinSystem
+    fun : callable or conmech.systems.NativeSystem (built-in or compiled)
         ``fun(t, y) -> dydt`` (shape (n,)), or a built-in system (no Python in the loop).
     t0 : float
         Initial time.
@@ -96,7 +96,7 @@ class RungeKutta:
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
-        self._builtin = isinstance(fun, BuiltinSystem)
+        self._builtin = isinstance(fun, NativeSystem)
         if not self._builtin and not callable(fun):
             raise TypeError("fun must be callable or a built-in system from "
                             f"conmech.systems, got {type(fun).__name__}")

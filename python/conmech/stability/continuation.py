@@ -8,7 +8,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _check_dim, _msg, _raise, _state
 
 _SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
@@ -131,7 +131,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     tang = np.zeros(1) if _tangent is None else np.array(_tangent, dtype=float).ravel()
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
             tang.size if _tangent is not None else 0, tang, int(max_points))
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         if param is None and in_period:
             param = 0
         if param is None:

@@ -8,7 +8,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state, _tols
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
@@ -30,7 +30,7 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     rtol, atol = _tols(rtol, atol)
     _no_jac_for_builtin(system, jac)
     njev = 0
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
             *system._flat_args(), y0, t0, t1, rtol, atol)
     else:
