@@ -3,15 +3,11 @@
 !! `make_generalized`, `make_constrained`; missing trailing parameters keep defaults; the
 !! counts and names are the library's, conmech_systems_params).
 module app_systems
-    use conmech_systems_mech, only: constrained_names, generalized_names
+    use conmech_systems, only: ode_names, constrained_names, generalized_names
     use conmech_systems_params, only: builtin_param_count, builtin_param_names
     implicit none
     private
     public :: ode_names, constrained_names, generalized_names, param_count, param_help
-
-    !> First-order built-ins of `make_system` (the generalized ones are also accepted).
-    character(len=*), parameter :: ode_names = "harmonic pendulum kepler arenstorf " &
-        //"vanderpol hill"
 
 contains
 

@@ -7,9 +7,10 @@
 
 For each model that is not hand-written, conmech.symbolic derives the equations (M, Q,
 the Jacobian of the accelerations, the energy, the constraints and their gamma terms, or
-f and df/dy) and one Fortran module is written, src/systems/builtin/<module>.f90, whose type
-extends ode_system, generalized_system or constrained_system, with every expression after
-one common-subexpression elimination per procedure. From every model, hand-written ones
+f and df/dy) and its Fortran type is written: per kind one module with the types (which
+extend ode_system, generalized_system or constrained_system) and the interfaces of their
+procedures, and one submodule with the procedures' bodies, every expression after one
+common-subexpression elimination per procedure. From every model, hand-written ones
 included, the registries are written: the parameter table (conmech_systems_params: counts,
 names, defaults), make_system and system_dimension (conmech_systems), make_generalized,
 make_constrained and the default initial states (conmech_systems_mech), the modules that
@@ -727,16 +728,16 @@ def params_module(models):
 
 def make_lines(m, arg):
     """Statements of a registry case that allocate the system `m` into `arg` from the whole
-    parameter vector p: a local of its type with the dimensions and parameters set, or the
-    hand-written model's own `make` statement."""
+    parameter vector p: its type's structure constructor with the dimensions and the
+    parameters by keyword, or the hand-written model's own `make` statement."""
     if not m.generated and m.make:
         return [m.make]
     dims = m.system.dims if m.generated else []
-    # (the lines stand 16 columns in: in a block of a case of a select)
-    sets = [ln[12:] for ln in pack(dims, " " * 16) + pack(
-        [f"s%{component(p)} = p({i + 1})" for i, p in enumerate(m.params)], " " * 16)]
-    return (["block", f"    type({m.type_name}) :: s"] + sets
-            + [f"    allocate ({arg}, source=s)", "end block"])
+    args = [d.removeprefix("s%").replace(" = ", "=") for d in dims]
+    args += [f"{component(p)}=p({i + 1})" for i, p in enumerate(m.params)]
+    # (the lines stand 12 columns in: in a case of a select)
+    return [ln[12:] for ln in wrap_statement(
+        f"allocate ({arg}, source={m.type_name}({', '.join(args)}))", " " * 12)]
 
 
 def called(statement):
@@ -837,8 +838,11 @@ def registry_modules(models):
             "    public :: make_system, system_dimension, make_generalized, "
             "make_generalized_ode",
             "    public :: make_constrained, mech_initial_state, constrained_names, "
-            "generalized_names", "",
-            "    !> Names of the built-in constrained systems (space separated)."]
+            "generalized_names", "    public :: ode_names", "",
+            "    !> Names of the built-in first-order systems of `make_system` (space "
+            "separated; the", "    !! generalized ones are first-order systems too)."]
+    out += string_parameter("ode_names", " ".join(m.name for m in ode))
+    out += ["    !> Names of the built-in constrained systems."]
     out += string_parameter("constrained_names", " ".join(m.name for m in con))
     out += ["    !> Names of the built-in generalized-coordinate systems."]
     out += string_parameter("generalized_names", " ".join(m.name for m in gen))
@@ -1007,7 +1011,7 @@ def factory(m):
     args = ", ".join(f"{p.name}={py_float(p.default) if not p.whole else int(p.default)}"
                      for p in m.params)
     out = [f"def {m.name}({args}):"]
-    doc = textwrap.wrap(m.summary, 88)
+    doc = textwrap.wrap(m.summary, 88, break_on_hyphens=False)
     if len(doc) == 1 and len(doc[0]) <= 86:
         out.append(f'    """{doc[0]}"""')
     else:

@@ -15,6 +15,8 @@ KINDS = {
     "arenstorf": "ode",
     "vanderpol": "ode",
     "hill": "ode",
+    "hill_spatial": "ode",
+    "cr3bp": "ode",
     "pendulum_angle": "generalized",
     "cart_pendulum": "generalized",
     "double_pendulum": "generalized",
@@ -45,6 +47,8 @@ PARAMS = {
     "arenstorf": (("mu", 0.012277471),),
     "vanderpol": (("mu", 1.0),),
     "hill": (("m", 0.080848933808312), ("kappa", 1.0),),
+    "hill_spatial": (("m", 0.080848933808312), ("kappa", 1.0),),
+    "cr3bp": (("mu", 0.012150585609624),),
     "pendulum_angle": (("m", 1.0), ("g", 9.81), ("l", 1.0),),
     "cart_pendulum": (("M", 1.0), ("m", 1.0), ("l", 1.0), ("g", 9.81),),
     "double_pendulum": (("m1", 1.0), ("m2", 1.0), ("l1", 1.0), ("l2", 1.0), ("g", 9.81),),
@@ -78,6 +82,8 @@ POSITIVE_PARAMS = {
     "pendulum": {1: "l"},
     "kepler": {0: "mu"},
     "hill": {1: "kappa"},
+    "hill_spatial": {1: "kappa"},
+    "cr3bp": {0: "mu"},
     "pendulum_angle": {0: "m", 2: "l"},
     "cart_pendulum": {0: "M", 1: "m", 2: "l"},
     "double_pendulum": {0: "m1", 1: "m2", 2: "l1", 3: "l2"},
@@ -103,6 +109,8 @@ POSITIVE_PARAMS = {
 RANGE_PARAMS = {
     "arenstorf": {0: ("mu", 0.0, 1.0)},
     "hill": {0: ("m", 0.0, math.inf)},
+    "hill_spatial": {0: ("m", 0.0, math.inf)},
+    "cr3bp": {0: ("mu", 0.0, 0.5)},
 }
 #: Names of the state components of the built-in first-order and generalized systems (for
 #: reports such as the direction of a secular drift): coordinates, then velocities.
@@ -113,6 +121,8 @@ STATE_NAMES = {
     "arenstorf": ("x", "y", "x'", "y'"),
     "vanderpol": ("x", "x'"),
     "hill": ("x", "y", "x'", "y'"),
+    "hill_spatial": ("x", "y", "z", "x'", "y'", "z'"),
+    "cr3bp": ("x", "y", "z", "x'", "y'", "z'"),
     "pendulum_angle": ("theta", "theta'"),
     "cart_pendulum": ("x", "theta", "x'", "theta'"),
     "double_pendulum": ("theta1", "theta2", "theta1'", "theta2'"),

@@ -69,6 +69,41 @@ class NativeSystem:
         kind, n, mh, mn, info, _ = _conmech.flat_mech_info(*self._flat_args())
         return int(n) if info == 0 and kind == 2 else None
 
+    def energy(self, y, t=0.0):
+        """The energy (first integral) at the state y (time t): T + U of the mechanical
+        systems y = [q, q'] (built-in, compiled and symbolic Lagrangian systems; the Jacobi
+        integral when the Lagrangian depends on time or has gyroscopic terms), the Jacobi
+        integral of the rotating-frame problems (arenstorf, cr3bp: C = 2 Omega - |v|^2;
+        hill, hill_spatial: |v|^2 - 2 F), the energy of harmonic, pendulum and kepler.
+        ValueError for a system without one (vanderpol, a compiled first-order system), or
+        y of the wrong size. A (k, n) array of states gives k energies."""
+        ys = np.asarray(y, dtype=float)
+        if ys.ndim == 2:
+            return np.array([self.energy(row, t) for row in ys])
+        ys = np.ascontiguousarray(ys.ravel())
+        if ys.size != self.dimension:
+            raise ValueError(f"y has {ys.size} components; the system '{self.name}' has "
+                             f"{self.dimension}")
+        if not np.all(np.isfinite(ys)):
+            raise ValueError("y must be finite")
+        name, np_, p, nspec, spec = self._flat_args()
+        e, info, message = _conmech.flat_system_energy(name, np_, p, nspec, spec, float(t),
+                                                       ys)
+        if info != 0:
+            msg = bytes(message).decode("ascii", "replace").strip() if not isinstance(
+                message, str) else message.strip()
+            raise ValueError(f"{msg} (system '{self.name}')")
+        return float(e)
+
+    @property
+    def has_energy(self):
+        """Whether :meth:`energy` is defined for this system."""
+        try:
+            self.energy(np.full(self.dimension, 0.5))
+        except ValueError:
+            return False
+        return True
+
 
 class BuiltinSystem(NativeSystem):
     """One of conmech's built-in first-order systems (or a system in generalized

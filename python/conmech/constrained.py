@@ -27,6 +27,8 @@ from . import _conmech
 from . import degrees_of_freedom as _dof
 from ._builtin_table import CONSTRAINED_NAMES
 from ._callback import Guard, as_result, message_text
+from ._checks import event_settings
+from ._methods import BY_NAME
 from ._native import _NO_SPEC, check_params
 
 __all__ = ["solve", "builtin", "NativeConstrained", "BuiltinConstrained",
@@ -38,8 +40,9 @@ __all__ = ["solve", "builtin", "NativeConstrained", "BuiltinConstrained",
 BUILTIN_NAMES = CONSTRAINED_NAMES
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
-_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
-            "RATTLE": 8, "Radau": 5, "RADAU5": 5}
+# the methods of the Fortran table that constrained_solve runs (codes from the table)
+_METHODS = {name: BY_NAME[name.upper()].code for name in (
+    "RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "RATTLE", "Radau", "RADAU5")}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
@@ -365,8 +368,7 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         if np.any(d <= 0):
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
-    from ._ivp import _event_settings
-    settings = _event_settings(events)
+    settings = event_settings(events)
     ne = len(settings)
     for i, (_, count, _) in enumerate(settings):
         if count > 1:

@@ -21,11 +21,12 @@ from ._native import BuiltinSystem, NativeSystem, check_params  # noqa: F401
 from .constrained import BuiltinConstrained
 
 __all__ = ["NativeSystem", "BuiltinSystem", "harmonic", "pendulum", "kepler", "arenstorf",
-           "vanderpol", "hill", "pendulum_angle", "cart_pendulum", "double_pendulum", "atwood",
-           "spring_pendulum", "double_spring_pendulum", "three_springs", "bead_hoop",
-           "polar_particle", "pendulum_moving", "yoyo_angle", "pendulum_xy", "rod_two_masses",
-           "double_pendulum_xy", "atwood_xy", "pendulum_moving_xy", "yoyo", "skate",
-           "rolling_disk", "pendulum_chain_xy", "rolling_ball"]
+           "vanderpol", "hill", "hill_spatial", "cr3bp", "pendulum_angle", "cart_pendulum",
+           "double_pendulum", "atwood", "spring_pendulum", "double_spring_pendulum",
+           "three_springs", "bead_hoop", "polar_particle", "pendulum_moving", "yoyo_angle",
+           "pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
+           "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "pendulum_chain_xy",
+           "rolling_ball"]
 
 
 def harmonic(omega=1.0):
@@ -57,6 +58,24 @@ def hill(m=0.080848933808312, kappa=1.0):
     """Hill's lunar problem x'' - 2 m y' = F_x, y'' + 2 m x' = F_y, F = kappa/r + (3/2) m^2
     x^2; y = [x, y, x', y'] (analytic Jacobian)."""
     return BuiltinSystem("hill", [m, kappa], ("m", "kappa"))
+
+
+def hill_spatial(m=0.080848933808312, kappa=1.0):
+    """Hill's lunar problem in space: x'' - 2 m y' = F_x, y'' + 2 m x' = F_y, z'' = F_z, F =
+    kappa/r + (3/2) m^2 x^2 - (1/2) m^2 z^2 (so z'' + m^2 z = -kappa z/r^3), in the units of
+    :func:`hill` (synodic month 2 pi); y = [x, y, z, x', y', z'] (analytic Jacobian);
+    energy: the Jacobi integral |v|^2 - 2 F."""
+    return BuiltinSystem("hill_spatial", [m, kappa], ("m", "kappa"))
+
+
+def cr3bp(mu=0.012150585609624):
+    """The spatial circular restricted three-body problem in the rotating frame: primaries of
+    masses 1 - mu at (-mu, 0, 0) and mu at (1 - mu, 0, 0) (0 < mu <= 1/2; default the
+    Earth-Moon value), x'' - 2 y' = Omega_x, y'' + 2 x' = Omega_y, z'' = Omega_z, Omega =
+    (x^2 + y^2)/2 + (1 - mu)/r1 + mu/r2; y = [x, y, z, x', y', z'] (analytic Jacobian and
+    Jacobian product); energy: the Jacobi constant C = 2 Omega - |v|^2. :mod:`conmech.cr3bp`
+    has its libration points and families."""
+    return BuiltinSystem("cr3bp", [mu], ("mu",))
 
 
 def pendulum_angle(m=1.0, g=9.81, l=1.0):

@@ -16,9 +16,9 @@ contains
     pure integer function builtin_param_count(name) result(np)
         character(len=*), intent(in) :: name
         select case (trim(name))
-        case ("harmonic", "kepler", "arenstorf", "vanderpol")
+        case ("harmonic", "kepler", "arenstorf", "vanderpol", "cr3bp")
             np = 1
-        case ("pendulum", "hill", "polar_particle", "rod_two_masses")
+        case ("pendulum", "hill", "hill_spatial", "polar_particle", "rod_two_masses")
             np = 2
         case ("pendulum_angle", "atwood", "three_springs", "pendulum_xy")
             np = 3
@@ -45,9 +45,9 @@ contains
             s = "omega"
         case ("pendulum", "rod_two_masses")
             s = "g, l"
-        case ("kepler", "arenstorf", "vanderpol")
+        case ("kepler", "arenstorf", "vanderpol", "cr3bp")
             s = "mu"
-        case ("hill")
+        case ("hill", "hill_spatial")
             s = "m, kappa"
         case ("pendulum_angle", "pendulum_xy")
             s = "m, g, l"
@@ -100,8 +100,10 @@ contains
             p = [9.81_dp, 1.0_dp]
         case ("arenstorf")
             p = [0.012277471_dp]
-        case ("hill")
+        case ("hill", "hill_spatial")
             p = [0.080848933808312_dp, 1.0_dp]
+        case ("cr3bp")
+            p = [0.012150585609624_dp]
         case ("pendulum_angle", "pendulum_xy")
             p = [1.0_dp, 9.81_dp, 1.0_dp]
         case ("cart_pendulum")

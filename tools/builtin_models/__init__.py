@@ -31,7 +31,8 @@ __all__ = ["Param", "Ode", "Lagrangian", "Constrained", "Handwritten", "FIRST_OR
            "GENERALIZED", "CONSTRAINED", "load", "load_file", "load_all"]
 
 #: first-order systems (``make_system``; the generalized ones are first-order too, y = [q, v])
-FIRST_ORDER = ["harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill"]
+FIRST_ORDER = ["harmonic", "pendulum", "kepler", "arenstorf", "vanderpol", "hill",
+               "hill_spatial", "cr3bp"]
 #: systems in generalized coordinates (``make_generalized``)
 GENERALIZED = ["pendulum_angle", "cart_pendulum", "double_pendulum", "atwood",
                "spring_pendulum", "double_spring_pendulum", "three_springs", "bead_hoop",

@@ -77,7 +77,7 @@ def _callback(fun, n, y0, t0, jac=None):
     are probed once at (t0, y0) in Python first: a wrong shape or an exception is raised
     before the Fortran side allocates anything (the STM of a large system is big)."""
     if not callable(fun):
-        raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+        raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                         "fun(t, y)")
     if jac is not None and not callable(jac):
         raise TypeError("jac must be a callable jac(t, y) -> (n, n) array, or None")
