@@ -1043,8 +1043,8 @@ def systems_py(models):
            "this module (see the guide's page", '"Adding a built-in system").', ""]
     out += textwrap.wrap(PY_NOTE, 92) + ['"""']
     out += ["from ._builtin_table import POSITIVE_PARAMS, RANGE_PARAMS, STATE_NAMES  "
-            "# noqa: F401", "from ._native import BuiltinSystem, NativeSystem, check_params  "
-            "# noqa: F401", "from .constrained import BuiltinConstrained", ""]
+            "# noqa: F401", "from ._native import _NO_SPEC, BuiltinSystem, NativeSystem, "
+            "check_params  # noqa: F401", "from .constrained import BuiltinConstrained", ""]
     names = ["NativeSystem", "BuiltinSystem"] + [m.name for m in allm]
     out += wrap_py("__all__ = [" + ", ".join(pq(n) for n in names) + "]", "")
     for m in allm:
