@@ -24,7 +24,6 @@ module conmech
     use conmech_systems_constrained
     use conmech_systems_mech
     use conmech_model_library
-    use conmech_systems_ball
     use conmech_hill
     use conmech_equilibria
     use conmech_jordan
