@@ -33,7 +33,7 @@ import numpy as np
 
 from .. import _conmech
 from ..compiled import CompiledConstrained, evaluate
-from ..constrained import BuiltinConstrained, ConstrainedSystem, builtin
+from ..constrained import ConstrainedSystem, NativeConstrained, builtin
 from ..constrained import solve as _constrained_solve
 from .continuation import continuation
 from .orbits import periodic_orbit, symmetric_orbit
@@ -58,7 +58,7 @@ def _evaluator(system):
     constrained system, G q'' = gamma."""
     if isinstance(system, str):
         system = builtin(system)
-    if isinstance(system, BuiltinConstrained):
+    if isinstance(system, NativeConstrained):
         if system.n_nh > 0:
             raise ValueError(f"system: '{system.name}' has non-holonomic constraints; "
                              "periodic orbits on a constraint manifold need holonomic ones")

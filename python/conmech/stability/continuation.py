@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import _conmech
 from .._callback import Guard, as_result
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _check_dim, _count, _msg, _raise, _state
 from .orbits import _METHODS, stable_tolerance
 
@@ -258,7 +258,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     if jac is not None and not callable(jac):
         raise TypeError("jac must be a callable jac(t, y, p) (jac(t, y) with in_period) "
                         "returning df/dy, or None")
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         if jac is not None:
             raise ValueError("jac: a built-in or compiled system has its own Jacobian")
         if param is None and in_period:
@@ -281,7 +281,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                                            ip + 1, y0, period, *args)
     else:
         if not callable(system):
-            raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+            raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                             "fun(t, y, p)")
         if p0 is None and in_period:
             p0 = 0.0

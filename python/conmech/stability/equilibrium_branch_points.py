@@ -36,7 +36,7 @@ from typing import Any, Callable  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _real
 from .continuation import _param_index
 from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoint,
@@ -49,7 +49,7 @@ _H = np.finfo(float).eps**(1/3)
 
 def _fun_jac(system, branch, param, jac, t):
     """F(y, p) and J(y, p) = [F_y F_p] (n x (n+1)) of the branch's system."""
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         if jac is not None:
             raise ValueError("jac: a built-in or compiled system has its own Jacobian")
         ip = _param_index(system, branch.param if param is None else param)
@@ -67,7 +67,7 @@ def _fun_jac(system, branch, param, jac, t):
             return np.array(f), (np.array(jy) if analytic else None)
     else:
         if not callable(system):
-            raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+            raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                             "fun(t, y, p)")
         if jac is not None and not callable(jac):
             raise TypeError("jac must be a callable jac(t, y, p) -> (n, n) or None")
