@@ -10,11 +10,12 @@
 !!     spec(6:15) function addresses (0 = absent):
 !!         ode:          6 rhs, 7 jac
 !!         generalized:  6 mass, 7 forces, 8 forces_jac, 9 energy
-!!         constrained:  6 mass, 7 forces, 8 (unused), 9 energy, 10 phi, 11 phi_jac,
+!!         constrained:  6 mass, 7 forces, 8 forces_jac, 9 energy, 10 phi, 11 phi_jac,
 !!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
 !!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
 !!     spec(18) (optional, ode) jac_prod: J x for an n x k block x (set_c_jac_prod)
+!!     spec(20) (optional, constrained) constraint_hessian: d(C^T lam)/dq, d(C v + c0)/dq
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -73,6 +74,7 @@ contains
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
         if (size(spec) >= 17) fp%accel = fptr(spec(17))
+        if (size(spec) >= 20) fp%constraint_hessian = fptr(spec(20))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
