@@ -1,0 +1,15 @@
+"""Published benchmark problems of constrained mechanics, ready to solve:
+
+- :mod:`conmech.benchmarks.bari`: Andrews' squeezing mechanism and the car axis problem
+  of the Test Set for IVP Solvers (University of Bari), with their reference solutions and
+  the test set's accuracy measure (mixed significant correct digits, :func:`mescd`);
+- :mod:`conmech.benchmarks.iftomm`: problems of the IFToMM library of computational
+  benchmark problems for multibody dynamics (A01 pendulum, A02 N-four-bar, A04 Bricard
+  mechanism, A05 flyball governor) with their closed forms or reference values.
+
+Each problem is built with :func:`conmech.symbolic.constrained_system` (kinetic and
+potential energies and holonomic constraints) and compiled on first use (cached).
+"""
+from .bari import Problem, andrews, car_axis, mescd
+
+__all__ = ["Problem", "andrews", "car_axis", "mescd"]
