@@ -51,9 +51,11 @@ class ConstrainedResult(dict):
     """Result of :func:`solve` (a dict whose keys are also attributes).
 
     Keys: ``t`` (nt,), ``q``, ``v`` and the accelerations ``a`` (also ``accelerations``)
-    (n, nt), ``lam`` (m, nt) multipliers (the reaction of each constraint: constraint i
-    acts on the coordinates with the generalized force C_i^T lam_i, see
-    :func:`constraint_forces`), ``reaction`` (n, nt) = C^T lambda, their sum,
+    (n, nt), ``lam`` (m, nt) multipliers, ``reactions`` (m, n, nt) the generalized force
+    C_i^T lam_i by which constraint i acts on the coordinates (the rows of one joint, e.g.
+    the two of a planar revolute joint, summed give that joint's reaction; for a joint
+    written as the coincidence of two points in Cartesian coordinates its multipliers are
+    the force components), ``reaction`` (n, nt) = C^T lambda, their sum,
     ``res_pos`` (max |phi|) and ``res_vel``
     (max |C v + c0|) (nt,), ``energy`` (nt,) (zeros if the system defines none),
     ``power`` (nt,) of the reactions, ``nfev``, ``naccept``, ``nreject``, ``nproj``,
@@ -430,11 +432,12 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
                      float(proj_tol)])
     out = {}
 
-    def store(t, q, v, acc, lam, reac, rp, rv, en, pw, n_, mm, nt):
-        out.update(t=np.array(t), q=np.array(q), v=np.array(v), a=np.array(acc),
-                   lam=np.array(lam),
-                   reaction=np.array(reac), res_pos=np.array(rp), res_vel=np.array(rv),
-                   energy=np.array(en), power=np.array(pw))
+    def store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n_, mm, nt):
+        lam = np.array(lam)
+        out.update(t=np.array(t), q=np.array(q), v=np.array(v), a=np.array(acc), lam=lam,
+                   reaction=np.array(reac), reactions=np.array(cm) * lam[:, None, :],
+                   res_pos=np.array(rp), res_vel=np.array(rv), energy=np.array(en),
+                   power=np.array(pw))
 
     common = dict(n=n, t_span=np.array([t0, tf]), q0=q0, v0=v0, method=_METHODS[method],
                   rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
@@ -461,9 +464,11 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
     if not out:
         out = dict(t=np.zeros(0), q=np.zeros((n, 0)), v=np.zeros((n, 0)),
                    a=np.zeros((n, 0)), lam=np.zeros((max(m, 1), 0)), reaction=np.zeros((n, 0)),
+                   reactions=np.zeros((max(m, 1), n, 0)),
                    res_pos=np.zeros(0), res_vel=np.zeros(0), energy=np.zeros(0),
                    power=np.zeros(0))
     out["lam"] = out["lam"][:m]
+    out["reactions"] = out["reactions"][:m]
     out["accelerations"] = out["a"]
     if isinstance(system, ConstrainedSystem) and system.energy is not None:
         out["energy"] = np.array([float(system.energy(t, q.copy(), v.copy()))

@@ -127,13 +127,14 @@ subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events
             real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
             integer(c_int), intent(in) :: ev_id(nev)
         end subroutine evstore
-        subroutine store(t, q, v, acc, lam, reac, rp, rv, en, pw, n, mm, nt)
+        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
             real(c_double), intent(in) :: t(nt)
             real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
             real(c_double), intent(in) :: lam(mm, nt)
             real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: cm(mm, n, nt)
             real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
         end subroutine store
     end interface
@@ -244,13 +245,14 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
             real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
             integer(c_int), intent(in) :: ev_id(nev)
         end subroutine evstore
-        subroutine store(t, q, v, acc, lam, reac, rp, rv, en, pw, n, mm, nt)
+        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
             real(c_double), intent(in) :: t(nt)
             real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
             real(c_double), intent(in) :: lam(mm, nt)
             real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: cm(mm, n, nt)
             real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
         end subroutine store
     end interface

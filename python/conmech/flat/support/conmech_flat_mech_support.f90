@@ -12,9 +12,11 @@
 !!     gamma(t, q, v, gam, n, mh)   G q'' = gam                 (if has_gamma, else FD)
 !!     nh(t, q, a, b, n, mn)        a(mn, n), b(mn): A q' + b = 0
 !!     nhgamma(t, q, v, gam, n, mn) A q'' = gam                 (if has_nh_gamma, else FD)
-!!     store(t, q, v, acc, lam, reac, rp, rv, en, pw, n, mm, nt)  the result, once, at the
-!!         end (acc (n, nt) the accelerations; lam is (mm, nt), mm = max(n_hol + n_nh, 1);
-!!         zero rows when there is no constraint)
+!!     store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)  the result, once, at
+!!         the end (acc (n, nt) the accelerations; lam is (mm, nt), mm = max(n_hol + n_nh,
+!!         1); cm (mm, n, nt) the constraint matrix C = [G; A] at every output, from which
+!!         the caller forms the generalized force C_i^T lam_i of each constraint; zero rows
+!!         when there is no constraint)
 module conmech_flat_mech_support
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
@@ -168,8 +170,9 @@ contains
         type(callback_events) :: ev
         integer(c_int) :: nev_fun
         type(constrained_result) :: r
-        real(dp), allocatable :: lam(:, :)
-        integer(c_int) :: m, mm, nt, nn
+        real(dp), allocatable :: lam(:, :), cm(:, :, :)
+        real(dp), allocatable :: c0(:)
+        integer(c_int) :: m, mm, nt, nn, j
 
         stats = 0
         moved = 0.0_dp
@@ -214,7 +217,14 @@ contains
         allocate (lam(mm, max(nt, 1)))
         lam = 0.0_dp
         if (m > 0 .and. nt > 0) lam(1:m, 1:nt) = r%lam
-        if (nt > 0) call store(r%t, r%q, r%v, r%acc, lam, r%reaction, r%res_pos, &
+        allocate (cm(mm, n, max(nt, 1)), c0(mm))
+        cm = 0.0_dp
+        if (m > 0) then
+            do j = 1, nt
+                call constraint_matrix(sys, r%t(j), r%q(:, j), cm(1:m, :, j), c0(1:m))
+            end do
+        end if
+        if (nt > 0) call store(r%t, r%q, r%v, r%acc, lam, r%reaction, cm, r%res_pos, &
                                r%res_vel, r%energy, r%power, nn, mm, nt)
         if (nev_fun > 0 .and. r%nev > 0) call evstore(r%ev_t, r%ev_q, r%ev_v, r%ev_id, nn, &
                                                       int(r%nev, c_int))
