@@ -3,13 +3,13 @@
 - :mod:`conmech.benchmarks.bari`: Andrews' squeezing mechanism and the car axis problem
   of the Test Set for IVP Solvers (University of Bari), with their reference solutions and
   the test set's accuracy measure (mixed significant correct digits, :func:`mescd`);
-- :mod:`conmech.benchmarks.iftomm`: problems of the IFToMM library of computational
-  benchmark problems for multibody dynamics (A01 pendulum, A02 N-four-bar, A04 Bricard
-  mechanism, A05 flyball governor) with their closed forms or reference values.
+- :mod:`conmech.benchmarks.iftomm`: the IFToMM library of computational benchmark
+  problems for multibody dynamics: A01, the simple pendulum, with its closed form.
 
 Each problem is built with :func:`conmech.symbolic.constrained_system` (kinetic and
 potential energies and holonomic constraints) and compiled on first use (cached).
 """
 from .bari import Problem, andrews, car_axis, mescd
+from .iftomm import a01_exact, a01_pendulum
 
-__all__ = ["Problem", "andrews", "car_axis", "mescd"]
+__all__ = ["Problem", "andrews", "car_axis", "mescd", "a01_pendulum", "a01_exact"]
