@@ -248,17 +248,34 @@ contains
                 call ode_solve(g2, t_span, y0, opt, ores, t_eval=t_eval, stepper=rstp)
             end if
             call build_constrained_result(res, ores, sys, sys)
-            call explain_newton_failure(rstp%y(1:2*n))
+            call explain_newton_failure(rstp%t, rstp%y(1:2*n))
         end subroutine solve_dae
 
-        !> A Newton failure of Radau at tolerances near round-off: say so. Velocities of
-        !! size |v| carry a round-off of about eps |v| (more where they couple); a
-        !! component that crosses zero with atol far below it cannot converge.
-        subroutine explain_newton_failure(y)
+        !> A Newton failure of Radau: say why when it can be seen. (1) The constraints
+        !! have become dependent where the run stopped (a singular configuration, e.g. a
+        !! parallelogram linkage passing its flat position): Radau IIA needs independent
+        !! constraints all along. (2) Tolerances near round-off: velocities of size |v|
+        !! carry a round-off of about eps |v| (more where they couple); a component that
+        !! crosses zero with atol far below it cannot converge.
+        subroutine explain_newton_failure(ts, y)
+            real(dp), intent(in) :: ts
             real(dp), intent(in) :: y(:)
             character(len=12) :: b1, b2
+            real(dp) :: a_s(n), l_s(m)
+            integer :: rk, inf_s
             if (res%status /= CM_STEP_TOO_SMALL) return
             if (index(res%message, "Newton") == 0) return
+            if (m > 0) then
+                call constrained_accel(sys, ts, y(1:n), y(n + 1:2*n), a_s, l_s, inf_s, &
+                                       rank=rk)
+                if (rk < m) then
+                    res%message = res%message//"; the constraints have become dependent "// &
+                                  "there (rank "//itoa(rk)//" of "//itoa(m)//": a "// &
+                                  "singular configuration), which Radau IIA cannot pass; "// &
+                                  "the projected methods (the default DOP853) can"
+                    return
+                end if
+            end if
             if (options%ode%atol >= 1.0e3_dp*epsilon(1.0_dp)*maxval(abs(y))) return
             write (b1, '(es9.2)') options%ode%atol
             write (b2, '(es9.2)') maxval(abs(y))
