@@ -95,6 +95,7 @@ program test_constrained_dae
     call check_jacobian(g2, 0.3_dp, y0, "GGL (index-2) Jacobian")
     call index3_setup(sb, q0, v0, acc, lam, g3, y0, stp)
     call check_jacobian(g3, 0.3_dp, y0, "index-3 Jacobian")
+    deallocate (g2%mech, g3%mech, y0, rv, av)   ! program variables are not freed at its end
 
     ! Radau on both forms against projected DOP853 at tight tolerance
     opt%ode%rtol = 1.0e-12_dp
