@@ -23,6 +23,11 @@ compiled function serves every parameter value)::
     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+    /* optional, constrained: the Jacobian of the force balance (forces_jac above, n x 2n)
+       and hl = d(C^T lam)/dq (n x n), hv = d(C v + c0)/dq (m x n), m = n_hol + n_nh:
+       together the exact Jacobian of Radau IIA on the constrained equations */
+    void constraint_hessian(double t, const double *q, const double *v, const double *lam,
+                            double *hl, double *hv, const double *p);
 
 with ``gamma_h = -d/dt [G v + phi_t]`` and ``gamma_n = -d/dt [A v + b]`` at fixed v (the
 acceleration-level right-hand sides of ``G q'' = gamma_h``, ``A q'' = gamma_n``). A missing
@@ -52,10 +57,11 @@ __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSy
            "library_taylor"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 26
+_SPEC_SIZE = 27
 _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
           "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
-          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18}
+          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18,
+          "constraint_hessian": 27}
 # Taylor coefficients (conmech_flat_spec: 19 taylor, 20 its work columns, 21 taylor_var,
 # 22 its columns, 23 taylor written out for one order, 24 that order, 25/26 the same for
 # taylor_var)
@@ -311,11 +317,14 @@ def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=
                        phi_jac=None, phi_t=None, phi_gamma=None, nh_matrix=None, nh_gamma=None,
                        energy=None, rheonomic: bool = False,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
-                       keep=None, name: str = "compiled") -> CompiledConstrained:
+                       keep=None, name: str = "compiled", *, forces_jac=None,
+                       constraint_hessian=None) -> CompiledConstrained:
     """A constrained system in excessive coordinates from compiled functions: ``n``
     coordinates, ``n_hol`` holonomic constraints phi(t, q) = 0 and ``n_nh`` Pfaffian
     constraints A(t, q) q' + b(t, q) = 0. Missing phi_jac, phi_t, phi_gamma, nh_gamma
-    fall back to finite differences (phi_t only when ``rheonomic``)."""
+    fall back to finite differences (phi_t only when ``rheonomic``); so do the optional
+    ``forces_jac`` and ``constraint_hessian`` (the derivatives behind the Jacobian of
+    ``method="Radau"``; see the module's signatures)."""
     n = _count(n, "n", 1)
     n_hol = _count(n_hol, "n_hol", 0)
     n_nh = _count(n_nh, "n_nh", 0)
@@ -330,7 +339,8 @@ def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=
         raise ValueError("nh_matrix is required when n_nh > 0")
     values, names = _params(params, param_names)
     funcs = dict(mass=mass, forces=forces, energy=energy, phi=phi, phi_jac=phi_jac,
-                 phi_t=phi_t, phi_gamma=phi_gamma, nh_matrix=nh_matrix, nh_gamma=nh_gamma)
+                 phi_t=phi_t, phi_gamma=phi_gamma, nh_matrix=nh_matrix, nh_gamma=nh_gamma,
+                 forces_jac=forces_jac, constraint_hessian=constraint_hessian)
     spec = _make_spec(_KIND_CON, n, n_hol, n_nh, rheonomic, funcs)
     return CompiledConstrained(str(name), spec, values, names, (keep, tuple(funcs.values())))
 
@@ -415,8 +425,9 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
     ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_accel``,
-    ``conmech_jac_prod``, and the Taylor routines ``conmech_taylor``,
-    ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran programs load the same libraries (``sweep --model``,
+    ``conmech_jac_prod``, ``conmech_constraint_hessian``, and the Taylor routines
+    ``conmech_taylor``, ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran
+    programs load the same libraries (``sweep --model``,
     conmech_model_library)."""
     try:
         lib = ctypes.CDLL(str(path))
@@ -452,4 +463,5 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
                               fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
                               fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,
-                              name=name)
+                              name=name, forces_jac=fn["forces_jac"],
+                              constraint_hessian=fn["constraint_hessian"])

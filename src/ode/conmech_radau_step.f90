@@ -35,6 +35,21 @@ contains
                 return
             end if
         end if
+        if (allocated(self%dae_index)) then
+            if (size(self%dae_index) /= n) then
+                msg = "bad input: dae_index must have n elements"
+                return
+            else if (any(self%dae_index < 1 .or. self%dae_index > 3)) then
+                msg = "bad input: dae_index values must be 1, 2 or 3"
+                return
+            end if
+        else if (allocated(self%mass)) then
+            allocate (self%dae_index(n))
+            self%dae_index = 1
+            if (allocated(self%index2)) then
+                where (self%index2) self%dae_index = 2
+            end if
+        end if
         call tolerance_vectors(opt, n, self%rtolv, self%atolv, info, msg)
         if (info /= CM_SUCCESS) return
 
@@ -162,8 +177,9 @@ contains
             end if
             self%nsteps = self%nsteps + 1
             self%scal = self%scal0
-            if (allocated(self%index2)) then
-                where (self%index2) self%scal = self%scal0/abs(self%h)
+            if (allocated(self%dae_index)) then
+                where (self%dae_index == 2) self%scal = self%scal0/abs(self%h)
+                where (self%dae_index == 3) self%scal = self%scal0/self%h**2
             end if
 
             call radau_newton(self, sys)

@@ -35,10 +35,12 @@
 !!   a singular iteration matrix halves the step, five singular ones in a row end the run
 !!   (CM_SINGULAR).
 !! - Mass-matrix form M y' = f(t, y) with a constant, possibly singular M (differential-
-!!   algebraic systems of index 1 and 2, RADAU5's IMAS = 1): the components `mass` and
-!!   `index2` set before `init` (index-2 components get their error scaled by h, as
-!!   RADAU5's NIND2); the initial step is then 1e-6 unless given. The constrained layer
-!!   uses it for the stabilised index-2 formulation (conmech_constrained_dae).
+!!   algebraic systems of index up to 3, RADAU5's IMAS = 1): the components `mass` and
+!!   `dae_index` (or `index2`) set before `init`; the error (and the Newton increments) of
+!!   an index-k component are weighted by |h|^(k-1), as RADAU5's NIND2, NIND3; the initial
+!!   step is then 1e-6 unless given. The constrained layer uses it for the stabilised
+!!   index-2 formulation (conmech_constrained_dae) and the index-3 formulation with the
+!!   accelerations and multipliers as algebraic variables (conmech_constrained_index3).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
 !! This module holds the state and its packing; the step itself is the submodule
 !! conmech_radau_step, on conmech_radau_newton (Jacobian, LU, Newton) and
@@ -64,8 +66,11 @@ module conmech_radau_stepper
         !! the caller before `init`; unallocated: M = I
         real(dp), allocatable :: mass(:, :)
         !> the index-2 algebraic components (their error is scaled by h, as RADAU5), set
-        !! with `mass`
+        !! with `mass` (shorthand for `dae_index` = 2 on them)
         logical, allocatable :: index2(:)
+        !> the differentiation index of each component (1, 2 or 3), set with `mass`: the
+        !! error of an index-k component is weighted by |h|^(k-1) (RADAU5's NIND2, NIND3)
+        integer, allocatable :: dae_index(:)
         real(dp) :: hmax = 0, uround = 0, fnewt = 0   !! largest |h|, roundoff, Newton tol.
         real(dp) :: faccon = 1, theta = 0     !! Newton contraction memory and rate
         real(dp) :: hacc = 0, erracc = 1      !! last accepted step and error (Gustafsson)
@@ -196,9 +201,9 @@ contains
         call p%item(has_mass)
         if (has_mass) then
             call p%columns(self%mass, 1, n)
-            if (.not. p%reading()) idx = merge(1, 0, self%index2)
+            if (.not. p%reading()) idx = self%dae_index
             call p%ints(idx, n)
-            if (p%reading()) self%index2 = idx /= 0
+            if (p%reading()) self%dae_index = idx
         end if
         if (p%reading()) then
             call radau_allocate_work(self)

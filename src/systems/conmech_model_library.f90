@@ -14,7 +14,8 @@
 !! conmech_c_mechanics, named conmech_rhs, conmech_jac (ode); conmech_mass,
 !! conmech_forces, conmech_forces_jac, conmech_energy (generalized and constrained);
 !! conmech_phi, conmech_phi_jac, conmech_phi_t, conmech_phi_gamma, conmech_nh_matrix,
-!! conmech_nh_gamma (constrained). Optional fast entries: conmech_jac_prod (ode: J x for a
+!! conmech_nh_gamma, optionally conmech_constraint_hessian (constrained). Optional fast
+!! entries: conmech_jac_prod (ode: J x for a
 !! block x, `set_c_jac_prod`, used by `integrate_stm`), conmech_mass_forces (M and Q in
 !! one call) and conmech_accel (a = M^-1 Q, `void accel(double t, const double *q, const
 !! double *v, double *a, const double *p)`) for generalized models. Missing optional
@@ -192,6 +193,7 @@ contains
         lib%fp%phi_gamma = symbol(h, "conmech_phi_gamma")
         lib%fp%nh_matrix = symbol(h, "conmech_nh_matrix")
         lib%fp%nh_gamma = symbol(h, "conmech_nh_gamma")
+        lib%fp%constraint_hessian = symbol(h, "conmech_constraint_hessian")
         info = CM_SUCCESS
         msg = "success"
     end subroutine load_model

@@ -66,6 +66,8 @@ _SIG = {
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
     "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
 }
+# constrained systems: the second derivatives of the constraints (inputs q, v, lam)
+_SIG["constraint_hessian"] = ("in3", "out2")
 
 
 class CompiledModel:
@@ -93,7 +95,8 @@ class CompiledModel:
                 "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
-                "mass_forces": [(n, n), (n,)], "accel": [(n,)]}[entry]
+                "mass_forces": [(n, n), (n,)], "accel": [(n,)],
+                "constraint_hessian": [(n, n), (h + k, n)]}[entry]
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
@@ -116,9 +119,12 @@ class CompiledModel:
             raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
         ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = self.derived.n
-        for a in ins:
-            if a.shape != (n,):
-                raise ValueError(f"input arrays must have shape ({n},), got {a.shape}")
+        shapes = [(n,)] * len(ins)
+        if entry == "constraint_hessian":
+            shapes[2] = (self.derived.n_hol + self.derived.n_nh,)
+        for a, shape in zip(ins, shapes):
+            if a.shape != shape:
+                raise ValueError(f"input arrays must have shape {shape}, got {a.shape}")
         outs = [np.zeros(s, order="F") for s in self._shapes(entry)]
         kind = _SIG[entry][1]
         restype = _D if kind == "ret" else None
@@ -224,7 +230,8 @@ def _system(model):
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
         nh_matrix=a.get("nh_matrix"), nh_gamma=a.get("nh_gamma"), energy=a.get("energy"),
-        rheonomic=bool(d.rheonomic), **common)
+        rheonomic=bool(d.rheonomic), forces_jac=a.get("forces_jac"),
+        constraint_hessian=a.get("constraint_hessian"), **common)
 
 
 def _input_key(kind, inputs, params, options):
