@@ -42,7 +42,13 @@ RANGE_PARAMS = {"arenstorf": {0: ("mu", 0.0, 1.0)}, "hill": {0: ("m", 0.0, np.in
 
 
 def check_params(name, params):
-    """ValueError naming a parameter of the built-in ``name`` that is out of its range."""
+    """ValueError naming a parameter of the built-in ``name`` that is out of its range, or
+    more parameters than the system has (missing trailing ones keep their defaults)."""
+    count, names = _conmech.flat_builtin_params(name)
+    if 0 <= count < params.size:
+        names = bytes(names).decode() if not isinstance(names, str) else names
+        raise ValueError(f"params: {params.size} values given for the system '{name}', "
+                         f"which has {int(count)} ({names.strip()})")
     for i, pname in POSITIVE_PARAMS.get(name, {}).items():
         if i < params.size and not params[i] > 0:
             raise ValueError(f"{pname} of the system '{name}' must be positive, got "

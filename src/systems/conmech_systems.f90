@@ -10,6 +10,7 @@ module conmech_systems
     use conmech_systems_basic
     use conmech_systems_mech, only: make_generalized_ode, mech_initial_state
     use conmech_hill, only: hill_problem
+    use conmech_systems_params, only: check_param_count
     implicit none
     private
     public :: make_system, system_dimension
@@ -25,8 +26,8 @@ contains
         class(ode_system), allocatable, intent(out) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        info = CM_SUCCESS
-        msg = "success"
+        call check_param_count(name, size(params), info, msg)
+        if (info /= CM_SUCCESS) return
         select case (trim(name))
         case ("harmonic")
             block
@@ -69,8 +70,8 @@ contains
         case default
             ! the generalized-coordinate seed systems (conmech_systems_mech), y = [q, q']
             call make_generalized_ode(name, params, sys, info, msg)
-            if (info /= CM_SUCCESS) msg = "bad input: unknown built-in system '" &
-                                          //trim(name)//"'"
+            if (info /= CM_SUCCESS .and. index(msg, "parameters given") == 0) &
+                msg = "bad input: unknown built-in system '"//trim(name)//"'"
         end select
     end subroutine make_system
 

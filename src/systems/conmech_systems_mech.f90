@@ -11,7 +11,8 @@
 !!   double_spring_pendulum: m1, m2, k1, k2, l1, l2, g | three_springs: m, k, l0 |
 !!   bead_hoop: m, R, omega, g | polar_particle: m, mu | pendulum_moving: m, g, l, a, b, w |
 !!   yoyo_angle: m, r, I, g, ah, vh, h0
-!! Missing trailing parameters keep their defaults.
+!! Missing trailing parameters keep their defaults; more than a system has is an error
+!! (conmech_systems_params).
 module conmech_systems_mech
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -22,6 +23,7 @@ module conmech_systems_mech
     use conmech_systems_chain, only: pendulum_chain_xy, chain_initial_state
     use conmech_systems_ball, only: rolling_ball
     use conmech_ode_system, only: ode_system
+    use conmech_systems_params, only: check_param_count
     implicit none
     private
 
@@ -55,8 +57,8 @@ contains
         class(constrained_system), allocatable, intent(out) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        info = CM_SUCCESS
-        msg = "success"
+        call check_param_count(name, size(params), info, msg)
+        if (info /= CM_SUCCESS) return
         select case (trim(name))
         case ("pendulum_xy")
             block
@@ -170,8 +172,8 @@ contains
         class(generalized_system), allocatable, intent(out) :: mech
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        info = CM_SUCCESS
-        msg = "success"
+        call check_param_count(name, size(params), info, msg)
+        if (info /= CM_SUCCESS) return
         select case (trim(name))
         case ("pendulum_angle")
             block
