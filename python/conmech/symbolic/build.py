@@ -385,12 +385,19 @@ def compile_source(source, flags=None, symbols=()):
                                   f"compiling ({fc}: {msg[-300:]})")
             raise CompileError(f"{fc} failed to compile the generated module "
                                f"(exit {res.returncode}):\n{msg}")
+        expected = [f"conmech_{e}" for e in symbols]
         try:
             data = read_regular(out)
-            check_bytes(data, out, [f"conmech_{e}" for e in symbols])
+            exported = check_bytes(data, out, expected)
         except LibraryError as exc:
             raise CompileError(f"{fc} reported success but wrote a damaged library: {exc}"
                                ) from None
+        # a generated library exports conmech's entry points and nothing else (names with
+        # a leading underscore belong to the toolchain)
+        extra = sorted(s for s in exported if s not in expected and not s.startswith("_"))
+        if symbols and extra:
+            raise CompileError("the compiled library exports symbols that are not conmech "
+                               f"entry points ({', '.join(extra[:5])}): refused")
         try:
             os.chmod(out, 0o755)
             os.chmod(src, 0o644)

@@ -225,6 +225,10 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     fortran_name_check(module, "module name")
     if module.lower() == name.lower():
         raise ValueError("the module and the type need different names")
+    if d.kind == "generalized" and d.R is None:
+        raise ValueError("emit: the model was derived without its Jacobian (jacobian=False); "
+                         "the emitted type's exact Jacobian needs it: derive with "
+                         "jacobian=True")
     comp = _component_names(d)
     em = _Emitter(d, name, comp)
     n = d.n
