@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import _conmech
 from ..systems import BuiltinSystem
-from ._validate import _check_dim, _msg, _raise, _state
+from ._validate import _check_dim, _count, _msg, _raise, _real, _state
 
 _SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
 
@@ -101,18 +101,22 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     y0 = _state(y0)
     _check_dim(system, y0)
     n = y0.size
-    period = float(period)
-    if not period > 0:
-        raise ValueError("period must be positive")
-    if int(max_points) < 1:
-        raise ValueError("max_points must be >= 1")
+    period = _real(period, "period", 0.0, low_open=True)
+    max_points = _count(max_points, "max_points")
+    max_iter = _count(max_iter, "max_iter")
     for name, v in (("ds", ds), ("ds_min", ds_min), ("ds_max", ds_max), ("rtol", rtol),
-                    ("atol", atol), ("tol", tol), ("res_tol", res_tol)):
-        if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be positive and finite")
+                    ("atol", atol), ("tol", tol), ("res_tol", res_tol),
+                    ("locate_tol", locate_tol), ("period_factor", period_factor)):
+        _real(v, name, 0.0, low_open=True)
     if not rtol < 1:
         raise ValueError("rtol must be < 1")
-    lo, hi = (float(v) for v in p_range)
+    if p0 is not None:
+        p0 = _real(p0, "p0")
+    direction = _real(direction, "direction")
+    if not (isinstance(p_range, (tuple, list, np.ndarray)) and len(p_range) == 2):
+        raise TypeError("p_range must be a pair (p_min, p_max)")
+    lo, hi = (_real(v, name) if not (isinstance(v, (float, np.floating)) and np.isinf(v))
+              else float(v) for v, name in zip(p_range, ("p_range[0]", "p_range[1]")))
     sym = free is not None or targets is not None
     if sym and (free is None or targets is None):
         raise ValueError("symmetric shooting needs both free and targets")
