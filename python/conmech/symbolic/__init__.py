@@ -59,6 +59,7 @@ __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledMod
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
+_V = ctypes.c_void_p
 # argument layouts of the C ABI (after t): number of input arrays, output arrays
 _SIG = {
     "rhs": ("in1", "out1"), "jac": ("in1", "out1"),
@@ -96,27 +97,45 @@ class CompiledModel:
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
                 "mass_forces": [(n, n), (n,)], "accel": [(n,)]}[entry]
 
-    def _function(self, entry):
-        """The ctypes function of an entry point (built once per model and entry)."""
-        fns = self.__dict__.setdefault("_fns", {})
-        fn = fns.get(entry)
-        if fn is None:
+    def _entry(self, entry):
+        """(ctypes function, number of input arrays, output shapes, returns a value) of an
+        entry point, built once per model and entry (pointers passed as addresses)."""
+        cache = self.__dict__.setdefault("_entries", {})
+        e = cache.get(entry)
+        if e is None:
+            if entry not in self.addresses:
+                raise ValueError(f"this model has no entry point '{entry}' "
+                                 f"(has: {', '.join(self.addresses)})")
             if entry == "jac_prod":
-                proto = ctypes.CFUNCTYPE(None, _D, _P, ctypes.c_int, _P, _P, _P)
+                fn = ctypes.CFUNCTYPE(None, _D, _V, ctypes.c_int, _V, _V, _V)(
+                    self.addresses[entry])
+                e = (fn, 2, [], False)
             else:
-                n_args = int(_SIG[entry][0][2:]) + len(self._shapes(entry)) + 1
-                proto = ctypes.CFUNCTYPE(_D if _SIG[entry][1] == "ret" else None, _D,
-                                         *([_P] * n_args))
-            fn = fns[entry] = proto(self.addresses[entry])
-        return fn
+                shapes = self._shapes(entry)
+                n_in = int(_SIG[entry][0][2:])
+                ret = _SIG[entry][1] == "ret"
+                fn = ctypes.CFUNCTYPE(_D if ret else None, _D,
+                                      *([_V] * (n_in + len(shapes) + 1)))(
+                    self.addresses[entry])
+                e = (fn, n_in, shapes, ret)
+            cache[entry] = e
+        return e
 
     def _params(self, params):
-        p = self.derived.param_values if params is None else params
+        """The parameter array (the model's values when None), checked: real numbers, as
+        many as the model has."""
+        if params is None:
+            p = self.__dict__.get("_p0")
+            if p is None:
+                p = self._p0 = self._params(list(self.derived.param_values))
+            return p
         names = self.derived.param_names
-        if isinstance(p, (str, bytes)) or any(isinstance(v, (bool, np.bool_, str, bytes))
-                                              for v in np.ravel(np.asarray(p, dtype=object))):
-            raise TypeError(f"params must be {len(names)} real numbers")
-        p = np.ascontiguousarray(p, dtype=float)
+        if not (isinstance(params, np.ndarray) and params.dtype == np.float64):
+            if isinstance(params, (str, bytes)) or any(
+                    isinstance(v, (bool, np.bool_, str, bytes))
+                    for v in np.ravel(np.asarray(params, dtype=object))):
+                raise TypeError(f"params must be {len(names)} real numbers")
+        p = np.ascontiguousarray(params, dtype=float)
         if p.ndim != 1 or p.size != len(names):
             raise ValueError(f"params must have {len(names)} values ({', '.join(names)})")
         return p if p.size else np.zeros(1)
@@ -125,28 +144,27 @@ class CompiledModel:
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
         (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
         parameters or `params`."""
-        if entry not in self.addresses:
-            raise ValueError(f"this model has no entry point '{entry}' "
-                             f"(has: {', '.join(self.addresses)})")
+        fn, n_in, shapes, ret = self._entry(entry)
         if entry == "jac_prod":
-            return self._call_jac_prod(t, *arrays, params=params)
+            return self._call_jac_prod(fn, t, *arrays, params=params)
         p = self._params(params)
-        n_in = int(_SIG[entry][0][2:])
         if len(arrays) != n_in:
             raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
-        ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = self.derived.n
-        for a in ins:
+        ins = []
+        for a in arrays:
+            a = np.ascontiguousarray(a, dtype=float)
             if a.shape != (n,):
                 raise ValueError(f"input arrays must have shape ({n},), got {a.shape}")
-        outs = [np.zeros(s, order="F") for s in self._shapes(entry)]
-        ptr = [a.ctypes.data_as(_P) for a in ins + outs + [p]]
-        r = self._function(entry)(float(t), *ptr)
-        if _SIG[entry][1] == "ret":
+            ins.append(a)
+        outs = [np.zeros(s, order="F") for s in shapes]
+        r = fn(float(t), *[a.ctypes.data for a in ins], *[o.ctypes.data for o in outs],
+               p.ctypes.data)
+        if ret:
             return float(r)
         return outs[0] if len(outs) == 1 else tuple(outs)
 
-    def _call_jac_prod(self, t, y, x, params=None):
+    def _call_jac_prod(self, fn, t, y, x, params=None):
         """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
         n = self.derived.n
         p = self._params(params)
@@ -157,9 +175,7 @@ class CompiledModel:
         if y.shape != (n,) or x.ndim != 2 or x.shape[0] != n or x.shape[1] < 1:
             raise ValueError(f"jac_prod needs y of shape ({n},) and x of shape ({n}, k)")
         jx = np.zeros(x.shape, order="F")
-        self._function("jac_prod")(float(t), y.ctypes.data_as(_P), x.shape[1],
-                                   x.ctypes.data_as(_P), jx.ctypes.data_as(_P),
-                                   p.ctypes.data_as(_P))
+        fn(float(t), y.ctypes.data, x.shape[1], x.ctypes.data, jx.ctypes.data, p.ctypes.data)
         return jx.ravel() if vec else jx
 
 

@@ -158,8 +158,11 @@ def _as_value(name, v):
     real number); a bool, a string, a complex number or an expression is refused."""
     if v is None:
         raise ValueError(f"parameter '{name}' has no value")
-    if isinstance(v, (bool, np.bool_, str, bytes)):
+    if isinstance(v, (bool, np.bool_)):
         raise TypeError(f"parameter '{name}' must be a real number, got {v!r}")
+    if isinstance(v, (str, bytes)):
+        raise ValueError(f"parameter '{name}' has no numeric value (got the string {v!r}: "
+                         "give a number)")
     if isinstance(v, sp.Basic) and not (v.is_number and v.is_real):
         raise ValueError(f"parameter '{name}' has no real numeric value (got {v!r})")
     if isinstance(v, (complex, np.complexfloating)):
