@@ -14,6 +14,9 @@
 !!   with contents (sh_offset + sh_size);
 !! - the dynamic symbol table defines every requested symbol.
 !!
+!! The message returned is the reason alone ("truncated: segment 2 ends at byte 8524, the
+!! file has 7000"); callers name the file.
+!!
 !! The Python package makes the same checks (conmech/_elf.py) before ctypes loads a model.
 module conmech_library_check
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
@@ -55,14 +58,14 @@ contains
         open (newunit=u, file=path, access="stream", form="unformatted", action="read", &
               status="old", iostat=ios, iomsg=iomsg)
         if (ios /= 0) then
-            msg = "cannot open the library '"//path//"': "//trim(iomsg)
+            msg = reason(iomsg)
             allocate (buf(0))
             return
         end if
         inquire (unit=u, size=sz)
         if (sz < 0 .or. sz > MAX_BYTES) then
             close (u)
-            msg = "'"//path//"' is not a regular file of a readable size"
+            msg = "not a regular file of a readable size"
             allocate (buf(0))
             return
         end if
@@ -70,12 +73,25 @@ contains
         if (sz > 0) read (u, iostat=ios, iomsg=iomsg) buf
         close (u)
         if (ios /= 0) then
-            msg = "cannot read the library '"//path//"': "//trim(iomsg)
+            msg = reason(iomsg)
             return
         end if
         info = CM_SUCCESS
         msg = "success"
     end subroutine read_bytes
+
+    !> The system's reason in an I/O message ("Cannot open file 'x': No such file or
+    !! directory" -> "No such file or directory").
+    function reason(iomsg) result(s)
+        character(len=*), intent(in) :: iomsg
+        character(len=:), allocatable :: s
+        integer :: k
+        k = index(iomsg, ": ", back=.true.)
+        s = trim(iomsg(k + 1:))
+        if (k > 0) s = trim(iomsg(k + 2:))
+        if (index(s, "Is a directory") > 0 .or. len(s) == 0) s = "not a regular file ("// &
+            trim(iomsg)//")"
+    end function reason
 
     !> The ELF machine of the running executable (-1 if unknown).
     integer(int64) function host_machine() result(m)
@@ -127,42 +143,40 @@ contains
         integer(int64) :: stype, soff, ssize, slink, sent, str_off, str_size, j, st_name
         integer(int64) :: st_shndx, m
         logical, allocatable :: found(:)
-        character(len=:), allocatable :: pre
         integer :: i
         call read_bytes(path, buf, info, msg)
         if (info /= CM_SUCCESS) return
         info = CM_BAD_INPUT
-        pre = "'"//path//"' is not a usable shared library: "
         sz = size(buf, kind=int64)
         if (sz == 0) then
-            msg = pre//"empty (0 bytes)"
+            msg = "empty (0 bytes)"
             return
         end if
         if (sz < 16) then
-            msg = pre//"not an ELF file ("//itoa(sz)//" bytes)"
+            msg = "not an ELF file ("//itoa(sz)//" bytes)"
             return
         end if
         if (.not. (buf(1) == 127_int8 .and. buf(2) == 69_int8 .and. buf(3) == 76_int8 .and. &
                    buf(4) == 70_int8)) then
-            msg = pre//"not an ELF file"
+            msg = "not an ELF file"
             return
         end if
         if (buf(5) /= 2_int8 .or. buf(6) /= little_endian()) then
-            msg = pre//"not a 64-bit ELF file of this machine's byte order"
+            msg = "not a 64-bit ELF file of this machine's byte order"
             return
         end if
         if (sz < EHDR) then
-            msg = pre//"truncated ("//itoa(sz)//" bytes: the ELF header alone takes 64)"
+            msg = "truncated ("//itoa(sz)//" bytes: the ELF header alone takes 64)"
             return
         end if
         if (le(buf, 16_int64, 2) /= ET_DYN) then
-            msg = pre//"an ELF file of type "//itoa(le(buf, 16_int64, 2))// &
+            msg = "an ELF file of type "//itoa(le(buf, 16_int64, 2))// &
                   ", not a shared object"
             return
         end if
         m = host_machine()
         if (m >= 0 .and. le(buf, 18_int64, 2) /= m) then
-            msg = pre//"built for another architecture (ELF machine "// &
+            msg = "built for another architecture (ELF machine "// &
                   itoa(le(buf, 18_int64, 2))//", this one is "//itoa(m)//")"
             return
         end if
@@ -172,15 +186,15 @@ contains
         shnum = le(buf, 60_int64, 2)
         if (le(buf, 52_int64, 2) /= EHDR .or. (phnum > 0 .and. le(buf, 54_int64, 2) /= PHDR) &
             .or. (shnum > 0 .and. le(buf, 58_int64, 2) /= SHDR)) then
-            msg = pre//"inconsistent ELF header sizes"
+            msg = "inconsistent ELF header sizes"
             return
         end if
         if (phnum == 0) then
-            msg = pre//"no program headers"
+            msg = "no program headers"
             return
         end if
         if (phoff < 0 .or. phoff + phnum*PHDR > sz) then
-            msg = pre//"truncated: the program headers end at byte "// &
+            msg = "truncated: the program headers end at byte "// &
                   itoa(phoff + phnum*PHDR)//", the file has "//itoa(sz)
             return
         end if
@@ -191,21 +205,21 @@ contains
             pfsz = le(buf, off + 32, 8)
             pmsz = le(buf, off + 40, 8)
             if (poff < 0 .or. pfsz < 0 .or. poff + pfsz > sz) then
-                msg = pre//"truncated: segment "//itoa(k)//" ends at byte "// &
+                msg = "truncated: segment "//itoa(k)//" ends at byte "// &
                       itoa(poff + pfsz)//", the file has "//itoa(sz)
                 return
             end if
             if (ptype == PT_LOAD .and. pfsz > pmsz) then
-                msg = pre//"segment "//itoa(k)//" is larger in the file than in memory"
+                msg = "segment "//itoa(k)//" is larger in the file than in memory"
                 return
             end if
         end do
         if (shnum == 0 .or. shoff == 0) then
-            msg = pre//"no section headers (its symbols cannot be checked)"
+            msg = "no section headers (its symbols cannot be checked)"
             return
         end if
         if (shoff < 0 .or. shoff + shnum*SHDR > sz) then
-            msg = pre//"truncated: the section headers end at byte "// &
+            msg = "truncated: the section headers end at byte "// &
                   itoa(shoff + shnum*SHDR)//", the file has "//itoa(sz)
             return
         end if
@@ -217,7 +231,7 @@ contains
             soff = le(buf, off + 24, 8)
             ssize = le(buf, off + 32, 8)
             if (stype /= SHT_NOBITS .and. (soff < 0 .or. ssize < 0 .or. soff + ssize > sz)) then
-                msg = pre//"truncated: section "//itoa(k)//" ends at byte "// &
+                msg = "truncated: section "//itoa(k)//" ends at byte "// &
                       itoa(soff + ssize)//", the file has "//itoa(sz)
                 return
             end if
@@ -230,14 +244,14 @@ contains
             slink = le(buf, off + 40, 4)
             sent = le(buf, off + 56, 8)
             if (sent /= SYM .or. slink >= shnum) then
-                msg = pre//"invalid dynamic symbol table"
+                msg = "invalid dynamic symbol table"
                 return
             end if
             str_off = le(buf, shoff + slink*SHDR + 24, 8)
             str_size = le(buf, shoff + slink*SHDR + 32, 8)
             if (str_off < 0 .or. str_size < 1 .or. str_off + str_size > sz &
                 .or. soff + ssize > sz) then
-                msg = pre//"invalid dynamic string table"
+                msg = "invalid dynamic string table"
                 return
             end if
             do j = 0, ssize/SYM - 1
@@ -254,7 +268,7 @@ contains
         end do
         do i = 1, size(symbols)
             if (.not. found(i)) then
-                msg = pre//"it does not define "//trim(symbols(i))
+                msg = "it does not define "//trim(symbols(i))
                 if (i == 1 .and. .not. any(found)) msg = msg//" (not a conmech model library?)"
                 return
             end if

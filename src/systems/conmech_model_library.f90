@@ -149,7 +149,10 @@ contains
         ! before dlopen: a truncated library would be mapped past its end (SIGBUS at the
         ! first access); a foreign file is named as such
         call check_shared_library(trim(path), ["conmech_model_info"], info, msg)
-        if (info /= CM_SUCCESS) return
+        if (info /= CM_SUCCESS) then
+            msg = "cannot load the model library '"//trim(path)//"': "//msg
+            return
+        end if
         info = CM_BAD_INPUT
         h = c_dlopen(dl_path(trim(path))//c_null_char, RTLD_NOW)
         if (.not. c_associated(h)) then
