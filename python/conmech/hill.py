@@ -213,7 +213,8 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
     return HillOrbit(m=m, kappa=kappa, y0=y0, period=period, jacobi=jacobi, monodromy=mono,
-                     multipliers=mult.T.view(np.complex128)[:, 0], stability_index=s, c=c, residual=residual,
+                     multipliers=mult.T.view(np.complex128)[:, 0], stability_index=s, c=c,
+                     residual=residual,
                      quarter_state=quarter, nsteps=nsu, iterations=iterations, nfev=nfev)
 
 

@@ -56,7 +56,7 @@ CODEGEN_VERSION = "7"   # 2: conmech_* entry names, model-library description;
 #                         6: conmech_accel of planar trees (articulated-body algorithm)
 #                         7: user strings escaped (comments, parameter names as data)
 
-_SQRT = sp.Function("conmech_sqrt")
+_SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
 # ------------------------------------------------------------------ user strings
 # Every string a user gives (symbol, coordinate, parameter, body and joint names, file
@@ -192,7 +192,7 @@ def check_source(src, procedures, c_names=None, max_line=132):
                                  f"{b.group(2)!r}")
     if sorted(seen) != sorted(allowed):
         raise ValueError("generated Fortran defines the procedures "
-                         f"{sorted(seen)}, expected {sorted(allowed)}")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
+                         f"{sorted(seen)}, expected {sorted(allowed)}")
 
 
 class FortranPrinter(FCodePrinter):
