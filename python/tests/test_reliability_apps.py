@@ -274,3 +274,23 @@ def test_namelist_forms_the_read_accepts(exes, tmp_path):
         (tmp_path / "bad.nml").write_text(f"&{prog}\n nope = 1\n/\n")
         r = run([exes[prog], "--input", "bad.nml"], tmp_path)
         assert r.returncode == 2 and f"line 2: unknown key 'nope' in &{prog}" in r.stderr
+
+
+# ------------------------------------------------------------------ install footprint
+
+def test_install_puts_the_library_modules_only(tmp_path):
+    """scripts/install.sh: libconmech.a and exactly the modules of src/ (fpm 0.12 alone also
+    installs the programs' and the examples' modules); --library-only: no programs."""
+    import re
+    r = subprocess.run(["bash", str(ROOT / "scripts" / "install.sh"), "--prefix",
+                        str(tmp_path / "p"), "--library-only"], cwd=ROOT, capture_output=True,
+                       text=True, timeout=1800)
+    assert r.returncode == 0, r.stderr[-2000:]
+    src = set()
+    for f in (ROOT / "src").rglob("*.f90"):
+        src |= {m.lower() for m in re.findall(r"(?im)^\s*module\s+([a-z]\w*)\s*(?:!.*)?$",
+                                               f.read_text())}
+    mods = {p.stem for p in (tmp_path / "p" / "include").glob("*.mod")}
+    assert mods == src and "conmech" in mods and "arenstorf_model" not in mods
+    assert (tmp_path / "p" / "lib" / "libconmech.a").is_file()
+    assert not (tmp_path / "p" / "bin").exists()

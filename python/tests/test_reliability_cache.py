@@ -535,3 +535,21 @@ def test_check_source_refuses_injected_code():
         check_source(src.replace('name="conmech_rhs"', 'name="system"'), procs)
     with pytest.raises(ValueError, match="character"):
         check_source(src.replace("Generated", "Gener\u00e4ted"), procs)
+
+
+def test_emitted_files_get_the_umask_mode(tmp_path):
+    """emit writes through a temporary file, which mkstemp creates 0600: the result must
+    have the mode of any new file (0666 less the umask), like the files it sits beside."""
+    from conmech.symbolic.__main__ import main
+    model = ROOT / "example" / "models" / "arenstorf.py"
+    old = os.umask(0o022)
+    try:
+        assert main(["emit", str(model), "-o", str(tmp_path / "arenstorf_model.f90")]) == 0
+        assert stat.S_IMODE(os.stat(tmp_path / "arenstorf_model.f90").st_mode) == 0o644
+        os.umask(0o077)
+        assert main(["emit", str(model), "-o", str(tmp_path / "b_model.f90"),
+                     "--name", "aren"]) == 0
+        assert stat.S_IMODE(os.stat(tmp_path / "b_model.f90").st_mode) == 0o600
+    finally:
+        os.umask(old)
+    assert not [f for f in os.listdir(tmp_path) if f.startswith(".emit_")]
