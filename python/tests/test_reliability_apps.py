@@ -11,6 +11,7 @@
   always by a library shim (LD_PRELOAD) that makes the C library's fwrite fail with ENOSPC.
 - Every namelist mistake names the key, the value and the line (exit 2).
 """
+import errno
 import os
 import shutil
 import subprocess
@@ -140,8 +141,9 @@ def test_threads_write_rows_in_job_order(sweep_omp, clean, tmp_path):
 # ------------------------------------------------------------------ full disks
 
 SHIM = textwrap.dedent(r"""
-    /* fwrite fails with ENOSPC after CONMECH_TEST_FWRITES successful calls (a full disk,
-       as the C library reports it through the count and the stream's error flag) */
+    /* fwrite fails after CONMECH_TEST_FWRITES successful calls with the errno
+       CONMECH_TEST_ERRNO (default ENOSPC: a full disk), as the C library reports a failed
+       write: through the count and the stream's error flag */
     #define _GNU_SOURCE
     #include <dlfcn.h>
     #include <errno.h>
@@ -155,14 +157,15 @@ SHIM = textwrap.dedent(r"""
                           dlsym(RTLD_NEXT, "fwrite");
         const char *lim = getenv("CONMECH_TEST_FWRITES");
         if (f != stderr && f != stdout && lim && calls++ >= atol(lim)) {
-            failed = 1; errno = ENOSPC; return 0;
+            const char *e = getenv("CONMECH_TEST_ERRNO");
+            failed = e ? atoi(e) : ENOSPC; errno = failed; return 0;
         }
         return real(p, s, n, f);
     }
     int ferror(FILE *f) {
         static int (*real)(FILE *) = 0;
         if (!real) real = (int (*)(FILE *))dlsym(RTLD_NEXT, "ferror");
-        if (failed && f != stderr && f != stdout) { errno = ENOSPC; return 1; }
+        if (failed && f != stderr && f != stdout) { errno = failed; return 1; }
         return real(f);
     }
 """)
@@ -177,13 +180,17 @@ def shim(tmp_path_factory):
     return str(d / "shim.so")
 
 
-@pytest.mark.parametrize("prog", ["sweep", "hill_family"])
-def test_full_disk_is_named_not_counted_as_failed_jobs_simulated(exes, shim, tmp_path, prog):
+@pytest.mark.parametrize("prog, code", [("sweep", errno.ENOSPC), ("hill_family", errno.ENOSPC),
+                                        ("sweep", errno.EIO), ("sweep", errno.EACCES),
+                                        ("hill_family", errno.EDQUOT)])
+def test_full_disk_is_named_not_counted_as_failed_jobs_simulated(exes, shim, tmp_path, prog,
+                                                                code):
     args = PEND if prog == "sweep" else ["--n", "150", "--batch", "32", "--quiet"]
-    env = dict(os.environ, LD_PRELOAD=shim, CONMECH_TEST_FWRITES="40")
+    env = dict(os.environ, LD_PRELOAD=shim, CONMECH_TEST_FWRITES="40",
+               CONMECH_TEST_ERRNO=str(code))
     r = run([exes[prog], *args, "--out", "o.csv"], tmp_path, env=env)
     assert r.returncode == 3, (r.returncode, r.stderr)
-    assert "cannot write o.csv: No space left on device" in r.stderr
+    assert f"cannot write o.csv: {os.strerror(code)}" in r.stderr
     assert "failed" not in r.stderr.replace("not a failed computation", "")
     # space again: the same command resumes and completes
     r = run([exes[prog], *args, "--out", "o.csv"], tmp_path)
