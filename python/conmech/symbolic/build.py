@@ -274,7 +274,8 @@ def verify_entry(path, symbols=()):
     check_private(path)
     info = _read_json(manifest)
     if info is None or info.get("format") != _MANIFEST_FORMAT:
-        return False, "it has no valid manifest (a build killed before it finished?)"
+        return False, ("it has no valid manifest (made by an older conmech, or by a build "
+                       "killed before it finished)")
     try:
         data = read_regular(path)
     except LibraryError as exc:
