@@ -51,7 +51,7 @@ import sympy as sp
 from .build import (CacheError, CacheWarning, CompileError, _conmech_version, cache_dir,
                     check_private, compile_source, load)
 from .codegen import CODEGEN_VERSION, generate
-from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
+from .derive import Derived, _as_value, derive_constrained, derive_lagrangian, derive_ode
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
            "CompileError", "CacheError", "CacheWarning", "cache_dir", "Derived",
@@ -331,9 +331,10 @@ def _from_cache(key, params, flags):
         return None
     if fl != (list(flags) if flags is not None else None):
         return None
-    d.param_values = [float(v) for v in params.values()]
-    if len(d.param_values) != len(d.param_names) or not np.all(np.isfinite(d.param_values)):
+    if len(params) != len(d.param_names):
         return None
+    # the same checks as the derivation: a value out of range is a ValueError naming it
+    d.param_values = [_as_value(n, v) for n, v in zip(d.param_names, params.values())]
     t1 = time.perf_counter()
     lib_path, hit = compile_source(src, flags, entries)
     t2 = time.perf_counter()
