@@ -14,9 +14,9 @@ contains
     pure integer function builtin_param_count(name) result(np)
         character(len=*), intent(in) :: name
         select case (trim(name))
-        case ("harmonic", "kepler", "arenstorf", "vanderpol")
+        case ("harmonic", "kepler", "arenstorf", "vanderpol", "cr3bp")
             np = 1
-        case ("pendulum", "hill", "polar_particle", "rod_two_masses")
+        case ("pendulum", "hill", "hill_spatial", "polar_particle", "rod_two_masses")
             np = 2
         case ("pendulum_angle", "atwood", "three_springs", "pendulum_xy")
             np = 3
@@ -41,8 +41,8 @@ contains
         select case (trim(name))
         case ("harmonic"); s = "omega"
         case ("pendulum"); s = "g, l"
-        case ("kepler", "arenstorf", "vanderpol"); s = "mu"
-        case ("hill"); s = "m, kappa"
+        case ("kepler", "arenstorf", "vanderpol", "cr3bp"); s = "mu"
+        case ("hill", "hill_spatial"); s = "m, kappa"
         case ("pendulum_xy", "pendulum_angle"); s = "m, g, l"
         case ("rod_two_masses"); s = "g, l"
         case ("double_pendulum_xy", "double_pendulum"); s = "m1, m2, l1, l2, g"
