@@ -36,7 +36,8 @@ import symbolic_seeds as seeds  # noqa: E402
 from conmech import compiled, symbolic  # noqa: E402
 from conmech._elf import LibraryError, check_library  # noqa: E402
 from conmech.symbolic import build  # noqa: E402
-from conmech.symbolic.codegen import check_source, comment_text, generate  # noqa: E402
+from conmech.symbolic.codegen import (check_source, comment_text, generate,  # noqa: E402
+                                      private_procedures)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -485,7 +486,8 @@ def test_hostile_names_cannot_inject_code(kind, tmp_path, built, monkeypatch):
     assert _exports(model.path) == {f"conmech_{e}" for e in model.addresses}
     head = model.source.split("\nmodule conmech_symbolic_model")[0]
     assert all(ln.startswith("!") for ln in head.split("\n"))     # names stay in comments
-    check_source(model.source, [f"conmech_{e}" for e in model.addresses])
+    c_names = [f"conmech_{e}" for e in model.addresses]
+    check_source(model.source, c_names + private_procedures(model.addresses), c_names)
     # the model library: parameter names kept as data, exactly
     lib = symbolic.save_model(s, tmp_path / "m.so")
     entries = {f"conmech_{e}" for e in model.addresses} | {
@@ -525,16 +527,17 @@ def test_check_source_refuses_injected_code():
     from conmech.symbolic.derive import derive_ode
     d = derive_ode([v, -k * x], [x, v], {k: 1.0})
     src, entries = generate(d)
-    procs = [f"conmech_{e}" for e in entries]
-    check_source(src, procs)
+    cn = [f"conmech_{e}" for e in entries]
+    procs = cn + private_procedures(entries)
+    check_source(src, procs, cn)
     evil = src.replace("contains\n", "contains\n    subroutine pwn() bind(C, name=\"pwn\")\n"
                        "    end subroutine pwn\n", 1)
     with pytest.raises(ValueError, match="unexpected procedure 'pwn'"):
-        check_source(evil, procs)
+        check_source(evil, procs, cn)
     with pytest.raises(ValueError, match="unexpected C name"):
-        check_source(src.replace('name="conmech_rhs"', 'name="system"'), procs)
+        check_source(src.replace('name="conmech_rhs"', 'name="system"'), procs, cn)
     with pytest.raises(ValueError, match="character"):
-        check_source(src.replace("Generated", "Gener\u00e4ted"), procs)
+        check_source(src.replace("Generated", "Gener\u00e4ted"), procs, cn)
 
 
 def test_emitted_files_get_the_umask_mode(tmp_path):

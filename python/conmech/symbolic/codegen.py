@@ -6,7 +6,8 @@ compiled systems (``value`` for t, explicit-shape arrays, column-major matrices,
 parameter array ``p`` last)::
 
     ode:          cm_rhs(t, y, dydt, p), cm_jac(t, y, dfdy, p),
-                  cm_jac_prod(t, y, k, x, jx, p)   (jx = J x, x an n x k block)
+                  cm_jac_prod(t, y, k, x, jx, p)   (jx = J x, x an n x k block),
+                  cm_taylor(t, order, w, p) and its variants (conmech.symbolic.taylor)
     generalized:  cm_mass(t, q, M, p), cm_forces(t, q, v, Q, p),
                   cm_forces_jac(t, q, v, a, R, p), real cm_energy(t, q, v, p),
                   cm_mass_forces(t, q, v, M, Q, p), and for planar trees
@@ -49,12 +50,13 @@ ENTRY_POINTS = {
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "7"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "8"   # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
 #                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
 #                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed);
 #                         6: conmech_accel of planar trees (articulated-body algorithm)
-#                         7: user strings escaped (comments, parameter names as data)
+#                         7: conmech_taylor* (Taylor coefficients, conmech.symbolic.taylor)
+#                         8: user strings escaped (comments, parameter names as data)
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -157,6 +159,12 @@ def _code_part(line):
     string_constant)."""
     k = line.find("!")
     return line if k < 0 else line[:k]
+
+
+def private_procedures(entries):
+    """The internal (private, not C-bound) procedures the generated module defines beside
+    the entry points `entries`: the body that the quadruple-precision Taylor entry wraps."""
+    return [f"conmech_{e}_body" for e in entries if e.endswith("taylor_qp")]
 
 
 def check_source(src, procedures, c_names=None, max_line=132):
@@ -666,6 +674,12 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                 [("dfdy", d.jac, True)]))
         procs.append(_jac_prod_procedure(pr, d))
         entries = ["rhs", "jac", "jac_prod"]
+        # Taylor coefficients of the solution (conmech.symbolic.taylor), when f is smooth
+        from .taylor import ode_taylor_lines
+        tl, te, _ = ode_taylor_lines(d, pr.names)
+        if tl:
+            procs.append(tl)
+            entries += te
     else:
         Q1 = [T, arr("q", [n])]
         QV = Q1 + [arr("v", [n])]
@@ -735,13 +749,17 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     head += comment_lines(f"Coordinates {names}; parameters p = [{pnames}]. Do not edit.")
     head += [
         f"module {module}",
-        "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char, c_null_char",
+        "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char, c_null_char, "
+        "c_ptr, c_f_pointer",
+        "    use, intrinsic :: iso_fortran_env, only: real128",
         "    implicit none",
-        "    integer, parameter :: dp = c_double",
+        "    integer, parameter :: dp = c_double, qp = real128",
         "    public",
-        "contains",
-        "",
     ]
+    # the quadruple-precision Taylor entry wraps an internal body: private, so that the
+    # library exports conmech's C entry points only
+    internal = private_procedures(entries)
+    head += [f"    private :: {p}" for p in internal] + ["contains", ""]
     if model_values is not None:
         if len(model_values) != len(d.params):
             raise ValueError(f"{len(model_values)} parameter values for {len(d.params)} "
@@ -754,5 +772,5 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     c_names = [f"conmech_{e}" for e in entries]
     if model_values is not None:
         c_names += ["conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
-    check_source(src, c_names)
+    check_source(src, c_names + internal, c_names)
     return src, entries
