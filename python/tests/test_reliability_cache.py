@@ -513,6 +513,51 @@ def test_hostile_names_cannot_inject_code(kind, tmp_path, built, monkeypatch):
     assert r.returncode == 0, r.stderr[-3000:]
 
 
+HOSTILE_TYPE_NAMES = ["do", "end", "module", "contains", "type", "if", "pure", "program",
+                      "real", "integer", "complex", "doubleprecision", "character", "conmech",
+                      "conmech_ode", "ode_system", "constrained_system", "dp", "self", "rhs",
+                      "cm_success", "mass_cholesky", "x" * 41, "a b", "\u03b8", "1abc", "_a",
+                      "n\nsubroutine p()", "k!", "q&", ""]
+
+
+@pytest.mark.parametrize("kind", ["ode", "constrained"])
+def test_hostile_type_and_module_names_in_emit(kind, tmp_path):
+    """A type or module name for emit is refused with a ValueError naming it, or the emitted
+    module compiles: never Fortran that gfortran rejects (an intrinsic type's name, a name
+    the generated code takes from conmech, a module name that is also a name inside)."""
+    from conmech.symbolic.derive import derive_constrained, derive_ode
+    from conmech.symbolic.emit_fortran import emit
+    x, v, k = sp.symbols("x v k")
+    if kind == "ode":
+        d = derive_ode([v, -k * x], [x, v], {k: 1.0})
+    else:
+        t = sp.Symbol("t")
+        q = [sp.Function("a")(t), sp.Function("b")(t)]
+        qd = [qi.diff(t) for qi in q]
+        d = derive_constrained((qd[0] ** 2 + qd[1] ** 2) / 2, k * q[1], q,
+                               [q[0] ** 2 + q[1] ** 2 - 1], [], {k: 9.81})
+    mods = sorted(glob.glob(str(ROOT / "build" / "**" / "conmech.mod"), recursive=True))
+    assert mods, "conmech.mod not found under build/ (run scripts/setup.sh)"
+    cases = [(n, None) for n in HOSTILE_TYPE_NAMES]
+    cases += [("osc", m) for m in HOSTILE_TYPE_NAMES + ["new_osc", "osc_rhs", "osc_n", "k",
+                                                         "osc_model", "t", "y"]]
+    compiled_ok = refused = 0
+    for i, (name, module) in enumerate(cases):
+        try:
+            src = emit(d, name, module=module)
+        except ValueError as exc:
+            assert f"'{name if module is None else module}'" in str(exc), (name, module, exc)
+            refused += 1
+            continue
+        f = tmp_path / f"case{i}.f90"
+        f.write_text(src)
+        r = subprocess.run(["gfortran", "-fsyntax-only", f"-I{os.path.dirname(mods[0])}",
+                            f"-J{tmp_path}", str(f)], capture_output=True, text=True)
+        assert r.returncode == 0, (name, module, r.stderr[-2000:])
+        compiled_ok += 1
+    assert compiled_ok >= 8 and refused >= 30, (compiled_ok, refused)
+
+
 def test_hostile_parameter_names_are_validated_or_kept_as_data():
     x, v = sp.symbols("x v")
     for bad in ["k\nsubroutine", "k k", "k\"", "1k", "", "k!"]:

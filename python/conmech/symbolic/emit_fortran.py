@@ -58,6 +58,13 @@ _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energ
              "rhs", "jacobian", "has_jacobian", "self", "dp", "jacobian_product",
              "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian",
              "taylor_size", "taylor_jet"}
+# names the type may not take: Fortran's intrinsic types (C424 of Fortran 2008) and what the
+# emitted code takes from conmech and the intrinsic modules (a local name would hide them)
+_TYPE_TAKEN = {"real", "integer", "logical", "character", "complex", "doubleprecision",
+               "doublecomplex", "ode_system", "generalized_system", "constrained_system",
+               "cm_success", "mass_cholesky", "dpotrs", "ieee_value", "ieee_quiet_nan",
+               "ieee_arithmetic", "ieee_exceptions", "ieee_features", "iso_c_binding",
+               "iso_fortran_env"}
 _IND = "        "
 
 
@@ -101,6 +108,12 @@ def _component_names(d):
         seen[cand.lower()] = name
         out.append(cand)
     return out
+
+
+def _code(line):
+    """A generated line without its comment (no string literal in emitted code holds '!')."""
+    k = line.find("!")
+    return line if k < 0 else line[:k]
 
 
 def _lit(x):
@@ -220,12 +233,20 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     fortran_name_check(name, "type name")
     if len(name) > 40:
         raise ValueError(f"type name '{name}' is longer than 40 characters")
-    if keyword.iskeyword(name) or name.lower() in _RESERVED:
-        raise ValueError(f"type name '{name}' is reserved")
+    if keyword.iskeyword(name) or name.lower() in _RESERVED | _TYPE_TAKEN:
+        raise ValueError(f"type name '{name}' is reserved (an intrinsic type or module, or a "
+                         "name the generated code uses)")
     module = module or f"{name}_model"
     fortran_name_check(module, "module name")
     if module.lower() == name.lower():
         raise ValueError("the module and the type need different names")
+    if keyword.iskeyword(module) or module.lower() in _RESERVED | _TYPE_TAKEN:
+        raise ValueError(f"module name '{module}' is reserved (an intrinsic type or module, "
+                         "or a name the generated code uses)")
+    for what, nm in (("type", name), ("module", module)):
+        if nm.lower().startswith("conmech"):
+            raise ValueError(f"{what} name '{nm}': names beginning with 'conmech' belong to "
+                             "the library's modules")
     if d.kind == "generalized" and d.R is None:
         raise ValueError("emit: the model was derived without its Jacobian (jacobian=False); "
                          "the emitted type's exact Jacobian needs it: derive with "
@@ -396,6 +417,11 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
               if ln.startswith("    function new_")]
     procs += helpers
     check_source(text, sorted(set(procs)), c_names=[], max_line=100)
+    # the module's name is a global name: no entity inside may take it
+    inner = "\n".join(_code(ln) for ln in src[1:-2] if not ln.startswith("module "))
+    if re.search(rf"(?<![%\w]){re.escape(module)}(?!\w)", inner, re.IGNORECASE):
+        raise ValueError(f"module name '{module}' is also a name inside the module (a "
+                         "procedure, constant or component): choose another")
     return text
 
 
