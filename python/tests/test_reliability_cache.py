@@ -499,6 +499,18 @@ def test_hostile_names_cannot_inject_code(kind, tmp_path, built, monkeypatch):
     if sum(len(n.encode()) + 1 for n in want) < 4096:
         assert got == want
     np.testing.assert_allclose(list(loaded.parameters.values()), model.derived.param_values)
+    if kind != "ode" and kind != "constrained":
+        # the analytical-mechanics generators (momenta, first integrals, energy Hessian)
+        y = np.full(2 * model.derived.n, 0.1)
+        assert np.all(np.isfinite(s.momenta.p_of(y)))
+        fi = s.first_integrals
+        assert np.all(np.isfinite(fi.values(y))) and np.all(np.isfinite(fi.energy_hessian(y)))
+    # every library any generator built into the cache exports conmech's names only
+    libs = glob.glob(str(tmp_path / "cache" / "**" / "*.so"), recursive=True)
+    assert libs
+    for so in libs:
+        extra = {e for e in _exports(so) if not e.startswith("conmech_")}
+        assert not extra, (so, extra)
     # emit: a standalone module, checked and compiled against conmech's modules
     from conmech.symbolic.emit_fortran import emit
     src = emit(model.derived, "hostile", source="evil\nsubroutine q()\n.py")
