@@ -187,3 +187,23 @@ def test_continuation_arguments_give_clear_messages(kw, exc, msg):
 def test_hill_arguments_are_strict(m):
     with pytest.raises((TypeError, ValueError), match="m must be"):
         conmech.hill.variation_orbit(m)
+
+
+@pytest.mark.parametrize("expr, exc, msg", [
+    (x + sp.I, ValueError, r"events\[0\] contains the imaginary unit I"),
+    (x + 2j, ValueError, r"events\[0\] contains the imaginary unit I"),
+    (x * sp.nan, ValueError, r"events\[0\] contains nan"),
+    (x + sp.zoo, ValueError, r"events\[0\] contains an infinity"),
+    (x - sp.oo, ValueError, r"events\[0\] contains an infinity"),
+    (sp.Sum(x / k, (k, 1, 3)), ValueError, r"events\[0\] contains the unevaluated Sum"),
+    (x + sp.Rational(10 ** 400, 3), ValueError, r"events\[0\] contains the number"),
+    (sp.Matrix([x, x]), TypeError, r"(?s)events\[0\]: .* is not a scalar expression"),
+    (sp.Function("f")(x), ValueError, r"events\[0\]: unknown function"),
+])
+def test_compiled_event_expressions_are_checked(expr, exc, msg):
+    """An event of a compiled system given as a sympy expression is checked like the
+    system's own entries: x + I used to drop the imaginary part (g = x), nan and zoo to
+    reach gfortran, oo to become the largest double."""
+    s = symbolic.ode_system([v, -k * x], [x, v], params={k: 1.0})
+    with pytest.raises(exc, match=msg):
+        symbolic.event(s, expr)(0.0, [0.5, 0.1])
