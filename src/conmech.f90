@@ -55,6 +55,10 @@ module conmech
     use conmech_system_energy
     use conmech_hopf
     use conmech_equilibrium_continuation
+    use conmech_periodic_multipliers
+    use conmech_periodic_schur
+    use conmech_block_chain
+    use conmech_taylor_stepper
     implicit none
     public
 end module conmech
