@@ -28,7 +28,9 @@ while [ $# -gt 0 ]; do
     shift
 done
 [ -n "$prefix" ] || { echo "usage: bash scripts/install.sh --prefix DIR [--library-only] [fpm install options]" >&2; exit 2; }
-fpm install "${args[@]}"
+# --no-prune: every module of the library, also those no program or test uses (fpm drops
+# them otherwise, from libconmech.a and from the installed modules alike)
+fpm install --no-prune "${args[@]}"
 inc="${includedir:-$prefix/include}"
 # the library's modules: `module NAME` statements in src/ (not `module procedure` etc.)
 keep="$(grep -rhoiE '^[[:space:]]*module[[:space:]]+[a-z][a-z0-9_]*[[:space:]]*(!.*)?$' src \

@@ -289,7 +289,8 @@ except ImportError:           # conmech without its symbolic extra: nothing to f
     sympy = None
 needs_sympy = pytest.mark.skipif(sympy is None, reason="sympy is not installed")
 if sympy is not None:
-    from conmech.symbolic.codegen import check_source, generate  # noqa: E402
+    from conmech.symbolic.codegen import (check_source, generate,  # noqa: E402
+                                          private_procedures)
     from conmech.symbolic.derive import derive_ode  # noqa: E402
     _X, _V, _K = sympy.symbols("x v k")
     junk_atom = st.one_of(
@@ -344,8 +345,9 @@ def test_fuzz_symbolic_front_end(f, params):
     except (ValueError, TypeError) as exc:
         check_text(str(exc), ascii_only=False)
         return
-    check_source(src, [f"conmech_{e}" for e in entries] + [
-        "conmech_model_info", "conmech_model_params", "conmech_model_param_names"])
+    c_names = [f"conmech_{e}" for e in entries] + [
+        "conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
+    check_source(src, c_names + private_procedures(entries), c_names)
     assert len(d.f) == 2
     for e in d.f:
         assert not e.has(sympy.I, sympy.nan, sympy.zoo, sympy.oo, sympy.Integral, sympy.Sum)

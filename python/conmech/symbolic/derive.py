@@ -381,7 +381,7 @@ def _resolve_params(params, exprs, known, t):
         else:
             raise TypeError(f"params key {k!r} must be a sympy Symbol or a string")
         if not name.isidentifier():
-            raise ValueError(f"parameter name '{name}' is not an identifier")
+            raise ValueError(f"parameter name {name!r} is not an identifier")
         if name in known_names:
             raise ValueError(f"'{name}' is a coordinate, a velocity or the time, not a "
                              "parameter")
