@@ -45,6 +45,7 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import ctypes
 import math
+import os
 
 import numpy as np
 
@@ -102,19 +103,34 @@ def function_address(f, what: str = "function") -> int:
     return addr
 
 
+def _real(name, v):
+    """float(v) for a real number v (a bool, a string, a complex or None is a TypeError
+    naming the parameter)."""
+    if isinstance(v, (bool, np.bool_, str, bytes)) or v is None or np.iscomplexobj(v):
+        raise TypeError(f"parameter {name} must be a real number, got {v!r}")
+    try:
+        x = float(v)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"parameter {name} must be a real number, got {v!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"parameter {name} must be finite, got {v!r}")
+    return x
+
+
 def _params(params, param_names):
     """(values, names) from a sequence or a dict of parameters."""
     if isinstance(params, dict):
         names = tuple(str(k) for k in params)
-        values = list(params.values())
+        values = [_real(k, v) for k, v in params.items()]
     else:
-        values = list(np.ravel(np.asarray(params, dtype=float))) if np.size(params) else []
+        if isinstance(params, (str, bytes)):
+            raise TypeError("params must be a sequence of real numbers or a dict")
+        flat = list(np.ravel(np.asarray(params, dtype=object))) if np.size(params) else []
         names = tuple(param_names) if param_names else tuple(f"p{i}" for i in
-                                                             range(len(values)))
-    try:
-        values = np.array(values, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise TypeError("params must be real numbers") from None
+                                                             range(len(flat)))
+        values = [_real(names[i] if i < len(names) else f"p{i}", v)
+                  for i, v in enumerate(flat)]
+    values = np.array(values, dtype=float).ravel()
     if len(names) != values.size:
         raise ValueError(f"param_names has {len(names)} names for {values.size} params")
     if len(set(names)) != len(names):
@@ -146,13 +162,7 @@ def _with_params(obj, kw):
     for k, v in kw.items():
         if k not in values:
             raise ValueError(f"unknown parameter {k!r} (known: {', '.join(obj.param_names)})")
-        try:
-            v = float(v)
-        except (TypeError, ValueError):
-            raise TypeError(f"parameter {k} must be a real number") from None
-        if not math.isfinite(v):
-            raise ValueError(f"parameter {k} must be finite, got {v}")
-        values[k] = v
+        values[k] = _real(k, v)
     return np.array([values[k] for k in obj.param_names], dtype=float)
 
 
@@ -429,25 +439,35 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     ``conmech_taylor``, ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran
     programs load the same libraries (``sweep --model``,
     conmech_model_library)."""
+    from ._elf import LibraryError, check_library
+    path = os.fspath(path)
     try:
-        lib = ctypes.CDLL(str(path))
+        # before dlopen: a truncated library would be mapped past its end (SIGBUS at the
+        # first access), a foreign file gives an obscure error
+        check_library(path, ["conmech_model_info"])
+        lib = ctypes.CDLL(os.path.abspath(path) if os.sep not in path else path)
+    except LibraryError as e:
+        raise ValueError(f"cannot load the model library {path!r}: {e.reason}") from None
     except OSError as e:
-        raise ValueError(f"cannot load the model library {str(path)!r}: {e}") from None
-    if not hasattr(lib, "conmech_model_info"):
-        raise ValueError(f"{str(path)!r} is not a conmech model (no conmech_model_info)")
+        raise ValueError(f"cannot load the model library {path!r}: {e}") from None
     info = (ctypes.c_int*6)()
     lib.conmech_model_info(info)
     kind, n, n_hol, n_nh, rheo, npar = list(info)
-    if kind not in (1, 2, 3) or n < 1 or npar < 0:
-        raise ValueError(f"{str(path)!r}: invalid description from conmech_model_info")
+    if kind not in (1, 2, 3) or not 1 <= n <= 1000000 or not 0 <= npar <= 4096 \
+            or not 0 <= n_hol <= n or not 0 <= n_nh <= n:
+        raise ValueError(f"{path!r}: invalid description from conmech_model_info "
+                         f"(kind {kind}, n {n}, n_hol {n_hol}, n_nh {n_nh}, {npar} "
+                         "parameters)")
     p = (ctypes.c_double*max(npar, 1))()
     if npar:
+        if not hasattr(lib, "conmech_model_params"):
+            raise ValueError(f"{path!r} has {npar} parameters but no conmech_model_params")
         lib.conmech_model_params(p)
     names = ()
     if hasattr(lib, "conmech_model_param_names"):
         buf = ctypes.create_string_buffer(4096)
         lib.conmech_model_param_names(buf, ctypes.c_int(4096))
-        names = tuple(buf.value.decode("ascii", "replace").split())
+        names = tuple(buf.value.decode("utf-8", "replace").split())
     if len(names) != npar:
         names = tuple(f"p{i}" for i in range(npar))
     params = dict(zip(names, list(p)[:npar]))
