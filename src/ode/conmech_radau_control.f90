@@ -104,10 +104,12 @@ contains
     !! QUOT1 <= hnew/h <= QUOT2.
     subroutine radau_next_step(s)
         type(radau_stepper), intent(inout) :: s
+        s%h_capped = abs(s%hnew) > s%hmax
         s%hnew = s%posneg*min(abs(s%hnew), s%hmax)
         if (s%reject) s%hnew = s%posneg*min(abs(s%hnew), abs(s%h))
         s%reject = .false.
-        s%need_jac = s%newt > 2 .and. s%theta > THET
+        ! a constant Jacobian is never re-evaluated (SciPy keeps the LU then as well)
+        s%need_jac = s%newt > 2 .and. s%theta > THET .and. .not. s%jstruct%constant
         if ((s%t + s%hnew - s%tf)*s%posneg >= 0.0_dp) then
             s%h = s%tf - s%t
             s%final_step = .true.
