@@ -441,7 +441,7 @@ def _butcher(cls):
     n_stages stages) from the Fortran tableau of the method."""
     s = cls.n_stages
     a, b, c = _conmech.flat_rk_tableau(cls._code)
-    cls.A = np.array(a[:s, :s])
+    cls.A = np.array(a[:s, :s], order="C")     # C order: row sums as SciPy adds them
     cls.B = np.array(b[:s])
     cls.C = np.array(c[:s])
 

@@ -77,12 +77,32 @@ EXPECTED_FAILURES = {
 }
 
 
+#: The tests that fail on conmech on a bound of SciPy's own step sequence: conmech's Radau
+#: is Hairer's RADAU5 step control (its counts on Robertson and Van der Pol are the
+#: project's reference), which takes another path than SciPy's Radau. They run a second
+#: time below (name + "_radau5_bounds") with only that bound set to RADAU5's count, so that
+#: the rest of each test still checks conmech.
+RADAU5_BOUNDS = {
+    "test_integration": (
+        "assert_(0 < res.nlu < 10)", "assert_(0 < res.nlu <= 10)",
+        "on t_span [5, 1] RADAU5 rejects one step and makes 5 decompositions (nlu 10, "
+        "nfev 23) where SciPy makes 4 (nlu 8, nfev 36); the test bounds nlu < 10"),
+    "test_integration_const_jac": (
+        "assert_(0 < res.nlu < 15)", "assert_(0 < res.nlu <= 18)",
+        "with a constant Jacobian RADAU5 makes 9 decompositions in 12 steps (nlu 18, nfev "
+        "58) where SciPy makes 7 (nlu 14, nfev 92); the test bounds nlu < 15"),
+}
+EXPECTED_FAILURES.update({k: v[2] for k, v in RADAU5_BOUNDS.items()})
+
+
 def _load():
     src_dir = pathlib.Path(si.__file__).parent / "_ivp" / "tests"
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="conmech_scipy_tests_"))
     tests = {}
     for name, rewrites in _REWRITES.items():
         text = (src_dir / name).read_text()
+        if name == "test_ivp.py":
+            text += _radau5_variants(text)
         for old, new in rewrites:
             pattern = re.compile(r"^" + re.escape(old) + r"$", re.MULTILINE)
             text, count = pattern.subn(new, text)
@@ -100,6 +120,20 @@ def _load():
                     raise RuntimeError(f"{key} is defined in two of SciPy's files")
                 tests[key] = value
     return tests
+
+
+def _radau5_variants(text):
+    """The source of each test of RADAU5_BOUNDS again, renamed, with its bound line set to
+    RADAU5's count (each line must be found once)."""
+    out = []
+    for test, (old, new, _) in RADAU5_BOUNDS.items():
+        m = re.search(r"^def " + test + r"\(.*?(?=^(?:def |@|class ))", text,
+                      re.MULTILINE | re.DOTALL)
+        if m is None or m.group(0).count(old) != 1:
+            raise RuntimeError(f"SciPy's {test} changed: update RADAU5_BOUNDS")
+        out.append("\n\n" + m.group(0).replace(f"def {test}(", f"def {test}_radau5_bounds(",
+                                                 1).replace(old, new))
+    return "".join(out)
 
 
 globals().update(_load())

@@ -115,7 +115,9 @@ contains
             s%final_step = .true.
             s%need_lu = .true.
         else
-            if (.not. s%need_jac .and. s%hnew/s%h >= QUOT1 .and. s%hnew/s%h <= QUOT2) then
+            ! (h is kept only within hmax: a step raised to the smallest one may exceed it)
+            if (.not. s%need_jac .and. s%hnew/s%h >= QUOT1 .and. s%hnew/s%h <= QUOT2 .and. &
+                abs(s%h) <= s%hmax) then
                 s%need_lu = .false.
             else
                 s%h = s%hnew
