@@ -41,6 +41,7 @@ __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4
 (_R_T, _R_TOLD, _R_HDONE, _I_NF, _I_FORM, _I_NFEV, _I_NJEV, _I_NLU, _I_NACCEPT, _I_NREJECT,
  _W_Y, _W_FC) = (int(v) - 1 for v in _conmech.flat_stepper_layout())
 _START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
+assert (_I_NJEV, _I_NLU) == (_I_NFEV + 1, _I_NFEV + 2)   # read as one slice
 _CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
 _NO_LIMIT = 2**31 - 1
@@ -193,6 +194,7 @@ class Stepper:
         self._failure = []
         self._r = np.zeros(1)
         self._iv = np.zeros(1, dtype=np.intc)
+        self._cached = {}
         if n == 0:
             # nothing to integrate: SciPy's solver evaluates fun once and finishes at the
             # first step (t = t_bound)
@@ -258,7 +260,31 @@ class Stepper:
     def nreject(self):
         return int(self._iv[_I_NREJECT]) if self._iv.size > _I_NREJECT else 0
 
+    def _positional(self, action):
+        """The flat routine and its positional arguments for a step or a dense output:
+        built once (the state arrays r, iv, w are updated in place, so the same objects
+        serve every call); f2py parses positional arguments much faster than ~25 keywords,
+        which is most of the Python cost of a step."""
+        nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
+        head = (action, nr, ni, nw, 0.0, self.t_bound, self._y0, self._code)
+        tol = (self._rtol, self._atol, self._first_step, self._max_step, self._max_steps)
+        pat = (self._pattern["nnz"], self._pattern["sp_ptr"], self._pattern["sp_idx"])
+        state = (self._r, self._iv, self._w)
+        if self._builtin:
+            return (_conmech.flat_stepper_builtin,
+                    self.fun._flat_args() + head + tol + pat + state)
+        return (_conmech.flat_stepper_callback,
+                (self._rhs, self._jac_cb) + head + (self._has_jac,) + tol +
+                (self._jac_const,) + pat + state)
+
     def _call(self, action):
+        if action == _STEP or action == _DENSE:
+            cached = self._cached.get(action)
+            if cached is None:
+                cached = self._cached[action] = self._positional(action)
+            routine, args = cached
+            sizes, info, message = routine(*args)
+            return self._after(action, sizes, info, message)
         nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
         if action == _SIZES:
             nr = ni = nw = 0
@@ -275,19 +301,24 @@ class Stepper:
             sizes, info, message = _conmech.flat_stepper_callback(
                 self._rhs, self._jac_cb, has_jac=self._has_jac, jac_const=self._jac_const,
                 **common)
+        return self._after(action, sizes, info, message)
+
+    def _after(self, action, sizes, info, message):
+        """Failures of the callbacks re-raised, the counts and t read from the state."""
         if self._failure:
             self._guard.fail(self._failure.pop(0))
         if self._guard.failed:
             self.status = "failed"
             self._guard.check()
-        message = message_text(message)
+        info = int(info)
+        # the 256-character message is cleaned only when there is one to report (cleaning
+        # it costs more than the rest of a step's glue)
+        message = message_text(message) if info != 0 else ""
         if action != _SIZES and self._iv.size > _I_NREJECT:
-            self.nfev = int(self._iv[_I_NFEV])
-            self.njev = int(self._iv[_I_NJEV])
-            self.nlu = int(self._iv[_I_NLU])
+            self.nfev, self.njev, self.nlu = self._iv[_I_NFEV:_I_NLU + 1].tolist()
             if action == _STEP:
-                self.t = float(self._r[_R_T])
-        return int(info), message, sizes
+                self.t = self._r.item(_R_T)
+        return info, message, sizes
 
     # ------------------------------------------------------------------ SciPy's API
     def step(self):
