@@ -126,8 +126,9 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
         return value is checked on every call: None, a wrong shape, or complex values for
         a real y0 raise ValueError/TypeError.
     t_span : 2-sequence of float
-        (t0, tf); tf < t0 integrates backwards; tf may be infinite (the run then ends at
-        a terminal event or a failure; not for the fixed-step methods).
+        (t0, tf); tf < t0 integrates backwards; tf may be infinite with a terminal event
+        or ``max_steps`` to end the run (else ValueError: SciPy would integrate for ever;
+        not for the fixed-step methods).
     y0 : array_like, shape (n,)
         Initial state, real or complex (a complex system is integrated as its real and
         imaginary parts, as SciPy's explicit methods do; Radau refuses it, as SciPy's),
@@ -288,6 +289,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
+    step_cap = max_steps is not None
     if max_steps is None:
         max_steps = _NO_LIMIT
     elif isinstance(max_steps, (bool, np.bool_)) or \
@@ -338,6 +340,10 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
 
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
+    if math.isinf(tf) and not step_cap and not any(c > 0 for _, c, _, _ in settings):
+        # SciPy would integrate for ever: nothing ends such a run but a failure
+        raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
+                         "end the integration")
     problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
                    t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
                    settings=settings, vectorized=bool(vectorized))

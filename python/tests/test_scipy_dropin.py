@@ -247,3 +247,13 @@ def test_contract_counts_unchanged():
         b = conmech.solve_ivp(f, (0, 100), [2.0, 0.0], method="Radau", rtol=1e-6,
                               atol=1e-6, jac_sparsity=np.ones((2, 2)))
     assert (a.nfev, a.njev, a.nlu, a.naccept) == (b.nfev, b.njev, b.nlu, b.naccept)
+
+
+def test_infinite_span_without_an_end_is_refused():
+    """Nothing would end the run (SciPy integrates for ever): refused, naming t_span; with
+    max_steps it ends there (status -1)."""
+    with pytest.raises(ValueError, match="t_span"):
+        conmech.solve_ivp(lambda t, y: -y, (0, np.inf), [1.0])
+    res = conmech.solve_ivp(lambda t, y: -y, (0, np.inf), [1.0], max_steps=50)
+    assert res.status == -1 and 2 <= res.t.size <= 51   # attempts include rejections
+    assert np.all(np.isfinite(res.t)) and np.all(np.diff(res.t) > 0)

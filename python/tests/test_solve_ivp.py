@@ -255,7 +255,10 @@ def test_terminal_event_with_t_eval():
 def test_no_events_found_gives_empty_arrays():
     r = conmech.solve_ivp(lambda t, y: -y, (0, 1), [1.0], events=lambda t, y: y[0] + 1)
     assert len(r.t_events) == 1 and r.t_events[0].size == 0
-    assert r.y_events[0].shape == (0, 1)
+    # SciPy's shape for an event that never fires: (0,), not (0, n)
+    ref = scipy_solve_ivp(lambda t, y: -y, (0, 1), [1.0],
+                          events=lambda t, y: y[0] + 1)
+    assert r.y_events[0].shape == ref.y_events[0].shape == (0,)
 
 
 # --------------------------------------------------------------------- dense output
