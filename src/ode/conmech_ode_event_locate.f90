@@ -23,6 +23,9 @@ module conmech_ode_event_locate
     private
     public :: find_events, check_events
 
+    !> the largest count of sub-intervals of one step (half the int64 range)
+    integer(int64), parameter :: M_MAX = ishft(huge(1_int64), -1)
+
 contains
 
     !> Check the event settings: terminal and direction allocated with one entry per
@@ -174,8 +177,8 @@ contains
         if (.not. (r > 0.0_dp .and. r < huge(1.0_dp))) return
         q = abs(stp%h_done)/r
         if (.not. q > 1.0_dp) return
-        if (q >= real(huge(1_int64)/2, dp)) then
-            m = huge(1_int64)/2
+        if (q >= real(M_MAX, dp)) then
+            m = M_MAX
         else
             m = ceiling(q, int64)
         end if
