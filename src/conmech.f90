@@ -38,6 +38,16 @@ module conmech
     use conmech_hill_family
     use conmech_continuation
     use conmech_transverse
+    use conmech_rotation_log
+    use conmech_transverse_model
+    use conmech_transverse_mech
+    use conmech_transverse_general
+    use conmech_control_system
+    use conmech_mech_plant
+    use conmech_vhc
+    use conmech_periodic_riccati
+    use conmech_transverse_lqr
+    use conmech_orbital_stabilisation
     use conmech_param_system
     use conmech_branch_switch
     use conmech_cr3bp
@@ -45,6 +55,10 @@ module conmech
     use conmech_system_energy
     use conmech_hopf
     use conmech_equilibrium_continuation
+    use conmech_periodic_multipliers
+    use conmech_periodic_schur
+    use conmech_block_chain
+    use conmech_taylor_stepper
     implicit none
     public
 end module conmech

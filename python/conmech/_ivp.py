@@ -659,7 +659,16 @@ class _Run:
         kw = dict(t_span=np.array([t_a, tf]), y0=y_a, first_step=h0, neval=t_ev.size,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir,
                   ev_term=ev_term, ev_res=ev_res, **self.pattern, **common)
-        if self.builtin:
+        if self.builtin and ne and _compiled_events(self.fun, common["method"], self.settings):
+            # Taylor's method with events from conmech.symbolic.event: no Python in the loop
+            # (no sampling inside the steps: _compiled_events requires resolution 0)
+            from ._taylor import run_compiled_events
+            kw_taylor = {k: v for k, v in kw.items()
+                         if k not in ("ev_res", "nnz", "sp_ptr", "sp_idx")}
+            counts, form, info, message = run_compiled_events(
+                self.fun, [st[0] for st in self.settings], store, kw_taylor,
+                self.zero_at_start)
+        elif self.builtin:
             counts, form, info, message = _conmech.flat_solve_builtin(
                 *self.fun._flat_args(), events_cb, store, **kw)
         else:
@@ -679,6 +688,18 @@ class _Run:
         res.update(nfev=int(nfev), naccept=int(naccept), nreject=int(nreject),
                    form=int(form), info=int(info), message=message_text(message))
         return res
+
+
+def _compiled_events(fun, code, settings):
+    """True when method TAYLOR runs with events that are all conmech.symbolic events of
+    fun's model (then the Fortran stepper locates them itself) and none asks for samples
+    inside the steps (a resolution: the Python-located path samples them)."""
+    if METHODS.get(code) is None or METHODS[code].name != "TAYLOR":
+        return False
+    if any(st[3] > 0 for st in settings):
+        return False
+    from .symbolic.taylor_events import compiled_events
+    return compiled_events(fun, [st[0] for st in settings]) is not None
 
 
 def _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, dense_output, form, status,

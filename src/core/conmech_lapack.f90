@@ -13,7 +13,7 @@ module conmech_lapack
     private
 
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
-        dgelsy, dlange, dpstrf, dgesvd, dgeqp3
+        dgelsy, dlange, dpstrf, dgesvd, dgeqp3, dgees
     public :: la_solve, la_eig, la_sym_eig, la_det, la_finite
 
     !> True if every entry is finite (call it before handing data to LAPACK: NaN input
@@ -144,6 +144,24 @@ module conmech_lapack
             real(dp), intent(out) :: tau(*), work(*)
             integer, intent(out) :: info
         end subroutine dgeqp3
+        !> Real Schur form A = Z T Z^T, optionally ordered: the eigenvalues for which
+        !! select(wr, wi) is true lead (sdim of them).
+        subroutine dgees(jobvs, sort, select, n, a, lda, sdim, wr, wi, vs, ldvs, work, &
+                         lwork, bwork, info)
+            import :: dp
+            character(len=1), intent(in) :: jobvs, sort
+            interface
+                logical function select(wr, wi)
+                    import :: dp
+                    real(dp), intent(in) :: wr, wi
+                end function select
+            end interface
+            integer, intent(in) :: n, lda, ldvs, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: sdim, info
+            real(dp), intent(out) :: wr(*), wi(*), vs(ldvs, *), work(*)
+            logical, intent(out) :: bwork(*)
+        end subroutine dgees
     end interface
 
     ! Unblocked Cholesky factorisations (for the small matrices of mechanical systems).

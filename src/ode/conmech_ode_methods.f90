@@ -9,6 +9,7 @@ module conmech_ode_methods
     use conmech_ode_options
     use conmech_ode_stepper, only: ode_stepper
     use conmech_rk_stepper, only: rk_stepper
+    use conmech_taylor_stepper, only: taylor_stepper
     use conmech_radau_stepper, only: radau_stepper
     use conmech_gauss, only: gauss_stepper
     implicit none
@@ -60,6 +61,9 @@ contains
         case (METHOD_GAUSS6)
             info = method_info(code, "GAUSS6", "", 6, fixed_step=.true.)
             if (present(stp)) allocate (gauss_stepper :: stp)
+        case (METHOD_TAYLOR)     ! order from the tolerance (15 at 1e-12)
+            info = method_info(code, "TAYLOR", "", 0)
+            if (present(stp)) allocate (taylor_stepper :: stp)
         case (METHOD_RATTLE)
             info = method_info(code, "RATTLE", "", 2, fixed_step=.true., &
                                constrained_only=.true.)

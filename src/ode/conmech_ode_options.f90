@@ -14,6 +14,7 @@ module conmech_ode_options
     integer, parameter, public :: METHOD_GAUSS4 = 6  !! Gauss-Legendre s = 2, fixed step
     integer, parameter, public :: METHOD_GAUSS6 = 7  !! Gauss-Legendre s = 3, fixed step
     integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (constrained_solve)
+    integer, parameter, public :: METHOD_TAYLOR = 9  !! Taylor's method (conmech_taylor_stepper)
 
     public :: ode_options, ode_stats
 

@@ -45,19 +45,25 @@ def stable_orbits(branch: Branch, tol: float | None = None) -> tuple:
     """(stable, tau): which orbits of a periodic branch are linearly stable, every
     non-trivial multiplier with |mu| <= 1 + tau. The trivial multipliers (1 for an
     autonomous system, a second 1 for a conservative one) are the ones nearest 1. The
-    default tolerance per orbit, tau = max(1e-6, 100 sqrt(eps max|mu|)), covers the
-    round-off of multipliers taken from the eigenvalues of the formed monodromy (a pair on
-    the unit circle of a symplectic map, or one near 1, moves by ~sqrt(eps |M|)) and the
-    integration error (~1e-9 at the continuation's default tolerances), so that small,
-    stable orbits of a conservative family are not called unstable for a 1e-7 excess;
-    ``tol`` fixes tau."""
+    default tolerance per orbit is the branch's own ``stable_tol`` (from the multipliers'
+    error estimates, see :func:`~conmech.stability.continuation`); for a branch without
+    one, tau = max(1e-6, 100 sqrt(eps max|mu|)), which covers the round-off of multipliers
+    taken from the eigenvalues of a formed monodromy (a pair on the unit circle of a
+    symplectic map, or one near 1, moves by ~sqrt(eps |M|)) and the integration error, so
+    that small, stable orbits of a conservative family are not called unstable for a 1e-7
+    excess; ``tol`` fixes tau."""
     if not isinstance(branch, Branch):
         raise TypeError("stable_orbits needs a Branch of periodic orbits")
     mult = np.asarray(branch.multipliers)
     ntriv = 1 + int(bool(branch.conservative))
     big = np.max(np.abs(mult), axis=1)
-    tau = np.maximum(1e-6, 100.0*np.sqrt(_EPS*big)) if tol is None else \
-        np.full(len(mult), float(tol))
+    own = getattr(branch, "stable_tol", None)
+    if tol is not None:
+        tau = np.full(len(mult), float(tol))
+    elif own is not None:
+        tau = np.asarray(own, dtype=float)
+    else:
+        tau = np.maximum(1e-6, 100.0*np.sqrt(_EPS*big))
     stable = np.array([np.all(np.abs(_nontrivial(m, ntriv)) <= 1.0 + t)
                        for m, t in zip(mult, tau)], dtype=bool)
     return stable, tau

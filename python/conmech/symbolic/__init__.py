@@ -214,7 +214,7 @@ def _system(model):
                   name="symbolic")
     if d.kind == "ode":
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
-                                   **common)
+                                   taylor=compiled.library_taylor(model.lib), **common)
     if d.kind == "generalized":
         return as_lagrangian_system(compiled.generalized_system(
             d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
@@ -347,7 +347,7 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      jacobian=True, flags=None, model_only=False):
+                      jacobian=True, flags=None, model_only=False, inputs=None):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -374,7 +374,15 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     jacobian : bool
         Generate the exact Jacobian of the accelerations (forces_jac); False saves
         derivation and compile time for large systems that are only integrated.
+    inputs : list, optional
+        Control inputs: coordinates of q (one input each), input symbols appearing
+        linearly in ``forces``, or a matrix B (ndof x m); then the result is a
+        :class:`conmech.control.ControlledSystem` with M q'' = Q + B(q) u.
     """
+    if inputs is not None:
+        from ..control._symbolic import controlled_lagrangian
+        return controlled_lagrangian(L, q, params, forces, inputs, velocities=velocities,
+                                     simplify=simplify, jacobian=jacobian, flags=flags)
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
                       (simplify, bool(jacobian)),
                       lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
@@ -421,6 +429,11 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
+from .taylor_events import Event, event  # noqa: E402
+
+__all__ += ["Event", "event"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]
 
