@@ -340,7 +340,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
 
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
-    if math.isinf(tf) and not step_cap and not any(c > 0 for _, c, _, _ in settings):
+    if math.isinf(tf) and n and not step_cap and not any(c > 0 for _, c, _, _ in settings):
         # SciPy would integrate for ever: nothing ends such a run but a failure
         raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
                          "end the integration")
