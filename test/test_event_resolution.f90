@@ -94,6 +94,7 @@ program test_event_resolution
         call ts%check(info == CM_BAD_INPUT .and. index(msg, "jac_sparsity") > 0, &
                       "a malformed pattern refused: "//msg)
     end select
+    deallocate (stp)          ! a main program's variables are never freed by themselves
     call ts%finish()
 
 contains
