@@ -94,7 +94,8 @@ program test_event_resolution
         call ts%check(info == CM_BAD_INPUT .and. index(msg, "jac_sparsity") > 0, &
                       "a malformed pattern refused: "//msg)
     end select
-    deallocate (stp)          ! a main program's variables are never freed by themselves
+    ! a main program's variables are never freed by themselves
+    deallocate (stp, col_ptr, row_idx, msg)
     call ts%finish()
 
 contains
