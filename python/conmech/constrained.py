@@ -401,6 +401,11 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
     settings = event_settings(events)
+    for i, (_, _, _, res) in enumerate(settings):
+        if res > 0:     # sampling inside the steps is solve_ivp's (not this driver's)
+            raise ValueError(f"events[{i}].resolution is not supported by constrained.solve (only "
+                             "by conmech.solve_ivp)")
+    settings = [s[:3] for s in settings]
     ne = len(settings)
     for i, (_, count, _) in enumerate(settings):
         if count > 1:

@@ -27,7 +27,12 @@
 !!   order 3, unless first_step is given.
 !! - Jacobian: the system's analytic `jacobian` if `has_jacobian()`, else forward
 !!   differences with Hairer's steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, counted in
-!!   nfev).
+!!   nfev; with a sparsity pattern in `jstruct`, one evaluation per Curtis-Powell-Reid
+!!   group of columns). A Jacobian declared constant (`jstruct%constant`, SciPy's constant
+!!   `jac`) is read once at the start and never re-evaluated; it counts no evaluation
+!!   (njev 0, as SciPy).
+!! - Smallest step: SciPy's (`min_step_at`, 10 spacings of t): a step proposed below it is
+!!   raised to it once; an attempt below it ends the run.
 !! - Continuous extension: the collocation polynomial (degree 3, power basis), on which the
 !!   driver finds t_eval points and events.
 !! - Failures: a Newton iteration that does not converge (or meets non-finite values)
@@ -53,6 +58,7 @@ module conmech_radau_stepper
     use conmech_ode_stepper, only: ode_stepper
     use conmech_state_packer, only: state_packer
     use conmech_radau_collocation, only: radau_collocation_basis
+    use conmech_jacobian_structure, only: jacobian_structure
     implicit none
     private
 
@@ -71,6 +77,9 @@ module conmech_radau_stepper
         !> the differentiation index of each component (1, 2 or 3), set with `mass`: the
         !! error of an index-k component is weighted by |h|^(k-1) (RADAU5's NIND2, NIND3)
         integer, allocatable :: dae_index(:)
+        !> what is known of df/dy: constant, or a sparsity pattern for grouped
+        !! differences; set by the caller before `init`
+        type(jacobian_structure) :: jstruct
         real(dp) :: hmax = 0, uround = 0, fnewt = 0   !! largest |h|, roundoff, Newton tol.
         real(dp) :: faccon = 1, theta = 0     !! Newton contraction memory and rate
         real(dp) :: hacc = 0, erracc = 1      !! last accepted step and error (Gustafsson)
@@ -94,6 +103,7 @@ module conmech_radau_stepper
         logical :: converged = .false.        !! the last Newton iteration converged
         logical :: f_ok = .true.              !! f0 = f(t, y) is finite
         logical :: final_step = .false.       !! the step to attempt ends at tf
+        logical :: h_capped = .false.         !! h was cut to hmax after the last step
         real(dp), allocatable :: f0(:), scal(:), scal0(:), rtolv(:), atolv(:)
         real(dp), allocatable :: jac(:, :), e1(:, :)    !! J and the LU of gamma/h M - J
         complex(dp), allocatable :: e2(:, :)            !! LU of (alpha + i beta)/h M - J
@@ -188,6 +198,8 @@ contains
         call p%item(self%newton_failed)
         call p%item(self%f_ok)
         call p%item(self%final_step)
+        call p%item(self%h_capped)
+        call self%jstruct%transfer(p)
         call p%column(self%f0)
         call p%column(self%scal0)
         call p%column(self%rtolv)
