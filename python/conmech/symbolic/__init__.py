@@ -62,6 +62,7 @@ _SIG = {
     "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
     "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
+    "accel_jac": ("in2", "out2"),
 }
 
 
@@ -90,7 +91,8 @@ class CompiledModel:
                 "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
-                "mass_forces": [(n, n), (n,)], "accel": [(n,)]}[entry]
+                "mass_forces": [(n, n), (n,)], "accel": [(n,)],
+                "accel_jac": [(n,), (n, 2 * n)]}[entry]
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
@@ -217,7 +219,8 @@ def _system(model):
                                            forces_jac=a.get("forces_jac"),
                                            energy=a.get("energy"),
                                            mass_forces=a.get("mass_forces"),
-                                           accel=a.get("accel"), **common)
+                                           accel=a.get("accel"),
+                                           accel_jac=a.get("accel_jac"), **common)
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
@@ -419,5 +422,10 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# closed loops on trees, forces at points of bodies, consistent initial states
+from .loops import Loop, PointForce, consistent_state  # noqa: E402
+
+__all__ += ["Loop", "PointForce", "consistent_state"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]

@@ -500,6 +500,8 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`."""
     if not module.isidentifier() or keyword.iskeyword(module):
         raise ValueError(f"bad module name {module!r}")
+    if hasattr(type(d), "generate_fortran"):     # a record that writes its own module
+        return d.generate_fortran(module, model_values)
     pr = FortranPrinter(_names(d))
     n = d.n
     npar = max(len(d.params), 1)

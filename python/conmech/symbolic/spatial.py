@@ -452,8 +452,9 @@ def derive_spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None,
     return _derive(parts, params, simplify, jacobian)
 
 
-def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, simplify="auto",
-                 jacobian=True, flags=None, model_only=False):
+def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=None,
+                 point_forces=None, method="recursive", simplify="auto", jacobian=True,
+                 flags=None, model_only=False):
     """A compiled spatial multibody tree (see the module docstring of
     ``conmech.symbolic.spatial`` for frames and conventions).
 
@@ -470,6 +471,15 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, simplif
         Generalized forces (joint torques or forces, dampers, springs, motors) in t, the
         coordinates and their derivatives: one per coordinate, or {body name or
         coordinate: force}.
+    loops : list of Loop, optional
+        Joints that close kinematic loops (:class:`conmech.symbolic.Loop`: spherical or
+        revolute); the system is then a constrained system in the tree's coordinates.
+    point_forces : list of PointForce, optional
+        Forces at points of bodies, mapped through the points' Jacobians.
+    method : {"recursive", "lagrangian"}
+        "recursive" (default): M, Q and the exact Jacobian of the accelerations from the
+        recursive algorithms (construction linear in the number of bodies); "lagrangian":
+        from T and U by the Lagrangian derivation.
     simplify, jacobian, flags, model_only
         As in :func:`conmech.symbolic.lagrangian_system`.
 
@@ -478,7 +488,9 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, simplif
     conmech.compiled.CompiledSystem
         A system in generalized coordinates, state y = [q, q'], whose right-hand side uses
         the spatial articulated-body algorithm; mass matrix, forces, energy and the exact
-        Jacobian come from the Lagrangian (``model_only=True``: the CompiledModel).
+        Jacobian (``accel_jac``: d a/d[q, v] without a LAPACK factorisation) come from the
+        recursive algorithms; with ``loops`` a constrained system (``model_only=True``:
+        the CompiledModel).
 
     Examples
     --------
@@ -493,13 +505,23 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, simplif
         sys = spatial_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, 0, -g))
     """
     from . import _construct, _tup
+    from .tree import _loop_names, _method_key
     parts = build_spatial_tree(bodies, gravity, forces, lazy=True)
     _check_bodies(parts["order"], parts["data"], params)
+    method, extra = _method_key(method, loops, point_forces)
+    if method == "recursive":
+        from .recursive import derive_recursive
 
-    def derive():
-        return _derive(parts, params, simplify, jacobian)
+        def derive():
+            return derive_recursive("spatial", parts, params, planar=False, loops=loops,
+                                    jacobian=jacobian, point_forces=point_forces)
+    else:
+        def derive():
+            return _derive(parts, params, simplify, jacobian)
 
     topo = tuple((b.name, b.parent, b.joint) for b in parts["order"])
     return _construct("spatial_tree", [_tup(parts["q"]), _tup(parts["forces"]),
-                                       _tup(list(parts["gravity"])), _body_key(parts)],
-                      params, (simplify, bool(jacobian), topo), derive, flags, model_only)
+                                       _tup(list(parts["gravity"])), _body_key(parts)]
+                      + extra, params,
+                      (simplify, bool(jacobian), topo, method)
+                      + _loop_names(loops, point_forces), derive, flags, model_only)

@@ -15,6 +15,7 @@
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
 !!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
 !!     spec(18) (optional, ode) jac_prod: J x for an n x k block x (set_c_jac_prod)
+!!     spec(19) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -73,6 +74,7 @@ contains
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
         if (size(spec) >= 17) fp%accel = fptr(spec(17))
+        if (size(spec) >= 19) fp%accel_jac = fptr(spec(19))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
