@@ -427,5 +427,10 @@ __all__ += ["SpatialBody", "spatial_tree"]
 from .loops import Loop, PointForce, consistent_state  # noqa: E402
 
 __all__ += ["Loop", "PointForce", "consistent_state"]
+
+# robots from URDF files
+from .urdf import Robot, from_urdf, read_urdf  # noqa: E402
+
+__all__ += ["Robot", "from_urdf", "read_urdf"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]

@@ -368,7 +368,8 @@ class _LoopCode:
         I = "        "
         T = f"{I}real(dp), value, intent(in) :: t"
         P = f"{I}real(dp), intent(in) :: p({npar})"
-        W = f"{I}type(tree_work) :: w"
+        from .tree_fortran import SC_DECL, pos_call
+        W = f"{I}type(tree_work) :: w\n{SC_DECL}"
         h = len(self.phi)
         out = []
 
@@ -384,8 +385,7 @@ class _LoopCode:
         out += proc("phi", ["t", "q", "c", "p"],
                     [T, f"{I}real(dp), intent(in) :: q({n})",
                      f"{I}real(dp), intent(out) :: c({h})", P, W],
-                    [f"{I}call tree_pos(t, q, p, w)"],
-                    [f"c({i + 1})" for i in range(h)], self.phi)
+                    pos_call(em), [f"c({i + 1})" for i in range(h)], self.phi)
         tg, ex = [], []
         for i, row in enumerate(self.Gu):
             for j, e in sorted(row.items()):
@@ -395,13 +395,13 @@ class _LoopCode:
         out += proc("phi_jac", ["t", "q", "g", "p"],
                     [T, f"{I}real(dp), intent(in) :: q({n})",
                      f"{I}real(dp), intent(out) :: g({h}, {n})", P, W],
-                    [f"{I}call tree_pos(t, q, p, w)"], tg, ex, zero="g")
+                    pos_call(em), tg, ex, zero="g")
         out += proc("phi_gamma", ["t", "q", "v", "gam", "p"],
                     [T, f"{I}real(dp), intent(in) :: q({n}), v({n})",
                      f"{I}real(dp), intent(out) :: gam({h})", P, W,
                      f"{I}real(dp) :: z({n})"],
-                    [f"{I}z = 0.0_dp", f"{I}call tree_pos(t, q, p, w)",
-                     f"{I}call tree_vel(t, q, v, z, p, w, .false.)"],
+                    [f"{I}z = 0.0_dp"] + pos_call(em)
+                    + [f"{I}call tree_vel(t, q, v, z, p, w, .false.)"],
                     [f"gam({i + 1})" for i in range(h)], self.gamma)
         return out
 

@@ -272,9 +272,10 @@ def relative(joints, xs):
 
 # ------------------------------------------------------------------ the passes
 
-def pos_pass(code, joints, qrel, gravity):
+def pos_pass(code, joints, qrel, gravity, trig=None):
     """Poses, world motion subspaces, spatial inertias about the origin, composite
-    inertias, alpha = Ic S and the potential energy -g . sum h. Returns a list of dicts
+    inertias, alpha = Ic S and the potential energy -g . sum h (`trig`: {k: (cos, sin)}
+    symbols of the revolute joints' angles computed elsewhere). Returns a list of dicts
     (R, p, S, I, Jw, cw, Ic, alpha) and U."""
     L = code.let
     out = []
@@ -287,7 +288,10 @@ def pos_pass(code, joints, qrel, gravity):
         pJ = code.lv(_add(pp, _matvec(Rp, J.at)))
         kw = code.lv(_matvec(RJ, J.axis))
         if J.kind == "revolute":
-            c, s = L(sp.cos(qrel[k])), L(sp.sin(qrel[k]))
+            if trig is not None:
+                c, s = trig[k]
+            else:
+                c, s = L(sp.cos(qrel[k])), L(sp.sin(qrel[k]))
             E = [[L(e) for e in row] for row in _rodrigues(J.axis, c, s)]
             R = _matmul(RJ, E, L)
             p = pJ
@@ -391,6 +395,9 @@ def vel_pass(code, joints, pos, vrel, arel, gravity, deriv):
         D_psi = imul(Dc, psi) if Dc is not None else zero
         SH = crf(S, H)
         d["eta"] = code.lv([x - y for x, y in zip(D_S, SH)])
+        if joints[k].parent < 0:         # Phi, Omega serve the strict ancestors only
+            d["Phi"] = d["Omega"] = zero
+            continue
         d["Phi"] = code.lv([x1 + x2 + x3 + x4 for x1, x2, x3, x4 in
                             zip(crf(S, F), Ic_c, D_psi, crf(psi, H))])
         d["Omega"] = code.lv([2*x1 + x2 + x3 for x1, x2, x3 in zip(Ic_psi, D_S, SH)])

@@ -177,8 +177,9 @@ class _Code:
         self.defs.append((s, "positive"))
 
 
-def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
-    """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs."""
+def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
+    """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs
+    (`trig`: {body name: (cos, sin) symbols} of the joint angles computed elsewhere)."""
     code = _Code()
     L = code.let
     n = len(order)
@@ -200,7 +201,10 @@ def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
         qd = vs[i] - vs[index[k]] if k is not None else vs[i]
         qd = L(qd, "qd")
         if b.joint == "revolute":
-            s, c = L(sp.sin(qrel), "s"), L(sp.cos(qrel), "c")
+            if trig is not None:
+                c, s = trig[b.name]
+            else:
+                s, c = L(sp.sin(qrel), "s"), L(sp.cos(qrel), "c")
             E = [[c, s], [-s, c]]
             rx, ry = at
             S = (1, 0, 0)

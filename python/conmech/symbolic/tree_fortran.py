@@ -234,6 +234,124 @@ class Emit:
         return _decl_temps(list(self.local.values()))
 
 
+#: for trees of more than STRAIGHT_MAX bodies, a straight-line pass longer than this many
+#: statements is split into procedures of about this size (the compiler's time grows
+#: faster than linearly with the size of one procedure: 30 joints compile in half the
+#: time in pieces of 150); the values that cross from one piece to a later one go
+#: through an array. Smaller trees keep each pass in one procedure (fastest code).
+CHUNK = 150
+
+
+def chunked(em, name, args, decls, blocks, prefix, size=None):
+    """A straight-line pass as the procedure `name` (arguments `args`, declarations
+    `decls`), from `blocks`: a list of (condition, definitions, stores), condition None
+    (always), "deriv" or "plain" (the branches of ``if (deriv)``). Short passes are one
+    procedure; long ones call pieces ``name_<k>`` with the values that cross pieces in a
+    carry array. Returns the lines."""
+    size = CHUNK if size is None else size
+    total = sum(1 for _, defs, _ in blocks for _, e in defs if not isinstance(e, str))
+    if em.nb <= STRAIGHT_MAX:
+        size = max(size, total)
+    I = _IND
+    if total <= size:
+        em.reset()
+        body = []
+        conds = [c for c, _, _ in blocks]
+        for cond, defs, stores in blocks:
+            ind = I if cond is None else I + "    "
+            lines = em.defs(defs, prefix, ind) + em.assign(stores, ind)
+            if cond == "deriv":
+                lines = [f"{I}if (deriv) then"] + lines
+            elif cond == "plain":
+                lines = [f"{I}else" if "deriv" in conds else f"{I}if (.not. deriv) then"] \
+                    + lines
+            body += lines
+        if "deriv" in conds or "plain" in conds:
+            body.append(f"{I}end if")
+        return _proc(f"subroutine {name}({', '.join(args)})", decls + em.temps(), body, name)
+    # the pieces: consecutive definitions, each pivot check right after its definition
+    chunks = []
+    for cond, defs, stores in blocks:
+        checks = {s_ for s_, e in defs if isinstance(e, str)}
+        flat = []
+        for s_, e in defs:
+            if isinstance(e, str):
+                continue
+            flat.append((s_, e))
+            if s_ in checks:
+                flat.append((s_, "positive"))
+        defs = flat
+        start = len(chunks)
+        cur, count = [], 0
+        for item in defs:
+            if not isinstance(item[1], str) and count >= size:
+                chunks.append(dict(cond=cond, defs=cur, stores=[]))
+                cur, count = [], 0
+            cur.append(item)
+            count += 0 if isinstance(item[1], str) else 1
+        chunks.append(dict(cond=cond, defs=cur, stores=[]))
+        where = {}
+        for c in range(start, len(chunks)):
+            for s_, e in chunks[c]["defs"]:
+                where[s_] = c
+        for tgt, e in stores:
+            c = max([where[x] for x in sp.sympify(e).free_symbols if x in where],
+                    default=start)
+            chunks[c]["stores"].append((tgt, e))
+    home = {}
+    for c, ch in enumerate(chunks):
+        for s_, e in ch["defs"]:
+            if not isinstance(e, str):
+                home[s_] = c
+    carry = {}
+    for c, ch in enumerate(chunks):
+        used = set()
+        for s_, e in ch["defs"]:
+            if not isinstance(e, str):
+                used |= e.free_symbols
+        for tgt, e in ch["stores"]:
+            used |= sp.sympify(e).free_symbols
+        for x in home:                  # (in definition order: a deterministic source)
+            if home[x] < c and x in used and x not in carry:
+                carry[x] = len(carry) + 1
+    ncx = max(len(carry), 1)
+    out, calls = [], []
+    cargs = [a for a in args if a != "deriv"] + ["cx"]
+    cdecls = [d_ for d_ in decls if "deriv" not in d_] + \
+        [f"{I}real(dp), intent(inout) :: cx({ncx})"]
+    saved = dict(em.pr.names)
+    for c, ch in enumerate(chunks):
+        em.reset()
+        for x, k in carry.items():
+            if home[x] < c:
+                em.pr.names[x] = f"cx({k})"
+        lines = em.defs(ch["defs"], prefix)
+        lines += [f"{I}cx({carry[x]}) = {em.local[x]}" for x, _ in ch["defs"]
+                  if x in carry and x in em.local]
+        lines += em.assign(ch["stores"])
+        out += _proc(f"subroutine {name}_{c + 1}({', '.join(cargs)})",
+                     cdecls + em.temps(), lines, f"{name}_{c + 1}")
+        em.pr.names = dict(saved)
+        calls.append((ch["cond"], f"call {name}_{c + 1}({', '.join(cargs)})"))
+    body = []
+    conds = [c for c, _ in calls]
+    for cond in (None, "deriv", "plain"):
+        mine = [call for c, call in calls if c == cond]
+        if not mine:
+            continue
+        if cond is None:
+            body += [f"{I}{x}" for x in mine]
+        elif cond == "deriv":
+            body += [f"{I}if (deriv) then"] + [f"{I}    {x}" for x in mine]
+        else:
+            body += ([f"{I}else"] if "deriv" in conds else [f"{I}if (.not. deriv) then"]) \
+                + [f"{I}    {x}" for x in mine]
+    if "deriv" in conds or "plain" in conds:
+        body.append(f"{I}end if")
+    return out + _proc(f"subroutine {name}({', '.join(args)})",
+                       decls + [f"{I}real(dp) :: cx({ncx})"], body, name)
+
+
 def _proc(head, decls, body, name, kind="subroutine"):
     return [f"    {head}"] + decls + body + [f"    end {kind} {name}", ""]
 
@@ -253,8 +371,13 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
         keep_pose |= {k for k in item["bodies"] if k >= 0}
     # ---- position pass
     cp = Code()
-    qrel = [cp.let(x) for x in relative(joints, d.coords)]
-    pos, U = pos_pass(cp, joints, qrel, d.gravity)
+    qrel_expr = relative(joints, d.coords)
+    qrel = [cp.let(x) for x in qrel_expr]
+    # the sines and cosines of the joint angles: computed once per entry point (shared by
+    # the articulated-body pass and the position pass of the Jacobian)
+    trig = {k: (sp.Dummy("tc", real=True), sp.Dummy("ts", real=True))
+            for k, J in enumerate(joints) if J.kind == "revolute"}
+    pos, U = pos_pass(cp, joints, qrel, d.gravity, trig=trig)
     lpos = _loaded_pos(st, pos, keep_pose)
     # ---- velocity pass (on the loaded positions)
     cv = Code()
@@ -278,12 +401,20 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
                         deriv_out.append(((name, i, k), e))
     # ---- loop constraints (on loaded positions and velocities)
     lc = loop_code(d, joints, lpos, vel) if constrained else None
-    base_defs = cv.live([e for _, e in vel_out])
-    base_set = {s for s, _ in base_defs}
-    extra = [(s, e) for s, e in cv.live([e for _, e in vel_out + deriv_out])
-             if s not in base_set]
+    # the definitions both modes need, those of the plain mode only (tau, the kinetic
+    # energy, the loops' velocities), those of the derivatives only
+    plain_defs = cv.live([e for _, e in vel_out])
+    deriv_defs = cv.live([e for _, e in deriv_out]) if jac else []
+    dset = {s for s, _ in deriv_defs}
+    pset = {s for s, _ in plain_defs}
+    base_defs = [(s, e) for s, e in plain_defs if s in dset] if jac else plain_defs
+    only_plain = [(s, e) for s, e in plain_defs if s not in dset] if jac else []
+    extra = [(s, e) for s, e in deriv_defs if s not in pset]
+    bset = {s for s, _ in base_defs}
+    base_defs = [(s, e) for s, e in cv.live([e for _, e in vel_out + deriv_out])
+                 if s in bset]
     # ---- what the position pass must store: the loads used later, the loop arrays
-    used_by = [e for _, e in base_defs + extra if not isinstance(e, str)] \
+    used_by = [e for _, e in base_defs + extra + only_plain if not isinstance(e, str)] \
         + [e for _, e in vel_out + deriv_out] + (lc.expressions() if lc else [])
     pos_out = st.used(used_by, always=("sv", "al")) + [("w%pe", U)]
     active = {tgt[1] for tgt, _ in pos_out + deriv_out if not isinstance(tgt, str)}
@@ -292,33 +423,52 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     na = len(act)
     # ---- printing
     em = Emit(d, {**st.loads, **st_vel.loads}, cidx)
+    em.nb = nb
+    for k, (c, sn) in trig.items():
+        em.pr.names[c] = f"sc(1, {k + 1})"
+        em.pr.names[sn] = f"sc(2, {k + 1})"
+    em.trig_lines = []
+    for k in sorted(trig):
+        arg = fast_print(sp.sympify(qrel_expr[k]), em.pr.names, em.pr)
+        em.trig_lines += [f"{_IND}sc(1, {k + 1}) = cos({arg})",
+                          f"{_IND}sc(2, {k + 1}) = sin({arg})"]
     out = []
-    em.reset()
-    lines = em.defs(cp.live([e for _, e in pos_out]), "s")
-    lines += [f"{_IND}w%{a} = 0.0_dp" for a in ("sv", "al")] + em.assign(pos_out)
-    out += _proc("subroutine tree_pos(t, q, p, w)",
-                 [f"{_IND}real(dp), intent(in) :: t, q({n}), p({npar})",
-                  f"{_IND}type(tree_work), intent(inout) :: w"] + em.temps(),
-                 lines, "tree_pos")
-    em.reset()
-    body = em.defs(base_defs, "u") + em.assign(vel_out)
+    out += chunked(em, "tree_pos", ["t", "q", "sc", "p", "w"],
+                   [f"{_IND}real(dp), intent(in) :: t, q({n}), sc(2, nb), p({npar})",
+                    f"{_IND}type(tree_work), intent(inout) :: w"],
+                   [(None, cp.live([e for _, e in pos_out]),
+                     _with_zeros(pos_out, ("sv", "al"), nb, act))], "s")
     if jac:
-        body += [f"{_IND}if (deriv) then"]
-        body += [f"{_IND}    w%{a} = 0.0_dp" for a in ("ps", "cc", "et", "ph", "om")]
-        body += em.defs(extra, "u", _IND + "    ") + em.assign(deriv_out, _IND + "    ")
-        body += [f"{_IND}end if"]
-    out += _proc("subroutine tree_vel(t, q, v, a, p, w, deriv)",
-                 [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), a({n}), p({npar})",
-                  f"{_IND}type(tree_work), intent(inout) :: w",
-                  f"{_IND}logical, intent(in) :: deriv"] + em.temps(),
-                 body, "tree_vel")
+        blocks = [(None, base_defs, []),
+                  ("deriv", extra, _with_zeros(deriv_out, ("ps", "cc", "et", "ph", "om"),
+                                               nb, act)),
+                  ("plain", only_plain, vel_out)]
+    else:
+        blocks = [(None, base_defs, vel_out)]
+    out += chunked(em, "tree_vel", ["t", "q", "v", "a", "p", "w", "deriv"],
+                   [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), a({n}), p({npar})",
+                    f"{_IND}type(tree_work), intent(inout) :: w",
+                    f"{_IND}logical, intent(in) :: deriv"], blocks, "u")
     em.reset()
     out += _user_forces(d, em.pr)
     if jac:
         out += _user_jac(d, em.pr)
     if not constrained:
-        out += _aba_proc(d, em)
-    out += _FIXED.splitlines() + [""]
+        out += _aba_proc(d, em, trig)
+    chain = all(J.parent == k - 1 for k, J in enumerate(joints))
+    fixed = _FIXED.replace("ZEROH", "" if chain else f"{_IND}h = 0.0_dp")
+    fixed = fixed.replace("ZEROX", "" if chain else f"{_IND}xt = 0.0_dp")
+    procs = fixed.split("\n    !> ")
+    if nb <= STRAIGHT_MAX:
+        # the pair loops written out: no loop overhead, structural zeros skipped
+        nz = {}
+        for tgt, e in pos_out + deriv_out:
+            if not isinstance(tgt, str):
+                nz.setdefault((tgt[0], tgt[2]), set()).add(cidx[tgt[1]] + 1)
+        straight = _straight_pairs(joints, nz, jac)
+        procs = [next((v for key, v in straight.items() if pr.startswith(key)), pr)
+                 for pr in procs]
+    out += "\n    !> ".join(procs).splitlines() + [""]
     # ---- entry points
     ent, procs = _entries(d, n, npar, absolute, jac, constrained, lc, em)
     out += procs
@@ -331,9 +481,9 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     col = ", ".join(str(J.col + 1) for J in joints)
     ka = ", ".join(str(J.ka + 1) for J in joints)
     head = [
-        f"!> Generated by conmech.symbolic (recursive algorithms): a tree of {nb} bodies, "
-        f"{'constrained' if constrained else 'generalized'} system.",
-        "!! Do not edit.",
+        "!> Generated by conmech.symbolic (recursive algorithms of rigid-body dynamics):",
+        f"!! a tree of {nb} bodies, {'constrained' if constrained else 'generalized'} "
+        "system. Do not edit.",
         f"module {module}",
         "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char, c_null_char",
         "    implicit none",
@@ -356,9 +506,123 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
         "",
     ]
     head = [ln for h in head for ln in (_wrap(h.strip(), h[:len(h) - len(h.lstrip())])
-                                        if len(h) > 90 else [h])]
+                                        if len(h) > 90 and not h.startswith("!") else [h])]
     src = "\n".join(head + out + [f"end module {module}", ""])
     return src, ent
+
+
+#: trees of at most this many bodies get the pair loops as straight-line code
+STRAIGHT_MAX = 12
+
+
+def _straight_pairs(joints, nz, jac):
+    """Straight-line forms of tree_mass_topo, tree_did, tree_ltdl and tree_ltdl_solve
+    (keyed by the text that starts their doc comment), for small trees."""
+    nb = len(joints)
+    anc = []
+    for k in range(nb):
+        a, j = [], k
+        while j >= 0:
+            a.append(j)
+            j = joints[j].parent
+        anc.append(a)
+    related = {(j, k) for k in range(nb) for j in anc[k]}
+    related |= {(k, j) for j, k in related}
+    I = _IND
+
+    def dot(x, j, y, k, scale=""):
+        cs = sorted(nz.get((x, j), set()) & nz.get((y, k), set()))
+        terms = [f"w%{x}({c}, {j + 1})*w%{y}({c}, {k + 1})" for c in cs]
+        return (scale + "(" + " + ".join(terms) + ")") if terms else ""
+
+    def neg(*parts):
+        parts = [x for x in parts if x]
+        return "-(" + " + ".join(parts) + ")" if parts else "0.0_dp"
+    out = {}
+    # mass matrix
+    lines = []
+    for k in range(nb):
+        for j in anc[k]:
+            d = dot("sv", j, "al", k) or "0.0_dp"
+            lines += _wrap(f"h({j + 1}, {k + 1}) = {d}", I)
+            if j != k:
+                lines.append(f"{I}h({k + 1}, {j + 1}) = h({j + 1}, {k + 1})")
+    lines += [f"{I}h({i + 1}, {j + 1}) = 0.0_dp" for i in range(nb) for j in range(nb)
+              if (i, j) not in related]
+    out["M (relative"] = "\n".join([
+        "M (relative coordinates, topological order), written out.",
+        "    pure subroutine tree_mass_topo(w, h)",
+        f"{I}type(tree_work), intent(in) :: w",
+        f"{I}real(dp), intent(out) :: h(nb, nb)"] + lines + [
+        "    end subroutine tree_mass_topo", ""])
+    # derivatives of inverse dynamics
+    lines = []
+    if jac:
+        for k in range(nb):
+            for j in anc[k]:
+                lines += _wrap(f"xt({j + 1}, {k + 1}) = " + neg(
+                    dot("al", k, "cc", j), dot("et", k, "ps", j)), I)
+                lines += _wrap(f"xt({nb + j + 1}, {k + 1}) = " + neg(
+                    dot("al", k, "ps", j, "2.0_dp*"), dot("et", k, "sv", j)), I)
+                if j != k:
+                    lines += _wrap(f"xt({k + 1}, {j + 1}) = " + neg(dot("sv", j, "ph", k)), I)
+                    lines += _wrap(f"xt({nb + k + 1}, {j + 1}) = "
+                                   + neg(dot("sv", j, "om", k)), I)
+        lines += [f"{I}xt({h + 1}, {i + 1}) = 0.0_dp" for i in range(nb) for j in range(nb)
+                  if (j, i) not in related for h in (j, nb + j)]
+    out["xt = -[d tau"] = "\n".join([
+        "xt = -[d tau/d q, d tau/d qd]^T (relative, topological), written out.",
+        "    pure subroutine tree_did(w, xt)",
+        f"{I}type(tree_work), intent(in) :: w",
+        f"{I}real(dp), intent(out) :: xt(2*nb, nb)"] + lines + [
+        "    end subroutine tree_did", ""])
+    # L^T D L
+    lines = []
+    for k in reversed(range(nb)):
+        kk = k + 1
+        lines.append(f"{I}if (.not. (h({kk}, {kk}) > 0.0_dp)) h({kk}, {kk}) = 0.0_dp")
+        for i in anc[k][1:]:
+            lines.append(f"{I}a = h({kk}, {i + 1})/h({kk}, {kk})")
+            for j in anc[i]:
+                lines.append(f"{I}h({i + 1}, {j + 1}) = h({i + 1}, {j + 1}) - "
+                             f"a*h({kk}, {j + 1})")
+            lines.append(f"{I}h({kk}, {i + 1}) = a")
+        lines.append(f"{I}h({kk}, {kk}) = 1.0_dp/h({kk}, {kk})")
+    out["M = L^T D L"] = "\n".join([
+        "M = L^T D L in place (D stored inverted), written out.",
+        "    pure subroutine tree_ltdl(h)",
+        f"{I}real(dp), intent(inout) :: h(nb, nb)",
+        f"{I}real(dp) :: a"] + lines + ["    end subroutine tree_ltdl", ""])
+    lines = []
+    for i in reversed(range(nb)):
+        for j in anc[i][1:]:
+            lines.append(f"{I}xt(:, {j + 1}) = xt(:, {j + 1}) - h({i + 1}, {j + 1})*"
+                         f"xt(:, {i + 1})")
+    for i in range(nb):
+        lines.append(f"{I}xt(:, {i + 1}) = xt(:, {i + 1})*h({i + 1}, {i + 1})")
+        for j in anc[i][1:]:
+            lines.append(f"{I}xt(:, {i + 1}) = xt(:, {i + 1}) - h({i + 1}, {j + 1})*"
+                         f"xt(:, {j + 1})")
+    out["xt := xt M^-1"] = "\n".join([
+        "xt := xt M^-1 (x = M^-1 x kept transposed), written out.",
+        "    pure subroutine tree_ltdl_solve(h, xt)",
+        f"{I}real(dp), intent(in) :: h(nb, nb)",
+        f"{I}real(dp), intent(inout) :: xt(2*nb, nb)"] + lines + [
+        "    end subroutine tree_ltdl_solve", ""])
+    return out
+
+
+def _with_zeros(pairs, arrays, nb, act):
+    """The stores `pairs` with explicit zeros for the entries of the loop arrays `arrays`
+    that no store sets (instead of zeroing the arrays first)."""
+    have = {tgt for tgt, _ in pairs if not isinstance(tgt, str)}
+    out = list(pairs)
+    for name in arrays:
+        for k in range(nb):
+            for c in act:
+                if (name, c, k) not in have:
+                    out.append(((name, c, k), sp.Integer(0)))
+    return out
 
 
 def _user_forces(d, pr):
@@ -374,9 +638,16 @@ def _user_forces(d, pr):
                  [f"{_IND}fu = 0.0_dp"] + lines, "tree_user_forces")
 
 
+def _has_user_jac(d):
+    xs = set(d.coords) | set(d.speeds)
+    return any(sp.sympify(e).free_symbols & xs for e in d.user_forces)
+
+
 def _user_jac(d, pr):
-    """tree_user_jac(t, q, v, p, ru): d(user forces)/d[q, v] (n x 2n)."""
+    """tree_user_jac(t, q, v, p, xt): adds d(user forces)/d[q, v] to the transposed
+    Jacobian xt (variables x equations, topological order)."""
     n, npar = d.n, max(len(d.params), 1)
+    topo = {J.col: k for k, J in enumerate(d.joints)}
     xs = list(d.coords) + list(d.speeds)
     tg, ex = [], []
     for i, e in enumerate(d.user_forces):
@@ -389,41 +660,62 @@ def _user_jac(d, pr):
                 if de.has(sp.DiracDelta):
                     de = de.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
                 if de != 0:
-                    tg.append(f"ru({i + 1}, {j + 1})")
+                    var = topo[j] if j < n else n + topo[j - n]
+                    tgt = f"xt({var + 1}, {topo[i] + 1})"
+                    tg.append(tgt)
                     ex.append(de)
-    temps, lines = assignments(tg, ex, pr, _IND, prefix="g") if ex else ([], [])
-    return _proc("subroutine tree_user_jac(t, q, v, p, ru)",
+    gt = [f"gj({k + 1})" for k in range(len(ex))]
+    temps, lines = assignments(gt, ex, pr, _IND, prefix="g") if ex else ([], [])
+    lines += [f"{_IND}{t} = {t} + {g}" for t, g in zip(tg, gt)]
+    return _proc("subroutine tree_user_jac(t, q, v, p, xt)",
                  [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), p({npar})",
-                  f"{_IND}real(dp), intent(out) :: ru({n}, {2*n})"] + _decl_temps(temps),
-                 [f"{_IND}ru = 0.0_dp"] + lines, "tree_user_jac")
+                  f"{_IND}real(dp), intent(inout) :: xt({2*n}, {n})",
+                  f"{_IND}real(dp) :: gj({max(len(ex), 1)})"] + _decl_temps(temps),
+                 lines, "tree_user_jac")
 
 
-def _aba_proc(d, em):
-    """tree_aba(t, q, v, a, p): the articulated-body accelerations (tree.py / spatial.py)."""
+def _aba_proc(d, em, trig):
+    """tree_aba(t, q, v, sc, a, p): the articulated-body accelerations (tree.py /
+    spatial.py) on the sines and cosines sc; conmech_accel computes them and calls it."""
     from .tree import _aba
     from .spatial import _spatial_aba
     n, npar = d.n, max(len(d.params), 1)
     order = d.aba_order
     index = {name: J.col for name, J in zip(d.order_names, d.joints)}
+    btrig = {d.order_names[k]: cs for k, cs in trig.items()}
     if d.planar:
         defs, acc = _aba(order, index, d.cdata, list(d.coords), list(d.speeds),
-                         list(d.user_forces), d.gravity[:2], d.absolute)
+                         list(d.user_forces), d.gravity[:2], d.absolute, trig=btrig)
     else:
         defs, acc = _spatial_aba(order, index, d.cdata, list(d.coords), list(d.speeds),
-                                 list(d.user_forces), sp.Matrix(d.gravity))
-    em.reset()
-    body = em.defs(defs, "b") + em.assign([(f"a({i + 1})", e) for i, e in enumerate(acc)])
-    return _proc('subroutine conmech_accel(t, q, v, a, p) bind(C, name="conmech_accel")',
+                                 list(d.user_forces), sp.Matrix(d.gravity), trig=btrig)
+    out = chunked(em, "tree_aba", ["t", "q", "v", "sc", "a", "p"],
+                  [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), sc(2, nb), p({npar})",
+                   f"{_IND}real(dp), intent(inout) :: a({n})"],
+                  [(None, defs, [(f"a({i + 1})", e) for i, e in enumerate(acc)])], "b")
+    out += _proc('subroutine conmech_accel(t, q, v, a, p) bind(C, name="conmech_accel")',
                  [f"{_IND}real(dp), value, intent(in) :: t",
                   f"{_IND}real(dp), intent(in) :: q({n}), v({n})",
                   f"{_IND}real(dp), intent(out) :: a({n})",
-                  f"{_IND}real(dp), intent(in) :: p({npar})"] + em.temps(), body,
+                  f"{_IND}real(dp), intent(in) :: p({npar})", SC_DECL],
+                 em.trig_lines + [f"{_IND}call tree_aba(t, q, v, sc, a, p)"],
                  "conmech_accel")
+    return out
+
+
+SC_DECL = f"{_IND}real(dp) :: sc(2, nb)"
+
+
+def pos_call(em, I=_IND):
+    """The statements that evaluate the sines and cosines and the position pass."""
+    return em.trig_lines + [f"{I}call tree_pos(t, q, sc, p, w)"]
 
 
 # fixed procedures: mass matrix (composite rigid bodies), derivatives of inverse dynamics
-# over the ancestor pairs, L^T D L factorisation of M and its solve (Featherstone,
-# Rigid Body Dynamics Algorithms, 6.5: the sparsity of the tree), maps of absolute angles
+# over the ancestor pairs, L^T D L factorisation of M and its solve (Featherstone, Rigid
+# Body Dynamics Algorithms, 6.5: the sparsity of the tree), maps of absolute angles. The
+# Jacobians are kept transposed, xt(variable, equation) with the variables [q; v] and the
+# equations in topological order, so that the row operations of the solve are contiguous.
 _FIXED = """
     !> M (relative coordinates, topological order): M_jk = S_j . alpha_k, j an ancestor
     !! of k or k.
@@ -432,11 +724,17 @@ _FIXED = """
         real(dp), intent(out) :: h(nb, nb)
         integer :: j, k
         real(dp) :: s
-        h = 0.0_dp
+ZEROH
+        integer :: c
+        real(dp) :: ak(na)
         do k = 1, nb
+            ak = w%al(:, k)
             j = k
             do while (j > 0)
-                s = dot_product(w%sv(:, j), w%al(:, k))
+                s = 0.0_dp
+                do c = 1, na
+                    s = s + w%sv(c, j)*ak(c)
+                end do
                 h(j, k) = s
                 h(k, j) = s
                 j = par(j)
@@ -444,31 +742,49 @@ _FIXED = """
         end do
     end subroutine tree_mass_topo
 
-    !> d tau / d q and d tau / d qd of inverse dynamics (relative, topological).
-    pure subroutine tree_did(w, dq, dv)
+    !> xt = -[d tau/d q, d tau/d qd]^T of inverse dynamics (relative, topological).
+    pure subroutine tree_did(w, xt)
         type(tree_work), intent(in) :: w
-        real(dp), intent(out) :: dq(nb, nb), dv(nb, nb)
-        integer :: j, k
-        dq = 0.0_dp
-        dv = 0.0_dp
+        real(dp), intent(out) :: xt(2*nb, nb)
+        integer :: c, j, k
+        real(dp) :: ak(na), ek(na), pk(na), ok(na), s1, s2, s3, s4
+ZEROX
         do k = 1, nb
-            j = k
+            ak = w%al(:, k)
+            ek = w%et(:, k)
+            pk = w%ph(:, k)
+            ok = w%om(:, k)
+            s1 = 0.0_dp
+            s2 = 0.0_dp
+            do c = 1, na
+                s1 = s1 + ak(c)*w%cc(c, k) + ek(c)*w%ps(c, k)
+                s2 = s2 + 2.0_dp*ak(c)*w%ps(c, k) + ek(c)*w%sv(c, k)
+            end do
+            xt(k, k) = -s1
+            xt(nb + k, k) = -s2
+            j = par(k)
             do while (j > 0)
-                dq(k, j) = dot_product(w%al(:, k), w%cc(:, j)) &
-                    + dot_product(w%et(:, k), w%ps(:, j))
-                dv(k, j) = 2.0_dp*dot_product(w%al(:, k), w%ps(:, j)) &
-                    + dot_product(w%et(:, k), w%sv(:, j))
-                if (j /= k) then
-                    dq(j, k) = dot_product(w%sv(:, j), w%ph(:, k))
-                    dv(j, k) = dot_product(w%sv(:, j), w%om(:, k))
-                end if
+                s1 = 0.0_dp
+                s2 = 0.0_dp
+                s3 = 0.0_dp
+                s4 = 0.0_dp
+                do c = 1, na
+                    s1 = s1 + ak(c)*w%cc(c, j) + ek(c)*w%ps(c, j)
+                    s2 = s2 + 2.0_dp*ak(c)*w%ps(c, j) + ek(c)*w%sv(c, j)
+                    s3 = s3 + w%sv(c, j)*pk(c)
+                    s4 = s4 + w%sv(c, j)*ok(c)
+                end do
+                xt(j, k) = -s1
+                xt(nb + j, k) = -s2
+                xt(k, j) = -s3
+                xt(nb + k, j) = -s4
                 j = par(j)
             end do
         end do
     end subroutine tree_did
 
     !> M = L^T D L in place (L unit lower triangular with the tree's sparsity, D on the
-    !! diagonal); a pivot that is not positive makes the factor NaN.
+    !! diagonal, stored inverted); a pivot that is not positive makes the factor NaN.
     pure subroutine tree_ltdl(h)
         real(dp), intent(inout) :: h(nb, nb)
         integer :: i, j, k
@@ -486,88 +802,77 @@ _FIXED = """
                 h(k, i) = a
                 i = par(i)
             end do
+            h(k, k) = 1.0_dp/h(k, k)
         end do
     end subroutine tree_ltdl
 
-    !> x := M^-1 x for the columns of x, M = L^T D L from tree_ltdl.
-    pure subroutine tree_ltdl_solve(h, m, x)
+    !> xt := xt M^-1 (the rows of x = M^-1 x, x kept transposed), M from tree_ltdl.
+    pure subroutine tree_ltdl_solve(h, xt)
         real(dp), intent(in) :: h(nb, nb)
-        integer, intent(in) :: m
-        real(dp), intent(inout) :: x(nb, m)
-        integer :: i, j
+        real(dp), intent(inout) :: xt(2*nb, nb)
+        integer :: c, i, j
+        real(dp) :: f
         do i = nb, 1, -1
             j = par(i)
             do while (j > 0)
-                x(j, :) = x(j, :) - h(i, j)*x(i, :)
+                f = h(i, j)
+                do c = 1, 2*nb
+                    xt(c, j) = xt(c, j) - f*xt(c, i)
+                end do
                 j = par(j)
             end do
         end do
         do i = 1, nb
-            x(i, :) = x(i, :)/h(i, i)
-        end do
-        do i = 1, nb
+            f = h(i, i)
+            do c = 1, 2*nb
+                xt(c, i) = xt(c, i)*f
+            end do
             j = par(i)
             do while (j > 0)
-                x(i, :) = x(i, :) - h(i, j)*x(j, :)
+                f = h(i, j)
+                do c = 1, 2*nb
+                    xt(c, i) = xt(c, i) - f*xt(c, j)
+                end do
                 j = par(j)
             end do
         end do
     end subroutine tree_ltdl_solve
 
-    !> x := T^T x (rows; T maps absolute to relative angles).
-    pure subroutine tree_tt_left(m, x)
-        integer, intent(in) :: m
-        real(dp), intent(inout) :: x(nb, m)
-        real(dp) :: y(nb, m)
+    !> x := T^T x on the equations (rows of x: columns of xt) and := x T on the variables
+    !! (both halves), T mapping absolute to relative angles.
+    pure subroutine tree_abs_r(xt)
+        real(dp), intent(inout) :: xt(2*nb, nb)
+        real(dp) :: y(2*nb, nb)
         integer :: k
-        y = x
+        y = xt
         do k = 1, nb
-            if (ka(k) > 0) x(ka(k), :) = x(ka(k), :) - y(k, :)
+            if (ka(k) > 0) xt(:, ka(k)) = xt(:, ka(k)) - y(:, k)
         end do
-    end subroutine tree_tt_left
-
-    !> x := x T (columns).
-    pure subroutine tree_t_right(m, x)
-        integer, intent(in) :: m
-        real(dp), intent(inout) :: x(m, nb)
-        real(dp) :: y(m, nb)
-        integer :: k
-        y = x
+        y = xt
         do k = 1, nb
-            if (ka(k) > 0) x(:, ka(k)) = x(:, ka(k)) - y(:, k)
+            if (ka(k) > 0) then
+                xt(ka(k), :) = xt(ka(k), :) - y(k, :)
+                xt(nb + ka(k), :) = xt(nb + ka(k), :) - y(nb + k, :)
+            end if
         end do
-    end subroutine tree_t_right
-
-    !> x := T^-T x (rows: subtree sums along the revolute ancestors).
-    pure subroutine tree_tinvt_left(m, x)
-        integer, intent(in) :: m
-        real(dp), intent(inout) :: x(nb, m)
-        integer :: k
-        do k = nb, 1, -1
-            if (ka(k) > 0) x(ka(k), :) = x(ka(k), :) + x(k, :)
-        end do
-    end subroutine tree_tinvt_left
-
-    !> x := T^-1 x (rows: accumulated along the revolute ancestors).
-    pure subroutine tree_tinv_left(m, x)
-        integer, intent(in) :: m
-        real(dp), intent(inout) :: x(nb, m)
-        integer :: k
-        do k = 1, nb
-            if (ka(k) > 0) x(k, :) = x(k, :) + x(ka(k), :)
-        end do
-    end subroutine tree_tinv_left
+    end subroutine tree_abs_r
 
     !> M in the user's coordinates and order.
     pure subroutine tree_mass_user(w, mm)
         type(tree_work), intent(in) :: w
         real(dp), intent(out) :: mm(nb, nb)
-        real(dp) :: h(nb, nb)
-        integer :: i, j
+        real(dp) :: h(nb, nb), y(nb, nb)
+        integer :: i, j, k
         call tree_mass_topo(w, h)
         if (any(ka > 0)) then
-            call tree_tt_left(nb, h)
-            call tree_t_right(nb, h)
+            y = h
+            do k = 1, nb
+                if (ka(k) > 0) h(ka(k), :) = h(ka(k), :) - y(k, :)
+            end do
+            y = h
+            do k = 1, nb
+                if (ka(k) > 0) h(:, ka(k)) = h(:, ka(k)) - y(:, k)
+            end do
         end if
         do j = 1, nb
             do i = 1, nb
@@ -581,63 +886,47 @@ _FIXED = """
         type(tree_work), intent(in) :: w
         real(dp), intent(in) :: fu(nb)
         real(dp), intent(out) :: f(nb)
-        real(dp) :: y(nb, 1)
-        integer :: i
-        y(:, 1) = w%tau
-        if (any(ka > 0)) call tree_tt_left(1, y)
+        real(dp) :: y(nb)
+        integer :: i, k
+        y = w%tau
+        do k = 1, nb
+            if (ka(k) > 0) y(ka(k)) = y(ka(k)) - w%tau(k)
+        end do
         do i = 1, nb
-            f(col(i)) = fu(col(i)) - y(i, 1)
+            f(col(i)) = fu(col(i)) - y(i)
         end do
     end subroutine tree_q_user
 
-    !> R = d(fu)/d[q, v] - T^T dID/d[q, v] diag(T, T), user order (ru: the user part).
-    pure subroutine tree_r_user(w, ru, r)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(in) :: ru(nb, 2*nb)
+    !> An n x 2n matrix in the user's order from its transpose in topological order.
+    pure subroutine tree_untranspose(xt, r)
+        real(dp), intent(in) :: xt(2*nb, nb)
         real(dp), intent(out) :: r(nb, 2*nb)
-        real(dp) :: dq(nb, nb), dv(nb, nb)
         integer :: i, j
-        call tree_did(w, dq, dv)
-        if (any(ka > 0)) then
-            call tree_tt_left(nb, dq)
-            call tree_t_right(nb, dq)
-            call tree_tt_left(nb, dv)
-            call tree_t_right(nb, dv)
-        end if
-        r = ru
         do j = 1, nb
             do i = 1, nb
-                r(col(i), col(j)) = r(col(i), col(j)) - dq(i, j)
-                r(col(i), nb + col(j)) = r(col(i), nb + col(j)) - dv(i, j)
+                r(col(i), col(j)) = xt(j, i)
+                r(col(i), nb + col(j)) = xt(nb + j, i)
             end do
         end do
-    end subroutine tree_r_user
+    end subroutine tree_untranspose
 
-    !> d a / d[q, v] = T^-1 M_rel^-1 T^-T R (user order).
-    pure subroutine tree_accel_jac_user(w, r, jac)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(in) :: r(nb, 2*nb)
-        real(dp), intent(out) :: jac(nb, 2*nb)
-        real(dp) :: h(nb, nb), x(nb, 2*nb)
-        integer :: i, j
-        do j = 1, nb
-            do i = 1, nb
-                x(i, j) = r(col(i), col(j))
-                x(i, nb + j) = r(col(i), nb + col(j))
+    !> xt := (M^-1 R)^T with M^-1 = T^-1 M_rel^-1 T^-T (absolute angles), h from tree_ltdl.
+    pure subroutine tree_solve_r(h, xt)
+        real(dp), intent(in) :: h(nb, nb)
+        real(dp), intent(inout) :: xt(2*nb, nb)
+        integer :: k
+        if (any(ka > 0)) then
+            do k = nb, 1, -1
+                if (ka(k) > 0) xt(:, ka(k)) = xt(:, ka(k)) + xt(:, k)
             end do
-        end do
-        call tree_mass_topo(w, h)
-        call tree_ltdl(h)
-        if (any(ka > 0)) call tree_tinvt_left(2*nb, x)
-        call tree_ltdl_solve(h, 2*nb, x)
-        if (any(ka > 0)) call tree_tinv_left(2*nb, x)
-        do j = 1, nb
-            do i = 1, nb
-                jac(col(i), col(j)) = x(i, j)
-                jac(col(i), nb + col(j)) = x(i, nb + j)
+        end if
+        call tree_ltdl_solve(h, xt)
+        if (any(ka > 0)) then
+            do k = 1, nb
+                if (ka(k) > 0) xt(:, k) = xt(:, k) + xt(:, ka(k))
             end do
-        end do
-    end subroutine tree_accel_jac_user
+        end if
+    end subroutine tree_solve_r
 """
 
 
@@ -648,16 +937,16 @@ def _entries(d, n, npar, absolute, jac, constrained, lc, em):
     P = f"{I}real(dp), intent(in) :: p({npar})"
     Q1 = f"{I}real(dp), intent(in) :: q({n})"
     QV = f"{I}real(dp), intent(in) :: q({n}), v({n})"
-    W = f"{I}type(tree_work) :: w"
+    W = f"{I}type(tree_work) :: w\n{SC_DECL}"
 
     def head(name, args):
         return f'subroutine conmech_{name}({", ".join(args)}) bind(C, name="conmech_{name}")'
     out, ent = [], []
     out += _proc(head("mass", ["t", "q", "mm", "p"]),
                  [T, Q1, f"{I}real(dp), intent(out) :: mm({n}, {n})", P, W],
-                 [f"{I}call tree_pos(t, q, p, w)", f"{I}call tree_mass_user(w, mm)"],
+                 pos_call(em) + [f"{I}call tree_mass_user(w, mm)"],
                  "conmech_mass")
-    forces_body = [f"{I}z = 0.0_dp", f"{I}call tree_pos(t, q, p, w)",
+    forces_body = [f"{I}z = 0.0_dp"] + pos_call(em) + [
                    f"{I}call tree_vel(t, q, v, z, p, w, .false.)",
                    f"{I}call tree_user_forces(t, q, v, p, fu)",
                    f"{I}call tree_q_user(w, fu, f)"]
@@ -672,23 +961,30 @@ def _entries(d, n, npar, absolute, jac, constrained, lc, em):
                      forces_body + [f"{I}call tree_mass_user(w, mm)"], "conmech_mass_forces")
         ent += ["mass_forces", "accel"]
         if jac:
-            rbody = [f"{I}call tree_pos(t, q, p, w)",
-                     f"{I}call tree_vel(t, q, v, a, p, w, .true.)",
-                     f"{I}call tree_user_jac(t, q, v, p, ru)",
-                     f"{I}call tree_r_user(w, ru, r)"]
+            rbody = [f"{I}call tree_vel(t, q, v, a, p, w, .true.)",
+                     f"{I}call tree_did(w, xt)"]
+            if any(ka >= 0 for ka in (J.ka for J in d.joints)):
+                rbody.append(f"{I}call tree_abs_r(xt)")
+            if _has_user_jac(d):
+                rbody.append(f"{I}call tree_user_jac(t, q, v, p, xt)")
+            XT = f"{I}real(dp) :: xt({2*n}, {n})"
             out += _proc(head("forces_jac", ["t", "q", "v", "a", "r", "p"]),
                          [T, QV, f"{I}real(dp), intent(in) :: a({n})",
-                          f"{I}real(dp), intent(out) :: r({n}, {2*n})", P, W,
-                          f"{I}real(dp) :: ru({n}, {2*n})"], rbody, "conmech_forces_jac")
+                          f"{I}real(dp), intent(out) :: r({n}, {2*n})", P, W, XT],
+                         pos_call(em) + rbody + [f"{I}call tree_untranspose(xt, r)"],
+                         "conmech_forces_jac")
             out += _proc(head("accel_jac", ["t", "q", "v", "a", "jac", "p"]),
                          [T, QV, f"{I}real(dp), intent(out) :: a({n}), jac({n}, {2*n})", P, W,
-                          f"{I}real(dp) :: ru({n}, {2*n}), r({n}, {2*n})"],
-                         [f"{I}call conmech_accel(t, q, v, a, p)"] + rbody
-                         + [f"{I}call tree_accel_jac_user(w, r, jac)"], "conmech_accel_jac")
+                          XT, f"{I}real(dp) :: h({n}, {n})"],
+                         em.trig_lines + [f"{I}call tree_aba(t, q, v, sc, a, p)",
+                                          f"{I}call tree_pos(t, q, sc, p, w)"] + rbody
+                         + [f"{I}call tree_mass_topo(w, h)", f"{I}call tree_ltdl(h)",
+                            f"{I}call tree_solve_r(h, xt)",
+                            f"{I}call tree_untranspose(xt, jac)"], "conmech_accel_jac")
             ent += ["forces_jac", "accel_jac"]
     out += ["    function conmech_energy(t, q, v, p) bind(C, name=\"conmech_energy\") "
             "result(e)", T, QV, P, f"{I}real(dp) :: e", W, f"{I}real(dp) :: z({n})",
-            f"{I}z = 0.0_dp", f"{I}call tree_pos(t, q, p, w)",
+            f"{I}z = 0.0_dp"] + pos_call(em) + [
             f"{I}call tree_vel(t, q, v, z, p, w, .false.)", f"{I}e = w%ke + w%pe",
             "    end function conmech_energy", ""]
     ent.append("energy")
