@@ -468,6 +468,11 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
         straight = _straight_pairs(joints, nz, jac)
         procs = [next((v for key, v in straight.items() if pr.startswith(key)), pr)
                  for pr in procs]
+    if not jac:     # what no entry point calls is not generated
+        skip = ("tree_did", "tree_ltdl", "tree_ltdl_solve", "tree_abs_r", "tree_untranspose",
+                "tree_solve_r")
+        procs = [pr for pr in procs
+                 if not any(f"subroutine {nm}(" in pr for nm in skip)]
     out += "\n    !> ".join(procs).splitlines() + [""]
     # ---- entry points
     ent, procs = _entries(d, n, npar, absolute, jac, constrained, lc, em)
