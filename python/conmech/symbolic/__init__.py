@@ -348,7 +348,7 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      jacobian=True, flags=None, model_only=False):
+                      jacobian=True, mass=None, energy=None, flags=None, model_only=False):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -375,7 +375,23 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     jacobian : bool
         Generate the exact Jacobian of the accelerations (forces_jac); False saves
         derivation and compile time for large systems that are only integrated.
+    mass : square matrix, optional
+        The mass matrix M(t, q) given directly (symmetric, positive definite, free of the
+        velocities; ``L`` must then be None): the system is M q'' = Q with Q = ``forces``,
+        the complete generalized forces (velocity terms included), with the exact
+        Jacobian; ``energy`` (an expression in t, q, q') is optional.
     """
+    if mass is not None:
+        from .direct import derive_direct
+        if L is not None:
+            raise ValueError("give either the Lagrangian L or mass= (then L=None)")
+        return _construct("direct", [sp.Matrix(mass), _tup(forces), _tup(q),
+                                     _tup(velocities), energy], params, (bool(jacobian),),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                bool(jacobian)),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (a Lagrangian defines its own energy)")
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
                       (simplify, bool(jacobian)),
                       lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
@@ -384,13 +400,30 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
 
 
 def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
-                       velocities=None, simplify="auto", flags=None, model_only=False):
+                       velocities=None, simplify="auto", mass=None, energy=None, flags=None,
+                       model_only=False):
     """A compiled system in excessive coordinates for ``conmech.constrained.solve``:
     kinetic energy T, potential U, holonomic constraints phi(t, q) = 0 and non-holonomic
     constraints given as expressions linear in the velocities (A(t, q) q' + b(t, q) = 0).
     Derives M, Q, G = d phi/dq, phi_t, gamma_h, A, b, gamma_n and the energy T + U (Jacobi
     integral); rheonomic constraints (explicit t) are detected.
+
+    ``mass=`` gives the mass matrix M(t, q) directly instead of T (``T`` must then be
+    None): the forces are ``forces`` (complete, velocity terms included) minus dU/dq when
+    U is given (U may be None), and the energy is ``energy`` or v^T M v / 2 + U.
     """
+    if mass is not None:
+        from .direct import derive_direct
+        if T is not None:
+            raise ValueError("give either the kinetic energy T or mass= (then T=None)")
+        return _construct("direct_constrained",
+                          [sp.Matrix(mass), _tup(forces), _tup(q), _tup(velocities), energy,
+                           U, _tup(holonomic), _tup(nonholonomic)], params, (),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                True, list(holonomic), nonholonomic, U),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (T and U define the energy)")
     return _construct("constrained", [T, U, _tup(q), _tup(holonomic), _tup(nonholonomic),
                                       _tup(forces), _tup(velocities)], params, (simplify,),
                       lambda: derive_constrained(T, U, q, holonomic, nonholonomic, params,

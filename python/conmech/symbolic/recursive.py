@@ -524,3 +524,74 @@ def derive_recursive(kind, parts, params, planar, absolute=False, loops=(), jaco
         d.n_hol = count_rows(loop_items)
         d.rheonomic = False
     return d
+
+
+def _path_to_root(joints, k):
+    out = []
+    while k >= 0:
+        out.append(k)
+        k = joints[k].parent
+    return out
+
+
+def point_force_code(d, trig=None):
+    """(code, Q) of the forces at points of bodies (d.point_forces): Q (user order) are
+    expressions in the definitions of `code`: Q_rel_j = S_j . [p x F; F] over the joints
+    j on the body's path (p the point and F the force in the ground frame), mapped by
+    T^T for absolute angles (`trig`: the joint angles' cosines and sines computed
+    elsewhere, as pos_pass). None when there are none."""
+    if not getattr(d, "point_forces", None):
+        return None
+    joints = d.joints
+    nb = len(joints)
+    code = Code()
+    qrel = [code.let(x) for x in relative(joints, d.coords)]
+    pos, _ = pos_pass(code, joints, qrel, d.gravity, trig=trig)
+    Qrel = [sp.Integer(0)]*nb
+    for item in d.point_forces:
+        k, dim, e = item["body"], item["npt"], item["exprs"]
+        pt = list(e[:dim]) + [0]*(3 - dim)
+        F = list(e[dim:2*dim]) + [0]*(3 - dim)
+        R, p = pos[k]["R"], pos[k]["p"]
+        pw = code.lv(_add(p, _matvec(R, pt)))
+        Fw = code.lv(F if item["frame"] == "world" else _matvec(R, F))
+        f6 = code.lv(_cross(pw, Fw) + Fw)
+        for j in _path_to_root(joints, k):
+            Qrel[j] = Qrel[j] + _dot(pos[j]["S"], f6)
+    Q = [sp.Integer(0)]*nb
+    for a, J in enumerate(joints):
+        Q[J.col] += Qrel[a]
+        if J.ka >= 0:
+            Q[joints[J.ka].col] -= Qrel[a]
+    return code, [code.let(x) for x in Q]
+
+
+def forward_diff(code, outputs, xs):
+    """Forward-mode derivatives of the expressions `outputs` (over the definitions of
+    `code`) with respect to the symbols `xs`: a list (one per output) of {index in xs:
+    expression}, the new definitions appended to `code` (each a short product of
+    partial derivatives; the order is the definitions' order: a deterministic code)."""
+    defs = code.live(outputs)
+    rank = {x: -1 - i for i, x in enumerate(xs)}
+    rank.update({s: i for i, (s, e) in enumerate(defs) if not isinstance(e, str)})
+    deriv = {x: {i: sp.Integer(1)} for i, x in enumerate(xs)}
+
+    def grad(e):
+        acc = {}
+        for u in sorted((u for u in e.free_symbols if u in deriv), key=rank.get):
+            pe = sp.diff(e, u)
+            if pe.has(sp.DiracDelta):
+                pe = pe.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
+            if pe == 0:
+                continue
+            pe = code.let(pe)
+            for j, val in deriv[u].items():
+                acc[j] = acc.get(j, 0) + pe*val
+        return {j: code.let(v) for j, v in sorted(acc.items()) if v != 0}
+    for s, e in defs:
+        if isinstance(e, str):
+            continue
+        g = grad(e)
+        if g:
+            deriv[s] = g
+    return [grad(sp.sympify(o)) for o in outputs]

@@ -449,12 +449,13 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
                    [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), a({n}), p({npar})",
                     f"{_IND}type(tree_work), intent(inout) :: w",
                     f"{_IND}logical, intent(in) :: deriv"], blocks, "u")
-    em.reset()
-    out += _user_forces(d, em.pr)
+    from .recursive import point_force_code
+    pfc = point_force_code(d)
+    out += _user_forces(d, em, pfc)
     if jac:
-        out += _user_jac(d, em.pr)
+        out += _user_jac(d, em, pfc)
     if not constrained:
-        out += _aba_proc(d, em, trig)
+        out += _aba_proc(d, em, trig, point_force_code(d, trig))
     chain = all(J.parent == k - 1 for k, J in enumerate(joints))
     fixed = _FIXED.replace("ZEROH", "" if chain else f"{_IND}h = 0.0_dp")
     fixed = fixed.replace("ZEROX", "" if chain else f"{_IND}xt = 0.0_dp")
@@ -630,13 +631,27 @@ def _with_zeros(pairs, arrays, nb, act):
     return out
 
 
-def _user_forces(d, pr):
-    """tree_user_forces(t, q, v, p, fu): the user's generalized forces (user order)."""
+def _user_forces(d, em, pfc):
+    """tree_user_forces(t, q, v, p, fu): the user's generalized forces (user order), with
+    those of the forces at points of bodies (pfc: point_force_code's (code, Q))."""
     n, npar = d.n, max(len(d.params), 1)
     fl = [sp.sympify(e) for e in d.user_forces]
     tg = [f"fu({i + 1})" for i, e in enumerate(fl) if e != 0]
     ex = [e for e in fl if e != 0]
-    temps, lines = assignments(tg, ex, pr, _IND, prefix="f") if ex else ([], [])
+    em.reset()
+    temps, lines = assignments(tg, ex, em.pr, _IND, prefix="f") if ex else ([], [])
+    if pfc is not None:
+        code, Q = pfc
+        lines += em.defs(code.live(Q), "pf")
+        saved = em.pr.names
+        em.pr.names = {**saved, **em.local}
+        try:
+            lines += [f"{_IND}fu({i + 1}) = fu({i + 1}) + "
+                      f"{fast_print(sp.sympify(e), em.pr.names, em.pr)}"
+                      for i, e in enumerate(Q) if e != 0]
+        finally:
+            em.pr.names = saved
+        temps = temps + list(em.local.values())
     return _proc("subroutine tree_user_forces(t, q, v, p, fu)",
                  [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), p({npar})",
                   f"{_IND}real(dp), intent(out) :: fu({n})"] + _decl_temps(temps),
@@ -645,15 +660,22 @@ def _user_forces(d, pr):
 
 def _has_user_jac(d):
     xs = set(d.coords) | set(d.speeds)
-    return any(sp.sympify(e).free_symbols & xs for e in d.user_forces)
+    return bool(getattr(d, "point_forces", None)) or any(
+        sp.sympify(e).free_symbols & xs for e in d.user_forces)
 
 
-def _user_jac(d, pr):
-    """tree_user_jac(t, q, v, p, xt): adds d(user forces)/d[q, v] to the transposed
+def _user_jac(d, em, pfc):
+    """tree_user_jac(t, q, v, p, xt): adds d(user forces)/d[q, v] (and that of the forces
+    at points of bodies, by forward differentiation of their code) to the transposed
     Jacobian xt (variables x equations, topological order)."""
+    from .recursive import forward_diff
     n, npar = d.n, max(len(d.params), 1)
     topo = {J.col: k for k, J in enumerate(d.joints)}
     xs = list(d.coords) + list(d.speeds)
+
+    def target(i, j):
+        var = topo[j] if j < n else n + topo[j - n]
+        return f"xt({var + 1}, {topo[i] + 1})"
     tg, ex = [], []
     for i, e in enumerate(d.user_forces):
         e = sp.sympify(e)
@@ -665,13 +687,25 @@ def _user_jac(d, pr):
                 if de.has(sp.DiracDelta):
                     de = de.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
                 if de != 0:
-                    var = topo[j] if j < n else n + topo[j - n]
-                    tgt = f"xt({var + 1}, {topo[i] + 1})"
-                    tg.append(tgt)
+                    tg.append(target(i, j))
                     ex.append(de)
     gt = [f"gj({k + 1})" for k in range(len(ex))]
-    temps, lines = assignments(gt, ex, pr, _IND, prefix="g") if ex else ([], [])
+    em.reset()
+    temps, lines = assignments(gt, ex, em.pr, _IND, prefix="g") if ex else ([], [])
     lines += [f"{_IND}{t} = {t} + {g}" for t, g in zip(tg, gt)]
+    if pfc is not None:
+        code, Q = pfc
+        grads = forward_diff(code, Q, xs)
+        outs = [(target(i, j), e) for i, gr in enumerate(grads) for j, e in gr.items()]
+        lines += em.defs(code.live([e for _, e in outs]), "pg")
+        saved = em.pr.names
+        em.pr.names = {**saved, **em.local}
+        try:
+            lines += [f"{_IND}{t} = {t} + {fast_print(sp.sympify(e), em.pr.names, em.pr)}"
+                      for t, e in outs]
+        finally:
+            em.pr.names = saved
+        temps = temps + list(em.local.values())
     return _proc("subroutine tree_user_jac(t, q, v, p, xt)",
                  [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), p({npar})",
                   f"{_IND}real(dp), intent(inout) :: xt({2*n}, {n})",
@@ -679,7 +713,7 @@ def _user_jac(d, pr):
                  lines, "tree_user_jac")
 
 
-def _aba_proc(d, em, trig):
+def _aba_proc(d, em, trig, pfc=None):
     """tree_aba(t, q, v, sc, a, p): the articulated-body accelerations (tree.py /
     spatial.py) on the sines and cosines sc; conmech_accel computes them and calls it."""
     from .tree import _aba
@@ -688,12 +722,19 @@ def _aba_proc(d, em, trig):
     order = d.aba_order
     index = {name: J.col for name, J in zip(d.order_names, d.joints)}
     btrig = {d.order_names[k]: cs for k, cs in trig.items()}
+    tau = list(d.user_forces)
+    pre = []
+    if pfc is not None:         # the generalized forces of the point forces first
+        code, Q = pfc
+        pre = code.live(Q)
+        tau = [a + b for a, b in zip(tau, Q)]
     if d.planar:
-        defs, acc = _aba(order, index, d.cdata, list(d.coords), list(d.speeds),
-                         list(d.user_forces), d.gravity[:2], d.absolute, trig=btrig)
+        defs, acc = _aba(order, index, d.cdata, list(d.coords), list(d.speeds), tau,
+                         d.gravity[:2], d.absolute, trig=btrig)
     else:
         defs, acc = _spatial_aba(order, index, d.cdata, list(d.coords), list(d.speeds),
-                                 list(d.user_forces), sp.Matrix(d.gravity), trig=btrig)
+                                 tau, sp.Matrix(d.gravity), trig=btrig)
+    defs = pre + list(defs)
     out = chunked(em, "tree_aba", ["t", "q", "v", "sc", "a", "p"],
                   [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), sc(2, nb), p({npar})",
                    f"{_IND}real(dp), intent(inout) :: a({n})"],
