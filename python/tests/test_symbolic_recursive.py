@@ -161,16 +161,17 @@ def test_large_tree_forms_agree(monkeypatch):
     (with the crossing values in an array) give the straight-line results."""
     from conmech.symbolic import tree_fortran
     from conmech.symbolic.recursive import derive_recursive
-    bodies, params, forces, g = spatial_arm(5)
-    parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -g), forces, lazy=True)
-    d = derive_recursive("spatial", parts, params, planar=False)
-    m0 = symbolic.compile_model(d)
-    monkeypatch.setattr(tree_fortran, "STRAIGHT_MAX", 2)
-    monkeypatch.setattr(tree_fortran, "CHUNK", 40)
-    m1 = symbolic.compile_model(d)
-    assert "subroutine tree_vel_3(" in m1.source and "do while (j > 0)" in m1.source
-    assert "subroutine tree_vel_3(" not in m0.source
-    assert agree(m1, m0, 5, np.random.default_rng(3), k=2) <= 1e-13
+    for bodies, params, forces, g in (spatial_arm(5), spatial_branched()):
+        parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -g), forces, lazy=True)
+        d = derive_recursive("spatial", parts, params, planar=False)
+        m0 = symbolic.compile_model(d)
+        with monkeypatch.context() as mp:
+            mp.setattr(tree_fortran, "STRAIGHT_MAX", 2)
+            mp.setattr(tree_fortran, "CHUNK", 40)
+            m1 = symbolic.compile_model(d)
+        assert "subroutine tree_vel_3(" in m1.source and "do while (j > 0)" in m1.source
+        assert "subroutine tree_vel_3(" not in m0.source
+        assert agree(m1, m0, len(bodies), np.random.default_rng(3), k=2) <= 1e-13
 
 
 def passes(src):

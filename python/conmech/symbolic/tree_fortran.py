@@ -768,11 +768,9 @@ _FIXED = """
     pure subroutine tree_mass_topo(w, h)
         type(tree_work), intent(in) :: w
         real(dp), intent(out) :: h(nb, nb)
-        integer :: j, k
-        real(dp) :: s
+        integer :: c, j, k
+        real(dp) :: s, ak(na)
 ZEROH
-        integer :: c
-        real(dp) :: ak(na)
         do k = 1, nb
             ak = w%al(:, k)
             j = k
