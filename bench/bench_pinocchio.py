@@ -87,8 +87,10 @@ def build_harnesses(work, pin_model):
     subprocess.run([cc, "-O3", "-o", ch, os.path.join(HERE, "pinocchio", "conmech_harness.c"),
                     "-ldl"], check=True)
     import pinocchio
-    prefix = os.path.join(os.path.dirname(os.path.dirname(pinocchio.__file__)),
-                          "cmeel.prefix")
+    # the wheel's prefix: .../cmeel.prefix/lib/pythonX.Y/site-packages/pinocchio/
+    prefix = os.path.abspath(pinocchio.__file__)
+    while prefix != os.path.dirname(prefix) and os.path.basename(prefix) != "cmeel.prefix":
+        prefix = os.path.dirname(prefix)
     if not (cxx and os.path.isdir(os.path.join(prefix, "include", "pinocchio"))
             and os.path.isdir(os.path.join(prefix, "include", "eigen3"))):
         return ch, None, ("no C++ harness (needs g++, the pin wheel's headers and Eigen's: "

@@ -351,3 +351,17 @@ def test_bad_loops():
     with pytest.raises(ValueError, match="unknown joint 'prismatic' for a spatial"):
         symbolic.spatial_tree(sb, {}, loops=[Loop("a", (1, 0, 0), None, (1, 0, 0),
                                                   "prismatic")])
+
+
+def test_fourbar_example_runs():
+    """example/fourbar.py: a crank-rocker closed by a Loop, on its constraints."""
+    import os
+    import re
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    r = subprocess.run([sys.executable, os.path.join(root, "example", "fourbar.py")],
+                       capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stderr
+    res = float(re.search(r"max \|phi\| = (\S+);", r.stdout).group(1))
+    assert "success" in r.stdout and res <= 1e-10

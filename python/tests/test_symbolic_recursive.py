@@ -163,11 +163,13 @@ def test_large_tree_forms_agree(monkeypatch):
     from conmech.symbolic.recursive import derive_recursive
     for bodies, params, forces, g in (spatial_arm(5), spatial_branched()):
         parts = symbolic.spatial.build_spatial_tree(bodies, (0, 0, -g), forces, lazy=True)
-        d = derive_recursive("spatial", parts, params, planar=False)
-        m0 = symbolic.compile_model(d)
+        d = derive_recursive(parts, params, planar=False)
+        with monkeypatch.context() as mp:
+            mp.setattr(tree_fortran, "CHUNK", 10**6)
+            m0 = symbolic.compile_model(d)
         with monkeypatch.context() as mp:
             mp.setattr(tree_fortran, "STRAIGHT_MAX", 2)
-            mp.setattr(tree_fortran, "CHUNK", 40)
+            mp.setattr(tree_fortran, "CHUNK_LARGE", 40)
             m1 = symbolic.compile_model(d)
         assert "subroutine tree_vel_3(" in m1.source and "do while (j > 0)" in m1.source
         assert "subroutine tree_vel_3(" not in m0.source
@@ -227,7 +229,7 @@ def test_source_is_deterministic(tmp_path):
             "import test_symbolic_recursive as T\n"
             "b, p, f, g = T.spatial_branched()\n"
             "parts = symbolic.spatial.build_spatial_tree(b, (0, 0, -g), f, lazy=True)\n"
-            "d = derive_recursive('spatial', parts, p, planar=False)\n"
+            "d = derive_recursive(parts, p, planar=False)\n"
             "print(hashlib.sha256(generate_tree(d)[0].encode()).hexdigest())\n")
     env = dict(os.environ, PYTHONPATH=os.path.dirname(__file__), PYTHONHASHSEED="random")
     out = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
@@ -241,3 +243,15 @@ def test_cache_hit_skips_derivation_and_compilation():
     symbolic.spatial_tree(bodies, params, **kw)
     again = symbolic.spatial_tree(bodies, params, **kw)
     assert again.cache_hit and again.times["derive"] == 0.0 and "derived_cache" in again.times
+
+
+def test_radau_runs_on_the_exact_jacobian():
+    """Radau IIA on a recursive tree (its Jacobian from accel_jac) follows DOP853."""
+    from conmech import solve_ivp
+    bodies, params, forces, g = spatial_branched()
+    sysm = symbolic.spatial_tree(bodies, params, gravity=(0, 0, -g), forces=forces)
+    y0 = [0.1, 0.5, -0.4, 0.3, 0.0, 0.2, 0.0, -0.1]
+    r1 = solve_ivp(sysm, (0, 2), y0, method="Radau", rtol=1e-10, atol=1e-10)
+    r2 = solve_ivp(sysm, (0, 2), y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    assert r1.success and r2.success and r1.njev > 0
+    assert np.max(np.abs(r1.y[:, -1] - r2.y[:, -1])) <= 1e-7

@@ -97,7 +97,7 @@ class Code:
             return e
         s = self.memo.get(e)
         if s is None:
-            s = sp.Dummy("w", real=True)
+            s = sp.Dummy("w")          # (no assumptions: creating them is costly)
             self.defs.append((s, e))
             self.memo[e] = s
         return s
@@ -426,7 +426,7 @@ class TreeDerived(Derived):
         return generate_tree(self, module, model_values)
 
 
-def derive_recursive(kind, parts, params, planar, absolute=False, loops=(), jacobian=True,
+def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=True,
                      point_forces=()):
     """The :class:`TreeDerived` record of a planar or spatial tree (parts from
     tree.build_tree / spatial.build_spatial_tree), with the loop closures `loops`
@@ -440,7 +440,6 @@ def derive_recursive(kind, parts, params, planar, absolute=False, loops=(), jaco
     order, data = parts["order"], parts["data"]
     coords = parts["q"]
     c = _Coords(coords, None, t, need_speeds=True)
-    n = len(coords)
     # every expression of the description, flattened (then put back by position)
     flat = []
 

@@ -556,7 +556,7 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=N
         from .recursive import derive_recursive
 
         def derive():
-            return derive_recursive("spatial", parts, params, planar=False, loops=loops,
+            return derive_recursive(parts, params, planar=False, loops=loops,
                                     jacobian=jacobian, point_forces=point_forces)
     else:
         def derive():

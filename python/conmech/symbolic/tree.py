@@ -166,7 +166,7 @@ class _Code:
             return e
         if e in self.memo:
             return self.memo[e]
-        s = sp.Dummy(f"{name}{len(self.defs) + 1}", real=True)
+        s = sp.Dummy(f"{name}{len(self.defs) + 1}")
         self.defs.append((s, e))
         self.mine.add(s)
         self.memo[e] = s
@@ -596,7 +596,7 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
         from .recursive import derive_recursive
 
         def derive():
-            return derive_recursive("planar", parts, params, planar=True,
+            return derive_recursive(parts, params, planar=True,
                                     absolute=coordinates == "absolute", loops=loops,
                                     jacobian=jacobian, point_forces=point_forces)
     else:

@@ -35,7 +35,7 @@ class _Store:
         self.loads = {}          # Dummy -> target
 
     def _new(self, tgt, e):
-        s = sp.Dummy("ld", real=True)
+        s = sp.Dummy("ld")
         self.items.append((s, tgt, e))
         self.loads[s] = tgt
         return s
@@ -234,12 +234,14 @@ class Emit:
         return _decl_temps(list(self.local.values()))
 
 
-#: for trees of more than STRAIGHT_MAX bodies, a straight-line pass longer than this many
-#: statements is split into procedures of about this size (the compiler's time grows
-#: faster than linearly with the size of one procedure: 30 joints compile in half the
-#: time in pieces of 150); the values that cross from one piece to a later one go
-#: through an array. Smaller trees keep each pass in one procedure (fastest code).
-CHUNK = 150
+#: a straight-line pass longer than CHUNK statements (CHUNK_LARGE for trees of more than
+#: STRAIGHT_MAX bodies) is split into procedures of about that size: the compiler's time
+#: grows faster than linearly with the size of one procedure (measured, gfortran -O3:
+#: the seven-joint arm compiles in 0.83 of the time of whole passes at the same speed of
+#: its accelerations, and a 30-joint chain in half the time with pieces of 150); the
+#: values that cross from one piece to a later one go through an array
+CHUNK = 300
+CHUNK_LARGE = 150
 
 
 def chunked(em, name, args, decls, blocks, prefix, size=None):
@@ -248,9 +250,10 @@ def chunked(em, name, args, decls, blocks, prefix, size=None):
     (always), "deriv" or "plain" (the branches of ``if (deriv)``). Short passes are one
     procedure; long ones call pieces ``name_<k>`` with the values that cross pieces in a
     carry array. Returns the lines."""
-    size = CHUNK if size is None else size
+    if size is None:
+        size = CHUNK if em.nb <= STRAIGHT_MAX else CHUNK_LARGE
     total = sum(1 for _, defs, _ in blocks for _, e in defs if not isinstance(e, str))
-    if em.nb <= STRAIGHT_MAX:
+    if em.nb <= WHOLE_MAX:
         size = max(size, total)
     I = _IND
     if total <= size:
@@ -375,7 +378,7 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     qrel = [cp.let(x) for x in qrel_expr]
     # the sines and cosines of the joint angles: computed once per entry point (shared by
     # the articulated-body pass and the position pass of the Jacobian)
-    trig = {k: (sp.Dummy("tc", real=True), sp.Dummy("ts", real=True))
+    trig = {k: (sp.Dummy("tc"), sp.Dummy("ts"))
             for k, J in enumerate(joints) if J.kind == "revolute"}
     pos, U = pos_pass(cp, joints, qrel, d.gravity, trig=trig)
     lpos = _loaded_pos(st, pos, keep_pose)
@@ -459,6 +462,17 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     chain = all(J.parent == k - 1 for k, J in enumerate(joints))
     fixed = _FIXED.replace("ZEROH", "" if chain else f"{_IND}h = 0.0_dp")
     fixed = fixed.replace("ZEROX", "" if chain else f"{_IND}xt = 0.0_dp")
+    if all(J.col == k for k, J in enumerate(joints)):       # the user's order is topological
+        fixed = fixed.replace("UNTRANSPOSE", "\n".join([
+            f"{_IND}do j = 1, nb", f"{_IND}    do i = 1, nb",
+            f"{_IND}        r(i, j) = xt(j, i)", f"{_IND}        r(i, nb + j) = xt(nb + j, i)",
+            f"{_IND}    end do", f"{_IND}end do"]))
+    else:
+        fixed = fixed.replace("UNTRANSPOSE", "\n".join([
+            f"{_IND}do j = 1, nb", f"{_IND}    do i = 1, nb",
+            f"{_IND}        r(col(i), col(j)) = xt(j, i)",
+            f"{_IND}        r(col(i), nb + col(j)) = xt(nb + j, i)",
+            f"{_IND}    end do", f"{_IND}end do"]))
     procs = fixed.split("\n    !> ")
     if nb <= STRAIGHT_MAX:
         # the pair loops written out: no loop overhead, structural zeros skipped
@@ -519,6 +533,9 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
 
 #: trees of at most this many bodies get the pair loops as straight-line code
 STRAIGHT_MAX = 12
+#: trees of at most this many bodies keep each straight-line pass in one procedure (none
+#: by default: pieces of CHUNK statements compile faster at nearly the same speed)
+WHOLE_MAX = 0
 
 
 def _straight_pairs(joints, nz, jac):
@@ -946,12 +963,7 @@ ZEROX
         real(dp), intent(in) :: xt(2*nb, nb)
         real(dp), intent(out) :: r(nb, 2*nb)
         integer :: i, j
-        do j = 1, nb
-            do i = 1, nb
-                r(col(i), col(j)) = xt(j, i)
-                r(col(i), nb + col(j)) = xt(nb + j, i)
-            end do
-        end do
+UNTRANSPOSE
     end subroutine tree_untranspose
 
     !> xt := (M^-1 R)^T with M^-1 = T^-1 M_rel^-1 T^-T (absolute angles), h from tree_ltdl.
