@@ -425,11 +425,17 @@ def _spatial_aba(order, index, data, qs, vs, tau, g, trig=None):
         kb.update(U=U, Dinv=Dinv, u=u)
         if b.parent is None:
             continue
-        Ia = sym6([[IA[r_][c_] - U[r_]*U[c_]*Dinv for c_ in range(6)] for r_ in range(6)],
-                  "ja")
+        # Ia S = 0 exactly: for a motion subspace along a coordinate axis (S = e_k, the
+        # usual joint axes) row and column k of Ia vanish and pa_k = tau (written so:
+        # fewer products below, and exact zeros instead of rounding residues)
+        unit = [j for j, x in enumerate(S) if x != 0]
+        k = unit[0] if len(unit) == 1 and S[unit[0]] == 1 else None
+        Ia = sym6([[0 if k in (r_, c_) else IA[r_][c_] - U[r_]*U[c_]*Dinv
+                    for c_ in range(6)] for r_ in range(6)], "ja")
         uD = L(u*Dinv)
         Iac = _mv(Ia, kb["c"])
-        pa = lv([pA[j] + Iac[j] + U[j]*uD for j in range(6)], "pb")
+        pa = lv([tau[index[b.name]] if j == k else pA[j] + Iac[j] + U[j]*uD
+                 for j in range(6)], "pb")
         E, r = kb["X"]
         Er = _mm(E, [[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
         Xm = [[0]*6 for _ in range(6)]
