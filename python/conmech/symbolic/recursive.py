@@ -69,7 +69,8 @@ def recursive_version():
         import os
         h = hashlib.sha256()
         here = os.path.dirname(os.path.abspath(__file__))
-        for name in ("recursive.py", "tree_fortran.py", "loops.py"):
+        for name in ("recursive.py", "tree_fortran.py", "tree_pairs.py", "tree_print.py",
+                     "tree_user.py", "loops.py", "tree.py", "spatial.py"):
             try:
                 with open(os.path.join(here, name), "rb") as fh:
                     h.update(fh.read())

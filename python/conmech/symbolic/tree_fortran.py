@@ -13,12 +13,13 @@ generated identifiers come from indices only.
 """
 import sympy as sp
 
-from .codegen import FortranPrinter, _decl_temps, _model_info, _wrap, assignments, prepare
+from .codegen import FortranPrinter, _decl_temps, _model_info, _wrap
 from .recursive import Code, pos_pass, relative, vel_pass
+from .tree_pairs import FIXED, straight_pairs
+from .tree_print import IND as _IND, fast_print, proc as _proc
+from .tree_user import has_user_jac, user_forces, user_jac
 
 __all__ = ["generate_tree"]
-
-_IND = "        "
 
 
 class _Store:
@@ -62,76 +63,6 @@ class _Store:
             need |= sp.sympify(e).free_symbols
         return [(tgt, e) for s, tgt, e in self.items
                 if s in need or (not isinstance(tgt, str) and tgt[0] in always)]
-
-
-def fast_print(e, names, pr):
-    """Fortran text of a straight-line definition: sums, products, integer powers,
-    numbers, symbols (through `names`), sin and cos printed directly (much faster than
-    the general printer, which orders the terms first); anything else through the
-    printer `pr` (conmech's FortranPrinter)."""
-    if e.is_Symbol:
-        return names[e]
-    if e.is_Number:
-        return _num(e, pr)
-    if e.is_Add:
-        out = []
-        for a in e.args:
-            c, r = a.as_coeff_Mul()
-            if c.is_Number and c < 0:
-                txt = fast_print(-a, names, pr)
-                out.append(f" - {txt}" if out else f"-{txt}")
-            else:
-                txt = fast_print(a, names, pr)
-                out.append(f" + {txt}" if out else txt)
-        return "".join(out)
-    if e.is_Mul:
-        num, den = [], []
-        sign = ""
-        for f in e.args:
-            if f.is_Number:
-                if f == -1:
-                    sign = "-"
-                    continue
-                num.append(_num(f, pr))     # a ratio: a folded constant, no division
-            elif f.is_Pow and f.exp.is_Integer and f.exp < 0:
-                den.append(_factor(f.base**(-f.exp), names, pr))
-            else:
-                num.append(_factor(f, names, pr))
-        txt = "*".join(num) if num else _num(sp.Integer(1), pr)
-        if den:
-            txt += "/" + (den[0] if len(den) == 1 else "(" + "*".join(den) + ")")
-        return sign + txt
-    if e.is_Pow and e.exp.is_Integer:
-        k = int(e.exp)
-        if k > 0:
-            return f"{_factor(e.base, names, pr)}**{k}"
-        return f"{_num(sp.Integer(1), pr)}/{_factor(e.base**(-k), names, pr)}"
-    if isinstance(e, (sp.sin, sp.cos)):
-        return f"{type(e).__name__}({fast_print(e.args[0], names, pr)})"
-    saved = pr.names
-    pr.names = names
-    try:
-        return pr._print(prepare(e))
-    finally:
-        pr.names = saved
-
-
-def _factor(f, names, pr):
-    txt = fast_print(f, names, pr)
-    if f.is_Add or (f.is_Number and f < 0) or (f.is_Mul and (txt.startswith("-")
-                                                              or "/" in txt)):
-        return f"({txt})"
-    if f.is_Pow:
-        return f"({txt})" if "/" in txt else txt
-    return txt
-
-
-def _num(x, pr):
-    if x.is_Integer or x.is_Float:
-        txt = pr._real(x)
-    else:
-        txt = pr._print(x)
-    return f"({txt})" if txt.startswith("-") else txt
 
 
 def _loaded_pos(st, pos, keep_pose):
@@ -355,10 +286,6 @@ def chunked(em, name, args, decls, blocks, prefix, size=None):
                        decls + [f"{I}real(dp) :: cx({ncx})"], body, name)
 
 
-def _proc(head, decls, body, name, kind="subroutine"):
-    return [f"    {head}"] + decls + body + [f"    end {kind} {name}", ""]
-
-
 def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     """(source, entry points) of the Fortran module of a :class:`TreeDerived` record."""
     from .loops import loop_code
@@ -454,13 +381,13 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
                     f"{_IND}logical, intent(in) :: deriv"], blocks, "u")
     from .recursive import point_force_code
     pfc = point_force_code(d)
-    out += _user_forces(d, em, pfc)
+    out += user_forces(d, em, pfc)
     if jac:
-        out += _user_jac(d, em, pfc)
+        out += user_jac(d, em, pfc)
     if not constrained:
         out += _aba_proc(d, em, trig, point_force_code(d, trig))
     chain = all(J.parent == k - 1 for k, J in enumerate(joints))
-    fixed = _FIXED.replace("ZEROH", "" if chain else f"{_IND}h = 0.0_dp")
+    fixed = FIXED.replace("ZEROH", "" if chain else f"{_IND}h = 0.0_dp")
     fixed = fixed.replace("ZEROX", "" if chain else f"{_IND}xt = 0.0_dp")
     if all(J.col == k for k, J in enumerate(joints)):       # the user's order is topological
         fixed = fixed.replace("UNTRANSPOSE", "\n".join([
@@ -480,7 +407,7 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
         for tgt, e in pos_out + deriv_out:
             if not isinstance(tgt, str):
                 nz.setdefault((tgt[0], tgt[2]), set()).add(cidx[tgt[1]] + 1)
-        straight = _straight_pairs(joints, nz, jac)
+        straight = straight_pairs(joints, nz, jac)
         procs = [next((v for key, v in straight.items() if pr.startswith(key)), pr)
                  for pr in procs]
     if not jac:     # what no entry point calls is not generated
@@ -538,103 +465,6 @@ STRAIGHT_MAX = 12
 WHOLE_MAX = 0
 
 
-def _straight_pairs(joints, nz, jac):
-    """Straight-line forms of tree_mass_topo, tree_did, tree_ltdl and tree_ltdl_solve
-    (keyed by the text that starts their doc comment), for small trees."""
-    nb = len(joints)
-    anc = []
-    for k in range(nb):
-        a, j = [], k
-        while j >= 0:
-            a.append(j)
-            j = joints[j].parent
-        anc.append(a)
-    related = {(j, k) for k in range(nb) for j in anc[k]}
-    related |= {(k, j) for j, k in related}
-    I = _IND
-
-    def dot(x, j, y, k, scale=""):
-        cs = sorted(nz.get((x, j), set()) & nz.get((y, k), set()))
-        terms = [f"w%{x}({c}, {j + 1})*w%{y}({c}, {k + 1})" for c in cs]
-        return (scale + "(" + " + ".join(terms) + ")") if terms else ""
-
-    def neg(*parts):
-        parts = [x for x in parts if x]
-        return "-(" + " + ".join(parts) + ")" if parts else "0.0_dp"
-    out = {}
-    # mass matrix
-    lines = []
-    for k in range(nb):
-        for j in anc[k]:
-            d = dot("sv", j, "al", k) or "0.0_dp"
-            lines += _wrap(f"h({j + 1}, {k + 1}) = {d}", I)
-            if j != k:
-                lines.append(f"{I}h({k + 1}, {j + 1}) = h({j + 1}, {k + 1})")
-    lines += [f"{I}h({i + 1}, {j + 1}) = 0.0_dp" for i in range(nb) for j in range(nb)
-              if (i, j) not in related]
-    out["M (relative"] = "\n".join([
-        "M (relative coordinates, topological order), written out.",
-        "    pure subroutine tree_mass_topo(w, h)",
-        f"{I}type(tree_work), intent(in) :: w",
-        f"{I}real(dp), intent(out) :: h(nb, nb)"] + lines + [
-        "    end subroutine tree_mass_topo", ""])
-    # derivatives of inverse dynamics
-    lines = []
-    if jac:
-        for k in range(nb):
-            for j in anc[k]:
-                lines += _wrap(f"xt({j + 1}, {k + 1}) = " + neg(
-                    dot("al", k, "cc", j), dot("et", k, "ps", j)), I)
-                lines += _wrap(f"xt({nb + j + 1}, {k + 1}) = " + neg(
-                    dot("al", k, "ps", j, "2.0_dp*"), dot("et", k, "sv", j)), I)
-                if j != k:
-                    lines += _wrap(f"xt({k + 1}, {j + 1}) = " + neg(dot("sv", j, "ph", k)), I)
-                    lines += _wrap(f"xt({nb + k + 1}, {j + 1}) = "
-                                   + neg(dot("sv", j, "om", k)), I)
-        lines += [f"{I}xt({h + 1}, {i + 1}) = 0.0_dp" for i in range(nb) for j in range(nb)
-                  if (j, i) not in related for h in (j, nb + j)]
-    out["xt = -[d tau"] = "\n".join([
-        "xt = -[d tau/d q, d tau/d qd]^T (relative, topological), written out.",
-        "    pure subroutine tree_did(w, xt)",
-        f"{I}type(tree_work), intent(in) :: w",
-        f"{I}real(dp), intent(out) :: xt(2*nb, nb)"] + lines + [
-        "    end subroutine tree_did", ""])
-    # L^T D L
-    lines = []
-    for k in reversed(range(nb)):
-        kk = k + 1
-        lines.append(f"{I}if (.not. (h({kk}, {kk}) > 0.0_dp)) h({kk}, {kk}) = 0.0_dp")
-        for i in anc[k][1:]:
-            lines.append(f"{I}a = h({kk}, {i + 1})/h({kk}, {kk})")
-            for j in anc[i]:
-                lines.append(f"{I}h({i + 1}, {j + 1}) = h({i + 1}, {j + 1}) - "
-                             f"a*h({kk}, {j + 1})")
-            lines.append(f"{I}h({kk}, {i + 1}) = a")
-        lines.append(f"{I}h({kk}, {kk}) = 1.0_dp/h({kk}, {kk})")
-    out["M = L^T D L"] = "\n".join([
-        "M = L^T D L in place (D stored inverted), written out.",
-        "    pure subroutine tree_ltdl(h)",
-        f"{I}real(dp), intent(inout) :: h(nb, nb)",
-        f"{I}real(dp) :: a"] + lines + ["    end subroutine tree_ltdl", ""])
-    lines = []
-    for i in reversed(range(nb)):
-        for j in anc[i][1:]:
-            lines.append(f"{I}xt(:, {j + 1}) = xt(:, {j + 1}) - h({i + 1}, {j + 1})*"
-                         f"xt(:, {i + 1})")
-    for i in range(nb):
-        lines.append(f"{I}xt(:, {i + 1}) = xt(:, {i + 1})*h({i + 1}, {i + 1})")
-        for j in anc[i][1:]:
-            lines.append(f"{I}xt(:, {i + 1}) = xt(:, {i + 1}) - h({i + 1}, {j + 1})*"
-                         f"xt(:, {j + 1})")
-    out["xt := xt M^-1"] = "\n".join([
-        "xt := xt M^-1 (x = M^-1 x kept transposed), written out.",
-        "    pure subroutine tree_ltdl_solve(h, xt)",
-        f"{I}real(dp), intent(in) :: h(nb, nb)",
-        f"{I}real(dp), intent(inout) :: xt(2*nb, nb)"] + lines + [
-        "    end subroutine tree_ltdl_solve", ""])
-    return out
-
-
 def _with_zeros(pairs, arrays, nb, act):
     """The stores `pairs` with explicit zeros for the entries of the loop arrays `arrays`
     that no store sets (instead of zeroing the arrays first)."""
@@ -646,88 +476,6 @@ def _with_zeros(pairs, arrays, nb, act):
                 if (name, c, k) not in have:
                     out.append(((name, c, k), sp.Integer(0)))
     return out
-
-
-def _user_forces(d, em, pfc):
-    """tree_user_forces(t, q, v, p, fu): the user's generalized forces (user order), with
-    those of the forces at points of bodies (pfc: point_force_code's (code, Q))."""
-    n, npar = d.n, max(len(d.params), 1)
-    fl = [sp.sympify(e) for e in d.user_forces]
-    tg = [f"fu({i + 1})" for i, e in enumerate(fl) if e != 0]
-    ex = [e for e in fl if e != 0]
-    em.reset()
-    temps, lines = assignments(tg, ex, em.pr, _IND, prefix="f") if ex else ([], [])
-    if pfc is not None:
-        code, Q = pfc
-        lines += em.defs(code.live(Q), "pf")
-        saved = em.pr.names
-        em.pr.names = {**saved, **em.local}
-        try:
-            lines += [f"{_IND}fu({i + 1}) = fu({i + 1}) + "
-                      f"{fast_print(sp.sympify(e), em.pr.names, em.pr)}"
-                      for i, e in enumerate(Q) if e != 0]
-        finally:
-            em.pr.names = saved
-        temps = temps + list(em.local.values())
-    return _proc("subroutine tree_user_forces(t, q, v, p, fu)",
-                 [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), p({npar})",
-                  f"{_IND}real(dp), intent(out) :: fu({n})"] + _decl_temps(temps),
-                 [f"{_IND}fu = 0.0_dp"] + lines, "tree_user_forces")
-
-
-def _has_user_jac(d):
-    xs = set(d.coords) | set(d.speeds)
-    return bool(getattr(d, "point_forces", None)) or any(
-        sp.sympify(e).free_symbols & xs for e in d.user_forces)
-
-
-def _user_jac(d, em, pfc):
-    """tree_user_jac(t, q, v, p, xt): adds d(user forces)/d[q, v] (and that of the forces
-    at points of bodies, by forward differentiation of their code) to the transposed
-    Jacobian xt (variables x equations, topological order)."""
-    from .recursive import forward_diff
-    n, npar = d.n, max(len(d.params), 1)
-    topo = {J.col: k for k, J in enumerate(d.joints)}
-    xs = list(d.coords) + list(d.speeds)
-
-    def target(i, j):
-        var = topo[j] if j < n else n + topo[j - n]
-        return f"xt({var + 1}, {topo[i] + 1})"
-    tg, ex = [], []
-    for i, e in enumerate(d.user_forces):
-        e = sp.sympify(e)
-        if e == 0:
-            continue
-        for j, x in enumerate(xs):
-            if x in e.free_symbols:
-                de = sp.diff(e, x)
-                if de.has(sp.DiracDelta):
-                    de = de.replace(sp.DiracDelta, lambda *a: sp.S.Zero)
-                if de != 0:
-                    tg.append(target(i, j))
-                    ex.append(de)
-    gt = [f"gj({k + 1})" for k in range(len(ex))]
-    em.reset()
-    temps, lines = assignments(gt, ex, em.pr, _IND, prefix="g") if ex else ([], [])
-    lines += [f"{_IND}{t} = {t} + {g}" for t, g in zip(tg, gt)]
-    if pfc is not None:
-        code, Q = pfc
-        grads = forward_diff(code, Q, xs)
-        outs = [(target(i, j), e) for i, gr in enumerate(grads) for j, e in gr.items()]
-        lines += em.defs(code.live([e for _, e in outs]), "pg")
-        saved = em.pr.names
-        em.pr.names = {**saved, **em.local}
-        try:
-            lines += [f"{_IND}{t} = {t} + {fast_print(sp.sympify(e), em.pr.names, em.pr)}"
-                      for t, e in outs]
-        finally:
-            em.pr.names = saved
-        temps = temps + list(em.local.values())
-    return _proc("subroutine tree_user_jac(t, q, v, p, xt)",
-                 [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), p({npar})",
-                  f"{_IND}real(dp), intent(inout) :: xt({2*n}, {n})",
-                  f"{_IND}real(dp) :: gj({max(len(ex), 1)})"] + _decl_temps(temps),
-                 lines, "tree_user_jac")
 
 
 def _aba_proc(d, em, trig, pfc=None):
@@ -774,218 +522,6 @@ def pos_call(em, I=_IND):
     return em.trig_lines + [f"{I}call tree_pos(t, q, sc, p, w)"]
 
 
-# fixed procedures: mass matrix (composite rigid bodies), derivatives of inverse dynamics
-# over the ancestor pairs, L^T D L factorisation of M and its solve (Featherstone, Rigid
-# Body Dynamics Algorithms, 6.5: the sparsity of the tree), maps of absolute angles. The
-# Jacobians are kept transposed, xt(variable, equation) with the variables [q; v] and the
-# equations in topological order, so that the row operations of the solve are contiguous.
-_FIXED = """
-    !> M (relative coordinates, topological order): M_jk = S_j . alpha_k, j an ancestor
-    !! of k or k.
-    pure subroutine tree_mass_topo(w, h)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(out) :: h(nb, nb)
-        integer :: c, j, k
-        real(dp) :: s, ak(na)
-ZEROH
-        do k = 1, nb
-            ak = w%al(:, k)
-            j = k
-            do while (j > 0)
-                s = 0.0_dp
-                do c = 1, na
-                    s = s + w%sv(c, j)*ak(c)
-                end do
-                h(j, k) = s
-                h(k, j) = s
-                j = par(j)
-            end do
-        end do
-    end subroutine tree_mass_topo
-
-    !> xt = -[d tau/d q, d tau/d qd]^T of inverse dynamics (relative, topological).
-    pure subroutine tree_did(w, xt)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(out) :: xt(2*nb, nb)
-        integer :: c, j, k
-        real(dp) :: ak(na), ek(na), pk(na), ok(na), s1, s2, s3, s4
-ZEROX
-        do k = 1, nb
-            ak = w%al(:, k)
-            ek = w%et(:, k)
-            pk = w%ph(:, k)
-            ok = w%om(:, k)
-            s1 = 0.0_dp
-            s2 = 0.0_dp
-            do c = 1, na
-                s1 = s1 + ak(c)*w%cc(c, k) + ek(c)*w%ps(c, k)
-                s2 = s2 + 2.0_dp*ak(c)*w%ps(c, k) + ek(c)*w%sv(c, k)
-            end do
-            xt(k, k) = -s1
-            xt(nb + k, k) = -s2
-            j = par(k)
-            do while (j > 0)
-                s1 = 0.0_dp
-                s2 = 0.0_dp
-                s3 = 0.0_dp
-                s4 = 0.0_dp
-                do c = 1, na
-                    s1 = s1 + ak(c)*w%cc(c, j) + ek(c)*w%ps(c, j)
-                    s2 = s2 + 2.0_dp*ak(c)*w%ps(c, j) + ek(c)*w%sv(c, j)
-                    s3 = s3 + w%sv(c, j)*pk(c)
-                    s4 = s4 + w%sv(c, j)*ok(c)
-                end do
-                xt(j, k) = -s1
-                xt(nb + j, k) = -s2
-                xt(k, j) = -s3
-                xt(nb + k, j) = -s4
-                j = par(j)
-            end do
-        end do
-    end subroutine tree_did
-
-    !> M = L^T D L in place (L unit lower triangular with the tree's sparsity, D on the
-    !! diagonal, stored inverted); a pivot that is not positive makes the factor NaN.
-    pure subroutine tree_ltdl(h)
-        real(dp), intent(inout) :: h(nb, nb)
-        integer :: i, j, k
-        real(dp) :: a
-        do k = nb, 1, -1
-            if (.not. (h(k, k) > 0.0_dp)) h(k, k) = 0.0_dp
-            i = par(k)
-            do while (i > 0)
-                a = h(k, i)/h(k, k)
-                j = i
-                do while (j > 0)
-                    h(i, j) = h(i, j) - a*h(k, j)
-                    j = par(j)
-                end do
-                h(k, i) = a
-                i = par(i)
-            end do
-            h(k, k) = 1.0_dp/h(k, k)
-        end do
-    end subroutine tree_ltdl
-
-    !> xt := xt M^-1 (the rows of x = M^-1 x, x kept transposed), M from tree_ltdl.
-    pure subroutine tree_ltdl_solve(h, xt)
-        real(dp), intent(in) :: h(nb, nb)
-        real(dp), intent(inout) :: xt(2*nb, nb)
-        integer :: c, i, j
-        real(dp) :: f
-        do i = nb, 1, -1
-            j = par(i)
-            do while (j > 0)
-                f = h(i, j)
-                do c = 1, 2*nb
-                    xt(c, j) = xt(c, j) - f*xt(c, i)
-                end do
-                j = par(j)
-            end do
-        end do
-        do i = 1, nb
-            f = h(i, i)
-            do c = 1, 2*nb
-                xt(c, i) = xt(c, i)*f
-            end do
-            j = par(i)
-            do while (j > 0)
-                f = h(i, j)
-                do c = 1, 2*nb
-                    xt(c, i) = xt(c, i) - f*xt(c, j)
-                end do
-                j = par(j)
-            end do
-        end do
-    end subroutine tree_ltdl_solve
-
-    !> x := T^T x on the equations (rows of x: columns of xt) and := x T on the variables
-    !! (both halves), T mapping absolute to relative angles.
-    pure subroutine tree_abs_r(xt)
-        real(dp), intent(inout) :: xt(2*nb, nb)
-        real(dp) :: y(2*nb, nb)
-        integer :: k
-        y = xt
-        do k = 1, nb
-            if (ka(k) > 0) xt(:, ka(k)) = xt(:, ka(k)) - y(:, k)
-        end do
-        y = xt
-        do k = 1, nb
-            if (ka(k) > 0) then
-                xt(ka(k), :) = xt(ka(k), :) - y(k, :)
-                xt(nb + ka(k), :) = xt(nb + ka(k), :) - y(nb + k, :)
-            end if
-        end do
-    end subroutine tree_abs_r
-
-    !> M in the user's coordinates and order.
-    pure subroutine tree_mass_user(w, mm)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(out) :: mm(nb, nb)
-        real(dp) :: h(nb, nb), y(nb, nb)
-        integer :: i, j, k
-        call tree_mass_topo(w, h)
-        if (any(ka > 0)) then
-            y = h
-            do k = 1, nb
-                if (ka(k) > 0) h(ka(k), :) = h(ka(k), :) - y(k, :)
-            end do
-            y = h
-            do k = 1, nb
-                if (ka(k) > 0) h(:, ka(k)) = h(:, ka(k)) - y(:, k)
-            end do
-        end if
-        do j = 1, nb
-            do i = 1, nb
-                mm(col(i), col(j)) = h(i, j)
-            end do
-        end do
-    end subroutine tree_mass_user
-
-    !> Q = fu - T^T tau in the user's order.
-    pure subroutine tree_q_user(w, fu, f)
-        type(tree_work), intent(in) :: w
-        real(dp), intent(in) :: fu(nb)
-        real(dp), intent(out) :: f(nb)
-        real(dp) :: y(nb)
-        integer :: i, k
-        y = w%tau
-        do k = 1, nb
-            if (ka(k) > 0) y(ka(k)) = y(ka(k)) - w%tau(k)
-        end do
-        do i = 1, nb
-            f(col(i)) = fu(col(i)) - y(i)
-        end do
-    end subroutine tree_q_user
-
-    !> An n x 2n matrix in the user's order from its transpose in topological order.
-    pure subroutine tree_untranspose(xt, r)
-        real(dp), intent(in) :: xt(2*nb, nb)
-        real(dp), intent(out) :: r(nb, 2*nb)
-        integer :: i, j
-UNTRANSPOSE
-    end subroutine tree_untranspose
-
-    !> xt := (M^-1 R)^T with M^-1 = T^-1 M_rel^-1 T^-T (absolute angles), h from tree_ltdl.
-    pure subroutine tree_solve_r(h, xt)
-        real(dp), intent(in) :: h(nb, nb)
-        real(dp), intent(inout) :: xt(2*nb, nb)
-        integer :: k
-        if (any(ka > 0)) then
-            do k = nb, 1, -1
-                if (ka(k) > 0) xt(:, ka(k)) = xt(:, ka(k)) + xt(:, k)
-            end do
-        end if
-        call tree_ltdl_solve(h, xt)
-        if (any(ka > 0)) then
-            do k = 1, nb
-                if (ka(k) > 0) xt(:, k) = xt(:, k) + xt(:, ka(k))
-            end do
-        end if
-    end subroutine tree_solve_r
-"""
-
-
 def _entries(d, n, npar, absolute, jac, constrained, lc, em):
     """The bind(C) entry points: (names, lines)."""
     I = _IND
@@ -1021,7 +557,7 @@ def _entries(d, n, npar, absolute, jac, constrained, lc, em):
                      f"{I}call tree_did(w, xt)"]
             if any(ka >= 0 for ka in (J.ka for J in d.joints)):
                 rbody.append(f"{I}call tree_abs_r(xt)")
-            if _has_user_jac(d):
+            if has_user_jac(d):
                 rbody.append(f"{I}call tree_user_jac(t, q, v, p, xt)")
             XT = f"{I}real(dp) :: xt({2*n}, {n})"
             out += _proc(head("forces_jac", ["t", "q", "v", "a", "r", "p"]),
