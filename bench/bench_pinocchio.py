@@ -11,9 +11,9 @@ same URDF file (conmech/symbolic/data/arm7.urdf), in one run:
    pinocchio's C++ functions; both built with -O3 -DNDEBUG, the counts are (I(2R) -
    I(R))/R) and as same-run wall-time ratios of the two harnesses (median, min and max
    over --repeat runs);
-3. construction: the arm from the URDF (derivation, generation, compilation into a fresh
-   cache; CPU time of this process and of the compiler), a cache hit, a 30-joint chain
-   and a 30-body branched tree;
+3. construction, --build-repeat times: the arm from the URDF, a 30-joint chain and a
+   30-body branched tree (derivation, generation, compilation into an empty cache; CPU
+   time of this process and of the compiler, the load average), and cache hits;
 4. a 10 s simulation at rtol = atol = 1e-10 (DOP853 both; the URDF's joint damping on):
    conmech.solve_ivp of the compiled arm against scipy.integrate.solve_ivp driving
    pinocchio.aba from Python; CPU time (best of --sim-repeat), nfev, final states.
@@ -22,6 +22,7 @@ Writes bench/results/pinocchio.md (--out). Needs gcc/g++ and valgrind for item 2
 C++ harness also needs Eigen's headers: ``pip install cmeel-eigen`` beside ``pin``).
 
 Usage: python bench/bench_pinocchio.py [--repeat 7] [--reps 20000] [--sim-repeat 3]
+                                      [--build-repeat 3] [--construction-only]
 """
 import argparse
 import os
@@ -143,6 +144,9 @@ def main():
     ap.add_argument("--reps", type=int, default=20000, help="calls per timed run")
     ap.add_argument("--sim-repeat", type=int, default=3)
     ap.add_argument("--skip-callgrind", action="store_true")
+    ap.add_argument("--build-repeat", type=int, default=3, help="builds of each system")
+    ap.add_argument("--construction-only", action="store_true",
+                    help="only the construction table (printed, not written)")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "pinocchio.md"))
     a = ap.parse_args()
     try:
@@ -161,19 +165,47 @@ def main():
              f"{pin.__version__}; load average at the start "
              f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs). Arm: "
              "`conmech/symbolic/data/arm7.urdf` (7 revolute joints, a fixed hand).", ""]
-    # ---- construction
-    res = {}
-    model, w, pc, cc = timed_build(lambda: symbolic.from_urdf(
-        urdf, torques=None, damping=False, model_only=True))
-    res["arm7"] = (w, pc, cc, model.times)
-    _, w2, _, _ = timed_build(lambda: symbolic.from_urdf(
-        urdf, torques=None, damping=False, model_only=True))
-    res["hit"] = w2
-    for label, branched in (("30-joint chain", False), ("30-body branched tree", True)):
-        b, p, g = chain(30, branched)
-        m30, w, pc, cc = timed_build(lambda: symbolic.spatial_tree(b, p, gravity=g,
-                                                                   model_only=True))
-        res[label] = (w, pc, cc, m30.times, len(m30.source.splitlines()))
+    # ---- construction: --build-repeat builds of each system, each into an empty cache
+    def fresh_cache(k):
+        os.environ["CONMECH_CACHE"] = os.path.join(work, f"cache{k}")
+
+    def arm():
+        return symbolic.from_urdf(urdf, torques=None, damping=False, model_only=True)
+    trees = {label: chain(30, branched) for label, branched in
+             (("30-joint chain", False), ("30-body branched tree", True))}
+    runs = {"arm7": [], "30-joint chain": [], "30-body branched tree": []}
+    hits = []
+    for k in range(a.build_repeat):
+        fresh_cache(k)
+        load = os.getloadavg()[0]
+        model, w, pc, cc = timed_build(arm)
+        runs["arm7"].append((w, pc, cc, model.times, len(model.source.splitlines()), load))
+        hits.append(timed_build(arm)[1])
+        for label, (b, p, g) in trees.items():
+            load = os.getloadavg()[0]
+            m30, w, pc, cc = timed_build(lambda: symbolic.spatial_tree(b, p, gravity=g,
+                                                                       model_only=True))
+            runs[label].append((w, pc, cc, m30.times, len(m30.source.splitlines()), load))
+    # `model`: the arm of the last build, used below
+    # ---- construction table
+    ctable = ["## Construction", "",
+              f"{a.build_repeat} builds of each system, each into an empty cache; per build: "
+              "wall time, CPU time of this process (derivation, generation) and of the "
+              "compiler (gfortran -O3), and the load average when it started. The load of "
+              "the shared machine inflates the wall time most; the CPU times less.", "",
+              "| system | build | load | wall | CPU Python | CPU gfortran | CPU total "
+              "| lines of Fortran |", "|---|---|---|---|---|---|---|---|"]
+    for label, rs in runs.items():
+        name = "arm7 from the URDF" if label == "arm7" else label
+        for k, (w, pc, cc, tm, nl, load) in enumerate(rs):
+            ctable.append(f"| {name} | {k + 1} | {load:.1f} | {w:.2f} s | {pc:.2f} s | "
+                          f"{cc:.2f} s | {pc + cc:.2f} s | {nl} |")
+    ctable += ["", "Cache hits (the arm again from the URDF, same process; parsing the "
+               "document, building the tree and its cache key, loading the library): "
+               + ", ".join(f"{h*1e3:.0f} ms" for h in hits) + ".", ""]
+    if a.construction_only:
+        print("\n".join(lines[:4] + ctable))
+        return
     # ---- agreement
     pm = pin.buildModelFromUrdf(urdf)
     pd = pm.createData()
@@ -240,22 +272,7 @@ def main():
                          f"{max(r):.3f}] | {statistics.median(x[1] for x in ratios[w_])*1e6:.2f}"
                          f" us | {statistics.median(x[2] for x in ratios[w_])*1e6:.2f} us |")
         lines.append("")
-    # ---- construction table
-    w, pc, cc, tm = res["arm7"]
-    lines += ["## Construction", "",
-              "Wall time (and CPU time: this process + the compiler) into an empty cache; "
-              "the machine's load inflates both (see the load above).", "",
-              "| system | wall | CPU Python | CPU gfortran | derive + generate | compile "
-              "| lines of Fortran |", "|---|---|---|---|---|---|---|",
-              f"| arm7 from the URDF | {w:.2f} s | {pc:.2f} s | {cc:.2f} s | "
-              f"{tm['derive'] + tm['generate']:.2f} s | {tm['compile_or_load']:.2f} s | "
-              f"{len(model.source.splitlines())} |"]
-    for label in ("30-joint chain", "30-body branched tree"):
-        w, pc, cc, tm, nl = res[label]
-        lines.append(f"| {label} | {w:.2f} s | {pc:.2f} s | {cc:.2f} s | "
-                     f"{tm['derive'] + tm['generate']:.2f} s | {tm['compile_or_load']:.2f} s"
-                     f" | {nl} |")
-    lines += ["", f"A cache hit (the arm again, same process): {res['hit']*1e3:.1f} ms.", ""]
+    lines += ctable
     # ---- simulation
     sysm = symbolic.from_urdf(urdf, torques=None, damping=True)
     damp = symbolic.read_urdf(urdf).damping
