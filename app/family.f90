@@ -85,6 +85,7 @@ program family
     sw_opt = ""
     force_ = .false.
     tfree = .false.
+    o%direction = 1     ! the program's documented default (the library's is automatic)
     allocate (params(0), y0(0), freer(0), targr(0))
     if (len(cli%input) > 0) call read_input(params, y0, period)
     do while (cli%next(key))

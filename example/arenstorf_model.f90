@@ -21,6 +21,8 @@ module arenstorf_model
         procedure :: jacobian_product => arenstorf_sym_jacobian_product
         procedure :: rhs_jacobian_product => arenstorf_sym_rhs_jacobian_product
         procedure :: has_jacobian_product => arenstorf_sym_has_jacobian_product
+        procedure :: taylor_size => arenstorf_sym_taylor_size
+        procedure :: taylor_jet => arenstorf_sym_taylor_jet
     end type arenstorf_sym
 
 contains
@@ -178,5 +180,389 @@ contains
         class(arenstorf_sym), intent(in) :: self
         arenstorf_sym_has_jacobian_product = .true.
     end function arenstorf_sym_has_jacobian_product
+
+    !> Columns of the Taylor work array (kind 0: the system, 1: its variational system).
+    integer function arenstorf_sym_taylor_size(self, kind)
+        class(arenstorf_sym), intent(in) :: self
+        integer, intent(in) :: kind
+        arenstorf_sym_taylor_size = 0
+        if (kind == 0) arenstorf_sym_taylor_size = 21
+        if (kind == 1) arenstorf_sym_taylor_size = 76
+    end function arenstorf_sym_taylor_size
+
+    !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated recurrences).
+    subroutine arenstorf_sym_taylor_jet(self, kind, t, order, nw, w)
+        use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+        class(arenstorf_sym), intent(in) :: self
+        integer, intent(in) :: kind, order, nw
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: w(0:order, nw)
+        if (kind == 0 .and. nw >= 21) then
+            call arenstorf_sym_taylor0(self, t, order, w)
+        else if (kind == 1 .and. nw >= 76) then
+            call arenstorf_sym_taylor1(self, t, order, w)
+        else
+            w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+        end if
+    end subroutine arenstorf_sym_taylor_jet
+
+    subroutine arenstorf_sym_taylor0(self, t, order, w)
+        type(arenstorf_sym), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: order
+        real(dp), intent(inout) :: w(0:order, 21)
+        real(dp) :: tc1, tc2
+        real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
+        real(dp) :: h11, iv1, iv2
+        real(dp) :: fk, rk, rk1
+        integer :: k, j
+        if (order < 1) return
+        tc1 = self%mu
+        tc2 = 1.0_dp - self%mu
+        w(0, 5) = w(0, 2)**2
+        w(0, 6) = tc1 + w(0, 1)
+        w(0, 7) = w(0, 6)**2
+        w(0, 8) = w(0, 5) + w(0, 7)
+        w(0, 9) = 1.0_dp/sqrt(w(0, 8))**3
+        iv1 = 1.0_dp/w(0, 8)
+        w(0, 10) = tc1 + (-1.0_dp) + w(0, 1)
+        w(0, 11) = w(0, 10)**2
+        w(0, 12) = w(0, 5) + w(0, 11)
+        w(0, 13) = 1.0_dp/sqrt(w(0, 12))**3
+        iv2 = 1.0_dp/w(0, 12)
+        w(0, 14) = tc2*w(0, 9)
+        w(0, 15) = w(0, 6)*w(0, 14)
+        w(0, 16) = tc1*w(0, 13)
+        w(0, 17) = w(0, 10)*w(0, 16)
+        w(0, 18) = w(0, 2)*w(0, 14)
+        w(0, 19) = w(0, 2)*w(0, 16)
+        w(1, 1) = w(0, 3)
+        w(1, 2) = w(0, 4)
+        w(1, 3) = w(0, 1) + 2.0_dp*w(0, 4) - w(0, 15) - w(0, 17)
+        w(1, 4) = w(0, 2) - 2.0_dp*w(0, 3) - w(0, 18) - w(0, 19)
+        do k = 1, order - 1
+            fk = real(k, dp)
+            rk = 1.0_dp/fk
+            rk1 = 1.0_dp/(fk + 1.0_dp)
+            h1 = 0.0_dp
+            h2 = 0.0_dp
+            h3 = 0.0_dp
+            h4 = 0.0_dp
+            h5 = 0.0_dp
+            h6 = 0.0_dp
+            h7 = 0.0_dp
+            h8 = 0.0_dp
+            h9 = 0.0_dp
+            h10 = 0.0_dp
+            h11 = 0.0_dp
+            do j = 1, k - 1
+                h1 = h1 + w(j, 2)*w(k - j, 2)
+                h2 = h2 + w(j, 6)*w(k - j, 6)
+                h3 = h3 + w(j, 8)*w(k - j, 9)
+                h4 = h4 + w(j, 20)*w(k - j, 9)
+                h5 = h5 + w(j, 10)*w(k - j, 10)
+                h6 = h6 + w(j, 12)*w(k - j, 13)
+                h7 = h7 + w(j, 21)*w(k - j, 13)
+                h8 = h8 + w(j, 6)*w(k - j, 14)
+                h9 = h9 + w(j, 10)*w(k - j, 16)
+                h10 = h10 + w(j, 2)*w(k - j, 14)
+                h11 = h11 + w(j, 2)*w(k - j, 16)
+            end do
+            w(k, 5) = h1 + 2.0_dp*w(0, 2)*w(k, 2)
+            w(k, 6) = w(k, 1)
+            w(k, 7) = h2 + 2.0_dp*w(0, 6)*w(k, 6)
+            w(k, 8) = w(k, 5) + w(k, 7)
+            w(k, 20) = fk*w(k, 8)
+            w(k, 9) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 8)*w(0, 9))*iv1
+            w(k, 10) = w(k, 1)
+            w(k, 11) = h5 + 2.0_dp*w(0, 10)*w(k, 10)
+            w(k, 12) = w(k, 5) + w(k, 11)
+            w(k, 21) = fk*w(k, 12)
+            w(k, 13) = (((-1.0_dp/2.0_dp)*h7 - fk*h6)*rk + (-3.0_dp/2.0_dp)*w(k, 12)*w(0,&
+                & 13))*iv2
+            w(k, 14) = tc2*w(k, 9)
+            w(k, 15) = h8 + w(0, 6)*w(k, 14) + w(k, 6)*w(0, 14)
+            w(k, 16) = tc1*w(k, 13)
+            w(k, 17) = h9 + w(0, 10)*w(k, 16) + w(k, 10)*w(0, 16)
+            w(k, 18) = h10 + w(0, 2)*w(k, 14) + w(k, 2)*w(0, 14)
+            w(k, 19) = h11 + w(0, 2)*w(k, 16) + w(k, 2)*w(0, 16)
+            w(k + 1, 1) = rk1*(w(k, 3))
+            w(k + 1, 2) = rk1*(w(k, 4))
+            w(k + 1, 3) = rk1*(w(k, 1) + 2.0_dp*w(k, 4) - w(k, 15) - w(k, 17))
+            w(k + 1, 4) = rk1*(w(k, 2) - 2.0_dp*w(k, 3) - w(k, 18) - w(k, 19))
+        end do
+    end subroutine arenstorf_sym_taylor0
+
+    subroutine arenstorf_sym_taylor1(self, t, order, w)
+        type(arenstorf_sym), intent(in) :: self
+        real(dp), intent(in) :: t
+        integer, intent(in) :: order
+        real(dp), intent(inout) :: w(0:order, 76)
+        real(dp) :: tc1, tc2, tc3, tc4, tc5
+        real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
+        real(dp) :: h11, h12, h13, h14, h15, h16, h17, h18, h19, h20
+        real(dp) :: h21, h22, h23, h24, h25, h26, h27, h28, h29, h30
+        real(dp) :: h31, h32, h33, h34, h35, h36, h37, h38, h39, h40
+        real(dp) :: h41, h42, h43, iv1, iv2, iv3, iv4
+        real(dp) :: fk, rk, rk1
+        integer :: k, j
+        if (order < 1) return
+        tc1 = self%mu
+        tc2 = 1.0_dp - self%mu
+        tc3 = tc2
+        tc4 = 3.0_dp*self%mu
+        tc5 = tc4
+        w(0, 21) = w(0, 2)**2
+        w(0, 22) = tc1 + w(0, 1)
+        w(0, 23) = w(0, 22)**2
+        w(0, 24) = w(0, 21) + w(0, 23)
+        w(0, 25) = 1.0_dp/sqrt(w(0, 24))**3
+        iv1 = 1.0_dp/w(0, 24)
+        w(0, 26) = tc1 + (-1.0_dp) + w(0, 1)
+        w(0, 27) = w(0, 26)**2
+        w(0, 28) = w(0, 21) + w(0, 27)
+        w(0, 29) = 1.0_dp/sqrt(w(0, 28))**3
+        iv2 = 1.0_dp/w(0, 28)
+        w(0, 30) = 1.0_dp/sqrt(w(0, 24))**5
+        iv3 = 1.0_dp/w(0, 24)
+        w(0, 31) = 1.0_dp/sqrt(w(0, 28))**5
+        iv4 = 1.0_dp/w(0, 28)
+        w(0, 32) = w(0, 26)*w(0, 31)
+        w(0, 33) = 3.0_dp*tc3*w(0, 30)
+        w(0, 34) = w(0, 2)*w(0, 22)
+        w(0, 35) = w(0, 33)*w(0, 34)
+        w(0, 36) = w(0, 2)*w(0, 32)
+        w(0, 37) = tc5 + 3.0_dp*w(0, 1)
+        w(0, 38) = tc3*w(0, 30)
+        w(0, 39) = w(0, 37)*w(0, 38)
+        w(0, 40) = -w(0, 39)
+        w(0, 41) = w(0, 22)*w(0, 40)
+        w(0, 42) = tc1*(3.0_dp - tc5) - 3.0_dp*tc1*w(0, 1)
+        w(0, 43) = w(0, 32)*w(0, 42)
+        w(0, 44) = w(0, 2)*w(0, 40)
+        w(0, 45) = w(0, 2)*w(0, 31)
+        w(0, 46) = w(0, 42)*w(0, 45)
+        w(0, 47) = w(0, 21)*w(0, 33)
+        w(0, 48) = w(0, 21)*w(0, 31)
+        w(0, 49) = tc3*w(0, 25)
+        w(0, 50) = w(0, 22)*w(0, 49)
+        w(0, 51) = tc1*w(0, 29)
+        w(0, 52) = w(0, 26)*w(0, 51)
+        w(0, 53) = w(0, 2)*w(0, 49)
+        w(0, 54) = w(0, 2)*w(0, 51)
+        w(0, 55) = w(0, 35) + tc5*w(0, 36)
+        w(0, 56) = w(0, 6)*w(0, 55)
+        w(0, 57) = 1.0_dp - tc3*w(0, 25) - tc1*w(0, 29) - w(0, 41) - w(0, 43)
+        w(0, 58) = w(0, 5)*w(0, 57)
+        w(0, 59) = -w(0, 44) - w(0, 46)
+        w(0, 60) = w(0, 5)*w(0, 59)
+        w(0, 61) = 1.0_dp - tc3*w(0, 25) - tc1*w(0, 29) + w(0, 47) + tc5*w(0, 48)
+        w(0, 62) = w(0, 6)*w(0, 61)
+        w(0, 63) = w(0, 10)*w(0, 55)
+        w(0, 64) = w(0, 9)*w(0, 57)
+        w(0, 65) = w(0, 9)*w(0, 59)
+        w(0, 66) = w(0, 10)*w(0, 61)
+        w(0, 67) = w(0, 14)*w(0, 55)
+        w(0, 68) = w(0, 13)*w(0, 57)
+        w(0, 69) = w(0, 13)*w(0, 59)
+        w(0, 70) = w(0, 14)*w(0, 61)
+        w(0, 71) = w(0, 18)*w(0, 55)
+        w(0, 72) = w(0, 17)*w(0, 57)
+        w(0, 73) = w(0, 17)*w(0, 59)
+        w(0, 74) = w(0, 18)*w(0, 61)
+        w(1, 1) = w(0, 3)
+        w(1, 2) = w(0, 4)
+        w(1, 3) = w(0, 1) + 2.0_dp*w(0, 4) - w(0, 50) - w(0, 52)
+        w(1, 4) = w(0, 2) - 2.0_dp*w(0, 3) - w(0, 53) - w(0, 54)
+        w(1, 5) = w(0, 7)
+        w(1, 6) = w(0, 8)
+        w(1, 7) = 2.0_dp*w(0, 8) + w(0, 56) + w(0, 58)
+        w(1, 8) = -2.0_dp*w(0, 7) + w(0, 60) + w(0, 62)
+        w(1, 9) = w(0, 11)
+        w(1, 10) = w(0, 12)
+        w(1, 11) = 2.0_dp*w(0, 12) + w(0, 63) + w(0, 64)
+        w(1, 12) = -2.0_dp*w(0, 11) + w(0, 65) + w(0, 66)
+        w(1, 13) = w(0, 15)
+        w(1, 14) = w(0, 16)
+        w(1, 15) = 2.0_dp*w(0, 16) + w(0, 67) + w(0, 68)
+        w(1, 16) = -2.0_dp*w(0, 15) + w(0, 69) + w(0, 70)
+        w(1, 17) = w(0, 19)
+        w(1, 18) = w(0, 20)
+        w(1, 19) = 2.0_dp*w(0, 20) + w(0, 71) + w(0, 72)
+        w(1, 20) = -2.0_dp*w(0, 19) + w(0, 73) + w(0, 74)
+        do k = 1, order - 1
+            fk = real(k, dp)
+            rk = 1.0_dp/fk
+            rk1 = 1.0_dp/(fk + 1.0_dp)
+            h1 = 0.0_dp
+            h2 = 0.0_dp
+            h3 = 0.0_dp
+            h4 = 0.0_dp
+            h5 = 0.0_dp
+            h6 = 0.0_dp
+            h7 = 0.0_dp
+            h8 = 0.0_dp
+            h9 = 0.0_dp
+            h10 = 0.0_dp
+            h11 = 0.0_dp
+            h12 = 0.0_dp
+            h13 = 0.0_dp
+            h14 = 0.0_dp
+            h15 = 0.0_dp
+            h16 = 0.0_dp
+            h17 = 0.0_dp
+            h18 = 0.0_dp
+            h19 = 0.0_dp
+            h20 = 0.0_dp
+            h21 = 0.0_dp
+            h22 = 0.0_dp
+            h23 = 0.0_dp
+            h24 = 0.0_dp
+            h25 = 0.0_dp
+            h26 = 0.0_dp
+            h27 = 0.0_dp
+            h28 = 0.0_dp
+            h29 = 0.0_dp
+            h30 = 0.0_dp
+            h31 = 0.0_dp
+            h32 = 0.0_dp
+            h33 = 0.0_dp
+            h34 = 0.0_dp
+            h35 = 0.0_dp
+            h36 = 0.0_dp
+            h37 = 0.0_dp
+            h38 = 0.0_dp
+            h39 = 0.0_dp
+            h40 = 0.0_dp
+            h41 = 0.0_dp
+            h42 = 0.0_dp
+            h43 = 0.0_dp
+            do j = 1, k - 1
+                h1 = h1 + w(j, 2)*w(k - j, 2)
+                h2 = h2 + w(j, 22)*w(k - j, 22)
+                h3 = h3 + w(j, 24)*w(k - j, 25)
+                h4 = h4 + w(j, 75)*w(k - j, 25)
+                h5 = h5 + w(j, 26)*w(k - j, 26)
+                h6 = h6 + w(j, 28)*w(k - j, 29)
+                h7 = h7 + w(j, 76)*w(k - j, 29)
+                h8 = h8 + w(j, 24)*w(k - j, 30)
+                h9 = h9 + w(j, 75)*w(k - j, 30)
+                h10 = h10 + w(j, 28)*w(k - j, 31)
+                h11 = h11 + w(j, 76)*w(k - j, 31)
+                h12 = h12 + w(j, 26)*w(k - j, 31)
+                h13 = h13 + w(j, 2)*w(k - j, 22)
+                h14 = h14 + w(j, 33)*w(k - j, 34)
+                h15 = h15 + w(j, 2)*w(k - j, 32)
+                h16 = h16 + w(j, 37)*w(k - j, 38)
+                h17 = h17 + w(j, 22)*w(k - j, 40)
+                h18 = h18 + w(j, 32)*w(k - j, 42)
+                h19 = h19 + w(j, 2)*w(k - j, 40)
+                h20 = h20 + w(j, 2)*w(k - j, 31)
+                h21 = h21 + w(j, 42)*w(k - j, 45)
+                h22 = h22 + w(j, 21)*w(k - j, 33)
+                h23 = h23 + w(j, 21)*w(k - j, 31)
+                h24 = h24 + w(j, 22)*w(k - j, 49)
+                h25 = h25 + w(j, 26)*w(k - j, 51)
+                h26 = h26 + w(j, 2)*w(k - j, 49)
+                h27 = h27 + w(j, 2)*w(k - j, 51)
+                h28 = h28 + w(j, 6)*w(k - j, 55)
+                h29 = h29 + w(j, 5)*w(k - j, 57)
+                h30 = h30 + w(j, 5)*w(k - j, 59)
+                h31 = h31 + w(j, 6)*w(k - j, 61)
+                h32 = h32 + w(j, 10)*w(k - j, 55)
+                h33 = h33 + w(j, 9)*w(k - j, 57)
+                h34 = h34 + w(j, 9)*w(k - j, 59)
+                h35 = h35 + w(j, 10)*w(k - j, 61)
+                h36 = h36 + w(j, 14)*w(k - j, 55)
+                h37 = h37 + w(j, 13)*w(k - j, 57)
+                h38 = h38 + w(j, 13)*w(k - j, 59)
+                h39 = h39 + w(j, 14)*w(k - j, 61)
+                h40 = h40 + w(j, 18)*w(k - j, 55)
+                h41 = h41 + w(j, 17)*w(k - j, 57)
+                h42 = h42 + w(j, 17)*w(k - j, 59)
+                h43 = h43 + w(j, 18)*w(k - j, 61)
+            end do
+            w(k, 21) = h1 + 2.0_dp*w(0, 2)*w(k, 2)
+            w(k, 22) = w(k, 1)
+            w(k, 23) = h2 + 2.0_dp*w(0, 22)*w(k, 22)
+            w(k, 24) = w(k, 21) + w(k, 23)
+            w(k, 75) = fk*w(k, 24)
+            w(k, 25) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 24)*w(0,&
+                & 25))*iv1
+            w(k, 26) = w(k, 1)
+            w(k, 27) = h5 + 2.0_dp*w(0, 26)*w(k, 26)
+            w(k, 28) = w(k, 21) + w(k, 27)
+            w(k, 76) = fk*w(k, 28)
+            w(k, 29) = (((-1.0_dp/2.0_dp)*h7 - fk*h6)*rk + (-3.0_dp/2.0_dp)*w(k, 28)*w(0,&
+                & 29))*iv2
+            w(k, 30) = (((-3.0_dp/2.0_dp)*h9 - fk*h8)*rk + (-5.0_dp/2.0_dp)*w(k, 24)*w(0,&
+                & 30))*iv3
+            w(k, 31) = (((-3.0_dp/2.0_dp)*h11 - fk*h10)*rk + (-5.0_dp/2.0_dp)*w(k, 28)*w(0,&
+                & 31))*iv4
+            w(k, 32) = h12 + w(0, 26)*w(k, 31) + w(k, 26)*w(0, 31)
+            w(k, 33) = 3.0_dp*tc3*w(k, 30)
+            w(k, 34) = h13 + w(0, 2)*w(k, 22) + w(k, 2)*w(0, 22)
+            w(k, 35) = h14 + w(0, 33)*w(k, 34) + w(k, 33)*w(0, 34)
+            w(k, 36) = h15 + w(0, 2)*w(k, 32) + w(k, 2)*w(0, 32)
+            w(k, 37) = 3.0_dp*w(k, 1)
+            w(k, 38) = tc3*w(k, 30)
+            w(k, 39) = h16 + w(0, 37)*w(k, 38) + w(k, 37)*w(0, 38)
+            w(k, 40) = -w(k, 39)
+            w(k, 41) = h17 + w(0, 22)*w(k, 40) + w(k, 22)*w(0, 40)
+            w(k, 42) = -3.0_dp*tc1*w(k, 1)
+            w(k, 43) = h18 + w(0, 32)*w(k, 42) + w(k, 32)*w(0, 42)
+            w(k, 44) = h19 + w(0, 2)*w(k, 40) + w(k, 2)*w(0, 40)
+            w(k, 45) = h20 + w(0, 2)*w(k, 31) + w(k, 2)*w(0, 31)
+            w(k, 46) = h21 + w(0, 42)*w(k, 45) + w(k, 42)*w(0, 45)
+            w(k, 47) = h22 + w(0, 21)*w(k, 33) + w(k, 21)*w(0, 33)
+            w(k, 48) = h23 + w(0, 21)*w(k, 31) + w(k, 21)*w(0, 31)
+            w(k, 49) = tc3*w(k, 25)
+            w(k, 50) = h24 + w(0, 22)*w(k, 49) + w(k, 22)*w(0, 49)
+            w(k, 51) = tc1*w(k, 29)
+            w(k, 52) = h25 + w(0, 26)*w(k, 51) + w(k, 26)*w(0, 51)
+            w(k, 53) = h26 + w(0, 2)*w(k, 49) + w(k, 2)*w(0, 49)
+            w(k, 54) = h27 + w(0, 2)*w(k, 51) + w(k, 2)*w(0, 51)
+            w(k, 55) = w(k, 35) + tc5*w(k, 36)
+            w(k, 56) = h28 + w(0, 6)*w(k, 55) + w(k, 6)*w(0, 55)
+            w(k, 57) = -tc3*w(k, 25) - tc1*w(k, 29) - w(k, 41) - w(k, 43)
+            w(k, 58) = h29 + w(0, 5)*w(k, 57) + w(k, 5)*w(0, 57)
+            w(k, 59) = -w(k, 44) - w(k, 46)
+            w(k, 60) = h30 + w(0, 5)*w(k, 59) + w(k, 5)*w(0, 59)
+            w(k, 61) = -tc3*w(k, 25) - tc1*w(k, 29) + w(k, 47) + tc5*w(k, 48)
+            w(k, 62) = h31 + w(0, 6)*w(k, 61) + w(k, 6)*w(0, 61)
+            w(k, 63) = h32 + w(0, 10)*w(k, 55) + w(k, 10)*w(0, 55)
+            w(k, 64) = h33 + w(0, 9)*w(k, 57) + w(k, 9)*w(0, 57)
+            w(k, 65) = h34 + w(0, 9)*w(k, 59) + w(k, 9)*w(0, 59)
+            w(k, 66) = h35 + w(0, 10)*w(k, 61) + w(k, 10)*w(0, 61)
+            w(k, 67) = h36 + w(0, 14)*w(k, 55) + w(k, 14)*w(0, 55)
+            w(k, 68) = h37 + w(0, 13)*w(k, 57) + w(k, 13)*w(0, 57)
+            w(k, 69) = h38 + w(0, 13)*w(k, 59) + w(k, 13)*w(0, 59)
+            w(k, 70) = h39 + w(0, 14)*w(k, 61) + w(k, 14)*w(0, 61)
+            w(k, 71) = h40 + w(0, 18)*w(k, 55) + w(k, 18)*w(0, 55)
+            w(k, 72) = h41 + w(0, 17)*w(k, 57) + w(k, 17)*w(0, 57)
+            w(k, 73) = h42 + w(0, 17)*w(k, 59) + w(k, 17)*w(0, 59)
+            w(k, 74) = h43 + w(0, 18)*w(k, 61) + w(k, 18)*w(0, 61)
+            w(k + 1, 1) = rk1*(w(k, 3))
+            w(k + 1, 2) = rk1*(w(k, 4))
+            w(k + 1, 3) = rk1*(w(k, 1) + 2.0_dp*w(k, 4) - w(k, 50) - w(k, 52))
+            w(k + 1, 4) = rk1*(w(k, 2) - 2.0_dp*w(k, 3) - w(k, 53) - w(k, 54))
+            w(k + 1, 5) = rk1*(w(k, 7))
+            w(k + 1, 6) = rk1*(w(k, 8))
+            w(k + 1, 7) = rk1*(2.0_dp*w(k, 8) + w(k, 56) + w(k, 58))
+            w(k + 1, 8) = rk1*(-2.0_dp*w(k, 7) + w(k, 60) + w(k, 62))
+            w(k + 1, 9) = rk1*(w(k, 11))
+            w(k + 1, 10) = rk1*(w(k, 12))
+            w(k + 1, 11) = rk1*(2.0_dp*w(k, 12) + w(k, 63) + w(k, 64))
+            w(k + 1, 12) = rk1*(-2.0_dp*w(k, 11) + w(k, 65) + w(k, 66))
+            w(k + 1, 13) = rk1*(w(k, 15))
+            w(k + 1, 14) = rk1*(w(k, 16))
+            w(k + 1, 15) = rk1*(2.0_dp*w(k, 16) + w(k, 67) + w(k, 68))
+            w(k + 1, 16) = rk1*(-2.0_dp*w(k, 15) + w(k, 69) + w(k, 70))
+            w(k + 1, 17) = rk1*(w(k, 19))
+            w(k + 1, 18) = rk1*(w(k, 20))
+            w(k + 1, 19) = rk1*(2.0_dp*w(k, 20) + w(k, 71) + w(k, 72))
+            w(k + 1, 20) = rk1*(-2.0_dp*w(k, 19) + w(k, 73) + w(k, 74))
+        end do
+    end subroutine arenstorf_sym_taylor1
 
 end module arenstorf_model

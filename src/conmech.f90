@@ -16,7 +16,7 @@ module conmech
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_rattle
-    use conmech_rattle_dae
+    use conmech_rattle_stepper
     use conmech_radau
     use conmech_radau_stepper
     use conmech_gauss
@@ -27,6 +27,9 @@ module conmech
     use conmech_systems_ball
     use conmech_hill
     use conmech_equilibria
+    use conmech_jordan
+    use conmech_relative_equilibria
+    use conmech_degrees_of_freedom
     use conmech_variational
     use conmech_floquet
     use conmech_shooting
@@ -35,8 +38,27 @@ module conmech
     use conmech_hill_family
     use conmech_continuation
     use conmech_transverse
+    use conmech_rotation_log
+    use conmech_transverse_model
+    use conmech_transverse_mech
+    use conmech_transverse_general
+    use conmech_control_system
+    use conmech_mech_plant
+    use conmech_vhc
+    use conmech_periodic_riccati
+    use conmech_transverse_lqr
+    use conmech_orbital_stabilisation
     use conmech_param_system
     use conmech_branch_switch
+    use conmech_cr3bp
+    use conmech_hill_spatial
+    use conmech_system_energy
+    use conmech_hopf
+    use conmech_equilibrium_continuation
+    use conmech_periodic_multipliers
+    use conmech_periodic_schur
+    use conmech_block_chain
+    use conmech_taylor_stepper
     implicit none
     public
 end module conmech

@@ -120,12 +120,14 @@ contains
                 br%special(k)%point%p
         end do
         call ts%check(all(nfound == [0, 1, 1, 1]), "one each of BP, PD, NS and no fold")
+        call check_honest(br)
         ! closed forms: PD at p = 1, BP at p = 2, NS at p = 3
         call ts%check_close(found(SP_PD), 1.0_dp, 1.0e-8_dp, "period doubling at p = 1")
         call ts%check_close(found(SP_BP), 2.0_dp, 1.0e-8_dp, "branch point at p = 2")
         call ts%check_close(found(SP_NS), 3.0_dp, 1.0e-8_dp, "Neimark-Sacker at p = 3")
         call ts%check_close(br%points(br%npoints)%period, 8.0_dp*atan(1.0_dp), 1.0e-9_dp, &
                             "the period stays 2 pi")
+        call same_by_multiple_shooting(sys, found)
         ! branch switching at the period doubling: the doubled orbit has period 4 pi and
         ! u^2 + w^2 = |xi|^2 = p - 1 (closed form), p > 1 (supercritical)
         do k = 1, br%nspecial
@@ -133,6 +135,53 @@ contains
             if (br%special(k)%kind == SP_BP) call check_pitchfork(sys, br, k)
         end do
     end subroutine test_pd_bp_ns
+
+    !> Every special point located, its orbit's independent closure below 1e-8, and (fold,
+    !! branch point, period doubling) its test function below 1e-6; the Neimark-Sacker
+    !! test is a product over all pairs of multipliers, not normalised.
+    subroutine check_honest(br)
+        type(branch), intent(in) :: br
+        integer :: k
+        logical :: ok
+        ok = br%nspecial > 0
+        do k = 1, br%nspecial
+            ok = ok .and. br%special(k)%located .and. br%special(k)%closure < 1.0e-8_dp
+            if (br%special(k)%kind /= SP_NS) ok = ok .and. abs(br%special(k)%test) < 1.0e-6_dp
+        end do
+        call ts%check(ok, "every special point located, closure < 1e-8, test ~ 0")
+    end subroutine check_honest
+
+    !> The same branch by multiple shooting (4 segments) and by collocation (24 intervals
+    !! of degree 5): the same special points, located to 1e-8.
+    subroutine same_by_multiple_shooting(sys, found)
+        type(nf_cycles), intent(inout) :: sys
+        real(dp), intent(in) :: found(4)
+        type(branch) :: br
+        type(cont_options) :: o
+        integer :: k, d
+        logical :: ok
+        do d = ORBIT_MULTIPLE, ORBIT_COLLOCATION
+            o%ds = 0.05_dp
+            o%ds_max = 0.25_dp
+            o%p_max = 3.6_dp
+            o%max_points = 100
+            o%discretisation = d
+            o%segments = 4
+            o%intervals = 24
+            o%degree = 5
+            call continue_orbits(sys, set_p, 0.0_dp, [1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                 0.0_dp, 0.0_dp, 0.0_dp], 6.0_dp, br, o)
+            ok = br%info == CM_SUCCESS .and. br%nspecial == 3
+            do k = 1, br%nspecial
+                ok = ok .and. abs(br%special(k)%point%p - found(br%special(k)%kind)) &
+                     < 1.0e-8_dp .and. br%special(k)%located
+            end do
+            call ts%check(ok, orbit_method_name(d)//": the same located BP, PD, NS: "// &
+                          br%message)
+            call ts%check(abs(br%points(br%npoints)%p - 3.6_dp) < 1.0e-13_dp, &
+                          orbit_method_name(d)//": the branch ends at p_max")
+        end do
+    end subroutine same_by_multiple_shooting
 
     !> Branch switching at the pitchfork p = 2 of z' = (p - 2) z - z^3 (the symmetry
     !! z -> -z broken): the new orbits have z^2 = p - 2 (closed form by construction), the
@@ -230,6 +279,7 @@ contains
             write (*, '(2a, f20.15)') "  ", special_name(br%special(k)%kind), &
                 br%special(k)%point%p
         end do
+        call check_honest(br)
         nf = 0
         do k = 1, br%nspecial
             if (br%special(k)%kind == SP_FOLD) then

@@ -1,6 +1,7 @@
 !> Radau IIA (order 5) through ode_solve: Hairer's scaled Van der Pol (eps = 1e-6) against
 !! a tight reference, counters, dense output, bad input; ode_integrate with the implicit
-!! methods (the end point of ode_solve, bit for bit; its failure with the time); Newton
+!! methods (the end point of ode_solve, bit for bit; its failure with the time); the
+!! stepper packed and unpacked at every step (ode_solve's steps, bit for bit); Newton
 !! failure (step reduced to the minimum, the time in the message) and a singular iteration
 !! matrix (its message).
 program test_radau
@@ -15,7 +16,8 @@ program test_radau
     real(dp), parameter :: HS = 0.01_dp, GAM0 = 3.6378342527444957322_dp
     integer :: info, m
     type(ode_stats) :: st
-    type(radau_stepper) :: rs
+    type(radau_stepper), allocatable :: rs
+    type(state_packer) :: pk
     integer :: k
     logical :: same
     character(len=:), allocatable :: msg
@@ -53,19 +55,31 @@ program test_radau
     call ts%check(info == CM_TOO_MANY_STEPS .and. index(msg, "t =") > 0 .and. &
                   all(yi /= [2.0_dp, -0.66_dp]), "ode_integrate Radau failure: "//msg)
     opt%max_steps = 100000
-    ! the step-by-step integration makes the steps of radau_solve, bit for bit
-    call radau_stepper_init(rs, f, 0.0_dp, 2.0_dp, [2.0_dp, -0.66_dp], opt, info, msg)
-    call ts%check(info == CM_SUCCESS, "radau_stepper_init: "//msg)
+    ! step by step, the whole state packed into plain arrays after every step and unpacked
+    ! into a fresh stepper before the next (nothing kept between steps, as the Python
+    ! objects do): the steps and counters of ode_solve, bit for bit
+    allocate (rs)
+    call rs%init(0.0_dp, 2.0_dp, [2.0_dp, -0.66_dp], opt, info, msg)
+    if (info == CM_SUCCESS) call rs%start(f, info, msg)
+    call ts%check(info == CM_SUCCESS, "Radau stepper init, start: "//msg)
     same = .true.
     do k = 2, r%nt
-        call radau_stepper_step(rs, f, opt, info, msg)
+        call stepper_pack(rs, pk)
+        deallocate (rs)
+        allocate (rs)
+        call stepper_unpack(rs, METHOD_RADAU5, pk%r(1:pk%nr), pk%iv(1:pk%ni), &
+                            pk%w(:, 1:pk%nw), info, msg)
         if (info /= CM_SUCCESS) exit
-        same = same .and. rs%r(RADAU_RT) == r%t(k) .and. all(rs%w(:, RADAU_WY) == r%y(:, k))
+        call rs%step(f, 2.0_dp, info, msg)
+        if (info /= CM_SUCCESS) exit
+        same = same .and. rs%t == r%t(k) .and. all(rs%y == r%y(:, k))
     end do
-    call ts%check(info == CM_SUCCESS .and. same .and. rs%r(RADAU_RT) == 2.0_dp .and. &
-                  all(rs%iv(RADAU_IFEV:RADAU_IFEV + 4) == [r%stats%nfev, r%stats%njev, &
-                  r%stats%nlu, r%stats%naccept, r%stats%nreject]), &
-                  "radau_stepper: the steps and counters of radau_solve: "//msg)
+    call ts%check(info == CM_SUCCESS .and. same .and. rs%t == 2.0_dp .and. rs%last .and. &
+                  all([rs%st%nfev, rs%st%njev, rs%st%nlu, rs%st%naccept, rs%st%nreject] == &
+                      [r%stats%nfev, r%stats%njev, r%stats%nlu, r%stats%naccept, &
+                       r%stats%nreject]), &
+                  "Radau stepper, packed and unpacked at every step: the steps and "// &
+                  "counters of ode_solve")
     f%f => osc
     do m = METHOD_GAUSS4, METHOD_GAUSS6
         opt%method = m
@@ -135,6 +149,7 @@ program test_radau
     call ts%check(r%status == CM_BAD_INPUT .and. index(r%message, "constrained") > 0, &
                   "RATTLE in ode_solve: "//r%message)
     call ts%finish()
+    deallocate (rs)         ! (main-program allocatables are not freed at exit)
 
 contains
 

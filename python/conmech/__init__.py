@@ -11,11 +11,11 @@ from . import hill, stability
 from . import compiled
 from ._ivp import DenseOutput, OdeResult, solve_ivp
 from . import ensemble  # noqa: E402  (after _ivp: it builds on it)
-from ._stepper import DOP853, DOPRI5, RK4, RK45, VERNER98  # noqa: F401 (stepper classes)
-from ._implicit_stepper import Gauss4, Gauss6, Radau  # noqa: F401 (implicit steppers)
+from ._stepper import (DOP853, DOPRI5, RK4, RK45, VERNER98, Gauss4, Gauss6,  # noqa: F401
+                       Radau, Stepper)
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "systems", "hill", "stability",
            "constrained", "compiled"]
 __all__ += ["ensemble", "DOP853", "DOPRI5", "RK4", "RK45", "VERNER98"]
-__all__ += ["Radau", "Gauss4", "Gauss6"]
+__all__ += ["Radau", "Gauss4", "Gauss6", "Stepper"]
 __version__ = "0.1.0"

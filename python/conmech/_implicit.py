@@ -1,13 +1,14 @@
-"""The implicit methods of solve_ivp (Radau IIA, Gauss-Legendre) on the flat routines of
-flat_implicit.f90; called by :func:`conmech.solve_ivp` for method "Radau", "GAUSS4",
-"GAUSS6" after its argument checks."""
+"""The Jacobian callback of the methods that use one (Radau IIA): a user's ``jac`` for the
+flat routines of solve_ivp and of the steppers."""
 import math
 
 import numpy as np
 
-from . import _conmech
 
-IMPLICIT_CODES = {"RADAU": 5, "RADAU5": 5, "GAUSS4": 6, "GAUSS6": 7}
+def _no_jacobian(t, y):
+    """The Jacobian argument of the flat routines when there is none (has_jac = 0: never
+    called)."""
+    return np.zeros((1, 1))
 
 
 def jacobian_callback(jac, n, args, failure):
@@ -15,11 +16,8 @@ def jacobian_callback(jac, n, args, failure):
     or a constant array_like); (callback, has_jac). Shapes and finiteness are checked: a
     bad return is kept in ``failure`` (raised by the caller) and NaN is returned so that
     the Fortran solver stops."""
-    nan_j = np.full((n, n), math.nan)
     if jac is None:
-        def none_cb(t, y):  # never called when has_jac = 0
-            return nan_j
-        return none_cb, 0
+        return _no_jacobian, 0
     if not callable(jac):
         if hasattr(jac, "toarray") or hasattr(jac, "tocsr"):
             raise TypeError("jac: sparse matrices are not supported, pass a dense array")
@@ -39,7 +37,7 @@ def jacobian_callback(jac, n, args, failure):
 
     def jac_cb(t, y):
         if failure:
-            return nan_j
+            return np.full((n, n), math.nan)
         try:
             m = np.asarray(jac(t, y.copy(), *args), dtype=float)
             if m.shape != (n, n):
@@ -50,21 +48,5 @@ def jacobian_callback(jac, n, args, failure):
             return m
         except BaseException as exc:
             failure.append(exc)
-            return nan_j
+            return np.full((n, n), math.nan)
     return jac_cb, 1
-
-
-def run(builtin, fun, rhs, jac, args, n, events_cb, store, common, failure):
-    """Run the flat implicit solver; returns (nfev, njev, nlu, naccept, nreject, form,
-    info, message)."""
-    if builtin:
-        if jac is not None:
-            raise TypeError("jac cannot be used with a built-in system (it has its own)")
-        counts, form, info, message = _conmech.flat_solve_implicit_builtin(
-            *fun._flat_args(), events_cb, store, **common)
-    else:
-        jac_cb, has_jac = jacobian_callback(jac, n, args, failure)
-        counts, form, info, message = _conmech.flat_solve_implicit_callback(
-            rhs, jac_cb, events_cb, store, has_jac=has_jac, **common)
-    nfev, njev, nlu, naccept, nreject = (int(c) for c in counts)
-    return nfev, njev, nlu, naccept, nreject, form, info, message

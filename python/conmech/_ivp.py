@@ -1,4 +1,5 @@
-"""solve_ivp: SciPy's interface on conmech's Fortran Runge-Kutta integrators."""
+"""solve_ivp: SciPy's interface on conmech's Fortran integrators (every method of the
+method table, through the one driver loop)."""
 from __future__ import annotations
 
 from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
@@ -13,23 +14,25 @@ import numpy as np
 
 from . import _conmech
 from ._callback import Guard, as_result, message_text
+from ._checks import event_settings as _event_settings, initial_state as _initial_state, \
+    real_scalar as _real_scalar, tolerance as _tolerance
+from ._dense import DenseOutput
+from ._implicit import jacobian_callback
+from ._methods import METHODS, RK45_SCIPY, method_info
+from ._stepper import method_code
 from .systems import BuiltinSystem
-from . import _implicit
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
-_METHODS = ("RK45", "DOPRI5", "DOP853", "VERNER98", "VERN9", "RK4", "Radau", "GAUSS4",
-            "GAUSS6")
-# codes of conmech_ode_solver (METHOD_RK4 = 1, ...); checked against the Fortran
-# method_from_name by the tests (flat_method_code); the implicit methods' codes are
-# _implicit.IMPLICIT_CODES (their own flat routines)
-_METHOD_CODES = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
-                 **_implicit.IMPLICIT_CODES}
+# the names solve_ivp accepts: every method of the Fortran table (conmech_ode_methods) but
+# the constrained-only ones, with its aliases (the Python spelling first where SciPy has
+# one: "RK45", "Radau")
+_METHOD_CODES = {n.upper(): m.code for m in METHODS.values() if not m.constrained_only
+                 for n in (m.name, *m.aliases)}
+_METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45", "RADAU"))
 # solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
 # (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
-_RK45_SCIPY = 12
-_IMPLICIT = frozenset(_implicit.IMPLICIT_CODES.values())
-_RADAU = _implicit.IMPLICIT_CODES["RADAU"]
+_RK45_SCIPY = RK45_SCIPY
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -74,181 +77,6 @@ class OdeResult(dict):
 
     def __dir__(self):
         return list(self.keys())
-
-
-class DenseOutput:
-    """Continuous solution of an integration: piecewise polynomials, one per step.
-
-    ``sol(t)`` accepts a scalar (returns shape (n,)) or an array of times (returns shape
-    (n, len(t))); outside [t_min, t_max] the end polynomials are extrapolated, as SciPy's
-    OdeSolution does. SciPy's OdeSolution attributes: ``ts`` (segment boundaries, in the
-    direction of integration), ``ts_sorted``, ``interpolants`` (one callable per step, with
-    t_old and t), ``n_segments``, ``t_min``, ``t_max``, ``ascending``. On each step
-    [ts, ts + h], with x = (t - ts) / h, the polynomial is
-    in Hairer's form y0 + x (F1 + (1 - x)(F2 + x (F3 + (1 - x)(F4 + ...)))) (form 1:
-    RK4, DOPRI5, DOP853) or in the power basis y0 + x F1 + x^2 F2 + ... (form 2:
-    VERNER98), as in conmech_ode_solver's dense_solution.
-    """
-
-    HAIRER = 1
-    POWER = 2
-
-    def __init__(self, ts, hs, coef, t_min, t_max, form=HAIRER):
-        if form not in (self.HAIRER, self.POWER):
-            raise ValueError(f"unknown dense output form {form}")
-        self.form = form
-        self.t_start = np.ascontiguousarray(ts, dtype=float)   # step starts
-        self.h = np.ascontiguousarray(hs, dtype=float)          # signed step lengths
-        self.coef = np.ascontiguousarray(coef, dtype=float)     # (n, nf + 1, nseg)
-        self.t_min = float(min(t_min, t_max))
-        self.t_max = float(max(t_min, t_max))
-        self.n_segments = self.t_start.size
-        self.ts = np.append(self.t_start, self.t_start[-1] + self.h[-1]) \
-            if self.n_segments else np.array([t_min])
-        self._ascending = self.n_segments == 0 or self.h[0] > 0
-
-    # SciPy's OdeSolution attributes
-    @property
-    def ascending(self):
-        """True when the integration went forward in time."""
-        return bool(self._ascending)
-
-    @property
-    def ts_sorted(self):
-        """The segment boundaries in ascending order."""
-        return self.ts if self._ascending else self.ts[::-1]
-
-    @property
-    def side(self):
-        return "right" if self._ascending else "left"
-
-    @property
-    def interpolants(self):
-        """One callable per step (SciPy's DenseOutput objects): ``interpolants[i](t)``
-        evaluates the polynomial of step i, with attributes t_old, t, t_min, t_max."""
-        return [_Segment(self, i) for i in range(self.n_segments)]
-
-    def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        scalar = t.ndim == 0
-        tt = np.atleast_1d(t).ravel()
-        if self.n_segments == 0:
-            raise ValueError("the dense output is empty (no step was taken)")
-        if self._ascending:
-            idx = np.searchsorted(self.t_start, tt, side="right") - 1
-        else:
-            idx = np.searchsorted(-self.t_start, -tt, side="right") - 1
-        np.clip(idx, 0, self.n_segments - 1, out=idx)
-        x = (tt - self.t_start[idx]) / self.h[idx]
-        c = self.coef[:, :, idx]                      # (n, nf + 1, m)
-        nf = c.shape[1] - 1
-        x1 = 1.0 - x
-        y = c[:, nf, :].copy()
-        for j in range(nf - 1, 0, -1):
-            if self.form == self.POWER:
-                y *= x
-            else:
-                y *= x1 if j % 2 == 1 else x
-            y += c[:, j, :]
-        y *= x
-        y += c[:, 0, :]
-        return y[:, 0] if scalar else y
-
-
-class _Segment:
-    """The polynomial of one step of a :class:`DenseOutput` (SciPy's DenseOutput)."""
-
-    __slots__ = ("_sol", "_i", "t_old", "t", "t_min", "t_max")
-
-    def __init__(self, sol, i):
-        self._sol, self._i = sol, i
-        self.t_old = float(sol.t_start[i])
-        self.t = float(sol.t_start[i] + sol.h[i])
-        self.t_min, self.t_max = min(self.t_old, self.t), max(self.t_old, self.t)
-
-    def __call__(self, t):
-        sol = DenseOutput(self._sol.t_start[self._i:self._i + 1],
-                          self._sol.h[self._i:self._i + 1],
-                          self._sol.coef[:, :, self._i:self._i + 1], self.t_old, self.t,
-                          form=self._sol.form)
-        return sol(t)
-
-
-def _real_scalar(value, name):
-    if type(value) is float or type(value) is int:
-        return float(value)
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.ndarray)):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim != 0:
-        raise ValueError(f"{name} must be a scalar")
-    return float(arr)
-
-
-def _tolerance(value, name, n):
-    if type(value) is float or type(value) is int:   # fast path for the common case
-        v = float(value)
-        if not v >= 0:
-            raise ValueError(f"{name} must be non-negative")
-        if v == math.inf:
-            raise ValueError(f"{name} must be finite")
-        return np.full(n, v)
-    try:
-        arr = np.asarray(value)
-        if arr.dtype.kind not in "biuf" or isinstance(value, (bool, np.bool_)):
-            raise TypeError
-        arr = arr.astype(float)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} must be a non-negative number or an array of shape "
-                        f"({n},)") from exc
-    if arr.ndim == 0:
-        arr = np.full(n, float(arr))
-    elif arr.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},) like y0, got shape "
-                         f"{arr.shape}")
-    if np.isnan(arr).any() or (arr < 0).any():
-        raise ValueError(f"{name} must be non-negative")
-    if not np.isfinite(arr).all():
-        raise ValueError(f"{name} must be finite")
-    return np.ascontiguousarray(arr)
-
-
-def _event_settings(events):
-    """(function, terminal count (0: not terminal), direction) per event, SciPy's rules:
-    ``terminal`` is a bool or a positive integer (stop at that occurrence)."""
-    if events is None:
-        return []
-    evs = [events] if callable(events) else events
-    try:
-        evs = list(evs)
-    except TypeError:
-        raise TypeError("events must be a callable or a list of callables") from None
-    for i, e in enumerate(evs):
-        if not callable(e):
-            raise TypeError(f"events[{i}] is not callable")
-    settings = []
-    for i, e in enumerate(evs):
-        term = getattr(e, "terminal", None)
-        if term is None or isinstance(term, (bool, np.bool_)):
-            count = int(bool(term))
-        elif isinstance(term, numbers.Real):
-            tv = float(term)
-            if not (math.isfinite(tv) and 0 <= tv <= 2**31 - 1 and tv == int(tv)):
-                raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
-                                 f"integer (a count of occurrences), got {term!r}")
-            count = int(tv)
-        else:
-            raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
-                             f"integer (a count of occurrences), got {term!r}")
-        direction = getattr(e, "direction", 0)
-        try:
-            direction = float(direction)
-        except (TypeError, ValueError):
-            raise ValueError(f"events[{i}].direction must be a number") from None
-        if math.isnan(direction):
-            raise ValueError(f"events[{i}].direction must be a number")
-        settings.append((e, count, int(np.sign(direction))))
-    return settings
 
 
 class _StopAtStart(Exception):
@@ -399,7 +227,6 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
 
     # ---------------------------------------------------------------- method
     if isinstance(method, type):     # a stepper class: conmech.DOP853, scipy.integrate.RK45
-        from ._stepper import method_code
         code = method_code(method)
         if code == 0:
             raise ValueError(f"method {method.__name__} has no counterpart in conmech; use "
@@ -426,24 +253,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
     tf = _real_scalar(t_span[1], "t_span[1]")
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
-    y0_in = np.asarray(y0)
-    if y0_in.dtype.kind == "c":
-        raise TypeError("y0 must be real: complex states are not supported (split them "
-                        "into real and imaginary parts)")
-    try:
-        y0 = np.array(y0_in, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError("y0 must be an array of real numbers") from None
-    if y0.ndim != 1:
-        raise ValueError(f"y0 must be 1-dimensional, got shape {y0.shape}")
+    y0 = _initial_state(y0, fun, builtin)
     n = y0.size
-    if n == 0:
-        raise ValueError("y0 must not be empty")
-    if not np.isfinite(y0).all():
-        raise ValueError("y0 contains NaN or Inf")
-    if builtin and n != fun.dimension:
-        raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
-                         f"'{fun.name}', got {y0.shape}")
 
     # ---------------------------------------------------------------- tolerances, steps
     rtol_v = _tolerance(rtol, "rtol", n)
@@ -454,7 +265,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
         h0 = _positive_finite(first_step, "first_step")
         if h0 > abs(tf - t0) and tf != t0:
             raise ValueError("first_step exceeds the length of t_span")
-    if code in (1, 6, 7) and first_step is None:
+    info = method_info(code)
+    if info.fixed_step and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
@@ -463,8 +275,9 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
     if not 1 <= max_steps <= 2**31 - 1:
         raise ValueError("max_steps must be positive (and below 2**31)")
     _validate_jac(jac, n)
-    unused = sorted(options) + (["jac"] if jac is not None and code != _RADAU else [])
-    if jac is not None and code != _RADAU:
+    unused = sorted(options) + (["jac"] if jac is not None and not info.uses_jacobian
+                                else [])
+    if jac is not None and not info.uses_jacobian:
         jac = None
     if unused:   # as SciPy's explicit solvers
         warnings.warn("The following arguments have no effect for a chosen solver: "
@@ -593,6 +406,10 @@ class _Run:
         self.start_events = []          # SciPy's events at t0: (i, t0, y0)
         self.first_segment = True
         self.rhs = None
+        self.failure = []
+        if builtin and jac is not None:
+            raise TypeError("jac cannot be used with a built-in system (it has its own)")
+        self.jac_cb, self.has_jac = jacobian_callback(jac, n, args, self.failure)
         if not builtin:
             if vectorized:
                 def user(t, y, *a):
@@ -674,22 +491,22 @@ class _Run:
         kw = dict(t_span=np.array([t_a, tf]), y0=y_a, first_step=h0, neval=t_ev.size,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir,
                   ev_term=ev_term, **common)
-        if kw["method"] in _IMPLICIT:
-            failure = []
-            nfev, njev, nlu, naccept, nreject, form, info, message = _implicit.run(
-                self.builtin, self.fun, self.rhs, self.jac, self.args, n, events_cb, store,
-                kw, failure)
-            if failure:
-                self.guard.fail(failure[0])
-            self.njev += int(njev)
-            self.nlu += int(nlu)
+        if self.builtin and ne and _compiled_events(self.fun, common["method"], self.settings):
+            # Taylor's method with events from conmech.symbolic.event: no Python in the loop
+            from ._taylor import run_compiled_events
+            counts, form, info, message = run_compiled_events(
+                self.fun, [st[0] for st in self.settings], store, kw, self.zero_at_start)
         elif self.builtin:
-            fun = self.fun
-            nfev, naccept, nreject, form, info, message = _conmech.flat_solve_builtin(
-                *fun._flat_args(), events_cb, store, **kw)
+            counts, form, info, message = _conmech.flat_solve_builtin(
+                *self.fun._flat_args(), events_cb, store, **kw)
         else:
-            nfev, naccept, nreject, form, info, message = _conmech.flat_solve_callback(
-                self.rhs, events_cb, store, **kw)
+            counts, form, info, message = _conmech.flat_solve_callback(
+                self.rhs, self.jac_cb, events_cb, store, has_jac=self.has_jac, **kw)
+        if self.failure:
+            self.guard.fail(self.failure[0])
+        nfev, njev, nlu, naccept, nreject = (int(c) for c in counts)
+        self.njev += njev
+        self.nlu += nlu
         self.first_segment = False
         res.setdefault("t", np.array([t_a]))
         res.setdefault("y", y_a[:, None].copy())
@@ -698,6 +515,15 @@ class _Run:
         res.update(nfev=int(nfev), naccept=int(naccept), nreject=int(nreject),
                    form=int(form), info=int(info), message=message_text(message))
         return res
+
+
+def _compiled_events(fun, code, settings):
+    """True when method TAYLOR runs with events that are all conmech.symbolic events of
+    fun's model (then the Fortran stepper locates them itself)."""
+    if METHODS.get(code) is None or METHODS[code].name != "TAYLOR":
+        return False
+    from .symbolic.taylor_events import compiled_events
+    return compiled_events(fun, [st[0] for st in settings]) is not None
 
 
 def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, message,

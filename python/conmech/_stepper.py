@@ -1,18 +1,20 @@
-"""Step-by-step integration with SciPy's OdeSolver interface.
+"""Step-by-step integration with SciPy's OdeSolver interface, for every method.
 
 ``conmech.DOP853(fun, t0, y0, t_bound, rtol=..., atol=..., max_step=..., first_step=...)``
-(and ``RK45`` (SciPy's step control), ``DOPRI5`` (Hairer's), ``VERNER98``, ``RK4``) advance one accepted step per ``step()``
-call, as ``scipy.integrate.DOP853`` does: attributes ``t``, ``y``, ``t_old``,
+(and ``RK45`` (SciPy's step control), ``DOPRI5`` (Hairer's), ``VERNER98``, ``RK4``,
+``Radau`` (with ``jac``), ``Gauss4``, ``Gauss6``; any method of the table by name with
+``conmech.Stepper(fun, t0, y0, t_bound, method="...")``) advance one accepted step per
+``step()`` call, as ``scipy.integrate.DOP853`` does: attributes ``t``, ``y``, ``t_old``,
 ``t_bound``, ``direction``, ``n``, ``status`` ("running", "finished", "failed"),
-``step_size``, ``nfev``, ``njev``, ``nlu``; ``dense_output()`` is the continuous
-extension of the last step. The steps are those of :func:`conmech.solve_ivp` (the same
-Fortran stepper), bit for bit.
+``step_size``, ``nfev``, ``njev``, ``nlu``; ``dense_output()`` is the continuous extension
+of the last step. The steps are those of :func:`conmech.solve_ivp` (the same Fortran
+stepper), bit for bit.
 
 The Fortran side keeps no state between calls: the stepper's whole state (t, y, the
-stages, the step size and the controller's memory) lives in three numpy arrays of the
-Python object, which the flat routine ``flat_stepper_callback`` (or ``_builtin``) takes in
-and writes back at every call. Objects are independent; one object must not be stepped
-from two threads at once.
+stages, the step size and the controller's memory; for Radau the Jacobian and both LU
+factorisations) lives in three numpy arrays of the Python object, which the one flat
+routine ``flat_stepper_callback`` (or ``_builtin``) takes in and writes back at every call.
+Objects are independent; one object must not be stepped from two threads at once.
 """
 import math
 import numbers
@@ -22,16 +24,20 @@ import numpy as np
 
 from . import _conmech
 from ._callback import Guard, message_text
-from ._ivp import DenseOutput, _real_scalar, _tolerance
+from ._dense import DenseOutput
+from ._checks import initial_state, real_scalar, tolerance
+from ._implicit import jacobian_callback
+from ._methods import BY_NAME, RK45_SCIPY, method_info
 from .systems import BuiltinSystem
 
-__all__ = ["RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "method_code"]
+__all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "Radau",
+           "Gauss", "Gauss4", "Gauss6", "method_code"]
 
-_NR, _NI, _NW = (int(v) for v in _conmech.flat_stepper_sizes())
-_CFC = 25            # first column of the dense coefficients in the packed state (0-based)
+(_R_T, _R_TOLD, _R_HDONE, _I_NF, _I_FORM, _I_NFEV, _I_NJEV, _I_NLU, _I_NACCEPT, _I_NREJECT,
+ _W_Y, _W_FC) = (int(v) - 1 for v in _conmech.flat_stepper_layout())
+_START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
+_CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
-_PAD = np.zeros(1)
-_PAD.flags.writeable = False
 
 
 class StepDenseOutput(DenseOutput):
@@ -59,31 +65,38 @@ class ConstantDenseOutput:
         return np.repeat(self.value[:, None], t.size, axis=1)
 
 
-class RungeKutta:
-    """Base class of conmech's explicit Runge-Kutta steppers (SciPy's OdeSolver interface).
+class Stepper:
+    """A stepper of any method of the table (SciPy's OdeSolver interface); the classes
+    below fix the method, ``Stepper(..., method="NAME")`` takes it by name.
 
     Parameters
     ----------
     fun : callable or conmech.systems.BuiltinSystem
-        ``fun(t, y) -> dydt`` (shape (n,)), or a built-in system (no Python in the loop).
+        ``fun(t, y) -> dydt`` (shape (n,)), or a built-in or compiled system (no Python in
+        the loop; its own Jacobian where the method uses one).
     t0 : float
         Initial time.
     y0 : array_like, shape (n,)
         Initial state.
     t_bound : float
-        Boundary time: the integration does not go beyond it (may be infinite); it also
-        sets the direction of integration.
+        Boundary time: the integration does not go beyond it (may be infinite for the
+        adaptive methods); it also sets the direction of integration.
     max_step : float
         Largest step size (default: no limit).
     rtol, atol : float or array_like of shape (n,)
         Relative and absolute tolerances (SciPy's defaults 1e-3, 1e-6).
     first_step : float or None
-        Initial step size (None: SciPy's heuristic for RK45, Hairer's for the others).
-        RK4: its fixed step, required.
+        Initial step size (None: the method's heuristic). Fixed-step methods (RK4, Gauss4,
+        Gauss6): their step, required.
     vectorized : bool
         Accepted for SciPy compatibility, without effect.
     max_steps : int
         Attempted steps allowed over the whole integration.
+    jac : callable, array_like or None
+        Methods that use a Jacobian (Radau): ``jac(t, y) -> (n, n)`` or a constant matrix;
+        None: finite differences (counted in nfev). Not with a built-in system.
+    method : str
+        Only for ``Stepper`` itself: the method's name in the table.
     """
 
     _code = 0
@@ -93,6 +106,27 @@ class RungeKutta:
 
     def __init__(self, fun, t0, y0, t_bound, max_step=np.inf, rtol=1e-3, atol=1e-6,
                  vectorized=False, first_step=None, max_steps=100000, **extraneous):
+        code = self._code
+        if type(self) is Stepper:
+            name = extraneous.pop("method", None)
+            entry = BY_NAME.get(str(name).upper()) if isinstance(name, str) else None
+            if entry is None or entry.constrained_only:
+                raise ValueError(f"method must be a method of the table, one of "
+                                 f"{', '.join(sorted(BY_NAME))}, got {name!r}")
+            code = entry.code
+        self._code = code
+        info = method_info(code)
+        if info is None:
+            raise TypeError(f"{type(self).__name__} is a base class: use a method's class "
+                            "(conmech.DOP853, conmech.Gauss6, ...) or conmech.Stepper(..., "
+                            "method=NAME)")
+        jac = None
+        if info.uses_jacobian:
+            jac = extraneous.pop("jac", None)
+            if extraneous.pop("jac_sparsity", None) is not None:
+                raise ValueError(f"jac_sparsity is not supported: conmech.{info.name} uses "
+                                 "dense Jacobians (pass jac, or nothing for finite "
+                                 "differences)")
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
@@ -100,43 +134,35 @@ class RungeKutta:
         if not self._builtin and not callable(fun):
             raise TypeError("fun must be callable or a built-in system from "
                             f"conmech.systems, got {type(fun).__name__}")
-        t0 = _real_scalar(t0, "t0")
-        t_bound = _real_scalar(t_bound, "t_bound")
+        t0 = real_scalar(t0, "t0")
+        t_bound = real_scalar(t_bound, "t_bound")
         if not math.isfinite(t0):
             raise ValueError("t0 must be finite")
         if math.isnan(t_bound):
             raise ValueError("t_bound must not be NaN")
-        y0_in = np.asarray(y0)
-        if y0_in.dtype.kind == "c":
-            raise TypeError("y0 must be real: complex states are not supported")
-        try:
-            y = np.array(y0_in, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError("y0 must be an array of real numbers") from None
-        if y.ndim != 1:
-            raise ValueError(f"y0 must be 1-dimensional, got shape {y.shape}")
+        y = initial_state(y0, fun, self._builtin)
         n = y.size
-        if n == 0:
-            raise ValueError("y0 must not be empty")
-        if not np.isfinite(y).all():
-            raise ValueError("y0 contains NaN or Inf")
-        if self._builtin and n != fun.dimension:
-            raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
-                             f"'{fun.name}', got {y.shape}")
-        self._rtol = _tolerance(rtol, "rtol", n)
-        self._atol = _tolerance(atol, "atol", n)
+        self._rtol = tolerance(rtol, "rtol", n)
+        self._atol = tolerance(atol, "atol", n)
+        name = type(self).__name__ if type(self) is not Stepper else info.name
+        if info.fixed_step:
+            if first_step is None:
+                raise ValueError(f"first_step is required by {name} (a fixed-step "
+                                 "method): pass the step size")
+            if not math.isfinite(t_bound):
+                raise ValueError(f"t_bound must be finite for {name} (fixed steps over "
+                                 "[t0, t_bound])")
         if first_step is None:
             h0 = 0.0
         else:
-            h0 = _real_scalar(first_step, "first_step")
+            h0 = real_scalar(first_step, "first_step")
             if not (h0 > 0 and math.isfinite(h0)):
                 raise ValueError("first_step must be positive")
-            if h0 > abs(t_bound - t0) and t_bound != t0 and self._code != 1:
-                raise ValueError("first_step exceeds the length of the interval")
-        if self._code == 1 and first_step is None:
-            raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
-                             "step size")
-        hmax = _real_scalar(max_step, "max_step")
+            if h0 > abs(t_bound - t0) and t_bound != t0:
+                if not info.fixed_step:
+                    raise ValueError("first_step exceeds the length of the interval")
+                h0 = abs(t_bound - t0)          # one step, as solve_ivp
+        hmax = real_scalar(max_step, "max_step")
         if not hmax > 0:
             raise ValueError("max_step must be positive")
         if isinstance(max_steps, (bool, np.bool_)) or \
@@ -160,28 +186,39 @@ class RungeKutta:
         self._first_step = h0
         self._max_step = min(hmax, _HUGE)
         self._max_steps = int(max_steps)
-        self._r = np.zeros(_NR)
-        self._iv = np.zeros(_NI, dtype=np.intc)
-        self._w = np.zeros((n, _NW), order="F")
-        self._w[:, 0] = y
         self._pending = None
-        self._probe = 0
         self._guard = Guard()
-        if not self._builtin:
+        self._failure = []
+        self._r = np.zeros(1)
+        self._iv = np.zeros(1, dtype=np.intc)
+        self._w = np.zeros((n, 1), order="F")
+        self._w[:, 0] = y
+        if self._builtin:
+            if jac is not None:
+                raise TypeError("jac cannot be used with a built-in system (it has its own)")
+        else:
             # every return of fun is checked (shape, None, complex) by the one wrapper of
             # conmech._callback; an exception stops the step and is re-raised unchanged
             self._rhs = self._guard.wrap(fun, 2, (n,), "fun")
-        info, message = self._call(0)
-        if info == -4:
+            self._jac_cb, self._has_jac = jacobian_callback(jac, n, (), self._failure)
+        info_, message, sizes = self._call(_SIZES)
+        if info_ == _CM_BAD_INPUT:
             raise ValueError(message)
-        if info < 0:
+        self._r = np.zeros(max(int(sizes[0]), 1))
+        self._iv = np.zeros(max(int(sizes[1]), 1), dtype=np.intc)
+        self._w = np.zeros((n, max(int(sizes[2]), 1)), order="F")
+        self._sizes = tuple(int(s) for s in sizes)
+        info_, message, _ = self._call(_START)
+        if info_ == _CM_BAD_INPUT:
+            raise ValueError(message)
+        if info_ < 0:
             self._pending = message      # reported by the first step(), as SciPy would
 
     # ------------------------------------------------------------------ state
     @property
     def y(self):
         """Current state (a copy)."""
-        return self._w[:, 0].copy()
+        return self._w[:, _W_Y].copy() if self._w.shape[1] > _W_Y else self._y0.copy()
 
     @property
     def step_size(self):
@@ -190,30 +227,41 @@ class RungeKutta:
 
     @property
     def naccept(self):
-        return int(self._iv[16])
+        return int(self._iv[_I_NACCEPT]) if self._iv.size > _I_NACCEPT else 0
 
     @property
     def nreject(self):
-        return int(self._iv[17])
+        return int(self._iv[_I_NREJECT]) if self._iv.size > _I_NREJECT else 0
 
     def _call(self, action):
-        common = dict(action=action, t0=self.t if action == 0 else 0.0,
+        nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
+        if action == _SIZES:
+            nr = ni = nw = 0
+        common = dict(action=action, nr=nr, ni=ni, nw=nw,
+                      t0=self.t if action in (_START, _SIZES) else 0.0,
                       t_bound=self.t_bound, y0=self._y0, method=self._code,
                       rtol=self._rtol, atol=self._atol, first_step=self._first_step,
                       max_step=self._max_step, max_steps=self._max_steps,
                       r=self._r, iv=self._iv, w=self._w)
         if self._builtin:
-            info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(), **common)
+            sizes, info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(),
+                                                                 **common)
         else:
-            info, message = _conmech.flat_stepper_callback(self._rhs, **common)
+            sizes, info, message = _conmech.flat_stepper_callback(
+                self._rhs, self._jac_cb, has_jac=self._has_jac, **common)
+        if self._failure:
+            self._guard.fail(self._failure.pop(0))
         if self._guard.failed:
             self.status = "failed"
             self._guard.check()
         message = message_text(message)
-        self.nfev = int(self._iv[15]) + self._probe
-        if action == 1:
-            self.t = float(self._r[0])
-        return int(info), message
+        if action != _SIZES and self._iv.size > _I_NREJECT:
+            self.nfev = int(self._iv[_I_NFEV])
+            self.njev = int(self._iv[_I_NJEV])
+            self.nlu = int(self._iv[_I_NLU])
+            if action == _STEP:
+                self.t = float(self._r[_R_T])
+        return int(info), message, sizes
 
     # ------------------------------------------------------------------ SciPy's API
     def step(self):
@@ -230,7 +278,7 @@ class RungeKutta:
             self.status = "finished"
             return None
         t = self.t
-        info, message = self._call(1)
+        info, message, _ = self._call(_STEP)
         if info != 0:
             self.status = "failed"
             return message
@@ -246,19 +294,24 @@ class RungeKutta:
                                "made.")
         if self.t == self.t_old:
             return ConstantDenseOutput(self.t_old, self.t, self.y)
-        self._call(2)
-        nf = int(self._iv[2])
-        coef = np.array(self._w[:, _CFC:_CFC + nf + 1])
-        return StepDenseOutput(self.t_old, self.t, float(self._r[5]), coef, int(self._iv[3]))
+        self._call(_DENSE)
+        nf = int(self._iv[_I_NF])
+        coef = np.array(self._w[:, _W_FC:_W_FC + nf + 1])
+        return StepDenseOutput(float(self._r[_R_TOLD]), self.t, float(self._r[_R_HDONE]),
+                               coef, int(self._iv[_I_FORM]))
 
     def __repr__(self):
         return (f"conmech.{type(self).__name__}(t={self.t!r}, status={self.status!r}, "
                 f"n={self.n}, nfev={self.nfev})")
 
 
+class RungeKutta(Stepper):
+    """Base class of conmech's explicit Runge-Kutta steppers (parameters: :class:`Stepper`)."""
+
+
 class DOP853(RungeKutta):
     """Dormand-Prince 8(5,3) with dense output of order 7 (SciPy's OdeSolver interface)."""
-    _code = 3
+    _code = BY_NAME["DOP853"].code
     order = 8
     error_estimator_order = 7
     n_stages = 12
@@ -269,7 +322,7 @@ class RK45(RungeKutta):
     ``scipy.integrate.RK45`` and ``conmech.solve_ivp(method="RK45")``: no Lund
     stabilisation, SciPy's ``select_initial_step``), dense output of order 4; SciPy's
     OdeSolver interface. ``conmech.DOPRI5`` is the same pair with Hairer's control."""
-    _code = 12
+    _code = RK45_SCIPY
     order = 5
     error_estimator_order = 4
     n_stages = 6
@@ -278,7 +331,7 @@ class RK45(RungeKutta):
 class DOPRI5(RungeKutta):
     """Dormand-Prince 5(4) as Hairer's DOPRI5 (Lund-stabilised step control, Hairer's
     initial step, dense output of order 4), SciPy's OdeSolver interface."""
-    _code = 2
+    _code = BY_NAME["DOPRI5"].code
     order = 5
     error_estimator_order = 4
     n_stages = 6
@@ -286,7 +339,7 @@ class DOPRI5(RungeKutta):
 
 class VERNER98(RungeKutta):
     """Verner's 9(8) pair with dense output of order 8 (SciPy's OdeSolver interface)."""
-    _code = 4
+    _code = BY_NAME["VERNER98"].code
     order = 9
     error_estimator_order = 8
     n_stages = 16
@@ -294,19 +347,56 @@ class VERNER98(RungeKutta):
 
 class RK4(RungeKutta):
     """Classical fixed-step RK4 (step ``first_step``), SciPy's OdeSolver interface."""
-    _code = 1
+    _code = BY_NAME["RK4"].code
     order = 4
     error_estimator_order = 0
     n_stages = 4
 
 
-_SCIPY_COUNTERPARTS = {"RK45": 12, "DOP853": 3, "Radau": 5}   # 5: conmech.Radau
+class Radau(Stepper):
+    """Radau IIA of order 5 (Hairer's RADAU5 Newton and step control) with SciPy's
+    OdeSolver interface, for stiff problems; ``dense_output()`` is the collocation
+    polynomial of the last step.
+
+    Parameters as :class:`Stepper`, with ``jac`` (callable ``jac(t, y) -> (n, n)``, a
+    constant matrix, or None: forward differences counted in nfev; not with a built-in
+    system, which has its own) and ``jac_sparsity`` (only None: dense Jacobians).
+    """
+    _code = BY_NAME["RADAU5"].code
+    order = 5
+    error_estimator_order = 3
+    n_stages = 3
+
+
+class Gauss(Stepper):
+    """Base class of the Gauss-Legendre steppers (fixed step ``first_step``, required:
+    the steps are h = (t_bound - t0)/N with N = ceil(|t_bound - t0|/first_step), as
+    ``solve_ivp(method="GAUSS6", first_step=...)``, bit for bit; t_bound finite). No
+    Jacobian is used (fixed-point iteration of the stages to round-off); a step whose
+    iteration does not converge fails with the time."""
+
+
+class Gauss4(Gauss):
+    """Gauss-Legendre collocation with 2 stages (order 4, symplectic), fixed step."""
+    _code = BY_NAME["GAUSS4"].code
+    order = 4
+    n_stages = 2
+
+
+class Gauss6(Gauss):
+    """Gauss-Legendre collocation with 3 stages (order 6, symplectic), fixed step."""
+    _code = BY_NAME["GAUSS6"].code
+    order = 6
+    n_stages = 3
+
+
+_SCIPY_COUNTERPARTS = {"RK45": RK45_SCIPY, "DOP853": DOP853._code, "Radau": Radau._code}
 
 
 def method_code(method):
     """Method code of a stepper class (conmech's, or SciPy's RK45/DOP853/Radau); 0 if none."""
     if isinstance(method, type):
-        if issubclass(method, RungeKutta):
+        if issubclass(method, Stepper):
             return method._code
         if method.__module__.startswith("scipy.integrate"):
             return _SCIPY_COUNTERPARTS.get(method.__name__, 0)

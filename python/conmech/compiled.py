@@ -52,14 +52,21 @@ from .systems import BuiltinSystem
 from .constrained import BuiltinConstrained
 
 __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
-           "CompiledConstrained", "evaluate", "function_address", "load_model"]
+           "CompiledConstrained", "evaluate", "function_address", "load_model",
+           "library_taylor"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 19
+_SPEC_SIZE = 27
 _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
           "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
           "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18,
-          "accel_jac": 19}
+          "accel_jac": 27}
+# Taylor coefficients (conmech_flat_spec: 19 taylor, 20 its work columns, 21 taylor_var,
+# 22 its columns, 23 taylor written out for one order, 24 that order, 25/26 the same for
+# taylor_var)
+_TAYLOR_SLOTS = {"jet": 19, "nw": 20, "var": 21, "nw_var": 22, "jet_fixed": 23,
+                 "order": 24, "var_fixed": 25, "order_var": 26}
+_TAYLOR_FUNCS = ("jet", "var", "jet_fixed", "var_fixed")
 
 
 def function_address(f, what: str = "function") -> int:
@@ -148,16 +155,39 @@ def _with_params(obj, kw):
     return np.array([values[k] for k in obj.param_names], dtype=float)
 
 
+def _taylor_spec(spec, taylor):
+    """Write the Taylor entries of `taylor` (a dict, see :func:`ode_system`) into spec."""
+    if not taylor:
+        return spec
+    if not isinstance(taylor, dict):
+        raise TypeError("taylor must be a dict (jet, nw, and optionally var, nw_var)")
+    unknown = set(taylor) - set(_TAYLOR_SLOTS) - {"batch", "width", "qp", "model"}
+    if unknown:
+        raise ValueError(f"unknown taylor entries {sorted(unknown)}")
+    for key, slot in _TAYLOR_SLOTS.items():
+        v = taylor.get(key)
+        if v is None:
+            continue
+        if key in _TAYLOR_FUNCS:
+            spec[slot - 1] = function_address(v, f"taylor['{key}']")
+        else:
+            spec[slot - 1] = _count(v, f"taylor['{key}']", 0)
+    if spec[_TAYLOR_SLOTS["jet"] - 1] and spec[_TAYLOR_SLOTS["nw"] - 1] < spec[1]:
+        raise ValueError("taylor['nw'] (the work columns) must be at least n")
+    return spec
+
+
 class CompiledSystem(BuiltinSystem):
     """A first-order system (``kind`` 'ode') or a system in generalized coordinates
     (``kind`` 'generalized', state y = [q, q']) given by compiled functions. It works
     wherever a built-in system does: :func:`conmech.solve_ivp`, :mod:`conmech.stability`.
     Attributes: name, kind, dimension (state size), ndof (generalized only), params,
-    param_names, spec (the function table handed to Fortran)."""
+    param_names, spec (the function table handed to Fortran), taylor (the Taylor
+    coefficient routines, a dict, or None)."""
 
-    __slots__ = ("kind", "ndof")
+    __slots__ = ("kind", "ndof", "taylor")
 
-    def __init__(self, name, kind, spec, params, param_names, keep):
+    def __init__(self, name, kind, spec, params, param_names, keep, taylor=None):
         self.name = name
         self.kind = kind
         self.spec = spec
@@ -166,11 +196,23 @@ class CompiledSystem(BuiltinSystem):
         self.ndof = int(spec[1]) if kind == "generalized" else None
         self.dimension = 2*self.ndof if kind == "generalized" else int(spec[1])
         self._keep = keep
+        self.taylor = taylor
 
     def with_params(self, **kw):
         """A copy with new values of some parameters (same compiled code: no rebuild)."""
         return CompiledSystem(self.name, self.kind, self.spec, _with_params(self, kw),
-                              self.param_names, self._keep)
+                              self.param_names, self._keep, self.taylor)
+
+    def with_taylor(self, **entries):
+        """A copy whose Taylor entries (see :func:`ode_system`) are updated (e.g. the
+        routines written out for one order, ``jet_fixed`` and ``order``)."""
+        taylor = dict(self.taylor or {})
+        taylor.update(entries)
+        spec = _taylor_spec(self.spec.copy(), taylor)
+        extra = tuple(v for k, v in entries.items() if k in _TAYLOR_FUNCS)
+        keep = (tuple(self._keep) if isinstance(self._keep, tuple) else (self._keep,)) + extra
+        return CompiledSystem(self.name, self.kind, spec, self.params, self.param_names,
+                              keep, taylor)
 
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
@@ -213,7 +255,7 @@ class CompiledConstrained(BuiltinConstrained):
 
 def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
                param_names: Sequence[str] = (), keep=None,
-               name: str = "compiled", *, jac_prod=None) -> CompiledSystem:
+               name: str = "compiled", *, jac_prod=None, taylor=None) -> CompiledSystem:
     """A first-order system y' = rhs(t, y; p) of dimension ``n`` from compiled functions
     (``jac``: the exact Jacobian df/dy, column-major; None: finite differences).
     ``params``: a sequence (names from ``param_names``) or a dict name -> value.
@@ -221,14 +263,25 @@ def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
     *x, double *jx, const double *p)``, gives jx = J(t, y) x for an n x k block x
     (column-major): the variational equations (:func:`conmech.stability.stm`,
     ``monodromy``, shooting) then evaluate J Phi through it without forming J. It must
-    agree with ``jac``."""
+    agree with ``jac``.
+
+    ``taylor`` (optional) gives the normalized Taylor coefficients of the solution for
+    ``method="TAYLOR"``, a dict: ``jet``, ``void taylor(double t, int order, double *w,
+    const double *p)`` (w an (order + 1) x nw column-major array; on entry w[0, i] = y_i,
+    on exit column i holds y_i^[0..order]), ``nw`` (its work columns, >= n), and
+    optionally ``var``/``nw_var`` (the same for the variational system [f; J Phi], state
+    n + n**2), ``jet_fixed``/``order`` (a routine written out for one order),
+    ``batch``/``width`` (members in the fastest dimension) and ``qp`` (quadruple
+    precision); :mod:`conmech.symbolic` generates them."""
     n = _count(n, "n", 1)
     values, names = _params(params, param_names)
     spec = _make_spec(_KIND_ODE, n, 0, 0, False, {"rhs": rhs, "jac": jac,
                                                   "jac_prod": jac_prod})
     if spec[_SLOTS["rhs"] - 1] == 0:
         raise ValueError("rhs is required")
-    return CompiledSystem(str(name), "ode", spec, values, names, (keep, rhs, jac, jac_prod))
+    spec = _taylor_spec(spec, taylor)
+    return CompiledSystem(str(name), "ode", spec, values, names,
+                          (keep, rhs, jac, jac_prod, taylor), dict(taylor) if taylor else None)
 
 
 def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
@@ -343,6 +396,27 @@ def evaluate(system: Any, t: float, y: ArrayLike, v: ArrayLike | None = None) ->
     return res
 
 
+def library_taylor(lib):
+    """The Taylor entries of a loaded library (``conmech_taylor``, ``conmech_taylor_info``
+    and their variants, as :mod:`conmech.symbolic` generates them), as the ``taylor`` dict
+    of :func:`ode_system`; None if the library has none."""
+    if getattr(lib, "conmech_taylor", None) is None or \
+            getattr(lib, "conmech_taylor_info", None) is None:
+        return None
+    info = (ctypes.c_int*4)()
+    lib.conmech_taylor_info(info)
+    out = {"jet": lib.conmech_taylor, "nw": int(info[0])}
+    if info[1] > 0 and getattr(lib, "conmech_taylor_batch", None) is not None:
+        out.update(batch=lib.conmech_taylor_batch, width=int(info[1]))
+    if info[3] and getattr(lib, "conmech_taylor_qp", None) is not None:
+        out["qp"] = lib.conmech_taylor_qp
+    if getattr(lib, "conmech_taylor_var", None) is not None and \
+            getattr(lib, "conmech_taylor_var_info", None) is not None:
+        lib.conmech_taylor_var_info(info)
+        out.update(var=lib.conmech_taylor_var, nw_var=int(info[0]))
+    return out
+
+
 def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstrained:
     """A system from a model library: a shared library that exports, with C linkage,
     ``conmech_model_info(int info[6])`` (kind 1 ode / 2 generalized / 3 constrained, n,
@@ -352,9 +426,9 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
     ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_accel``,
-    ``conmech_accel_jac``,
-    ``conmech_jac_prod``). The Fortran programs load the same libraries (``sweep --model``,
-    conmech_model_library)."""
+    ``conmech_accel_jac``, ``conmech_jac_prod``, and the Taylor routines ``conmech_taylor``,
+    ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran programs load the
+    same libraries (``sweep --model``, conmech_model_library)."""
     try:
         lib = ctypes.CDLL(str(path))
     except OSError as e:
@@ -381,7 +455,7 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     name = name or str(path)
     if kind == _KIND_ODE:
         return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name,
-                          jac_prod=fn["jac_prod"])
+                          jac_prod=fn["jac_prod"], taylor=library_taylor(lib))
     if kind == _KIND_GEN:
         return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
                                   params=params, keep=lib, name=name,

@@ -24,7 +24,10 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
+from . import degrees_of_freedom as _dof
 from ._callback import Guard, as_result, message_text
+from ._checks import event_settings
+from ._methods import BY_NAME
 from .systems import _NO_SPEC
 
 __all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
@@ -36,8 +39,9 @@ BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_
                  "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "rolling_ball")
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
-_METHODS = {"RK4": 1, "DOPRI5": 2, "RK45": 2, "DOP853": 3, "VERNER98": 4, "VERN9": 4,
-            "RATTLE": 8, "Radau": 5, "RADAU5": 5}
+# the methods of the Fortran table that constrained_solve runs (codes from the table)
+_METHODS = {name: BY_NAME[name.upper()].code for name in (
+    "RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "RATTLE", "Radau", "RADAU5")}
 _CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
@@ -103,6 +107,13 @@ class BuiltinConstrained:
         p = self.params if self.params.size else _PAD
         nspec = self.spec.size if self.spec is not _NO_SPEC else 0
         return self.name, self.params.size, p, nspec, self.spec
+
+    @property
+    def degrees_of_freedom(self):
+        """n minus the independent holonomic constraints, at the default consistent state
+        (:func:`conmech.degrees_of_freedom.degrees_of_freedom` gives the whole report:
+        independent velocities, redundant constraints)."""
+        return _dof.degrees_of_freedom(self).dof
 
     def initial_state(self):
         """Default consistent initial state (q0, v0)."""
@@ -349,8 +360,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
         if np.any(d <= 0):
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
-    from ._ivp import _event_settings
-    settings = _event_settings(events)
+    settings = event_settings(events)
     ne = len(settings)
     for i, (_, count, _) in enumerate(settings):
         if count > 1:

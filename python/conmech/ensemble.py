@@ -190,6 +190,45 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
+def _taylor_batch(system, method, nt, ne, mp, first_step, progress):
+    """Whether an ensemble runs Taylor's method in batches (the generated batch routine
+    computes several members' coefficients at once): method TAYLOR, a system with the
+    batch routine, shared parameters, final states only (no t_eval, events, first_step
+    or progress)."""
+    taylor = getattr(system, "taylor", None)
+    return (isinstance(method, str) and method.upper() == "TAYLOR" and bool(taylor)
+            and taylor.get("batch") is not None and nt == 0 and ne == 0 and mp <= 1
+            and first_step is None and progress is None)
+
+
+def _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps, nthreads):
+    """The members in batches of the generated width, batches in OpenMP threads (each
+    member's steps are those of its solve_ivp run, bit for bit)."""
+    from .compiled import function_address
+    taylor = system.taylor
+    n = system.dimension
+    y0m = np.broadcast_to(y0a, (m, n)) if y0a.shape[0] == 1 else y0a
+    p = system.params if system.params.size else _PAD
+    (y_final, t_final, codes, nfev, naccept, nreject, info,
+     message) = _conmech.flat_taylor_ensemble(
+        fnaddr=function_address(taylor["batch"], "taylor['batch']"),
+        width=int(taylor["width"]), nw=int(taylor["nw"]), np=system.params.size, params=p,
+        n=n, m=m, y0=np.asfortranarray(y0m.T), t_span=np.array([t0, tf]), rtol=rtol_v,
+        atol=atol_v, max_step=hmax, max_steps=max_steps, threads=nthreads)
+    codes = np.asarray(codes, dtype=int)
+    status = np.where(codes >= 0, codes, -1)
+    info = int(info)
+    message = "Every member reached the end of the integration interval." if info >= 0 \
+        else ("a member failed: " + (bytes(message).decode("ascii", "replace").strip()
+                                     if not isinstance(message, str) else message.strip()))
+    return EnsembleResult(
+        t=None, y=None, t_final=t_final, y_final=np.ascontiguousarray(y_final.T),
+        status=status, member_success=status >= 0, codes=codes, nfev=nfev.astype(int),
+        naccept=naccept.astype(int), nreject=nreject.astype(int), t_events=None,
+        y_events=None, event_index=None, n_events=None, success=info >= 0, message=message,
+        done=m)
+
+
 def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
           params: ArrayLike | dict | None = None, *, t_eval: ArrayLike | None = None,
           method: str | None = None, rtol: float | None = None, atol: float | None = None,
@@ -389,6 +428,9 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         return 0
 
     nt = t_ev.size
+    if _taylor_batch(system, method, nt, ne, mp, first_step, progress):
+        return _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax,
+                                   int(max_steps), nthreads)
     name, _, _, nspec, spec = system._flat_args()
     (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,
      info, message) = _conmech.flat_ensemble_builtin(

@@ -29,10 +29,13 @@ import numpy as np
 
 from . import _conmech
 from ._callback import message_text
+from .stability.variational import stm as _stm
+from .systems import hill_spatial as _hill_spatial
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
            "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
-           "M_HILL", "C_HILL", "plot_orbit", "plot_multipliers", "plot_family"]
+           "M_HILL", "C_HILL", "plot_orbit", "plot_multipliers", "plot_family",
+           "node_constant"]
 
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
 C_HILL = 1.0715832774160     #: Hill's perigee constant for M_HILL
@@ -340,6 +343,49 @@ def transverse(orbit: HillOrbit, t: ArrayLike | None = None, rtol: float = 1e-13
         out["states"] = np.array(states)
         out["phi"] = np.array(phi)
     return out
+
+
+def node_constant(m: float, kappa: float = 1.0, rtol: float = 1e-14,
+                  full_output: bool = False):
+    """The node constant g of the variation orbit (Adams 1877): the motion of the lunar
+    node, in the units of :func:`variation_orbit` (the synodic month is 2 pi; the latitude
+    argument advances by g per unit of time, so the draconic month is 2 pi/g).
+
+    Hill's problem in space (:func:`conmech.systems.hill_spatial`) adds z'' + m^2 z =
+    -kappa z/r^3. Along the planar variation orbit the out-of-plane variation obeys the
+    Hill's equation dz'' + (m^2 + kappa/r^3) dz = 0, whose coefficient has period pi and
+    is even (the orbit is symmetric about both axes); its characteristic exponent is g.
+    With y1, y2 the solutions with (y1, y1') = (1, 0), (y2, y2') = (0, 1) at the
+    x-axis crossing, integrated over a quarter month pi/2 together with the orbit
+    (the z-block of the spatial problem's state transition matrix, DOP853 at ``rtol``,
+    the exact Jacobian), y1 y2' = cos^2(pi g/2) and y1' y2 = -sin^2(pi g/2), so that
+
+        g = (2/pi) atan2(sqrt(-y1' y2), sign(y1) sqrt(y1 y2'))
+
+    (well conditioned for every g in (0, 2); g -> 1 + m + 3 m^2/4 as m -> 0: the
+    node regresses as the perigee advances, to first order). ``full_output``: also a dict
+    with y1, y1p, y2, y2p at pi/2, the Wronskian y1 y2' - y1' y2 (1 up to the integration
+    error) and the orbit."""
+    m = _check_float(m, "m", nonneg=True)
+    kappa = _check_float(kappa, "kappa", positive=True)
+    rtol = _check_float(rtol, "rtol", positive=True)
+    if rtol > 1e-6:
+        raise ValueError(f"rtol must be in (0, 1e-6], got {rtol}")
+    orb = variation_orbit(m, kappa)
+    x0, _, vx0, vy0 = orb.y0
+    y = np.array([x0, 0.0, 0.0, vx0, vy0, 0.0])
+    _, phi = _stm(_hill_spatial(m=m, kappa=kappa), (0.0, 0.5*np.pi), y, rtol=rtol,
+                  atol=rtol)
+    y1, y1p, y2, y2p = phi[2, 2], phi[5, 2], phi[2, 5], phi[5, 5]
+    cc, ss = y1*y2p, -y1p*y2
+    if cc < -1e-10 or ss < -1e-10:
+        raise RuntimeError(f"node_constant: the vertical solutions are inconsistent "
+                           f"(y1 y2' = {cc:.3g}, y1' y2 = {-ss:.3g})")
+    g = 2.0/np.pi*np.arctan2(np.sqrt(max(ss, 0.0)), np.sign(y1)*np.sqrt(max(cc, 0.0)))
+    if not full_output:
+        return float(g)
+    return float(g), {"y1": float(y1), "y1p": float(y1p), "y2": float(y2), "y2p": float(y2p),
+                      "wronskian": float(y1*y2p - y1p*y2), "orbit": orb}
 
 
 # ------------------------------------------------------------------- Henon's units

@@ -116,30 +116,36 @@ def family(orbit, direction: int = 1, max_points: int = 50, ds: float = 0.05,
                                   atol=rtol, energy=lambda y, p: gamma(y), **options)
 
 
-def on_axis(y0, period: float, rtol: float = 1e-12) -> np.ndarray:
+def on_axis(y0, period: float, rtol: float = 1e-12, side: int = 1) -> np.ndarray:
     """The state [x0, 0, x', y'] where the periodic orbit through ``y0`` crosses the x axis
-    farthest to the right (for an orbit symmetric about the axis x' = 0 there), from an
-    integration over one period with an event on y."""
+    farthest to the right (``side`` = +1) or to the left (-1) (for an orbit symmetric about
+    the axis x' = 0 there), from an integration over a period and a quarter (so that a
+    crossing at the start or the end of the period is not missed) with an event on y."""
     from ._ivp import solve_ivp
     y0 = stability._state(y0)
     if y0.size != 4:
         raise ValueError("y0 must be [x, y, x', y']")
-    r = solve_ivp(system(), (0.0, float(period)), y0, method="DOP853", rtol=rtol,
+    if side not in (1, -1):
+        raise ValueError("side must be +1 (right) or -1 (left)")
+    period = stability._real(period, "period", 0.0, low_open=True)
+    r = solve_ivp(system(), (0.0, 1.25*period), y0, method="DOP853", rtol=rtol,
                   atol=rtol, events=lambda t, s: s[1])
     ys = r.y_events[0] if r.y_events else np.zeros((0, 4))
     if not r.success or len(ys) == 0:
         raise RuntimeError("the orbit does not cross the x axis within its period")
-    y = np.array(ys[int(np.argmax(ys[:, 0]))])
+    y = np.array(ys[int(np.argmax(side*ys[:, 0]))])
     y[1] = 0.0
     return y
 
 
 def orbit_at_gamma(branch, target: float, rtol: float = 1e-12, tol: float = 1e-11,
-                   max_iter: int = 30):
+                   max_iter: int = 60, side: int = 1):
     """The member of the continued family ``branch`` (from :func:`family`) with Gamma =
     ``target``: between the two branch points whose Gamma brackets it, started on the x
-    axis (:func:`on_axis`), by the secant method on x0 (each x0 corrected by symmetric
-    shooting, y'0 and the half period free) until |Gamma - target| <= tol. Returns the
+    axis at its crossing farthest right (``side`` = +1) or left (-1) (:func:`on_axis`; the
+    published tables list either), by Illinois' regula falsi on x0 inside that bracket
+    (each x0 corrected by symmetric shooting, y'0 and the half period free, from the
+    nearer bracket orbit) until |Gamma - target| <= tol. Returns the
     :class:`conmech.stability.PeriodicOrbit` (y0 = [x0, 0, 0, y'0])."""
     target = stability._real(target, "target")
     g = np.asarray(branch.energy, dtype=float)
@@ -150,18 +156,36 @@ def orbit_at_gamma(branch, target: float, rtol: float = 1e-12, tol: float = 1e-1
     k = int(k[0])
     pts = []
     for j in (k, k + 1):
-        y = on_axis(branch.y0[j], branch.p[j], rtol)
+        y = on_axis(branch.y0[j], branch.p[j], rtol, side)
         o = _symmetric(y, branch.p[j], rtol)
         pts.append((o.y0[0], gamma(o.y0) - target, o))
     (xa, fa, oa), (xb, fb, ob) = pts
+    if abs(fa) <= tol:
+        return oa
+    if abs(fb) <= tol:
+        return ob
+    if not fa*fb < 0:
+        raise RuntimeError("orbit_at_gamma: the bracketing orbits on the axis do not "
+                           "bracket the target (the family folds between them?)")
+    held = 0
+    fc = fb
     for _ in range(max_iter):
-        if abs(fb) <= tol:
-            return ob
-        if fb == fa:
-            break
-        xc = xb - fb*(xb - xa)/(fb - fa)
-        o = _symmetric([xc, 0.0, 0.0, ob.y0[3]], ob.period, rtol)
-        xa, fa, oa = xb, fb, ob
-        xb, fb, ob = o.y0[0], gamma(o.y0) - target, o
-    raise RuntimeError(f"orbit_at_gamma: the secant iteration did not reach Gamma = "
-                       f"{target} (last |Gamma - target| = {abs(fb):.3g})")
+        xc = (xa*fb - xb*fa)/(fb - fa)
+        if not min(xa, xb) < xc < max(xa, xb):
+            xc = 0.5*(xa + xb)
+        near = oa if abs(xc - xa) < abs(xc - xb) else ob
+        o = _symmetric([xc, 0.0, 0.0, near.y0[3]], near.period, rtol)
+        fc = gamma(o.y0) - target
+        if abs(fc) <= tol:
+            return o
+        xc = o.y0[0]
+        if fc*fb < 0:
+            xa, fa, oa = xb, fb, ob
+            held = 0
+        else:
+            held += 1
+            if held > 1:
+                fa *= 0.5
+        xb, fb, ob = xc, fc, o
+    raise RuntimeError(f"orbit_at_gamma: the iteration did not reach Gamma = "
+                       f"{target} (last |Gamma - target| = {abs(fc):.3g})")

@@ -35,10 +35,23 @@ POSITIVE_PARAMS = {
     "double_pendulum_xy": {0: "m1", 1: "m2", 2: "l1", 3: "l2"},
     "atwood_xy": {0: "m1", 1: "m2"}, "pendulum_moving_xy": {0: "m", 2: "l"},
     "yoyo": {0: "m", 1: "r", 2: "I"}, "skate": {0: "m", 1: "I"},
+    "hill_spatial": {1: "kappa"}, "cr3bp": {0: "mu"},
     "rolling_disk": {0: "m", 1: "R", 2: "I_roll", 3: "I_turn"},
 }
+#: Names of the state components of the built-in first-order and generalized systems (for
+#: reports such as the direction of a secular drift): coordinates, then velocities.
+_COORDS = {"pendulum_angle": ("theta",), "cart_pendulum": ("x", "theta"),
+           "double_pendulum": ("theta1", "theta2"), "atwood": ("y1",),
+           "spring_pendulum": ("r", "theta"), "double_spring_pendulum": ("x1", "y1", "x2", "y2"),
+           "three_springs": ("x1", "y1", "x2", "y2", "x3", "y3"), "bead_hoop": ("theta",),
+           "polar_particle": ("r", "theta"), "pendulum_moving": ("theta",),
+           "yoyo_angle": ("y",), "harmonic": ("x",), "pendulum": ("theta",),
+           "vanderpol": ("x",), "kepler": ("x", "y"), "arenstorf": ("x", "y"),
+           "hill": ("x", "y"), "cr3bp": ("x", "y", "z"), "hill_spatial": ("x", "y", "z")}
+STATE_NAMES = {k: v + tuple(c + "'" for c in v) for k, v in _COORDS.items()}
 #: Parameters that must lie in a closed interval.
-RANGE_PARAMS = {"arenstorf": {0: ("mu", 0.0, 1.0)}, "hill": {0: ("m", 0.0, np.inf)}}
+RANGE_PARAMS = {"arenstorf": {0: ("mu", 0.0, 1.0)}, "hill": {0: ("m", 0.0, np.inf)},
+                "hill_spatial": {0: ("m", 0.0, np.inf)}, "cr3bp": {0: ("mu", 0.0, 0.5)}}
 
 
 def check_params(name, params):
@@ -100,6 +113,49 @@ class BuiltinSystem:
         """The parameters as a dict (name -> value)."""
         names = self.param_names or tuple(f"p{i}" for i in range(self.params.size))
         return dict(zip(names, self.params.tolist()))
+
+    @property
+    def degrees_of_freedom(self):
+        """The number of generalized coordinates of a mechanical system in generalized
+        coordinates (its holonomic constraints eliminated); None for a first-order system
+        without mechanical structure."""
+        kind, n, mh, mn, info, _ = _conmech.flat_mech_info(*self._flat_args())
+        return int(n) if info == 0 and kind == 2 else None
+
+    def energy(self, y, t=0.0):
+        """The energy (first integral) at the state y (time t): T + U of the mechanical
+        systems y = [q, q'] (built-in, compiled and symbolic Lagrangian systems; the Jacobi
+        integral when the Lagrangian depends on time or has gyroscopic terms), the Jacobi
+        integral of the rotating-frame problems (arenstorf, cr3bp: C = 2 Omega - |v|^2;
+        hill, hill_spatial: |v|^2 - 2 F), the energy of harmonic, pendulum and kepler.
+        ValueError for a system without one (vanderpol, a compiled first-order system), or
+        y of the wrong size. A (k, n) array of states gives k energies."""
+        ys = np.asarray(y, dtype=float)
+        if ys.ndim == 2:
+            return np.array([self.energy(row, t) for row in ys])
+        ys = np.ascontiguousarray(ys.ravel())
+        if ys.size != self.dimension:
+            raise ValueError(f"y has {ys.size} components; the system '{self.name}' has "
+                             f"{self.dimension}")
+        if not np.all(np.isfinite(ys)):
+            raise ValueError("y must be finite")
+        name, np_, p, nspec, spec = self._flat_args()
+        e, info, message = _conmech.flat_system_energy(name, np_, p, nspec, spec, float(t),
+                                                       ys)
+        if info != 0:
+            msg = bytes(message).decode("ascii", "replace").strip() if not isinstance(
+                message, str) else message.strip()
+            raise ValueError(f"{msg} (system '{self.name}')")
+        return float(e)
+
+    @property
+    def has_energy(self):
+        """Whether :meth:`energy` is defined for this system."""
+        try:
+            self.energy(np.full(self.dimension, 0.5))
+        except ValueError:
+            return False
+        return True
 
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
@@ -275,3 +331,24 @@ def pendulum_chain_xy(N=8, m=1.0, l=1.0, g=9.81):
 
 
 __all__ += ["pendulum_chain_xy"]
+
+
+def hill_spatial(m=0.080848933808312, kappa=1.0):
+    """Hill's lunar problem in space: x'' - 2 m y' = F_x, y'' + 2 m x' = F_y, z'' = F_z,
+    F = kappa/r + (3/2) m^2 x^2 - (1/2) m^2 z^2 (so z'' + m^2 z = -kappa z/r^3), in the
+    units of :func:`hill` (synodic month 2 pi); y = [x, y, z, x', y', z'] (analytic
+    Jacobian); energy: the Jacobi integral |v|^2 - 2 F."""
+    return BuiltinSystem("hill_spatial", [m, kappa], ("m", "kappa"))
+
+
+def cr3bp(mu=0.012150585609624):
+    """The spatial circular restricted three-body problem in the rotating frame: primaries
+    of masses 1 - mu at (-mu, 0, 0) and mu at (1 - mu, 0, 0) (0 < mu <= 1/2; default the
+    Earth-Moon value), x'' - 2 y' = Omega_x, y'' + 2 x' = Omega_y, z'' = Omega_z,
+    Omega = (x^2 + y^2)/2 + (1 - mu)/r1 + mu/r2; y = [x, y, z, x', y', z'] (analytic
+    Jacobian and Jacobian product); energy: the Jacobi constant C = 2 Omega - |v|^2.
+    :mod:`conmech.cr3bp` has its libration points and families."""
+    return BuiltinSystem("cr3bp", [mu], ("mu",))
+
+
+__all__ += ["hill_spatial", "cr3bp"]

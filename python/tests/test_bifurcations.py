@@ -32,6 +32,7 @@ def test_branch_point_switching_pitchfork():
     assert br.success
     bps = [s for s in br.special if s.kind == "branch point"]
     assert len(bps) == 1 and bps[0].p == pytest.approx(2.0, abs=1e-8)
+    assert bps[0].located and bps[0].residual < 1e-8
     # on the old (symmetric) branch z stays 0
     assert np.max(np.abs(br.y0[:, 2])) < 1e-12
     new = stability.switch_branch_point(pitchfork_cycle, br, bps[0], ds=0.05, ds_max=0.1,
@@ -73,6 +74,7 @@ def test_branch_point_switching_transcritical():
                                 ds_max=0.2, p_range=(0, 2.4))
     bp = [s for s in br.special if s.kind == "branch point"]
     assert len(bp) == 1 and bp[0].p == pytest.approx(2.0, abs=1e-8)
+    assert bp[0].located and bp[0].residual < 1e-8
     for d in (1, -1):
         new = stability.switch_branch_point(transcritical_cycle, br, bp[0], direction=d,
                                             ds=0.05, max_points=5)
@@ -99,6 +101,7 @@ def test_neimark_sacker_from_python():
     assert br.success
     assert [s.kind for s in br.special] == ["Neimark-Sacker"]
     ns = br.special[0]
+    assert ns.located and ns.residual < 1e-8
     assert ns.p == pytest.approx(3.0, abs=1e-8)
     mu = ns.multipliers
     pair = mu[np.abs(mu.imag) > 1e-3]

@@ -30,7 +30,8 @@ def test_hill_loss_of_stability_by_continuation():
     assert br.success and br.param == "m"
     assert np.allclose(br.period, 2*np.pi)
     bp = [s for s in br.special if s.kind == "branch point"]
-    assert len(bp) == 1
+    assert len(bp) == 1 and bp[0].kind == "S=+1"         # one event, both names
+    assert bp[0].located and bp[0].residual < 1e-10
     assert 0.195 < bp[0].p < 0.196
     assert bp[0].stability_index == pytest.approx(1.0, abs=1e-9)
     ref = hill.locate_stability_change(0.19, 0.2)
@@ -48,6 +49,7 @@ def test_fold_on_a_callback_system():
     folds = [s for s in br.special if s.kind == "fold"]
     assert len(folds) == 1 and len(br.special) == 1
     f = folds[0]
+    assert f.located and f.residual < 1e-9 and abs(f.test) < 1e-8
     assert f.p == pytest.approx(-0.25, abs=1e-9)
     assert np.sum(f.y0**2) == pytest.approx(0.5, abs=1e-5)
     assert f.period == pytest.approx(4*np.pi/3, abs=1e-5)
@@ -273,6 +275,7 @@ def test_period_doubling_and_branch_switching():
                                 p_range=(0, 1.3), rtol=1e-10, atol=1e-10, locate_tol=1e-10)
     assert br.success and [s.kind for s in br.special] == ["period doubling"]
     pd = br.special[0]
+    assert pd.located and pd.residual < 1e-8
     assert pd.p == pytest.approx(1.0, abs=1e-8)
     assert np.min(np.abs(pd.multipliers + 1)) < 1e-7
     b2 = stability.switch_period_doubling(_moebius, pd, ds=0.05, max_points=4, rtol=1e-10,

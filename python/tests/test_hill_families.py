@@ -75,9 +75,10 @@ def test_family_g_loses_stability_where_the_variation_orbits_do():
     br = hf.family(o, max_points=40)
     assert br.success
     bp = [s for s in br.special if s.kind == "branch point"]
-    assert len(bp) == 1
+    assert len(bp) == 1 and bp[0].kind == "S=+1"
+    assert bp[0].located and bp[0].residual < 1e-9
     ref = hill.locate_stability_change(0.19, 0.2)
-    assert bp[0].p == pytest.approx(2*np.pi*ref["m"], abs=1e-8)
+    assert bp[0].p == pytest.approx(2*np.pi*ref["m"], abs=1e-10)
     v = hill.variation_orbit(ref["m"])
     assert hf.gamma(bp[0].y0) == pytest.approx(hill.henon_gamma(ref["m"], v.jacobi),
                                                abs=1e-7)
@@ -136,6 +137,7 @@ def test_family_g_prime_by_branch_switching():
     assert gp.success and gp.kernel_ratio < 1e-4
     assert [s.kind for s in gp.special] == ["period doubling"]
     pd = gp.special[0]
+    assert pd.located and pd.residual < 1e-9
     assert hf.gamma(pd.y0) == pytest.approx(4.271428, abs=1e-6)
     before = gp.p < pd.p
     assert np.all(np.abs(gp.stability_index[before]) < 1 + 1e-9)
@@ -145,3 +147,22 @@ def test_family_g_prime_by_branch_switching():
     # family g at the same Gamma has a much shorter period
     tg = np.interp(-gp.energy[k], -g.energy, g.p)
     assert gp.p[k] - tg > 0.5
+
+
+def test_published_orbit_of_family_g_by_orbit_at_gamma():
+    """Family g at C = 4.34943072, past its loss of stability (Hill2D, Satellite/g/g.dat,
+    row 466: x0 -0.295540401, p_y0 -1.93257001, T 1.35204787, S 1.20037665; the table
+    lists the orbit at its left crossing of the x axis). Reached along the continued family
+    by orbit_at_gamma at the left crossing (side=-1); at the right one (the default) the
+    same orbit mirrored, x0 -> -x0."""
+    g = hf.family(hf.satellite_orbit(0.1, "g"), max_points=40)
+    q = hf.orbit_at_gamma(g, 4.34943072, side=-1)
+    assert q.y0[0] == pytest.approx(-0.295540401, abs=1e-8)
+    assert q.y0[3] + q.y0[0] == pytest.approx(-1.93257001, abs=1e-8)
+    assert q.period == pytest.approx(1.35204787, abs=1e-8)
+    assert q.stability_index == pytest.approx(1.20037665, abs=1e-7)
+    r = hf.orbit_at_gamma(g, 4.34943072)
+    assert r.y0[0] == pytest.approx(0.295540401, abs=1e-8)
+    assert r.period == pytest.approx(q.period, abs=1e-10)
+    with pytest.raises(ValueError, match="side"):
+        hf.on_axis(q.y0, q.period, side=2)

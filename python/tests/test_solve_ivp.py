@@ -416,14 +416,28 @@ def test_nested_solve_inside_fun():
 
 
 def test_method_codes_match_the_fortran_names():
+    # solve_ivp's names are the Fortran method table's (names and aliases, the
+    # constrained-only RATTLE excepted), each with the code Fortran's lookup gives
     from conmech import _conmech, _ivp
     fortran_names = ["RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "Vern9", "Radau", "RADAU5",
                      "GAUSS4", "GAUSS6"]
     for name in fortran_names:
         code = int(_conmech.flat_method_code(name))
         assert code > 0 and _ivp._METHOD_CODES[name.upper()] == code
-    assert set(_ivp._METHOD_CODES) == {n.upper() for n in fortran_names}
+    table = set()
+    code, max_code = 1, 1
+    while code <= max_code:
+        found, name, aliases, _, flags, max_code = _conmech.flat_method_info(code)
+        if found and not flags[2]:
+            for n in [name.tobytes() if hasattr(name, "tobytes") else name] + \
+                    (aliases.tobytes() if hasattr(aliases, "tobytes") else aliases).split():
+                n = (n.decode() if isinstance(n, bytes) else n).strip().upper()
+                table.add(n)
+                assert int(_conmech.flat_method_code(n)) == code
+        code += 1
+    assert set(_ivp._METHOD_CODES) == table >= {n.upper() for n in fortran_names}
     assert int(_conmech.flat_method_code("RK23")) == 0
+    assert int(_conmech.flat_method_code("RATTLE")) == 8 and "RATTLE" not in table
     # solve_ivp runs RK45 as the flat layer's SciPy variant of DOPRI5
     assert _ivp._RK45_SCIPY == 12
 

@@ -299,3 +299,26 @@ def test_extreme_magnitudes_work_as_in_scipy(method, y0):
         c = conmech.solve_ivp(f, (0, 1), yy, method=method)
         assert s.success and c.success
         assert abs(c.y[0, -1] / s.y[0, -1] - 1) < 1e-3
+
+
+def test_stepper_by_name_is_the_class():
+    # conmech.Stepper(..., method=NAME) runs any method of the Fortran table by name: the
+    # same steps as the method's class, bit for bit (one flat routine serves them all)
+    y0 = [0.4, 0.0, 0.0, 2.0]
+    for name, cls, kw in (("DOP853", conmech.DOP853, dict(rtol=1e-8, atol=1e-8)),
+                          ("vern9", conmech.VERNER98, dict(rtol=1e-8, atol=1e-8)),
+                          ("Radau", conmech.Radau, dict(rtol=1e-6, atol=1e-8)),
+                          ("GAUSS6", conmech.Gauss6, dict(first_step=0.1))):
+        a = conmech.Stepper(kepler, 0.0, y0, 3.0, method=name, **kw)
+        b = cls(kepler, 0.0, y0, 3.0, **kw)
+        while a.status == "running":
+            a.step()
+            b.step()
+            assert a.t == b.t and np.array_equal(a.y, b.y)
+        assert b.status == "finished" and (a.nfev, a.njev, a.nlu) == (b.nfev, b.njev, b.nlu)
+    with pytest.raises(ValueError, match="method"):
+        conmech.Stepper(kepler, 0.0, y0, 3.0, method="RK23")
+    with pytest.raises(ValueError, match="method"):
+        conmech.Stepper(kepler, 0.0, y0, 3.0, method="RATTLE")    # constrained systems only
+    with pytest.raises(ValueError, match="first_step"):
+        conmech.Stepper(kepler, 0.0, y0, 3.0, method="GAUSS4")    # a fixed-step method

@@ -13,7 +13,7 @@ module conmech_lapack
     private
 
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
-        dgelsy, dlange, dpstrf, dgesvd, dgeqp3
+        dgelsy, dlange, dpstrf, dgesvd, dgeqp3, dgees
     public :: la_solve, la_eig, la_sym_eig, la_det, la_finite
 
     !> True if every entry is finite (call it before handing data to LAPACK: NaN input
@@ -23,6 +23,8 @@ module conmech_lapack
     end interface la_finite
     public :: dpotf2, dpstf2   ! unblocked forms: no ilaenv call, fast for tiny matrices
     public :: dtrsv   ! BLAS triangular solve, one right-hand side
+    public :: zgetrf, zgetrs   ! complex LU (Radau IIA's complex iteration matrix)
+    public :: dgetf2, dpotri   ! unblocked LU, inverse from the Cholesky factor (RATTLE)
 
     interface
         subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
@@ -142,6 +144,24 @@ module conmech_lapack
             real(dp), intent(out) :: tau(*), work(*)
             integer, intent(out) :: info
         end subroutine dgeqp3
+        !> Real Schur form A = Z T Z^T, optionally ordered: the eigenvalues for which
+        !! select(wr, wi) is true lead (sdim of them).
+        subroutine dgees(jobvs, sort, select, n, a, lda, sdim, wr, wi, vs, ldvs, work, &
+                         lwork, bwork, info)
+            import :: dp
+            character(len=1), intent(in) :: jobvs, sort
+            interface
+                logical function select(wr, wi)
+                    import :: dp
+                    real(dp), intent(in) :: wr, wi
+                end function select
+            end interface
+            integer, intent(in) :: n, lda, ldvs, lwork
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: sdim, info
+            real(dp), intent(out) :: wr(*), wi(*), vs(ldvs, *), work(*)
+            logical, intent(out) :: bwork(*)
+        end subroutine dgees
     end interface
 
     ! Unblocked Cholesky factorisations (for the small matrices of mechanical systems).
@@ -169,6 +189,40 @@ module conmech_lapack
             real(dp), intent(in) :: tol
             real(dp), intent(out) :: work(*)
         end subroutine dpstf2
+        !> Unblocked LU (no block-size query: fast for small constraint matrices).
+        subroutine dgetf2(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetf2
+        !> Inverse from the Cholesky factor.
+        subroutine dpotri(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotri
+    end interface
+
+    ! Complex LU factorisation and solve.
+    interface
+        subroutine zgetrf(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            complex(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine zgetrf
+        subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb
+            complex(dp), intent(in) :: a(lda, *)
+            integer, intent(in) :: ipiv(*)
+            complex(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine zgetrs
     end interface
 
 contains

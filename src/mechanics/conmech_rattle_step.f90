@@ -24,38 +24,22 @@
 !!   kick implicit; it is solved by fixed-point iteration (two force evaluations per step
 !!   when Q does not depend on v: the second one confirms the first).
 !! A step of any length from a prepared state is also the method's continuous extension
-!! (used for off-grid outputs and events by `conmech_rattle` and `conmech_rattle_events`).
+!! (the stepper's continuous extension for off-grid outputs and events: conmech_rattle_stepper).
 module conmech_rattle_step
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dgetrs
+    use conmech_lapack, only: dgetrs, dgetf2, dpotri
     use conmech_generalized, only: mass_cholesky
     use conmech_constrained_system, only: constrained_system
+    use conmech_state_packer, only: state_packer
     implicit none
     private
 
     public :: rattle_state, rattle_work, rattle_work_init, rattle_prepare, rattle_step
+    public :: rattle_state_transfer
 
     integer, parameter :: MASS_GENERAL = 0, MASS_DIAGONAL = 1, MASS_CONSTANT = 2
-
-    interface
-        !> Unblocked LU (no block-size query: fast for the small constraint matrices).
-        subroutine dgetf2(m, n, a, lda, ipiv, info)
-            import :: dp
-            integer, intent(in) :: m, n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgetf2
-        !> Inverse from the Cholesky factor (upper triangle).
-        subroutine dpotri(uplo, n, a, lda, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: info
-        end subroutine dpotri
-    end interface
 
     !> The state at one grid point with what the next step reuses.
     type :: rattle_state
@@ -247,6 +231,28 @@ contains
                  //"converge (or are not finite)"
         end if
     end subroutine rattle_step
+
+    !> Pack or unpack one grid state (conmech_state_packer), allocated for the run of wk.
+    subroutine rattle_state_transfer(wk, st, p)
+        type(rattle_work), intent(in) :: wk
+        type(rattle_state), intent(inout) :: st
+        type(state_packer), intent(inout) :: p
+        integer :: n, m
+        logical :: prepared
+        n = wk%n
+        m = wk%m
+        prepared = allocated(st%f)              ! (the second state before the first step)
+        call p%item(prepared)
+        if (.not. prepared) return
+        call p%item(st%t)
+        call p%reals(st%q, n)
+        call p%reals(st%v, n)
+        call p%reals(st%f, n)
+        call p%real_matrix(st%x, n, m)
+        call p%real_matrix(st%g, m, n)
+        if (wk%mkind == MASS_GENERAL) call p%real_matrix(st%mc, n, n)
+        if (wk%mkind == MASS_DIAGONAL) call p%reals(st%d, n)
+    end subroutine rattle_state_transfer
 
     subroutine allocate_state(wk, st)
         type(rattle_work), intent(in) :: wk

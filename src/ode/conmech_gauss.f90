@@ -1,8 +1,11 @@
 !> Gauss-Legendre collocation (implicit Runge-Kutta) with s = 2 and s = 3 stages, of
-!! orders 4 and 6: symplectic and symmetric, it keeps quadratic invariants (angular
-!! momentum) exactly and the energy error of Hamiltonian systems bounded over long times.
+!! orders 4 and 6, as a stepper of the integrator contract (conmech_ode_stepper):
+!! symplectic and symmetric, it keeps quadratic invariants (angular momentum) exactly and
+!! the energy error of Hamiltonian systems bounded over long times.
 !!
-!! - Fixed step: h = (tf - t0)/N with N = ceil(|tf - t0|/first_step).
+!! - Fixed step: h = (tf - t0)/N with N = ceil(|tf - t0|/first_step), the grid t0 + k h
+!!   (the last step ends on tf exactly); output points between grid points come from the
+!!   continuous extension (the stepper does not shorten steps onto them).
 !! - Stage equations Z_i = h sum_j a_ij f(t + c_j h, y + Z_j) solved by fixed-point
 !!   iteration to round-off (Hairer-Lubich-Wanner, GNI VIII.6): iterate until the
 !!   correction vanishes or stops decreasing at the round-off level; starting
@@ -11,29 +14,42 @@
 !!   stops with CM_NO_CONVERGENCE and the time.
 !! - Compensated (Kahan) summation of y_{n+1} = y_n + h sum_i b_i f_i, so that round-off
 !!   does not random-walk the invariants.
-!! - Outputs: every step, or t_eval on the collocation polynomial (degree s); dense
-!!   output and events on the same polynomial (power basis).
-!! - Step by step (SciPy's OdeSolver use, conmech.Gauss4 / Gauss6): `gauss_solve` with the
-!!   packed state (r_state(GAUSS_NR), i_state(GAUSS_NI), w_state(n, GAUSS_NW)) and
-!!   action 0 (start) or 1 (one step): the steps of the whole run, bit for bit.
+!! - Continuous extension: the collocation polynomial (degree s, power basis).
 module conmech_gauss
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_ode_system, only: ode_system, ode_events
-    use conmech_ode_solver, only: ode_options, ode_result
-    use conmech_radau_common
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: ode_options, METHOD_GAUSS4, METHOD_GAUSS6
+    use conmech_ode_dense, only: power_basis_matrix
+    use conmech_ode_stepper, only: ode_stepper, check_first_step, FORM_POWER
+    use conmech_state_packer, only: state_packer
     implicit none
     private
 
-    public :: gauss_solve, gauss_tableau
+    public :: gauss_stepper, gauss_tableau
 
     integer, parameter :: MAX_ITER = 50
-    !> Sizes of the packed state of a step-by-step run: reals (t0, tf, t, h, t_old),
-    !! integers (n, s, steps done, steps, nfev, naccept, polynomial known, started),
-    !! columns (y, the compensation of the summation, the polynomial fc(:, 0:s) of the
-    !! last step in x = (t - t_old)/h).
-    integer, parameter, public :: GAUSS_NR = 8, GAUSS_NI = 8, GAUSS_NW = 6
+
+    !> The state of a Gauss-Legendre integration on its fixed grid.
+    type, extends(ode_stepper) :: gauss_stepper
+        integer :: s = 0                      !! stages (2 or 3)
+        integer :: kdone = 0                  !! grid steps done
+        integer :: nsteps = 0                 !! grid steps of the run
+        integer :: max_steps = 100000
+        real(dp) :: t_start = 0.0_dp          !! t0 of the grid
+        real(dp) :: first_step = 0.0_dp       !! the option: the step asked for
+        logical :: have_poly = .false.        !! fc holds the last step's polynomial
+        real(dp), allocatable :: a(:, :), b(:), c(:), pmat(:, :)   !! tableau, basis
+        real(dp), allocatable :: comp(:)      !! compensation of the summation
+        real(dp), allocatable :: z(:, :), znew(:, :), f(:, :), incr(:), tmp(:)
+    contains
+        procedure :: setup => gauss_setup
+        procedure :: start => gauss_start
+        procedure :: step => gauss_step
+        procedure :: transfer_state => gauss_transfer
+        procedure :: refresh_f => gauss_refresh_f
+    end type gauss_stepper
 
 contains
 
@@ -58,113 +74,91 @@ contains
         end if
     end subroutine gauss_tableau
 
-    !> Solve y' = f(t, y) on t_span with the s-stage Gauss method (s = 2: opt%method =
-    !! METHOD_GAUSS4, s = 3: METHOD_GAUSS6), fixed step opt%first_step; outputs as
-    !! `ode_solve`.
-    subroutine gauss_solve(sys, s, t_span, y0, opt, res, t_eval, events, r_state, i_state, &
-                           w_state, action)
-        class(ode_system), intent(in) :: sys
-        integer, intent(in) :: s
-        real(dp), intent(in) :: t_span(2)
-        real(dp), intent(in) :: y0(:)
+    !> The stages from the method code, the tableau, the basis and the work arrays.
+    subroutine set_method(self, method, n)
+        type(gauss_stepper), intent(inout) :: self
+        integer, intent(in) :: method, n
+        integer :: s
+        s = merge(2, 3, method == METHOD_GAUSS4)
+        self%s = s
+        if (allocated(self%a)) deallocate (self%a, self%b, self%c, self%pmat, self%z, &
+                                           self%znew, self%f, self%incr, self%tmp)
+        allocate (self%a(s, s), self%b(s), self%c(s), self%pmat(s, s), self%z(n, s), &
+                  self%znew(n, s), self%f(n, s), self%incr(n), self%tmp(n))
+        call gauss_tableau(s, self%a, self%b, self%c)
+        self%pmat = power_basis_matrix(self%c)
+        self%z = 0.0_dp
+    end subroutine set_method
+
+    !> The method's part of init: the stages, the step option, the grid (no evaluation).
+    subroutine gauss_setup(self, opt, info, msg)
+        class(gauss_stepper), intent(inout) :: self
         type(ode_options), intent(in) :: opt
-        type(ode_result), intent(inout) :: res
-        real(dp), intent(in), optional :: t_eval(:)
-        class(ode_events), intent(in), optional :: events
-        !> step-by-step use: the packed state and the action (0: start, 1: one step)
-        real(dp), intent(inout), optional :: r_state(:)
-        integer, intent(inout), optional :: i_state(:)
-        real(dp), intent(inout), optional :: w_state(:, :)
-        integer, intent(in), optional :: action
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: t0, tf
+        if (opt%method /= METHOD_GAUSS4 .and. opt%method /= METHOD_GAUSS6) then
+            info = CM_BAD_INPUT
+            msg = "bad input: Gauss methods have s = 2 or 3 stages (METHOD_GAUSS4, " &
+                  //"METHOD_GAUSS6)"
+            return
+        end if
+        call check_first_step(self, opt, info, msg, fixed="Gauss")
+        if (info /= CM_SUCCESS) return
+        call set_method(self, opt%method, self%n)
+        t0 = self%t
+        tf = self%tf
+        self%nf = self%s
+        self%form = FORM_POWER
+        self%lands_on_target = .false.
+        self%t_start = t0
+        self%first_step = opt%first_step
+        self%max_steps = opt%max_steps
+        self%kdone = 0
+        self%have_poly = .false.
+        self%comp = self%y
+        self%comp = 0.0_dp
+        self%nsteps = 0
+        if (tf /= t0) self%nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step &
+                                                   *(1.0_dp - 1.0e-12_dp)))
+        if (self%nsteps > 0) self%h = (tf - t0)/real(self%nsteps, dp)
+    end subroutine gauss_setup
 
-        type(step_output) :: o
-        real(dp) :: a(s, s), b(s), c(s), pmat(s, s), h, t0, tf, t, tnew, tstop, xi
-        real(dp), allocatable :: y(:), comp(:), z(:, :), znew(:, :), f(:, :), fc(:, :)
-        real(dp), allocatable :: ynew(:), ystop(:), incr(:), tmp(:)
-        real(dp) :: dyno, dynold, scale
-        integer :: n, nsteps, k, i, j, it, kstart, kdone
-        logical :: converged, stop_now, have_poly, stepping, resume
-        real(dp) :: t_prev
-        character(len=:), allocatable :: m2
+    !> The grid is fixed: only its length is checked against max_steps (no evaluation).
+    subroutine gauss_start(self, sys, info, msg)
+        class(gauss_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
         character(len=32) :: buf
+        info = CM_SUCCESS
+        msg = "success"
+        if (self%nsteps > self%max_steps) then
+            write (buf, '(i0)') self%nsteps
+            info = CM_TOO_MANY_STEPS
+            msg = "too many steps: the run needs "//trim(buf)//" steps of first_step, " &
+                  //"more than max_steps"
+        end if
+    end subroutine gauss_start
 
-        n = size(y0)
-        t0 = t_span(1)
-        tf = t_span(2)
-        h = 0.0_dp
-        res%status = CM_BAD_INPUT
-        if (s /= 2 .and. s /= 3) then
-            res%message = "bad input: Gauss methods have s = 2 or 3 stages"
-        else if (n < 1) then
-            res%message = "bad input: y0 is empty"
-        else if (.not. all(ieee_is_finite(y0))) then
-            res%message = "bad input: y0 contains NaN or Inf"
-        else if (.not. (ieee_is_finite(t0) .and. ieee_is_finite(tf))) then
-            res%message = "bad input: t_span must be finite"
-        else if (.not. (opt%first_step > 0.0_dp .and. opt%first_step < huge(1.0_dp))) then
-            res%message = "bad input: Gauss methods are fixed-step methods and need a " &
-                          //"step (first_step > 0)"
-        else
-            res%status = CM_SUCCESS
-        end if
-        if (res%status == CM_SUCCESS .and. present(t_eval)) then
-            call check_t_eval(t_span, t_eval, res%status, m2)
-            if (res%status /= CM_SUCCESS) res%message = m2
-        end if
-        stepping = present(action) .and. present(r_state) .and. present(i_state) .and. &
-                   present(w_state)
-        resume = .false.
-        if (stepping) resume = action == 1
-        if (res%status == CM_SUCCESS .and. stepping) then
-            if (present(t_eval) .or. present(events) .or. size(r_state) < GAUSS_NR .or. &
-                size(i_state) < GAUSS_NI .or. size(w_state, 1) /= n .or. &
-                size(w_state, 2) < GAUSS_NW) then
-                res%status = CM_BAD_INPUT
-                res%message = "bad input: the packed Gauss state has the wrong size (or "// &
-                              "t_eval, events given to a step-by-step integration)"
-            else if (resume .and. (i_state(1) /= n .or. i_state(2) /= s .or. &
-                                   i_state(8) /= 1)) then
-                res%status = CM_BAD_INPUT
-                res%message = "bad input: the Gauss state was not started (action 0 first)"
-            end if
-        end if
-        if (res%status /= CM_SUCCESS) return
-
-        call gauss_tableau(s, a, b, c)
-        pmat = power_basis_matrix(c)
-        allocate (y(n), comp(n), z(n, s), znew(n, s), f(n, s), fc(n, 0:s), ynew(n), &
-                  ystop(n), incr(n), tmp(n))
-        y = y0
-        comp = 0.0_dp
-        t = t0
-        t_prev = t0
-        kdone = 0
-        fc = 0.0_dp
-        if (.not. stepping) call out_init(o, res, opt, t0, tf, y0, s, t_eval, events)
-        nsteps = 0
-        if (tf /= t0) nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step*(1.0_dp - 1.0e-12_dp)))
-        if (nsteps > opt%max_steps) then
-            write (buf, '(i0)') nsteps
-            call finish(CM_TOO_MANY_STEPS, "too many steps: the run needs "//trim(buf)// &
-                        " steps of first_step, more than max_steps")
-            return
-        end if
-        h = 0.0_dp
-        if (nsteps > 0) h = (tf - t0)/real(nsteps, dp)
-        have_poly = .false.
-        z = 0.0_dp
-        kstart = 1
-        if (resume) then
-            call load_state()
-            kstart = kdone + 1
-        else if (stepping) then
-            call finish(CM_SUCCESS, "success")
-            return
-        end if
-
-        do k = kstart, nsteps
+    !> The next step of the grid (`target` is not used: the grid ends on tf).
+    subroutine gauss_step(self, sys, target, info, msg)
+        class(gauss_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: target
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: xi, dyno, dynold, scale, h, tnew
+        integer :: i, j, it, k, s
+        logical :: converged
+        character(len=32) :: buf
+        info = CM_SUCCESS
+        s = self%s
+        h = self%h
+        k = self%kdone + 1
+        associate (z => self%z, f => self%f, fc => self%fc, y => self%y, c => self%c)
             ! starting values: the previous collocation polynomial, u(1 + c_i) - u(1)
-            if (have_poly) then
+            if (self%have_poly) then
                 do i = 1, s
                     xi = 1.0_dp + c(i)
                     z(:, i) = 0.0_dp
@@ -178,100 +172,82 @@ contains
             converged = .false.
             do it = 1, MAX_ITER
                 do i = 1, s
-                    call sys%rhs(t + c(i)*h, y + z(:, i), f(:, i))
+                    call sys%rhs(self%t + c(i)*h, y + z(:, i), f(:, i))
                 end do
-                res%stats%nfev = res%stats%nfev + s
+                self%st%nfev = self%st%nfev + s
                 if (.not. all(ieee_is_finite(f))) exit
-                znew = h*matmul(f, transpose(a))
-                dyno = maxval(abs(znew - z))
-                z = znew
+                self%znew = h*matmul(f, transpose(self%a))
+                dyno = maxval(abs(self%znew - z))
+                z = self%znew
                 ! converged when the correction vanishes or stops decreasing at the
                 ! round-off level (GNI's criterion)
                 if (dyno == 0.0_dp) then
                     converged = .true.
                     exit
                 end if
-                if (it >= 2 .and. dyno >= dynold .and. dyno <= 1.0e3_dp*epsilon(1.0_dp)*scale) &
-                    then
+                if (it >= 2 .and. dyno >= dynold .and. &
+                    dyno <= 1.0e3_dp*epsilon(1.0_dp)*scale) then
                     converged = .true.
                     exit
                 end if
                 dynold = dyno
             end do
             if (.not. converged) then
-                write (buf, '(es14.6)') t
-                call finish(CM_NO_CONVERGENCE, "the fixed-point iteration of the Gauss " &
-                            //"stages did not converge at t ="//trim(buf)// &
-                            " (step too large, or a stiff or non-finite right-hand side)")
+                write (buf, '(es14.6)') self%t
+                info = CM_NO_CONVERGENCE
+                msg = "the fixed-point iteration of the Gauss stages did not converge at t =" &
+                      //trim(buf)//" (step too large, or a stiff or non-finite right-hand side)"
                 return
             end if
-            ! compensated summation of y + h sum b_i f_i
-            incr = h*matmul(f, b)
-            tmp = incr + comp
-            ynew = y + tmp
-            comp = (y - ynew) + tmp
             ! collocation polynomial: u(0) = y, u(c_i) = y + z_i
             fc(:, 0) = y
             do j = 1, s
-                fc(:, j) = matmul(z, pmat(j, :))
+                fc(:, j) = matmul(z, self%pmat(j, :))
             end do
-            have_poly = .true.
-            if (k == nsteps) then
-                tnew = tf
-            else
-                tnew = t0 + real(k, dp)*h
-            end if
-            stop_now = .false.
-            if (.not. stepping) call out_step(o, res, t, tnew - t, fc, ynew, stop_now, &
-                                              tstop, ystop, t_eval, events)
-            res%stats%naccept = res%stats%naccept + 1
-            kdone = k
-            t_prev = t
-            if (stop_now) then
-                t = tstop
-                y = ystop
-                call finish(CM_EVENT_STOP, "a termination event occurred")
-                return
-            end if
-            y = ynew
-            t = tnew
-            if (stepping) exit           ! one step per call
-        end do
-        call finish(CM_SUCCESS, "success")
+            ! compensated summation of y + h sum b_i f_i
+            self%incr = h*matmul(f, self%b)
+            self%tmp = self%incr + self%comp
+            self%y_old = y
+            y = y + self%tmp
+            self%comp = (self%y_old - y) + self%tmp
+        end associate
+        self%have_poly = .true.
+        self%dense_ready = .true.
+        if (k == self%nsteps) then
+            tnew = self%tf
+        else
+            tnew = self%t_start + real(k, dp)*h
+        end if
+        self%kdone = k
+        self%last = k == self%nsteps
+        self%t_old = self%t
+        self%h_done = tnew - self%t
+        self%t = tnew
+        self%st%naccept = self%st%naccept + 1
+    end subroutine gauss_step
 
-    contains
+    !> After a hook changed y: the compensation of the summation no longer applies.
+    subroutine gauss_refresh_f(self, sys)
+        class(gauss_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        self%comp = 0.0_dp
+        self%f_stale = .false.
+    end subroutine gauss_refresh_f
 
-        subroutine finish(code, text)
-            integer, intent(in) :: code
-            character(len=*), intent(in) :: text
-            res%status = code
-            res%message = text
-            res%success = code >= 0
-            res%stats%h_next = h
-            if (stepping) then
-                r_state(1:GAUSS_NR) = [t0, tf, t, h, t_prev, 0.0_dp, 0.0_dp, 0.0_dp]
-                i_state(1:GAUSS_NI) = [n, s, kdone, nsteps, res%stats%nfev, &
-                                       res%stats%naccept, merge(1, 0, have_poly), 1]
-                w_state(:, 1) = y
-                w_state(:, 2) = comp
-                w_state(:, 3:3 + s) = fc
-            else
-                call out_finish(o, res, t, y)
-            end if
-        end subroutine finish
-
-        subroutine load_state()
-            t = r_state(3)
-            t_prev = r_state(5)
-            kdone = i_state(3)
-            res%stats%nfev = i_state(5)
-            res%stats%naccept = i_state(6)
-            have_poly = i_state(7) /= 0
-            y = w_state(:, 1)
-            comp = w_state(:, 2)
-            fc = w_state(:, 3:3 + s)
-        end subroutine load_state
-
-    end subroutine gauss_solve
+    !> The whole state (conmech_state_packer); the tableau is rebuilt from the method.
+    subroutine gauss_transfer(self, p)
+        class(gauss_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        call self%transfer_base(p)
+        if (p%reading()) call set_method(self, self%method, self%n)
+        call p%item(self%kdone)
+        call p%item(self%nsteps)
+        call p%item(self%max_steps)
+        call p%item(self%t_start)
+        call p%item(self%first_step)
+        call p%item(self%have_poly)
+        call p%column(self%comp)
+        call p%columns(self%z, 1, self%s)
+    end subroutine gauss_transfer
 
 end module conmech_gauss

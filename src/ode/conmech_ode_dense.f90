@@ -1,6 +1,7 @@
-!> Dense output of the Runge-Kutta integrators: the continuous extension of one step
-!! (`interp`, Hairer's form or the power basis) and the piecewise polynomial of a whole
-!! integration (`dense_solution`, one polynomial per accepted step).
+!> Dense output of the integrators: the continuous extension of one step (`interp`,
+!! Hairer's form or the power basis), the piecewise polynomial of a whole integration
+!! (`dense_solution`, one polynomial per accepted step), and the power-basis coefficients
+!! of a collocation polynomial from its values at the nodes (`power_basis_matrix`).
 module conmech_ode_dense
     use conmech_kinds, only: dp
     implicit none
@@ -9,7 +10,7 @@ module conmech_ode_dense
     integer, parameter, public :: FORM_HAIRER = 1   !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...)))
     integer, parameter, public :: FORM_POWER = 2    !! y0 + x F1 + x^2 F2 + ... + x^nf F_nf
 
-    public :: dense_solution, interp, dense_init, dense_push
+    public :: dense_solution, interp, dense_init, dense_push, power_basis_matrix
 
     !> Piecewise polynomial dense output, Hairer's form on each step [t0, t0 + h]:
     !! y(t0 + x h) = y0 + x (F1 + (1-x)(F2 + x (F3 + (1-x)(F4 + ...)))).
@@ -28,6 +29,33 @@ module conmech_ode_dense
     end type dense_solution
 
 contains
+
+    !> Matrix P (s x s) of the interpolation in the power basis through the origin: the
+    !! polynomial u with u(0) = 0 and u(c_i) = z_i is u(x) = sum_j x^j sum_i P(j, i) z_i
+    !! (expanded Lagrange basis x/c_i prod_{k /= i} (x - c_k)/(c_i - c_k); nodes distinct
+    !! and non-zero).
+    pure function power_basis_matrix(c) result(p)
+        real(dp), intent(in) :: c(:)
+        real(dp) :: p(size(c), size(c))
+        real(dp) :: poly(0:size(c)), den
+        integer :: i, k, j, s
+        s = size(c)
+        do i = 1, s
+            ! poly = x * prod_{k /= i} (x - c_k), coefficients of x^0..x^s
+            poly = 0.0_dp
+            poly(1) = 1.0_dp
+            den = c(i)
+            do k = 1, s
+                if (k == i) cycle
+                do j = s, 1, -1
+                    poly(j) = poly(j - 1) - c(k)*poly(j)
+                end do
+                poly(0) = -c(k)*poly(0)
+                den = den*(c(i) - c(k))
+            end do
+            p(:, i) = poly(1:s)/den
+        end do
+    end function power_basis_matrix
 
     !> Continuous extension at x = (t - t0)/h: Hairer's form
     !! y0 + x (F1 + (1-x)(F2 + x (F3 + ...))) or the power form y0 + sum_j x^j F_j.

@@ -1,8 +1,6 @@
-!> Options, counters and method codes of conmech's integrators (shared by the stepper, the
-!! drivers `ode_solve` / `ode_integrate` and the flat layer).
-!!
-!! Method codes 1-4 are the explicit Runge-Kutta methods; codes 5 and above are reserved
-!! for the implicit families (Radau IIA, Gauss).
+!> Options, counters and method codes of conmech's integrators (shared by the steppers, the
+!! driver and the flat layer). The method table (conmech_ode_methods) maps each code to its
+!! names and its stepper type.
 module conmech_ode_options
     use conmech_kinds, only: dp
     implicit none
@@ -12,13 +10,13 @@ module conmech_ode_options
     integer, parameter, public :: METHOD_DOPRI5 = 2  !! Dormand-Prince 5(4), dense order 4
     integer, parameter, public :: METHOD_DOP853 = 3  !! Dormand-Prince 8(5,3), dense order 7
     integer, parameter, public :: METHOD_VERNER98 = 4 !! Verner 9(8), dense order 8
-    ! implicit methods (conmech_radau, conmech_gauss; reached through implicit_solve)
     integer, parameter, public :: METHOD_RADAU5 = 5  !! Radau IIA order 5, stiff, adaptive
     integer, parameter, public :: METHOD_GAUSS4 = 6  !! Gauss-Legendre s = 2, fixed step
     integer, parameter, public :: METHOD_GAUSS6 = 7  !! Gauss-Legendre s = 3, fixed step
-    integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (rattle_solve)
+    integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (constrained_solve)
+    integer, parameter, public :: METHOD_TAYLOR = 9  !! Taylor's method (conmech_taylor_stepper)
 
-    public :: ode_options, ode_stats, method_from_name
+    public :: ode_options, ode_stats
 
     !> Options of the integrators. Zero means "use the method's default" for
     !! first_step, safety, fac_min, fac_max; beta < 0 means the default.
@@ -50,34 +48,5 @@ module conmech_ode_options
         integer :: njev = 0       !! Jacobian evaluations (implicit methods)
         integer :: nlu = 0        !! LU decompositions (implicit methods)
     end type ode_stats
-
-contains
-
-    !> Method code from a name: "RK4", "DOPRI5"/"RK45", "DOP853", "VERNER98"/"RKV98",
-    !! "RADAU5"/"Radau", "GAUSS4", "GAUSS6", "RATTLE"; 0 if unknown.
-    pure function method_from_name(name) result(m)
-        character(len=*), intent(in) :: name
-        integer :: m
-        select case (trim(adjustl(name)))
-        case ("RK4", "rk4")
-            m = METHOD_RK4
-        case ("DOPRI5", "dopri5", "RK45", "rk45")
-            m = METHOD_DOPRI5
-        case ("DOP853", "dop853")
-            m = METHOD_DOP853
-        case ("VERNER98", "verner98", "RKV98", "rkv98", "Vern9")
-            m = METHOD_VERNER98
-        case ("RADAU5", "radau5", "Radau", "RADAU", "radau")
-            m = METHOD_RADAU5
-        case ("GAUSS4", "gauss4")
-            m = METHOD_GAUSS4
-        case ("GAUSS6", "gauss6")
-            m = METHOD_GAUSS6
-        case ("RATTLE", "rattle")
-            m = METHOD_RATTLE
-        case default
-            m = 0
-        end select
-    end function method_from_name
 
 end module conmech_ode_options

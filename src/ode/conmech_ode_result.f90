@@ -28,41 +28,29 @@ module conmech_ode_result
 
 contains
 
+    !> Append the point (t, y) to the outputs.
     subroutine push_point(res, t, y)
         type(ode_result), intent(inout) :: res
         real(dp), intent(in) :: t, y(:)
-        real(dp), allocatable :: tt(:), yy(:, :)
-        integer :: cap
-        cap = size(res%t)
-        if (res%nt >= cap) then
-            cap = max(16, 2*cap)
-            allocate (tt(cap), yy(size(y), cap))
-            tt(1:res%nt) = res%t(1:res%nt)
-            yy(:, 1:res%nt) = res%y(:, 1:res%nt)
-            call move_alloc(tt, res%t)
-            call move_alloc(yy, res%y)
-        end if
+        if (res%nt >= size(res%t)) call resize(res%t, res%y, res%nt, max(16, 2*size(res%t)))
         res%nt = res%nt + 1
         res%t(res%nt) = t
         res%y(:, res%nt) = y
     end subroutine push_point
 
+    !> Append the event (t, y) of event function id.
     subroutine push_event(res, t, y, id)
         type(ode_result), intent(inout) :: res
         real(dp), intent(in) :: t, y(:)
         integer, intent(in) :: id
-        real(dp), allocatable :: tt(:), yy(:, :)
         integer, allocatable :: ii(:)
         integer :: cap
         cap = size(res%ev_t)
         if (res%nev >= cap) then
             cap = max(8, 2*cap)
-            allocate (tt(cap), yy(size(y), cap), ii(cap))
-            tt(1:res%nev) = res%ev_t(1:res%nev)
-            yy(:, 1:res%nev) = res%ev_y(:, 1:res%nev)
+            call resize(res%ev_t, res%ev_y, res%nev, cap)
+            allocate (ii(cap))
             ii(1:res%nev) = res%ev_id(1:res%nev)
-            call move_alloc(tt, res%ev_t)
-            call move_alloc(yy, res%ev_y)
             call move_alloc(ii, res%ev_id)
         end if
         res%nev = res%nev + 1
@@ -71,24 +59,28 @@ contains
         res%ev_id(res%nev) = id
     end subroutine push_event
 
+    !> The output and event arrays cut to their counts.
     subroutine shrink_result(res)
         type(ode_result), intent(inout) :: res
-        real(dp), allocatable :: tt(:), yy(:, :)
         integer, allocatable :: ii(:)
-        if (size(res%t) /= res%nt) then
-            tt = res%t(1:res%nt)
-            yy = res%y(:, 1:res%nt)
-            call move_alloc(tt, res%t)
-            call move_alloc(yy, res%y)
-        end if
+        if (size(res%t) /= res%nt) call resize(res%t, res%y, res%nt, res%nt)
         if (size(res%ev_t) /= res%nev) then
-            tt = res%ev_t(1:res%nev)
-            yy = res%ev_y(:, 1:res%nev)
+            call resize(res%ev_t, res%ev_y, res%nev, res%nev)
             ii = res%ev_id(1:res%nev)
-            call move_alloc(tt, res%ev_t)
-            call move_alloc(yy, res%ev_y)
             call move_alloc(ii, res%ev_id)
         end if
     end subroutine shrink_result
+
+    !> Times t and states y (columns) to capacity cap, keeping the first nkeep.
+    subroutine resize(t, y, nkeep, cap)
+        real(dp), allocatable, intent(inout) :: t(:), y(:, :)
+        integer, intent(in) :: nkeep, cap
+        real(dp), allocatable :: tt(:), yy(:, :)
+        allocate (tt(cap), yy(size(y, 1), cap))
+        tt(1:nkeep) = t(1:nkeep)
+        yy(:, 1:nkeep) = y(:, 1:nkeep)
+        call move_alloc(tt, t)
+        call move_alloc(yy, y)
+    end subroutine resize
 
 end module conmech_ode_result

@@ -1,11 +1,11 @@
 !> The collocation polynomial of a Radau IIA step (degree 3, power basis of
 !! x = (s - t)/h): its coefficients from the stage increments, and its extrapolation to
 !! the nodes of the next step (the Newton starting values). Dense output and events
-!! evaluate it with conmech_radau_common's poly_eval.
+!! evaluate it as the stepper's continuous extension (conmech_ode_dense's power form).
 module conmech_radau_collocation
     use conmech_kinds, only: dp
     use conmech_radau_coefficients, only: C1, C2
-    use conmech_radau_common, only: power_basis_matrix
+    use conmech_ode_dense, only: power_basis_matrix
     implicit none
     private
 

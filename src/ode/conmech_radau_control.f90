@@ -7,11 +7,10 @@ module conmech_radau_control
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_lapack, only: dgetrs
-    use conmech_ode_options, only: ode_stats
     use conmech_ode_system, only: ode_system
     use conmech_radau_coefficients, only: DD1, DD2, DD3, NIT, THET, QUOT1, QUOT2
     use conmech_radau_newton, only: radau_rhs
-    use conmech_radau_state, only: radau_state
+    use conmech_radau_stepper, only: radau_stepper
     implicit none
     private
 
@@ -21,10 +20,9 @@ module conmech_radau_control
 contains
 
     !> Initial step of SciPy's select_initial_step (error estimator order 3), signed.
-    function radau_initial_step(s, sys, stats) result(hh)
-        type(radau_state), intent(inout) :: s
+    function radau_initial_step(s, sys) result(hh)
+        type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
-        type(ode_stats), intent(inout) :: stats
         real(dp) :: hh, d0, d1, d2, h1
         d0 = sqrt(sum((s%y/s%scal)**2)/s%n)
         d1 = sqrt(sum((s%f0/s%scal)**2)/s%n)
@@ -35,7 +33,7 @@ contains
         end if
         hh = min(hh, s%hmax)
         s%a1 = s%y + hh*s%posneg*s%f0
-        call radau_rhs(sys, stats, s%t + hh*s%posneg, s%a1, s%a2)
+        call radau_rhs(sys, s%st, s%t + hh*s%posneg, s%a1, s%a2)
         d2 = sqrt(sum(((s%a2 - s%f0)/s%scal)**2)/s%n)/hh
         if (.not. ieee_is_finite(d2)) d2 = huge(1.0_dp)
         if (d1 <= 1.0e-15_dp .and. d2 <= 1.0e-15_dp) then
@@ -48,11 +46,9 @@ contains
 
     !> RADAU5's error estimate (estrad) into s%err: (I - h gamma0 J)^{-1}(f0 + (e1 z1 +
     !! e2 z2 + e3 z3)/h), refined by one more solve at the first step or after a rejection.
-    subroutine radau_estimate_error(s, sys, stats, mass)
-        type(radau_state), intent(inout) :: s
+    subroutine radau_estimate_error(s, sys)
+        type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
-        type(ode_stats), intent(inout) :: stats
-        real(dp), intent(in), optional :: mass(:, :)
         real(dp) :: hee1, hee2, hee3
         integer :: linfo, n
         n = s%n
@@ -60,14 +56,14 @@ contains
         hee2 = DD2/s%h
         hee3 = DD3/s%h
         s%a2 = hee1*s%z1 + hee2*s%z2 + hee3*s%z3
-        if (present(mass)) s%a2 = matmul(mass, s%a2)
+        if (allocated(s%mass)) s%a2 = matmul(s%mass, s%a2)
         s%cont = s%a2 + s%f0
         call dgetrs('N', n, 1, s%e1, n, s%ip1, s%cont, n, linfo)
         s%err = max(sqrt(sum((s%cont/s%scal)**2)/real(n, dp)), 1.0e-10_dp)
         if (s%err < 1.0_dp) return
         if (s%first .or. s%reject) then
             s%a1 = s%y + s%cont
-            call radau_rhs(sys, stats, s%t, s%a1, s%a3)
+            call radau_rhs(sys, s%st, s%t, s%a1, s%a3)
             s%cont = s%a3 + s%a2
             call dgetrs('N', n, 1, s%e1, n, s%ip1, s%cont, n, linfo)
             s%err = max(sqrt(sum((s%cont/s%scal)**2)/real(n, dp)), 1.0e-10_dp)
@@ -78,7 +74,7 @@ contains
     !> The proposed step s%hnew = h/quot, quot = max(facr, min(facl, err^(1/4)/fac)),
     !! fac = min(safe, safe (1 + 2 NIT)/(newt + 2 NIT)); returns quot.
     function radau_propose_step(s) result(quot)
-        type(radau_state), intent(inout) :: s
+        type(radau_stepper), intent(inout) :: s
         real(dp) :: quot, fac
         fac = min(s%safe, s%cfac/real(s%newt + 2*NIT, dp))
         quot = max(s%facr, min(s%facl, s%err**0.25_dp/fac))
@@ -88,7 +84,7 @@ contains
     !> After an accepted step (the naccept-th): Gustafsson's predictive controller (from
     !! the second accepted step on) may shrink s%hnew; then it remembers h and err.
     subroutine radau_predictive_step(s, quot, naccept)
-        type(radau_state), intent(inout) :: s
+        type(radau_stepper), intent(inout) :: s
         real(dp), intent(in) :: quot
         integer, intent(in) :: naccept
         real(dp) :: facgus, q
@@ -107,14 +103,14 @@ contains
     !! after a slow Newton iteration; otherwise h and the LU are kept when
     !! QUOT1 <= hnew/h <= QUOT2.
     subroutine radau_next_step(s)
-        type(radau_state), intent(inout) :: s
+        type(radau_stepper), intent(inout) :: s
         s%hnew = s%posneg*min(abs(s%hnew), s%hmax)
         if (s%reject) s%hnew = s%posneg*min(abs(s%hnew), abs(s%h))
         s%reject = .false.
         s%need_jac = s%newt > 2 .and. s%theta > THET
         if ((s%t + s%hnew - s%tf)*s%posneg >= 0.0_dp) then
             s%h = s%tf - s%t
-            s%last = .true.
+            s%final_step = .true.
             s%need_lu = .true.
         else
             if (.not. s%need_jac .and. s%hnew/s%h >= QUOT1 .and. s%hnew/s%h <= QUOT2) then

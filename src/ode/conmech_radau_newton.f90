@@ -6,34 +6,16 @@
 module conmech_radau_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
-    use conmech_lapack, only: dgetrf, dgetrs
+    use conmech_lapack, only: dgetrf, dgetrs, zgetrf, zgetrs
     use conmech_ode_options, only: ode_stats
     use conmech_ode_system, only: ode_system
     use conmech_radau_coefficients
     use conmech_radau_collocation, only: radau_extrapolate
-    use conmech_radau_state, only: radau_state
+    use conmech_radau_stepper, only: radau_stepper
     implicit none
     private
 
     public :: radau_rhs, radau_jacobian, radau_decompose, radau_newton
-
-    interface
-        subroutine zgetrf(m, n, a, lda, ipiv, info)
-            import :: dp
-            integer, intent(in) :: m, n, lda
-            complex(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine zgetrf
-        subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
-            import :: dp
-            character(len=1), intent(in) :: trans
-            integer, intent(in) :: n, nrhs, lda, ldb
-            complex(dp), intent(in) :: a(lda, *)
-            integer, intent(in) :: ipiv(*)
-            complex(dp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine zgetrs
-    end interface
 
 contains
 
@@ -49,13 +31,12 @@ contains
 
     !> s%jac = df/dy at (s%t, s%y): the system's `jacobian` if it has one, else forward
     !! differences with steps sqrt(eps max(1e-5, |y_j|)) (n evaluations; s%f0 = f(t, y)).
-    subroutine radau_jacobian(s, sys, stats)
-        type(radau_state), intent(inout) :: s
+    subroutine radau_jacobian(s, sys)
+        type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
-        type(ode_stats), intent(inout) :: stats
         real(dp) :: delt, ysafe
         integer :: jj
-        stats%njev = stats%njev + 1
+        s%st%njev = s%st%njev + 1
         if (sys%has_jacobian()) then
             call sys%jacobian(s%t, s%y, s%jac)
             return
@@ -64,28 +45,26 @@ contains
             ysafe = s%y(jj)
             delt = sqrt(s%uround*max(1.0e-5_dp, abs(ysafe)))
             s%y(jj) = ysafe + delt
-            call radau_rhs(sys, stats, s%t, s%y, s%a1)
+            call radau_rhs(sys, s%st, s%t, s%y, s%a1)
             s%y(jj) = ysafe
             s%jac(:, jj) = (s%a1 - s%f0)/delt
         end do
     end subroutine radau_jacobian
 
     !> LU of gamma/h M - J (real, s%e1) and (alpha + i beta)/h M - J (complex, s%e2);
-    !! M = I unless `mass` is given. linfo: LAPACK's info (/= 0: singular).
-    subroutine radau_decompose(s, stats, linfo, mass)
-        type(radau_state), intent(inout) :: s
-        type(ode_stats), intent(inout) :: stats
+    !! M = I unless s%mass is allocated. linfo: LAPACK's info (/= 0: singular).
+    subroutine radau_decompose(s, linfo)
+        type(radau_stepper), intent(inout) :: s
         integer, intent(out) :: linfo
-        real(dp), intent(in), optional :: mass(:, :)
         real(dp) :: fac1
         complex(dp) :: sig
         integer :: ii, n
         n = s%n
         fac1 = GAM0/s%h
         sig = cmplx(ALPH/s%h, BETA/s%h, kind=dp)
-        if (present(mass)) then
-            s%e1 = fac1*mass - s%jac
-            s%e2 = sig*mass - s%jac
+        if (allocated(s%mass)) then
+            s%e1 = fac1*s%mass - s%jac
+            s%e2 = sig*s%mass - s%jac
         else
             s%e1 = -s%jac
             s%e2 = cmplx(-s%jac, 0.0_dp, kind=dp)
@@ -95,20 +74,18 @@ contains
             end do
         end if
         call dgetrf(n, n, s%e1, n, s%ip1, linfo)
-        stats%nlu = stats%nlu + 1
+        s%st%nlu = s%st%nlu + 1
         if (linfo /= 0) return
         call zgetrf(n, n, s%e2, n, s%ip2, linfo)
-        stats%nlu = stats%nlu + 1
+        s%st%nlu = s%st%nlu + 1
     end subroutine radau_decompose
 
     !> Simplified Newton iteration for the stage increments z1..z3 (RADAU5's control):
     !! s%converged, s%newt; a slow contraction shrinks s%h (not converged), a failure
     !! (divergence, NIT iterations, non-finite values) halves it and sets s%newton_failed.
-    subroutine radau_newton(s, sys, stats, mass)
-        type(radau_state), intent(inout) :: s
+    subroutine radau_newton(s, sys)
+        type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
-        type(ode_stats), intent(inout) :: stats
-        real(dp), intent(in), optional :: mass(:, :)
         real(dp) :: fac1, alphn, betan, s2, s3, dyno, dynold, thq, thqold, dyth, qnewt
         real(dp) :: hhfac
         integer :: linfo, i, n
@@ -122,7 +99,7 @@ contains
             s%z1 = 0.0_dp; s%z2 = 0.0_dp; s%z3 = 0.0_dp
             s%w1 = 0.0_dp; s%w2 = 0.0_dp; s%w3 = 0.0_dp
         else
-            call radau_extrapolate(s%fc, s%cvec, s%h/s%hold, s%z1, s%z2, s%z3)
+            call radau_extrapolate(s%fc, s%cvec, s%h/s%h_done, s%z1, s%z2, s%z3)
             s%w1 = TI11*s%z1 + TI12*s%z2 + TI13*s%z3
             s%w2 = TI21*s%z1 + TI22*s%z2 + TI23*s%z3
             s%w3 = TI31*s%z1 + TI32*s%z2 + TI33*s%z3
@@ -134,15 +111,15 @@ contains
         thqold = 0.0_dp
         do
             if (s%newt >= NIT) exit
-            call radau_rhs(sys, stats, s%t + C1*s%h, s%y + s%z1, s%a1)
-            call radau_rhs(sys, stats, s%t + C2*s%h, s%y + s%z2, s%a2)
-            call radau_rhs(sys, stats, s%t + s%h, s%y + s%z3, s%a3)
+            call radau_rhs(sys, s%st, s%t + C1*s%h, s%y + s%z1, s%a1)
+            call radau_rhs(sys, s%st, s%t + C2*s%h, s%y + s%z2, s%a2)
+            call radau_rhs(sys, s%st, s%t + s%h, s%y + s%z3, s%a3)
             if (.not. (all(ieee_is_finite(s%a1)) .and. all(ieee_is_finite(s%a2)) .and. &
                        all(ieee_is_finite(s%a3)))) exit
-            if (present(mass)) then
-                s%b1 = matmul(mass, s%w1)
-                s%b2 = matmul(mass, s%w2)
-                s%b3 = matmul(mass, s%w3)
+            if (allocated(s%mass)) then
+                s%b1 = matmul(s%mass, s%w1)
+                s%b2 = matmul(s%mass, s%w2)
+                s%b3 = matmul(s%mass, s%w3)
             else
                 s%b1 = s%w1
                 s%b2 = s%w2

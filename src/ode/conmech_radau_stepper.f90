@@ -1,74 +1,225 @@
-!> Radau IIA step by step (SciPy's OdeSolver use; conmech.Radau in Python): a
-!! `radau_stepper` holds the whole state of a `radau_solve` integration in plain arrays
-!! (layout: conmech_radau_state, RADAU_NR, RADAU_NI, RADAU_NW), `radau_stepper_init` starts at
-!! (t0, y0), each `radau_stepper_step` makes one accepted step: the steps of `radau_solve`,
-!! bit for bit. No state outside the object (thread-safe for distinct objects).
+!> Radau IIA of order 5 (three stages) for stiff systems y' = f(t, y) and M y' = f(t, y):
+!! Hairer & Wanner's RADAU5 (Solving ODEs II, section IV.8), written anew as a stepper of
+!! the integrator contract (conmech_ode_stepper).
+!!
+!! - Simplified Newton iteration on the transformed stage system: with the eigenvalues
+!!   gamma and alpha +- i beta of the inverse Radau matrix, one real LU of
+!!   (gamma/h M - J) and one complex LU of ((alpha + i beta)/h M - J), both of size n
+!!   (LAPACK dgetrf/zgetrf). Convergence control by the contraction rate theta as
+!!   RADAU5: at most 7 iterations, stop when theta/(1 - theta) |dW| <= fnewt, a step
+!!   reduction when the predicted error after the remaining iterations is too large.
+!! - Error estimate (I - h gamma0 J)^{-1}(f0 + (e1 z1 + e2 z2 + e3 z3)/h), refined by one
+!!   more solve after a rejection or at the first step, as RADAU5.
+!! - Step size: h_new = h / max(1/8, min(5, err^(1/4)/fac)), fac = min(0.9, 0.9 (2 nit
+!!   + 1)/(newt + 2 nit)), then the predictive controller of Gustafsson. The Jacobian is
+!!   re-evaluated after an accepted step only when the Newton iteration was slow (more
+!!   than two iterations and theta > 0.001; RADAU5 uses theta alone, SciPy this rule),
+!!   and after a Newton failure if it is not current; a step rejected by the error test
+!!   keeps it (SciPy; RADAU5 refreshes it there);
+!!   otherwise the step and the LU are kept when the proposed ratio is below 1.2 (SciPy's
+!!   window; RADAU5's default is [1, 1.2]). With these two choices the counts of steps,
+!!   Jacobians and LUs are within a few per cent of SciPy's Radau (bench/bench_radau.py).
+!! - Tolerances are used as given (SciPy's convention; RADAU5 itself transforms rtol to
+!!   0.1 rtol^(2/3)): error norm sqrt(mean((err_i/sk_i)^2)), sk_i = atol_i + rtol_i |y_i|
+!!   at the start of the step; Newton tolerance fnewt = max(10 eps/rtol, min(0.03,
+!!   rtol^(1/2))) as SciPy and RADAU5.
+!! - Initial step: the heuristic of SciPy's select_initial_step for an error estimator of
+!!   order 3, unless first_step is given.
+!! - Jacobian: the system's analytic `jacobian` if `has_jacobian()`, else forward
+!!   differences with Hairer's steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, counted in
+!!   nfev).
+!! - Continuous extension: the collocation polynomial (degree 3, power basis), on which the
+!!   driver finds t_eval points and events.
+!! - Failures: a Newton iteration that does not converge (or meets non-finite values)
+!!   halves the step; 0.1 |h| <= eps |t| ends the run (CM_STEP_TOO_SMALL, with the time);
+!!   a singular iteration matrix halves the step, five singular ones in a row end the run
+!!   (CM_SINGULAR).
+!! - Mass-matrix form M y' = f(t, y) with a constant, possibly singular M (differential-
+!!   algebraic systems of index 1 and 2, RADAU5's IMAS = 1): the components `mass` and
+!!   `index2` set before `init` (index-2 components get their error scaled by h, as
+!!   RADAU5's NIND2); the initial step is then 1e-6 unless given. The constrained layer
+!!   uses it for the stabilised index-2 formulation (conmech_constrained_dae).
+!! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
+!! This module holds the state and its packing; the step itself is the submodule
+!! conmech_radau_step, on conmech_radau_newton (Jacobian, LU, Newton) and
+!! conmech_radau_control (initial step, error estimate, step-size control).
 module conmech_radau_stepper
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_ode_solver, only: ode_options, ode_result
-    use conmech_radau, only: radau_solve, RADAU_NR, RADAU_NI, RADAU_NW, RADAU_WY
+    use conmech_ode_options, only: ode_options
+    use conmech_ode_stepper, only: ode_stepper
+    use conmech_state_packer, only: state_packer
+    use conmech_radau_collocation, only: radau_collocation_basis
     implicit none
     private
 
-    public :: radau_stepper, radau_stepper_init, radau_stepper_step
+    public :: radau_stepper, radau_allocate_work
 
-    !> A step-by-step Radau IIA integration (SciPy's OdeSolver use): the whole state in
-    !! plain arrays (layout above), so that it can live in a caller's arrays between
-    !! calls. `radau_stepper_init` starts at (t0, y0), each `radau_stepper_step` makes one
-    !! accepted step, the same steps as `radau_solve` (bit for bit).
-    type :: radau_stepper
-        real(dp), allocatable :: r(:)        !! real scalars; r(RADAU_RT) = t
-        integer, allocatable :: iv(:)        !! integers, logicals (0/1), pivots
-        real(dp), allocatable :: w(:, :)     !! columns of length n; w(:, RADAU_WY) = y
+    !> Everything a Radau IIA integration carries from step to step (beyond the contract's
+    !! common state: t_old, h_done are the start and length of the last accepted step, fc
+    !! its collocation polynomial), its work arrays, and the mass matrix of M y' = f.
+    type, extends(ode_stepper) :: radau_stepper
+        !> constant mass matrix M of M y' = f(t, y) (n x n, may be singular: a DAE), set by
+        !! the caller before `init`; unallocated: M = I
+        real(dp), allocatable :: mass(:, :)
+        !> the index-2 algebraic components (their error is scaled by h, as RADAU5), set
+        !! with `mass`
+        logical, allocatable :: index2(:)
+        real(dp) :: hmax = 0, uround = 0, fnewt = 0   !! largest |h|, roundoff, Newton tol.
+        real(dp) :: faccon = 1, theta = 0     !! Newton contraction memory and rate
+        real(dp) :: hacc = 0, erracc = 1      !! last accepted step and error (Gustafsson)
+        real(dp) :: safe = 0.9_dp             !! safety factor
+        real(dp) :: facl = 5, facr = 0.125_dp !! bounds of h/h_new
+        real(dp) :: cfac = 0                  !! safe (1 + 2 NIT)
+        real(dp) :: err = 0                   !! scaled error estimate of the last attempt
+        real(dp) :: hnew = 0                  !! proposed next step
+        real(dp) :: first_step = 0            !! the option (0: heuristic)
+        real(dp) :: pmat(3, 3) = 0, cvec(3) = 0   !! collocation basis (nodes, power basis)
+        integer :: newt = 0                   !! Newton iterations of the last attempt
+        integer :: nsteps = 0, nsing = 0, nfail = 0   !! steps, singular LUs, Newton failures
+        integer :: max_steps = 100000
+        logical :: first = .true.             !! no step accepted yet
+        logical :: reject = .false.           !! the last attempt was rejected
+        logical :: caljac = .false.           !! the Jacobian is current
+        logical :: need_jac = .true.          !! evaluate the Jacobian before the step
+        logical :: need_lu = .true.           !! factorise before the step
+        logical :: have_cont = .false.        !! fc holds a polynomial
+        logical :: newton_failed = .false.    !! the last Newton iteration failed
+        logical :: converged = .false.        !! the last Newton iteration converged
+        logical :: f_ok = .true.              !! f0 = f(t, y) is finite
+        logical :: final_step = .false.       !! the step to attempt ends at tf
+        real(dp), allocatable :: f0(:), scal(:), scal0(:), rtolv(:), atolv(:)
+        real(dp), allocatable :: jac(:, :), e1(:, :)    !! J and the LU of gamma/h M - J
+        complex(dp), allocatable :: e2(:, :)            !! LU of (alpha + i beta)/h M - J
+        integer, allocatable :: ip1(:), ip2(:)          !! pivots of e1, e2
+        real(dp), allocatable :: z1(:), z2(:), z3(:), w1(:), w2(:), w3(:)
+        real(dp), allocatable :: a1(:), a2(:), a3(:), b1(:), b2(:), b3(:), cont(:)
+        complex(dp), allocatable :: zc(:)
+    contains
+        procedure :: setup => radau_setup
+        procedure :: start => radau_start
+        procedure :: step => radau_step
+        procedure :: transfer_state => radau_transfer
+        procedure :: refresh_f => radau_refresh_f
+        procedure :: f_finite => radau_f_finite
     end type radau_stepper
+
+    interface
+        !> The options and the mass matrix checked; constants and arrays (no evaluation).
+        module subroutine radau_setup(self, opt, info, msg)
+            class(radau_stepper), intent(inout) :: self
+            type(ode_options), intent(in) :: opt
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(out) :: msg
+        end subroutine radau_setup
+        !> f at t0, the scale and the initial step.
+        module subroutine radau_start(self, sys, info, msg)
+            class(radau_stepper), intent(inout) :: self
+            class(ode_system), intent(in) :: sys
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(out) :: msg
+        end subroutine radau_start
+        !> One accepted step (Jacobian, LUs, Newton, error test, step control).
+        module subroutine radau_step(self, sys, target, info, msg)
+            class(radau_stepper), intent(inout) :: self
+            class(ode_system), intent(in) :: sys
+            real(dp), intent(in) :: target
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(out) :: msg
+        end subroutine radau_step
+    end interface
 
 contains
 
-    !> Start a step-by-step integration of y' = f(t, y) at (t0, y0) towards tf (options
-    !! as `radau_solve`: tolerances, first_step, max_step, max_steps; no mass matrix).
-    subroutine radau_stepper_init(st, sys, t0, tf, y0, opt, info, message)
-        type(radau_stepper), intent(out) :: st
-        class(ode_system), intent(in) :: sys
-        real(dp), intent(in) :: t0, tf
-        real(dp), intent(in) :: y0(:)
-        type(ode_options), intent(in) :: opt
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: message
-        type(ode_result) :: res
+    !> Allocate the work arrays (not part of the packed state) for dimension self%n.
+    subroutine radau_allocate_work(self)
+        class(radau_stepper), intent(inout) :: self
         integer :: n
-        n = size(y0)
-        allocate (st%r(RADAU_NR), st%iv(RADAU_NI + 2*n), st%w(n, RADAU_NW + 4*n))
-        st%iv = 0
-        call radau_solve(sys, [t0, tf], y0, opt, res, r_state=st%r, i_state=st%iv, &
-                         w_state=st%w, action=0)
-        info = res%status
-        message = res%message
-    end subroutine radau_stepper_init
-
-    !> One accepted step of a started integration (the step of `radau_solve`); on failure
-    !! info < 0 with the message (the time in it). opt: as given to radau_stepper_init.
-    subroutine radau_stepper_step(st, sys, opt, info, message)
-        type(radau_stepper), intent(inout) :: st
-        class(ode_system), intent(in) :: sys
-        type(ode_options), intent(in) :: opt
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: message
-        type(ode_result) :: res
-        real(dp), allocatable :: ycopy(:)
-        real(dp) :: span(2)
-        if (.not. allocated(st%w)) then
-            info = CM_BAD_INPUT
-            message = "bad input: the Radau stepper was not started (radau_stepper_init)"
-            return
+        n = self%n
+        if (allocated(self%z1)) then
+            if (size(self%z1) == n) return
+            deallocate (self%z1, self%z2, self%z3, self%w1, self%w2, self%w3, self%a1, &
+                        self%a2, self%a3, self%scal, self%cont, self%zc, self%b1, self%b2, &
+                        self%b3)
         end if
-        ycopy = st%w(:, RADAU_WY)        ! (no aliasing with the packed state)
-        span = st%r(1:2)
-        call radau_solve(sys, span, ycopy, opt, res, r_state=st%r, i_state=st%iv, &
-                         w_state=st%w, action=1)
-        info = res%status
-        message = res%message
-    end subroutine radau_stepper_step
+        allocate (self%z1(n), self%z2(n), self%z3(n), self%w1(n), self%w2(n), self%w3(n), &
+                  self%a1(n), self%a2(n), self%a3(n), self%scal(n), self%cont(n), &
+                  self%zc(n), self%b1(n), self%b2(n), self%b3(n))
+    end subroutine radau_allocate_work
+
+    !> The whole state (conmech_state_packer): the controller's memory, f(t, y), the scale,
+    !! the tolerances, J, both LU factorisations with their pivots, the mass matrix if any.
+    subroutine radau_transfer(self, p)
+        class(radau_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        logical :: has_mass
+        integer :: n
+        integer, allocatable :: idx(:)
+        call self%transfer_base(p)
+        n = self%n
+        call p%item(self%hmax)
+        call p%item(self%uround)
+        call p%item(self%fnewt)
+        call p%item(self%faccon)
+        call p%item(self%theta)
+        call p%item(self%hacc)
+        call p%item(self%erracc)
+        call p%item(self%safe)
+        call p%item(self%facl)
+        call p%item(self%facr)
+        call p%item(self%cfac)
+        call p%item(self%first_step)
+        call p%item(self%nsteps)
+        call p%item(self%nsing)
+        call p%item(self%nfail)
+        call p%item(self%max_steps)
+        call p%item(self%first)
+        call p%item(self%reject)
+        call p%item(self%caljac)
+        call p%item(self%need_jac)
+        call p%item(self%need_lu)
+        call p%item(self%have_cont)
+        call p%item(self%newton_failed)
+        call p%item(self%f_ok)
+        call p%item(self%final_step)
+        call p%column(self%f0)
+        call p%column(self%scal0)
+        call p%column(self%rtolv)
+        call p%column(self%atolv)
+        call p%columns(self%jac, 1, n)
+        call p%columns(self%e1, 1, n)
+        call p%complex_columns(self%e2, n)
+        call p%ints(self%ip1, n)
+        call p%ints(self%ip2, n)
+        has_mass = allocated(self%mass)
+        call p%item(has_mass)
+        if (has_mass) then
+            call p%columns(self%mass, 1, n)
+            if (.not. p%reading()) idx = merge(1, 0, self%index2)
+            call p%ints(idx, n)
+            if (p%reading()) self%index2 = idx /= 0
+        end if
+        if (p%reading()) then
+            call radau_allocate_work(self)
+            call radau_collocation_basis(self%cvec, self%pmat)
+        end if
+    end subroutine radau_transfer
+
+    !> f(t, y) and the scale again after a step hook changed y.
+    subroutine radau_refresh_f(self, sys)
+        class(radau_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        call sys%rhs(self%t, self%y, self%f0)
+        self%st%nfev = self%st%nfev + 1
+        self%f_ok = all(ieee_is_finite(self%f0))
+        self%scal0 = self%atolv + self%rtolv*abs(self%y)
+        self%f_stale = .false.
+    end subroutine radau_refresh_f
+
+    logical function radau_f_finite(self)
+        class(radau_stepper), intent(in) :: self
+        radau_f_finite = self%f_ok
+    end function radau_f_finite
 
 end module conmech_radau_stepper

@@ -1,14 +1,16 @@
-!> The explicit Runge-Kutta stepper: one object holds the whole state of an integration
-!! (t, y, the stages, the step size and the controller's memory), advanced one accepted
-!! step at a time. The anchors are FLINT's ERK class and SciPy's OdeSolver:
+!> The explicit Runge-Kutta stepper (RK4, DOPRI5, DOP853, VERNER98) on the integrator
+!! contract of conmech_ode_stepper: one object holds the whole state of an integration (t,
+!! y, the stages, the step size and the controller's memory), advanced one accepted step at
+!! a time. The anchors are FLINT's ERK class and SciPy's OdeSolver:
 !!
-!! - `rk_init`   checks the options and sets up the method (no evaluation of f);
-!! - `rk_start`  evaluates f(t0, y0) and chooses the initial step (Hairer's hinit);
-!! - `rk_step`   attempts steps until one is accepted (Hairer's step control), then
+!! - `setup`     (the contract's `init`) checks the options and sets up the method (no
+!!               evaluation of f);
+!! - `start`     evaluates f(t0, y0) and chooses the initial step (Hairer's hinit);
+!! - `step`      attempts steps until one is accepted (Hairer's step control), then
 !!               advances: (t_old, y_old) is the start of that step, (t, y) its end;
-!! - `rk_dense`  builds the continuous extension of the last step (extra stages for
-!!               DOP853 and Verner), `rk_eval` evaluates it;
-!! - `rk_refresh_f` re-evaluates f after a step hook changed y.
+!! - `dense`     builds the continuous extension of the last step (extra stages for
+!!               DOP853 and Verner); `eval` evaluates it (the contract's default);
+!! - `refresh_f` re-evaluates f after a step hook changed y.
 !!
 !! The FSAL stage of an accepted step is moved into k(:, 1) lazily, at the start of the
 !! next step, so that the last step's stages stay available for its dense output.
@@ -22,9 +24,11 @@ module conmech_rk_stepper
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
-    use conmech_ode_options, only: ode_options, ode_stats, METHOD_RK4, METHOD_DOPRI5, &
+    use conmech_ode_options, only: ode_options, METHOD_RK4, METHOD_DOPRI5, &
         METHOD_DOP853, METHOD_VERNER98
-    use conmech_ode_dense, only: FORM_HAIRER, FORM_POWER, interp
+    use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
+        tolerance_vectors, FORM_HAIRER, FORM_POWER
+    use conmech_state_packer, only: state_packer
     use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
         verner98_tableau
     use conmech_rk_kernels, only: rk4_attempt, dopri5_attempt, dop853_attempt, &
@@ -33,21 +37,11 @@ module conmech_rk_stepper
     private
     public :: rk_stepper, rk_init, rk_start, rk_step
 
-    !> State of an explicit Runge-Kutta integration.
-    type :: rk_stepper
-        integer :: method = 0             !! METHOD_* code
-        integer :: n = 0                  !! dimension
-        integer :: nf = 0                 !! dense coefficients F1..F_nf
-        integer :: form = FORM_HAIRER     !! polynomial form of the dense coefficients
+    !> State of an explicit Runge-Kutta integration (beyond the contract's common state).
+    type, extends(ode_stepper) :: rk_stepper
         integer :: ifsal = 0              !! column of k holding f at the step's end
         logical :: adaptive = .true.      !! false: fixed step (RK4)
         type(rk_tableau) :: tab
-        real(dp) :: t = 0.0_dp            !! current time (end of the last step)
-        real(dp) :: t_old = 0.0_dp        !! start of the last step
-        real(dp) :: tf = 0.0_dp           !! end of the integration interval
-        real(dp) :: posneg = 1.0_dp       !! direction of integration
-        real(dp) :: h = 0.0_dp            !! step size to try next (signed)
-        real(dp) :: h_done = 0.0_dp       !! size of the last accepted step (signed)
         real(dp) :: hmax = 0.0_dp         !! largest |h|
         real(dp) :: h_fixed = 0.0_dp      !! RK4's step
         real(dp) :: safe = 0.9_dp, facc1 = 5.0_dp, facc2 = 0.1_dp, beta = 0.0_dp
@@ -58,96 +52,94 @@ module conmech_rk_stepper
         integer :: n_nonfinite = 0        !! consecutive non-finite error estimates
         logical :: reject = .false.       !! the previous attempt was rejected
         logical :: fsal_pending = .false. !! k(:, ifsal) is f(t, y), not yet in k(:, 1)
-        logical :: defer_fsal = .false.   !! the driver evaluates f after its step hook
-        logical :: dense_ready = .false.  !! fc holds the last step's dense coefficients
-        logical :: hit = .false.          !! the last step was shortened to land on a target
-        logical :: last = .false.         !! the last step reached tf
-        type(ode_stats) :: st             !! counters
-        real(dp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), sk(:)
+        real(dp), allocatable :: ynew(:), ytmp(:), sk(:)
         real(dp), allocatable :: rtol(:), atol(:)
         real(dp), allocatable :: k(:, :)  !! stages, (n, 21)
-        real(dp), allocatable :: fc(:, :) !! dense coefficients of the last step, (n, 0:nf)
     contains
+        procedure :: setup => rk_setup
+        procedure :: start => rk_start_impl
+        procedure :: step => rk_step_impl
+        procedure :: transfer_state => rk_transfer
         procedure :: dense => rk_dense
-        procedure :: eval => rk_eval
         procedure :: refresh_f => rk_refresh_f
         procedure :: f_finite => rk_f_finite
     end type rk_stepper
 
+    !> The contract's procedures under the stepper's own names: `rk_init(stp, ...)` is
+    !! `stp%init(...)`, and so on.
+    interface rk_init
+        module procedure stepper_init
+    end interface rk_init
+    interface rk_start
+        module procedure rk_start_impl
+    end interface rk_start
+    interface rk_step
+        module procedure rk_step_impl
+    end interface rk_step
+
 contains
 
-    !> Check the options and set the stepper up at (t0, y0) for the interval [t0, tf]
-    !! (no evaluation of f). An infinite tf is accepted if allow_inf (stepping without end).
-    subroutine rk_init(self, t0, tf, y0, opt, info, msg, allow_inf)
-        type(rk_stepper), intent(out) :: self
-        real(dp), intent(in) :: t0, tf, y0(:)
+    !> The method's part of init: its options (tolerances, step control; RK4's fixed step)
+    !! and arrays, at the common state set by the contract's init (no evaluation of f).
+    subroutine rk_setup(self, opt, info, msg)
+        class(rk_stepper), intent(inout) :: self
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: allow_inf
-        integer :: n
-        logical :: inf_ok
-        n = size(y0)
-        inf_ok = .false.
-        if (present(allow_inf)) inf_ok = allow_inf
-        info = CM_BAD_INPUT
-        if (n < 1) then
-            msg = "bad input: y0 is empty"
-        else if (.not. all(ieee_is_finite(y0))) then
-            msg = "bad input: y0 contains NaN or Inf"
-        else if (.not. (ieee_is_finite(t0) .and. (ieee_is_finite(tf) .or. &
-                                                  (inf_ok .and. .not. ieee_is_nan(tf))))) then
-            msg = "bad input: t_span must be finite"
-        else if (opt%method < METHOD_RK4 .or. opt%method > METHOD_VERNER98) then
+        if (opt%method < METHOD_RK4 .or. opt%method > METHOD_VERNER98) then
+            info = CM_BAD_INPUT
             msg = "bad input: unknown method"
-        else if (.not. allocated(opt%rtol_vec) .and. .not. (opt%rtol >= 0.0_dp)) then
-            msg = "bad input: rtol must be non-negative"
-        else if (.not. allocated(opt%atol_vec) .and. .not. (opt%atol >= 0.0_dp)) then
-            msg = "bad input: atol must be non-negative"
-        else if (.not. opt%max_step > 0.0_dp) then
-            msg = "bad input: max_step must be positive"
-        else if (.not. opt%first_step >= 0.0_dp) then
-            msg = "bad input: first_step must be positive"
-        else if (opt%max_steps < 1) then
-            msg = "bad input: max_steps must be positive"
-        else if (opt%method == METHOD_RK4 .and. .not. opt%first_step > 0.0_dp) then
-            msg = "bad input: RK4 is a fixed-step method and needs a step (first_step > 0)"
-        else if (opt%method /= METHOD_RK4 .and. opt%first_step > abs(tf - t0) .and. &
-                 tf /= t0) then
-            msg = "bad input: first_step exceeds the length of t_span"
+            return
+        end if
+        if (opt%method == METHOD_RK4) then
+            call check_first_step(self, opt, info, msg, fixed="RK4")
         else
-            info = CM_SUCCESS
-            msg = "success"
+            call check_first_step(self, opt, info, msg)
         end if
         if (info /= CM_SUCCESS) return
-        if (allocated(opt%rtol_vec)) call check_tol_vec(opt%rtol_vec, "rtol")
+        call tolerance_vectors(opt, self%n, self%rtol, self%atol, info, msg)
         if (info /= CM_SUCCESS) return
-        if (allocated(opt%atol_vec)) call check_tol_vec(opt%atol_vec, "atol")
-        if (info /= CM_SUCCESS) return
+        call set_method(self, opt%method)
+        self%safe = 0.9_dp
+        self%facold = 1.0e-4_dp
+        self%nsteps = 0
+        self%n_nonfinite = 0
+        self%reject = .false.
+        self%fsal_pending = .false.
+        if (self%adaptive) then
+            if (opt%beta >= 0.0_dp) self%beta = opt%beta
+            if (opt%method == METHOD_DOPRI5) then
+                self%expo1 = 0.2_dp - self%beta*0.75_dp
+            else if (opt%method == METHOD_VERNER98) then
+                self%expo1 = 1.0_dp/9.0_dp - self%beta*0.2_dp
+            else
+                self%expo1 = 1.0_dp/8.0_dp - self%beta*0.2_dp
+            end if
+        end if
+        if (opt%safety > 0.0_dp) self%safe = opt%safety
+        if (opt%fac_min > 0.0_dp) self%facc1 = 1.0_dp/opt%fac_min
+        if (opt%fac_max > 0.0_dp) self%facc2 = 1.0_dp/opt%fac_max
+        self%hmax = min(abs(opt%max_step), abs(self%tf - self%t))
+        self%first_step = opt%first_step
+        self%max_steps = opt%max_steps
+        call allocate_work(self)
+        self%k = 0.0_dp
+    end subroutine rk_setup
 
-        self%n = n
-        self%method = opt%method
-        self%t = t0
-        self%t_old = t0
-        self%tf = tf
-        self%posneg = sign(1.0_dp, tf - t0)
-        allocate (self%rtol(n), self%atol(n))
-        if (allocated(opt%rtol_vec)) then
-            self%rtol = opt%rtol_vec
-        else
-            self%rtol = opt%rtol
-        end if
-        if (allocated(opt%atol_vec)) then
-            self%atol = opt%atol_vec
-        else
-            self%atol = opt%atol
-        end if
-        self%rtol = max(self%rtol, 100.0_dp*epsilon(1.0_dp))   ! as SciPy: rtol >= 100 eps
+    !> The method's constants: tableau, dense degree and form, FSAL column, the default
+    !! step-ratio bounds and Lund stabilisation (from the method code alone, so that an
+    !! unpacked state rebuilds them).
+    subroutine set_method(self, method)
+        type(rk_stepper), intent(inout) :: self
+        integer, intent(in) :: method
+        self%adaptive = .true.
         self%form = FORM_HAIRER
-        select case (opt%method)
+        self%beta = 0.0_dp
+        select case (method)
         case (METHOD_RK4)
             self%adaptive = .false.
             self%nf = 3
+            self%tab = rk_tableau()
             self%tab%stages = 4
             self%ifsal = 13
         case (METHOD_DOPRI5)
@@ -155,52 +147,72 @@ contains
             self%nf = 4
             self%ifsal = 7
             self%facc1 = 1.0_dp/0.2_dp; self%facc2 = 1.0_dp/10.0_dp; self%beta = 0.04_dp
-            if (opt%beta >= 0.0_dp) self%beta = opt%beta
-            self%expo1 = 0.2_dp - self%beta*0.75_dp
         case (METHOD_VERNER98)
             self%tab = verner98_tableau()
             self%nf = 8
             self%form = FORM_POWER
             self%ifsal = 17
             self%facc1 = 1.0_dp/0.333_dp; self%facc2 = 1.0_dp/6.0_dp
-            if (opt%beta >= 0.0_dp) self%beta = opt%beta
-            self%expo1 = 1.0_dp/9.0_dp - self%beta*0.2_dp
         case default
             self%tab = dop853_tableau()
             self%nf = 7
             self%ifsal = 13
             self%facc1 = 1.0_dp/0.333_dp; self%facc2 = 1.0_dp/6.0_dp
-            if (opt%beta >= 0.0_dp) self%beta = opt%beta
-            self%expo1 = 1.0_dp/8.0_dp - self%beta*0.2_dp
         end select
-        if (opt%safety > 0.0_dp) self%safe = opt%safety
-        if (opt%fac_min > 0.0_dp) self%facc1 = 1.0_dp/opt%fac_min
-        if (opt%fac_max > 0.0_dp) self%facc2 = 1.0_dp/opt%fac_max
-        self%hmax = min(abs(opt%max_step), abs(tf - t0))
-        self%first_step = opt%first_step
-        self%max_steps = opt%max_steps
-        allocate (self%y(n), self%y_old(n), self%ynew(n), self%ytmp(n), self%sk(n), &
-                  self%k(n, 21), self%fc(n, 0:self%nf))
-        self%y = y0
-        self%y_old = y0
-        self%k = 0.0_dp
-    contains
-        subroutine check_tol_vec(v, name)
-            real(dp), intent(in) :: v(:)
-            character(len=*), intent(in) :: name
-            if (size(v) /= n) then
-                info = CM_BAD_INPUT
-                msg = "bad input: "//name//" must be a scalar or have the size of y0"
-            else if (.not. all(v >= 0.0_dp)) then
-                info = CM_BAD_INPUT
-                msg = "bad input: "//name//" must be non-negative"
-            end if
-        end subroutine check_tol_vec
-    end subroutine rk_init
+    end subroutine set_method
+
+    !> Work arrays and stages for dimension self%n.
+    subroutine allocate_work(self)
+        type(rk_stepper), intent(inout) :: self
+        integer :: n
+        n = self%n
+        if (allocated(self%ynew)) deallocate (self%ynew, self%ytmp, self%sk)
+        if (allocated(self%k)) deallocate (self%k)
+        allocate (self%ynew(n), self%ytmp(n), self%sk(n), self%k(n, 21))
+    end subroutine allocate_work
+
+    !> The whole state, for the step-by-step use from Python (conmech_state_packer). The
+    !! tableau and the method's constants are rebuilt from the method code.
+    subroutine rk_transfer(self, p)
+        class(rk_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        real(dp) :: facc1, facc2, beta
+        call self%transfer_base(p)
+        facc1 = self%facc1
+        facc2 = self%facc2
+        beta = self%beta
+        if (p%reading()) then
+            call set_method(self, self%method)
+            call allocate_work(self)
+            self%ynew = self%y
+            self%ytmp = 0.0_dp
+            self%sk = 0.0_dp
+        end if
+        call p%item(self%hmax)
+        call p%item(self%h_fixed)
+        call p%item(self%safe)
+        call p%item(facc1)
+        call p%item(facc2)
+        call p%item(beta)
+        call p%item(self%expo1)
+        call p%item(self%facold)
+        call p%item(self%first_step)
+        call p%item(self%nsteps)
+        call p%item(self%max_steps)
+        call p%item(self%n_nonfinite)
+        call p%item(self%reject)
+        call p%item(self%fsal_pending)
+        call p%column(self%rtol)
+        call p%column(self%atol)
+        call p%columns(self%k, 1, 21)
+        self%facc1 = facc1
+        self%facc2 = facc2
+        self%beta = beta
+    end subroutine rk_transfer
 
     !> Evaluate f at the initial point and choose the first step.
-    subroutine rk_start(self, sys, info, msg)
-        type(rk_stepper), intent(inout) :: self
+    subroutine rk_start_impl(self, sys, info, msg)
+        class(rk_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
@@ -228,11 +240,11 @@ contains
         self%h_fixed = self%h
         self%facold = 1.0e-4_dp
         self%reject = .false.
-    end subroutine rk_start
+    end subroutine rk_start_impl
 
     !> Hairer's initial step size (hinit of dopri5.f / dop853.f), with scale-safe norms.
     subroutine hinit(self, sys)
-        type(rk_stepper), intent(inout) :: self
+        class(rk_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         real(dp) :: hh, dnf, dny, der2, der12, h1, nf, ny
         associate (sk => self%sk, y => self%y, k => self%k, ytmp => self%ytmp)
@@ -305,8 +317,8 @@ contains
     !! a step lands on if it reaches it (tf, or the next output point; Hairer's rule:
     !! a step is stretched by up to 1 % to reach it). info: CM_SUCCESS after an accepted
     !! step, else the failure (too many steps, step too small, non-finite values).
-    subroutine rk_step(self, sys, target, info, msg)
-        type(rk_stepper), intent(inout) :: self
+    subroutine rk_step_impl(self, sys, target, info, msg)
+        class(rk_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: target
         integer, intent(out) :: info
@@ -314,6 +326,7 @@ contains
         real(dp) :: err, fac11, fac, hnew, h_unclipped, t_new
         real(dp), allocatable :: yswap(:)
         integer :: n
+        logical :: defer
         character(len=32) :: buf
         n = self%n
         info = CM_SUCCESS
@@ -423,12 +436,15 @@ contains
         end if
         t_new = self%t + self%h
         if (self%hit) t_new = target
-        ! f at the step's end (FSAL): DOPRI5 has it from the attempt
-        if (self%method /= METHOD_DOPRI5 .and. .not. self%defer_fsal) then
+        ! f at the step's end (FSAL): DOPRI5 has it from the attempt; the others evaluate
+        ! it unless a hook follows that changes y (the driver's defer_f)
+        defer = self%defer_f .and. self%method /= METHOD_DOPRI5
+        if (self%method /= METHOD_DOPRI5 .and. .not. defer) then
             call sys%rhs(t_new, self%ynew, self%k(:, self%ifsal))
             self%st%nfev = self%st%nfev + 1
         end if
-        self%fsal_pending = .not. self%defer_fsal
+        self%fsal_pending = .not. defer
+        self%f_stale = defer
         self%dense_ready = .false.
         ! (y_old, y, ynew) <- (y, ynew, y_old): a rotation of the buffers, no copies
         call move_alloc(self%y_old, yswap)
@@ -444,12 +460,12 @@ contains
         end if
         self%reject = .false.
         self%h = hnew
-    end subroutine rk_step
+    end subroutine rk_step_impl
 
     !> err**expo1, by square roots when expo1 = 1/8 (DOP853's exponent without
     !! stabilisation: a few instructions instead of a call to pow).
     pure real(dp) function err_power(self, err) result(p)
-        type(rk_stepper), intent(in) :: self
+        class(rk_stepper), intent(in) :: self
         real(dp), intent(in) :: err
         if (self%expo1 == 0.125_dp) then
             p = sqrt(sqrt(sqrt(err)))
@@ -522,14 +538,6 @@ contains
         end subroutine extra_stages
     end subroutine rk_dense
 
-    !> The continuous extension of the last step at time tt (after `rk_dense`).
-    subroutine rk_eval(self, tt, yout)
-        class(rk_stepper), intent(in) :: self
-        real(dp), intent(in) :: tt
-        real(dp), intent(out) :: yout(:)
-        call interp(self%fc, self%form, (tt - self%t_old)/self%h_done, yout)
-    end subroutine rk_eval
-
     !> Re-evaluate f at the current point (after a step hook changed y, or deferred FSAL).
     subroutine rk_refresh_f(self, sys)
         class(rk_stepper), intent(inout) :: self
@@ -537,6 +545,7 @@ contains
         call sys%rhs(self%t, self%y, self%k(:, 1))
         self%st%nfev = self%st%nfev + 1
         self%fsal_pending = .false.
+        self%f_stale = .false.
     end subroutine rk_refresh_f
 
     !> Whether f at the current point is finite.

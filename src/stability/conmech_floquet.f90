@@ -1,8 +1,10 @@
 !> Floquet theory: multipliers, exponents and stability indices of a monodromy matrix, and a
 !! solver for Hill's equation N'' + Phi(t) N = 0 with a periodic coefficient.
 !!
-!! Multipliers are the eigenvalues of the monodromy matrix M (LAPACK dgeev); Floquet
-!! exponents are log(mu)/T (principal branch of the complex logarithm).
+!! `floquet_analysis`: multipliers as the eigenvalues of a formed monodromy matrix M
+!! (LAPACK dgeev); `floquet_from_multipliers`: from the periodic eigenvalues of its factors
+!! (conmech_periodic_multipliers, what the orbit solvers use). Floquet exponents are
+!! log(mu)/T (principal branch of the complex logarithm).
 !!
 !! Trivial multipliers. A periodic orbit of an autonomous system has the multiplier 1
 !! (eigenvector f(y0)); in a conservative (Hamiltonian) system it is double and forms a
@@ -18,10 +20,12 @@ module conmech_floquet
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate
     use conmech_variational, only: integrate_stm
     use conmech_lapack, only: la_eig
+    use conmech_periodic_multipliers, only: multiplier_set, unit_circle_tolerance
     implicit none
     private
 
     public :: floquet_result, floquet_analysis, planar_stability_index
+    public :: floquet_from_multipliers
     public :: hill_coefficient_fun, hill_equation, hill_result, hill_solve, hill_solve_samples
     public :: fourier_coefficients, fourier_eval
 
@@ -115,6 +119,42 @@ contains
         res%max_abs = maxval(res%abs_mult)
         res%stable = res%max_abs <= 1.0_dp + tl
     end subroutine floquet_analysis
+
+    !> The floquet_result of multipliers computed from the factors of the monodromy
+    !! (conmech_periodic_multipliers): exponents, det (their product), trace (of the
+    !! formed monodromy m) and stability with the tolerance max(1e-6, ten times the
+    !! error estimate of the multipliers near the unit circle).
+    subroutine floquet_from_multipliers(ms, m, t_period, res)
+        type(multiplier_set), intent(in) :: ms
+        real(dp), intent(in) :: m(:, :)
+        real(dp), intent(in) :: t_period
+        type(floquet_result), intent(out) :: res
+        integer :: n, i
+        complex(dp) :: mu
+        res%info = ms%info
+        if (ms%info /= CM_SUCCESS .or. .not. allocated(ms%mr)) return
+        n = size(ms%mr)
+        res%mr = ms%mr
+        res%mi = ms%mi
+        res%abs_mult = sqrt(res%mr**2 + res%mi**2)
+        allocate (res%exponents(n))
+        res%trace = 0.0_dp
+        do i = 1, min(n, size(m, 1), size(m, 2))
+            res%trace = res%trace + m(i, i)
+        end do
+        mu = (1.0_dp, 0.0_dp)
+        do i = 1, n
+            mu = mu*cmplx(res%mr(i), res%mi(i), dp)
+            if (res%abs_mult(i) > 0.0_dp .and. t_period > 0.0_dp) then
+                res%exponents(i) = log(cmplx(res%mr(i), res%mi(i), dp))/t_period
+            else
+                res%exponents(i) = cmplx(-huge(1.0_dp), 0.0_dp, dp)
+            end if
+        end do
+        res%det = real(mu, dp)
+        res%max_abs = maxval(res%abs_mult)
+        res%stable = res%max_abs <= 1.0_dp + unit_circle_tolerance(ms, 1.0e-6_dp)
+    end subroutine floquet_from_multipliers
 
     !> Trace-based stability index of a planar conservative periodic orbit (4 x 4 monodromy):
     !! S = (trace M - 2)/2; linearly stable iff |S| < 1.

@@ -2,16 +2,20 @@
 !!
 !! The monodromy of an autonomous system has the trivial multiplier 1 (the flow direction);
 !! that of a conservative one a double trivial 1 (flow and energy: a Jordan block, only
-!! accurate to ~sqrt(eps) as eigenvalues). Given the vector field f at the orbit's start
-!! (M f = f), the flow direction is deflated exactly: with the Householder reflector H
-!! taking e1 to f/|f|, H M H = [1, *; 0, M'] and the multipliers of M' are the others
-!! (a multiplier crossing 1 near the trivial one is then not mistaken for it). Without f,
-!! or for the second trivial multiplier of a conservative system,
-!! `nontrivial_multipliers` drops the multipliers nearest to 1. From the others (mu_i):
+!! accurate to ~sqrt(eps) as eigenvalues of the formed matrix). The multipliers come from
+!! conmech_periodic_multipliers, where the flow direction is deflated exactly (its
+!! multiplier is the first of the set, and a conservative system's second trivial one a
+!! simple eigenvalue of the rest): a multiplier crossing 1 near the trivial one is not
+!! mistaken for it. Without the deflation (a forced system), or for the second trivial
+!! multiplier of a conservative system, `nontrivial_multipliers` drops the multipliers
+!! nearest to 1. From the others (mu_i):
 !! - branch point / period-preserving bifurcation (a real multiplier through +1):
-!!   psi_bp = prod over real mu_i of (mu_i - 1);
-!! - period doubling (a real multiplier through -1): psi_pd = prod over real mu_i of
-!!   (mu_i + 1);
+!!   psi_bp = prod over the non-trivial mu_i of (mu_i - 1), real (a complex pair gives
+!!   |mu - 1|^2 > 0) and continuous where a pair on the unit circle meets at +1 and
+!!   leaves it along the real axis (mu, 1/mu: a negative factor), as at the halo
+!!   bifurcation of a conservative family;
+!! - period doubling (a real multiplier through -1): psi_pd = prod over the non-trivial
+!!   mu_i of (mu_i + 1), likewise;
 !! - Neimark-Sacker (a complex pair through the unit circle): psi_ns = prod over i < j of
 !!   (mu_i mu_j - 1) (the eigenvalues of the bialternate product, Kuznetsov 2004, sec.
 !!   10.2); it also vanishes at a neutral saddle (real mu, 1/mu), which the caller tells
@@ -22,7 +26,7 @@
 module conmech_multiplier_tests
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: la_eig
+    use conmech_periodic_multipliers, only: multiplier_set
     implicit none
     private
 
@@ -30,52 +34,38 @@ module conmech_multiplier_tests
 
 contains
 
-    !> The multipliers (mr, mi) of m, the non-trivial ones, the test functions
-    !! psi(1:3) = (bp, pd, ns) and the stability index: S = (trace - 2)/2 for a conservative
-    !! 4 x 4 monodromy, else the largest |mu| among the non-trivial multipliers.
-    subroutine multiplier_tests(m, ntrivial, conservative, mr, mi, psi, s, info, f)
-        real(dp), intent(in) :: m(:, :)
+    !> The test functions psi(1:3) = (bp, pd, ns) of the multiplier set `ms` and the
+    !! stability index: S = (trace - 2)/2 for a conservative 4 x 4 monodromy (`trace` of
+    !! the monodromy), else the largest |mu| among the non-trivial multipliers.
+    subroutine multiplier_tests(ms, ntrivial, conservative, trace, psi, s, info)
+        type(multiplier_set), intent(in) :: ms
         integer, intent(in) :: ntrivial
         logical, intent(in) :: conservative
-        real(dp), intent(out) :: mr(:), mi(:), psi(3), s
+        real(dp), intent(in) :: trace
+        real(dp), intent(out) :: psi(3), s
         integer, intent(out) :: info
-        real(dp), intent(in), optional :: f(:)   !! vector field at the start (autonomous)
-        real(dp) :: nr(size(mr)), ni(size(mr)), v(size(mr)), b(size(mr), size(mr))
-        real(dp) :: dr(size(mr)), di(size(mr)), fn
-        integer :: n, k, i
-        n = size(m, 1)
+        real(dp), allocatable :: nr(:), ni(:)
+        integer :: n, k
         psi = 0.0_dp
         s = 0.0_dp
-        call la_eig(m, mr, mi, info)
+        info = ms%info
         if (info /= CM_SUCCESS) return
-        fn = 0.0_dp
-        if (present(f)) fn = norm2(f)
-        if (ntrivial >= 1 .and. n >= 2 .and. fn > 0.0_dp) then
-            ! exact deflation of the flow direction
-            v = f/fn
-            v(1) = v(1) + sign(1.0_dp, v(1))
-            b = m - 2.0_dp*spread(v, 2, n)*spread(matmul(v, m), 1, n)/dot_product(v, v)
-            b = b - 2.0_dp*spread(matmul(b, v), 2, n)*spread(v, 1, n)/dot_product(v, v)
-            call la_eig(b(2:n, 2:n), dr(1:n - 1), di(1:n - 1), info)
-            if (info /= CM_SUCCESS) return
-            call nontrivial_multipliers(dr(1:n - 1), di(1:n - 1), ntrivial - 1, nr, ni, k)
+        n = size(ms%mr)
+        allocate (nr(n), ni(n))
+        if (ms%deflated .and. ntrivial >= 1) then
+            call nontrivial_multipliers(ms%mr(2:), ms%mi(2:), ntrivial - 1, nr, ni, k)
         else
-            call nontrivial_multipliers(mr, mi, ntrivial, nr, ni, k)
+            call nontrivial_multipliers(ms%mr, ms%mi, ntrivial, nr, ni, k)
         end if
         if (conservative .and. n == 4) then
-            s = 0.5_dp*(m(1, 1) + m(2, 2) + m(3, 3) + m(4, 4) - 2.0_dp)
+            s = 0.5_dp*(trace - 2.0_dp)
             psi(1) = s - 1.0_dp
             psi(2) = s + 1.0_dp
             psi(3) = 1.0_dp
             return
         end if
-        psi(1:2) = 1.0_dp
-        do i = 1, k
-            if (ni(i) == 0.0_dp) then
-                psi(1) = psi(1)*(nr(i) - 1.0_dp)
-                psi(2) = psi(2)*(nr(i) + 1.0_dp)
-            end if
-        end do
+        psi(1) = real(product(cmplx(nr(1:k) - 1.0_dp, ni(1:k), dp)), dp)
+        psi(2) = real(product(cmplx(nr(1:k) + 1.0_dp, ni(1:k), dp)), dp)
         psi(3) = ns_product(nr(1:k), ni(1:k))
         if (conservative) psi(3) = 1.0_dp
         s = 0.0_dp

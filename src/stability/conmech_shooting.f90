@@ -19,8 +19,13 @@
 !! (`integrate_stm`, analytic Jacobians where the system has them). A rank-deficient
 !! Newton matrix (rcond 1e-10) is reported as CM_SINGULAR (e.g. a fixed period in an
 !! isochronous system, or a free period in a conservative one), a failed iteration as
-!! CM_NO_CONVERGENCE. On success the monodromy over the full period is integrated and its
-!! Floquet multipliers computed.
+!! CM_NO_CONVERGENCE. On success the monodromy over the full period is integrated (in
+!! `mono_segments` pieces) and its Floquet multipliers computed from the pieces by the
+!! periodic eigenvalue method (conmech_periodic_multipliers), the flow direction deflated.
+!!
+!! With shooting_options%discretisation = ORBIT_MULTIPLE or ORBIT_COLLOCATION both
+!! routines solve the same equations by multiple shooting or orthogonal collocation
+!! instead (conmech_orbit_newton).
 module conmech_shooting
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
@@ -28,57 +33,20 @@ module conmech_shooting
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, METHOD_DOP853
     use conmech_variational, only: integrate_stm
-    use conmech_floquet, only: floquet_result, floquet_analysis
-    use conmech_lapack, only: dgelsd, la_finite
+    use conmech_floquet, only: floquet_result, floquet_from_multipliers
+    use conmech_block_chain, only: lstsq_solve
+    use conmech_orbit_types
+    use conmech_orbit_newton, only: find_orbit_bvp
+    use conmech_periodic_multipliers, only: product_multipliers
     implicit none
     private
 
-    integer, parameter, public :: PO_FREE_PERIOD = 1
-    integer, parameter, public :: PO_FIXED_PERIOD = 2
-    integer, parameter, public :: PO_FIXED_ENERGY = 3
-
+    public :: PO_FREE_PERIOD, PO_FIXED_PERIOD, PO_FIXED_ENERGY
+    public :: ORBIT_SINGLE, ORBIT_MULTIPLE, ORBIT_COLLOCATION
     public :: shooting_options, periodic_orbit, energy_fun, set_parameter_proc
     public :: find_periodic_orbit, find_symmetric_orbit, orbit_monodromy
     public :: continue_symmetric_family, continue_periodic_family, lstsq_solve
-
-    !> Options of the shooting methods.
-    type :: shooting_options
-        integer :: method = METHOD_DOP853     !! integrator of the variational equations
-        real(dp) :: rtol = 1.0e-12_dp         !! its relative tolerance
-        real(dp) :: atol = 1.0e-12_dp         !! its absolute tolerance
-        integer :: max_steps = 100000         !! its step limit per integration
-        integer :: max_iter = 30              !! Newton iterations
-        real(dp) :: tol = 1.0e-10_dp          !! converged when |residual| and |step| <= tol
-        real(dp) :: rcond = 1.0e-10_dp        !! rank threshold of the Newton matrix
-        logical :: monodromy = .true.         !! integrate the monodromy on success
-    end type shooting_options
-
-    !> A periodic orbit.
-    type :: periodic_orbit
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
-        real(dp), allocatable :: y0(:)          !! initial state
-        real(dp) :: period = 0.0_dp
-        real(dp), allocatable :: monodromy(:, :)
-        type(floquet_result) :: floquet         !! multipliers of the monodromy
-        real(dp) :: residual = 0.0_dp           !! max |residual| at the solution
-        integer :: iterations = 0
-    end type periodic_orbit
-
-    abstract interface
-        !> Energy (or any first integral) E(y).
-        function energy_fun(y) result(e)
-            import :: dp
-            real(dp), intent(in) :: y(:)
-            real(dp) :: e
-        end function energy_fun
-        !> Set the continuation parameter of a system.
-        subroutine set_parameter_proc(sys, p)
-            import :: ode_system, dp
-            class(ode_system), intent(inout) :: sys
-            real(dp), intent(in) :: p
-        end subroutine set_parameter_proc
-    end interface
+    public :: symmetric_count_message, orbit_method_name, no_parameter
 
 contains
 
@@ -90,41 +58,6 @@ contains
         oo%atol = o%atol
         oo%max_steps = o%max_steps
     end function ode_opts
-
-    !> Minimum-norm least-squares solution of a x = b (dgelsd); rank returned.
-    subroutine lstsq_solve(a, b, x, rank, info, rcond)
-        real(dp), intent(in) :: a(:, :), b(:)
-        real(dp), intent(out) :: x(:)
-        integer, intent(out) :: rank, info
-        real(dp), intent(in) :: rcond
-        real(dp), allocatable :: aa(:, :), bb(:, :), s(:), work(:)
-        integer, allocatable :: iwork(:)
-        real(dp) :: wq(1)
-        integer :: m, n, ldb, lwork
-        m = size(a, 1)
-        n = size(a, 2)
-        ldb = max(m, n)
-        if (.not. (la_finite(a) .and. la_finite(b))) then
-            rank = 0
-            x = 0.0_dp
-            info = CM_NONFINITE
-            return
-        end if
-        allocate (aa(m, n), bb(ldb, 1), s(min(m, n)), iwork(64*max(m, n) + 64))
-        aa = a
-        bb = 0.0_dp
-        bb(1:m, 1) = b
-        call dgelsd(m, n, 1, aa, m, bb, ldb, s, rcond, rank, wq, -1, iwork, info)
-        lwork = max(1, int(wq(1)))
-        allocate (work(lwork))
-        call dgelsd(m, n, 1, aa, m, bb, ldb, s, rcond, rank, work, lwork, iwork, info)
-        if (info /= 0) then
-            info = CM_NO_CONVERGENCE
-            return
-        end if
-        x = bb(1:n, 1)
-        info = CM_SUCCESS
-    end subroutine lstsq_solve
 
     !> General Newton shooting for a periodic orbit from the guess (y0, period).
     !! `energy` and `energy_value` are required for PO_FIXED_ENERGY (its gradient is
@@ -160,6 +93,18 @@ contains
             then
             orbit%info = CM_BAD_INPUT
             orbit%message = "find_periodic_orbit: PO_FIXED_ENERGY needs energy and energy_value"
+            return
+        end if
+        if (md /= PO_FIXED_PERIOD) then
+            msg = equilibrium_message(sys, y0, period)
+            if (len(msg) > 0) then
+                orbit%info = CM_BAD_INPUT
+                orbit%message = "find_periodic_orbit: "//msg
+                return
+            end if
+        end if
+        if (opt%discretisation /= ORBIT_SINGLE) then
+            call find_orbit_bvp(sys, y0, period, orbit, opt, md, energy, energy_value)
             return
         end if
         neq = n + 1
@@ -235,7 +180,7 @@ contains
         if (orbit%info /= CM_SUCCESS) return
         orbit%y0 = y
         orbit%period = t
-        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt))
+        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt), opt%mono_segments)
     end subroutine find_periodic_orbit
 
     !> Symmetric shooting. y0 holds the fixed components (on the symmetry line); the
@@ -274,6 +219,25 @@ contains
             .or. .not. all(ieee_is_finite(y0))) then
             orbit%info = CM_BAD_INPUT
             orbit%message = "find_symmetric_orbit: bad input (indices, tau > 0, finite y0)"
+            return
+        end if
+        msg = symmetric_count_message(nf, ft_free, ntg, opt%discretisation /= ORBIT_SINGLE)
+        if (len(msg) > 0) then
+            orbit%info = CM_BAD_INPUT
+            orbit%message = "find_symmetric_orbit: "//msg
+            return
+        end if
+        if (ft_free) then
+            msg = equilibrium_message(sys, y0, pf*tau)
+            if (len(msg) > 0) then
+                orbit%info = CM_BAD_INPUT
+                orbit%message = "find_symmetric_orbit: "//msg
+                return
+            end if
+        end if
+        if (opt%discretisation /= ORBIT_SINGLE) then
+            call find_orbit_bvp(sys, y0, pf*tau, orbit, opt, free=free, targets=targets, &
+                                free_time=ft_free, period_factor=pf)
             return
         end if
         allocate (y(n), yt(n), phi(n, n), f(n), jac(ntg, nun), r(ntg), dx(nun))
@@ -328,34 +292,94 @@ contains
         if (orbit%info /= CM_SUCCESS) return
         orbit%y0 = y
         orbit%period = pf*t
-        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt))
+        if (opt%monodromy) call orbit_monodromy(sys, orbit, ode_opts(opt), opt%mono_segments)
     end subroutine find_symmetric_orbit
 
-    !> Integrate the monodromy of orbit (y0, period) and its Floquet multipliers.
-    subroutine orbit_monodromy(sys, orbit, ode)
+    !> Integrate the monodromy of orbit (y0, period) in `pieces` equal pieces (default 1)
+    !! and its Floquet multipliers from them (periodic eigenvalues, the flow direction
+    !! deflated; conmech_periodic_multipliers).
+    subroutine orbit_monodromy(sys, orbit, ode, pieces)
         class(ode_system), intent(in) :: sys
         type(periodic_orbit), intent(inout) :: orbit
         type(ode_options), intent(in) :: ode
-        real(dp), allocatable :: y(:), phi(:, :)
+        integer, intent(in), optional :: pieces
+        real(dp), allocatable :: y(:), phi(:, :, :), fs(:, :), fe(:, :)
         character(len=:), allocatable :: msg
-        integer :: n, info
+        real(dp) :: t0, t1
+        integer :: n, info, np, l, j
         n = size(orbit%y0)
-        allocate (y(n), phi(n, n))
+        np = 1
+        if (present(pieces)) np = max(1, pieces)
+        allocate (y(n), phi(n, n, np), fs(n, np), fe(n, np))
         y = orbit%y0
-        call identity(phi)
-        call integrate_stm(sys, 0.0_dp, orbit%period, y, phi, ode, info, msg)
-        if (info < 0) then
-            orbit%info = info
-            orbit%message = "monodromy: integration failed: "//msg
-            return
-        end if
-        orbit%monodromy = phi
-        call floquet_analysis(phi, orbit%period, orbit%floquet)
+        do l = 1, np
+            t0 = orbit%period*(l - 1)/np
+            t1 = orbit%period*l/np
+            phi(:, :, l) = 0.0_dp
+            do j = 1, n
+                phi(j, j, l) = 1.0_dp
+            end do
+            call sys%rhs(t0, y, fs(:, l))
+            call integrate_stm(sys, t0, t1, y, phi(:, :, l), ode, info, msg)
+            if (info < 0) then
+                orbit%info = info
+                orbit%message = "monodromy: integration failed: "//msg
+                return
+            end if
+            call sys%rhs(t1, y, fe(:, l))
+        end do
+        orbit%monodromy = phi(:, :, 1)
+        do l = 2, np
+            orbit%monodromy = matmul(phi(:, :, l), orbit%monodromy)
+        end do
+        call product_multipliers(phi, orbit%multipliers, fs, fe, max(ode%rtol, ode%atol))
+        call floquet_from_multipliers(orbit%multipliers, orbit%monodromy, orbit%period, &
+                                      orbit%floquet)
         if (orbit%floquet%info /= CM_SUCCESS) then
             orbit%info = orbit%floquet%info
-            orbit%message = "monodromy: eigenvalues failed"
+            orbit%message = "monodromy: the periodic eigenvalue iteration failed"
         end if
     end subroutine orbit_monodromy
+
+    !> "" if nfree free components (and the time, if free_time) can meet ntg targets, else
+    !! a message naming both counts: fewer unknowns than targets is an overdetermined
+    !! system Newton cannot solve in general; more unknowns than targets (a family, e.g.
+    !! an isochronous oscillator: single shooting's minimum-norm Gauss-Newton step picks a
+    !! member) is refused only with `exact` (multiple shooting and collocation).
+    pure function symmetric_count_message(nfree, free_time, ntg, exact) result(msg)
+        integer, intent(in) :: nfree, ntg
+        logical, intent(in) :: free_time, exact
+        character(len=:), allocatable :: msg
+        character(len=64) :: a, b
+        integer :: nun
+        nun = nfree + merge(1, 0, free_time)
+        msg = ""
+        if (nun == ntg .or. (nun > ntg .and. .not. exact)) return
+        write (a, '(i0,a,i0,a)') nun, " unknowns (", nfree, " free components"
+        if (free_time) a = trim(a)//" + the time"
+        write (b, '(i0,a)') ntg, " targets"
+        msg = trim(a)//") for "//trim(b)//": symmetric shooting needs as many "// &
+              "unknowns (free components, and the time if free) as targets"
+    end function symmetric_count_message
+
+    !> "" unless y0 is an equilibrium of an autonomous flow to the resolution of a
+    !! periodic orbit (|f(0, y0)| period <= 1e-10 max(1, |y0|)); then a message saying so.
+    function equilibrium_message(sys, y0, period) result(msg)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: y0(:), period
+        character(len=:), allocatable :: msg
+        real(dp) :: f(size(y0))
+        character(len=32) :: buf
+        call sys%rhs(0.0_dp, y0, f)
+        msg = ""
+        if (.not. all(ieee_is_finite(f))) return
+        if (norm2(f)*period <= 1.0e-10_dp*max(1.0_dp, maxval(abs(y0)))) then
+            write (buf, '(es9.2)') norm2(f)
+            msg = "y0 is an equilibrium (|f(y0)| = "//trim(adjustl(buf))// &
+                  "): a periodic orbit needs a start on the orbit, e.g. a small "// &
+                  "oscillation about the equilibrium"
+        end if
+    end function equilibrium_message
 
     !> Natural-parameter continuation of a symmetric family over the parameters ps: the
     !! parameter is set by `set_param`, each orbit starts from the (linear, then quadratic)

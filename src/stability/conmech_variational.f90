@@ -17,6 +17,8 @@ module conmech_variational
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate
+    use conmech_ode_options, only: METHOD_TAYLOR
+    use conmech_taylor_stepper, only: taylor_propagate
     implicit none
     private
 
@@ -229,6 +231,8 @@ contains
 
     !> Advance the state y and the STM phi (n x n) from t0 to t1 in place.
     !! On entry phi is the STM at t0 (usually the identity); on exit the STM at t1.
+    !! options%method = METHOD_TAYLOR integrates z = [y; Phi] by Taylor's method with the
+    !! system's variational expansion (taylor_size(1) > 0, else CM_BAD_INPUT).
     subroutine integrate_stm(sys, t0, t1, y, phi, options, info, message, stats, state_only)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, t1
@@ -292,7 +296,17 @@ contains
         allocate (z(nz))
         z(1:n) = y
         z(n + 1:) = reshape(phi, [n*n])
-        call ode_integrate(vs, t0, t1, z, opt, info, stats, msg)
+        if (options%method == METHOD_TAYLOR) then
+            ! Taylor's method on the variational system's own expansion (the state and Phi
+            ! by the same recurrences, conmech.symbolic's taylor_var)
+            block
+                type(ode_stats) :: st
+                call taylor_propagate(sys, t0, t1, z, opt, info, st, msg, kind=1)
+                if (present(stats)) stats = st
+            end block
+        else
+            call ode_integrate(vs, t0, t1, z, opt, info, stats, msg)
+        end if
         y = z(1:n)
         phi = reshape(z(n + 1:), [n, n])
         if (present(message)) message = msg

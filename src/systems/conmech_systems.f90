@@ -10,6 +10,8 @@ module conmech_systems
     use conmech_systems_basic
     use conmech_systems_mech, only: make_generalized_ode, mech_initial_state
     use conmech_hill, only: hill_problem
+    use conmech_hill_spatial, only: hill_spatial
+    use conmech_cr3bp, only: cr3bp
     implicit none
     private
     public :: make_system, system_dimension
@@ -18,7 +20,7 @@ contains
 
     !> Allocate a built-in system by name. Parameters (in order):
     !! harmonic: omega | pendulum: g, l | kepler: mu | arenstorf: mu | vanderpol: mu
-    !! | hill: m, kappa
+    !! | hill: m, kappa | hill_spatial: m, kappa | cr3bp: mu
     subroutine make_system(name, params, sys, info, msg)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
@@ -66,6 +68,19 @@ contains
                 if (size(params) >= 2) s%kappa = params(2)
                 allocate (sys, source=s)
             end block
+        case ("hill_spatial")
+            block
+                type(hill_spatial) :: s
+                if (size(params) >= 1) s%m = params(1)
+                if (size(params) >= 2) s%kappa = params(2)
+                allocate (sys, source=s)
+            end block
+        case ("cr3bp")
+            block
+                type(cr3bp) :: s
+                if (size(params) >= 1) s%mu = params(1)
+                allocate (sys, source=s)
+            end block
         case default
             ! the generalized-coordinate seed systems (conmech_systems_mech), y = [q, q']
             call make_generalized_ode(name, params, sys, info, msg)
@@ -82,6 +97,8 @@ contains
             n = 2
         case ("kepler", "arenstorf", "hill")
             n = 4
+        case ("cr3bp", "hill_spatial")
+            n = 6
         case default
             n = 0
             block

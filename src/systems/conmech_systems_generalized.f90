@@ -42,6 +42,8 @@ module conmech_systems_generalized
         procedure :: forces => dp_forces
         procedure :: energy => dp_energy
         procedure :: has_energy => yes_energy_dp
+        procedure :: forces_jacobian => dp_forces_jacobian
+        procedure :: has_forces_jacobian => yes_forces_jacobian_dp
     end type gen_double_pendulum
 
     !> Atwood machine, q = [y1] (downward): (m1 + m2) y1'' = (m1 - m2) g.
@@ -214,6 +216,31 @@ contains
     end function cp_energy
 
     ! ---------------------------------------------------------------- double pendulum
+    !> Exact r = [dQ/dq - d(M a)/dq, dQ/dv]: the variational equations (monodromy,
+    !! transverse linearisation) then need no difference quotients (~1e-10 accurate).
+    subroutine dp_forces_jacobian(self, t, q, v, a, r)
+        class(gen_double_pendulum), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        real(dp) :: k, s, c
+        k = self%m2*self%l1*self%l2
+        s = sin(q(1) - q(2))
+        c = cos(q(1) - q(2))
+        r(1, 1) = -k*c*v(2)**2 - (self%m1 + self%m2)*self%g*self%l1*cos(q(1)) + k*s*a(2)
+        r(1, 2) = k*c*v(2)**2 - k*s*a(2)
+        r(2, 1) = k*c*v(1)**2 + k*s*a(1)
+        r(2, 2) = -k*c*v(1)**2 - self%m2*self%g*self%l2*cos(q(2)) - k*s*a(1)
+        r(1, 3) = 0.0_dp
+        r(1, 4) = -2.0_dp*k*s*v(2)
+        r(2, 3) = 2.0_dp*k*s*v(1)
+        r(2, 4) = 0.0_dp
+    end subroutine dp_forces_jacobian
+    logical function yes_forces_jacobian_dp(self)
+        class(gen_double_pendulum), intent(in) :: self
+        yes_forces_jacobian_dp = .true.
+    end function yes_forces_jacobian_dp
+
     subroutine dp_mass(self, t, q, mm)
         class(gen_double_pendulum), intent(in) :: self
         real(dp), intent(in) :: t

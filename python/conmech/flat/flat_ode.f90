@@ -25,16 +25,38 @@
 !!   `procedure(), pointer, nopass` component at it (see conmech_flat_ode_support);
 !! - results of unknown size go back through a `store` callback, called once at the end.
 
-!> Method code (1 RK4, 2 DOPRI5, 3 DOP853) from a name ("RK4", "DOPRI5"/"RK45",
-!! "DOP853"); 0 if unknown.
+!> Method code from a name of the method table (case-insensitive: "RK4", "DOPRI5",
+!! "RK45", "DOP853", "Radau", ...); 0 if unknown.
 subroutine flat_method_code(name, code)
     use, intrinsic :: iso_c_binding, only: c_int
-    use conmech_ode_solver, only: method_from_name
+    use conmech_ode_methods, only: method_from_name
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(out) :: code
     code = method_from_name(name)
 end subroutine flat_method_code
+
+!> The method table's entry of `code` (conmech_ode_methods): found = 0 if there is none;
+!! its canonical name, aliases (space separated), order and flags = [fixed_step (first_step
+!! is the step, required), uses_jacobian, constrained_only]. Codes run over
+!! 1 .. max_code.
+subroutine flat_method_info(code, found, name, aliases, order, flags, max_code)
+    use, intrinsic :: iso_c_binding, only: c_int
+    use conmech_ode_methods, only: method_info, method_entry, MAX_METHOD_CODE
+    implicit none
+    integer(c_int), intent(in) :: code
+    integer(c_int), intent(out) :: found, order, flags(3), max_code
+    character(len=16), intent(out) :: name
+    character(len=48), intent(out) :: aliases
+    type(method_info) :: mi
+    call method_entry(code, mi)
+    found = merge(1, 0, mi%code /= 0)
+    name = mi%name
+    aliases = mi%aliases
+    order = mi%order
+    flags = merge(1, 0, [mi%fixed_step, mi%uses_jacobian, mi%constrained_only])
+    max_code = MAX_METHOD_CODE
+end subroutine flat_method_info
 
 !> State dimension of a built-in system (0 if the name is unknown).
 subroutine flat_system_dimension(name, n)
@@ -46,31 +68,33 @@ subroutine flat_system_dimension(name, n)
     n = system_dimension(name)
 end subroutine flat_system_dimension
 
-!> Solve y' = fun(t, y) for a Python right-hand side (f2py callback).
+!> Solve y' = fun(t, y) for a Python right-hand side (f2py callback) with any method of
+!! the table and, if has_jac /= 0, a Python Jacobian jac(t, y) -> (n, n) (methods that use
+!! one, e.g. Radau; else forward differences).
 !! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
 !! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
 !! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal. dense_form: form of the
 !! dense coefficients handed to `store` (1 Hairer's, 2 power basis, 0 none).
-subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, atol, &
-                               first_step, max_step, max_steps, dense, neval, t_eval, ne, &
-                               ev_dir, ev_term, nfev, naccept, nreject, dense_form, info, &
-                               message)
+!! counts = [nfev, njev, nlu, naccept, nreject].
+subroutine flat_solve_callback(fun, jac, events, store, n, t_span, y0, method, has_jac, &
+                               rtol, atol, first_step, max_step, max_steps, dense, neval, &
+                               t_eval, ne, ev_dir, ev_term, counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system, run_solve
+    use conmech_flat_ode_support, only: callback_jac_system, run_solve
     implicit none
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)
-    integer(c_int), intent(in) :: method
+    integer(c_int), intent(in) :: method, has_jac
     real(c_double), intent(in) :: rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
     integer(c_int), intent(in) :: max_steps, dense, neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
+    integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
-!f2py external fun, events, store
+!f2py external fun, jac, events, store
     interface
         subroutine fun(t, y, dydt, n)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -79,6 +103,13 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
             real(c_double), intent(in) :: y(n)
             real(c_double), intent(out) :: dydt(n)
         end subroutine fun
+        subroutine jac(t, y, dfdy, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dfdy(n, n)
+        end subroutine jac
         subroutine events(t, y, g, n, ne)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, ne
@@ -99,24 +130,24 @@ subroutine flat_solve_callback(fun, events, store, n, t_span, y0, method, rtol, 
             real(c_double), intent(in) :: coef(n, nf1, nseg)
         end subroutine store
     end interface
-    type(callback_system) :: sys
+    type(callback_jac_system) :: sys
 
     sys%f => fun
     sys%n = n
+    if (has_jac /= 0) sys%jac => jac
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
-                   nreject, dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
+                   dense_form, info, message)
 end subroutine flat_solve_callback
 
-!> Solve y' = f(t, y) for the built-in system `name` with parameters `params` (see
-!! conmech_systems::make_system; params has at least one element, np of them are used):
-!! no Python in the loop unless there are events.
-!! Other arguments as in flat_solve_callback.
+!> Solve y' = f(t, y) for the built-in (or compiled) system `name` with parameters `params`
+!! (see conmech_systems::make_system; params has at least one element, np of them are
+!! used; its analytic Jacobian where the method uses one, else forward differences): no
+!! Python in the loop unless there are events. Other arguments as in flat_solve_callback.
 subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t_span, y0, &
-                              method, rtol, &
-                              atol, first_step, max_step, max_steps, dense, neval, t_eval, &
-                              ne, ev_dir, ev_term, nfev, naccept, nreject, dense_form, &
-                              info, message)
+                              method, rtol, atol, first_step, max_step, max_steps, dense, &
+                              neval, t_eval, ne, ev_dir, ev_term, counts, dense_form, info, &
+                              message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -139,7 +170,7 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
+    integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
 !f2py external events, store
     interface
@@ -167,9 +198,7 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
     character(len=:), allocatable :: msg
     character(len=24) :: buf
 
-    nfev = 0
-    naccept = 0
-    nreject = 0
+    counts = 0
     dense_form = 0
     call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
@@ -184,6 +213,6 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
         return
     end if
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, nfev, naccept, &
-                   nreject, dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
+                   dense_form, info, message)
 end subroutine flat_solve_builtin

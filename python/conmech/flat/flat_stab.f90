@@ -1,6 +1,7 @@
 !> Flat f2py layer of the stability layer: Hill's variation orbit and family, transverse
-!! linearisation, equilibria, state transition matrices, periodic orbits (general and
-!! symmetric shooting) for built-in systems (by name) and Python callbacks, Hill's equation.
+!! linearisation, equilibria, state transition matrices for built-in systems (by name) and
+!! Python callbacks, Hill's equation. Periodic orbits: flat_orbits.f90; continuation:
+!! flat_branch.f90.
 !! Plain subroutines, c_double/c_int explicit-shape arrays, an `info` code and a message.
 !! Nothing is saved between calls; nothing stops or prints.
 !!
@@ -243,71 +244,6 @@ subroutine flat_lagrange_dirichlet(n, hess, tol, stable, w, info)
     stable = merge(1, 0, st)
 end subroutine flat_lagrange_dirichlet
 
-!> Periodic orbit of a built-in system: general shooting (kind 1; mode 1 free period, 2 fixed
-!! period) or symmetric shooting (kind 2; free_idx(nfree), targets(ntg) one-based, tau = period
-!! guess / period_factor, free_time /= 0). Returns y0, period, monodromy and multipliers.
-subroutine flat_orbit_builtin(name, np, params, nspec, spec, n, y0, period, kind, mode, nfree, &
-                              free_idx, ntg, &
-                              targets, free_time, period_factor, rtol, atol, max_iter, y0_out, &
-                              period_out, mono, mr, mi, residual, iterations, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
-    use conmech_support_stab, only: run_orbit
-    implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n, kind, mode, nfree, ntg, free_time, max_iter
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, period_factor, rtol, atol
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
-    real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), residual
-    integer(c_int), intent(out) :: iterations, info
-    character(len=256), intent(out) :: message
-    class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
-    call run_orbit(sys, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, free_time, &
-                   period_factor, rtol, atol, max_iter, y0_out, period_out, mono, mr, mi, &
-                   residual, iterations, info, message)
-end subroutine flat_orbit_builtin
-
-!> As flat_orbit_builtin for a Python right-hand side fun(t, y, dydt, n) (FD Jacobian).
-subroutine flat_orbit_callback(fun, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, &
-                               free_time, period_factor, rtol, atol, max_iter, y0_out, &
-                               period_out, mono, mr, mi, residual, iterations, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system
-    use conmech_support_stab, only: run_orbit
-    implicit none
-    integer(c_int), intent(in) :: n, kind, mode, nfree, ntg, free_time, max_iter
-    real(c_double), intent(in) :: y0(n), period, period_factor, rtol, atol
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1))
-    real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), residual
-    integer(c_int), intent(out) :: iterations, info
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_system) :: sys
-    sys%f => fun
-    sys%n = n
-    call run_orbit(sys, n, y0, period, kind, mode, nfree, free_idx, ntg, targets, free_time, &
-                   period_factor, rtol, atol, max_iter, y0_out, period_out, mono, mr, mi, &
-                   residual, iterations, info, message)
-end subroutine flat_orbit_callback
-
 !> State and state transition matrix of a built-in system from t0 to t1 (DOP853).
 subroutine flat_stm_builtin(name, np, params, nspec, spec, n, y0, t0, t1, rtol, atol, y1, phi, &
                             nfev, info, &
@@ -428,98 +364,6 @@ subroutine flat_hill_equation_callback(phi, period, rtol, mono, half_trace, det,
     end interface
     call callback_hill_solve(phi, period, rtol, mono, half_trace, det, info, message)
 end subroutine flat_hill_equation_callback
-
-!> Pseudo-arclength continuation of a periodic orbit of a built-in system in its parameter
-!! params(ip) (see conmech_continuation; options packed as in run_continuation). The branch
-!! in arrays of mp points (npts used), the special points (nsp, at most 64).
-subroutine flat_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, period, ropt, &
-                                     iopt, nfree, &
-                                     free_idx, ntg, targets, ntang, tang, mp, npts, pp, &
-                                     per, ys, mr, mi, &
-                                     s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
-                                     sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_ode_system, only: ode_system
-    use conmech_param_system, only: builtin_param_system, make_param_system, &
-                                    make_compiled_param_system
-    use conmech_flat_spec, only: spec_system, spec_kind, KIND_BUILTIN
-    use conmech_support_cont, only: run_continuation
-    implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, ip, n, iopt(11), nfree, ntg, mp
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(11)
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
-    real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
-    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
-    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
-    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
-    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
-    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
-    character(len=256), intent(out) :: message
-    type(builtin_param_system) :: sys
-    class(ode_system), allocatable :: inner
-    character(len=:), allocatable :: msg
-    npts = 0
-    nsp = 0
-    if (spec_kind(nspec, spec) == KIND_BUILTIN) then
-        call make_param_system(name, params(1:np), ip, sys, info, msg)
-    else      ! (no BLOCK construct: f2py reads this file)
-        call spec_system(name, params(1:np), nspec, spec, inner, info, msg)
-        if (info == 0) call make_compiled_param_system(inner, params(1:np), ip, sys, info, &
-                                                       msg)
-    end if
-    if (info /= 0) then
-        message = msg
-        return
-    end if
-    call run_continuation(sys, n, y0, period, params(ip), ropt, iopt, nfree, free_idx, ntg, &
-                          targets, ntang, tang, mp, npts, pp, per, ys, mr, mi, s, psi, res, &
-                          iters, nsp, &
-                          sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, &
-                          message)
-end subroutine flat_continuation_builtin
-
-!> As flat_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from the
-!! parameter value p0 (finite-difference Jacobian).
-subroutine flat_continuation_callback(fun, n, y0, period, p0, ropt, iopt, nfree, free_idx, &
-                                      ntg, targets, ntang, tang, mp, npts, pp, per, ys, mr, &
-                                      mi, s, psi, &
-                                      res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
-                                      sp_mr, sp_mi, sp_s, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_support_cont, only: callback_param_system, run_continuation
-    implicit none
-    integer(c_int), intent(in) :: n, iopt(11), nfree, ntg, mp
-    real(c_double), intent(in) :: y0(n), period, p0, ropt(11)
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
-    real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
-    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64), info
-    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
-    real(c_double), intent(out) :: s(mp), psi(4, mp), res(mp)
-    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
-    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64)
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, p, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t, p
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_param_system) :: sys
-    sys%f => fun
-    sys%n = n
-    sys%p = p0
-    call run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, targets, &
-                          ntang, tang, mp, npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, &
-                          sp_kind, &
-                          sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, info, message)
-end subroutine flat_continuation_callback
 
 !> Transverse linearisation of a periodic orbit (y0, period) of the planar natural system
 !! q'' = -grad V + 2 omega J q' with V from the callback pot(q, v, g, h): the 2 x 2 monodromy

@@ -1,38 +1,42 @@
-!> Flat f2py layer of the stepper (conmech.DOP853, conmech.RK45, ... in conmech/_stepper.py):
-!! the stepper's whole state lives in arrays owned by the Python object (r, iv, w; layout
-!! in conmech_flat_stepper_support), copied in and out by every call, so that nothing is
-!! kept in Fortran between calls. action: 0 init at (t0, y0), 1 one accepted step towards
-!! t_bound, 2 dense coefficients of the last step (in w). Conventions as in flat_ode.f90.
+!> Flat f2py layer of the steppers (conmech.DOP853, conmech.RK45, conmech.Radau,
+!! conmech.Gauss6, ... in conmech/_stepper.py): one entry for every method of the method
+!! table. The stepper's whole state lives in arrays owned by the Python object (r(nr),
+!! iv(ni), w(n, nw); sizes from action 3, the common part at the positions
+!! flat_stepper_layout gives), copied in and out by every call, so that nothing is kept in
+!! Fortran between calls. action: 0 init at (t0, y0) and start, 1 one accepted step towards
+!! t_bound, 2 dense coefficients of the last step (in w), 3 the sizes [nr, ni, nw] (init
+!! only). Conventions as in flat_ode.f90.
 
-!> Sizes of the packed state: nr reals, ni integers, nw columns of length n.
-subroutine flat_stepper_sizes(nr, ni, nw)
+!> Positions (1-based) of the common part of a packed state: layout = [r: t, t_old,
+!! h_done; iv: nf, form, nfev, njev, nlu, naccept, nreject; w: y, first dense column].
+subroutine flat_stepper_layout(layout)
     use, intrinsic :: iso_c_binding, only: c_int
-    use conmech_flat_stepper_support, only: NR_STATE, NI_STATE, NW_STATE
+    use conmech_ode_stepper, only: PACK_R_T, PACK_R_TOLD, PACK_R_HDONE, PACK_I_NF, &
+        PACK_I_FORM, PACK_I_NFEV, PACK_I_NJEV, PACK_I_NLU, PACK_I_NACCEPT, PACK_I_NREJECT, &
+        PACK_W_Y, PACK_W_FC
     implicit none
-    integer(c_int), intent(out) :: nr, ni, nw
-    nr = NR_STATE
-    ni = NI_STATE
-    nw = NW_STATE
-end subroutine flat_stepper_sizes
+    integer(c_int), intent(out) :: layout(12)
+    layout = [PACK_R_T, PACK_R_TOLD, PACK_R_HDONE, PACK_I_NF, PACK_I_FORM, PACK_I_NFEV, &
+              PACK_I_NJEV, PACK_I_NLU, PACK_I_NACCEPT, PACK_I_NREJECT, PACK_W_Y, PACK_W_FC]
+end subroutine flat_stepper_layout
 
-!> (r(20), iv(20), w(n, 34): the literal sizes NR_STATE, NI_STATE, NW_STATE of the support
-!! module, checked by the Python layer against flat_stepper_sizes.)
-
-!> One stepper action for a Python right-hand side fun(t, y) (f2py callback).
-subroutine flat_stepper_callback(fun, action, n, t0, t_bound, y0, method, rtol, atol, &
-                                 first_step, max_step, max_steps, r, iv, w, info, message)
+!> One stepper action for a Python right-hand side fun(t, y) and, if has_jac /= 0, its
+!! Jacobian jac(t, y) -> (n, n) (methods that use one; else finite differences).
+subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y0, method, &
+                                 has_jac, rtol, atol, first_step, max_step, max_steps, r, iv, &
+                                 w, sizes, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system
+    use conmech_flat_ode_support, only: callback_jac_system
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
-    integer(c_int), intent(in) :: action, n, method, max_steps
+    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, has_jac, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
-    real(c_double), intent(inout) :: r(20), w(n, 34)
-    integer(c_int), intent(inout) :: iv(20)
-    integer(c_int), intent(out) :: info
+    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
+    integer(c_int), intent(inout) :: iv(max(ni, 1))
+    integer(c_int), intent(out) :: sizes(3), info
     character(len=256), intent(out) :: message
-!f2py external fun
+!f2py external fun, jac
     interface
         subroutine fun(t, y, dydt, n)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -41,18 +45,27 @@ subroutine flat_stepper_callback(fun, action, n, t0, t_bound, y0, method, rtol, 
             real(c_double), intent(in) :: y(n)
             real(c_double), intent(out) :: dydt(n)
         end subroutine fun
+        subroutine jac(t, y, dfdy, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dfdy(n, n)
+        end subroutine jac
     end interface
-    type(callback_system) :: sys
+    type(callback_jac_system) :: sys
     sys%f => fun
     sys%n = n
-    call stepper_action(sys, action, n, t0, t_bound, y0, method, rtol, atol, first_step, &
-                        max_step, max_steps, r, iv, w, info, message)
+    if (has_jac /= 0) sys%jac => jac
+    call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
+                        first_step, max_step, max_steps, r, iv, w, sizes, info, message)
 end subroutine flat_stepper_callback
 
-!> One stepper action for the built-in system `name` with parameters params(1:np).
-subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, t0, t_bound, y0, &
-                                method, rtol, &
-                                atol, first_step, max_step, max_steps, r, iv, w, info, message)
+!> One stepper action for the built-in (or compiled) system `name` with parameters
+!! params(1:np) (its own Jacobian where the method uses one).
+subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni, nw, t0, &
+                                t_bound, y0, method, rtol, atol, first_step, max_step, &
+                                max_steps, r, iv, w, sizes, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -66,15 +79,16 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, t0, t_
     real(c_double), intent(in) :: params(max(np, 1))
     integer(c_int), intent(in) :: nspec
     integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    integer(c_int), intent(in) :: action, n, method, max_steps
+    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
-    real(c_double), intent(inout) :: r(20), w(n, 34)
-    integer(c_int), intent(inout) :: iv(20)
-    integer(c_int), intent(out) :: info
+    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
+    integer(c_int), intent(inout) :: iv(max(ni, 1))
+    integer(c_int), intent(out) :: sizes(3), info
     character(len=256), intent(out) :: message
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
+    sizes = 0
     call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
@@ -86,6 +100,6 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, t0, t_
                           //"'", message)
         return
     end if
-    call stepper_action(sys, action, n, t0, t_bound, y0, method, rtol, atol, first_step, &
-                        max_step, max_steps, r, iv, w, info, message)
+    call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
+                        first_step, max_step, max_steps, r, iv, w, sizes, info, message)
 end subroutine flat_stepper_builtin

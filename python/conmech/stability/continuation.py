@@ -1,5 +1,6 @@
 """Pseudo-arclength continuation of periodic orbits with special points located
-(conmech_continuation), and the switch onto a period-doubled branch."""
+(conmech_continuation), by single shooting, multiple shooting or collocation, and the switch
+onto a period-doubled branch."""
 from __future__ import annotations
 
 from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
@@ -8,43 +9,88 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
+from .._callback import Guard, as_result
 from ..systems import BuiltinSystem
-from ._validate import _check_dim, _msg, _raise, _state
+from ._validate import _check_dim, _count, _msg, _raise, _state
+from .orbits import _METHODS, stable_tolerance
 
 _SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
+_REASONS = {1: "a trial's corrector failed", 2: "a trial left the branch (another branch "
+            "crosses here)", 3: "the iteration limit"}
+
+
+class SpecialKind(str):
+    """The kind of a special point: its name ('fold', 'branch point', 'period doubling',
+    'Neimark-Sacker'), which for a conservative planar orbit (4 x 4 monodromy) also reads as
+    the stability-index event it is: 'S=+1' for a branch point, 'S=-1' for a period
+    doubling (the names conmech.hill uses). ``kind == 'S=+1'`` and ``kind == 'branch
+    point'`` are then both true; hashing and str() use the first name."""
+
+    __slots__ = ("alias",)
+
+    def __new__(cls, name, alias=None):
+        obj = super().__new__(cls, name)
+        obj.alias = alias
+        return obj
+
+    def __eq__(self, other):
+        return str.__eq__(self, other) or (self.alias is not None and other == self.alias)
+
+    def __ne__(self, other):
+        return not self.__eq__(other)
+
+    __hash__ = str.__hash__
+
+    def __repr__(self):
+        return (str.__repr__(self) if self.alias is None
+                else f"{str.__repr__(self)} ({self.alias})")
 
 
 class SpecialPoint:
-    """A located special point of a branch: kind ('fold', 'branch point', 'period
-    doubling', 'Neimark-Sacker'), index (between branch points index and index + 1), p,
-    period, y0, multipliers, stability_index."""
+    """A special point of a branch: kind (a :class:`SpecialKind`: 'fold', 'branch point',
+    'period doubling', 'Neimark-Sacker'; 'S=+1'/'S=-1' also match for conservative planar
+    orbits), index (between branch points index and index + 1), p, period, y0,
+    multipliers, stability_index; located (True when the locator converged; False: the
+    corrector failed or left the branch, and the point is the computed orbit nearest the
+    sign change, never an interpolated state), test (the test function at the point),
+    residual (the closure of its orbit by an independent integration: |y(T) - y0| for
+    single shooting, the largest miss of a node for multiple shooting and collocation),
+    p_bracket (the parameter at the ends of the final bracket around the sign change;
+    both on one side of a fold), message."""
 
-    __slots__ = ("kind", "index", "p", "period", "y0", "multipliers", "stability_index")
+    __slots__ = ("kind", "index", "p", "period", "y0", "multipliers", "stability_index",
+                 "located", "test", "residual", "p_bracket", "message")
 
     def __init__(self, **kw):
         for k in self.__slots__:
             setattr(self, k, kw.get(k))
 
     def __repr__(self):
-        return f"SpecialPoint({self.kind!r}, p={self.p!r}, index={self.index})"
+        loc = "" if self.located else ", not located"
+        return f"SpecialPoint({self.kind!r}, p={self.p!r}, index={self.index}{loc})"
 
 
 class Branch:
     """A branch of periodic orbits from :func:`continuation`.
 
-    Arrays over the points: p (parameter), period, y0 (N, n), multipliers (N, n) complex,
-    stability_index (S = (trace M - 2)/2 for a conservative planar orbit, else the largest
-    |mu| of the non-trivial multipliers), stable (bool), tests (N, 4: fold = parameter
-    component of the tangent, branch point, period doubling, Neimark-Sacker), residual,
-    iterations, energy (if an energy function was given); special (list of SpecialPoint);
-    success, status, message (a branch that stopped early keeps its points: success False
-    and the message names the parameter value); kernel_ratio (a branch from
+    Arrays over the points: p (parameter), period, y0 (N, n), multipliers (N, n) complex
+    (periodic eigenvalues of the segment factors), multiplier_error (N, n: their error
+    estimates), accuracy (N), stability_index (S = (trace M - 2)/2 for a conservative
+    planar orbit, else the largest |mu| of the non-trivial multipliers), stable (bool:
+    |S| <= 1 + tol, or every non-trivial |mu| <= 1 + tol), stable_tol (N: that tol, max(1e-9,
+    ten times the error estimate of the multipliers near the unit circle)), tests (N, 4:
+    fold = parameter component of the tangent, branch point, period doubling,
+    Neimark-Sacker), residual, iterations, energy (if an energy function was given);
+    special (list of SpecialPoint); success, status, message (a branch that stopped early
+    keeps its points: success False and the message names the parameter value); direction
+    (+1/-1: the side continued to first); method; kernel_ratio (a branch from
     :func:`switch_branch_point`: the second smallest singular value of the shooting
     Jacobian at the branch point over the third, small for a genuine branch point)."""
 
     __slots__ = ("p", "period", "y0", "multipliers", "stability_index", "stable", "tests",
                  "residual", "iterations", "energy", "special", "status", "message",
-                 "param", "conservative", "kernel_ratio")
+                 "param", "conservative", "kernel_ratio", "multiplier_error", "accuracy",
+                 "stable_tol", "direction", "method")
 
     def __init__(self, **kw):
         for k in self.__slots__:
@@ -75,13 +121,31 @@ def _param_index(system, param):
     raise ValueError(f"param must be a parameter name or index of '{system.name}'")
 
 
+def _range(value, name):
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a pair (low, high)") from None
+    if np.isnan(lo) or np.isnan(hi) or not lo <= hi:
+        raise ValueError(f"{name} must be a pair (low, high) with low <= high")
+    return max(lo, -1e300), min(hi, 1e300)
+
+
+def _stable(s, mu, merr, conservative, n, tol):
+    if conservative and n == 4:
+        return np.abs(s) <= 1 + tol
+    return s <= 1 + tol
+
+
 def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | None = None,
-                 p0: float | None = None, *, direction=1, ds=0.01, ds_min=1e-8, ds_max=0.1,
-                 p_range=(-np.inf, np.inf), max_points=200, autonomous=True, fixed_period=False,
-                 conservative=False, free=None, targets=None, free_time=False,
-                 period_factor=2.0, rtol=1e-11, atol=1e-11, tol=1e-10, res_tol=1e-8,
-                 max_iter=12, locate=True, locate_tol=1e-11, energy=None, in_period=False,
-                 _switch=0, _tangent=None) -> Branch:
+                 p0: float | None = None, *, direction=None, ds=0.01, ds_min=1e-8,
+                 ds_max=0.1, p_range=(-np.inf, np.inf), max_points=200, autonomous=True,
+                 fixed_period=False, conservative=False, free=None, targets=None,
+                 free_time=False, period_factor=2.0, rtol=1e-11, atol=1e-11, tol=1e-10,
+                 res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11, energy=None,
+                 in_period=False, period_range=(-np.inf, np.inf),
+                 energy_range=(-np.inf, np.inf), method="single", segments=8, degree=4,
+                 intervals=40, _switch=0, _tangent=None) -> Branch:
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -90,13 +154,27 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     General shooting (unknowns y0, period (unless ``fixed_period``), p; phase condition for
     ``autonomous`` systems) or symmetric shooting (``free``, ``targets``: 0-based indices of
     the free initial components and of the components of y(tau) that vanish; tau =
-    period/period_factor, free if ``free_time``). ``conservative``: a second trivial
-    multiplier (energy); continue at a fixed period, or with ``in_period`` along the family
-    of a conservative system without a parameter: the period is the continued quantity
-    (``p`` holds it; ``param``/``p0`` are not needed and a callable is ``fun(t, y)``).
-    ``energy(y, p)``: optional, evaluated along the branch. Raises ValueError on bad input
-    and RuntimeError when the start is not a periodic orbit or not isolated; a branch that
-    stops later is returned with success False and a message naming the parameter value.
+    period/period_factor, free if ``free_time``; as many unknowns besides p as targets).
+    ``conservative``: a second trivial multiplier (energy); continue at a fixed period, or
+    with ``in_period`` along the family of a conservative system without a parameter: the
+    period is the continued quantity (``p`` holds it; ``param``/``p0`` are not needed and a
+    callable is ``fun(t, y)``; general or symmetric shooting).
+
+    ``method``: "single" (default), "multiple" (``segments`` segments) or "collocation"
+    (``intervals`` intervals of ``degree`` Gauss points): the same equations discretised
+    as a boundary-value problem and solved by a structured Newton; the step ``ds``
+    measures the same unknowns (first node, period, parameter) for all three.
+
+    ``direction``: +1 (towards larger p) or -1; None (default): +1 unless the orbit's
+    amplitude shrinks that way to an equilibrium within the branch's reach, then -1 (a
+    family born at an equilibrium is followed away from it). ``p_range``,
+    ``period_range``, ``energy_range`` (with ``energy``): the branch ends exactly on the
+    bound it reaches (the orbit there is computed), or, if that orbit cannot be computed,
+    at the last point inside, with a message. ``energy(y, p)``: optional, evaluated along
+    the branch. Raises ValueError on bad input (a message naming it: inconsistent
+    free/targets counts, a start at an equilibrium) and RuntimeError when the start is not
+    a periodic orbit or not isolated; a branch that stops later is returned with success
+    False and a message naming the parameter value.
     """
     y0 = _state(y0)
     _check_dim(system, y0)
@@ -112,7 +190,25 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             raise ValueError(f"{name} must be positive and finite")
     if not rtol < 1:
         raise ValueError("rtol must be < 1")
-    lo, hi = (float(v) for v in p_range)
+    if not isinstance(method, str) or method not in _METHODS:
+        raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
+    segments = _count(segments, "segments", 1, 100000)
+    degree = _count(degree, "degree", 1, 8)
+    intervals = _count(intervals, "intervals", 2, 100000)
+    if direction is None:
+        dirn = 0
+    elif direction in (1, -1) or (isinstance(direction, (int, float)) and direction != 0):
+        dirn = 1 if direction > 0 else -1
+    else:
+        raise ValueError("direction must be +1, -1 or None (automatic)")
+    lo, hi = _range(p_range, "p_range")
+    tlo, thi = _range(period_range, "period_range")
+    elo, ehi = _range(energy_range, "energy_range")
+    has_range_e = elo > -1e300 or ehi < 1e300
+    if has_range_e and energy is None:
+        raise ValueError("energy_range needs energy(y, p)")
+    if energy is not None and not callable(energy):
+        raise TypeError("energy must be a callable energy(y, p)")
     sym = free is not None or targets is not None
     if sym and (free is None or targets is None):
         raise ValueError("symmetric shooting needs both free and targets")
@@ -121,16 +217,41 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     if sym and (fr.size == 0 or tg.size == 0 or fr.min() < 1 or fr.max() > n
                 or tg.min() < 1 or tg.max() > n):
         raise ValueError("free and targets must be non-empty state indices in range(len(y0))")
-    ropt = np.array([ds, ds_min, ds_max, max(lo, -1e300), min(hi, 1e300), tol, res_tol,
-                     rtol, atol, locate_tol, period_factor], dtype=float)
-    iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(autonomous),
+    if sym:
+        nun = fr.size + (1 if free_time else 0)
+        if nun != tg.size:
+            raise ValueError(
+                f"continuation: {nun} unknowns besides the parameter ({fr.size} free "
+                f"components{' + the time' if free_time else ''}) for {tg.size} targets: "
+                "symmetric shooting needs as many unknowns (free components, and the time if "
+                "free_time) as targets")
+    if in_period and not autonomous:
+        raise ValueError("in_period is for autonomous systems")
+    if in_period and sym and free_time:
+        raise ValueError("in_period continues in the time itself: free_time must be False")
+    if _tangent is not None and not _switch:
+        # start at a known solution with a given first tangent ([y0, T, p], T if free)
+        _switch = 3
+    ropt = np.array([ds, ds_min, ds_max, lo, hi, tol, res_tol, rtol, atol, locate_tol,
+                     period_factor, tlo, thi, elo, ehi], dtype=float)
+    iopt = np.array([max_points, dirn, max_iter, bool(autonomous),
                      bool(fixed_period), bool(conservative), bool(locate), sym,
-                     bool(free_time), int(_switch), bool(in_period)], dtype=np.int32)
-    if in_period and (sym or not autonomous):
-        raise ValueError("in_period is for general shooting of autonomous systems")
+                     bool(free_time), int(_switch), bool(in_period), _METHODS[method],
+                     segments, degree, intervals, bool(has_range_e)], dtype=np.int32)
     tang = np.zeros(1) if _tangent is None else np.array(_tangent, dtype=float).ravel()
+    g = Guard()
+    nan = float("nan")
+
+    def en(y, p):
+        if g.failed:
+            return nan
+        try:
+            return float(as_result(energy(y.copy(), float(p)), (), "energy"))
+        except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
+            g.fail(exc)
+            return nan
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
-            tang.size if _tangent is not None else 0, tang, int(max_points))
+            tang.size if _tangent is not None else 0, tang, int(max_points), en)
     if isinstance(system, BuiltinSystem):
         if param is None and in_period:
             param = 0
@@ -141,8 +262,8 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
         if p0 is not None:
             params[ip] = float(p0)
         name, _, _, nspec, spec = system._flat_args()
-        out = _conmech.flat_continuation_builtin(name, params.size, params, nspec, spec,
-                                                 ip + 1, y0, period, *args)
+        out = _conmech.flat_branch_builtin(name, params.size, params, nspec, spec,
+                                           ip + 1, y0, period, *args)
         pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
     else:
         if not callable(system):
@@ -152,46 +273,65 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             p0 = 0.0
         if p0 is None:
             raise ValueError("p0 (the start value of the parameter) is needed for a callable")
+        nans = np.full(n, np.nan)
 
         def rhs(t, y, p):
-            o = np.asarray(system(t, y) if in_period else system(t, y, p),
-                           dtype=float).ravel()
-            if o.size != n:
-                raise ValueError(f"fun(t, y, p) returned {o.size} values, expected {n}")
-            return o
-        out = _conmech.flat_continuation_callback(rhs, y0, period, float(p0), *args)
+            if g.failed:
+                return nans
+            try:
+                o = system(t, y.copy()) if in_period else system(t, y.copy(), float(p))
+                return as_result(o, (n,), "fun")
+            except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
+                g.fail(exc)
+                return nans
+        out = _conmech.flat_branch_callback(rhs, y0, period, float(p0), *args)
         pname = param if isinstance(param, str) else "p"
-    (npts, pp, per, ys, mr, mi, s, psi, res, iters, nsp, sk, si, sp_p, sp_per, sp_y,
-     sp_mr, sp_mi, sp_s, info, message) = out
+    g.check()
+    (npts, pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, sk, si, sp_p, sp_per,
+     sp_y, sp_mr, sp_mi, sp_s, sp_loc, sp_test, sp_clo, sp_br, dirout, info, message) = out
     npts = int(npts)
     if npts == 0:
         _raise(info, message)
     k = slice(0, npts)
     mult = (np.asarray(mr)[:, k] + 1j*np.asarray(mi)[:, k]).T.copy()
+    merr = np.array(merr[:, k]).T.copy()
     s = np.array(s[k])
-    if conservative and n == 4:
-        stable = np.abs(s) < 1
-    else:
-        stable = s < 1
+    tol_pts = np.array([stable_tolerance(e, m) for e, m in zip(merr, mult)])
+    stable = _stable(s, mult, merr, conservative, n, tol_pts)
+    planar = bool(conservative) and n == 4
     special = []
     for j in range(int(nsp)):
-        special.append(SpecialPoint(kind=_SPECIAL.get(int(sk[j]), "unknown"),
-                                    index=int(si[j]) - 1, p=float(sp_p[j]),
-                                    period=float(sp_per[j]), y0=np.array(sp_y[:, j]),
-                                    multipliers=np.asarray(sp_mr[:, j])
-                                    + 1j*np.asarray(sp_mi[:, j]),
-                                    stability_index=float(sp_s[j])))
+        kind = _SPECIAL.get(int(sk[j]), "unknown")
+        alias = {"branch point": "S=+1", "period doubling": "S=-1"}.get(kind) if planar \
+            else None
+        located = bool(int(sp_loc[j]) % 10)
+        reason = _REASONS.get(int(sp_loc[j]) // 10, "")
+        special.append(SpecialPoint(
+            kind=SpecialKind(kind, alias), index=int(si[j]) - 1, p=float(sp_p[j]),
+            period=float(sp_per[j]), y0=np.array(sp_y[:, j]),
+            multipliers=np.asarray(sp_mr[:, j]) + 1j*np.asarray(sp_mi[:, j]),
+            stability_index=float(sp_s[j]), located=located, test=float(sp_test[j]),
+            residual=float(sp_clo[j]), p_bracket=(float(sp_br[0, j]), float(sp_br[1, j])),
+            message=("located" if located and not reason else
+                     f"located to the bracket p in [{sp_br[0, j]:.12g}, {sp_br[1, j]:.12g}] "
+                     f"({reason})" if located else
+                     f"not located: {reason} (p in [{sp_br[0, j]:.12g}, "
+                     f"{sp_br[1, j]:.12g}]); the point is the computed orbit nearest the sign "
+                     f"change, test = {sp_test[j]:.3g}")))
     ys = np.array(ys[:, k]).T.copy()
     pp = np.array(pp[k])
-    en = None
+    en_vals = None
     if energy is not None:
-        en = np.array([float(energy(y, p)) for y, p in zip(ys, pp)])
+        en_vals = np.array([float(energy(y, p)) for y, p in zip(ys, pp)])
     return Branch(p=pp, period=np.array(per[k]), y0=ys, multipliers=mult,
-                  stability_index=s, stable=stable, tests=np.array(psi[:, k]).T.copy(),
+                  multiplier_error=merr, accuracy=np.array(acc[k]), stability_index=s,
+                  stable=stable, stable_tol=tol_pts, tests=np.array(psi[:, k]).T.copy(),
                   residual=np.array(res[k]), iterations=np.array(iters[k], dtype=int),
-                  energy=en, special=special, status=int(info), message=_msg(message),
+                  energy=en_vals, special=special, status=int(info), message=_msg(message),
                   param="period" if in_period else pname, conservative=bool(conservative),
-                  kernel_ratio=float(tang[0]) if _switch == 2 else None)
+                  kernel_ratio=float(tang[0]) if _switch == 2 else None,
+                  direction=int(dirout), method=method)
+
 
 def switch_period_doubling(system: Any, point: SpecialPoint, param: str | int | None = None,
                            **options) -> Branch:
@@ -199,13 +339,13 @@ def switch_period_doubling(system: Any, point: SpecialPoint, param: str | int | 
     period that bifurcates at ``point`` (a :class:`SpecialPoint` of kind 'period doubling'
     from :func:`continuation` on the same ``system``/``param``). The first step follows the
     eigenvector of the multiplier -1 (``direction`` picks its sign); the other options as
-    for :func:`continuation` (general shooting of an autonomous system)."""
+    for :func:`continuation` (general shooting of an autonomous system; ``method`` too)."""
     if not isinstance(point, SpecialPoint) or point.kind != "period doubling":
         raise ValueError("point must be a 'period doubling' SpecialPoint of a Branch")
     for bad in ("free", "targets", "p0", "_switch", "_tangent"):
         if bad in options:
             raise ValueError(f"{bad} is not an option of switch_period_doubling")
+    if options.get("direction") is None:
+        options["direction"] = 1
     return continuation(system, point.y0, point.period, param=param, p0=point.p,
                         _switch=1, **options)
-
-

@@ -13,13 +13,15 @@ from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
         atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
-        full_output: bool = False) -> tuple:
+        full_output: bool = False, method: str = "DOP853") -> tuple:
     """(y(t1), Phi(t1)) of the state and its state transition matrix from t0 to t1
     (DOP853 with the same step control on the state and the STM).
 
     ``jac``: exact Jacobian jac(t, y) -> (n, n) of a Python system (SciPy's name; default:
     central finite differences, accurate to ~1e-6 relative). With ``full_output`` a third
-    item, a dict {nfev, njev}, is returned."""
+    item, a dict {nfev, njev}, is returned. ``method="TAYLOR"``: Taylor's method on the
+    variational system's own recurrences (a system from :func:`conmech.symbolic.ode_system`:
+    the state and Phi expanded together, the step controlled on both)."""
     y0 = _state(y0)
     _check_dim(system, y0)
     try:
@@ -30,7 +32,15 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     rtol, atol = _tols(rtol, atol)
     _no_jac_for_builtin(system, jac)
     njev = 0
-    if isinstance(system, BuiltinSystem):
+    if not isinstance(method, str) or method.upper() not in ("DOP853", "TAYLOR"):
+        raise ValueError(f"method must be 'DOP853' or 'TAYLOR', got {method!r}")
+    if method.upper() == "TAYLOR":
+        if not isinstance(system, BuiltinSystem):
+            raise ValueError("method 'TAYLOR' needs a compiled system with Taylor code "
+                             "(conmech.symbolic.ode_system), not a Python function")
+        y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(
+            *system._flat_args(), y0, t0, t1, rtol, atol)
+    elif isinstance(system, BuiltinSystem):
         y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
             *system._flat_args(), y0, t0, t1, rtol, atol)
     else:
@@ -51,15 +61,24 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
 
 
 def monodromy(system: Any, y0: ArrayLike, period: float, rtol: float = 1e-12,
-              atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None) -> np.ndarray:
-    """Monodromy matrix Phi(period) of the orbit through y0 (``jac`` as in :func:`stm`)."""
+              atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
+              method: str = "DOP853") -> np.ndarray:
+    """Monodromy matrix Phi(period) of the orbit through y0 (``jac`` and ``method`` as in
+    :func:`stm`)."""
     period = _real(period, "period", 0.0, low_open=True)
-    return stm(system, (0.0, period), y0, rtol, atol, jac=jac)[1]
+    return stm(system, (0.0, period), y0, rtol, atol, jac=jac, method=method)[1]
 
 
-def floquet(m: ArrayLike, period: float) -> dict:
+def floquet(m: ArrayLike, period: float, rel_error: float = 0.0) -> dict:
     """Multipliers (eigenvalues of m), Floquet exponents log(mu)/period and, for a 4 x 4
-    monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict."""
+    monodromy, the trace-based stability index S = (trace - 2)/2. Returns a dict, with
+    ``multiplier_error``: an estimate of each multiplier's absolute error for an m known to
+    the relative accuracy ``rel_error`` (at least 10 eps; e.g. the integrator's rtol), by
+    the statistical condition estimate of conmech_periodic_multipliers (three seeded
+    random perturbations of that size, three times the largest change), and ``accuracy``
+    (the largest error relative to max(1, |mu|)). For multipliers that keep their digits
+    use :func:`periodic_orbit` (method="multiple"): eig of a formed monodromy of an
+    unstable orbit loses the small multipliers, and the estimate says so."""
     m = np.asarray(m)
     if m.dtype.kind not in "biuf":
         raise TypeError("m must be a real matrix")
@@ -69,10 +88,23 @@ def floquet(m: ArrayLike, period: float) -> dict:
     if not np.all(np.isfinite(m)):
         raise ValueError("m must be finite")
     period = _real(period, "period", 0.0, low_open=True)
+    rel_error = max(_real(rel_error, "rel_error", 0.0), 10*np.finfo(float).eps)
     mu = np.linalg.eigvals(m)
     with np.errstate(divide="ignore", invalid="ignore"):   # a zero multiplier: -inf
         expo = np.log(mu.astype(complex))/period
-    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m))}
+    rng = np.random.default_rng(12345)
+    change = np.zeros(mu.size)
+    for _ in range(3):
+        z = rng.standard_normal(m.shape)
+        z *= rel_error*np.linalg.norm(m)/np.linalg.norm(z)
+        pert = list(np.linalg.eigvals(m + z))
+        for i, v in enumerate(mu):
+            j = int(np.argmin(np.abs(np.asarray(pert) - v)))
+            change[i] = max(change[i], abs(pert.pop(j) - v))
+    err = 3.0*change
+    out = {"multipliers": mu, "exponents": expo, "trace": float(np.trace(m)),
+           "multiplier_error": err,
+           "accuracy": float(np.max(err/np.maximum(1.0, np.abs(mu))))}
     if m.shape == (4, 4):
         out["stability_index"] = 0.5*(np.trace(m) - 2.0)
     return out

@@ -49,9 +49,12 @@ import sympy as sp
 from .build import CompileError, _conmech_version, cache_dir, compile_source, load
 from .codegen import CODEGEN_VERSION, generate
 from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
+from .momenta import (FirstIntegrals, LagrangianSystem, Momenta, as_lagrangian_system,
+                      first_integrals, momenta)
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
-           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model"]
+           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model",
+           "momenta", "first_integrals", "Momenta", "FirstIntegrals", "LagrangianSystem"]
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
@@ -213,14 +216,12 @@ def _system(model):
                   name="symbolic")
     if d.kind == "ode":
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
-                                   **common)
+                                   taylor=compiled.library_taylor(model.lib), **common)
     if d.kind == "generalized":
-        return compiled.generalized_system(d.n, a["mass"], a["forces"],
-                                           forces_jac=a.get("forces_jac"),
-                                           energy=a.get("energy"),
-                                           mass_forces=a.get("mass_forces"),
-                                           accel=a.get("accel"),
-                                           accel_jac=a.get("accel_jac"), **common)
+        return as_lagrangian_system(compiled.generalized_system(
+            d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
+            energy=a.get("energy"), mass_forces=a.get("mass_forces"), accel=a.get("accel"),
+            accel_jac=a.get("accel_jac"), **common))
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
@@ -348,7 +349,8 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      jacobian=True, mass=None, energy=None, flags=None, model_only=False):
+                      jacobian=True, mass=None, energy=None, flags=None, model_only=False,
+                      inputs=None):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -380,7 +382,17 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
         velocities; ``L`` must then be None): the system is M q'' = Q with Q = ``forces``,
         the complete generalized forces (velocity terms included), with the exact
         Jacobian; ``energy`` (an expression in t, q, q') is optional.
+    inputs : list, optional
+        Control inputs: coordinates of q (one input each), input symbols appearing
+        linearly in ``forces``, or a matrix B (ndof x m); then the result is a
+        :class:`conmech.control.ControlledSystem` with M q'' = Q + B(q) u.
     """
+    if inputs is not None:
+        if mass is not None:
+            raise ValueError("inputs= needs the Lagrangian L (not mass=)")
+        from ..control._symbolic import controlled_lagrangian
+        return controlled_lagrangian(L, q, params, forces, inputs, velocities=velocities,
+                                     simplify=simplify, jacobian=jacobian, flags=flags)
     if mass is not None:
         from .direct import derive_direct
         if L is not None:
@@ -465,5 +477,25 @@ __all__ += ["Loop", "PointForce", "consistent_state"]
 from .urdf import Robot, from_urdf, read_urdf  # noqa: E402
 
 __all__ += ["Robot", "from_urdf", "read_urdf"]
+
+# compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
+from .taylor_events import Event, event  # noqa: E402
+
+__all__ += ["Event", "event"]
 __all__ += ["pfaffian", "pfaffian_system", "pfaffian_from_velocities", "pfaffian_of",
             "PfaffianResult", "PfaffianSystemResult"]
+
+# Routh reduction (cyclic coordinates eliminated for given momenta)
+from .reduction import Reduction, ReducedSystem, reduce  # noqa: E402
+
+__all__ += ["reduce", "Reduction", "ReducedSystem"]
+
+# D'Alembert's route (positions, applied forces, generalized forces)
+from .dalembert import DAlembertSystem, dalembert_system  # noqa: E402
+
+# Hamilton's principle along computed motions
+from .action import (Variation, action, check_stationary, first_variation,  # noqa: E402
+                     second_variation)
+
+__all__ += ["dalembert_system", "DAlembertSystem", "action", "first_variation",
+            "second_variation", "check_stationary", "Variation"]

@@ -55,7 +55,8 @@ __all__ = ["emit", "fortran_name_check"]
 _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energy",
              "has_energy", "phi", "phi_jac", "phi_t", "phi_gamma", "nh_matrix", "nh_gamma",
              "rhs", "jacobian", "has_jacobian", "self", "dp", "jacobian_product",
-             "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian"}
+             "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian",
+             "taylor_size", "taylor_jet"}
 _IND = "        "
 
 
@@ -253,9 +254,11 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                   f"        procedure :: has_jacobian => {name}_has_jacobian",
                   f"        procedure :: jacobian_product => {name}_jacobian_product",
                   f"        procedure :: rhs_jacobian_product => {name}_rhs_jacobian_product",
-                  f"        procedure :: has_jacobian_product => {name}_has_jacobian_product",
-                  f"    end type {name}", ""]
+                  f"        procedure :: has_jacobian_product => {name}_has_jacobian_product"]
         pr = em.printer()
+        from .taylor import emitted_taylor
+        tbind, tprocs, _ = emitted_taylor(name, d, pr.names)
+        lines += tbind + [f"    end type {name}", ""]
         body += _ctor(name, name, [], d)
         body += em.proc("ode", name, f"{name}_rhs", ["t", "y", "dydt"],
                         [_decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out")], pr,
@@ -265,6 +268,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                         pr, [("dfdy", d.jac, True)], "dfdy = df/dy (exact, from sympy).")
         body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
         body += _ode_products(name, pr, d)
+        body += tprocs
     elif d.kind == "generalized":
         mech = f"{name}_mech"
         lines += [f"    public :: {name}, {mech}", f"    public :: new_{name}, new_{mech}",

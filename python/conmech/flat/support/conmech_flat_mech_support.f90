@@ -20,10 +20,7 @@ module conmech_flat_mech_support
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system
     use conmech_constrained_solver
-    use conmech_ode_solver, only: METHOD_RATTLE, METHOD_RADAU5
     use conmech_ode_system, only: ode_events
-    use conmech_rattle, only: rattle_solve
-    use conmech_rattle_dae, only: radau_constrained_solve
     use conmech_flat_ode_support, only: copy_message, callback_events
     implicit none
     private
@@ -222,23 +219,10 @@ contains
 
     contains
 
-        !> The solver of `method`, with t_eval if given and the events if present.
+        !> constrained_solve (every method), with t_eval if given and the events if present.
         subroutine dispatch(evs)
             class(ode_events), intent(in), optional :: evs
-            if (method == METHOD_RADAU5) then
-                if (neval > 0) then
-                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, &
-                                                 t_eval(1:neval), events=evs)
-                else
-                    call radau_constrained_solve(sys, t_span, q0, v0, opt, r, events=evs)
-                end if
-            else if (method == METHOD_RATTLE) then
-                if (neval > 0) then
-                    call rattle_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), events=evs)
-                else
-                    call rattle_solve(sys, t_span, q0, v0, opt, r, events=evs)
-                end if
-            else if (neval > 0) then
+            if (neval > 0) then
                 call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), &
                                        events=evs)
             else

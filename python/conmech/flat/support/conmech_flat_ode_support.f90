@@ -92,7 +92,8 @@ contains
         dst = src
     end subroutine copy_message
 
-    !> Solve with `ode_solve` from plain arguments and pass the result to `store`.
+    !> Solve with `ode_solve` (any method of the table) from plain arguments and pass the
+    !! result to `store`; counts = [nfev, njev, nlu, naccept, nreject].
     !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
     !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
     !! t_eval, ev_dir, ev_term have at least one element (f2py cannot pass empty ones).
@@ -100,7 +101,7 @@ contains
     !! conmech_ode_solver: 1 Hairer's, 2 power basis; 0 without dense output).
     subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                          max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
-                         nfev, naccept, nreject, dense_form, info, message)
+                         counts, dense_form, info, message)
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: n
         real(c_double), intent(in) :: t_span(2)
@@ -113,7 +114,7 @@ contains
         integer(c_int), intent(in) :: ne
         integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
         external :: events, store
-        integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
+        integer(c_int), intent(out) :: counts(5), dense_form, info
         character(len=*), intent(out) :: message
 
         type(ode_options) :: opt
@@ -121,10 +122,10 @@ contains
         type(callback_events) :: ev
         real(c_double) :: empty1(0), empty3(n, 1, 0)
         integer :: nseg, nf1
+        integer(c_int) :: nfev
 
         nfev = 0
-        naccept = 0
-        nreject = 0
+        counts = 0
         dense_form = 0
         if (n < 1 .or. neval < 0 .or. ne < 0) then
             info = CM_BAD_INPUT
@@ -165,9 +166,8 @@ contains
             end if
         end if
 
-        nfev = nfev + res%stats%nfev
-        naccept = res%stats%naccept
-        nreject = res%stats%nreject
+        counts = [nfev + res%stats%nfev, res%stats%njev, res%stats%nlu, res%stats%naccept, &
+                  res%stats%nreject]
         info = res%status
         call copy_message(res%message, message)
 

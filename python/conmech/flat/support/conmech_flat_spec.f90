@@ -15,7 +15,11 @@
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
 !!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
 !!     spec(18) (optional, ode) jac_prod: J x for an n x k block x (set_c_jac_prod)
-!!     spec(19) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
+!!     spec(19:22) (optional, ode) Taylor coefficients (set_c_taylor): taylor, its work
+!!         columns, taylor_var (the variational system), its work columns
+!!     spec(23:26) (optional, ode) the same written out for one order (set_c_taylor_fixed):
+!!         taylor, its order, taylor_var, its order
+!!     spec(27) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -28,7 +32,8 @@ module conmech_flat_spec
     use conmech_systems_mech, only: make_constrained, make_generalized
     use conmech_generalized, only: generalized_system, generalized_ode
     use conmech_constrained_system, only: constrained_system
-    use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod
+    use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor, &
+                                set_c_taylor_fixed
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
     implicit none
@@ -74,7 +79,7 @@ contains
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
         if (size(spec) >= 17) fp%accel = fptr(spec(17))
-        if (size(spec) >= 19) fp%accel_jac = fptr(spec(19))
+        if (size(spec) >= 27) fp%accel_jac = fptr(spec(27))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
@@ -112,6 +117,11 @@ contains
                 call make_c_ode(int(spec(2)), fptr(spec(6)), fptr(spec(7)), params, s, &
                                 info, msg)
                 if (size(spec) >= 18) call set_c_jac_prod(s, fptr(spec(18)))
+                if (size(spec) >= 22) call set_c_taylor(s, fptr(spec(19)), int(spec(20)), &
+                                                        fptr(spec(21)), int(spec(22)))
+                if (size(spec) >= 26) call set_c_taylor_fixed(s, fptr(spec(23)), &
+                                                              int(spec(24)), &
+                                                              fptr(spec(25)), int(spec(26)))
                 if (info == CM_SUCCESS) allocate (sys, source=s)
             end block
         case (KIND_GENERALIZED)

@@ -1,0 +1,218 @@
+!> Flat f2py layer of the equilibrium structure: the full analysis of an equilibrium
+!! (eigenvalues, Jordan structure on the imaginary axis, family of equilibria, drift,
+!! classification), the classification of a plain matrix, the linearisation relative to
+!! first integrals, and the degrees of freedom of a constrained system. Plain subroutines,
+!! c_double/c_int explicit-shape arrays, an `info` code and a message. Nothing is saved
+!! between calls; nothing stops or prints.
+!!
+!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n), jac(t, y, dfdy, n).
+
+!> Full equilibrium analysis of a built-in or compiled system (by name / spec) at y.
+subroutine flat_equilibrium_structure_builtin(name, np, params, nspec, spec, n, y, t, tol, &
+                                              jac, wr, wi, kind, saddle, residual, analytic, &
+                                              zero_mult, largest_block, secular_freq, &
+                                              family_dim, family, ndrift, drift, info, &
+                                              message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_flat_spec, only: spec_system
+    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
+    use conmech_support_equilibria, only: unpack_structure
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
+    real(c_double), intent(out) :: family(n, n), drift(n, n)
+    integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
+    integer(c_int), intent(out) :: family_dim, ndrift, info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    type(equilibrium_result) :: e
+    character(len=:), allocatable :: msg
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call analyze_equilibrium(sys, y, e, t, tol)
+    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
+                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
+                          info, message)
+end subroutine flat_equilibrium_structure_builtin
+
+!> As flat_equilibrium_structure_builtin for a Python right-hand side (FD Jacobian).
+subroutine flat_equilibrium_structure_callback(fun, n, y, t, tol, jac, wr, wi, kind, saddle, &
+                                               residual, analytic, zero_mult, largest_block, &
+                                               secular_freq, family_dim, family, ndrift, &
+                                               drift, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_system
+    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
+    use conmech_support_equilibria, only: unpack_structure
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y(n), t, tol
+    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
+    real(c_double), intent(out) :: family(n, n), drift(n, n)
+    integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
+    integer(c_int), intent(out) :: family_dim, ndrift, info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_system) :: sys
+    type(equilibrium_result) :: e
+    sys%f => fun
+    sys%n = n
+    call analyze_equilibrium(sys, y, e, t, tol)
+    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
+                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
+                          info, message)
+end subroutine flat_equilibrium_structure_callback
+
+!> As flat_equilibrium_structure_builtin for a Python right-hand side and Jacobian.
+subroutine flat_equilibrium_structure_callback_jac(fun, jac_fun, n, y, t, tol, jac, wr, wi, &
+                                                   kind, saddle, residual, analytic, &
+                                                   zero_mult, largest_block, secular_freq, &
+                                                   family_dim, family, ndrift, drift, info, &
+                                                   message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_flat_ode_support, only: callback_jac_system
+    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
+    use conmech_support_equilibria, only: unpack_structure
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y(n), t, tol
+    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
+    real(c_double), intent(out) :: family(n, n), drift(n, n)
+    integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
+    integer(c_int), intent(out) :: family_dim, ndrift, info
+    character(len=256), intent(out) :: message
+!f2py external fun, jac_fun
+    interface
+        subroutine fun(t, y, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+        subroutine jac_fun(t, y, dfdy, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dfdy(n, n)
+        end subroutine jac_fun
+    end interface
+    type(callback_jac_system) :: sys
+    type(equilibrium_result) :: e
+    sys%f => fun
+    sys%jac => jac_fun
+    sys%n = n
+    call analyze_equilibrium(sys, y, e, t, tol)
+    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
+                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
+                          info, message)
+end subroutine flat_equilibrium_structure_callback_jac
+
+!> Eigenvalues, Jordan structure and classification of a plain n x n matrix (no family).
+subroutine flat_classify_matrix(n, a, tol, wr, wi, kind, saddle, zero_mult, largest_block, &
+                                secular_freq, ndrift, drift, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_equilibria, only: equilibrium_result, classify_matrix
+    use conmech_support_equilibria, only: unpack_structure
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: a(n, n), tol
+    real(c_double), intent(out) :: wr(n), wi(n), secular_freq, drift(n, n)
+    integer(c_int), intent(out) :: kind, saddle, zero_mult, largest_block, ndrift, info
+    character(len=256), intent(out) :: message
+    type(equilibrium_result) :: e
+    real(c_double) :: jac(n, n), residual, family(n, n)
+    integer(c_int) :: analytic, family_dim
+    call classify_matrix(a, e, tol)
+    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
+                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
+                          info, message)
+end subroutine flat_classify_matrix
+
+!> Linearisation relative to first integrals (gradient rows grads(k, n)) and a family
+!! (tangent family(n, d)): ar(1:m, 1:m) = W^T A W, W = w(:, 1:m)
+!! (conmech_relative_equilibria).
+subroutine flat_relative_linearization(n, k, d, a, grads, family, ar, w, m, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_relative_equilibria, only: relative_linearization
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    integer(c_int), intent(in) :: n, k, d
+    real(c_double), intent(in) :: a(n, n), grads(max(k, 1), n), family(n, max(d, 1))
+    real(c_double), intent(out) :: ar(n, n), w(n, n)
+    integer(c_int), intent(out) :: m, info
+    character(len=256), intent(out) :: message
+    character(len=:), allocatable :: msg
+    call relative_linearization(a, grads(1:k, :), family(:, 1:d), ar, w, m, info, msg)
+    call copy_message(msg, message)
+end subroutine flat_relative_linearization
+
+!> Degrees of freedom of a built-in or compiled constrained system at (t, q) (projected
+!! onto the constraint manifold first when project /= 0); see conmech_degrees_of_freedom.
+subroutine flat_degrees_of_freedom(name, np, params, nspec, spec, n, t, q, project, rank_tol, &
+                                   qout, residual, rank_h, rank_nh, dof, velocity_dof, info, &
+                                   message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_constrained_system, only: constrained_system
+    use conmech_flat_spec, only: spec_constrained
+    use conmech_degrees_of_freedom, only: dof_result, degrees_of_freedom
+    use conmech_flat_ode_support, only: copy_message
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, n, project
+    integer(c_int), intent(in) :: nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), t, q(n), rank_tol
+    real(c_double), intent(out) :: qout(n), residual
+    integer(c_int), intent(out) :: rank_h, rank_nh, dof, velocity_dof, info
+    character(len=256), intent(out) :: message
+    class(constrained_system), allocatable :: cs
+    type(dof_result) :: r
+    character(len=:), allocatable :: msg
+    qout = q
+    residual = 0.0_c_double
+    rank_h = 0
+    rank_nh = 0
+    dof = 0
+    velocity_dof = 0
+    call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
+    if (info /= CM_SUCCESS) then
+        call copy_message(msg, message)
+        return
+    end if
+    if (cs%n /= n) then
+        info = CM_BAD_INPUT
+        message = "degrees_of_freedom: q has the wrong number of components"
+        return
+    end if
+    call degrees_of_freedom(cs, t, q, r, project /= 0, rank_tol)
+    info = r%info
+    call copy_message(r%message, message)
+    if (info /= CM_SUCCESS) return
+    qout = r%q
+    residual = r%residual
+    rank_h = r%rank_h
+    rank_nh = r%rank_nh
+    dof = r%dof
+    velocity_dof = r%velocity_dof
+end subroutine flat_degrees_of_freedom

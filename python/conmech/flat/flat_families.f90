@@ -1,0 +1,180 @@
+!> Flat f2py layer: continuation of equilibria, the first Lyapunov coefficient at a Hopf
+!! point, the energy of a built-in or compiled system, the libration points of the
+!! circular restricted three-body problem (conventions: see flat_ode.f90; the Python side
+!! is conmech.stability.equilibrium_continuation, conmech.systems, conmech.cr3bp).
+
+!> Continuation of the equilibrium y0 of a built-in or compiled system in its parameter ip
+!! (1-based) from params(ip); see conmech_support_families::run_eq_continuation for ropt,
+!! iopt and the packed outputs.
+subroutine flat_eq_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, ropt, &
+                                        iopt, mp, npts, pp, ys, wr, wi, psi, nunst, res, &
+                                        iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, &
+                                        sp_a, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_system, only: ode_system
+    use conmech_param_system, only: builtin_param_system, make_param_system, &
+                                    make_compiled_param_system
+    use conmech_flat_spec, only: spec_system, spec_kind, KIND_BUILTIN
+    use conmech_support_families, only: run_eq_continuation
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, ip, n, iopt(4), mp, nspec
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), y0(n), ropt(11)
+    integer(c_int), intent(out) :: npts, nunst(mp), iters(mp), nsp, spi(5, 64), info
+    real(c_double), intent(out) :: pp(mp), ys(n, mp), wr(n, mp), wi(n, mp), psi(3, mp)
+    real(c_double), intent(out) :: res(mp), spr(8, 64), sp_y(n, 64), sp_wr(n, 64)
+    real(c_double), intent(out) :: sp_wi(n, 64), sp_q(2*n, 64), sp_a(2*n, 64)
+    character(len=256), intent(out) :: message
+    type(builtin_param_system) :: sys
+    class(ode_system), allocatable :: inner
+    character(len=:), allocatable :: msg
+    npts = 0
+    nsp = 0
+    if (spec_kind(nspec, spec) == KIND_BUILTIN) then
+        call make_param_system(name, params(1:np), ip, sys, info, msg)
+    else      ! (no BLOCK construct: f2py reads this file)
+        call spec_system(name, params(1:np), nspec, spec, inner, info, msg)
+        if (info == 0) call make_compiled_param_system(inner, params(1:np), ip, sys, info, &
+                                                       msg)
+    end if
+    if (info /= 0) then
+        message = msg
+        return
+    end if
+    call run_eq_continuation(sys, n, y0, params(ip), ropt, iopt, mp, npts, pp, ys, wr, wi, &
+                             psi, nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, &
+                             sp_a, info, message)
+end subroutine flat_eq_continuation_builtin
+
+!> As flat_eq_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from
+!! the parameter value p0 (finite-difference Jacobian).
+subroutine flat_eq_continuation_callback(fun, n, y0, p0, ropt, iopt, mp, npts, pp, ys, wr, &
+                                         wi, psi, nunst, res, iters, nsp, spi, spr, sp_y, &
+                                         sp_wr, sp_wi, sp_q, sp_a, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_support_cont, only: callback_param_system
+    use conmech_support_families, only: run_eq_continuation
+    implicit none
+    integer(c_int), intent(in) :: n, iopt(4), mp
+    real(c_double), intent(in) :: y0(n), p0, ropt(11)
+    integer(c_int), intent(out) :: npts, nunst(mp), iters(mp), nsp, spi(5, 64), info
+    real(c_double), intent(out) :: pp(mp), ys(n, mp), wr(n, mp), wi(n, mp), psi(3, mp)
+    real(c_double), intent(out) :: res(mp), spr(8, 64), sp_y(n, 64), sp_wr(n, 64)
+    real(c_double), intent(out) :: sp_wi(n, 64), sp_q(2*n, 64), sp_a(2*n, 64)
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, p, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t, p
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_param_system) :: sys
+    sys%f => fun
+    sys%n = n
+    sys%p = p0
+    call run_eq_continuation(sys, n, y0, p0, ropt, iopt, mp, npts, pp, ys, wr, wi, psi, &
+                             nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, sp_a, &
+                             info, message)
+end subroutine flat_eq_continuation_callback
+
+!> The first Lyapunov coefficient at the equilibrium y (time t) of a built-in or compiled
+!! system: out = [omega, re_lambda, l1, scale, l1_error, criticality, exact], q and adj as
+!! [real; imaginary] parts (see conmech_support_families::run_hopf).
+subroutine flat_hopf_builtin(name, np, params, nspec, spec, n, t, y, l1_tol, out, q, adj, &
+                             info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_ode_system, only: ode_system
+    use conmech_flat_spec, only: spec_system
+    use conmech_support_families, only: run_hopf
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, nspec, n
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), t, y(n), l1_tol
+    real(c_double), intent(out) :: out(7), q(2*n), adj(2*n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    out = 0.0_c_double
+    q = 0.0_c_double
+    adj = 0.0_c_double
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    if (info /= CM_SUCCESS) then
+        message = msg
+        return
+    end if
+    call run_hopf(sys, n, t, y, l1_tol, out, q, adj, info, message)
+end subroutine flat_hopf_builtin
+
+!> As flat_hopf_builtin for a Python right-hand side fun(t, y, p, dydt, n) at parameter p.
+subroutine flat_hopf_callback(fun, n, p, t, y, l1_tol, out, q, adj, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_support_cont, only: callback_param_system
+    use conmech_support_families, only: run_hopf
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: p, t, y(n), l1_tol
+    real(c_double), intent(out) :: out(7), q(2*n), adj(2*n)
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+!f2py external fun
+    interface
+        subroutine fun(t, y, p, dydt, n)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            integer(c_int), intent(in) :: n
+            real(c_double), intent(in) :: t, p
+            real(c_double), intent(in) :: y(n)
+            real(c_double), intent(out) :: dydt(n)
+        end subroutine fun
+    end interface
+    type(callback_param_system) :: sys
+    sys%f => fun
+    sys%n = n
+    sys%p = p
+    call run_hopf(sys, n, t, y, l1_tol, out, q, adj, info, message)
+end subroutine flat_hopf_callback
+
+!> The energy (first integral) of a built-in or compiled system at (t, y); info -4 with a
+!! message if it has none (conmech_system_energy).
+subroutine flat_system_energy(name, np, params, nspec, spec, n, t, y, e, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS
+    use conmech_ode_system, only: ode_system
+    use conmech_flat_spec, only: spec_system
+    use conmech_system_energy, only: system_energy
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(c_int), intent(in) :: np, nspec, n
+    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    real(c_double), intent(in) :: params(max(np, 1)), t, y(n)
+    real(c_double), intent(out) :: e
+    integer(c_int), intent(out) :: info
+    character(len=256), intent(out) :: message
+    class(ode_system), allocatable :: sys
+    character(len=:), allocatable :: msg
+    real(dp) :: ev
+    e = 0.0_c_double
+    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    if (info == CM_SUCCESS) call system_energy(sys, t, y, ev, info, msg)
+    message = msg
+    if (info == CM_SUCCESS) e = ev
+end subroutine flat_system_energy
+
+!> The libration points of the CR3BP: pos(:, k) of L_k and its Jacobi constant cj(k).
+subroutine flat_cr3bp_libration(mu, pos, cj, info)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_cr3bp, only: cr3bp_libration_points
+    implicit none
+    real(c_double), intent(in) :: mu
+    real(c_double), intent(out) :: pos(3, 5), cj(5)
+    integer(c_int), intent(out) :: info
+    call cr3bp_libration_points(mu, pos, cj, info)
+end subroutine flat_cr3bp_libration

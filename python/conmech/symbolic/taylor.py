@@ -1,0 +1,938 @@
+"""Taylor coefficients of the solution, generated from the model (automatic differentiation).
+
+For y' = f(t, y, p) the normalized Taylor coefficients y^[k] = y^(k)(t0)/k! follow from
+y^[k+1] = f^[k]/(k + 1), where f^[k] is the k-th coefficient of f along the solution. f is
+decomposed into elementary operations u_m = op(u_a, u_b) on the state, t and earlier
+operations (after sympy's common-subexpression elimination, identical subtrees shared);
+each operation has a recurrence for its k-th coefficient from lower ones (Jorba and Zou
+2005, heyoka's decomposition; Moore's rules):
+
+=========================  ==========================================================
+product c = a b            c[k] = sum_{j=0..k} a[j] b[k-j]
+square c = a^2             c[k] = sum_{j=0..k} a[j] a[k-j]
+quotient c = a / b         c[k] = (a[k] - sum_{j=1..k} b[j] c[k-j]) / b[0]
+square root c = a^(1/2)    c[k] = (a[k] - sum_{j=1..k-1} c[j] c[k-j]) / (2 c[0])
+power c = a^r              c[k] = sum_{j=1..k} ((r + 1) j - k) a[j] c[k-j] / (k a[0])
+exp, sin/cos, sinh/cosh    k c[k] = sum_{j=1..k} j a[j] g[k-j]   (g = c, cos, -sin, ...)
+tan, tanh                  the same with g = 1 + c^2, 1 - c^2 (built after c)
+log, atan, asin, ...       k u[0] c[k] = k a[k] - sum_{j=1..k-1} j c[j] u[k-j]
+                           (u c' = a': u = a, 1 + a^2, sqrt(1 - a^2), ...)
+=========================  ==========================================================
+
+Linear combinations with constant coefficients (sums, differences, scaling by parameters)
+cost one multiply-add per order. Subexpressions of the parameters alone are computed once.
+
+Every recurrence splits into a *history* sum over the coefficients of orders 1..k-1 (all
+known when order k starts) and a few *current* terms in the order-k coefficients of the
+operands. The generated code computes the history sums of all operations in ONE loop over
+j (independent accumulators: the multiply-adds pipeline instead of waiting on one chain),
+then the current terms in dependency order, then y^[k+1]:
+
+    subroutine conmech_taylor(t, order, w, p) bind(C)     ! w(0:order, nw)
+        w(0, 1:n) = y on entry; on exit w(0:order, 1:n) = y^[0..order]
+        (the columns n+1..nw hold the operations' coefficients up to order - 1)
+
+The batch form ``conmech_taylor_batch(t, order, w, p)`` does the same for ``width``
+independent members at once, w(width, 0:order, nw), t(width) (members in the fastest
+dimension: every statement is a short vector operation the compiler turns into SIMD).
+
+:func:`decompose` builds the decomposition; :func:`taylor_procedures` prints the Fortran
+(double, quadruple precision, batch); :func:`TaylorUnsupported` names what cannot be
+expanded (non-smooth functions: Abs, sign, Heaviside, Min, Max, ...).
+"""
+import sympy as sp
+
+from .codegen import FortranPrinter
+
+__all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
+           "variational_exprs", "TAYLOR_VERSION"]
+
+TAYLOR_VERSION = "1"
+
+
+class TaylorUnsupported(ValueError):
+    """The expression contains an operation without a Taylor recurrence here."""
+
+
+class _Lin:
+    """An affine form c0 + sum_i c_i u_i (constant coefficients, columns u_i)."""
+
+    __slots__ = ("c0", "terms")
+
+    def __init__(self, c0=sp.S.Zero, terms=None):
+        self.c0 = sp.sympify(c0)
+        self.terms = dict(terms or {})
+
+    @staticmethod
+    def col(c):
+        return _Lin(0, {c: sp.S.One})
+
+    def scaled(self, s):
+        return _Lin(self.c0 * s, {c: v * s for c, v in self.terms.items()})
+
+    def plus(self, other):
+        out = dict(self.terms)
+        for c, v in other.terms.items():
+            out[c] = out.get(c, 0) + v
+        return _Lin(self.c0 + other.c0, {c: v for c, v in out.items() if v != 0})
+
+    def single(self):
+        """The column if the form is exactly 1*u, else None."""
+        if self.c0 == 0 and len(self.terms) == 1:
+            (c, v), = self.terms.items()
+            if v == 1:
+                return c
+        return None
+
+    def key(self):
+        return (self.c0, tuple(sorted(self.terms.items())))
+
+
+class _Op:
+    """One elementary operation: kind, output columns, argument columns, data."""
+
+    __slots__ = ("kind", "out", "args", "data")
+
+    def __init__(self, kind, out, args, data=None):
+        self.kind, self.out, self.args, self.data = kind, out, args, data or {}
+
+
+# kinds whose history sums weight the argument's coefficients by j
+_JWEIGHT = {"pow", "exp", "sincos", "sinhcosh", "tan", "tanh"}
+_INVERSE = {"log": None, "atan": "1+a2", "asin": "sqrt(1-a2)", "acos": "-sqrt(1-a2)",
+            "asinh": "sqrt(1+a2)", "acosh": "sqrt(a2-1)", "atanh": "1-a2"}
+_SMOOTH_FUNCS = {sp.exp: "exp", sp.log: "log", sp.sin: "sin", sp.cos: "cos",
+                 sp.sinh: "sinh", sp.cosh: "cosh", sp.tan: "tan", sp.tanh: "tanh",
+                 sp.atan: "atan", sp.asin: "asin", sp.acos: "acos", sp.asinh: "asinh",
+                 sp.acosh: "acosh", sp.atanh: "atanh"}
+
+
+class Decomposition:
+    """The elementary operations of a set of output expressions.
+
+    state : list of Symbols (columns 1..n), t : the time Symbol, params : parameter
+    Symbols (run-time values p(1..)), outputs : expressions in t, state, params.
+    ``given=False`` (an ODE): output i is y_i'; ``given=True``: the state series is given
+    (e.g. events along a polynomial) and the outputs are materialized as columns.
+
+    Attributes: n, ncol (columns of w), ops (in evaluation order), consts [(name, expr)],
+    outputs (list of _Lin), out_cols (given=True: the output columns), t_col (or None).
+    """
+
+    def __init__(self, outputs, state, t, params, given=False):
+        self.state = list(state)
+        self.n = len(self.state)
+        self.t = t
+        self.params = list(params)
+        self.given = given
+        self.ops = []
+        self.consts = []               # (name, sympy expr in params / earlier consts)
+        self._const_memo = {}
+        self._memo = {}                # sympy expr -> _Lin
+        self._lin_memo = {}            # lin key -> column
+        self._op_memo = {}             # (kind, args, data) -> out columns
+        self.ncol = self.n + (len(outputs) if given else 0)   # given: the outputs' columns
+        self.t_col = None
+        self._var = set(self.state) | {t}
+        self._cse = {}
+        exprs = [sp.sympify(e) for e in outputs]
+        for e in exprs:
+            for f in e.atoms(sp.Function):
+                if not (type(f) in _SMOOTH_FUNCS or isinstance(f, sp.Function) and
+                        f.func in _SMOOTH_FUNCS):
+                    raise TaylorUnsupported(
+                        f"{type(f).__name__} ({f}) has no Taylor recurrence: the Taylor "
+                        "integrator needs smooth functions (exp, log, sin, cos, tan, sinh, "
+                        "cosh, tanh, their inverses, powers and roots)")
+            for a in e.atoms(sp.Abs, sp.Min, sp.Max, sp.Piecewise):
+                raise TaylorUnsupported(f"{a} is not smooth: no Taylor recurrence")
+        repl, red = sp.cse(exprs, symbols=sp.numbered_symbols("tcse", cls=sp.Dummy),
+                           order="none")
+        for s, e in repl:
+            if self._is_const(e):
+                self._cse[s] = ("c", self._const(e))
+            else:
+                self._var.add(s)
+                self._cse[s] = ("v", self._build(e))
+        self.outputs = [self._build(e) for e in red]
+        self.out_cols = list(range(self.n + 1, self.n + len(red) + 1)) if given else []
+        # columns whose coefficients enter history sums weighted by j (j u_j): kept as
+        # their own columns, so that each history term is one multiply-add
+        self.jcol = {}
+        for op in self.ops:
+            need = op.args[0] if op.kind in _JWEIGHT else op.out[0] if \
+                op.kind.startswith("inv_") else None
+            if need is not None and need not in self.jcol:
+                self.jcol[need] = self._new_cols(1)[0]
+
+    # ------------------------------------------------------------------ helpers
+    def _is_const(self, e):
+        return not (e.free_symbols & self._var)
+
+    def _const(self, e):
+        """A constant (no state, no t): a number, or a named value computed once."""
+        e = sp.sympify(e)
+        e = e.xreplace({s: v[1] for s, v in self._cse.items() if v[0] == "c"})
+        if e.is_Number:
+            return e
+        if e in self._const_memo:
+            return self._const_memo[e]
+        name = sp.Dummy(f"tc{len(self.consts) + 1}", real=True)
+        self.consts.append((name, e))
+        self._const_memo[e] = name
+        return name
+
+    def _new_cols(self, k):
+        cols = list(range(self.ncol + 1, self.ncol + k + 1))
+        self.ncol += k
+        return cols
+
+    def _op(self, kind, args, data=None, nout=1):
+        key = (kind, tuple(args), tuple(sorted((data or {}).items(), key=str)))
+        if key in self._op_memo:
+            return self._op_memo[key]
+        out = self._new_cols(nout)
+        self.ops.append(_Op(kind, out, list(args), data))
+        self._op_memo[key] = out
+        return out
+
+    def _mat(self, lin):
+        """The column of an affine form (a linear-combination operation if needed)."""
+        c = lin.single()
+        if c is not None:
+            return c
+        k = lin.key()
+        if k not in self._lin_memo:
+            out = self._new_cols(1)
+            self.ops.append(_Op("lin", out, sorted(lin.terms), {"lin": lin}))
+            self._lin_memo[k] = out[0]
+        return self._lin_memo[k]
+
+    def _col(self, e):
+        return self._mat(self._build(e))
+
+    def _tcol(self):
+        if self.t_col is None:
+            self.t_col = self._new_cols(1)[0]
+            self.ops.append(_Op("time", [self.t_col], []))
+        return self.t_col
+
+    # ------------------------------------------------------------------ build
+    def _build(self, e):
+        """The affine form of expression e (which depends on the state or t)."""
+        if e in self._memo:
+            return self._memo[e]
+        r = self._build_new(e)
+        self._memo[e] = r
+        return r
+
+    def _build_new(self, e):
+        if self._is_const(e):
+            return _Lin(self._const(e))
+        if e.is_Symbol:
+            if e in self._cse:
+                kind, v = self._cse[e]
+                return _Lin(v) if kind == "c" else v
+            if e == self.t:
+                return _Lin.col(self._tcol())
+            return _Lin.col(self.state.index(e) + 1)
+        if e.is_Add:
+            const, var = e.as_independent(*self._var, as_Add=True)
+            out = _Lin(self._const(const) if const != 0 else 0)
+            for term in sp.Add.make_args(var):
+                c, v = term.as_independent(*self._var, as_Add=False)
+                out = out.plus(self._build(v).scaled(self._const(c) if c != 1 else 1))
+            return out
+        if e.is_Mul:
+            c, v = e.as_independent(*self._var, as_Add=False)
+            if c != 1:
+                return self._build(v).scaled(self._const(c))
+            return _Lin.col(self._product(e))
+        if e.is_Pow:
+            return _Lin.col(self._power(e.base, e.exp))
+        if isinstance(e, sp.Function) and e.func in _SMOOTH_FUNCS:
+            return _Lin.col(self._function(_SMOOTH_FUNCS[e.func], e.args[0]))
+        raise TaylorUnsupported(f"cannot expand {type(e).__name__} ({e}) in Taylor series")
+
+    def _product(self, e):
+        """Column of a product of variable factors: numerator chain / denominator chain."""
+        num, den = [], []
+        for f in sp.Mul.make_args(e):
+            b, x = f.as_base_exp()
+            if x.is_Integer and x < 0 and not self._is_const(b):
+                den.append(b ** (-x))
+            else:
+                num.append(f)
+        nc = self._chain(num) if num else None
+        if not den:
+            return nc
+        dc = self._chain(den)
+        if nc is None:
+            return self._op("recip", [dc], {"c": sp.S.One})[0]
+        return self._op("div", [nc, dc])[0]
+
+    def _chain(self, factors):
+        cols = sorted(self._col(f) for f in factors)
+        acc = cols[0]
+        for c in cols[1:]:
+            acc = (self._op("sq", [acc]) if c == acc else
+                   self._op("mul", [min(acc, c), max(acc, c)]))[0]
+        return acc
+
+    def _power(self, b, x):
+        if self._is_const(x):
+            if self._is_const(b):       # cannot happen (caught as constant)
+                raise TaylorUnsupported(f"constant power {b}**{x}")
+            a = self._col(b)
+            if x.is_Number:
+                if x == 1:
+                    return a
+                if x == 2:
+                    return self._op("sq", [a])[0]
+                if x == 3:
+                    return self._op("mul", sorted([a, self._op("sq", [a])[0]]))[0]
+                if x == 4:
+                    return self._op("sq", [self._op("sq", [a])[0]])[0]
+                if x == sp.S.Half:
+                    return self._op("sqrt", [a])[0]
+                if x.is_Integer and x < 0:
+                    return self._op("recip", [self._power(b, -x)], {"c": sp.S.One})[0]
+                if x == 0:
+                    raise TaylorUnsupported("x**0")
+                return self._op("pow", [a], {"r": sp.nsimplify(x) if x.is_Float else x})[0]
+            return self._op("pow", [a], {"r": self._const(x)})[0]
+        # variable exponent: b**x = exp(x log b)
+        if self._is_const(b):
+            lb = self._const(sp.log(b))
+            return self._op("exp", [self._mat(self._build(x).scaled(lb))])[0]
+        return self._function("exp", x * sp.log(b))
+
+    def _function(self, name, arg):
+        a = self._col(arg)
+        if name in ("sin", "cos"):
+            s, c = self._op("sincos", [a], nout=2)
+            return s if name == "sin" else c
+        if name in ("sinh", "cosh"):
+            s, c = self._op("sinhcosh", [a], nout=2)
+            return s if name == "sinh" else c
+        if name == "exp":
+            return self._op("exp", [a])[0]
+        if name in ("tan", "tanh"):
+            key = (name, (a,), ())
+            if key in self._op_memo:
+                return self._op_memo[key][0]
+            out = self._new_cols(1)
+            op = _Op(name, out, [a, None])
+            self.ops.append(op)
+            self._op_memo[key] = out
+            sq = self._op("sq", [out[0]])[0]
+            g = self._mat(_Lin(1, {sq: 1 if name == "tan" else -1}))
+            op.args[1] = g
+            return out[0]
+        if name in _INVERSE:
+            if name == "log":
+                u = a
+            else:
+                a2 = self._op("sq", [a])[0]
+                form = _INVERSE[name]
+                if form == "1+a2":
+                    u = self._mat(_Lin(1, {a2: 1}))
+                elif form == "1-a2":
+                    u = self._mat(_Lin(1, {a2: -1}))
+                elif form == "sqrt(1-a2)":
+                    u = self._op("sqrt", [self._mat(_Lin(1, {a2: -1}))])[0]
+                elif form == "-sqrt(1-a2)":
+                    u = self._mat(_Lin(0, {self._op("sqrt", [self._mat(
+                        _Lin(1, {a2: -1}))])[0]: -1}))
+                elif form == "sqrt(1+a2)":
+                    u = self._op("sqrt", [self._mat(_Lin(1, {a2: 1}))])[0]
+                else:
+                    u = self._op("sqrt", [self._mat(_Lin(-1, {a2: 1}))])[0]
+            return self._op("inv_" + name, [a, u])[0]
+        raise TaylorUnsupported(f"no Taylor recurrence for {name}")
+
+    # ------------------------------------------------------------------ summary
+    def counts(self):
+        """{kind: number of operations}."""
+        out = {}
+        for op in self.ops:
+            out[op.kind] = out.get(op.kind, 0) + 1
+        return out
+
+
+def decompose(exprs, state, t, params, given=False):
+    """The :class:`Decomposition` of the expressions (see the class)."""
+    return Decomposition(exprs, state, t, params, given)
+
+
+def variational_exprs(f, jac, n):
+    """The first-order variational system z' = [f; J Phi] (Phi n x n, column-major in z)
+    as expressions in the state symbols and n*n new Dummies; returns (exprs, phi symbols)."""
+    phi = [sp.Dummy(f"phi{i + 1}_{j + 1}", real=True) for j in range(n) for i in range(n)]
+    P = sp.Matrix(n, n, lambda i, j: phi[j * n + i])
+    JP = jac * P
+    return list(f) + [JP[i, j] for j in range(n) for i in range(n)], phi
+
+
+# ---------------------------------------------------------------------- Fortran printing
+
+class _QuadPrinter(FortranPrinter):
+    """Constants with 36 significant digits (quadruple precision literals)."""
+
+    def _real(self, x):
+        if isinstance(x, int) or getattr(x, "is_Integer", False):
+            return f"{int(x)}.0{self.kind_suffix}"
+        v = sp.Float(x, 40)
+        if not v.is_finite:
+            raise ValueError(f"non-finite constant {x} in an expression")
+        s = str(sp.Float(v, 36))
+        if "." not in s and "e" not in s:
+            s += ".0"
+        return s + self.kind_suffix
+
+    def _print_NumberSymbol(self, expr):
+        return self._real(expr.evalf(40))
+
+    _print_Pi = _print_NumberSymbol
+    _print_Exp1 = _print_NumberSymbol
+
+
+class _Printer:
+    """Statements of one decomposition in scalar (w(k, c)) or batch (w(:, k, c)) form."""
+
+    def __init__(self, dec, names, batch, kind):
+        self.d = dec
+        self.batch = batch
+        self.kind = kind
+        cls = _QuadPrinter if kind == "qp" else FortranPrinter
+        self.pr = cls(names, kind_suffix="_" + kind)
+        self.const_names = {s: f"tc{k + 1}" for k, (s, _) in enumerate(dec.consts)}
+        self.pr.names.update(self.const_names)
+        self.scalars = None      # written-out code: the coefficients as scalars s<c>_<k>
+
+    def w(self, k, c):
+        if self.scalars is not None and isinstance(k, int):
+            name = f"s{c}_{k}"
+            self.scalars.add(name)
+            return name
+        return f"w(:, {k}, {c})" if self.batch else f"w({k}, {c})"
+
+    def num(self, x):
+        """A constant (sympy number or const symbol) as Fortran."""
+        x = sp.sympify(x)
+        if x in self.const_names:
+            return self.const_names[x]
+        return self.pr._print(x)
+
+    def lin_at(self, lin, k, with_const):
+        parts = []
+        if with_const and lin.c0 != 0:
+            parts.append(self.num(lin.c0))
+        for c, v in sorted(lin.terms.items()):
+            v = sp.sympify(v)
+            if v == 1:
+                parts.append(self.w(k, c))
+            elif v == -1:
+                parts.append(f"-{self.w(k, c)}")
+            else:
+                parts.append(f"{self.num(v)}*{self.w(k, c)}")
+        if not parts:
+            return "0.0_" + self.kind
+        s = parts[0]
+        for p in parts[1:]:
+            s += (" - " + p[1:]) if p.startswith("-") else (" + " + p)
+        return s
+
+    def real(self, x):
+        return self.pr._real(x)
+
+    def pow_order0(self, a, r):
+        r = sp.sympify(r)
+        if r in self.const_names:
+            return f"{a}**{self.const_names[r]}"
+        if r.is_Rational and r.q == 2:
+            m = int(r.p)
+            base = f"sqrt({a})"
+            if m == 1:
+                return base
+            if m == -1:
+                return f"{self.real(1)}/{base}"
+            return f"{base}**{m}" if m > 0 else f"{self.real(1)}/{base}**{-m}"
+        return f"{a}**{self.num(r)}"
+
+
+def _wrap(line, ind):
+    from .codegen import _wrap as w
+    return w(line, ind)
+
+
+class _Recipe:
+    """The statements of one decomposition, independent of how the orders are run: the
+    order-0 statements, the history terms (accumulator, left column, right column: the
+    term w(j, left) w(k - j, right), j = 1 .. k - 1) and the current-order statements
+    (functions of E: the order index k, its real fk and reciprocal rk as Fortran text)."""
+
+    def __init__(self, pp, given=False, order_name="order"):
+        self.pp = pp
+        d = pp.d
+        K = pp.kind
+        W = pp.w
+        one = pp.real(1)
+        self.consts = [(pp.const_names[s], pp.pr._print(e)) for s, e in d.consts]
+        s0, hist, cur, accs, invs = [], [], [], [], []
+
+        def JC(c):
+            return d.jcol[c]
+
+        def jset(c):
+            if c in d.jcol:
+                cur.append(lambda E, c=c: f"{W(E['k'], JC(c))} = {E['fk']}*{W(E['k'], c)}")
+        if d.t_col is not None and isinstance(order_name, int):     # written out
+            c = d.t_col
+            s0.append(f"{W(0, c)} = t")
+            for cc in [c] + ([JC(c)] if c in d.jcol else []):
+                s0 += [f"{W(k, cc)} = {one if k == 1 else '0.0_' + K}"
+                       for k in range(1, order_name + 1)]
+        elif d.t_col is not None:
+            c = d.t_col
+            s0.append(f"{W(0, c)} = t")
+            s0.append(f"if ({order_name} >= 1) {W(1, c)} = {one}")
+            s0.append(f"if ({order_name} >= 2) {W(f'2:{order_name}', c)} = 0.0_{K}")
+            if c in d.jcol:
+                s0.append(f"if ({order_name} >= 1) {W(1, JC(c))} = {one}")
+                s0.append(f"if ({order_name} >= 2) {W(f'2:{order_name}', JC(c))} = 0.0_{K}")
+
+        def acc():
+            h = f"h{len(accs) + 1}"
+            accs.append(h)
+            return h
+
+        def inv():
+            v = f"iv{len(invs) + 1}"
+            invs.append(v)
+            return v
+        for op in d.ops:
+            kind = op.kind
+            if kind == "time":
+                continue
+            o = op.out[0]
+            a = op.args[0] if op.args else None
+            if kind == "lin":
+                lin = op.data["lin"]
+                s0.append(f"{W(0, o)} = {pp.lin_at(lin, 0, True)}")
+                cur.append(lambda E, o=o, lin=lin: f"{W(E['k'], o)} = "
+                           f"{pp.lin_at(lin, E['k'], False)}")
+            elif kind == "mul":
+                b = op.args[1]
+                h = acc()
+                s0.append(f"{W(0, o)} = {W(0, a)}*{W(0, b)}")
+                hist.append((h, a, b))
+                cur.append(lambda E, o=o, a=a, b=b, h=h: f"{W(E['k'], o)} = {h} + "
+                           f"{W(0, a)}*{W(E['k'], b)} + {W(E['k'], a)}*{W(0, b)}")
+            elif kind == "sq":
+                h = acc()
+                s0.append(f"{W(0, o)} = {W(0, a)}**2")
+                hist.append((h, a, a))
+                two = pp.real(2)
+                cur.append(lambda E, o=o, a=a, h=h, two=two: f"{W(E['k'], o)} = {h} + "
+                           f"{two}*{W(0, a)}*{W(E['k'], a)}")
+            elif kind in ("div", "recip"):
+                b = op.args[1] if kind == "div" else op.args[0]
+                h, iv = acc(), inv()
+                s0.append(f"{iv} = {one}/{W(0, b)}")
+                num0 = W(0, a) if kind == "div" else pp.num(op.data["c"])
+                s0.append(f"{W(0, o)} = {num0}*{iv}")
+                hist.append((h, b, o))
+                cur.append(lambda E, o=o, a=a, b=b, h=h, iv=iv, dv=kind == "div":
+                           f"{W(E['k'], o)} = ({W(E['k'], a) + ' - ' if dv else '-'}{h} - "
+                           f"{W(E['k'], b)}*{W(0, o)})*{iv}")
+            elif kind == "sqrt":
+                h, iv = acc(), inv()
+                s0.append(f"{W(0, o)} = sqrt({W(0, a)})")
+                s0.append(f"{iv} = {pp.real(0.5)}/{W(0, o)}")
+                hist.append((h, o, o))
+                cur.append(lambda E, o=o, a=a, h=h, iv=iv:
+                           f"{W(E['k'], o)} = ({W(E['k'], a)} - {h})*{iv}")
+            elif kind == "pow":
+                r = op.data["r"]
+                h, h2, iv = acc(), acc(), inv()
+                s0.append(f"{W(0, o)} = {pp.pow_order0(W(0, a), r)}")
+                s0.append(f"{iv} = {one}/{W(0, a)}")
+                rs = pp.num(r)
+                rp1 = pp.num(sp.sympify(r) + 1) if sp.sympify(r).is_Number else \
+                    f"({rs} + {one})"
+                hist += [(h, a, o), (h2, JC(a), o)]
+                cur.append(lambda E, o=o, a=a, h=h, h2=h2, iv=iv, rs=rs, rp1=rp1:
+                           f"{W(E['k'], o)} = (({rp1}*{h2} - {E['fk']}*{h})*{E['rk']} + "
+                           f"{rs}*{W(E['k'], a)}*{W(0, o)})*{iv}")
+            elif kind == "exp":
+                h = acc()
+                s0.append(f"{W(0, o)} = exp({W(0, a)})")
+                hist.append((h, JC(a), o))
+                cur.append(lambda E, o=o, a=a, h=h: f"{W(E['k'], o)} = {h}*{E['rk']} + "
+                           f"{W(E['k'], a)}*{W(0, o)}")
+            elif kind in ("sincos", "sinhcosh"):
+                sn, cs = op.out
+                hy = kind == "sinhcosh"
+                h, h2 = acc(), acc()
+                s0.append(f"{W(0, sn)} = {'sinh' if hy else 'sin'}({W(0, a)})")
+                s0.append(f"{W(0, cs)} = {'cosh' if hy else 'cos'}({W(0, a)})")
+                hist += [(h, JC(a), cs), (h2, JC(a), sn)]
+                sg = "" if hy else "-"
+                cur.append(lambda E, sn=sn, cs=cs, a=a, h=h: f"{W(E['k'], sn)} = "
+                           f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, cs)}")
+                cur.append(lambda E, sn=sn, cs=cs, a=a, h2=h2, sg=sg: f"{W(E['k'], cs)} = "
+                           f"{sg}({h2}*{E['rk']} + {W(E['k'], a)}*{W(0, sn)})")
+            elif kind in ("tan", "tanh"):
+                g = op.args[1]
+                h = acc()
+                s0.append(f"{W(0, o)} = {kind}({W(0, a)})")
+                hist.append((h, JC(a), g))
+                cur.append(lambda E, o=o, a=a, g=g, h=h: f"{W(E['k'], o)} = "
+                           f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, g)}")
+            elif kind.startswith("inv_"):
+                u = op.args[1]
+                h, iv = acc(), inv()
+                s0.append(f"{W(0, o)} = {kind[4:]}({W(0, a)})")
+                s0.append(f"{iv} = {one}/{W(0, u)}")
+                hist.append((h, JC(o), u))
+                cur.append(lambda E, o=o, a=a, h=h, iv=iv: f"{W(E['k'], o)} = "
+                           f"({W(E['k'], a)} - {h}*{E['rk']})*{iv}")
+            else:
+                raise TaylorUnsupported(f"unknown operation {kind}")
+            for c in op.out:
+                jset(c)
+        self.s0, self.hist, self.cur, self.accs, self.invs = s0, hist, cur, accs, invs
+
+
+def _sum_tree(terms, zero):
+    """A balanced sum of the terms (shorter dependency chains than left to right)."""
+    if not terms:
+        return zero
+    while len(terms) > 1:
+        nxt = [f"({terms[i]} + {terms[i + 1]})" for i in range(0, len(terms) - 1, 2)]
+        if len(terms) % 2:
+            nxt.append(terms[-1])
+        terms = nxt
+    t = terms[0]
+    return t[1:-1] if t.startswith("(") and t.endswith(")") else t
+
+
+def _decls(names, typ, ind):
+    out = []
+    for i in range(0, len(names), 10):
+        out.append(f"{ind}{typ} :: " + ", ".join(names[i:i + 10]))
+    return out
+
+
+def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixed=None):
+    """(declarations, statements) computing the coefficients in w (see the module
+    docstring), for a procedure that declares t, order, w and the names the printer maps
+    the parameters to. kind "dp" or "qp"; batch > 0: w(batch, 0:order, nw), t(batch);
+    given: the state columns are inputs of orders 0..order and the operations are computed
+    up to `order` (the outputs as columns ``dec.out_cols``), else the ODE recursion.
+    fixed: an order p to write out (no loops, literal indices and constants, the history
+    sums as balanced trees); the procedure must then be called with order = p."""
+    pp = _Printer(dec, names, batch > 0, kind)
+    if fixed is not None:
+        pp.scalars = set()
+    rc = _Recipe(pp, given, "order" if fixed is None else fixed)
+    W = pp.w
+    vec = f"({batch})" if batch else ""
+    one = pp.real(1)
+    zero = f"0.0_{kind}"
+    decl = _decls([c for c, _ in rc.consts], f"real({kind})", ind)
+    decl += _decls([f"{x}{vec}" for x in rc.accs + rc.invs], f"real({kind})", ind)
+    body = [f"{ind}if (order < {0 if given else 1}) return"]
+    if fixed is not None:
+        body = [f"{ind}if (order /= {fixed}) return"]
+    for c, e in rc.consts:
+        body += _wrap(f"{c} = {e}", ind)
+    jstate = [i + 1 for i in range(dec.n) if i + 1 in dec.jcol]
+    if given and jstate:      # the given state's j-weighted coefficients, all orders
+        decl += [f"{ind}integer :: kk"]
+        body.append(f"{ind}do kk = 1, order")
+        body += [f"{ind}    {W('kk', dec.jcol[c])} = real(kk, {kind})*{W('kk', c)}"
+                 for c in jstate]
+        body.append(f"{ind}end do")
+    for x in rc.s0:
+        body += _wrap(x, ind)
+    if not given:
+        for i, o in enumerate(dec.outputs):
+            body += _wrap(f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}", ind)
+        body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+    if fixed is None:
+        decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j"]
+        E = {"k": "k", "fk": "fk", "rk": "rk"}
+        loop = [f"{ind}do k = 1, {'order' if given else 'order - 1'}",
+                f"{ind}    fk = real(k, {kind})",
+                f"{ind}    rk = {one}/fk",
+                f"{ind}    rk1 = {one}/(fk + {one})"]
+        loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
+        if rc.hist:
+            loop.append(f"{ind}    do j = 1, k - 1")
+            for h, lft, rgt in rc.hist:
+                loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', rgt)}", ind + "        ")
+            loop.append(f"{ind}    end do")
+        for f in rc.cur:
+            loop += _wrap(f(E), ind + "    ")
+        if not given:
+            for i, o in enumerate(dec.outputs):
+                loop += _wrap(f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})",
+                              ind + "    ")
+            loop += [f"{ind}    {W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}"
+                     for c in jstate]
+        loop.append(f"{ind}end do")
+        if given:      # the outputs into their columns n + 1 .. n + m
+            for c, o in zip(dec.out_cols, dec.outputs):
+                loop += _wrap(f"{W(0, c)} = {pp.lin_at(o, 0, True)}", ind)
+                loop += _wrap(f"if (order >= 1) {W('1:order', c)} = "
+                              f"{pp.lin_at(o, '1:order', False)}", ind)
+        return decl, body + loop
+    last = fixed if given else fixed - 1
+    state_in = [f"{ind}{W(k, c)} = w({k}, {c})" for c in range(1, dec.n + 1)
+                for k in (range(0, fixed + 1) if given else [0])]
+    body = body[:1] + state_in + body[1:]
+    for k in range(1, last + 1):
+        E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
+        for h, lft, rgt in rc.hist:
+            terms = [f"{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)]
+            body += _wrap(f"{h} = {_sum_tree(terms, zero)}", ind)
+        for f in rc.cur:
+            body += _wrap(f(E), ind)
+        if not given:
+            for i, o in enumerate(dec.outputs):
+                body += _wrap(f"{W(k + 1, i + 1)} = ({one}/{pp.real(k + 1)})*("
+                              f"{pp.lin_at(o, k, False)})", ind)
+            body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
+                     for c in jstate]
+    outs = dec.out_cols if given else range(1, dec.n + 1)
+    body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in outs
+             for k in range(0 if given else 1, fixed + 1)]
+    names_s = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
+    decl += _decls(names_s, f"real({kind})", ind)
+    return decl, body
+
+
+def c_routine(dec, names, cname, batch=0, given=False, fixed=None):
+    """The bind(C) routine ``cname(t, order, w, p)`` (double precision; batch > 0: t and w
+    with a leading member dimension; fixed: written out for that order only)."""
+    ind = "        "
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    vec = f"({batch})" if batch else ""
+    head = [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}real(dp), {'value, ' if not batch else ''}intent(in) :: t{vec}",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w({f'{batch}, ' if batch else ''}"
+            f"0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})"]
+    decl, body = body_lines(dec, names, "dp", batch, given, ind, fixed)
+    return head + decl + body + [f"    end subroutine {cname}", ""]
+
+
+def quad_routine(dec, names, cname):
+    """Quadruple precision ``cname(t, order, w, p)`` through C pointers to real128 values
+    (C has no standard 128-bit type): t, w(0:order, nw), p."""
+    ind = "        "
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    head = [f'    subroutine {cname}(tp, order, wp, pp) bind(C, name="{cname}")',
+            f"{ind}type(c_ptr), value, intent(in) :: tp, wp, pp",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(qp), pointer :: tq",
+            f"{ind}real(qp), pointer, contiguous :: wq(:, :), pq(:)",
+            f"{ind}call c_f_pointer(tp, tq)",
+            f"{ind}call c_f_pointer(wp, wq, [order + 1, {nw}])",
+            f"{ind}call c_f_pointer(pp, pq, [{npar}])",
+            f"{ind}call {cname}_body(tq, order, wq, pq)",
+            f"    end subroutine {cname}", ""]
+    inner = [f"    subroutine {cname}_body(t, order, w, p)",
+             f"{ind}real(qp), intent(in) :: t",
+             f"{ind}integer(c_int), intent(in) :: order",
+             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
+             f"{ind}real(qp), intent(in) :: p({npar})"]
+    decl, body = body_lines(dec, names, "qp", 0, False, ind)
+    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
+
+
+def taylor_procedures(dec, names, prefix="conmech_taylor", batch_width=4, quad=True):
+    """Fortran lines of the coefficient routines of a decomposition: ``prefix`` (double),
+    ``prefix_batch`` (batch_width members, if > 0), ``prefix_qp`` (quadruple precision,
+    if quad), and ``prefix_info(info)``: [columns of w, batch width, n, quad]."""
+    lines = c_routine(dec, names, prefix)
+    if batch_width:
+        lines += c_routine(dec, names, prefix + "_batch", batch=batch_width)
+    if quad:
+        lines += quad_routine(dec, names, prefix + "_qp")
+    ind = "        "
+    lines += [f'    subroutine {prefix}_info(info) bind(C, name="{prefix}_info")',
+              f"{ind}integer(c_int), intent(out) :: info(4)",
+              f"{ind}info = [{dec.ncol}, {batch_width}, {dec.n}, {int(quad)}]",
+              f"    end subroutine {prefix}_info", ""]
+    return lines
+
+
+def ode_decompositions(d, variational=True):
+    """(decomposition of f, decomposition of [f; J Phi] or None, reason): reason is the
+    TaylorUnsupported message when f has no Taylor recurrences (then both are None)."""
+    try:
+        dec = decompose(list(d.f), d.coords, d.t, d.params)
+    except TaylorUnsupported as exc:
+        return None, None, str(exc)
+    vdec = None
+    if variational:
+        vx, phi = variational_exprs(list(d.f), d.jac, d.n)
+        vdec = decompose(vx, list(d.coords) + phi, d.t, d.params)
+    return dec, vdec, None
+
+
+def ode_taylor_lines(d, names, batch_width=4, quad=True, variational=True):
+    """The Taylor routines of an ode record `d` (:mod:`conmech.symbolic.derive`):
+    (Fortran lines, entry names, reason). ``conmech_taylor`` / ``_batch`` / ``_qp`` /
+    ``_info`` for y' = f, and with `variational` ``conmech_taylor_var`` / ``_var_info`` for
+    z' = [f; J Phi] (the state transition matrix by the same recurrences). An expression
+    without recurrences (non-smooth) gives no lines, no entries and the reason."""
+    dec, vdec, why = ode_decompositions(d, variational)
+    if dec is None:
+        return [], [], why
+    lines = taylor_procedures(dec, names, "conmech_taylor", batch_width, quad)
+    entries = ["taylor", "taylor_info"] + (["taylor_batch"] if batch_width else []) + \
+        (["taylor_qp"] if quad else [])
+    if vdec is not None:
+        lines += taylor_procedures(vdec, names, "conmech_taylor_var", 0, False)
+        entries += ["taylor_var", "taylor_var_info"]
+    return lines, entries, None
+
+
+def emitted_taylor(tname, d, names):
+    """For a standalone module (conmech.symbolic.emit_fortran): the type-bound procedure
+    bindings and the procedures ``taylor_size`` / ``taylor_jet`` of the ode type `tname`
+    (the system, kind 0, and its variational system, kind 1), with the parameters printed
+    through `names` (self%name). Returns ([], [], reason) when f has no recurrences."""
+    dec, vdec, why = ode_decompositions(d, True)
+    if dec is None:
+        return [], [], why
+    ind = "        "
+    binds = [f"        procedure :: taylor_size => {tname}_taylor_size",
+             f"        procedure :: taylor_jet => {tname}_taylor_jet"]
+    procs = [
+        "    !> Columns of the Taylor work array (kind 0: the system, 1: its variational "
+        "system).",
+        f"    integer function {tname}_taylor_size(self, kind)",
+        f"{ind}class({tname}), intent(in) :: self",
+        f"{ind}integer, intent(in) :: kind",
+        f"{ind}{tname}_taylor_size = 0",
+        f"{ind}if (kind == 0) {tname}_taylor_size = {dec.ncol}",
+        f"{ind}if (kind == 1) {tname}_taylor_size = {vdec.ncol}",
+        f"    end function {tname}_taylor_size", "",
+        "    !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated "
+        "recurrences).",
+        f"    subroutine {tname}_taylor_jet(self, kind, t, order, nw, w)",
+        f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+        f"{ind}class({tname}), intent(in) :: self",
+        f"{ind}integer, intent(in) :: kind, order, nw",
+        f"{ind}real(dp), intent(in) :: t",
+        f"{ind}real(dp), intent(inout) :: w(0:order, nw)",
+        f"{ind}if (kind == 0 .and. nw >= {dec.ncol}) then",
+        f"{ind}    call {tname}_taylor0(self, t, order, w)",
+        f"{ind}else if (kind == 1 .and. nw >= {vdec.ncol}) then",
+        f"{ind}    call {tname}_taylor1(self, t, order, w)",
+        f"{ind}else",
+        f"{ind}    w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)",
+        f"{ind}end if",
+        f"    end subroutine {tname}_taylor_jet", ""]
+    for k, dd in enumerate((dec, vdec)):
+        decl, body = body_lines(dd, names, "dp", 0, False, ind)
+        procs += [f"    subroutine {tname}_taylor{k}(self, t, order, w)",
+                  f"{ind}type({tname}), intent(in) :: self",
+                  f"{ind}real(dp), intent(in) :: t",
+                  f"{ind}integer, intent(in) :: order",
+                  f"{ind}real(dp), intent(inout) :: w(0:order, {dd.ncol})"]
+        procs += decl + body + [f"    end subroutine {tname}_taylor{k}", ""]
+    return binds, procs, None
+
+
+def fixed_order_source(d, order, variational=True):
+    """Fortran source of a module with the Taylor routines of the ode record `d` written out
+    for one order (``conmech_taylor_fixed``, and ``conmech_taylor_var_fixed`` with
+    `variational`): no loops, so the compiler schedules every multiply-add of the expansion
+    at once. Same signature and work columns as ``conmech_taylor`` (called with order =
+    `order` only)."""
+    from .codegen import _names
+    dec, vdec, why = ode_decompositions(d, variational)
+    if dec is None:
+        raise TaylorUnsupported(why)
+    names = _names(d)
+    lines = c_routine(dec, names, "conmech_taylor_fixed", fixed=order)
+    if vdec is not None:
+        lines += c_routine(vdec, names, "conmech_taylor_var_fixed", fixed=order)
+    head = ["!> Generated by conmech.symbolic.taylor: Taylor coefficients written out for "
+            f"order {order}. Do not edit.",
+            "module conmech_symbolic_taylor_fixed",
+            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
+            "    implicit none",
+            "    integer, parameter :: dp = c_double",
+            "    public",
+            "contains", ""]
+    return "\n".join(head + lines + ["end module conmech_symbolic_taylor_fixed", ""])
+
+
+def event_source(d, exprs):
+    """Fortran source of a module with the Taylor series of event functions g(t, y) along a
+    given polynomial of the state of the ode record `d` (``conmech_taylor_events(t, order,
+    w, p)``: on entry w(0:order, 1:n) = the state's series, on exit w(0:order, n + 1 ..
+    n + m) the m events' series; order 0 evaluates g) and ``conmech_taylor_events_info``
+    ([work columns, m, n]). The expressions are in the record's symbols (see
+    :func:`event_exprs`)."""
+    from .codegen import _names
+    dec = decompose(list(exprs), d.coords, d.t, d.params, given=True)
+    lines = c_routine(dec, _names(d), "conmech_taylor_events", given=True)
+    ind = "        "
+    lines += ['    subroutine conmech_taylor_events_info(info) bind(C, '
+              'name="conmech_taylor_events_info")',
+              f"{ind}integer(c_int), intent(out) :: info(4)",
+              f"{ind}info = [{dec.ncol}, {len(exprs)}, {dec.n}, 0]",
+              "    end subroutine conmech_taylor_events_info", ""]
+    head = ["!> Generated by conmech.symbolic.taylor: Taylor series of event functions along "
+            "the solution. Do not edit.",
+            "module conmech_symbolic_taylor_events",
+            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
+            "    implicit none",
+            "    integer, parameter :: dp = c_double",
+            "    public",
+            "contains", ""]
+    return "\n".join(head + lines + ["end module conmech_symbolic_taylor_events", ""])
+
+
+def event_exprs(d, exprs):
+    """The event expressions in the symbols of the ode record `d`: the user's symbols are
+    matched by name (a state variable, t, or a parameter); anything else is a ValueError
+    naming it. Non-smooth functions are a TaylorUnsupported error."""
+    byname = dict(zip(getattr(d, "coord_names", [str(c) for c in d.coords]), d.coords))
+    byname.update(zip(d.param_names, d.params))
+    out = []
+    for i, e in enumerate(exprs):
+        try:
+            e = sp.sympify(e)
+        except (sp.SympifyError, TypeError) as exc:
+            raise TypeError(f"events[{i}]: cannot read {e!r} as a sympy expression") from exc
+        if not isinstance(e, sp.Expr):
+            raise TypeError(f"events[{i}]: {e!r} is not a scalar expression")
+        sub = {}
+        for s in e.free_symbols:
+            if s.name == d.t.name:
+                sub[s] = d.t
+            elif s.name in byname:
+                sub[s] = byname[s.name]
+            else:
+                raise ValueError(f"events[{i}]: unknown symbol '{s.name}' (neither t, a state "
+                                 f"variable ({', '.join(map(str, byname))}) nor a parameter)")
+        from sympy.core.function import AppliedUndef
+        for f in e.atoms(AppliedUndef):
+            name = str(f.func)
+            if name not in byname:
+                raise ValueError(f"events[{i}]: unknown function {f}")
+            sub[f] = byname[name]
+        out.append(e.xreplace(sub))
+    return out

@@ -1,0 +1,218 @@
+!> Numerical rank, null spaces, orthonormal ranges and minimum-norm least-squares solutions
+!! by LAPACK's singular value decomposition (dgesvd, dgelsd).
+!!
+!! A singular value sigma_i counts as zero when sigma_i <= thresh; the callers choose thresh
+!! (typically a relative tolerance times the matrix's largest singular value, or times a
+!! scale they know). The SVD is the rank-revealing factorisation of choice here: the
+!! matrices are small (a Jacobian at an equilibrium, a constraint Jacobian) and the rank
+!! decision is the whole point.
+module conmech_rank
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_LAPACK_ERROR, CM_NO_CONVERGENCE, &
+        CM_NONFINITE
+    use conmech_lapack, only: dgesvd, dgelsd, la_finite
+    implicit none
+    private
+
+    public :: svd, singular_values, numerical_rank, null_space, range_basis, min_norm_solve
+
+contains
+
+    !> Full SVD A = U diag(s) V^T of an m x n matrix (dgesvd, jobu = jobvt = 'A'):
+    !! u (m x m), s (min(m, n), descending), vt (n x n).
+    subroutine svd(a, u, s, vt, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: u(:, :)
+        real(dp), intent(out) :: s(:)
+        real(dp), intent(out) :: vt(:, :)
+        integer, intent(out) :: info
+        real(dp), allocatable :: tmp(:, :), work(:)
+        real(dp) :: wq(1)
+        integer :: m, n, lwork, lainfo
+        m = size(a, 1)
+        n = size(a, 2)
+        if (size(u, 1) /= m .or. size(u, 2) /= m .or. size(vt, 1) /= n .or. &
+            size(vt, 2) /= n .or. size(s) /= min(m, n)) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        if (.not. la_finite(a)) then
+            info = CM_NONFINITE
+            return
+        end if
+        if (m == 0 .or. n == 0) then
+            info = CM_SUCCESS
+            if (m > 0) u = identity(m)
+            if (n > 0) vt = identity(n)
+            return
+        end if
+        allocate (tmp(m, n))
+        tmp = a
+        call dgesvd('A', 'A', m, n, tmp, m, s, u, m, vt, n, wq, -1, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork))
+        call dgesvd('A', 'A', m, n, tmp, m, s, u, m, vt, n, work, lwork, lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = CM_NO_CONVERGENCE
+        else
+            info = CM_SUCCESS
+        end if
+    end subroutine svd
+
+    !> Singular values of an m x n matrix (descending; dgesvd without vectors).
+    subroutine singular_values(a, s, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: s(:)
+        integer, intent(out) :: info
+        real(dp), allocatable :: tmp(:, :), work(:)
+        real(dp) :: wq(1), du(1, 1), dv(1, 1)
+        integer :: m, n, lwork, lainfo
+        m = size(a, 1)
+        n = size(a, 2)
+        if (size(s) /= min(m, n)) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        if (.not. la_finite(a)) then
+            info = CM_NONFINITE
+            return
+        end if
+        info = CM_SUCCESS
+        if (m == 0 .or. n == 0) return
+        allocate (tmp(m, n))
+        tmp = a
+        call dgesvd('N', 'N', m, n, tmp, m, s, du, 1, dv, 1, wq, -1, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork))
+        call dgesvd('N', 'N', m, n, tmp, m, s, du, 1, dv, 1, work, lwork, lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = CM_NO_CONVERGENCE
+        end if
+    end subroutine singular_values
+
+    !> Numerical rank: the number of singular values > thresh.
+    subroutine numerical_rank(a, thresh, rank, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: thresh
+        integer, intent(out) :: rank
+        integer, intent(out) :: info
+        real(dp) :: s(min(size(a, 1), size(a, 2)))
+        rank = 0
+        call singular_values(a, s, info)
+        if (info /= CM_SUCCESS) return
+        rank = count(s > thresh)
+    end subroutine numerical_rank
+
+    !> Orthonormal basis of the null space of an m x n matrix: the right singular vectors of
+    !! the singular values <= thresh (and of the n - m missing ones when m < n).
+    !! basis(:, 1:nnull) holds it; basis must have n rows and at least n columns.
+    subroutine null_space(a, thresh, basis, nnull, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: thresh
+        real(dp), intent(out) :: basis(:, :)
+        integer, intent(out) :: nnull
+        integer, intent(out) :: info
+        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
+        integer :: m, n, r
+        m = size(a, 1)
+        n = size(a, 2)
+        nnull = 0
+        basis = 0.0_dp
+        if (size(basis, 1) /= n .or. size(basis, 2) < n) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        allocate (u(m, m), s(min(m, n)), vt(n, n))
+        call svd(a, u, s, vt, info)
+        if (info /= CM_SUCCESS) return
+        r = count(s > thresh)
+        nnull = n - r
+        if (nnull > 0) basis(:, 1:nnull) = transpose(vt(r + 1:n, :))
+    end subroutine null_space
+
+    !> Orthonormal basis of the range (column space) of an m x n matrix: the left singular
+    !! vectors of the singular values > thresh; basis(:, 1:r) holds it (basis: m rows, at
+    !! least min(m, n) columns).
+    subroutine range_basis(a, thresh, basis, r, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: thresh
+        real(dp), intent(out) :: basis(:, :)
+        integer, intent(out) :: r
+        integer, intent(out) :: info
+        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
+        integer :: m, n
+        m = size(a, 1)
+        n = size(a, 2)
+        r = 0
+        basis = 0.0_dp
+        if (size(basis, 1) /= m .or. size(basis, 2) < min(m, n)) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        allocate (u(m, m), s(min(m, n)), vt(n, n))
+        call svd(a, u, s, vt, info)
+        if (info /= CM_SUCCESS) return
+        r = count(s > thresh)
+        if (r > 0) basis(:, 1:r) = u(:, 1:r)
+    end subroutine range_basis
+
+    !> Minimum-norm least-squares solution x = A^+ b of A x = b (dgelsd; m x n A, one
+    !! right-hand side), singular values <= rcond * sigma_max treated as zero; `rank` is
+    !! the effective rank. A and b are not changed.
+    subroutine min_norm_solve(a, b, x, rcond, rank, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: b(:)
+        real(dp), intent(out) :: x(:)
+        real(dp), intent(in) :: rcond
+        integer, intent(out) :: rank
+        integer, intent(out) :: info
+        real(dp), allocatable :: tmp(:, :), rhs(:, :), s(:), work(:)
+        integer, allocatable :: iwork(:)
+        real(dp) :: wq(1)
+        integer :: m, n, lwork, lainfo, iq(1)
+        m = size(a, 1)
+        n = size(a, 2)
+        rank = 0
+        x = 0.0_dp
+        if (size(b) /= m .or. size(x) /= n .or. m == 0 .or. n == 0) then
+            info = CM_BAD_INPUT
+            return
+        end if
+        if (.not. (la_finite(a) .and. all(abs(b) <= huge(1.0_dp)))) then
+            info = CM_NONFINITE
+            return
+        end if
+        allocate (tmp(m, n), rhs(max(m, n), 1), s(min(m, n)))
+        tmp = a
+        rhs = 0.0_dp
+        rhs(1:m, 1) = b
+        call dgelsd(m, n, 1, tmp, m, rhs, max(m, n), s, rcond, rank, wq, -1, iq, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork), iwork(max(1, iq(1))))
+        call dgelsd(m, n, 1, tmp, m, rhs, max(m, n), s, rcond, rank, work, lwork, iwork, &
+                    lainfo)
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = CM_NO_CONVERGENCE
+        else
+            info = CM_SUCCESS
+            x = rhs(1:n, 1)
+        end if
+    end subroutine min_norm_solve
+
+    pure function identity(n) result(e)
+        integer, intent(in) :: n
+        real(dp) :: e(n, n)
+        integer :: i
+        e = 0.0_dp
+        do i = 1, n
+            e(i, i) = 1.0_dp
+        end do
+    end function identity
+
+end module conmech_rank

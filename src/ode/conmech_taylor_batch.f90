@@ -1,0 +1,164 @@
+!> Taylor's method for a batch of members at once: the coefficients of `width` members are
+!! computed together by a generated routine whose arrays have the members in the fastest
+!! dimension (w(width, 0:order, nw): every statement is a short vector operation the
+!! compiler turns into SIMD), and each member steps with its own step size, exactly as
+!! conmech_taylor_stepper would step it alone (same arithmetic from conmech_taylor_core:
+!! bit for bit the same result). A member that has reached tf waits for the others.
+!!
+!! Each round: every member's candidate step is evaluated on its polynomial, the batch is
+!! expanded at all candidate points in one call, and each member accepts (its candidate
+!! becomes its current point, the new expansion its polynomial) or, if the safety check
+!! fails, retries from its current expansion with a shorter step in the next round.
+module conmech_taylor_batch
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_rho, &
+        taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
+    implicit none
+    private
+    public :: taylor_batch_fn, taylor_batch_propagate
+
+    abstract interface
+        !> The batch coefficients: t(width), w(width, 0:order, nw); on entry w(:, 0, 1:n) =
+        !! the members' states, on exit w(:, 0:order, 1:n) their Taylor coefficients.
+        subroutine taylor_batch_fn(t, order, w, p) bind(c)
+            import :: c_double, c_int
+            real(c_double), intent(in) :: t(*)
+            integer(c_int), value :: order
+            real(c_double), intent(inout) :: w(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine taylor_batch_fn
+    end interface
+
+contains
+
+    !> Advance the members y(:, 1:nm) (nm <= width) from t0 to tf in place by Taylor's
+    !! method with the batch routine `fn` (width members, nw work columns, parameters p),
+    !! tolerances rtol, atol (per component), at most max_steps attempted steps and steps of
+    !! at most hmax per member. info(j): CM_SUCCESS, CM_TOO_MANY_STEPS, CM_STEP_TOO_SMALL or
+    !! CM_NONFINITE (y(:, j) where member j stopped, at time tend(j)); nfev counts the
+    !! batch expansions, naccept/nreject each member's steps.
+    subroutine taylor_batch_propagate(fn, width, nw, p, n, nm, t0, tf, y, rtol, atol, hmax, &
+                                      max_steps, info, tend, nfev, naccept, nreject)
+        procedure(taylor_batch_fn) :: fn
+        integer, intent(in) :: width, nw, n, nm, max_steps
+        real(dp), intent(in) :: p(:), t0, tf, rtol(n), atol(n), hmax
+        real(dp), intent(inout) :: y(n, nm)
+        integer, intent(out) :: info(nm), nfev, naccept(nm), nreject(nm)
+        real(dp), intent(out) :: tend(nm)
+        real(dp), allocatable :: w(:, :, :), cur(:, :, :)
+        real(dp) :: t(width), tlo(width), h(width), tc(width), e(n, width), hcand(width)
+        real(dp) :: ynew(n), dy(n), f1(n), eps, decay, posneg, hm, err, rt(n)
+        integer :: ord, j, k, nsteps(width)
+        logical :: active(width), hit(width)
+        info = CM_SUCCESS
+        nfev = 0
+        naccept = 0
+        nreject = 0
+        tend = t0
+        if (nm < 1 .or. tf == t0) return
+        rt = max(rtol, epsilon(1.0_dp))
+        eps = max(minval(rt), minval(atol))
+        ord = taylor_order(eps)
+        decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
+        posneg = sign(1.0_dp, tf - t0)
+        hm = min(abs(hmax), abs(tf - t0))
+        allocate (w(width, 0:ord, nw), cur(0:ord, n, width))
+        w = 0.0_dp
+        t = t0
+        tlo = 0.0_dp
+        nsteps = 0
+        active = .false.
+        active(1:nm) = .true.
+        ! the expansions at t0 (idle lanes repeat the last member)
+        do j = 1, width
+            w(j, 0, 1:n) = y(:, min(j, nm))
+        end do
+        call fn(t, int(ord, c_int), w, p)
+        nfev = nfev + 1
+        do j = 1, nm
+            cur(:, :, j) = w(j, :, 1:n)
+            if (.not. all(ieee_is_finite(cur(1, :, j)))) then
+                info(j) = CM_NONFINITE
+                active(j) = .false.
+                cycle
+            end if
+            call taylor_scales(n, n, y(:, j), rt, atol, e(:, j))
+            h(j) = min(taylor_rho(n, ord, cur(:, :, j), e(:, j), eps, decay), hm)*posneg
+        end do
+        do while (any(active))
+            ! candidate points of the active members
+            do j = 1, width
+                tc(j) = t(min(j, nm))
+                hcand(j) = 0.0_dp
+                hit(j) = .false.
+                if (j > nm) then
+                    w(j, 0, 1:n) = y(:, nm)
+                    cycle
+                end if
+                if (.not. active(j)) then
+                    w(j, 0, 1:n) = y(:, j)
+                    cycle
+                end if
+                if (nsteps(j) >= max_steps) then
+                    info(j) = CM_TOO_MANY_STEPS
+                    active(j) = .false.
+                    w(j, 0, 1:n) = y(:, j)
+                    cycle
+                end if
+                if (.not. (0.1_dp*abs(h(j)) > abs(t(j))*epsilon(1.0_dp))) then
+                    info(j) = CM_STEP_TOO_SMALL
+                    active(j) = .false.
+                    w(j, 0, 1:n) = y(:, j)
+                    cycle
+                end if
+                hcand(j) = h(j)
+                if ((t(j) + hcand(j) - tf)*posneg >= 0.0_dp) then
+                    hcand(j) = (tf - t(j)) - tlo(j)
+                    hit(j) = .true.
+                end if
+                nsteps(j) = nsteps(j) + 1
+                call taylor_eval_step(n, ord, cur(:, :, j), hcand(j), ynew, dy)
+                w(j, 0, 1:n) = ynew
+                tc(j) = t(j) + hcand(j)
+            end do
+            if (.not. any(active)) exit
+            call fn(tc, int(ord, c_int), w, p)
+            nfev = nfev + 1
+            do j = 1, nm
+                if (.not. active(j) .or. hcand(j) == 0.0_dp) cycle
+                call taylor_eval_step(n, ord, cur(:, :, j), hcand(j), ynew, dy)
+                f1 = w(j, 1, 1:n)
+                err = taylor_check(n, ord, hcand(j), ynew, dy, f1, e(:, j))
+                if (.not. (err <= TAYLOR_CHECK_MAX)) then
+                    nreject(j) = nreject(j) + 1
+                    h(j) = taylor_shrink(hcand(j), err, ord)
+                    cycle
+                end if
+                naccept(j) = naccept(j) + 1
+                y(:, j) = ynew
+                cur(:, :, j) = w(j, :, 1:n)
+                if (hit(j)) then
+                    t(j) = tf
+                    tlo(j) = 0.0_dp
+                    active(j) = .false.
+                else
+                    call taylor_add_time(t(j), tlo(j), hcand(j))
+                end if
+                if (.not. all(ieee_is_finite(cur(1, :, j)))) then
+                    info(j) = CM_NONFINITE
+                    active(j) = .false.
+                    cycle
+                end if
+                call taylor_scales(n, n, y(:, j), rt, atol, e(:, j))
+                h(j) = min(taylor_rho(n, ord, cur(:, :, j), e(:, j), eps, decay), hm)*posneg
+            end do
+        end do
+        do k = 1, nm
+            tend(k) = t(k)
+        end do
+    end subroutine taylor_batch_propagate
+
+end module conmech_taylor_batch

@@ -1,0 +1,418 @@
+!> Taylor's method with the coefficients the system supplies (`taylor_size`, `taylor_jet` of
+!! conmech_ode_system; generated from the model by `conmech.symbolic`).
+!!
+!! Each step expands the solution about the current point to order p,
+!! y(t + s) = sum_k y^[k] s^k, and evaluates the polynomial at s = h. Order and step follow
+!! Jorba and Zou (2005), as heyoka does:
+!!
+!! - p = ceil(-ln(eps)/2 + 1) for the tolerance eps = max(rtol, atol) (the smallest
+!!   components of vector tolerances), at least 2 (order 15 at 1e-12, 20 at 1e-16);
+!! - rho = min over k = p - 1, p of (1/N_k)^(1/k), N_k = max_i |y_i^[k]| eps/E_i with
+!!   E_i = max(atol_i, rtol_i ||y||_inf) (the radius of convergence seen by the last two
+!!   coefficients; rtol = atol = eps gives Jorba and Zou's mixed absolute/relative norm);
+!!   h = rho exp(-2) exp(-0.7/(p - 1)): the terms of order p - 1 and p stay below E_i.
+!!
+!! Safety check of the step: the coefficients at the step's end are computed at once (the
+!! next step needs them), so f(t + h, y(t + h)) = y^[1] there is known for free; it is
+!! compared with the derivative of the step's polynomial at h. The difference times h is
+!! about (p + 1) times the local error; a step whose estimate exceeds 10 E_i (plus a rounding
+!! floor) is rejected and retried from the same expansion with a shorter step. This guards
+!! against accidentally small last coefficients (symmetries, a passage near a
+!! singularity), where the Jorba-Zou estimate alone would be too optimistic.
+!!
+!! The continuous extension of a step is its Taylor polynomial itself (degree p, the
+!! accuracy of the step anywhere in it): fc(:, k) = y^[k] h^k in the power form.
+!! All state is in the object (thread-safe). nfev counts the expansions (one per step,
+!! plus one at the start and one per rejected step).
+module conmech_taylor_stepper
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use conmech_kinds, only: dp
+    use conmech_status
+    use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: ode_options, ode_stats, METHOD_TAYLOR
+    use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
+    use conmech_state_packer, only: state_packer
+    use conmech_taylor_events, only: taylor_events, limit_step
+    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_rho, &
+        taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
+    implicit none
+    private
+
+    public :: taylor_stepper, taylor_order, taylor_propagate
+
+    !> State of a Taylor integration beyond the contract's common state: the two
+    !! expansions (at the current point, and at the start of the last step: its polynomial).
+    !! Set `kind` = 1 before `init` to integrate the variational system (y0 = [y; Phi]).
+    type, extends(ode_stepper) :: taylor_stepper
+        integer :: kind = 0               !! 0 the system, 1 its variational system
+        integer :: nblock = 0             !! first block of y (the state; the rest: Phi)
+        integer :: order = 0              !! p
+        integer :: nw = 0                 !! columns of the work arrays (from the system)
+        real(dp) :: t_lo = 0.0_dp         !! t + t_lo: the time in double length
+        real(dp) :: hmax = huge(1.0_dp)
+        real(dp) :: first_step = 0.0_dp
+        real(dp) :: eps = 0.0_dp          !! tolerance that set the order
+        real(dp) :: decay = 0.0_dp        !! exp(-2 - 0.7/(p - 1)), Jorba and Zou's factor
+        real(dp) :: err = 0.0_dp          !! safety-check ratio of the last accepted step
+        integer :: nsteps = 0, max_steps = 100000
+        real(dp), allocatable :: rtol(:), atol(:), dy(:), ynew(:), e(:)
+        real(dp), allocatable :: jet(:, :)    !! (0:p, nw) expansion at (t, y)
+        real(dp), allocatable :: jold(:, :)   !! (0:p, nw) expansion at (t_old, y_old)
+        !> compiled events: steps are shortened so that none holds two roots of one event
+        class(taylor_events), pointer :: ev => null()
+    contains
+        procedure :: init => taylor_init
+        procedure :: start => taylor_start
+        procedure :: step => taylor_step
+        procedure :: transfer_state => taylor_transfer
+        procedure :: dense => taylor_dense
+        procedure :: eval => taylor_eval
+        procedure :: eval_unit => taylor_eval_unit
+        procedure :: refresh_f => taylor_refresh
+        procedure :: f_finite => taylor_f_finite
+    end type taylor_stepper
+
+contains
+
+    !> Check the options and set up at (t0, y0) on [t0, tf] (no evaluation: the system's
+    !! Taylor code is looked up in `start`). rtol may go down to the unit round-off.
+    subroutine taylor_init(self, t0, tf, y0, opt, info, msg, allow_inf)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: t0, tf
+        real(dp), intent(in) :: y0(:)
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        logical, intent(in), optional :: allow_inf
+        integer :: n
+        n = size(y0)
+        call check_interval(t0, tf, y0, opt, info, msg, allow_inf=allow_inf)
+        if (info /= CM_SUCCESS) return
+        call tolerances(self, opt, n, info, msg)
+        if (info /= CM_SUCCESS) return
+        self%eps = max(minval(self%rtol), minval(self%atol))
+        self%order = taylor_order(self%eps)
+        self%decay = exp(-2.0_dp - 0.7_dp/real(self%order - 1, dp))
+        call self%setup_base(METHOD_TAYLOR, t0, tf, y0, self%order, FORM_POWER)
+        self%nblock = n
+        if (self%kind == 1) self%nblock = nint((sqrt(4.0_dp*n + 1.0_dp) - 1.0_dp)/2.0_dp)
+        if (self%kind == 1 .and. self%nblock*(self%nblock + 1) /= n) then
+            info = CM_BAD_INPUT
+            msg = "bad input: the variational system's state must have n + n**2 components"
+            return
+        end if
+        self%t_lo = 0.0_dp
+        self%hmax = min(abs(opt%max_step), abs(tf - t0))
+        if (.not. ieee_is_finite(self%hmax)) self%hmax = huge(1.0_dp)
+        self%first_step = opt%first_step
+        self%max_steps = opt%max_steps
+        self%nsteps = 0
+        self%err = 0.0_dp
+        self%nw = 0
+        if (allocated(self%jet)) deallocate (self%jet)
+        if (allocated(self%jold)) deallocate (self%jold)
+        if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+        allocate (self%dy(n), self%ynew(n), self%e(n))
+    end subroutine taylor_init
+
+    !> Per-component tolerances (non-negative; rtol at least the unit round-off).
+    subroutine tolerances(self, opt, n, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        type(ode_options), intent(in) :: opt
+        integer, intent(in) :: n
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        if (allocated(self%rtol)) deallocate (self%rtol, self%atol)
+        allocate (self%rtol(n), self%atol(n))
+        info = CM_BAD_INPUT
+        if (allocated(opt%rtol_vec)) then
+            if (size(opt%rtol_vec) /= n) then
+                msg = "bad input: rtol must be a scalar or have the size of y0"
+                return
+            end if
+            self%rtol = opt%rtol_vec
+        else
+            self%rtol = opt%rtol
+        end if
+        if (allocated(opt%atol_vec)) then
+            if (size(opt%atol_vec) /= n) then
+                msg = "bad input: atol must be a scalar or have the size of y0"
+                return
+            end if
+            self%atol = opt%atol_vec
+        else
+            self%atol = opt%atol
+        end if
+        if (.not. (all(self%rtol >= 0.0_dp) .and. all(self%atol >= 0.0_dp))) then
+            msg = "bad input: rtol and atol must be non-negative"
+            return
+        end if
+        self%rtol = max(self%rtol, epsilon(1.0_dp))
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine tolerances
+
+    !> The expansion at the initial point and the first step. A system without Taylor
+    !! coefficients is CM_BAD_INPUT with a message saying so.
+    subroutine taylor_start(self, sys, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_SUCCESS
+        msg = "success"
+        self%nw = sys%taylor_size(self%kind)
+        if (self%nw < self%n) then
+            info = CM_BAD_INPUT
+            if (self%kind == 1) then
+                msg = "bad input: the system has no Taylor coefficients of its variational "// &
+                      "system (method TAYLOR)"
+            else
+                msg = "bad input: the system has no Taylor coefficients (method TAYLOR "// &
+                      "needs a system from conmech.symbolic with a smooth right-hand "// &
+                      "side, or a type that overrides taylor_size and taylor_jet)"
+            end if
+            return
+        end if
+        if (allocated(self%jet)) deallocate (self%jet, self%jold)
+        allocate (self%jet(0:self%order, self%nw), self%jold(0:self%order, self%nw))
+        self%jet = 0.0_dp
+        self%jold = 0.0_dp
+        call expand(self, sys, self%jet, self%t, self%y)
+        if (.not. self%f_finite()) then
+            info = CM_NONFINITE
+            msg = "the right-hand side is not finite at the initial point"
+            return
+        end if
+        call propose(self)
+        if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
+    end subroutine taylor_start
+
+    subroutine expand(self, sys, w, t, y)
+        class(taylor_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(inout) :: w(0:self%order, self%nw)
+        real(dp), intent(in) :: t, y(self%n)
+        w(0, 1:self%n) = y
+        call sys%taylor_jet(self%kind, t, self%order, self%nw, w)
+        self%st%nfev = self%st%nfev + 1
+    end subroutine expand
+
+    !> Jorba and Zou's step from the current expansion (signed, at most hmax); the scales
+    !! E_i at the current point are kept for the step's safety check.
+    subroutine propose(self)
+        class(taylor_stepper), intent(inout) :: self
+        call taylor_scales(self%n, self%nblock, self%y, self%rtol, self%atol, self%e)
+        self%h = min(taylor_rho(self%n, self%order, self%jet, self%e, self%eps, self%decay), &
+                     self%hmax)*self%posneg
+    end subroutine propose
+
+    !> One accepted step towards `target` (landing on it if the step would pass it).
+    subroutine taylor_step(self, sys, target, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: target
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: h, err, d
+        integer :: p
+        character(len=32) :: buf
+        real(dp), allocatable :: tmp(:, :)
+        info = CM_SUCCESS
+        msg = "success"
+        p = self%order
+        h = self%h
+        self%last = .false.
+        do
+            if (self%nsteps >= self%max_steps) then
+                info = CM_TOO_MANY_STEPS
+                write (buf, '(es14.6)') self%t
+                msg = "more than max_steps steps, at t ="//trim(buf)
+                return
+            end if
+            if (.not. (0.1_dp*abs(h) > abs(self%t)*epsilon(1.0_dp))) then
+                info = CM_STEP_TOO_SMALL
+                write (buf, '(es14.6)') self%t
+                msg = "step size too small at t ="//trim(buf)
+                return
+            end if
+            self%hit = .false.
+            if ((self%t + h - target)*self%posneg >= 0.0_dp) then
+                h = (target - self%t) - self%t_lo
+                self%hit = .true.
+            end if
+            if (associated(self%ev)) then
+                d = h
+                call limit_step(self%ev, self%t, p, self%jet, h)
+                if (h /= d) self%hit = .false.
+            end if
+            self%nsteps = self%nsteps + 1
+            call taylor_eval_step(self%n, p, self%jet, h, self%ynew, self%dy)
+            call expand(self, sys, self%jold, self%t + h, self%ynew)
+            err = taylor_check(self%n, p, h, self%ynew, self%dy, self%jold(1, 1:self%n), &
+                               self%e)
+            if (err <= TAYLOR_CHECK_MAX) exit
+            ! rejected (or not finite): a shorter step from the same expansion
+            self%st%nreject = self%st%nreject + 1
+            h = taylor_shrink(h, err, p)
+        end do
+        ! accept: the new expansion becomes the current one, the old the step's polynomial
+        self%err = err
+        call move_alloc(self%jet, tmp)
+        call move_alloc(self%jold, self%jet)
+        call move_alloc(tmp, self%jold)
+        self%st%naccept = self%st%naccept + 1
+        self%t_old = self%t
+        self%y_old = self%y
+        if (self%hit) then
+            self%t = target
+            self%t_lo = 0.0_dp
+        else
+            call taylor_add_time(self%t, self%t_lo, h)
+        end if
+        self%y = self%ynew
+        self%h_done = h
+        self%dense_ready = .false.
+        self%last = self%hit .and. target == self%tf
+        call propose(self)
+        self%st%h_next = self%h
+    end subroutine taylor_step
+
+    !> The continuous extension of the last step: fc(:, k) = y^[k] h^k (power form in
+    !! x = (s - t_old)/h_done).
+    subroutine taylor_dense(self, sys)
+        class(taylor_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        real(dp) :: hk
+        integer :: k
+        hk = 1.0_dp
+        do k = 0, self%order
+            self%fc(:, k) = self%jold(k, 1:self%n)*hk
+            hk = hk*self%h_done
+        end do
+        self%dense_ready = .true.
+    end subroutine taylor_dense
+
+    !> The last step's Taylor polynomial at tt (in [t_old, t]).
+    subroutine taylor_eval(self, tt, yout, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: tt
+        real(dp), intent(out) :: yout(:)
+        integer, intent(out), optional :: info
+        character(len=:), allocatable, intent(inout), optional :: msg
+        real(dp) :: s
+        integer :: i, k
+        s = tt - self%t_old
+        do i = 1, self%n
+            yout(i) = self%jold(self%order, i)
+            do k = self%order - 1, 0, -1
+                yout(i) = self%jold(k, i) + s*yout(i)
+            end do
+        end do
+        if (present(info)) info = CM_SUCCESS
+    end subroutine taylor_eval
+
+    !> The same at x = (s - t_old)/h_done in [0, 1].
+    subroutine taylor_eval_unit(self, x, yout, info, msg)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: x
+        real(dp), intent(out) :: yout(:)
+        integer, intent(out), optional :: info
+        character(len=:), allocatable, intent(inout), optional :: msg
+        call taylor_eval(self, self%t_old + x*self%h_done, yout, info, msg)
+    end subroutine taylor_eval_unit
+
+    !> After a hook changed y: the expansion at the new point (and a new step).
+    subroutine taylor_refresh(self, sys)
+        class(taylor_stepper), intent(inout) :: self
+        class(ode_system), intent(in) :: sys
+        call expand(self, sys, self%jet, self%t, self%y)
+        call propose(self)
+        self%f_stale = .false.
+    end subroutine taylor_refresh
+
+    logical function taylor_f_finite(self)
+        class(taylor_stepper), intent(in) :: self
+        taylor_f_finite = .false.
+        if (allocated(self%jet)) taylor_f_finite = all(ieee_is_finite(self%jet(1, 1:self%n)))
+    end function taylor_f_finite
+
+    !> The whole state, for step-by-step use (the state parts of both expansions; the
+    !! operations' columns are scratch, recomputed by the next expansion).
+    subroutine taylor_transfer(self, p)
+        class(taylor_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        real(dp), allocatable :: a(:, :), b(:, :)
+        call self%transfer_base(p)
+        call p%item(self%kind)
+        call p%item(self%nblock)
+        call p%item(self%order)
+        call p%item(self%nw)
+        call p%item(self%t_lo)
+        call p%item(self%hmax)
+        call p%item(self%first_step)
+        call p%item(self%eps)
+        call p%item(self%decay)
+        call p%item(self%err)
+        call p%item(self%nsteps)
+        call p%item(self%max_steps)
+        call p%column(self%rtol)
+        call p%column(self%atol)
+        if (.not. p%reading()) then
+            a = transpose(self%jet(:, 1:self%n))
+            b = transpose(self%jold(:, 1:self%n))
+        end if
+        call p%columns(a, 0, self%order)
+        call p%columns(b, 0, self%order)
+        if (p%reading()) then
+            if (allocated(self%jet)) deallocate (self%jet, self%jold)
+            allocate (self%jet(0:self%order, max(self%nw, self%n)), &
+                      self%jold(0:self%order, max(self%nw, self%n)))
+            self%jet = 0.0_dp
+            self%jold = 0.0_dp
+            if (allocated(a)) self%jet(:, 1:self%n) = transpose(a)
+            if (allocated(b)) self%jold(:, 1:self%n) = transpose(b)
+            if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+            allocate (self%dy(self%n), self%ynew(self%n), self%e(self%n))
+        end if
+    end subroutine taylor_transfer
+
+    !> Advance y from t0 to t1 in place by Taylor's method (kind 0: the system, kind 1: its
+    !! variational system, y = [y; Phi]), storing nothing: the lean path for shooting and
+    !! ensembles.
+    subroutine taylor_propagate(sys, t0, t1, y, opt, info, stats, msg, kind)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t0, t1
+        real(dp), intent(inout) :: y(:)
+        type(ode_options), intent(in) :: opt
+        integer, intent(out) :: info
+        type(ode_stats), intent(out) :: stats
+        character(len=:), allocatable, intent(out) :: msg
+        integer, intent(in), optional :: kind
+        type(taylor_stepper) :: stp
+        character(len=32) :: buf
+        stats = ode_stats()
+        if (present(kind)) stp%kind = kind
+        call stp%init(t0, t1, y, opt, info, msg)
+        if (info /= CM_SUCCESS .or. t1 == t0) return
+        call stp%start(sys, info, msg)
+        if (info /= CM_SUCCESS) then
+            stats = stp%st
+            return
+        end if
+        do
+            call stp%step(sys, t1, info, msg)
+            if (info /= CM_SUCCESS) exit
+            if (.not. stp%f_finite()) then
+                info = CM_NONFINITE
+                write (buf, '(es14.6)') stp%t
+                msg = "non-finite right-hand side at t ="//trim(buf)
+                exit
+            end if
+            if (stp%last) exit
+        end do
+        y = stp%y
+        stats = stp%st
+    end subroutine taylor_propagate
+
+end module conmech_taylor_stepper
