@@ -426,6 +426,47 @@ class TreeDerived(Derived):
         from .tree_fortran import generate_tree
         return generate_tree(self, module, model_values)
 
+    @property
+    def lagrangian(self):
+        """L = T - U in the canonical symbols, built from the bodies' data when first read
+        (for the analysis of momenta and cyclic coordinates; the compiled code never needs
+        it); None for a tree with forces at points of bodies (their generalized forces are
+        not kept as expressions)."""
+        if "_lagrangian" not in self.__dict__:
+            self.__dict__["_lagrangian"] = None if self.point_forces else _tree_lagrangian(self)
+        return self.__dict__["_lagrangian"]
+
+
+def _tree_lagrangian(d):
+    """T - U of the tree of a TreeDerived record: its canonical data rebuilt as bodies whose
+    coordinates are functions of time, their energies, then the coordinates and their rates
+    replaced by the canonical symbols."""
+    from sympy.physics.mechanics import dynamicsymbols
+    from .spatial import SpatialBody, build_spatial_tree
+    from .tree import Body, build_tree
+    tt = dynamicsymbols._t
+    qf = [sp.Function(f"cq{i}")(tt) for i in range(d.n)]
+    index = {name: J.col for name, J in zip(d.order_names, d.joints)}
+    bodies = []
+    for b in d.aba_order:
+        c, q = d.cdata[b.name], qf[index[b.name]]
+        if d.planar:
+            bodies.append(Body(b.name, b.parent, b.joint, q, at=c[0], axis=c[1], mass=c[2],
+                               com=c[3], inertia=c[4]))
+        else:
+            bodies.append(SpatialBody(b.name, b.parent, b.joint, q, axis=list(c[2]),
+                                      at=list(c[0]), rot=c[1], mass=c[3], com=list(c[4]),
+                                      inertia=c[5]))
+    if d.planar:
+        parts = build_tree(bodies, d.gravity[:2], None,
+                           "absolute" if d.absolute else "relative", lazy=True)
+    else:
+        parts = build_spatial_tree(bodies, d.gravity, None, lazy=True)
+    T, U = parts["energies"]()
+    L = sp.sympify(T - U)
+    L = L.xreplace({f.diff(tt): v for f, v in zip(qf, d.speeds)})
+    return L.xreplace(dict(zip(qf, d.coords))).xreplace({tt: d.t})
+
 
 def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=True,
                      point_forces=()):
@@ -511,6 +552,7 @@ def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=T
     d.joints = joints
     d.gravity = gravity
     d.user_forces = forces
+    d.gen_forces = None if pf_items else list(forces)
     d.loops = loop_items
     d.point_forces = pf_items
     d.planar = bool(planar)

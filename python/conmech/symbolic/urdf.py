@@ -100,9 +100,9 @@ class Robot:
             dict may name joints).
         params : dict, optional
             Values of further symbols in gravity, torques and forces.
-        **kw
-            Passed to :func:`conmech.symbolic.spatial_tree` (method, jacobian, loops,
-            point_forces, flags, model_only, ...).
+        kw
+            Further keyword arguments, passed to :func:`conmech.symbolic.spatial_tree`
+            (method, jacobian, loops, point_forces, flags, model_only, ...).
         """
         import sympy as sp
         from .spatial import spatial_tree
