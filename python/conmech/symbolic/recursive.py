@@ -433,14 +433,31 @@ class TreeDerived(Derived):
         it); None for a tree with forces at points of bodies (their generalized forces are
         not kept as expressions)."""
         if "_lagrangian" not in self.__dict__:
-            self.__dict__["_lagrangian"] = None if self.point_forces else _tree_lagrangian(self)
+            self._energies()
         return self.__dict__["_lagrangian"]
 
+    @property
+    def energy(self):
+        """T + U in the canonical symbols (the Jacobi integral of the tree, which is
+        scleronomic), built like :attr:`lagrangian` when first read."""
+        if self.__dict__.get("_energy") is None:
+            self._energies()
+        return self.__dict__["_energy"]
 
-def _tree_lagrangian(d):
-    """T - U of the tree of a TreeDerived record: its canonical data rebuilt as bodies whose
-    coordinates are functions of time, their energies, then the coordinates and their rates
-    replaced by the canonical symbols."""
+    @energy.setter
+    def energy(self, value):
+        self.__dict__["_energy"] = value
+
+    def _energies(self):
+        T, U = _tree_energies(self)
+        self.__dict__["_energy"] = T + U
+        self.__dict__["_lagrangian"] = None if self.point_forces else T - U
+
+
+def _tree_energies(d):
+    """(T, U) of the tree of a TreeDerived record: its canonical data rebuilt as bodies
+    whose coordinates are functions of time, their energies, then the coordinates and their
+    rates replaced by the canonical symbols."""
     from sympy.physics.mechanics import dynamicsymbols
     from .spatial import SpatialBody, build_spatial_tree
     from .tree import Body, build_tree
@@ -462,10 +479,10 @@ def _tree_lagrangian(d):
                            "absolute" if d.absolute else "relative", lazy=True)
     else:
         parts = build_spatial_tree(bodies, d.gravity, None, lazy=True)
-    T, U = parts["energies"]()
-    L = sp.sympify(T - U)
-    L = L.xreplace({f.diff(tt): v for f, v in zip(qf, d.speeds)})
-    return L.xreplace(dict(zip(qf, d.coords))).xreplace({tt: d.t})
+    rates = {f.diff(tt): v for f, v in zip(qf, d.speeds)}
+    values = dict(zip(qf, d.coords))
+    return tuple(sp.sympify(e).xreplace(rates).xreplace(values).xreplace({tt: d.t})
+                 for e in parts["energies"]())
 
 
 def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=True,
@@ -560,7 +577,7 @@ def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=T
     d.cdata = cdata
     d.order_names = [b.name for b in order]
     d.aba_order = list(order)
-    d.energy = None
+    d.energy = None         # T + U, built when first read
     if loop_items:
         from .loops import count_rows
         d.n_hol = count_rows(loop_items)
