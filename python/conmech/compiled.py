@@ -16,6 +16,10 @@ compiled function serves every parameter value)::
     void forces_jac(double t, const double *q, const double *v, const double *a,
                     double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv], nd x 2nd */
     double energy(double t, const double *q, const double *v, const double *p);
+    /* optional: a = M^-1 Q, and a with its Jacobian d a/d[q, v] (nd x 2nd) */
+    void accel(double t, const double *q, const double *v, double *a, const double *p);
+    void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
+                   const double *p);
     /* constrained systems (n coordinates): mass, forces, energy as above, and */
     void phi(double t, const double *q, double *c, const double *p);         /* n_hol   */
     void phi_jac(double t, const double *q, double *G, const double *p);     /* n_hol x n */
@@ -58,11 +62,11 @@ __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSy
            "library_taylor"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 27
+_SPEC_SIZE = 28
 _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
           "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
           "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18,
-          "constraint_hessian": 27}
+          "constraint_hessian": 27, "accel_jac": 28}
 # Taylor coefficients (conmech_flat_spec: 19 taylor, 20 its work columns, 21 taylor_var,
 # 22 its columns, 23 taylor written out for one order, 24 that order, 25/26 the same for
 # taylor_var)
@@ -298,7 +302,7 @@ def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
 def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
                        keep=None, name: str = "compiled", *,
-                       mass_forces=None, accel=None) -> CompiledSystem:
+                       mass_forces=None, accel=None, accel_jac=None) -> CompiledSystem:
     """M(t, q) q'' = Q(t, q, q') with ``ndof`` coordinates from compiled functions; the
     state is y = [q, q']. ``forces_jac`` gives the exact Jacobian of the accelerations
     (see the module's signatures); without it the Jacobian is a finite difference.
@@ -309,7 +313,12 @@ def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
     double *v, double *a, const double *p)``, computes the accelerations a = M^-1 Q directly
     (e.g. by the articulated-body algorithm of :func:`conmech.symbolic.planar_tree`); the
     right-hand side then uses it instead of factorising M (non-finite output, e.g. where
-    M is not positive definite, stops the integration with success=False)."""
+    M is not positive definite, stops the integration with success=False). ``accel_jac``
+    (optional), ``void accel_jac(double t, const double *q, const double *v, double *a,
+    double *jac, const double *p)``, computes the accelerations and their Jacobian
+    jac = d a/d[q, v] (ndof x 2 ndof, column-major) directly (e.g. from the derivatives of
+    the recursive algorithms of :func:`conmech.symbolic.spatial_tree`); the Jacobian of the
+    system then uses it instead of ``forces_jac`` and a factorisation of M."""
     ndof = _count(ndof, "ndof", 1)
     values, names = _params(params, param_names)
     if mass is None or forces is None:
@@ -318,9 +327,10 @@ def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
                                                      "forces_jac": forces_jac,
                                                      "energy": energy,
                                                      "mass_forces": mass_forces,
-                                                     "accel": accel})
+                                                     "accel": accel, "accel_jac": accel_jac})
     return CompiledSystem(str(name), "generalized", spec, values, names,
-                          (keep, mass, forces, forces_jac, energy, mass_forces, accel))
+                          (keep, mass, forces, forces_jac, energy, mass_forces, accel,
+                           accel_jac))
 
 
 def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=None,
@@ -435,10 +445,10 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
     ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_accel``,
-    ``conmech_jac_prod``, ``conmech_constraint_hessian``, and the Taylor routines
-    ``conmech_taylor``, ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran
-    programs load the same libraries (``sweep --model``,
-    conmech_model_library)."""
+    ``conmech_accel_jac``, ``conmech_jac_prod``, ``conmech_constraint_hessian``, and the
+    Taylor routines ``conmech_taylor``, ``conmech_taylor_info``, ... of
+    :func:`library_taylor`). The Fortran programs load the same libraries (``sweep
+    --model``, conmech_model_library)."""
     from ._elf import LibraryError, check_library
     path = os.fspath(path)
     try:
@@ -479,7 +489,8 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     if kind == _KIND_GEN:
         return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
                                   params=params, keep=lib, name=name,
-                                  mass_forces=fn["mass_forces"], accel=fn["accel"])
+                                  mass_forces=fn["mass_forces"], accel=fn["accel"],
+                                  accel_jac=fn["accel_jac"])
     return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
                               fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
                               fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,

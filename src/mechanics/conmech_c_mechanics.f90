@@ -24,6 +24,9 @@
 !!     /* optional, generalized systems: the accelerations a = M^-1 Q directly (e.g. by the
 !!        articulated-body algorithm); non-finite entries where M is not positive definite */
 !!     void accel(double t, const double *q, const double *v, double *a, const double *p);
+!!     /* optional, generalized systems: a and its Jacobian jac = d a/d[q, v] (nd x 2nd) */
+!!     void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
+!!                    const double *p);
 !!
 !! Only `mass` and `forces` are required; a missing optional function falls back to the
 !! finite-difference default of the parent type (see conmech_constrained_system).
@@ -104,6 +107,8 @@ module conmech_c_mechanics
         type(c_funptr) :: mass_forces = c_null_funptr
         !> optional: the accelerations a = M^-1 Q (generalized systems)
         type(c_funptr) :: accel = c_null_funptr
+        !> optional: a and d a/d[q, v] (generalized systems)
+        type(c_funptr) :: accel_jac = c_null_funptr
     end type c_mech_pointers
 
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
@@ -115,8 +120,11 @@ module conmech_c_mechanics
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
         procedure(c_mf_fn), pointer, nopass :: mf_f => null()
         procedure(c_qv_fn), pointer, nopass :: accel_f => null()
+        procedure(c_mf_fn), pointer, nopass :: accel_jac_f => null()
     contains
         procedure :: mass => cg_mass
+        procedure :: accelerations_jacobian => cg_accelerations_jacobian
+        procedure :: has_accelerations_jacobian => cg_has_accelerations_jacobian
         procedure :: accelerations => cg_accelerations
         procedure :: has_accelerations => cg_has_accelerations
         procedure :: mass_forces => cg_mass_forces
@@ -193,6 +201,7 @@ contains
         if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
         if (c_associated(fp%mass_forces)) call c_f_procpointer(fp%mass_forces, sys%mf_f)
         if (c_associated(fp%accel)) call c_f_procpointer(fp%accel, sys%accel_f)
+        if (c_associated(fp%accel_jac)) call c_f_procpointer(fp%accel_jac, sys%accel_jac_f)
         call set_params(sys%p, params)
         info = CM_SUCCESS
         msg = "success"
@@ -283,6 +292,19 @@ contains
         class(c_generalized_system), intent(in) :: self
         cg_has_accelerations = associated(self%accel_f)
     end function cg_has_accelerations
+
+    subroutine cg_accelerations_jacobian(self, t, q, v, a, jac)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:), jac(:, :)
+        call self%accel_jac_f(t, q, v, a, jac, self%p)
+    end subroutine cg_accelerations_jacobian
+
+    logical function cg_has_accelerations_jacobian(self)
+        class(c_generalized_system), intent(in) :: self
+        cg_has_accelerations_jacobian = associated(self%accel_jac_f)
+    end function cg_has_accelerations_jacobian
 
     subroutine cg_forces(self, t, q, v, f)
         class(c_generalized_system), intent(in) :: self

@@ -70,6 +70,7 @@ _SIG = {
     "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
     "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
+    "accel_jac": ("in2", "out2"),
 }
 # constrained systems: the second derivatives of the constraints (inputs q, v, lam)
 _SIG["constraint_hessian"] = ("in3", "out2")
@@ -101,7 +102,8 @@ class CompiledModel:
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
                 "mass_forces": [(n, n), (n,)], "accel": [(n,)],
-                "constraint_hessian": [(n, n), (h + k, n)]}[entry]
+                "constraint_hessian": [(n, n), (h + k, n)],
+                "accel_jac": [(n,), (n, 2 * n)]}[entry]
 
     def _entry(self, entry):
         """(ctypes function, number of input arrays, output shapes, returns a value) of an
@@ -285,7 +287,7 @@ def _system(model):
         return as_lagrangian_system(compiled.generalized_system(
             d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
             energy=a.get("energy"), mass_forces=a.get("mass_forces"), accel=a.get("accel"),
-            **common))
+            accel_jac=a.get("accel_jac"), **common))
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
@@ -423,7 +425,8 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      jacobian=True, flags=None, model_only=False, inputs=None):
+                      jacobian=True, mass=None, energy=None, flags=None, model_only=False,
+                      inputs=None):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -450,15 +453,33 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     jacobian : bool
         Generate the exact Jacobian of the accelerations (forces_jac); False saves
         derivation and compile time for large systems that are only integrated.
+    mass : square matrix, optional
+        The mass matrix M(t, q) given directly (symmetric, positive definite, free of the
+        velocities; ``L`` must then be None): the system is M q'' = Q with Q = ``forces``,
+        the complete generalized forces (velocity terms included), with the exact
+        Jacobian; ``energy`` (an expression in t, q, q') is optional.
     inputs : list, optional
         Control inputs: coordinates of q (one input each), input symbols appearing
         linearly in ``forces``, or a matrix B (ndof x m); then the result is a
         :class:`conmech.control.ControlledSystem` with M q'' = Q + B(q) u.
     """
     if inputs is not None:
+        if mass is not None:
+            raise ValueError("inputs= needs the Lagrangian L (not mass=)")
         from ..control._symbolic import controlled_lagrangian
         return controlled_lagrangian(L, q, params, forces, inputs, velocities=velocities,
                                      simplify=simplify, jacobian=jacobian, flags=flags)
+    if mass is not None:
+        from .direct import derive_direct
+        if L is not None:
+            raise ValueError("give either the Lagrangian L or mass= (then L=None)")
+        return _construct("direct", [sp.Matrix(mass), _tup(forces), _tup(q),
+                                     _tup(velocities), energy], params, (bool(jacobian),),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                bool(jacobian)),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (a Lagrangian defines its own energy)")
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
                       (simplify, bool(jacobian)),
                       lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
@@ -467,13 +488,30 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
 
 
 def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
-                       velocities=None, simplify="auto", flags=None, model_only=False):
+                       velocities=None, simplify="auto", mass=None, energy=None, flags=None,
+                       model_only=False):
     """A compiled system in excessive coordinates for ``conmech.constrained.solve``:
     kinetic energy T, potential U, holonomic constraints phi(t, q) = 0 and non-holonomic
     constraints given as expressions linear in the velocities (A(t, q) q' + b(t, q) = 0).
     Derives M, Q, G = d phi/dq, phi_t, gamma_h, A, b, gamma_n and the energy T + U (Jacobi
     integral); rheonomic constraints (explicit t) are detected.
+
+    ``mass=`` gives the mass matrix M(t, q) directly instead of T (``T`` must then be
+    None): the forces are ``forces`` (complete, velocity terms included) minus dU/dq when
+    U is given (U may be None), and the energy is ``energy`` or v^T M v / 2 + U.
     """
+    if mass is not None:
+        from .direct import derive_direct
+        if T is not None:
+            raise ValueError("give either the kinetic energy T or mass= (then T=None)")
+        return _construct("direct_constrained",
+                          [sp.Matrix(mass), _tup(forces), _tup(q), _tup(velocities), energy,
+                           U, _tup(holonomic), _tup(nonholonomic)], params, (),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                True, list(holonomic), nonholonomic, U),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (T and U define the energy)")
     return _construct("constrained", [T, U, _tup(q), _tup(holonomic), _tup(nonholonomic),
                                       _tup(forces), _tup(velocities)], params, (simplify,),
                       lambda: derive_constrained(T, U, q, holonomic, nonholonomic, params,
@@ -505,6 +543,16 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# closed loops on trees, forces at points of bodies, consistent initial states
+from .loops import Loop, PointForce, consistent_state  # noqa: E402
+
+__all__ += ["Loop", "PointForce", "consistent_state"]
+
+# robots from URDF files
+from .urdf import Robot, from_urdf, read_urdf  # noqa: E402
+
+__all__ += ["Robot", "from_urdf", "read_urdf"]
 
 # compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
 from .taylor_events import Event, event  # noqa: E402

@@ -684,6 +684,8 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     if not isinstance(module, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", module):
         raise ValueError(f"bad module name {module!r} (a Fortran name: a letter, then "
                          "letters, digits or underscores; at most 63 characters)")
+    if hasattr(type(d), "generate_fortran"):     # a record that writes its own module
+        return d.generate_fortran(module, model_values)
     pr = FortranPrinter(_names(d))
     n = d.n
     npar = max(len(d.params), 1)

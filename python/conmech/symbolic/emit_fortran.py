@@ -230,6 +230,11 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         raise TypeError("emit: expected a conmech.symbolic.derive.Derived record")
     if d.kind not in ("ode", "generalized", "constrained"):
         raise ValueError(f"emit: unknown kind {d.kind!r}")
+    if hasattr(type(d), "generate_fortran"):     # a tree built by the recursive algorithms
+        raise ValueError("emit: this tree was built by the recursive algorithms (bind(C) "
+                         "module only); for a standalone module use the Lagrangian route: "
+                         "conmech.symbolic.tree.derive_tree(...) or "
+                         "conmech.symbolic.spatial.derive_spatial_tree(...)")
     fortran_name_check(name, "type name")
     if len(name) > 40:
         raise ValueError(f"type name '{name}' is longer than 40 characters")

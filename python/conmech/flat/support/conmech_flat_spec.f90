@@ -20,6 +20,7 @@
 !!     spec(23:26) (optional, ode) the same written out for one order (set_c_taylor_fixed):
 !!         taylor, its order, taylor_var, its order
 !!     spec(27) (optional, constrained) constraint_hessian: d(C^T lam)/dq, d(C v + c0)/dq
+!!     spec(28) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -80,6 +81,7 @@ contains
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
         if (size(spec) >= 17) fp%accel = fptr(spec(17))
         if (size(spec) >= 27) fp%constraint_hessian = fptr(spec(27))
+        if (size(spec) >= 28) fp%accel_jac = fptr(spec(28))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
