@@ -47,6 +47,7 @@ __all__ = ["CompileError", "CacheError", "CacheWarning", "cache_dir", "compile_s
 
 #: the flags of the package's release build (meson buildtype=release), for a shared library
 FFLAGS = ["-O3", "-fPIC", "-shared"]
+_EXPORTS_MAP = "exports.map"     # the linker version script written beside the source
 
 _MANIFEST_FORMAT = 1
 _VERSION_CACHE = {}
@@ -331,6 +332,10 @@ def compile_source(source, flags=None, symbols=()):
     entry names (``rhs``, ``mass``, ...) whose ``conmech_<name>`` the library must
     define."""
     flags = list(FFLAGS if flags is None else flags)
+    if "-shared" in flags:
+        # the library exports conmech's entry points only: gfortran also makes module
+        # procedures and the type-bound tables of derived types (__mod_MOD_...) global
+        flags.append(f"-Wl,--version-script={_EXPORTS_MAP}")
     fc = compiler()
     skey = _source_key(source, flags)
     try:
@@ -374,6 +379,12 @@ def compile_source(source, flags=None, symbols=()):
                 fh.write(source)
         except OSError as exc:
             raise _os_problem(exc, d, "writing the generated source") from None
+        if any(f.startswith("-Wl,--version-script=") for f in flags):
+            try:
+                with open(os.path.join(work, _EXPORTS_MAP), "w") as fh:
+                    fh.write("{ global: conmech_*; local: *; };\n")
+            except OSError as exc:
+                raise _os_problem(exc, d, "writing the export list") from None
         cmd = [fc] + flags + ["-o", out, src]
         try:
             res = subprocess.run(cmd, cwd=work, capture_output=True, text=True, timeout=600)

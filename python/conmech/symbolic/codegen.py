@@ -164,10 +164,19 @@ def _code_part(line):
     return line if k < 0 else line[:k]
 
 
-def private_procedures(entries):
+_TREE_PROC = re.compile(r"^\s*(?:pure\s+)?subroutine\s+(tree_[a-z0-9_]+)\s*\(",
+                        re.I | re.M)
+
+
+def private_procedures(entries, source=None):
     """The internal (private, not C-bound) procedures the generated module defines beside
-    the entry points `entries`: the body that the quadruple-precision Taylor entry wraps."""
-    return [f"conmech_{e}_body" for e in entries if e.endswith("taylor_qp")]
+    the entry points `entries`: the body that the quadruple-precision Taylor entry wraps,
+    and, given the `source` of a recursive tree, its passes (``tree_pos``, ``tree_vel``,
+    ... and their pieces: names the generator makes, never from user strings)."""
+    out = [f"conmech_{e}_body" for e in entries if e.endswith("taylor_qp")]
+    if source is not None:
+        out += sorted({m.lower() for m in _TREE_PROC.findall(source)})
+    return out
 
 
 def check_source(src, procedures, c_names=None, max_line=132):
@@ -685,7 +694,13 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
         raise ValueError(f"bad module name {module!r} (a Fortran name: a letter, then "
                          "letters, digits or underscores; at most 63 characters)")
     if hasattr(type(d), "generate_fortran"):     # a record that writes its own module
-        return d.generate_fortran(module, model_values)
+        src, entries = d.generate_fortran(module, model_values)
+        c_names = [f"conmech_{e}" for e in entries]
+        if model_values is not None:
+            c_names += ["conmech_model_info", "conmech_model_params",
+                        "conmech_model_param_names"]
+        check_source(src, c_names + private_procedures(entries, src), c_names)
+        return src, entries
     pr = FortranPrinter(_names(d))
     n = d.n
     npar = max(len(d.params), 1)
