@@ -217,10 +217,20 @@ def _full_key(skey, version):
     return hashlib.sha256(f"{skey}\0{version}\0".encode()).hexdigest()
 
 
+def _link_flags(flags):
+    """The compiler flags (FFLAGS by default); a shared library gets the version script
+    that exports conmech's entry points only (gfortran also makes module procedures and the
+    tables of derived types, __mod_MOD_..., global)."""
+    flags = list(FFLAGS if flags is None else flags)
+    if "-shared" in flags:
+        flags.append(f"-Wl,--version-script={_EXPORTS_MAP}")
+    return flags
+
+
 def library_path(source, flags=None):
     """(path, key) of the cached library for this source and flags (needs the compiler,
     whose version is part of the key)."""
-    flags = list(FFLAGS if flags is None else flags)
+    flags = _link_flags(flags)
     key = _full_key(_source_key(source, flags), _compiler_version(compiler()))
     return os.path.join(cache_dir(), f"conmech_{key}.so"), key
 
@@ -331,11 +341,7 @@ def compile_source(source, flags=None, symbols=()):
     intact). Returns (path, hit) with hit True when no compilation was needed. `symbols`:
     entry names (``rhs``, ``mass``, ...) whose ``conmech_<name>`` the library must
     define."""
-    flags = list(FFLAGS if flags is None else flags)
-    if "-shared" in flags:
-        # the library exports conmech's entry points only: gfortran also makes module
-        # procedures and the type-bound tables of derived types (__mod_MOD_...) global
-        flags.append(f"-Wl,--version-script={_EXPORTS_MAP}")
+    flags = _link_flags(flags)
     fc = compiler()
     skey = _source_key(source, flags)
     try:
