@@ -168,6 +168,15 @@ _TREE_PROC = re.compile(r"^\s*(?:pure\s+)?subroutine\s+(tree_[a-z0-9_]+)\s*\(",
                         re.I | re.M)
 
 
+def _c_names(entries, model_values):
+    """The C names a generated module binds: its entry points, and the model-library
+    description when it has default parameter values."""
+    names = [f"conmech_{e}" for e in entries]
+    if model_values is not None:
+        names += ["conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
+    return names
+
+
 def private_procedures(entries, source=None):
     """The internal (private, not C-bound) procedures the generated module defines beside
     the entry points `entries`: the body that the quadruple-precision Taylor entry wraps,
@@ -695,10 +704,7 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                          "letters, digits or underscores; at most 63 characters)")
     if hasattr(type(d), "generate_fortran"):     # a record that writes its own module
         src, entries = d.generate_fortran(module, model_values)
-        c_names = [f"conmech_{e}" for e in entries]
-        if model_values is not None:
-            c_names += ["conmech_model_info", "conmech_model_params",
-                        "conmech_model_param_names"]
+        c_names = _c_names(entries, model_values)
         check_source(src, c_names + private_procedures(entries, src), c_names)
         return src, entries
     pr = FortranPrinter(_names(d))
@@ -821,8 +827,6 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     for p in procs:
         body += p
     src = "\n".join(head + body + [f"end module {module}", ""])
-    c_names = [f"conmech_{e}" for e in entries]
-    if model_values is not None:
-        c_names += ["conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
+    c_names = _c_names(entries, model_values)
     check_source(src, c_names + internal, c_names)
     return src, entries
