@@ -20,6 +20,7 @@ from ._dense import DenseOutput
 from ._implicit import jacobian_callback
 from ._methods import METHODS, RK45_SCIPY, method_info
 from ._stepper import method_code
+from ._taylor import with_fixed_order
 from .systems import BuiltinSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
@@ -33,6 +34,7 @@ _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45
 # solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
 # (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
 _RK45_SCIPY = RK45_SCIPY
+_TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -314,6 +316,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
     ne = len(settings)
+    if builtin and code == _TAYLOR and getattr(fun, "taylor", None):   # written out
+        fun = with_fixed_order(fun, rtol, atol)
     run = _Run(fun, builtin, args, n, settings, bool(vectorized), t0, jac)
     remaining = [s[1] for s in settings]       # occurrences left before termination
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
@@ -479,7 +483,7 @@ class _Run:
             res["t"] = t.copy()
             res["y"] = y.reshape(n, t.size).copy()
             res["ev"] = [(int(i) - 1, float(te), ev_y.reshape(n, -1)[:, k].copy())
-                         for k, (te, i) in enumerate(zip(ev_t, ev_id))]
+                         for k, (te, i) in enumerate(zip(ev_t, ev_id))] if ev_t.size else []
             if ts.size:
                 res["dense"] = (ts.copy(), hs.copy(), coef.reshape(n, -1, ts.size).copy())
 
@@ -504,7 +508,7 @@ class _Run:
                 self.rhs, self.jac_cb, events_cb, store, has_jac=self.has_jac, **kw)
         if self.failure:
             self.guard.fail(self.failure[0])
-        nfev, njev, nlu, naccept, nreject = (int(c) for c in counts)
+        nfev, njev, nlu, naccept, nreject = counts.tolist()
         self.njev += njev
         self.nlu += nlu
         self.first_segment = False
@@ -512,7 +516,7 @@ class _Run:
         res.setdefault("y", y_a[:, None].copy())
         res.setdefault("ev", [])
         res.setdefault("dense", None)
-        res.update(nfev=int(nfev), naccept=int(naccept), nreject=int(nreject),
+        res.update(nfev=nfev, naccept=naccept, nreject=nreject,
                    form=int(form), info=int(info), message=message_text(message))
         return res
 
@@ -533,8 +537,11 @@ def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, 
     ts = [s["t"] for s in segs]
     ys = [s["y"] if s["y"] is not None else np.repeat(y0[:, None], s["t"].size, axis=1)
           for s in segs]
-    t = np.concatenate(ts) if ts else np.array([t0])
-    y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
+    if len(segs) == 1:      # one segment (no terminal event restarted it): its own arrays
+        t, y = ts[0], ys[0]
+    else:
+        t = np.concatenate(ts) if ts else np.array([t0])
+        y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
     res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None,
                     nfev=nfev, njev=run.njev, nlu=run.nlu, status=status,
                     message=message, success=status >= 0, naccept=naccept,
