@@ -24,7 +24,6 @@ module conmech
     use conmech_systems_constrained
     use conmech_systems_mech
     use conmech_model_library
-    use conmech_systems_ball
     use conmech_hill
     use conmech_equilibria
     use conmech_jordan
@@ -55,6 +54,10 @@ module conmech
     use conmech_system_energy
     use conmech_hopf
     use conmech_equilibrium_continuation
+    use conmech_periodic_multipliers
+    use conmech_periodic_schur
+    use conmech_block_chain
+    use conmech_taylor_stepper
     implicit none
     public
 end module conmech

@@ -21,7 +21,7 @@ from ._implicit import jacobian_callback
 from ._methods import METHODS, RK45_SCIPY, method_info
 from ._stepper import method_code
 from ._taylor import with_fixed_order
-from .systems import BuiltinSystem
+from ._native import NativeSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
 
@@ -114,7 +114,7 @@ def _positive_finite(value, name, allow_inf=False):
 _OPTION_NAMES = ("jac", "jac_sparsity", "lband", "uband", "min_step")
 
 
-def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[float],
+def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[float],
               y0: ArrayLike, method: str | type = "RK45", t_eval: ArrayLike | None = None,
               dense_output: bool = False,
               events: Callable[..., float] | Sequence[Callable[..., float]] | None = None,
@@ -132,7 +132,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
 
     Parameters
     ----------
-    fun : callable or conmech.systems.BuiltinSystem
+    fun : callable or conmech.systems.NativeSystem
         ``fun(t, y, *args) -> dydt`` (array of shape (n,)), called from Fortran through
         an f2py callback; or a compiled built-in system such as
         ``conmech.systems.kepler(mu=1.0)``, integrated with no Python in the loop. The
@@ -210,7 +210,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | BuiltinSystem, t_span: Sequence[fl
         or an event function reaches the caller unchanged.
     """
     # ---------------------------------------------------------------- fun and args
-    builtin = isinstance(fun, BuiltinSystem)
+    builtin = isinstance(fun, NativeSystem)
     if not builtin and not callable(fun):
         raise TypeError("fun must be callable or a built-in system from conmech.systems, "
                         f"got {type(fun).__name__}")

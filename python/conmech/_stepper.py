@@ -28,7 +28,7 @@ from ._dense import DenseOutput
 from ._checks import initial_state, real_scalar, tolerance
 from ._implicit import jacobian_callback
 from ._methods import BY_NAME, RK45_SCIPY, method_info
-from .systems import BuiltinSystem
+from ._native import NativeSystem
 
 __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "Radau",
            "Gauss", "Gauss4", "Gauss6", "method_code"]
@@ -71,7 +71,7 @@ class Stepper:
 
     Parameters
     ----------
-    fun : callable or conmech.systems.BuiltinSystem
+    fun : callable or conmech.systems.NativeSystem
         ``fun(t, y) -> dydt`` (shape (n,)), or a built-in or compiled system (no Python in
         the loop; its own Jacobian where the method uses one).
     t0 : float
@@ -130,7 +130,7 @@ class Stepper:
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
-        self._builtin = isinstance(fun, BuiltinSystem)
+        self._builtin = isinstance(fun, NativeSystem)
         if not self._builtin and not callable(fun):
             raise TypeError("fun must be callable or a built-in system from "
                             f"conmech.systems, got {type(fun).__name__}")

@@ -44,8 +44,8 @@ import math
 import numpy as np
 
 from . import _conmech
-from .systems import BuiltinSystem
-from .constrained import BuiltinConstrained
+from ._native import NativeSystem
+from .constrained import NativeConstrained
 
 __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
            "CompiledConstrained", "evaluate", "function_address", "load_model",
@@ -172,7 +172,7 @@ def _taylor_spec(spec, taylor):
     return spec
 
 
-class CompiledSystem(BuiltinSystem):
+class CompiledSystem(NativeSystem):
     """A first-order system (``kind`` 'ode') or a system in generalized coordinates
     (``kind`` 'generalized', state y = [q, q']) given by compiled functions. It works
     wherever a built-in system does: :func:`conmech.solve_ivp`, :mod:`conmech.stability`.
@@ -214,7 +214,7 @@ class CompiledSystem(BuiltinSystem):
         return f"<compiled {self.kind} system {self.name!r} n={self.dimension} ({args})>"
 
 
-class CompiledConstrained(BuiltinConstrained):
+class CompiledConstrained(NativeConstrained):
     """A constrained system in excessive coordinates given by compiled functions; it
     works with :func:`conmech.constrained.solve` like a built-in (every projection,
     multipliers, reactions, energy). q0 and v0 must be given to solve."""
@@ -345,8 +345,8 @@ def _check(info, message):
 def evaluate(system: Any, t: float, y: ArrayLike, v: ArrayLike | None = None) -> dict:
     """The quantities of a built-in or compiled system at one state, as a dict.
 
-    - first-order systems (:class:`conmech.systems.BuiltinSystem`, compiled 'ode' or
-      'generalized'), ``evaluate(system, t, y)``: ``f`` and ``jac`` (``analytic`` tells
+    - first-order systems (:class:`conmech.systems.NativeSystem`: built-in, or compiled
+      'ode' or 'generalized'), ``evaluate(system, t, y)``: ``f`` and ``jac`` (``analytic`` tells
       whether the Jacobian is exact);
     - mechanical systems, ``evaluate(system, t, q, v)``: ``M``, ``Q``, ``energy`` (None if
       undefined), and for constrained systems ``phi``, ``G``, ``gamma_h``, ``A``, ``b``,
@@ -355,11 +355,11 @@ def evaluate(system: Any, t: float, y: ArrayLike, v: ArrayLike | None = None) ->
     """
     t = float(t)
     y = np.ascontiguousarray(np.asarray(y, dtype=float).ravel())
-    if not isinstance(system, (BuiltinSystem, BuiltinConstrained)):
+    if not isinstance(system, (NativeSystem, NativeConstrained)):
         raise TypeError("system must be a built-in or compiled conmech system")
     name, np_, p, nspec, spec = system._flat_args()
     if v is None:
-        if not isinstance(system, BuiltinSystem):
+        if not isinstance(system, NativeSystem):
             raise ValueError("a constrained system needs q and v: evaluate(system, t, q, v)")
         f, jac, analytic, info, message = _conmech.flat_evaluate_ode(
             name, np_, p, nspec, spec, t=t, y=y)

@@ -25,18 +25,19 @@ import numpy as np
 
 from . import _conmech
 from . import degrees_of_freedom as _dof
+from ._builtin_table import CONSTRAINED_NAMES
 from ._callback import Guard, as_result, message_text
 from ._checks import event_settings
 from ._methods import BY_NAME
-from .systems import _NO_SPEC
+from ._native import _NO_SPEC, check_params
 
-__all__ = ["solve", "builtin", "BuiltinConstrained", "ConstrainedSystem",
-           "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS", "plot_trajectory",
-           "plot_drift"]
+__all__ = ["solve", "builtin", "NativeConstrained", "BuiltinConstrained",
+           "ConstrainedSystem", "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS",
+           "plot_trajectory", "plot_drift"]
 
-#: Names of the built-in constrained systems (excessive coordinates).
-BUILTIN_NAMES = ("pendulum_xy", "rod_two_masses", "double_pendulum_xy", "atwood_xy",
-                 "pendulum_moving_xy", "yoyo", "skate", "rolling_disk", "rolling_ball")
+#: Names of the built-in constrained systems (excessive coordinates) with a fixed number of
+#: coordinates (the pendulum chain, whose size is a parameter, is not listed).
+BUILTIN_NAMES = CONSTRAINED_NAMES
 #: Projection names and their codes in conmech_constrained_solver.
 PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
 # the methods of the Fortran table that constrained_solve runs (codes from the table)
@@ -78,29 +79,12 @@ class ConstrainedResult(dict):
                 f"{np.max(self.res_pos, initial=0.0):.3g})")
 
 
-class BuiltinConstrained:
-    """A built-in constrained system of the Fortran registry, by name and parameters."""
+class NativeConstrained:
+    """A constrained system evaluated in native code (a built-in of the Fortran registry or
+    compiled functions), for :func:`solve`: attributes name, params, n, n_hol, n_nh and
+    spec (the function table handed to Fortran; empty for a built-in)."""
 
     __slots__ = ("name", "params", "n", "n_hol", "n_nh", "spec", "_keep")
-
-    def __init__(self, name, params=()):
-        if not isinstance(name, str):
-            raise TypeError("system name must be a string")
-        params = np.array(params, dtype=float).ravel()
-        if not np.all(np.isfinite(params)):
-            raise ValueError("params must be finite")
-        from .systems import check_params
-        check_params(name, params)
-        kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
-            name, params.size, params if params.size else _PAD, 0, _NO_SPEC)
-        if kind != 1:
-            raise ValueError(f"system: unknown built-in constrained system '{name}' "
-                             f"(known: {', '.join(BUILTIN_NAMES)})")
-        self.name = name
-        self.params = params
-        self.n, self.n_hol, self.n_nh = int(n), int(mh), int(mn)
-        self.spec = _NO_SPEC
-        self._keep = None
 
     def _flat_args(self):
         """(name, np, params, nspec, spec) for the flat routines (built-in or compiled)."""
@@ -114,6 +98,30 @@ class BuiltinConstrained:
         (:func:`conmech.degrees_of_freedom.degrees_of_freedom` gives the whole report:
         independent velocities, redundant constraints)."""
         return _dof.degrees_of_freedom(self).dof
+
+
+class BuiltinConstrained(NativeConstrained):
+    """A built-in constrained system of the Fortran registry, by name and parameters."""
+
+    __slots__ = ()
+
+    def __init__(self, name, params=()):
+        if not isinstance(name, str):
+            raise TypeError("system name must be a string")
+        params = np.array(params, dtype=float).ravel()
+        if not np.all(np.isfinite(params)):
+            raise ValueError("params must be finite")
+        check_params(name, params)
+        kind, n, mh, mn, info, msg = _conmech.flat_mech_info(
+            name, params.size, params if params.size else _PAD, 0, _NO_SPEC)
+        if kind != 1:
+            raise ValueError(f"system: unknown built-in constrained system '{name}' "
+                             f"(known: {', '.join(BUILTIN_NAMES)})")
+        self.name = name
+        self.params = params
+        self.n, self.n_hol, self.n_nh = int(n), int(mh), int(mn)
+        self.spec = _NO_SPEC
+        self._keep = None
 
     def initial_state(self):
         """Default consistent initial state (q0, v0)."""
@@ -228,7 +236,7 @@ def _int(value, name, low=1, high=2**31 - 1):
     return int(value)
 
 
-def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence[float],
+def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[float],
           q0: ArrayLike | None = None, v0: ArrayLike | None = None, method: str = "DOP853",
           projection: str = "position+velocity", t_eval: ArrayLike | None = None,
           rtol: float = 1e-8, atol: float = 1e-10, params: Sequence[float] = (),
@@ -241,7 +249,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
 
     Parameters
     ----------
-    system : str, BuiltinConstrained or ConstrainedSystem
+    system : str, NativeConstrained (built-in or compiled) or ConstrainedSystem
         A built-in (name, with ``params``) or a system of Python callables.
     t_span : (t0, tf)
     q0, v0 : array_like, optional
@@ -290,7 +298,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
     """
     if isinstance(system, str):
         system = BuiltinConstrained(system, params)
-    elif not isinstance(system, (BuiltinConstrained, ConstrainedSystem)):
+    elif not isinstance(system, (NativeConstrained, ConstrainedSystem)):
         raise TypeError("system must be a built-in name, conmech.constrained.builtin(...) or "
                         "a ConstrainedSystem")
     n = system.n
@@ -306,7 +314,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
     if not (np.isfinite(t0) and np.isfinite(tf)):
         raise ValueError("t_span must be finite")
     if q0 is None or v0 is None:
-        if not isinstance(system, BuiltinConstrained):
+        if not isinstance(system, NativeConstrained):
             raise ValueError("q0 and v0 are required for a user-defined system")
         dq, dv = system.initial_state()
         q0 = dq if q0 is None else q0
@@ -409,7 +417,7 @@ def solve(system: str | BuiltinConstrained | ConstrainedSystem, t_span: Sequence
                   rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
                   neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD, ne=ne,
                   ev_dir=ev_dir, ev_term=ev_term)
-    if isinstance(system, BuiltinConstrained):
+    if isinstance(system, NativeConstrained):
         stats, moved, info, message = _conmech.flat_constrained_builtin(
             *system._flat_args(), store, events_cb, evstore, **common)
     else:

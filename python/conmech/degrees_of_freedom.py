@@ -1,7 +1,7 @@
 """Degrees of freedom of mechanical systems (the lecture notes' n = 3N - R).
 
 - A constrained system in excessive coordinates (:class:`conmech.constrained.
-  BuiltinConstrained`, compiled or symbolic): n coordinates minus the number of independent
+  NativeConstrained`: built-in, compiled or symbolic): n coordinates minus the number of independent
   holonomic constraints, the rank of G = dphi/dq at a point of the constraint manifold
   (Fortran conmech_degrees_of_freedom: Gauss-Newton onto phi = 0, ranks by LAPACK's SVD).
   Pfaffian (non-holonomic) constraints do not reduce the degrees of freedom; they reduce
@@ -18,7 +18,7 @@ import numpy as np
 
 from . import _conmech
 from ._callback import message_text
-from .systems import BuiltinSystem
+from ._native import NativeSystem
 
 __all__ = ["DegreesOfFreedom", "degrees_of_freedom"]
 
@@ -48,7 +48,7 @@ def _generalized_dof(system):
     ndof = getattr(system, "ndof", None)
     if ndof:
         return int(ndof)
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         kind, n, mh, mn, info, _ = _conmech.flat_mech_info(*system._flat_args())
         if info == 0 and kind == 2:
             return int(n)
@@ -63,7 +63,7 @@ def degrees_of_freedom(system, q=None, t: float = 0.0, project: bool = True,
     consistent initial state; for a compiled system without one, points drawn from a fixed
     seed and projected onto the manifold), moved onto phi = 0 first when ``project``."""
     if hasattr(system, "n_hol") and hasattr(system, "_flat_args"):
-        # conmech.constrained.BuiltinConstrained (built-in, compiled, symbolic)
+        # conmech.constrained.NativeConstrained (built-in, compiled, symbolic)
         return _constrained_dof(system, q, float(t), project, float(rank_tol))
     if hasattr(system, "n_hol") and callable(getattr(system, "mass", None)):
         # conmech.constrained.ConstrainedSystem (Python callables)

@@ -42,7 +42,7 @@ import numpy as np
 from . import _conmech
 from ._ivp import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
 from ._ivp import solve_ivp as _solve_ivp
-from .systems import BuiltinSystem
+from ._native import NativeSystem
 
 __all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
 
@@ -123,7 +123,7 @@ class EnsembleResult(OdeResult):
 
 
 def _check_system(system):
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         return system
     if type(system).__name__ in ("BuiltinConstrained", "CompiledConstrained"):
         raise TypeError("ensemble.solve integrates first-order systems (conmech.systems "
@@ -240,7 +240,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
 
     Parameters
     ----------
-    system : conmech.systems.BuiltinSystem or a compiled system
+    system : conmech.systems.NativeSystem (a built-in or a compiled system)
         The system (its parameters are the default of every member): built-in
         (``conmech.systems``) or compiled (``conmech.compiled.ode_system``,
         ``generalized_system``); constrained systems are not supported.

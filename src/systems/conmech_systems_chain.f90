@@ -10,13 +10,15 @@
 !! the windows give a detected bandwidth of 2, as rows 1 and 2 share their window).
 module conmech_systems_chain
     use conmech_kinds, only: dp
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system, only: constrained_system
     implicit none
     private
-    public :: pendulum_chain_xy, chain_initial_state
+    public :: pendulum_chain_xy, chain_initial_state, make_pendulum_chain, pendulum_chain_state
 
     !> N links; set n = 2N, n_hol = N, diagonal_mass, jac_width = min(4, n) (or use
-    !! conmech_systems_mech::make_constrained("pendulum_chain_xy", [N, m, l, g])).
+    !! conmech_systems_mech::make_constrained("pendulum_chain_xy", [N, m, l, g]), which
+    !! calls make_pendulum_chain).
     type, extends(constrained_system) :: pendulum_chain_xy
         real(dp) :: m = 1.0_dp
         real(dp) :: l = 1.0_dp
@@ -34,6 +36,57 @@ module conmech_systems_chain
     end type pendulum_chain_xy
 
 contains
+
+    !> The number of links N from the registry's first parameter: a whole number in
+    !! 1..100000, else 0.
+    pure integer function links_of(p) result(nl)
+        real(dp), intent(in) :: p(:)
+        nl = 0
+        if (p(1) >= 1.0_dp .and. p(1) <= 1.0e5_dp .and. p(1) == aint(p(1))) nl = nint(p(1))
+    end function links_of
+
+    !> `sys`: a chain with the registry's parameters p = [N, m, l, g] and its structure
+    !! declared (n = 2N, n_hol = N, diagonal mass, row windows of width 4); CM_BAD_INPUT
+    !! unless N is a whole number in 1..100000.
+    subroutine make_pendulum_chain(p, sys, info, msg)
+        real(dp), intent(in) :: p(:)
+        class(constrained_system), allocatable, intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        type(pendulum_chain_xy) :: s
+        integer :: nl
+        nl = links_of(p)
+        if (nl == 0) then
+            info = CM_BAD_INPUT
+            msg = "bad input: pendulum_chain_xy needs a whole number of links N " &
+                  //"(1 <= N <= 100000) as its first parameter"
+            return
+        end if
+        info = CM_SUCCESS
+        msg = "success"
+        s%m = p(2); s%l = p(3); s%g = p(4)
+        s%n = 2*nl; s%n_hol = nl
+        s%diagonal_mass = .true.
+        s%jac_width = min(4, s%n)
+        allocate (sys, source=s)
+    end subroutine make_pendulum_chain
+
+    !> The registry's default initial state of the chain with the parameters p = [N, m, l, g]
+    !! (chain_initial_state); CM_BAD_INPUT unless N is a whole number in 1..100000.
+    subroutine pendulum_chain_state(p, q0, v0, info)
+        real(dp), intent(in) :: p(:)
+        real(dp), allocatable, intent(out) :: q0(:), v0(:)
+        integer, intent(out) :: info
+        integer :: nl
+        nl = links_of(p)
+        if (nl == 0) then
+            info = CM_BAD_INPUT
+            allocate (q0(0), v0(0))
+            return
+        end if
+        info = CM_SUCCESS
+        call chain_initial_state(nl, p(3), q0, v0)
+    end subroutine pendulum_chain_state
 
     !> A consistent initial state of N links: link i at the angle 1 - 0.5 (i-1)/N from the
     !! downward vertical, at rest.

@@ -13,7 +13,7 @@ from .. import _conmech
 from .._callback import Guard, as_result, message_text
 from .._ivp import DenseOutput, OdeResult, _event_settings, _METHOD_CODES
 from ..compiled import function_address
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 
 __all__ = ["ControlledSystem", "FeedbackLaw", "PythonLaw", "CompiledLaw", "ZeroLaw",
            "simulate"]
@@ -52,7 +52,7 @@ class ControlledSystem:
 
     def __init__(self, system, actuated=None, *, B=None, input_matrix=None, n_inputs=None,
                  input_params=(), keep=None):
-        if not isinstance(system, BuiltinSystem):
+        if not isinstance(system, NativeSystem):
             raise TypeError("system must be a built-in or compiled system in generalized "
                             "coordinates (e.g. conmech.systems.cart_pendulum() or "
                             "conmech.symbolic.lagrangian_system(...))")

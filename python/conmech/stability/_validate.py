@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import _conmech  # noqa: F401
 from .._callback import Guard, as_result, message_text
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 
 def _msg(message):
     return message_text(message)
@@ -77,7 +77,7 @@ def _callback(fun, n, y0, t0, jac=None):
     are probed once at (t0, y0) in Python first: a wrong shape or an exception is raised
     before the Fortran side allocates anything (the STM of a large system is big)."""
     if not callable(fun):
-        raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+        raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                         "fun(t, y)")
     if jac is not None and not callable(jac):
         raise TypeError("jac must be a callable jac(t, y) -> (n, n) array, or None")
@@ -91,13 +91,13 @@ def _callback(fun, n, y0, t0, jac=None):
 
 
 def _check_dim(system, y):
-    if isinstance(system, BuiltinSystem) and y.size != system.dimension:
+    if isinstance(system, NativeSystem) and y.size != system.dimension:
         raise ValueError(f"y0 has {y.size} components; the system '{system.name}' has "
                          f"{system.dimension}")
 
 
 def _no_jac_for_builtin(system, jac):
-    if jac is not None and isinstance(system, BuiltinSystem):
+    if jac is not None and isinstance(system, NativeSystem):
         raise TypeError("jac is for Python callables; a built-in system has its own "
                         "Jacobian")
 

@@ -26,7 +26,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..compiled import CompiledConstrained, evaluate
-from ..constrained import BuiltinConstrained, ConstrainedSystem, builtin
+from ..constrained import ConstrainedSystem, NativeConstrained, builtin
 from .equilibria import equilibrium, lagrange_dirichlet, potential_hessian
 from ._validate import _real, _state
 
@@ -68,7 +68,7 @@ def _evaluator(system, t):
     """(n, m, fun(q, v) -> (M, Q, phi, G), energy(q) or None) of a constrained system."""
     if isinstance(system, str):
         system = builtin(system)
-    if isinstance(system, BuiltinConstrained):
+    if isinstance(system, NativeConstrained):
         if system.n_nh > 0:
             raise ValueError(f"'{system.name}' has non-holonomic constraints: equilibria on "
                              "a constraint manifold need holonomic constraints only")

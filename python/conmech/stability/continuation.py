@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import _conmech
 from .._callback import Guard, as_result
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _check_dim, _count, _msg, _raise, _state
 from .orbits import _METHODS, stable_tolerance
 
@@ -252,7 +252,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             return nan
     args = (ropt, iopt, fr.size if sym else 0, fr, tg.size if sym else 0, tg,
             tang.size if _tangent is not None else 0, tang, int(max_points), en)
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         if param is None and in_period:
             param = 0
         if param is None:
@@ -267,7 +267,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
         pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
     else:
         if not callable(system):
-            raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+            raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                             "fun(t, y, p)")
         if p0 is None and in_period:
             p0 = 0.0

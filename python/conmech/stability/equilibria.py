@@ -8,7 +8,8 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import STATE_NAMES, BuiltinSystem
+from .._builtin_table import STATE_NAMES
+from .._native import BuiltinSystem, NativeSystem
 from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate",
@@ -152,7 +153,7 @@ def equilibrium(system: Any, y: ArrayLike, t: float = 0.0, tol: float = 1e-8,
     _no_jac_for_builtin(system, jac)
     n = y.size
     njev = 0
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         out = _conmech.flat_equilibrium_structure_builtin(*system._flat_args(), y, t, tol)
     else:
         g, rhs, dfdy = _callback(system, n, y, t, jac)
@@ -302,7 +303,7 @@ def find_equilibrium(system: Any, guess: ArrayLike, t: float = 0.0, tol: float =
     _check_dim(system, y)
     if not (np.isfinite(tol) and tol > 0) or int(max_iter) < 1:
         raise ValueError("tol must be positive and max_iter >= 1")
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         yout, info, message = _conmech.flat_find_equilibrium_builtin(
             *system._flat_args(), y, float(t), float(tol), int(max_iter))
     else:

@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import _conmech
 from .._callback import Guard, as_result
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _check_dim, _count, _msg, _raise, _real, _state
 from .continuation import Branch, _param_index, continuation
 
@@ -112,7 +112,7 @@ class EquilibriumBranch:
 def _param_rhs(system, n, y0, p0):
     """The guarded callback fun(t, y, p) for f2py (probed once at (0, y0, p0))."""
     if not callable(system):
-        raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+        raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                         "fun(t, y, p)")
     as_result(system(0.0, y0.copy(), float(p0)), (n,), "fun")
     g = Guard()
@@ -180,7 +180,7 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
                      locate_tol, test_tol, l1_tol, _real(t, "t")], dtype=float)
     iopt = np.array([max_points, 1 if direction >= 0 else -1, max_iter, bool(locate)],
                     dtype=np.int32)
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         ip, params, pname = _builtin_args(system, param, p0)
         if not lo <= params[ip] <= hi:
             raise ValueError(f"the start value {pname} = {params[ip]:g} is outside p_range")
@@ -244,7 +244,7 @@ def first_lyapunov_coefficient(system: Any, y: ArrayLike, p: float | None = None
     n = y.size
     t = _real(t, "t")
     l1_tol = _real(l1_tol, "l1_tol", 0.0, low_open=True)
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         params = np.array(system.params, dtype=float)
         if p is not None:
             if param is None:
@@ -310,7 +310,7 @@ def hopf_orbits(system: Any, branch: EquilibriumBranch, point: EquilibriumSpecia
                          "side of the point the cycles exist")
     amplitude = _real(amplitude, "amplitude", 0.0, low_open=True)
     amplitude *= max(1.0, float(np.max(np.abs(point.y))))
-    if param is None and isinstance(system, BuiltinSystem):
+    if param is None and isinstance(system, NativeSystem):
         param = branch.param
     for bad in ("p0", "free", "targets", "in_period", "conservative", "_switch", "_tangent",
                 "fixed_period", "autonomous", "direction"):

@@ -9,7 +9,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from ..compiled import CompiledSystem, evaluate
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _count, _real, _state
 from .continuation import Branch, continuation
 from .equilibria import equilibrium, find_equilibrium
@@ -63,7 +63,7 @@ def _equilibrium_state(system, q_eq, jac):
     """The equilibrium state y_eq from a configuration (y = [q, 0]) or a full state,
     polished by Newton; ValueError if it is not (near) an equilibrium."""
     q = _state(q_eq, "q_eq")
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         n = system.dimension
         if q.size == n:
             y = q
@@ -74,7 +74,7 @@ def _equilibrium_state(system, q_eq, jac):
                              f"the state ({n}) of the system '{system.name}' is expected")
     else:
         if not callable(system):
-            raise TypeError("system must be a conmech.systems.BuiltinSystem or a callable "
+            raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
                             "fun(t, y)")
         y = q
     try:
@@ -151,7 +151,7 @@ def _small_orbit(system, y_eq, v, u, period, eps, rtol, jac, max_iter=30):
     scale = max(1.0, float(np.max(np.abs(y_eq))))
     for _ in range(max_iter):
         y1, phi = stm(system, (0.0, t), y0, rtol=rtol, atol=rtol, jac=jac)
-        f1 = np.asarray(system(t, y1) if not isinstance(system, BuiltinSystem) else
+        f1 = np.asarray(system(t, y1) if not isinstance(system, NativeSystem) else
                         _rhs(system, y1), dtype=float)
         z = np.vdot(u, y0 - y_eq)
         r = np.concatenate([y1 - y0, [z.imag, z.real - eps]])
@@ -206,7 +206,7 @@ def lyapunov_family(system: Any, q_eq: ArrayLike, mode: int = 0, *, amplitude: f
         raise TypeError(f"mode must be an integer, got {type(mode).__name__}")
     amplitude = _real(amplitude, "amplitude", 0.0, low_open=True)
     rtol = _real(rtol, "rtol", 0.0, low_open=True)
-    if jac is not None and isinstance(system, BuiltinSystem):
+    if jac is not None and isinstance(system, NativeSystem):
         raise TypeError("jac is for Python callables; a built-in system has its own Jacobian")
     nm = normal_modes(system, q_eq, jac=jac)
     if not 0 <= int(mode) < nm.omega.size:
@@ -218,7 +218,7 @@ def lyapunov_family(system: Any, q_eq: ArrayLike, mode: int = 0, *, amplitude: f
         raise ValueError(f"mode {k} (omega = {nm.omega[k]:.12g}) is resonant: "
                          f"{nm.resonant[k]}; Lyapunov's theorem does not give its family")
     if energy is None:
-        if not isinstance(system, BuiltinSystem):
+        if not isinstance(system, NativeSystem):
             raise ValueError("energy(y) is needed for a callable system")
         efun = system.energy
         efun(nm.y_eq)          # a ValueError naming the system if it has none
@@ -236,7 +236,7 @@ def lyapunov_family(system: Any, q_eq: ArrayLike, mode: int = 0, *, amplitude: f
                          f"(T = {ta:.15g} at amplitudes {eps:.3g} and {2*eps:.3g}): the "
                          "family cannot be continued in the period (a linear or isochronous "
                          "mode)")
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         csys = system
         if system.params.size == 0 and isinstance(system, CompiledSystem):
             # continuation() needs a parameter slot even when it continues in the period

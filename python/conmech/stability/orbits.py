@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import _conmech
 from .._ivp import solve_ivp
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import (_callback, _check_dim, _count, _no_jac_for_builtin, _raise, _real,
                         _state, _tols)
 
@@ -108,7 +108,7 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     args = (y0, period, kind, mode, nfree, fr, ntg, tg, int(bool(free_time)),
             period_factor, rtol, atol, max_iter, iopt, nk)
     njev = 0
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         out = _conmech.flat_po_builtin(*system._flat_args(), *args)
     else:
         g, rhs, dfdy = _callback(system, y0.size, y0, 0.0, jac)

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .._ivp import solve_ivp
-from ..systems import BuiltinSystem
+from .._native import BuiltinSystem, NativeSystem
 from .continuation import Branch
 from .equilibrium_continuation import EquilibriumBranch
 
@@ -289,7 +289,7 @@ def _orbit_system(system, branch, k):
     """The right-hand side of orbit k of the branch (its parameter value set)."""
     in_period = branch.param == "period"
     p = float(branch.p[k])
-    if isinstance(system, BuiltinSystem):
+    if isinstance(system, NativeSystem):
         if in_period:
             return system
         names = system.param_names or tuple(f"p{i}" for i in range(system.params.size))

@@ -10,8 +10,8 @@ import numpy as np
 
 from .. import _conmech
 from .._callback import Guard, as_result
-from ..systems import BuiltinSystem
-from ..constrained import BuiltinConstrained
+from .._native import NativeSystem
+from ..constrained import NativeConstrained
 from ._validate import _raise, _real, _state
 
 __all__ = ["TransverseLinearisation", "transverse_linearisation", "nontrivial_multipliers"]
@@ -166,11 +166,11 @@ def transverse_linearisation(system: Any, orbit: Any, period: float | None = Non
         raise ValueError("rtol must be < 1")
     n = y0.size
     full = int(bool(full_monodromy))
-    if isinstance(system, (BuiltinSystem, BuiltinConstrained)):
+    if isinstance(system, (NativeSystem, NativeConstrained)):
         if jac is not None or energy_gradient is not None:
             raise TypeError("jac and energy_gradient are for Python callables; a built-in or "
                             "compiled system has its own")
-        if isinstance(system, BuiltinConstrained):
+        if isinstance(system, NativeConstrained):
             if n != 2*system.n:
                 raise ValueError(f"y0 must be [q, v] with {2*system.n} values for this "
                                  f"constrained system, got {n}")

@@ -8,7 +8,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..systems import BuiltinSystem
+from .._native import NativeSystem
 from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state, _tols
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
@@ -35,12 +35,12 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     if not isinstance(method, str) or method.upper() not in ("DOP853", "TAYLOR"):
         raise ValueError(f"method must be 'DOP853' or 'TAYLOR', got {method!r}")
     if method.upper() == "TAYLOR":
-        if not isinstance(system, BuiltinSystem):
+        if not isinstance(system, NativeSystem):
             raise ValueError("method 'TAYLOR' needs a compiled system with Taylor code "
                              "(conmech.symbolic.ode_system), not a Python function")
         y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(
             *system._flat_args(), y0, t0, t1, rtol, atol)
-    elif isinstance(system, BuiltinSystem):
+    elif isinstance(system, NativeSystem):
         y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
             *system._flat_args(), y0, t0, t1, rtol, atol)
     else:
