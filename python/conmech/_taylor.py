@@ -89,8 +89,8 @@ def _fixed_library(d, order):
         return None
     try:
         path, _ = build.compile_source(fixed_order_source(d, order, variational=False))
-    except TaylorUnsupported:
-        return None
+    except (TaylorUnsupported, build.CompileError):
+        return None         # the loop version runs (same coefficients, a little slower)
     return ctypes.CDLL(path)
 
 
