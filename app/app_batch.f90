@@ -12,6 +12,7 @@ module app_batch
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long
     use conmech_kinds, only: dp
     use app_cli, only: cli_parser, parse_real, parse_int
+    use app_output, only: results_file
     implicit none
     private
     public :: row_t, load_rows, check_args_file, write_args_file, file_exists, file_size
@@ -136,18 +137,25 @@ contains
     subroutine write_args_file(cli, out, args)
         type(cli_parser), intent(inout) :: cli
         character(len=*), intent(in) :: out, args
-        integer :: u, ios, l
-        character(len=:), allocatable :: cmd
+        integer :: l
+        character(len=:), allocatable :: cmd, msg
+        type(results_file) :: f
+        logical :: ok
         call get_command(length=l)
         allocate (character(len=l) :: cmd)
         call get_command(cmd)
-        open (newunit=u, file=out//".args", status="replace", action="write", iostat=ios)
-        if (ios /= 0) call cli%fail("cannot write "//out//".args")
-        write (u, '(a)') "# conmech "//cli%prog//": the arguments that made "//out// &
-            " (a resume must match them)"
-        write (u, '(a)') args
-        write (u, '(a)') "# command: "//cmd
-        close (u)
+        call f%open(out//".args", "w", ok, msg)
+        if (.not. ok) call cli%fail("cannot write "//out//".args: "//msg)
+        call f%put("# conmech "//cli%prog//": the arguments that made "//out// &
+                   " (a resume must match them)"//new_line("a")//args//new_line("a")// &
+                   "# command: "//cmd, ok, msg)
+        if (ok) then
+            call f%close(ok, msg)
+        else
+            call f%close(ok, cmd)
+            ok = .false.
+        end if
+        if (.not. ok) call cli%fail_io("cannot write "//out//".args: "//msg)
     end subroutine write_args_file
 
     !> Is this a number as the programs write it (incl. NaN, Infinity)?
@@ -163,13 +171,19 @@ contains
     end function csv_number
 
     !> Read and check an existing results CSV: line 1 must be `header`, every row
-    !! `nfields` numbers with an integer key in [lo, hi] first (`ordered`: keys lo, lo+1,..).
-    !! A last line without its newline (torn by a kill) is dropped; with `repair` it is also
-    !! cut from the file. Any other bad line is an error naming the file and line.
-    !! have(key) / rows(key)%s receive the rows (the first copy of a key wins); nfail counts
-    !! the rows whose field `status_col` is not 0.
+    !! `nfields` numbers with an integer key in [lo, hi] first (`ordered`: keys lo, lo+1,..
+    !! in this order). A last line without its newline (torn by a kill) is dropped; with
+    !! `repair` it is also cut from the file. A key seen twice: a row identical to the first
+    !! copy is a duplicate (a resume of a copied or merged file) and is dropped (with
+    !! `repair` also from the file, rewritten durably, with a note on stderr); a different
+    !! row is an error naming both lines. Any other bad line, a key out of range, or (when
+    !! `ordered`) out of order is an error naming the file and line.
+    !! have(key) / rows(key)%s receive the rows (the first copy wins; with `rows`, a key
+    !! already there from an earlier file is compared with it); nrows counts the distinct
+    !! keys of this file; nfail the rows whose field `status_col` is not 0; in_order tells
+    !! whether the keys come in increasing order.
     subroutine load_rows(cli, file, header, nfields, lo, hi, ordered, repair, have, nrows, &
-                         rows, status_col, nfail)
+                         rows, status_col, nfail, in_order)
         type(cli_parser), intent(inout) :: cli
         character(len=*), intent(in) :: file, header
         integer, intent(in) :: nfields, lo, hi
@@ -179,14 +193,22 @@ contains
         type(row_t), intent(inout), optional :: rows(lo:)
         integer, intent(in), optional :: status_col
         integer, intent(out), optional :: nfail
-        integer(int64) :: sz, keep
-        integer :: u, ios, ln, key, nf, a, b, j, sl
+        logical, intent(out), optional :: in_order
+        integer(int64) :: sz, keep, here
+        integer(int64), allocatable :: first_at(:)
+        integer, allocatable :: first_line(:), dups(:)
+        integer :: u, ios, ln, key, nf, a, b, j, sl, ndup, last_key
         character(len=8192) :: line
         character :: last
-        logical :: torn, ok, failed
-        character(len=16) :: lnum
+        logical :: torn, ok, failed, seen_here, sorted
+        character(len=:), allocatable :: first, kname
+        kname = header(:max(1, index(header, ",") - 1))
         nrows = 0
+        ndup = 0
+        last_key = lo - 1
+        sorted = .true.
         if (present(nfail)) nfail = 0
+        if (present(in_order)) in_order = .true.
         sz = file_size(file)
         if (sz <= 0) return
         open (newunit=u, file=file, access="stream", form="unformatted", action="read", &
@@ -195,6 +217,8 @@ contains
         read (u, pos=sz) last
         close (u)
         torn = last /= new_line("a")
+        allocate (first_at(lo:hi), first_line(lo:hi), dups(16))
+        first_line = 0
         open (newunit=u, file=file, status="old", action="read", iostat=ios)
         if (ios /= 0) call cli%fail("cannot read "//file)
         ln = 0
@@ -210,7 +234,6 @@ contains
                 ! skip the rest of an over-long line
                 read (u, '(a)', iostat=ios)
             end if
-            write (lnum, '(i0)') ln
             if (torn) then
                 ! is this the last line? peek by position: the torn tail has no newline
                 if (keep + sl >= sz) then
@@ -220,12 +243,13 @@ contains
                         if (ln == 1) call cli%fail(file//" has a torn header line (a kill "// &
                             "during its creation?); use --force")
                         write (error_unit, '(a)') cli%prog//": "//file//" line "// &
-                            trim(lnum)//": incomplete last row dropped (a kill mid-write)"
-                        return
+                            itoa(ln)//": incomplete last row dropped (a kill mid-write)"
+                        u = -1
                     end if
                     exit
                 end if
             end if
+            here = keep
             keep = keep + sl + 1
             if (ln == 1) then
                 if (line(:sl) /= header) call cli%fail(file//" line 1: header '"// &
@@ -236,6 +260,7 @@ contains
             ok = sl <= len(line)
             nf = 0
             failed = .false.
+            key = lo - 1
             if (ok) then
                 a = 1
                 do j = 1, nfields
@@ -255,8 +280,6 @@ contains
                     end if
                     if (j == 1) then
                         call parse_int(line(a:b - 1), key, ok)
-                        ok = ok .and. key >= lo .and. key <= hi
-                        if (ordered) ok = ok .and. key == lo + nrows
                     else
                         ok = csv_number(line(a:b - 1))
                         if (present(status_col)) then
@@ -267,17 +290,59 @@ contains
                     a = b + 1
                 end do
             end if
-            if (.not. ok) call cli%fail(file//" line "//trim(lnum)//": not a valid row: '"// &
+            if (.not. ok) call cli%fail(file//" line "//itoa(ln)//": not a valid row: '"// &
                 line(:min(sl, 200))//"'; fix or delete the line, or use --force to start over")
-            nrows = nrows + 1
-            if (.not. have(key)) then
-                have(key) = .true.
-                if (present(rows)) rows(key)%s = line(:sl)
-                if (present(nfail) .and. failed) nfail = nfail + 1
+            if (key < lo .or. key > hi) call cli%fail(file//" line "//itoa(ln)//": "//kname// &
+                " = "//itoa(key)//" is out of range "//itoa(lo)//".."//itoa(hi)//": '"// &
+                line(:min(sl, 200))//"'; fix or delete the line, or use --force to start over")
+            seen_here = first_line(key) > 0
+            if (have(key)) then
+                ! the key again: the same row is a harmless duplicate, another is an error
+                if (seen_here) then
+                    first = read_at(first_at(key))
+                else if (present(rows)) then
+                    first = rows(key)%s
+                else
+                    first = line(:sl)
+                end if
+                if (first /= line(:sl)) then
+                    if (seen_here) then
+                        call cli%fail(file//" line "//itoa(ln)//": "//kname//" = "// &
+                            itoa(key)//" appears again (first at line "//itoa(first_line(key))// &
+                            ") with different values; keep one of the two lines, or use "// &
+                            "--force to start over")
+                    else
+                        call cli%fail(file//" line "//itoa(ln)//": "//kname//" = "// &
+                            itoa(key)//" was already read from another file with different "// &
+                            "values; keep one of the two rows, or use --force to start over")
+                    end if
+                end if
+                ndup = ndup + 1
+                if (ndup > size(dups)) dups = [dups, dups]
+                dups(ndup) = ln
+                cycle
             end if
+            if (ordered .and. key /= lo + nrows) call cli%fail(file//" line "//itoa(ln)// &
+                ": "//kname//" = "//itoa(key)//" out of order (expected "//itoa(lo + nrows)// &
+                "; the rows are written in order); use --force to start over")
+            if (key < last_key) sorted = .false.
+            last_key = key
+            have(key) = .true.
+            first_at(key) = here
+            first_line(key) = ln
+            nrows = nrows + 1
+            if (present(rows)) rows(key)%s = line(:sl)
+            if (present(nfail) .and. failed) nfail = nfail + 1
         end do
-        close (u)
+        if (u /= -1) close (u)
         if (ln == 0 .and. repair) call cut(file, 0_int64)
+        if (present(in_order)) in_order = sorted
+        if (ndup > 0 .and. repair) then
+            call drop_lines(dups(:ndup))
+            write (error_unit, '(a)') cli%prog//": "//file//": "//itoa(ndup)// &
+                " duplicated row(s) removed (identical copies of earlier rows, from line "// &
+                itoa(dups(1))//" on)"
+        end if
     contains
         subroutine cut(name, length)
             character(len=*), intent(in) :: name
@@ -285,7 +350,79 @@ contains
             if (c_truncate(name//c_null_char, int(length, c_long)) /= 0) &
                 call cli%fail("cannot repair "//name)
         end subroutine cut
+
+        !> The line starting at byte offset `off` (0-based) of `file`.
+        function read_at(off) result(s)
+            integer(int64), intent(in) :: off
+            character(len=:), allocatable :: s
+            integer :: v, io
+            character :: ch
+            integer(int64) :: k
+            s = ""
+            open (newunit=v, file=file, access="stream", form="unformatted", action="read", &
+                  status="old", iostat=io)
+            if (io /= 0) call cli%fail("cannot read "//file)
+            k = off + 1
+            do
+                read (v, pos=k, iostat=io) ch
+                if (io /= 0 .or. ch == new_line("a")) exit
+                s = s//ch
+                k = k + 1
+            end do
+            close (v)
+        end function read_at
+
+        !> Rewrite `file` without the lines `drop` (increasing), durably.
+        subroutine drop_lines(drop)
+            integer, intent(in) :: drop(:)
+            integer :: r, io, l, k, ll
+            character(len=:), allocatable :: tmp, why
+            character(len=256) :: msg
+            logical :: done, ok
+            type(results_file) :: w
+            tmp = file//".tmp"
+            open (newunit=r, file=file, status="old", action="read", iostat=io, iomsg=msg)
+            if (io /= 0) call cli%fail("cannot read "//file//": "//trim(msg))
+            call w%open(tmp, "w", ok, why)
+            if (.not. ok) call cli%fail_io("cannot write "//tmp//": "//why)
+            l = 0
+            k = 1
+            do
+                read (r, '(a)', iostat=io, size=ll, advance="no") line
+                if (is_iostat_end(io)) exit
+                l = l + 1
+                if (k <= size(drop)) then
+                    if (drop(k) == l) then
+                        k = k + 1
+                        cycle
+                    end if
+                end if
+                call w%put(line(:ll), ok, why)
+                if (.not. ok) exit
+            end do
+            close (r)
+            if (ok) then
+                call w%close(ok, why)
+            else
+                call w%close(done, tmp)
+                tmp = file//".tmp"
+            end if
+            if (.not. ok) then
+                call delete_file(tmp)
+                call cli%fail_io("cannot write "//tmp//": "//why)
+            end if
+            call durable_rename(tmp, file, done)
+            if (.not. done) call cli%fail_io("cannot replace "//file//" by "//tmp)
+        end subroutine drop_lines
     end subroutine load_rows
+
+    function itoa(k) result(s)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: s
+        character(len=16) :: b
+        write (b, '(i0)') k
+        s = trim(b)
+    end function itoa
 
     subroutine progress_begin(self, prog, total, start_done, on)
         class(progress_t), intent(inout) :: self

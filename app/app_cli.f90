@@ -5,8 +5,10 @@
 !! and remembers `--input FILE.nml`; `next` walks the options (`--key value` or
 !! `--key=value`); the `get_*` procedures parse the value strictly (the whole field must be
 !! a number: `/`, `1,2`, `abc`, `1,,1` are errors naming the option); `fail` prints
-!! "PROG: error: ..." on stderr and exits with status 2 (no ERROR STOP, no backtrace).
-!! The programs exit 0 on success, 1 when a computation failed, 2 on bad input.
+!! "PROG: error: ..." on stderr and exits with status 2 (no ERROR STOP, no backtrace);
+!! `fail_io` does the same with status 3 for a file-system error during a run.
+!! The programs exit 0 on success, 1 when a computation failed, 2 on bad input, 3 when a
+!! results file could not be written (disk full, I/O error, permission).
 module app_cli
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -50,6 +52,7 @@ module app_cli
         procedure :: flag => cli_flag
         procedure :: unknown => cli_unknown
         procedure :: fail => cli_fail
+        procedure :: fail_io => cli_fail_io
         procedure :: bad_name => cli_bad_name
         procedure :: done => cli_done
         procedure :: clear => cli_clear
@@ -236,6 +239,21 @@ contains
         if (associated(self%cleanup)) call self%cleanup(2)
         stop 2, quiet=.true.
     end subroutine cli_fail
+
+    !> A file-system error during a run (a results file that cannot be written: disk full,
+    !! I/O error, permission): print "PROG: error: MSG" on stderr and exit with status 3.
+    !! Rerunning the same command resumes once the cause is fixed.
+    subroutine cli_fail_io(self, msg)
+        class(cli_parser), intent(inout) :: self
+        character(len=*), intent(in) :: msg
+        if (self%talk) then
+            write (error_unit, '(a)') self%prog//": error: "//msg
+            write (error_unit, '(a)') "(a file-system error, not a failed computation: "// &
+                "fix it and rerun the same command to resume)"
+        end if
+        if (associated(self%cleanup)) call self%cleanup(3)
+        stop 3, quiet=.true.
+    end subroutine cli_fail_io
 
     !> Exit 0 (after --help / --version).
     subroutine cli_done(self)

@@ -17,7 +17,9 @@ program family
     use, intrinsic :: iso_fortran_env, only: error_unit
     use conmech
     use app_cli
-    use app_batch, only: file_exists
+    use app_namelist, only: check_namelist
+    use app_batch, only: file_exists, row_t
+    use app_output, only: results_file
     implicit none
     character(len=*), parameter :: nl = new_line("a")
     character(len=*), parameter :: help = &
@@ -44,14 +46,15 @@ program family
         "continues the branch born there (period doubling: the orbits of twice the"//nl// &
         "period) on the side --switch-direction (default 1) for --switch-points points"//nl// &
         "(default --max-points) and writes it to --switch-out (default switched.csv, the"//nl// &
-        "columns of --out, row 1 = the bifurcation point) and its special points to"//nl// &
-        "--switch-special (default switched_special.csv). General shooting only (not"//nl// &
+        "columns of --out, row 1 = the bifurcation point); its special points are printed"//nl// &
+        "and, with --switch-special FILE, written there. General shooting only (not"//nl// &
         "with --free/--targets, --conservative, --fixed-period); no resume: an existing"//nl// &
         "--out or --switch-out needs --force."//nl// &
         "--input FILE.nml: the options from a namelist &family ... / (names as the"//nl// &
         "options, '-' -> '_'; switch = K; see jobs/family.nml); the command line"//nl// &
         "overrides them."//nl// &
-        "Exit: 0 done, 1 stopped early or no K-th bifurcation point, 2 bad input."//nl// &
+        "Exit: 0 done, 1 stopped early or no K-th bifurcation point, 2 bad input, 3 an"//nl// &
+        "output could not be written (disk full, I/O error)."//nl// &
         "Example: Hill's variation orbits in m, the loss of stability at m = 0.195..."//nl// &
         "  family --system hill --params 0.15,1 --param 1 --y0 0.8,0,0,1"//nl// &
         "         --period 6.283185307179586 --free 1,4 --targets 1,4 --period-factor 4"//nl// &
@@ -75,7 +78,7 @@ program family
     out_file = "branch.csv"
     sp_file = "special.csv"
     sw_file = "switched.csv"
-    sw_sp_file = "switched_special.csv"
+    sw_sp_file = ""          ! the switched branch's special points: only when asked
     period = -1.0_dp
     pf = 2.0_dp
     ipar = 1
@@ -240,7 +243,7 @@ contains
 
     logical function same_file(a, b)
         character(len=*), intent(in) :: a, b
-        same_file = trim(a) == trim(b)
+        same_file = len_trim(a) > 0 .and. trim(a) == trim(b)
     end function same_file
 
     !> --model: load the library, check its kind, y0 and the parameters (missing trailing
@@ -273,27 +276,38 @@ contains
         if (info /= CM_SUCCESS) call cli%fail("--model: "//msg)
     end subroutine check_model
 
-    !> New branch and special-point files with their header lines.
+    !> New branch and special-point files with their header lines (no special-point file
+    !! when `sfile` is empty).
     subroutine write_headers(bfile, sfile)
         character(len=*), intent(in) :: bfile, sfile
-        integer :: uu, ios, j
-        open (newunit=uu, file=trim(bfile), status="replace", action="write", iostat=ios)
-        if (ios /= 0) call cli%fail("cannot write "//trim(bfile))
-        write (uu, '(a)', advance="no") "i,p,period,stability_index,stable,residual,iterations"
+        character(len=:), allocatable :: cols
+        integer :: j
+        cols = ""
         do j = 1, n
-            write (uu, '(a)', advance="no") ",y0_"//itoa(j)
+            cols = cols//",y0_"//itoa(j)
         end do
-        write (uu, '(a)') ""
-        close (uu)
-        open (newunit=uu, file=trim(sfile), status="replace", action="write", iostat=ios)
-        if (ios /= 0) call cli%fail("cannot write "//trim(sfile))
-        write (uu, '(a)', advance="no") "kind,index,p,period,stability_index"
-        do j = 1, n
-            write (uu, '(a)', advance="no") ",y0_"//itoa(j)
-        end do
-        write (uu, '(a)') ""
-        close (uu)
+        call write_header(bfile, "i,p,period,stability_index,stable,residual,iterations"//cols)
+        if (len_trim(sfile) > 0) call write_header(sfile, "kind,index,p,period,"// &
+                                                   "stability_index"//cols)
     end subroutine write_headers
+
+    !> A new file holding one header line, written through C stdio so that a full disk
+    !! or an I/O error is reported (exit 3), not lost.
+    subroutine write_header(file, line)
+        character(len=*), intent(in) :: file, line
+        type(results_file) :: f
+        logical :: ok, ok2
+        character(len=:), allocatable :: why, why2
+        call f%open(trim(file), "w", ok, why)
+        if (.not. ok) call cli%fail("cannot write "//trim(file)//": "//why)
+        call f%put(line, ok, why)
+        if (ok) then
+            call f%close(ok, why)
+        else
+            call f%close(ok2, why2)
+        end if
+        if (.not. ok) call cli%fail_io("cannot write "//trim(file)//": "//why)
+    end subroutine write_header
 
     !> Append the points of `b` (after `nr` rows already there, whose last is b's first)
     !! and its special points; name the special points on stdout.
@@ -301,20 +315,22 @@ contains
         character(len=*), intent(in) :: bfile, sfile
         type(branch), intent(in) :: b
         integer, intent(in) :: nr
-        integer :: uu, j, off
+        integer :: j, off
+        type(row_t), allocatable :: rows(:)
         off = merge(1, 0, nr > 0)
-        open (newunit=uu, file=trim(bfile), status="old", position="append", action="write")
+        allocate (rows(max(b%npoints - off, 0)))
         do j = 1 + off, b%npoints
-            write (uu, '(a)') itoa(nr + j - off)//","// &
+            rows(j - off)%s = itoa(nr + j - off)//","// &
                 fmt_real(b%points(j)%p)//","//fmt_real(b%points(j)%period)//","// &
                 fmt_real(b%points(j)%stability_index)//","//itoa(merge(1, 0, &
                 stable(b%points(j))))//","//fmt_real(b%points(j)%residual)//","// &
                 itoa(b%points(j)%iterations)//","//fmt_list(b%points(j)%y0)
         end do
-        close (uu)
-        open (newunit=uu, file=trim(sfile), status="old", position="append", action="write")
+        call append_rows(bfile, rows)
+        deallocate (rows)
+        allocate (rows(b%nspecial))
         do j = 1, b%nspecial
-            write (uu, '(a)') trim(special_name(b%special(j)%kind))//","// &
+            rows(j)%s = trim(special_name(b%special(j)%kind))//","// &
                 itoa(nr + b%special(j)%index - off)//","// &
                 fmt_real(b%special(j)%point%p)//","//fmt_real(b%special(j)%point%period)// &
                 ","//fmt_real(b%special(j)%point%stability_index)//","// &
@@ -322,8 +338,30 @@ contains
             write (*, '(a, es24.16)') "family: "//special_name(b%special(j)%kind)// &
                 " at p =", b%special(j)%point%p
         end do
-        close (uu)
+        if (len_trim(sfile) > 0) call append_rows(sfile, rows)
     end subroutine write_branch
+
+    !> Append rows to a file (C stdio: a write error is reported, exit 3).
+    subroutine append_rows(file, rows)
+        character(len=*), intent(in) :: file
+        type(row_t), intent(in) :: rows(:)
+        type(results_file) :: f
+        logical :: ok, ok2
+        character(len=:), allocatable :: why, why2
+        integer :: j
+        call f%open(trim(file), "a", ok, why)
+        if (.not. ok) call cli%fail_io("cannot append to "//trim(file)//": "//why)
+        do j = 1, size(rows)
+            call f%put(rows(j)%s, ok, why)
+            if (.not. ok) exit
+        end do
+        if (ok) then
+            call f%close(ok, why)
+        else
+            call f%close(ok2, why2)
+        end if
+        if (.not. ok) call cli%fail_io("cannot write "//trim(file)//": "//why)
+    end subroutine append_rows
 
     !> --switch: the branch born at the K-th bifurcation point (branch point or period
     !! doubling) of `b`, written to --switch-out / --switch-special.
@@ -444,8 +482,9 @@ contains
         real(dp) :: period, period_factor, ds, ds_min, ds_max, p_min, p_max, rtol
         integer :: param, max_points, direction, switch, switch_direction, switch_points
         logical :: free_time, conservative, fixed_period, non_autonomous, force
-        integer :: uu, ios
+        integer :: ios
         character(len=512) :: iomsg_
+        character(len=:), allocatable :: lines(:)
         namelist /family/ system, model, params, param, y0, period, free, targets, &
             period_factor, free_time, conservative, fixed_period, non_autonomous, ds, &
             ds_min, ds_max, p_min, p_max, max_points, direction, rtol, out, special, force, &
@@ -459,13 +498,15 @@ contains
         ds_max = o%ds_max; p_min = o%p_min; p_max = o%p_max; max_points = o%max_points
         direction = o%direction; rtol = o%rtol; force = force_; switch = kswitch
         switch_direction = sw_dir; switch_points = sw_points
-        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, &
-              iomsg=iomsg_)
-        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(iomsg_))
-        read (uu, nml=family, iostat=ios, iomsg=iomsg_)
+        call check_namelist(cli, cli%input, "family", &
+            "system:s64 model:s1024 params:r64 param:i y0:r64 period:r free:r64 "// &
+            "targets:r64 period_factor:r free_time:l conservative:l fixed_period:l "// &
+            "non_autonomous:l ds:r ds_min:r ds_max:r p_min:r p_max:r max_points:i "// &
+            "direction:i rtol:r out:s1024 special:s1024 force:l switch:i "// &
+            "switch_direction:i switch_points:i switch_out:s1024 switch_special:s1024", lines)
+        read (lines, nml=family, iostat=ios, iomsg=iomsg_)
         if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &family: "// &
                                     trim(iomsg_))
-        close (uu)
         if (switch < 0) call cli%fail("--input "//cli%input//": switch must be >= 1 "// &
                                       "(0 or absent: no switching)")
         if (switch_direction /= sw_dir .or. switch_points /= sw_points .or. &

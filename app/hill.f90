@@ -9,6 +9,7 @@ program hill
     use, intrinsic :: iso_fortran_env, only: error_unit
     use conmech
     use app_cli
+    use app_namelist, only: check_namelist
     use app_batch, only: file_exists, max_jobs
     implicit none
     character(len=*), parameter :: help = &
@@ -154,17 +155,17 @@ contains
     subroutine read_input()
         real(dp) :: m, kappa
         character(len=1024) :: csv, phi
-        integer :: npoints, uu, ios
+        integer :: npoints, ios
+        character(len=:), allocatable :: lines(:)
         logical :: force
         character(len=512) :: msg
         namelist /hill/ m, kappa, csv, phi, npoints, force
         m = m_; kappa = kappa_; csv = csv_file; phi = phi_file; npoints = npts
         force = force_
-        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, iomsg=msg)
-        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(msg))
-        read (uu, nml=hill, iostat=ios, iomsg=msg)
+        call check_namelist(cli, cli%input, "hill", &
+            "m:r kappa:r csv:s1024 phi:s1024 npoints:i force:l", lines)
+        read (lines, nml=hill, iostat=ios, iomsg=msg)
         if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &hill: "//trim(msg))
-        close (uu)
         m_ = m; kappa_ = kappa; csv_file = csv; phi_file = phi; npts = npoints
         force_ = force
     end subroutine read_input

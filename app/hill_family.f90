@@ -14,7 +14,9 @@ program hill_family_app
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use conmech
     use app_cli
+    use app_namelist, only: check_namelist
     use app_batch
+    use app_output, only: results_file
     implicit none
     !> Orbits per continuation block (part of the result's definition: do not change).
     integer, parameter :: block = 32
@@ -38,14 +40,15 @@ program hill_family_app
         " (see jobs/hill_family.nml)"//new_line("a")//"  --help, --version"//new_line("a")// &
         "Threads: fpm run hill_family --flag -fopenmp (results identical to serial)."// &
         new_line("a")//"Exit status: 0 every orbit converged, 1 some failed (status < 0 in"// &
-        " their rows), 2 bad input."//new_line("a")//"Example:"//new_line("a")// &
+        " their rows), 2 bad input,"//new_line("a")//"3 the results could not be written "// &
+        "(disk full, I/O error: rerun to resume)."//new_line("a")//"Example:"//new_line("a")// &
         "  hill_family --m0 0.01 --m1 0.15 --n 10000 --out family.csv"
     character(len=*), parameter :: header = &
         "i,m,x0,v0,jacobi,stability_index,c,status,iterations"
     type(cli_parser) :: cli
     type(progress_t) :: progress
     real(dp) :: m0_, m1_, kappa_
-    integer :: n_, batch_, i, b0, b1, ios, u, ndone, nfail, nrows, ib, nb, first_block
+    integer :: n_, batch_, i, b0, b1, ndone, nfail, nrows, ib, nb, first_block
     character(len=1024) :: out_file
     character(len=:), allocatable :: key, canon
     logical :: force_, quiet_, fresh
@@ -53,6 +56,9 @@ program hill_family_app
     type(hill_orbit), allocatable :: orbs(:)
     type(hill_orbit_options) :: hopt
     logical, allocatable :: have(:)
+    type(results_file) :: outf
+    logical :: ok
+    character(len=:), allocatable :: why, row
 
     call cli%start("hill_family", help)
     m0_ = 0.01_dp
@@ -102,25 +108,22 @@ program hill_family_app
     allocate (have(n_))
     have = .false.
     ndone = 0
-    if (fresh .or. file_size(trim(out_file)) <= 0) then
-        open (newunit=u, file=trim(out_file), status="replace", action="write", iostat=ios)
-        if (ios /= 0) call cli%fail("cannot write "//trim(out_file))
-        write (u, '(a)') header
-        close (u)
-    else
+    if (.not. fresh .and. file_size(trim(out_file)) > 0) then
         call load_rows(cli, trim(out_file), header, 9, 1, n_, .true., .true., have, ndone)
-        if (file_size(trim(out_file)) <= 0) then
-            ! the header itself was torn: start the file again
-            open (newunit=u, file=trim(out_file), status="replace", action="write")
-            write (u, '(a)') header
-            close (u)
-        end if
-        write (*, '(a, i0, a)') "resuming: ", ndone, " orbits already in "//trim(out_file)
+        if (file_size(trim(out_file)) > 0) write (*, '(a, i0, a)') "resuming: ", ndone, &
+            " orbits already in "//trim(out_file)
+    end if
+    if (file_size(trim(out_file)) <= 0) then
+        ! a new file (or one whose header was torn): start it with the header
+        call outf%open(trim(out_file), "w", ok, why)
+        if (.not. ok) call cli%fail("cannot write "//trim(out_file)//": "//why)
+        call outf%put(header, ok, why)
+        if (ok) call outf%close(ok, why)
+        if (.not. ok) call cli%fail_io("cannot write "//trim(out_file)//": "//why)
     end if
     deallocate (have)
-    open (newunit=u, file=trim(out_file), status="old", position="append", action="write", &
-          iostat=ios)
-    if (ios /= 0) call cli%fail("cannot append to "//trim(out_file))
+    call outf%open(trim(out_file), "a", ok, why)
+    if (.not. ok) call cli%fail("cannot append to "//trim(out_file)//": "//why)
     call progress%begin("hill_family", n_, ndone, on=.not. quiet_)
 
     ! the multipliers (dgeev) are not written: S and c come from the quarter map
@@ -139,16 +142,21 @@ program hill_family_app
         end do
         !$omp end parallel do
         do i = max(b0, ndone + 1), b1
-            write (u, '(a)') itoa(i)//","//fmt_real(ms(i))//","//fmt_real(orbs(i)%y0(1))// &
+            row = itoa(i)//","//fmt_real(ms(i))//","//fmt_real(orbs(i)%y0(1))// &
                 ","//fmt_real(orbs(i)%y0(4))//","//fmt_real(orbs(i)%jacobi)//","// &
                 fmt_real(orbs(i)%stability_index)//","//fmt_real(orbs(i)%c)//","// &
                 itoa(orbs(i)%info)//","//itoa(orbs(i)%iterations)
+            call outf%put(row, ok, why)
+            if (.not. ok) exit
         end do
-        flush (u)
+        if (ok) call outf%flush(ok, why)
+        ! a full disk or an I/O error is not a failed orbit: say what it is
+        if (.not. ok) call cli%fail_io("cannot write "//trim(out_file)//": "//why)
         deallocate (orbs)
         call progress%tick(b1)
     end do
-    close (u)
+    call outf%close(ok, why)
+    if (.not. ok) call cli%fail_io("cannot write "//trim(out_file)//": "//why)
 
     ! the whole file: count rows and failures
     allocate (have(n_))
@@ -158,6 +166,9 @@ program hill_family_app
     write (*, '(a, i0, a)') "wrote "//trim(out_file)//" (", nrows, " orbits)"
     flush (output_unit)
     deallocate (key, canon, ms, have)
+    if (allocated(why)) deallocate (why)
+    if (allocated(row)) deallocate (row)
+    if (allocated(outf%name)) deallocate (outf%name)
     call cli%clear()
     call progress%clear()
     if (nrows /= n_) then
@@ -183,20 +194,19 @@ contains
     !> The options from a namelist &hill_family ... / (the command line overrides them).
     subroutine read_input()
         real(dp) :: m0, m1, kappa
-        integer :: n, batch, uu, ios2
+        integer :: n, batch, ios2
+        character(len=:), allocatable :: lines(:)
         character(len=1024) :: out
         logical :: force, quiet
         character(len=512) :: msg
         namelist /hill_family/ m0, m1, n, kappa, batch, out, force, quiet
         m0 = m0_; m1 = m1_; n = n_; kappa = kappa_; batch = batch_; out = out_file
         force = force_; quiet = quiet_
-        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios2, &
-              iomsg=msg)
-        if (ios2 /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(msg))
-        read (uu, nml=hill_family, iostat=ios2, iomsg=msg)
+        call check_namelist(cli, cli%input, "hill_family", &
+            "m0:r m1:r n:i kappa:r batch:i out:s1024 force:l quiet:l", lines)
+        read (lines, nml=hill_family, iostat=ios2, iomsg=msg)
         if (ios2 /= 0) call cli%fail("--input "//cli%input//": namelist &hill_family: "// &
                                      trim(msg))
-        close (uu)
         m0_ = m0; m1_ = m1; n_ = n; kappa_ = kappa; batch_ = batch; out_file = out
         force_ = force; quiet_ = quiet
     end subroutine read_input

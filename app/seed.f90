@@ -13,6 +13,7 @@ program seed
     use, intrinsic :: iso_fortran_env, only: error_unit
     use conmech
     use app_cli
+    use app_namelist, only: check_namelist
     use app_batch, only: file_exists, max_jobs
     use app_systems, only: param_count, param_help
     implicit none
@@ -288,7 +289,8 @@ contains
         character(len=64) :: system, projection, method
         character(len=1024) :: out
         real(dp) :: t_end, step, rtol, atol, params(64), q0(64), v0(64)
-        integer :: n_out, every, uu, ios
+        integer :: n_out, every, ios
+        character(len=:), allocatable :: lines(:)
         logical :: force
         character(len=512) :: iomsg_
         namelist /seed/ system, projection, method, t_end, step, rtol, atol, n_out, every, &
@@ -297,13 +299,12 @@ contains
         t_end = tend; step = h_rk4; rtol = rtol_; atol = atol_; n_out = nout
         every = every_k; force = force_
         params = unset; q0 = unset; v0 = unset
-        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, &
-              iomsg=iomsg_)
-        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(iomsg_))
-        read (uu, nml=seed, iostat=ios, iomsg=iomsg_)
+        call check_namelist(cli, cli%input, "seed", &
+            "system:s64 projection:s64 method:s64 t_end:r step:r rtol:r atol:r n_out:i "// &
+            "every:i params:r64 q0:r64 v0:r64 out:s1024 force:l", lines)
+        read (lines, nml=seed, iostat=ios, iomsg=iomsg_)
         if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &seed: "// &
                                     trim(iomsg_))
-        close (uu)
         name = system; proj_name = projection; method_name = method; out_file = out
         tend = t_end; h_rk4 = step; rtol_ = rtol; atol_ = atol; nout = n_out
         every_k = every; force_ = force

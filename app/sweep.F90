@@ -14,8 +14,10 @@ program sweep
     use conmech
     use app_events, only: section_events
     use app_cli
+    use app_namelist, only: check_namelist
     use app_batch
     use app_systems, only: ode_names, generalized_names, param_count, param_help
+    use app_output, only: results_file
     !$ use omp_lib
     implicit none
 #ifdef CONMECH_MPI
@@ -105,27 +107,41 @@ program sweep
         new_line("a")//"                    an existing FILE made by the same arguments is"// &
         " resumed"//new_line("a")// &
         "  --force           overwrite FILE made by other arguments"//new_line("a")// &
+        "  --order job|completion   rows in job order (default; with threads the rows"// &
+        new_line("a")//"                    finished early wait for the earlier ones, with"// &
+        " ranks the"//new_line("a")//"                    final merge sorts) or as jobs"// &
+        " finish"//new_line("a")// &
         "  --quiet           no progress line on stderr"//new_line("a")// &
         "  --input FILE.nml  read the options from a namelist &sweep ... / (the command"// &
         new_line("a")//"                    line overrides it); see jobs/sweep.nml"// &
         new_line("a")//"  --help, --version"//new_line("a")// &
         "Threads: fpm run sweep --flag -fopenmp; ranks: build with --compiler mpifort "// &
         "--flag -DCONMECH_MPI."//new_line("a")// &
-        "Exit status: 0 all jobs succeeded, 1 some failed (counted), 2 bad input."// &
+        "Exit status: 0 all jobs succeeded, 1 some failed (counted), 2 bad input, 3 the"// &
+        new_line("a")//"results could not be written (disk full, I/O error: rerun to resume)."// &
         new_line("a")//"Example:"//new_line("a")// &
         "  sweep --system pendulum --params 9.81,1 --y0 0.1,0 --vary y0:1 --from 0.1 "// &
         "--to 3 \"//new_line("a")// &
         "        --count 100 --t-end 10 --section 2 --out sweep.csv"
 
     type(cli_parser) :: cli
-    character(len=64) :: sys_name, method_name
+    character(len=64) :: sys_name, method_name, order_name
     character(len=1024) :: out_file, vary_spec, model_path
     type(model_library) :: model
     real(dp), allocatable :: pars(:), ystart(:)
     real(dp) :: vfrom, vto, tend, rtol_, atol_
-    integer :: count_, isec, n, i, u, rank, nranks, nthreads, ntodo, next_free, nfail
+    integer :: count_, isec, n, i, rank, nranks, nthreads, ntodo, next_free, nfail
     integer :: nfinished, vary_index, nrows
-    logical :: vary_param, force_, quiet_, symmetric, have_y0
+    logical :: vary_param, force_, quiet_, symmetric, have_y0, job_order, io_failed, in_order
+    character(len=512) :: io_msg
+    type(results_file) :: outf                 !! the results file (OUT, or OUT.rankR)
+    logical :: ok_io
+    character(len=:), allocatable :: why
+    !> Rows finished ahead of an earlier job wait here (a ring indexed by todo position)
+    !! so that a threaded run writes them in job order.
+    integer, parameter :: ring = 65536
+    type(row_t), allocatable :: pending(:)
+    integer :: next_out
     logical, allocatable :: done(:)
     integer, allocatable :: todo(:)
     character(len=:), allocatable :: key, header, canon, part_file
@@ -145,6 +161,9 @@ program sweep
     sys_name = ""
     model_path = ""
     method_name = "DOP853"
+    order_name = "job"
+    io_failed = .false.
+    io_msg = ""
     out_file = "sweep.csv"
     vary_spec = ""
     vfrom = 0.0_dp
@@ -184,6 +203,7 @@ program sweep
         case ("--out"); call cli%get_string(out_file)
         case ("--force"); call cli%flag(); force_ = .true.
         case ("--quiet"); call cli%flag(); quiet_ = .true.
+        case ("--order"); call cli%get_string(order_name)
         case default; call cli%unknown()
         end select
     end do
@@ -207,16 +227,18 @@ program sweep
 #endif
     if (nranks > 1) then
         part_file = trim(out_file)//".rank"//itoa(rank)
-        open (newunit=u, file=part_file, status="replace", action="write", iostat=i)
-        if (i /= 0) call cli%fail("cannot write "//part_file)
-        write (u, '(a)') header
-        flush (u)
+        call outf%open(part_file, "w", ok_io, why)
+        if (.not. ok_io) call cli%fail("cannot write "//part_file//": "//why)
+        call outf%put(header, ok_io, why)
+        if (ok_io) call outf%flush(ok_io, why)
+        if (.not. ok_io) call cli%fail_io("cannot write "//part_file//": "//why)
     else
         part_file = trim(out_file)
-        open (newunit=u, file=part_file, status="old", position="append", action="write", &
-              iostat=i)
-        if (i /= 0) call cli%fail("cannot append to "//part_file)
+        call outf%open(part_file, "a", ok_io, why)
+        if (.not. ok_io) call cli%fail("cannot append to "//part_file//": "//why)
     end if
+    allocate (pending(0:ring - 1))
+    next_out = 0
     ntodo = count(.not. done)
     todo = pack([(i, i=0, count_ - 1)], .not. done)
     nthreads = 1
@@ -241,10 +263,21 @@ program sweep
         if (nranks > 1) call progress%tick(count_ - ntodo + min(i, ntodo))
         !$omp end critical (sweep_next)
         if (i >= ntodo) exit
-        call run_job(todo(i + 1))
+        call run_job(todo(i + 1), i)
     end do
     !$omp end parallel
-    close (u)
+    i = 0
+    if (.not. io_failed) call flush_ring(ntodo, i)     ! nothing left normally
+    if (i /= 0) io_failed = .true.
+    if (.not. io_failed) then
+        call outf%close(ok_io, why)
+        if (.not. ok_io) io_msg = why
+        if (.not. ok_io) i = 1
+    end if
+    if (io_failed .or. i /= 0) then
+        ! a full disk or an I/O error is not a failed job: say what it is
+        call cli%fail_io("cannot write "//part_file//": "//trim(io_msg))
+    end if
     if (nranks > 1) write (*, '(a,i0,a,i0,a)') "sweep: rank ", rank, " ran ", &
         nfinished - (count_ - ntodo), " job(s)"
 
@@ -254,7 +287,10 @@ program sweep
     if (rank == 0 .and. nranks > 1) call merge_parts(.true.)
 #endif
     if (rank == 0) then
-        call count_results(nrows, nfail)
+        call count_results(nrows, nfail, in_order)
+        ! job order: rows that finished out of order (a resumed completion-order file, a
+        ! ring overflow) are sorted now
+        if (job_order .and. .not. in_order) call merge_parts(.true.)
         if (nrows < count_) then
             write (error_unit, '(a,i0,a,i0,a)') "sweep: only ", nrows, " of ", count_, &
                 " jobs in "//trim(out_file)
@@ -267,7 +303,9 @@ program sweep
 #ifdef CONMECH_MPI
     call mpi_finalize(ierr)
 #endif
-    deallocate (pars, ystart, done, todo, key, header, canon, part_file)
+    deallocate (pars, ystart, done, todo, key, header, canon, part_file, pending)
+    if (allocated(why)) deallocate (why)
+    if (allocated(outf%name)) deallocate (outf%name)
     call cli%clear()
     call progress%clear()
     if (rank == 0 .and. nfail > 0) stop 1, quiet=.true.
@@ -285,25 +323,29 @@ contains
     !> The options from a namelist file (&sweep ... /, names as the options with _ for -),
     !! read before the command line (which overrides them).
     subroutine read_input()
-        character(len=64) :: system, method
+        character(len=64) :: system, method, order
         character(len=1024) :: out, vary, model
         real(dp) :: params(64), y0(64), from, to, t_end, rtol, atol
-        integer :: count, section, uu, ios
+        integer :: count, section, ios
+        character(len=:), allocatable :: lines(:)
         logical :: force, quiet
         character(len=512) :: msg
         namelist /sweep/ system, model, method, params, y0, vary, from, to, count, t_end, &
-            section, rtol, atol, out, force, quiet
+            section, rtol, atol, out, force, quiet, order
         system = sys_name; method = method_name; out = out_file; vary = vary_spec
+        order = order_name
         model = model_path
         params = unset; y0 = unset
         from = vfrom; to = vto; t_end = tend; rtol = rtol_; atol = atol_
         count = count_; section = isec; force = force_; quiet = quiet_
-        open (newunit=uu, file=cli%input, status="old", action="read", iostat=ios, iomsg=msg)
-        if (ios /= 0) call cli%fail("cannot open --input "//cli%input//": "//trim(msg))
-        read (uu, nml=sweep, iostat=ios, iomsg=msg)
+        call check_namelist(cli, cli%input, "sweep", &
+            "system:s64 model:s1024 method:s64 params:r64 y0:r64 vary:s1024 from:r to:r "// &
+            "count:i t_end:r section:i rtol:r atol:r out:s1024 force:l quiet:l order:s64", &
+            lines)
+        read (lines, nml=sweep, iostat=ios, iomsg=msg)
         if (ios /= 0) call cli%fail("--input "//cli%input//": namelist &sweep: "//trim(msg))
-        close (uu)
         sys_name = system; method_name = method; out_file = out; vary_spec = vary
+        order_name = order
         model_path = model
         pars = nml_list(cli, params, "params")
         ystart = nml_list(cli, y0, "y0")
@@ -375,6 +417,11 @@ contains
         opt%atol = atol_
         opt%save_steps = .false.
         if (len_trim(out_file) == 0) call cli%fail("--out must not be empty")
+        select case (trim(order_name))
+        case ("job"); job_order = .true.
+        case ("completion"); job_order = .false.
+        case default; call cli%bad_name("--order", order_name, "job completion")
+        end select
     end subroutine validate
 
     !> --model: load the library, check its kind and the parameters (missing trailing ones
@@ -412,8 +459,10 @@ contains
 
     !> Rank 0, before any job: check the arguments file, repair or merge what is there.
     subroutine prepare_output()
-        logical :: fresh
-        integer :: uu, ios, r
+        logical :: fresh, ok
+        integer :: r
+        type(results_file) :: f
+        character(len=:), allocatable :: msg
         if (force_) then
             r = 0
             do while (file_exists(trim(out_file)//".rank"//itoa(r)))
@@ -426,11 +475,11 @@ contains
             trim(out_file)//".rank0 exists without "//trim(out_file)//".args; use --force")
         call write_args_file(cli, trim(out_file), canon)
         if (fresh .or. file_size(trim(out_file)) <= 0) then
-            open (newunit=uu, file=trim(out_file), status="replace", action="write", &
-                  iostat=ios)
-            if (ios /= 0) call cli%fail("cannot write "//trim(out_file))
-            write (uu, '(a)') header
-            close (uu)
+            call f%open(trim(out_file), "w", ok, msg)
+            if (.not. ok) call cli%fail("cannot write "//trim(out_file)//": "//msg)
+            call f%put(header, ok, msg)
+            if (ok) call f%close(ok, msg)
+            if (.not. ok) call cli%fail_io("cannot write "//trim(out_file)//": "//msg)
         end if
         ! parts of an earlier MPI run (even when this run has one rank): merge them first
         if (nranks > 1 .or. file_exists(trim(out_file)//".rank0")) then
@@ -449,19 +498,24 @@ contains
                        done, nr)
     end subroutine mark_done
 
-    !> Rows and failed jobs (status /= 0) in OUT.
-    subroutine count_results(nr, nf)
+    !> Rows and failed jobs (status /= 0) in OUT; whether they are in job order.
+    subroutine count_results(nr, nf, sorted)
         integer, intent(out) :: nr, nf
+        logical, intent(out) :: sorted
         logical, allocatable :: have(:)
         allocate (have(0:count_ - 1))
         have = .false.
         call load_rows(cli, trim(out_file), header, n + 5, 0, count_ - 1, .false., .false., &
-                       have, nr, status_col=n + 5, nfail=nf)
+                       have, nr, status_col=n + 5, nfail=nf, in_order=sorted)
         nr = count(have)
     end subroutine count_results
 
     !> Index (0-based) into todo of the next job to run, shared by all threads and ranks.
     integer function next_job() result(k)
+        if (io_failed) then
+            k = ntodo
+            return
+        end if
 #ifdef CONMECH_MPI
         call mpi_win_lock(MPI_LOCK_SHARED, 0, 0, win, ierr)
         call mpi_fetch_and_op(1, k, MPI_INTEGER, 0, 0_mpi_address_kind, MPI_SUM, win, ierr)
@@ -472,8 +526,9 @@ contains
 #endif
     end function next_job
 
-    subroutine run_job(i)
-        integer, intent(in) :: i
+    subroutine run_job(i, pos)
+        integer, intent(in) :: i      !! the job
+        integer, intent(in) :: pos    !! its position in todo (0-based)
         class(ode_system), allocatable :: sys
         type(ode_result) :: res
         type(section_events) :: ev
@@ -527,12 +582,66 @@ contains
         !$omp critical (sweep_output)
         line = itoa(i)//","//fmt_real(v)//","//fmt_list(yend)//","//fmt_real(tret)//","// &
             itoa(res%stats%nfev)//","//itoa(info)
-        write (u, '(a)') line
-        flush (u)
+        call emit_row(pos, line)
         nfinished = nfinished + 1
         if (nranks == 1) call progress%tick(nfinished)
         !$omp end critical (sweep_output)
     end subroutine run_job
+
+    !> Write the row of the job at todo position `pos` (inside the output critical
+    !! section). In job order with one rank, a row finished ahead of an earlier job waits
+    !! in the ring until the rows before it are written; a job slower than `ring` later
+    !! ones lets them through (the ring is flushed in order and the slow row written when
+    !! it comes) and the file is sorted at the end. A write error stops the run.
+    subroutine emit_row(pos, line)
+        integer, intent(in) :: pos
+        character(len=*), intent(in) :: line
+        integer :: ios
+        logical :: ok
+        character(len=:), allocatable :: msg
+        if (io_failed) return
+        ios = 0
+        if (.not. job_order .or. nranks > 1 .or. pos < next_out) then
+            call outf%put(line, ok, msg)
+            if (.not. ok) ios = 1
+            if (.not. ok) io_msg = msg
+        else
+            if (pos - next_out >= ring) call flush_ring(pos - ring + 1, ios)
+            pending(mod(pos, ring))%s = line
+            if (ios == 0) call flush_ring(next_out, ios)
+        end if
+        if (ios == 0) then
+            call outf%flush(ok, msg)
+            if (.not. ok) ios = 1
+            if (.not. ok) io_msg = msg
+        end if
+        if (ios /= 0) io_failed = .true.
+    end subroutine emit_row
+
+    !> Write the waiting rows in order: every one before position `upto` (skipping the
+    !! gaps), then the contiguous ones from there; next_out moves past them.
+    subroutine flush_ring(upto, ios)
+        integer, intent(in) :: upto
+        integer, intent(inout) :: ios
+        integer :: slot
+        logical :: ok
+        character(len=:), allocatable :: msg
+        do
+            slot = mod(next_out, ring)
+            if (next_out >= upto .and. .not. allocated(pending(slot)%s)) exit
+            if (next_out >= ntodo) exit
+            if (allocated(pending(slot)%s)) then
+                call outf%put(pending(slot)%s, ok, msg)
+                deallocate (pending(slot)%s)
+                if (.not. ok) then
+                    ios = 1
+                    io_msg = msg
+                    return
+                end if
+            end if
+            next_out = next_out + 1
+        end do
+    end subroutine flush_ring
 
     !> Rank 0: OUT and every OUT.rankR into OUT (sorted by job, first copy of a job wins),
     !! written to OUT.tmp, fsync'ed and renamed; only then are the parts deleted.
@@ -540,9 +649,10 @@ contains
         logical, intent(in) :: at_end
         type(row_t), allocatable :: rows(:)
         logical, allocatable :: have(:)
-        integer :: r, uu, job, nr, nparts, ios
-        logical :: ok
-        character(len=:), allocatable :: tmp
+        integer :: r, job, nr, nparts
+        logical :: ok, ok2
+        character(len=:), allocatable :: tmp, msg, msg2
+        type(results_file) :: f
         allocate (rows(0:count_ - 1), have(0:count_ - 1))
         have = .false.
         call load_rows(cli, trim(out_file), header, n + 5, 0, count_ - 1, .false., .false., &
@@ -555,15 +665,26 @@ contains
         end do
         if (nparts == 0 .and. .not. at_end) return
         tmp = trim(out_file)//".tmp"
-        open (newunit=uu, file=tmp, status="replace", action="write", iostat=ios)
-        if (ios /= 0) call cli%fail("cannot write "//tmp)
-        write (uu, '(a)') header
+        call f%open(tmp, "w", ok, msg)
+        if (.not. ok) call cli%fail_io("cannot write "//tmp//": "//msg)
+        call f%put(header, ok, msg)
         do job = 0, count_ - 1
-            if (have(job)) write (uu, '(a)') rows(job)%s
+            if (.not. ok) exit
+            if (have(job)) call f%put(rows(job)%s, ok, msg)
         end do
-        close (uu)
+        if (ok) then
+            call f%close(ok, msg)
+        else
+            call f%close(ok2, msg2)
+        end if
+        if (.not. ok) then
+            call delete_file(tmp)
+            call cli%fail_io("cannot write "//tmp//": "//msg//" (the results so far are in "// &
+                             trim(out_file)//merge(" and its .rank parts", "                    ", &
+                             nparts > 0))
+        end if
         call durable_rename(tmp, trim(out_file), ok)
-        if (.not. ok) call cli%fail("cannot replace "//trim(out_file)//" by "//tmp)
+        if (.not. ok) call cli%fail_io("cannot replace "//trim(out_file)//" by "//tmp)
         do r = 0, nparts - 1
             call delete_file(trim(out_file)//".rank"//itoa(r))
         end do

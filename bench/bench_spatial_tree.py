@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """conmech.symbolic.spatial_tree: the spatial articulated-body right-hand side (conmech_accel,
 O(n)) against the Cholesky right-hand side of the same compiled model (mass and forces
-from the Lagrangian derivation, M factorised per evaluation), in one run.
+from the recursive algorithms, or with --method lagrangian from the Lagrangian
+derivation; M factorised per evaluation), in one run.
 
 The system: a spatial chain of N links (revolute joints about z, y, x, y, z, x, ...; each
 link 0.3 long along z with its COM at the middle, mass 1, a diagonal inertia tensor of a
@@ -11,6 +12,7 @@ the same interval with DOP853 at the same tolerance; reported: the construction 
 for both over [0, --tf], their ratio, and the endpoints' agreement over [0, 1].
 
 Usage:  python bench/bench_spatial_tree.py [--n 3 6] [--tf 30] [--tol 1e-10] [--repeat 3]
+                                          [--method recursive|lagrangian]
 """
 import argparse
 import os
@@ -55,6 +57,7 @@ def main():
     ap.add_argument("--tf", type=float, default=30.0)
     ap.add_argument("--tol", type=float, default=1e-10)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--method", choices=("recursive", "lagrangian"), default="recursive")
     a = ap.parse_args()
     os.environ.setdefault("CONMECH_CACHE", tempfile.mkdtemp(prefix="bench_spatial_"))
     from conmech import compiled, symbolic
@@ -63,7 +66,8 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|")
     for N in a.n:
         bodies, params, gravity = chain(N)
-        sysm = symbolic.spatial_tree(bodies, params, gravity=gravity, jacobian=False)
+        sysm = symbolic.spatial_tree(bodies, params, gravity=gravity, jacobian=False,
+                                     method=a.method)
         model = symbolic.model_of(sysm)
         tm = model.times
         d = model.addresses

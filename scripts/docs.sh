@@ -15,6 +15,11 @@ if ! ford -q docs/ford.md >"$log" 2>&1 || grep -qi "warning" "$log"; then
     echo "[docs] FAILED: FORD reported warnings or errors" >&2
     status=1
 fi
+# FORD's pages load Bootstrap, MathJax and lunr from the network: local copies instead
+if ! python scripts/ford_offline.py build/docs/fortran; then
+    echo "[docs] FAILED: the FORD site still needs the network" >&2
+    status=1
+fi
 echo "[docs] Sphinx -> build/docs/html"
 # MPLBACKEND: the figures are drawn without a display
 if ! MPLBACKEND=Agg python -m sphinx -W --keep-going -q -b html docs build/docs/html; then

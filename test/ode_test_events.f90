@@ -4,13 +4,19 @@ module ode_test_events
     use conmech_ode_system, only: ode_events, ode_step_hook
     implicit none
     private
-    public :: radial_events, circle_projection
+    public :: radial_events, circle_projection, sine_event
 
     !> Both components: the radial velocity r.v of a planar orbit (zero at the apsides).
     type, extends(ode_events) :: radial_events
     contains
         procedure :: eval => radial_eval
     end type radial_events
+
+    !> sin(50 y_1) + 0.9: with y_1 = t, 32 zeros on [0, 2], the closest 0.018 apart.
+    type, extends(ode_events) :: sine_event
+    contains
+        procedure :: eval => sine_eval
+    end type sine_event
 
     !> Projects [x, v] back onto x^2 + v^2 = r2 after every step; stops after max_calls.
     type, extends(ode_step_hook) :: circle_projection
@@ -29,6 +35,13 @@ contains
         real(dp), intent(out) :: g(:)
         g = y(1)*y(3) + y(2)*y(4)
     end subroutine radial_eval
+
+    subroutine sine_eval(self, t, y, g)
+        class(sine_event), intent(in) :: self
+        real(dp), intent(in) :: t, y(:)
+        real(dp), intent(out) :: g(:)
+        g(1) = sin(50.0_dp*y(1)) + 0.9_dp
+    end subroutine sine_eval
 
     subroutine circle_after_step(self, t, y, changed, info)
         class(circle_projection), intent(inout) :: self

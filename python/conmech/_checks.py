@@ -2,10 +2,15 @@
 argument, as SciPy's do."""
 import math
 import numbers
+import warnings
 
 import numpy as np
 
-__all__ = ["real_scalar", "tolerance", "event_settings", "initial_state"]
+__all__ = ["real_scalar", "tolerance", "event_settings", "initial_state", "RTOL_FLOOR"]
+
+#: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
+#: with SciPy's warning.
+RTOL_FLOOR = 100 * np.finfo(float).eps
 
 
 def real_scalar(value, name):
@@ -20,15 +25,18 @@ def real_scalar(value, name):
     return float(arr)
 
 
-def tolerance(value, name, n):
+def tolerance(value, name, n, stacklevel=3):
     """A tolerance as a contiguous float array of shape (n,), checked (non-negative,
-    finite; a scalar or one value per component)."""
+    finite; a scalar or one value per component). ``rtol`` below 100 eps is raised to it
+    with SciPy's UserWarning (``stacklevel``: the user's call)."""
     if type(value) is float or type(value) is int:   # fast path for the common case
         v = float(value)
         if not v >= 0:
             raise ValueError(f"{name} must be non-negative")
         if v == math.inf:
             raise ValueError(f"{name} must be finite")
+        if name == "rtol" and v < RTOL_FLOOR:
+            _warn_rtol(stacklevel + 1)
         return np.full(n, v)
     try:
         arr = np.asarray(value)
@@ -47,12 +55,26 @@ def tolerance(value, name, n):
         raise ValueError(f"{name} must be non-negative")
     if not np.isfinite(arr).all():
         raise ValueError(f"{name} must be finite")
+    if name == "rtol" and (arr < RTOL_FLOOR).any():
+        _warn_rtol(stacklevel + 1)
     return np.ascontiguousarray(arr)
 
 
+def _warn_rtol(stacklevel):
+    # SciPy's warning (validate_tol); the solvers raise rtol to the floor themselves
+    warnings.warn("At least one element of `rtol` is too small. Setting `rtol = "
+                  f"np.maximum(rtol, {RTOL_FLOOR})`.", UserWarning, stacklevel=stacklevel)
+
+
+_TERMINAL = ("The `terminal` attribute of each event must be a boolean or positive "
+             "integer")
+
+
 def event_settings(events):
-    """(function, terminal count (0: not terminal), direction) per event, SciPy's rules:
-    ``terminal`` is a bool or a positive integer (stop at that occurrence)."""
+    """(function, terminal count (0: not terminal), direction, resolution) per event,
+    SciPy's rules: ``terminal`` is a bool or a positive integer (stop at that occurrence);
+    ``resolution`` (conmech's: None or 0, SciPy's rule; else a positive time) the largest
+    spacing of the event's samples inside each step."""
     if events is None:
         return []
     evs = [events] if callable(events) else events
@@ -71,12 +93,12 @@ def event_settings(events):
         elif isinstance(term, numbers.Real):
             tv = float(term)
             if not (math.isfinite(tv) and 0 <= tv <= 2**31 - 1 and tv == int(tv)):
-                raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
-                                 f"integer (a count of occurrences), got {term!r}")
+                raise ValueError(f"{_TERMINAL} (a count of occurrences): events[{i}]."
+                                 f"terminal is {term!r}")
             count = int(tv)
         else:
-            raise ValueError(f"events[{i}].terminal must be a boolean or a positive "
-                             f"integer (a count of occurrences), got {term!r}")
+            raise ValueError(f"{_TERMINAL} (a count of occurrences): events[{i}].terminal "
+                             f"is {term!r}")
         direction = getattr(e, "direction", 0)
         try:
             direction = float(direction)
@@ -84,27 +106,44 @@ def event_settings(events):
             raise ValueError(f"events[{i}].direction must be a number") from None
         if math.isnan(direction):
             raise ValueError(f"events[{i}].direction must be a number")
-        settings.append((e, count, int(np.sign(direction))))
+        settings.append((e, count, int(np.sign(direction)),
+                         _resolution(getattr(e, "resolution", None), i)))
     return settings
 
 
-def initial_state(y0, fun, builtin):
-    """y0 as a 1-dimensional float array, checked: real, not empty, finite, and of the
-    system's dimension when ``fun`` is a built-in system."""
+def _resolution(value, i):
+    """An event's ``resolution``: None or 0 (the step's ends only, SciPy's rule), else a
+    positive finite time."""
+    if value is None:
+        return 0.0
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"events[{i}].resolution must be None or a positive number (a "
+                        f"time), got {type(value).__name__}")
+    r = float(value)
+    if not (r >= 0 and math.isfinite(r)):
+        raise ValueError(f"events[{i}].resolution must be None or a positive finite number "
+                         f"(a time), got {value!r}")
+    return r
+
+
+def initial_state(y0, fun, builtin, allow_complex=False, allow_empty=False):
+    """y0 as a 1-dimensional float array (complex128 if allow_complex and y0 is
+    complex), checked: real unless allowed, not empty unless allowed, finite (SciPy's
+    message), and of the system's dimension when ``fun`` is a built-in system."""
     y0_in = np.asarray(y0)
-    if y0_in.dtype.kind == "c":
-        raise TypeError("y0 must be real: complex states are not supported (split them "
-                        "into real and imaginary parts)")
+    if y0_in.dtype.kind == "c" and not allow_complex:
+        raise TypeError("y0 must be real: complex states are not supported here (split "
+                        "them into real and imaginary parts)")
     try:
-        y = np.array(y0_in, dtype=float)
+        y = np.array(y0_in, dtype=complex if y0_in.dtype.kind == "c" else float)
     except (TypeError, ValueError):
-        raise TypeError("y0 must be an array of real numbers") from None
+        raise TypeError("y0 must be an array of real (or complex) numbers") from None
     if y.ndim != 1:
         raise ValueError(f"y0 must be 1-dimensional, got shape {y.shape}")
-    if y.size == 0:
+    if y.size == 0 and not allow_empty:
         raise ValueError("y0 must not be empty")
     if not np.isfinite(y).all():
-        raise ValueError("y0 contains NaN or Inf")
+        raise ValueError("All components of the initial state `y0` must be finite.")
     if builtin and y.size != fun.dimension:
         raise ValueError(f"y0 must have shape ({fun.dimension},) for the system "
                          f"'{fun.name}', got {y.shape}")

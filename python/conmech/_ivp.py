@@ -16,14 +16,14 @@ from . import _conmech
 from ._callback import Guard, as_result, message_text
 from ._checks import event_settings as _event_settings, initial_state as _initial_state, \
     real_scalar as _real_scalar, tolerance as _tolerance
-from ._dense import DenseOutput
-from ._implicit import jacobian_callback
+from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSolution
+from ._implicit import jacobian_callback, is_sparse, sparsity_pattern
 from ._methods import METHODS, RK45_SCIPY, method_info
 from ._stepper import method_code
 from ._taylor import with_fixed_order
 from ._native import NativeSystem
 
-__all__ = ["solve_ivp", "OdeResult", "DenseOutput"]
+__all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
 
 # the names solve_ivp accepts: every method of the Fortran table (conmech_ode_methods) but
 # the constrained-only ones, with its aliases (the Python spelling first where SciPy has
@@ -41,11 +41,15 @@ _MESSAGES = {
 }
 _CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
+# no step limit (SciPy has none): the largest count the Fortran counters hold
+_NO_LIMIT = 2**31 - 1
 # placeholders for f2py, which cannot pass empty arrays (read only, shared)
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
 _PAD.flags.writeable = False
 _PADI.flags.writeable = False
+_COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
+                    "in a complex domain.")
 
 
 class OdeResult(dict):
@@ -85,24 +89,6 @@ class _StopAtStart(Exception):
     """Internal: a terminal event zero at t0 stops the run there (SciPy's rule)."""
 
 
-def _validate_jac(jac, n):
-    """SciPy's ``jac`` option: None, a callable jac(t, y) -> (n, n), or a constant
-    (n, n) array. Returns (callable or None, constant array or None)."""
-    if jac is None:
-        return None, None
-    if callable(jac):
-        return jac, None
-    try:
-        j = np.array(jac, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError("jac must be None, a callable jac(t, y) or an (n, n) array") from None
-    if j.shape != (n, n):
-        raise ValueError(f"jac must have shape ({n}, {n}), got {j.shape}")
-    if not np.all(np.isfinite(j)):
-        raise ValueError("jac must be finite")
-    return None, j
-
-
 def _positive_finite(value, name, allow_inf=False):
     v = _real_scalar(value, name)
     if math.isnan(v) or not v > 0 or (v == math.inf and not allow_inf):
@@ -121,14 +107,17 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
               vectorized: bool = False, args: tuple | None = None, *,
               rtol: float | ArrayLike = 1e-3, atol: float | ArrayLike = 1e-6,
               first_step: float | None = None, max_step: float = np.inf,
-              max_steps: int = 100000, jac: Callable[..., ArrayLike] | ArrayLike | None = None,
+              max_steps: int | None = None,
+              jac: Callable[..., ArrayLike] | ArrayLike | None = None,
               **options: Any) -> OdeResult:
     """Solve an initial value problem y' = fun(t, y), y(t0) = y0 (SciPy's interface).
 
-    A drop-in for ``scipy.integrate.solve_ivp`` with the explicit methods: the same
-    defaults (method RK45, rtol 1e-3, atol 1e-6, so a default run takes the same steps
-    and about the same nfev), the same event rules (``terminal`` as a count, an event zero
-    at t0 counted as SciPy does) and the same result fields.
+    A drop-in for ``scipy.integrate.solve_ivp``: the same defaults (method RK45, rtol
+    1e-3, atol 1e-6, so a default run takes the same steps and about the same nfev, and no
+    limit on the number of steps), the same event rules (``terminal`` as a count, an event
+    zero at t0 counted as SciPy does), the same result fields and shapes, complex and
+    empty states, infinite ``t_span`` with terminal events; SciPy's own test files run on
+    it (python/tests/test_scipy_own_suite.py).
 
     Parameters
     ----------
@@ -136,21 +125,25 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         ``fun(t, y, *args) -> dydt`` (array of shape (n,)), called from Fortran through
         an f2py callback; or a compiled built-in system such as
         ``conmech.systems.kepler(mu=1.0)``, integrated with no Python in the loop. The
-        return value is checked on every call: None, a complex value or a wrong shape
-        raises ValueError/TypeError (as SciPy).
+        return value is checked on every call: None, a wrong shape, or complex values for
+        a real y0 raise ValueError/TypeError.
     t_span : 2-sequence of float
-        (t0, tf); tf < t0 integrates backwards.
+        (t0, tf); tf < t0 integrates backwards; tf may be infinite with a terminal event
+        or ``max_steps`` to end the run (else ValueError: SciPy would integrate for ever;
+        not for the fixed-step methods).
     y0 : array_like, shape (n,)
-        Initial state (real; complex states raise TypeError).
+        Initial state, real or complex (a complex system is integrated as its real and
+        imaginary parts, as SciPy's explicit methods do; Radau refuses it, as SciPy's),
+        possibly empty (n = 0: nothing is integrated).
     method : str or a stepper class
         "RK45" (default), "DOPRI5", "DOP853", "VERNER98" (alias "Vern9"), "RK4", "Radau"
         (alias "RADAU5"), "GAUSS4" or "GAUSS6"; or a stepper class: conmech.DOP853,
-        conmech.RK45, ..., and SciPy's scipy.integrate.RK45 / DOP853 (mapped to conmech's
-        counterparts). RK45: Dormand-Prince 5(4) with SciPy's step control and initial step
-        (SciPy's default method). DOPRI5: the same pair with Hairer's control (Lund
-        stabilisation beta = 0.04). DOP853: Dormand-Prince 8(5,3), dense output of order 7.
-        VERNER98: Verner's 9(8) pair, dense output of order 8, for tight tolerances. RK4:
-        classical fixed-step RK4, step ``first_step``.
+        conmech.RK45, ..., and SciPy's scipy.integrate.RK45 / DOP853 / Radau (mapped to
+        conmech's counterparts). RK45: Dormand-Prince 5(4) with SciPy's step control and
+        initial step (SciPy's default method). DOPRI5: the same pair with Hairer's control
+        (Lund stabilisation beta = 0.04). DOP853: Dormand-Prince 8(5,3), dense output of
+        order 7. VERNER98: Verner's 9(8) pair, dense output of order 8, for tight
+        tolerances. RK4: classical fixed-step RK4, step ``first_step``.
         Radau: Radau IIA of order 5 for stiff problems (Hairer's RADAU5: simplified
         Newton with one real and one complex LU, dense output of order 3, events; counts
         njev and nlu). GAUSS4 / GAUSS6: Gauss-Legendre collocation with 2 / 3 stages
@@ -160,14 +153,20 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         Times at which to store the solution (strictly monotonic in the direction of
         integration, inside t_span), from the dense output. None: every accepted step.
     dense_output : bool
-        Return ``sol``, a callable continuous solution (SciPy's OdeSolution attributes:
-        ts, interpolants, n_segments, t_min, t_max, ascending).
+        Return ``sol``, a callable continuous solution with SciPy's OdeSolution
+        attributes (ts, interpolants, n_segments, t_min, t_max, ascending); always
+        present when asked (a zero-length span or a stop at t0: the constant y0).
     events : callable or list of callables
         ``event(t, y, *args) -> float``; zero crossings are located on the dense output.
         Optional attributes ``terminal`` (bool, or a positive integer: stop at that
         occurrence) and ``direction`` (>0 rising, <0 falling, 0 both), as in SciPy >= 1.11.
         An event that is zero at t0 is reported at t0 when the first step moves it in its
-        direction (SciPy's rule).
+        direction (SciPy's rule). SciPy's rule compares an event at the two ends of each
+        step only, so two crossings inside one step cancel and are missed; conmech's
+        optional attribute ``resolution`` (a time) also samples the event on each step's
+        continuous extension at points at most that far apart, and locates every sign
+        change between them: crossings more than ``resolution`` apart are all found
+        (without changing the steps; cost: event evaluations).
     vectorized : bool
         As SciPy's explicit methods: ``fun`` is called with y of shape (n, 1) and its
         result flattened.
@@ -175,30 +174,39 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         Extra arguments passed to ``fun``, ``jac`` and every event function.
     rtol, atol : float or array_like of shape (n,)
         Relative and absolute tolerances (finite, non-negative; rtol is raised to 100 eps
-        at least, as SciPy).
+        at least, with SciPy's warning).
     first_step : float or None
-        Initial step (None: SciPy's heuristic for RK45, Hairer's for the others).
-        Required by RK4 (its fixed step).
+        Initial step (None: SciPy's heuristic for RK45 and Radau, Hairer's for the
+        others). Required by RK4, GAUSS4 and GAUSS6 (their fixed step).
     max_step : float
         Largest step size (default no limit; positive, NaN rejected).
-    max_steps : int
-        Attempted steps before giving up (status -1).
-    jac : callable, array_like or None
-        Used by method="Radau": ``jac(t, y, *args) -> (n, n)`` (dense) or a constant
-        matrix; None: forward differences (n evaluations of fun per Jacobian). The other
-        methods validate it and warn that it has no effect, as SciPy's explicit ones.
+    max_steps : int or None
+        Attempted steps before giving up (status -1). None (default): no limit, as SciPy.
+    jac : callable, array_like, sparse matrix or None
+        Used by method="Radau": ``jac(t, y, *args) -> (n, n)`` (a dense array or a
+        scipy.sparse matrix) or a constant matrix (dense or sparse: read once, njev 0, as
+        SciPy); None: forward differences (n evaluations of fun per Jacobian, or one per
+        group of columns with ``jac_sparsity``). The LU factorisations are dense (LAPACK).
+        The other methods validate it and warn that it has no effect, as SciPy's
+        explicit ones.
     **options
-        SciPy's other solver options for implicit methods (jac_sparsity, lband, uband,
-        min_step) are accepted and warned about as SciPy does; anything else is a
-        TypeError.
+        ``jac_sparsity`` (Radau, without ``jac``): the sparsity structure of df/dy (an
+        (n, n) array_like or sparse matrix, nonzero where f_i depends on y_j): the
+        finite-difference Jacobian then takes one evaluation per group of columns that
+        share no row (Curtis-Powell-Reid, as SciPy's). SciPy's other solver options
+        (lband, uband, min_step) are accepted and warned about as SciPy does; anything
+        else is a TypeError.
 
     Returns
     -------
     OdeResult
-        t, y (n, nt), sol (DenseOutput or None), t_events, y_events (lists per event, or
-        None), nfev, njev, nlu (Jacobian evaluations and LU decompositions: Radau's; 0
-        for the other methods), status (0 reached the end, 1 terminal event, -1 failure),
-        message, success, and the step counts naccept, nreject.
+        t, y (n, nt), sol (OdeSolution-like or None), t_events, y_events (lists per
+        event, None without events; an event that never fired has t_events[k] of shape
+        (0,) and y_events[k] of shape (0,), as SciPy), nfev, njev, nlu (Radau's Jacobian
+        evaluations and LU decompositions; 0 for the other methods), status (0 reached
+        the end, 1 terminal event, -1 failure), message, success, and the step counts
+        naccept, nreject. With ``t_eval`` and no point reached (a terminal event first),
+        t and y are empty lists, as SciPy's.
 
     The positional order of the arguments is SciPy's; rtol, atol, first_step, max_step,
     max_steps and jac (SciPy's ``**options``) are keyword-only.
@@ -215,9 +223,13 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise TypeError("fun must be callable or a built-in system from conmech.systems, "
                         f"got {type(fun).__name__}")
     if args is not None:
-        if isinstance(args, (str, bytes)) or not hasattr(args, "__iter__"):
-            raise TypeError("args should be a tuple")
-        args = tuple(args)
+        if isinstance(args, (str, bytes)):
+            raise TypeError("args should be a tuple, not a string")
+        try:
+            args = tuple(args)
+        except TypeError:
+            raise TypeError("Supplied 'args' cannot be unpacked. Please supply `args` as "
+                            f"a tuple (e.g. `args=({args},)`)") from None
         if builtin and args:
             raise TypeError("args cannot be used with a built-in system: pass its "
                             "parameters to the factory in conmech.systems")
@@ -244,6 +256,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     elif isinstance(method, type) and method.__module__.startswith("scipy.integrate") \
             and method.__name__ == "RK45":
         code = _RK45_SCIPY      # SciPy's own RK45: its step control, as the name "RK45"
+    info = method_info(code)
 
     # ---------------------------------------------------------------- t_span, y0
     try:
@@ -253,10 +266,17 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise TypeError("t_span must be a sequence (t0, tf)") from None
     t0 = _real_scalar(t_span[0], "t_span[0]")
     tf = _real_scalar(t_span[1], "t_span[1]")
-    if not (math.isfinite(t0) and math.isfinite(tf)):
-        raise ValueError("t_span must be finite")
-    y0 = _initial_state(y0, fun, builtin)
+    if not math.isfinite(t0):
+        raise ValueError("t_span[0] must be finite")
+    if math.isnan(tf):
+        raise ValueError("t_span[1] must not be NaN")
+    if math.isinf(tf) and info.fixed_step:
+        raise ValueError(f"t_span must be finite for {method} (a fixed-step method)")
+    y0 = _initial_state(y0, fun, builtin, allow_complex=not builtin, allow_empty=not builtin)
     n = y0.size
+    is_complex = y0.dtype.kind == "c"
+    if is_complex and info.uses_jacobian:
+        raise ValueError(_COMPLEX_REFUSED)
 
     # ---------------------------------------------------------------- tolerances, steps
     rtol_v = _tolerance(rtol, "rtol", n)
@@ -267,23 +287,30 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         h0 = _positive_finite(first_step, "first_step")
         if h0 > abs(tf - t0) and tf != t0:
             raise ValueError("first_step exceeds the length of t_span")
-    info = method_info(code)
     if info.fixed_step and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
-    if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
-        raise TypeError("max_steps must be an integer")
-    if not 1 <= max_steps <= 2**31 - 1:
+    step_cap = max_steps is not None
+    if max_steps is None:
+        max_steps = _NO_LIMIT
+    elif isinstance(max_steps, (bool, np.bool_)) or \
+            not isinstance(max_steps, numbers.Integral):
+        raise TypeError("max_steps must be None or an integer")
+    elif not 1 <= max_steps <= _NO_LIMIT:
         raise ValueError("max_steps must be positive (and below 2**31)")
-    _validate_jac(jac, n)
-    unused = sorted(options) + (["jac"] if jac is not None and not info.uses_jacobian
-                                else [])
+    sparsity = options.get("jac_sparsity")
+    unused = sorted(k for k in options if not (k == "jac_sparsity" and info.uses_jacobian))
     if jac is not None and not info.uses_jacobian:
+        unused.append("jac")
+        _check_jac_value(jac, n)
         jac = None
-    if unused:   # as SciPy's explicit solvers
+    if unused:   # as SciPy's solvers
         warnings.warn("The following arguments have no effect for a chosen solver: "
                       f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
+    if not info.uses_jacobian or jac is not None:
+        sparsity = None        # SciPy: jac_sparsity only serves finite differences
+    pattern = sparsity_pattern(sparsity, n) if sparsity is not None and n else None
     if vectorized not in (True, False, 0, 1) or isinstance(vectorized, float):
         raise TypeError("vectorized must be a bool")
     if dense_output not in (True, False, 0, 1) or isinstance(dense_output, float):
@@ -315,21 +342,156 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
 
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
-    ne = len(settings)
+    if math.isinf(tf) and n and not step_cap and not any(c > 0 for _, c, _, _ in settings):
+        # SciPy would integrate for ever: nothing ends such a run but a failure
+        raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
+                         "end the integration")
     if builtin and code == _TAYLOR and getattr(fun, "taylor", None):   # written out
         fun = with_fixed_order(fun, rtol, atol)
-    run = _Run(fun, builtin, args, n, settings, bool(vectorized), t0, jac)
-    remaining = [s[1] for s in settings]       # occurrences left before termination
+    problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
+                   t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
+                   settings=settings, vectorized=bool(vectorized))
+    if n == 0:
+        return _solve_empty(**problem)
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
                   max_steps=int(max_steps), dense=int(bool(dense_output)))
+    if not is_complex:
+        return _solve(problem, common, h0, jac, pattern)
+    # a complex system as its real and imaginary parts: y = u + i v, [u; v]' = [Re f; Im f]
+    problem.update(fun=_real_form(fun, n), y0=np.concatenate([y0.real, y0.imag]),
+                   settings=[(_real_form_event(e, n), c, d, r) for e, c, d, r in settings])
+    common.update(rtol=np.concatenate([rtol_v, rtol_v]),
+                  atol=np.concatenate([atol_v, atol_v]))
+    res = _solve(problem, common, h0, None, None)
+    return _complex_result(res, n)
+
+
+def _check_jac_value(jac, n):
+    """SciPy's explicit methods ignore jac but a constant one must still be (n, n)."""
+    if jac is None or callable(jac):
+        return
+    shape = jac.shape if is_sparse(jac) else np.shape(jac)
+    if tuple(shape) != (n, n):
+        raise ValueError(f"`jac` is expected to have shape {(n, n)}, but actually has "
+                         f"{tuple(shape)}.")
+
+
+def _real_form(fun, n):
+    """fun of a complex y as a function of [Re y; Im y] returning [Re f; Im f] (also for
+    a vectorized fun: columns)."""
+    def real_fun(t, u, *a):
+        y = u[:n] + 1j * u[n:]
+        r = fun(t, y, *a)
+        if r is None:
+            return None
+        f = np.asarray(r)
+        if f.dtype.kind not in "biufc":
+            return f          # the callback wrapper names the bad type
+        if f.size != y.size:
+            raise ValueError(f"fun must return an array of shape {y.shape} (complex), got "
+                             f"shape {f.shape}")
+        f = f.reshape(y.shape)
+        return np.concatenate([f.real, f.imag], axis=0)
+    return real_fun
+
+
+def _real_form_event(event, n):
+    def real_event(t, u, *a):
+        return event(t, u[:n] + 1j * u[n:], *a)
+    return real_event
+
+
+def _complex_result(res, n):
+    """The result of the real form back in complex numbers."""
+    if isinstance(res.y, np.ndarray):
+        res.y = res.y[:n] + 1j * res.y[n:]
+    if res.y_events is not None:
+        res.y_events = [ye[:, :n] + 1j * ye[:, n:] if ye.size else ye for ye in res.y_events]
+    if res.sol is not None:
+        res.sol = ComplexSolution(res.sol, n)
+    return res
+
+
+def _solve_empty(fun, builtin, args, t0, tf, y0, t_ev, with_t_eval, dense, settings,
+                 vectorized):
+    """A state of dimension zero (SciPy's solvers finish at once): fun is called once
+    (its return must be empty), the events are functions of t alone and located by
+    bisection on [t0, tf] (tf finite)."""
+    y = y0.copy()
+    yy = y[:, None] if vectorized else y
+    r = fun(t0, yy, *args)
+    as_result(r if r is not None else None, (0,), "fun")
+    t_end, status = tf, 0
+    t_events = y_events = None
+    if settings:
+        t_events = [[] for _ in settings]
+        remaining = [c for _, c, _, _ in settings]
+        found = []
+        if math.isfinite(tf) and tf != t0:
+            for k, (e, _, d, _) in enumerate(settings):
+                ga = float(as_result(e(t0, y.copy(), *args), (), f"events[{k}]"))
+                gb = float(as_result(e(tf, y.copy(), *args), (), f"events[{k}]"))
+                if (ga < 0 <= gb and d >= 0) or (ga > 0 >= gb and d <= 0):
+                    found.append((_bisect(lambda t: e(t, y.copy(), *args), t0, tf, ga, gb),
+                                  k))
+        for te, k in sorted(found, key=lambda x: (x[0] - t0) * math.copysign(1, tf - t0)):
+            if status == 1:
+                break
+            t_events[k].append(te)
+            if remaining[k] > 0:
+                remaining[k] -= 1
+                if remaining[k] == 0:
+                    t_end, status = te, 1
+        y_events = [np.zeros((len(te), 0)) if te else np.asarray([]) for te in t_events]
+        t_events = [np.asarray(te) for te in t_events]
+    if with_t_eval:
+        sgn = math.copysign(1.0, tf - t0)
+        t = t_ev[(t_ev - t_end) * sgn <= 0]
+    else:
+        t = np.array([t0, t_end])
+    sol = OdeSolution([t0, t_end], [ConstantDenseOutput(t0, t_end, y)]) if dense else None
+    return OdeResult(t=t, y=np.zeros((0, t.size), dtype=y.dtype), sol=sol,
+                     t_events=t_events, y_events=y_events, nfev=1, njev=0, nlu=0,
+                     status=status, message=_MESSAGES[status], success=True, naccept=0,
+                     nreject=0)
+
+
+def _bisect(g, a, b, ga, gb):
+    """A zero of g(t) between a and b (g(a) = ga, g(b) = gb of opposite signs or gb = 0)
+    by bisection to the spacing of doubles."""
+    if gb == 0:
+        return b
+    for _ in range(2100):
+        m = 0.5 * (a + b)
+        if m == a or m == b:
+            break
+        gm = float(g(m))
+        if gm == 0:
+            return m
+        if (gm < 0) == (ga < 0):
+            a, ga = m, gm
+        else:
+            b = m
+    return b
+
+
+def _solve(problem, common, h0, jac, pattern):
+    """solve_ivp on a real, non-empty problem (checked), in segments: a terminal event
+    whose count is not reached yet ends a segment and the next one starts at the event
+    (its function is taken as zero there, so it is not found again at once)."""
+    fun, builtin, args = problem["fun"], problem["builtin"], problem["args"]
+    t0, tf, y0, t_ev = problem["t0"], problem["tf"], problem["y0"], problem["t_ev"]
+    with_t_eval, settings = problem["with_t_eval"], problem["settings"]
+    n = y0.size
+    ne = len(settings)
+    run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern)
+    remaining = [s[1] for s in settings]       # occurrences left before termination
     if ne:
         ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
+        ev_res = np.array([s[3] for s in settings], dtype=float)
     else:
-        ev_dir = _PADI
+        ev_dir, ev_res = _PADI, _PAD
 
-    # The integration runs in segments: a terminal event whose count is not reached yet
-    # ends a segment and the next one starts at the event (its function is taken as zero
-    # there, so it is not found again at once).
     t_cur, y_cur, t_ev_cur, first_seg = t0, y0, t_ev, True
     segs = []
     nfev = naccept = nreject = 0
@@ -337,7 +499,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     while True:
         ev_term = np.array([int(r > 0) for r in remaining], dtype=np.intc) if ne else _PADI
         out = run.call(t_cur, tf, y_cur, t_ev_cur, h0 if first_seg else 0.0, ev_dir,
-                       ev_term, common)
+                       ev_term, ev_res, common)
         stop_at_start = isinstance(run.guard.error, _StopAtStart)
         if stop_at_start:
             run.guard.error = None
@@ -351,12 +513,12 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
             raise ValueError(message)
         if stop_at_start:
             # SciPy: a terminal event zero at t0, moving in its direction, stops there
-            segs.append(dict(t=np.array([t0, t0]) if t_eval is None else
+            segs.append(dict(t=np.array([t0, t0]) if not with_t_eval else
                              t_ev[t_ev == t0], y=None, ev=run.start_events, dense=None))
             status = 1
             break
         if not first_seg:
-            out = _drop_first_point(out, t_eval is not None)
+            out = _drop_first_point(out, with_t_eval)
         segs.append(out)
         if first_seg and run.start_events:
             out["ev"] = run.start_events + out["ev"]
@@ -379,12 +541,12 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
             status = 1
             break
         t_cur, y_cur = t_stop, out["ev"][-1][2].copy()
-        if t_eval is not None:
+        if with_t_eval:
             t_ev_cur = t_ev_cur[(t_ev_cur - t_stop)*math.copysign(1.0, tf - t0) > 0]
         run.zero_at_start = fired
 
-    return _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status,
-                     message, nfev, naccept, nreject)
+    return _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, problem["dense"], form,
+                     status, message, nfev, naccept, nreject)
 
 
 def _drop_first_point(out, with_t_eval):
@@ -399,7 +561,8 @@ class _Run:
     """The callbacks of one solve_ivp call (one Guard for fun and the events) and the
     Fortran call of one segment."""
 
-    def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None):
+    def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None,
+                 pattern=None):
         self.guard = Guard()
         self.jac = jac
         self.njev = self.nlu = 0
@@ -413,7 +576,11 @@ class _Run:
         self.failure = []
         if builtin and jac is not None:
             raise TypeError("jac cannot be used with a built-in system (it has its own)")
-        self.jac_cb, self.has_jac = jacobian_callback(jac, n, args, self.failure)
+        self.jac_cb, self.has_jac, self.jac_const = jacobian_callback(jac, n, args,
+                                                                      self.failure)
+        nnz, ptr, idx = pattern if pattern is not None else (-1, None, _PADI)
+        self.pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
+                            np.zeros(n + 1, dtype=np.intc), sp_idx=idx)
         if not builtin:
             if vectorized:
                 def user(t, y, *a):
@@ -464,7 +631,8 @@ class _Run:
 
     def _scipy_start_rule(self, zero, g_new, y_start):
         # SciPy's find_active_events with g = 0 at t0: up if g_new >= 0, down if <= 0;
-        # the root is t0 itself.
+        # the root is t0 itself. (The driver evaluates the events at the end of the first
+        # step before any sample inside it: this is g_new.)
         for i in zero:
             d = self.settings[i][2]
             up, down = g_new[i] >= 0, g_new[i] <= 0
@@ -473,7 +641,7 @@ class _Run:
                 if self.settings[i][1] == 1:
                     raise _StopAtStart()
 
-    def call(self, t_a, tf, y_a, t_ev, h0, ev_dir, ev_term, common):
+    def call(self, t_a, tf, y_a, t_ev, h0, ev_dir, ev_term, ev_res, common):
         ne = len(self.settings)
         n = self.n
         res = {}
@@ -494,18 +662,23 @@ class _Run:
                 return _PAD
         kw = dict(t_span=np.array([t_a, tf]), y0=y_a, first_step=h0, neval=t_ev.size,
                   t_eval=t_ev if t_ev.size else _PAD, ne=ne, ev_dir=ev_dir,
-                  ev_term=ev_term, **common)
+                  ev_term=ev_term, ev_res=ev_res, **self.pattern, **common)
         if self.builtin and ne and _compiled_events(self.fun, common["method"], self.settings):
             # Taylor's method with events from conmech.symbolic.event: no Python in the loop
+            # (no sampling inside the steps: _compiled_events requires resolution 0)
             from ._taylor import run_compiled_events
+            kw_taylor = {k: v for k, v in kw.items()
+                         if k not in ("ev_res", "nnz", "sp_ptr", "sp_idx")}
             counts, form, info, message = run_compiled_events(
-                self.fun, [st[0] for st in self.settings], store, kw, self.zero_at_start)
+                self.fun, [st[0] for st in self.settings], store, kw_taylor,
+                self.zero_at_start)
         elif self.builtin:
             counts, form, info, message = _conmech.flat_solve_builtin(
                 *self.fun._flat_args(), events_cb, store, **kw)
         else:
             counts, form, info, message = _conmech.flat_solve_callback(
-                self.rhs, self.jac_cb, events_cb, store, has_jac=self.has_jac, **kw)
+                self.rhs, self.jac_cb, events_cb, store, has_jac=self.has_jac,
+                jac_const=self.jac_const, **kw)
         if self.failure:
             self.guard.fail(self.failure[0])
         nfev, njev, nlu, naccept, nreject = counts.tolist()
@@ -523,15 +696,18 @@ class _Run:
 
 def _compiled_events(fun, code, settings):
     """True when method TAYLOR runs with events that are all conmech.symbolic events of
-    fun's model (then the Fortran stepper locates them itself)."""
+    fun's model (then the Fortran stepper locates them itself) and none asks for samples
+    inside the steps (a resolution: the Python-located path samples them)."""
     if METHODS.get(code) is None or METHODS[code].name != "TAYLOR":
+        return False
+    if any(st[3] > 0 for st in settings):
         return False
     from .symbolic.taylor_events import compiled_events
     return compiled_events(fun, [st[0] for st in settings]) is not None
 
 
-def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, message,
-              nfev, naccept, nreject):
+def _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, dense_output, form, status,
+              message, nfev, naccept, nreject):
     if status >= 0:
         message = _MESSAGES.get(status, message)
     ts = [s["t"] for s in segs]
@@ -542,6 +718,11 @@ def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, 
     else:
         t = np.concatenate(ts) if ts else np.array([t0])
         y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
+    if tf == t0 and not with_t_eval:
+        # SciPy's solver makes one (empty) step: t = [t0, t0]
+        t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)
+    if with_t_eval and t.size == 0:
+        t, y = [], []          # SciPy's lists when no point of t_eval was reached
     res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None,
                     nfev=nfev, njev=run.njev, nlu=run.nlu, status=status,
                     message=message, success=status >= 0, naccept=naccept,
@@ -549,11 +730,13 @@ def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, 
     if ne > 0:
         evs = [e for s in segs for e in s["ev"]]
         res.t_events = [np.array([te for i, te, _ in evs if i == k]) for k in range(ne)]
-        res.y_events = [np.array([ye for i, _, ye in evs if i == k]).reshape(-1, n)
-                        for k in range(ne)]
+        res.y_events = [np.array([ye for i, _, ye in evs if i == k]) for k in range(ne)]
+        res.y_events = [ye if ye.size else np.asarray([]) for ye in res.y_events]
+    if not dense_output:
+        return res
     dens = [s["dense"] for s in segs if s.get("dense") is not None]
-    if dense_output and dens:
-        t_last = float(t[-1]) if t_eval is None and t.size else None
+    if dens:
+        t_last = float(t[-1]) if not with_t_eval and len(t) else None
         last = dens[-1]
         if t_last is None:
             t_last = float(last[0][-1] + last[1][-1])
@@ -563,4 +746,8 @@ def _assemble(segs, run, n, ne, t0, tf, y0, t_eval, dense_output, form, status, 
                               np.concatenate([d[1] for d in dens]),
                               np.concatenate([d[2] for d in dens], axis=2), t0, t_last,
                               form=int(form))
+    else:
+        # no step (a zero-length span, a terminal event at t0, a failure at the first
+        # step): the constant y0 on [t0, t0], as SciPy's OdeSolution of one empty step
+        res.sol = OdeSolution([t0, t0], [ConstantDenseOutput(t0, t0, y0)])
     return res

@@ -13,8 +13,13 @@ stepper), bit for bit.
 The Fortran side keeps no state between calls: the stepper's whole state (t, y, the
 stages, the step size and the controller's memory; for Radau the Jacobian and both LU
 factorisations) lives in three numpy arrays of the Python object, which the one flat
-routine ``flat_stepper_callback`` (or ``_builtin``) takes in and writes back at every call.
-Objects are independent; one object must not be stepped from two threads at once.
+routine ``flat_stepper_callback`` (or ``_builtin``) reads and writes back in place at every
+call. Objects are independent; one object must not be stepped from two threads at once.
+
+As SciPy's solvers: a complex y0 is integrated as its real and imaginary parts (not by
+Radau, as SciPy's Radau), an empty y0 finishes at the first step, ``t_bound`` may be
+infinite for the adaptive methods, and there is no limit on the number of steps unless
+``max_steps`` is given.
 """
 import math
 import numbers
@@ -23,21 +28,25 @@ import warnings
 import numpy as np
 
 from . import _conmech
-from ._callback import Guard, message_text
-from ._dense import DenseOutput
+from ._callback import Guard, as_result, message_text
+from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput
 from ._checks import initial_state, real_scalar, tolerance
-from ._implicit import jacobian_callback
+from ._implicit import jacobian_callback, sparsity_pattern
 from ._methods import BY_NAME, RK45_SCIPY, method_info
 from ._native import NativeSystem
 
 __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "Radau",
-           "Gauss", "Gauss4", "Gauss6", "method_code"]
+           "Gauss", "Gauss4", "Gauss6", "method_code", "ConstantDenseOutput"]
 
 (_R_T, _R_TOLD, _R_HDONE, _I_NF, _I_FORM, _I_NFEV, _I_NJEV, _I_NLU, _I_NACCEPT, _I_NREJECT,
  _W_Y, _W_FC) = (int(v) - 1 for v in _conmech.flat_stepper_layout())
 _START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
+assert (_I_NJEV, _I_NLU) == (_I_NFEV + 1, _I_NFEV + 2)   # read as one slice
 _CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
+_NO_LIMIT = 2**31 - 1
+_COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
+                    "in a complex domain.")
 
 
 class StepDenseOutput(DenseOutput):
@@ -48,21 +57,6 @@ class StepDenseOutput(DenseOutput):
         super().__init__([t_old], [h], coef[:, :, None], t_old, t, form=form)
         self.t_old = t_old
         self.t = t
-
-
-class ConstantDenseOutput:
-    """The constant y on a step of length zero (as SciPy's ConstantDenseOutput)."""
-
-    def __init__(self, t_old, t, value):
-        self.t_old, self.t = t_old, t
-        self.t_min, self.t_max = min(t, t_old), max(t, t_old)
-        self.value = np.array(value, dtype=float)
-
-    def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        if t.ndim == 0:
-            return self.value.copy()
-        return np.repeat(self.value[:, None], t.size, axis=1)
 
 
 class Stepper:
@@ -90,11 +84,15 @@ class Stepper:
         Gauss6): their step, required.
     vectorized : bool
         Accepted for SciPy compatibility, without effect.
-    max_steps : int
-        Attempted steps allowed over the whole integration.
-    jac : callable, array_like or None
-        Methods that use a Jacobian (Radau): ``jac(t, y) -> (n, n)`` or a constant matrix;
-        None: finite differences (counted in nfev). Not with a built-in system.
+    max_steps : int or None
+        Attempted steps allowed over the whole integration (None: no limit, as SciPy).
+    jac : callable, array_like, sparse matrix or None
+        Methods that use a Jacobian (Radau): ``jac(t, y) -> (n, n)`` (dense or a
+        scipy.sparse matrix) or a constant matrix (read once, njev 0); None: finite
+        differences (counted in nfev). Not with a built-in system.
+    jac_sparsity : array_like, sparse matrix or None
+        Methods that use a Jacobian, without ``jac``: the structure of df/dy for finite
+        differences by groups of columns (Curtis-Powell-Reid).
     method : str
         Only for ``Stepper`` itself: the method's name in the table.
     """
@@ -105,7 +103,7 @@ class Stepper:
     n_stages = 0
 
     def __init__(self, fun, t0, y0, t_bound, max_step=np.inf, rtol=1e-3, atol=1e-6,
-                 vectorized=False, first_step=None, max_steps=100000, **extraneous):
+                 vectorized=False, first_step=None, max_steps=None, **extraneous):
         code = self._code
         if type(self) is Stepper:
             name = extraneous.pop("method", None)
@@ -120,13 +118,12 @@ class Stepper:
             raise TypeError(f"{type(self).__name__} is a base class: use a method's class "
                             "(conmech.DOP853, conmech.Gauss6, ...) or conmech.Stepper(..., "
                             "method=NAME)")
-        jac = None
+        jac = sparsity = None
         if info.uses_jacobian:
             jac = extraneous.pop("jac", None)
-            if extraneous.pop("jac_sparsity", None) is not None:
-                raise ValueError(f"jac_sparsity is not supported: conmech.{info.name} uses "
-                                 "dense Jacobians (pass jac, or nothing for finite "
-                                 "differences)")
+            sparsity = extraneous.pop("jac_sparsity", None)
+            if jac is not None:
+                sparsity = None        # SciPy: the pattern only serves finite differences
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
@@ -140,8 +137,12 @@ class Stepper:
             raise ValueError("t0 must be finite")
         if math.isnan(t_bound):
             raise ValueError("t_bound must not be NaN")
-        y = initial_state(y0, fun, self._builtin)
+        y = initial_state(y0, fun, self._builtin, allow_complex=not self._builtin,
+                          allow_empty=not self._builtin)
         n = y.size
+        self._complex = y.dtype.kind == "c"
+        if self._complex and info.uses_jacobian:
+            raise ValueError(_COMPLEX_REFUSED)
         self._rtol = tolerance(rtol, "rtol", n)
         self._atol = tolerance(atol, "atol", n)
         name = type(self).__name__ if type(self) is not Stepper else info.name
@@ -149,7 +150,7 @@ class Stepper:
             if first_step is None:
                 raise ValueError(f"first_step is required by {name} (a fixed-step "
                                  "method): pass the step size")
-            if not math.isfinite(t_bound):
+            if not math.isfinite(t_bound) and n:
                 raise ValueError(f"t_bound must be finite for {name} (fixed steps over "
                                  "[t0, t_bound])")
         if first_step is None:
@@ -165,10 +166,12 @@ class Stepper:
         hmax = real_scalar(max_step, "max_step")
         if not hmax > 0:
             raise ValueError("max_step must be positive")
-        if isinstance(max_steps, (bool, np.bool_)) or \
+        if max_steps is None:
+            max_steps = _NO_LIMIT
+        elif isinstance(max_steps, (bool, np.bool_)) or \
                 not isinstance(max_steps, numbers.Integral):
-            raise TypeError("max_steps must be an integer")
-        if not 1 <= max_steps <= 2**31 - 1:
+            raise TypeError("max_steps must be None or an integer")
+        elif not 1 <= max_steps <= _NO_LIMIT:
             raise ValueError("max_steps must be positive (and below 2**31)")
 
         self.fun = fun
@@ -191,22 +194,43 @@ class Stepper:
         self._failure = []
         self._r = np.zeros(1)
         self._iv = np.zeros(1, dtype=np.intc)
-        self._w = np.zeros((n, 1), order="F")
+        self._cached = {}
+        if n == 0:
+            # nothing to integrate: SciPy's solver evaluates fun once and finishes at the
+            # first step (t = t_bound)
+            r = fun(self.t, y.copy())
+            as_result(r, (0,), "fun")
+            self.nfev = 1
+            return
+        if self._complex:
+            # [Re y; Im y] for the real stepper, tolerances per part
+            y = np.concatenate([y.real, y.imag])
+            self._y0 = y.copy()
+            self._rtol = np.concatenate([self._rtol, self._rtol])
+            self._atol = np.concatenate([self._atol, self._atol])
+            fun = _real_form(fun, n)
+        m = y.size
+        self._w = np.zeros((m, 1), order="F")
         self._w[:, 0] = y
+        nnz, ptr, idx = sparsity_pattern(sparsity, m) if sparsity is not None else \
+            (-1, None, np.zeros(1, dtype=np.intc))
+        self._pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
+                             np.zeros(m + 1, dtype=np.intc), sp_idx=idx)
         if self._builtin:
             if jac is not None:
                 raise TypeError("jac cannot be used with a built-in system (it has its own)")
         else:
             # every return of fun is checked (shape, None, complex) by the one wrapper of
             # conmech._callback; an exception stops the step and is re-raised unchanged
-            self._rhs = self._guard.wrap(fun, 2, (n,), "fun")
-            self._jac_cb, self._has_jac = jacobian_callback(jac, n, (), self._failure)
+            self._rhs = self._guard.wrap(fun, 2, (m,), "fun")
+            self._jac_cb, self._has_jac, self._jac_const = jacobian_callback(
+                jac, m, (), self._failure)
         info_, message, sizes = self._call(_SIZES)
         if info_ == _CM_BAD_INPUT:
             raise ValueError(message)
         self._r = np.zeros(max(int(sizes[0]), 1))
         self._iv = np.zeros(max(int(sizes[1]), 1), dtype=np.intc)
-        self._w = np.zeros((n, max(int(sizes[2]), 1)), order="F")
+        self._w = np.zeros((m, max(int(sizes[2]), 1)), order="F")
         self._sizes = tuple(int(s) for s in sizes)
         info_, message, _ = self._call(_START)
         if info_ == _CM_BAD_INPUT:
@@ -218,7 +242,10 @@ class Stepper:
     @property
     def y(self):
         """Current state (a copy)."""
-        return self._w[:, _W_Y].copy() if self._w.shape[1] > _W_Y else self._y0.copy()
+        if self.n == 0:
+            return self._y0.copy()
+        y = self._w[:, _W_Y].copy() if self._w.shape[1] > _W_Y else self._y0.copy()
+        return y[:self.n] + 1j * y[self.n:] if self._complex else y
 
     @property
     def step_size(self):
@@ -233,7 +260,31 @@ class Stepper:
     def nreject(self):
         return int(self._iv[_I_NREJECT]) if self._iv.size > _I_NREJECT else 0
 
+    def _positional(self, action):
+        """The flat routine and its positional arguments for a step or a dense output:
+        built once (the state arrays r, iv, w are updated in place, so the same objects
+        serve every call); f2py parses positional arguments much faster than ~25 keywords,
+        which is most of the Python cost of a step."""
+        nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
+        head = (action, nr, ni, nw, 0.0, self.t_bound, self._y0, self._code)
+        tol = (self._rtol, self._atol, self._first_step, self._max_step, self._max_steps)
+        pat = (self._pattern["nnz"], self._pattern["sp_ptr"], self._pattern["sp_idx"])
+        state = (self._r, self._iv, self._w)
+        if self._builtin:
+            return (_conmech.flat_stepper_builtin,
+                    self.fun._flat_args() + head + tol + pat + state)
+        return (_conmech.flat_stepper_callback,
+                (self._rhs, self._jac_cb) + head + (self._has_jac,) + tol +
+                (self._jac_const,) + pat + state)
+
     def _call(self, action):
+        if action == _STEP or action == _DENSE:
+            cached = self._cached.get(action)
+            if cached is None:
+                cached = self._cached[action] = self._positional(action)
+            routine, args = cached
+            sizes, info, message = routine(*args)
+            return self._after(action, sizes, info, message)
         nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
         if action == _SIZES:
             nr = ni = nw = 0
@@ -242,26 +293,32 @@ class Stepper:
                       t_bound=self.t_bound, y0=self._y0, method=self._code,
                       rtol=self._rtol, atol=self._atol, first_step=self._first_step,
                       max_step=self._max_step, max_steps=self._max_steps,
-                      r=self._r, iv=self._iv, w=self._w)
+                      r=self._r, iv=self._iv, w=self._w, **self._pattern)
         if self._builtin:
             sizes, info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(),
                                                                  **common)
         else:
             sizes, info, message = _conmech.flat_stepper_callback(
-                self._rhs, self._jac_cb, has_jac=self._has_jac, **common)
+                self._rhs, self._jac_cb, has_jac=self._has_jac, jac_const=self._jac_const,
+                **common)
+        return self._after(action, sizes, info, message)
+
+    def _after(self, action, sizes, info, message):
+        """Failures of the callbacks re-raised, the counts and t read from the state."""
         if self._failure:
             self._guard.fail(self._failure.pop(0))
         if self._guard.failed:
             self.status = "failed"
             self._guard.check()
-        message = message_text(message)
+        info = int(info)
+        # the 256-character message is cleaned only when there is one to report (cleaning
+        # it costs more than the rest of a step's glue)
+        message = message_text(message) if info != 0 else ""
         if action != _SIZES and self._iv.size > _I_NREJECT:
-            self.nfev = int(self._iv[_I_NFEV])
-            self.njev = int(self._iv[_I_NJEV])
-            self.nlu = int(self._iv[_I_NLU])
+            self.nfev, self.njev, self.nlu = self._iv[_I_NFEV:_I_NLU + 1].tolist()
             if action == _STEP:
-                self.t = float(self._r[_R_T])
-        return int(info), message, sizes
+                self.t = self._r.item(_R_T)
+        return info, message, sizes
 
     # ------------------------------------------------------------------ SciPy's API
     def step(self):
@@ -273,8 +330,9 @@ class Stepper:
             self.status = "failed"
             message, self._pending = self._pending, None
             return message
-        if self.t == self.t_bound:
+        if self.n == 0 or self.t == self.t_bound:
             self.t_old = self.t
+            self.t = self.t_bound
             self.status = "finished"
             return None
         t = self.t
@@ -292,13 +350,14 @@ class Stepper:
         if self.t_old is None:
             raise RuntimeError("Dense output is available after a successful step was "
                                "made.")
-        if self.t == self.t_old:
+        if self.t == self.t_old or self.n == 0:
             return ConstantDenseOutput(self.t_old, self.t, self.y)
         self._call(_DENSE)
         nf = int(self._iv[_I_NF])
         coef = np.array(self._w[:, _W_FC:_W_FC + nf + 1])
-        return StepDenseOutput(float(self._r[_R_TOLD]), self.t, float(self._r[_R_HDONE]),
-                               coef, int(self._iv[_I_FORM]))
+        sol = StepDenseOutput(float(self._r[_R_TOLD]), self.t, float(self._r[_R_HDONE]),
+                              coef, int(self._iv[_I_FORM]))
+        return ComplexSolution(sol, self.n) if self._complex else sol
 
     def __repr__(self):
         return (f"conmech.{type(self).__name__}(t={self.t!r}, status={self.status!r}, "
@@ -389,6 +448,37 @@ class Gauss6(Gauss):
     order = 6
     n_stages = 3
 
+
+def _real_form(fun, n):
+    """fun of a complex y as a function of [Re y; Im y] returning [Re f; Im f]."""
+    def real_fun(t, u):
+        y = u[:n] + 1j * u[n:]
+        r = fun(t, y)
+        if r is None:
+            return None
+        f = np.asarray(r)
+        if f.dtype.kind not in "biufc":
+            return f          # the callback wrapper names the bad type
+        if f.size != n:
+            raise ValueError(f"fun must return an array of shape ({n},) (complex), got "
+                             f"shape {f.shape}")
+        f = f.reshape(n)
+        return np.concatenate([f.real, f.imag])
+    return real_fun
+
+
+def _butcher(cls):
+    """SciPy's class attributes A, B, C (the Butcher tableau of the propagated solution,
+    n_stages stages) from the Fortran tableau of the method."""
+    s = cls.n_stages
+    a, b, c = _conmech.flat_rk_tableau(cls._code)
+    cls.A = np.array(a[:s, :s], order="C")     # C order: row sums as SciPy adds them
+    cls.B = np.array(b[:s])
+    cls.C = np.array(c[:s])
+
+
+for _cls in (RK45, DOPRI5, DOP853, VERNER98):
+    _butcher(_cls)
 
 _SCIPY_COUNTERPARTS = {"RK45": RK45_SCIPY, "DOP853": DOP853._code, "Radau": Radau._code}
 

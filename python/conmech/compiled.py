@@ -16,6 +16,10 @@ compiled function serves every parameter value)::
     void forces_jac(double t, const double *q, const double *v, const double *a,
                     double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv], nd x 2nd */
     double energy(double t, const double *q, const double *v, const double *p);
+    /* optional: a = M^-1 Q, and a with its Jacobian d a/d[q, v] (nd x 2nd) */
+    void accel(double t, const double *q, const double *v, double *a, const double *p);
+    void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
+                   const double *p);
     /* constrained systems (n coordinates): mass, forces, energy as above, and */
     void phi(double t, const double *q, double *c, const double *p);         /* n_hol   */
     void phi_jac(double t, const double *q, double *G, const double *p);     /* n_hol x n */
@@ -23,6 +27,11 @@ compiled function serves every parameter value)::
     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+    /* optional, constrained: the Jacobian of the force balance (forces_jac above, n x 2n)
+       and hl = d(C^T lam)/dq (n x n), hv = d(C v + c0)/dq (m x n), m = n_hol + n_nh:
+       together the exact Jacobian of Radau IIA on the constrained equations */
+    void constraint_hessian(double t, const double *q, const double *v, const double *lam,
+                            double *hl, double *hv, const double *p);
 
 with ``gamma_h = -d/dt [G v + phi_t]`` and ``gamma_n = -d/dt [A v + b]`` at fixed v (the
 acceleration-level right-hand sides of ``G q'' = gamma_h``, ``A q'' = gamma_n``). A missing
@@ -40,6 +49,7 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import ctypes
 import math
+import os
 
 import numpy as np
 
@@ -52,10 +62,11 @@ __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSy
            "library_taylor"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 26
+_SPEC_SIZE = 28
 _SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
           "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
-          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18}
+          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18,
+          "constraint_hessian": 27, "accel_jac": 28}
 # Taylor coefficients (conmech_flat_spec: 19 taylor, 20 its work columns, 21 taylor_var,
 # 22 its columns, 23 taylor written out for one order, 24 that order, 25/26 the same for
 # taylor_var)
@@ -96,19 +107,34 @@ def function_address(f, what: str = "function") -> int:
     return addr
 
 
+def _real(name, v):
+    """float(v) for a real number v (a bool, a string, a complex or None is a TypeError
+    naming the parameter)."""
+    if isinstance(v, (bool, np.bool_, str, bytes)) or v is None or np.iscomplexobj(v):
+        raise TypeError(f"parameter {name} must be a real number, got {v!r}")
+    try:
+        x = float(v)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"parameter {name} must be a real number, got {v!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"parameter {name} must be finite, got {v!r}")
+    return x
+
+
 def _params(params, param_names):
     """(values, names) from a sequence or a dict of parameters."""
     if isinstance(params, dict):
         names = tuple(str(k) for k in params)
-        values = list(params.values())
+        values = [_real(k, v) for k, v in params.items()]
     else:
-        values = list(np.ravel(np.asarray(params, dtype=float))) if np.size(params) else []
+        if isinstance(params, (str, bytes)):
+            raise TypeError("params must be a sequence of real numbers or a dict")
+        flat = list(np.ravel(np.asarray(params, dtype=object))) if np.size(params) else []
         names = tuple(param_names) if param_names else tuple(f"p{i}" for i in
-                                                             range(len(values)))
-    try:
-        values = np.array(values, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise TypeError("params must be real numbers") from None
+                                                             range(len(flat)))
+        values = [_real(names[i] if i < len(names) else f"p{i}", v)
+                  for i, v in enumerate(flat)]
+    values = np.array(values, dtype=float).ravel()
     if len(names) != values.size:
         raise ValueError(f"param_names has {len(names)} names for {values.size} params")
     if len(set(names)) != len(names):
@@ -140,13 +166,7 @@ def _with_params(obj, kw):
     for k, v in kw.items():
         if k not in values:
             raise ValueError(f"unknown parameter {k!r} (known: {', '.join(obj.param_names)})")
-        try:
-            v = float(v)
-        except (TypeError, ValueError):
-            raise TypeError(f"parameter {k} must be a real number") from None
-        if not math.isfinite(v):
-            raise ValueError(f"parameter {k} must be finite, got {v}")
-        values[k] = v
+        values[k] = _real(k, v)
     return np.array([values[k] for k in obj.param_names], dtype=float)
 
 
@@ -282,7 +302,7 @@ def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
 def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
                        keep=None, name: str = "compiled", *,
-                       mass_forces=None, accel=None) -> CompiledSystem:
+                       mass_forces=None, accel=None, accel_jac=None) -> CompiledSystem:
     """M(t, q) q'' = Q(t, q, q') with ``ndof`` coordinates from compiled functions; the
     state is y = [q, q']. ``forces_jac`` gives the exact Jacobian of the accelerations
     (see the module's signatures); without it the Jacobian is a finite difference.
@@ -293,7 +313,12 @@ def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
     double *v, double *a, const double *p)``, computes the accelerations a = M^-1 Q directly
     (e.g. by the articulated-body algorithm of :func:`conmech.symbolic.planar_tree`); the
     right-hand side then uses it instead of factorising M (non-finite output, e.g. where
-    M is not positive definite, stops the integration with success=False)."""
+    M is not positive definite, stops the integration with success=False). ``accel_jac``
+    (optional), ``void accel_jac(double t, const double *q, const double *v, double *a,
+    double *jac, const double *p)``, computes the accelerations and their Jacobian
+    jac = d a/d[q, v] (ndof x 2 ndof, column-major) directly (e.g. from the derivatives of
+    the recursive algorithms of :func:`conmech.symbolic.spatial_tree`); the Jacobian of the
+    system then uses it instead of ``forces_jac`` and a factorisation of M."""
     ndof = _count(ndof, "ndof", 1)
     values, names = _params(params, param_names)
     if mass is None or forces is None:
@@ -302,20 +327,24 @@ def generalized_system(ndof: int, mass, forces, forces_jac=None, energy=None,
                                                      "forces_jac": forces_jac,
                                                      "energy": energy,
                                                      "mass_forces": mass_forces,
-                                                     "accel": accel})
+                                                     "accel": accel, "accel_jac": accel_jac})
     return CompiledSystem(str(name), "generalized", spec, values, names,
-                          (keep, mass, forces, forces_jac, energy, mass_forces, accel))
+                          (keep, mass, forces, forces_jac, energy, mass_forces, accel,
+                           accel_jac))
 
 
 def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=None,
                        phi_jac=None, phi_t=None, phi_gamma=None, nh_matrix=None, nh_gamma=None,
                        energy=None, rheonomic: bool = False,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
-                       keep=None, name: str = "compiled") -> CompiledConstrained:
+                       keep=None, name: str = "compiled", *, forces_jac=None,
+                       constraint_hessian=None) -> CompiledConstrained:
     """A constrained system in excessive coordinates from compiled functions: ``n``
     coordinates, ``n_hol`` holonomic constraints phi(t, q) = 0 and ``n_nh`` Pfaffian
     constraints A(t, q) q' + b(t, q) = 0. Missing phi_jac, phi_t, phi_gamma, nh_gamma
-    fall back to finite differences (phi_t only when ``rheonomic``)."""
+    fall back to finite differences (phi_t only when ``rheonomic``); so do the optional
+    ``forces_jac`` and ``constraint_hessian`` (the derivatives behind the Jacobian of
+    ``method="Radau"``; see the module's signatures)."""
     n = _count(n, "n", 1)
     n_hol = _count(n_hol, "n_hol", 0)
     n_nh = _count(n_nh, "n_nh", 0)
@@ -330,7 +359,8 @@ def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=
         raise ValueError("nh_matrix is required when n_nh > 0")
     values, names = _params(params, param_names)
     funcs = dict(mass=mass, forces=forces, energy=energy, phi=phi, phi_jac=phi_jac,
-                 phi_t=phi_t, phi_gamma=phi_gamma, nh_matrix=nh_matrix, nh_gamma=nh_gamma)
+                 phi_t=phi_t, phi_gamma=phi_gamma, nh_matrix=nh_matrix, nh_gamma=nh_gamma,
+                 forces_jac=forces_jac, constraint_hessian=constraint_hessian)
     spec = _make_spec(_KIND_CON, n, n_hol, n_nh, rheonomic, funcs)
     return CompiledConstrained(str(name), spec, values, names, (keep, tuple(funcs.values())))
 
@@ -415,28 +445,39 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     ``conmech_forces``, ``conmech_forces_jac``, ``conmech_energy``, ``conmech_phi``,
     ``conmech_phi_jac``, ``conmech_phi_t``, ``conmech_phi_gamma``, ``conmech_nh_matrix``,
     ``conmech_nh_gamma`` (and optionally ``conmech_mass_forces``, ``conmech_accel``,
-    ``conmech_jac_prod``, and the Taylor routines ``conmech_taylor``,
-    ``conmech_taylor_info``, ... of :func:`library_taylor`). The Fortran programs load the same libraries (``sweep --model``,
-    conmech_model_library)."""
+    ``conmech_accel_jac``, ``conmech_jac_prod``, ``conmech_constraint_hessian``, and the
+    Taylor routines ``conmech_taylor``, ``conmech_taylor_info``, ... of
+    :func:`library_taylor`). The Fortran programs load the same libraries (``sweep
+    --model``, conmech_model_library)."""
+    from ._elf import LibraryError, check_library
+    path = os.fspath(path)
     try:
-        lib = ctypes.CDLL(str(path))
+        # before dlopen: a truncated library would be mapped past its end (SIGBUS at the
+        # first access), a foreign file gives an obscure error
+        check_library(path, ["conmech_model_info"])
+        lib = ctypes.CDLL(os.path.abspath(path) if os.sep not in path else path)
+    except LibraryError as e:
+        raise ValueError(f"cannot load the model library {path!r}: {e.reason}") from None
     except OSError as e:
-        raise ValueError(f"cannot load the model library {str(path)!r}: {e}") from None
-    if not hasattr(lib, "conmech_model_info"):
-        raise ValueError(f"{str(path)!r} is not a conmech model (no conmech_model_info)")
+        raise ValueError(f"cannot load the model library {path!r}: {e}") from None
     info = (ctypes.c_int*6)()
     lib.conmech_model_info(info)
     kind, n, n_hol, n_nh, rheo, npar = list(info)
-    if kind not in (1, 2, 3) or n < 1 or npar < 0:
-        raise ValueError(f"{str(path)!r}: invalid description from conmech_model_info")
+    if kind not in (1, 2, 3) or not 1 <= n <= 1000000 or not 0 <= npar <= 4096 \
+            or not 0 <= n_hol <= n or not 0 <= n_nh <= n:
+        raise ValueError(f"{path!r}: invalid description from conmech_model_info "
+                         f"(kind {kind}, n {n}, n_hol {n_hol}, n_nh {n_nh}, {npar} "
+                         "parameters)")
     p = (ctypes.c_double*max(npar, 1))()
     if npar:
+        if not hasattr(lib, "conmech_model_params"):
+            raise ValueError(f"{path!r} has {npar} parameters but no conmech_model_params")
         lib.conmech_model_params(p)
     names = ()
     if hasattr(lib, "conmech_model_param_names"):
         buf = ctypes.create_string_buffer(4096)
         lib.conmech_model_param_names(buf, ctypes.c_int(4096))
-        names = tuple(buf.value.decode("ascii", "replace").split())
+        names = tuple(buf.value.decode("utf-8", "replace").split())
     if len(names) != npar:
         names = tuple(f"p{i}" for i in range(npar))
     params = dict(zip(names, list(p)[:npar]))
@@ -448,8 +489,10 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     if kind == _KIND_GEN:
         return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
                                   params=params, keep=lib, name=name,
-                                  mass_forces=fn["mass_forces"], accel=fn["accel"])
+                                  mass_forces=fn["mass_forces"], accel=fn["accel"],
+                                  accel_jac=fn["accel_jac"])
     return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
                               fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
                               fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,
-                              name=name)
+                              name=name, forces_jac=fn["forces_jac"],
+                              constraint_hessian=fn["constraint_hessian"])

@@ -10,7 +10,7 @@ which drifts)::
 
     from conmech import constrained
     res = constrained.solve("pendulum_xy", (0, 10), rtol=1e-10, atol=1e-10)
-    res.q, res.lam, res.reaction, res.res_pos
+    res.q, res.a, res.lam, res.reaction, res.res_pos
 
 A system is a built-in (:func:`builtin` or its name; see :data:`BUILTIN_NAMES`) or a
 :class:`ConstrainedSystem` made of Python callables. Integrations of built-ins run
@@ -51,8 +51,13 @@ _PAD.flags.writeable = False
 class ConstrainedResult(dict):
     """Result of :func:`solve` (a dict whose keys are also attributes).
 
-    Keys: ``t`` (nt,), ``q`` and ``v`` (n, nt), ``lam`` (m, nt) multipliers,
-    ``reaction`` (n, nt) = C^T lambda, ``res_pos`` (max |phi|) and ``res_vel``
+    Keys: ``t`` (nt,), ``q``, ``v`` and the accelerations ``a`` (also ``accelerations``)
+    (n, nt), ``lam`` (m, nt) multipliers, ``reactions`` (m, n, nt) the generalized force
+    C_i^T lam_i by which constraint i acts on the coordinates (the rows of one joint, e.g.
+    the two of a planar revolute joint, summed give that joint's reaction; for a joint
+    written as the coincidence of two points in Cartesian coordinates its multipliers are
+    the force components), ``reaction`` (n, nt) = C^T lambda, their sum,
+    ``res_pos`` (max |phi|) and ``res_vel``
     (max |C v + c0|) (nt,), ``energy`` (nt,) (zeros if the system defines none),
     ``power`` (nt,) of the reactions, ``nfev``, ``naccept``, ``nreject``, ``nproj``,
     ``proj_iter`` (total simplified Newton iterations), ``proj_iter_max``, ``rank`` (of
@@ -238,13 +243,13 @@ def _int(value, name, low=1, high=2**31 - 1):
 
 def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[float],
           q0: ArrayLike | None = None, v0: ArrayLike | None = None, method: str = "DOP853",
-          projection: str = "position+velocity", t_eval: ArrayLike | None = None,
+          projection: str | None = None, t_eval: ArrayLike | None = None,
           rtol: float = 1e-8, atol: float = 1e-10, params: Sequence[float] = (),
           first_step: float | None = None, max_step: float = np.inf, max_steps: int = 1000000,
           every: int = 1, alpha: float = 5.0, beta: float = 5.0, proj_tol: float = 1e-14,
           proj_max_iter: int = 10,
-          events: Callable[..., float] | Sequence[Callable[..., float]] | None = None
-          ) -> ConstrainedResult:
+          events: Callable[..., float] | Sequence[Callable[..., float]] | None = None,
+          dae_index: int | None = None) -> ConstrainedResult:
     """Integrate a constrained mechanical system.
 
     Parameters
@@ -255,15 +260,23 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     q0, v0 : array_like, optional
         Initial coordinates and velocities (built-ins: their default state if omitted).
         They are projected onto the constraints first; ``dq0``/``dv0`` say how far.
-    method : "RK4" (fixed step ``first_step``), "DOPRI5", "DOP853", "VERNER98" or "RATTLE"
+    method : "RK4" (fixed step ``first_step``), "DOPRI5", "DOP853" (default), "VERNER98",
+        "RATTLE" or "Radau"
         RATTLE: the symplectic constrained integrator for holonomic constraints (fixed
-        step ``first_step``; constraints solved to round-off every step; ``projection``,
-        rtol and atol are not used; a t_eval point between grid points is reached by a
-        side step, so every output is on the manifold). Radau: Radau IIA (order 5,
-        adaptive, rtol/atol) on the stabilised index-2 DAE [q, v, lambda, mu] in
-        mass-matrix form: no drift and no projection; stiff forces welcome; the mass
-        matrix must be constant.
-    projection : "position+velocity" (default), "velocity", "baumgarte", "none"
+        step ``first_step``, deliberately: a variable step destroys the symplecticity and
+        the bounded energy error, see the integrators guide; constraints solved to
+        round-off every step; rtol and atol are not used; a t_eval point between grid
+        points is reached by a side step, so every output is on the manifold). Radau: Radau IIA (order 5,
+        adaptive, rtol/atol) on a differential-algebraic form of the equations (see
+        ``dae_index``): no drift and no projection; stiff forces and any mass matrix
+        M(t, q) welcome; the Jacobian is exact for systems of :mod:`conmech.symbolic`
+        (central differences of M, Q and the constraints otherwise). RATTLE and Radau
+        need independent constraints: redundant ones, or a singular configuration at t0,
+        raise ValueError before the first step.
+    projection : "position+velocity" (the default of the explicit methods), "velocity",
+        "baumgarte", "none"
+        For the explicit methods only (RATTLE and Radau keep the constraints themselves:
+        giving a projection with them raises ValueError).
     t_eval : array_like, optional
         Output times (sorted, inside t_span; the steps hit them exactly). Default: every
         accepted step.
@@ -274,6 +287,12 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         Baumgarte parameters.
     proj_tol, proj_max_iter :
         Position projection: target max |phi| and simplified Newton iterations.
+    dae_index : 2 or 3, optional (Radau only)
+        2 (default): the stabilised index-2 form of Gear, Gupta and Leimkuhler, y = [q, v,
+        lambda, mu] (q and v to order 5, both constraint levels at every step); 3: the
+        index-3 form of the Bari test set, y = [q, v, a, lambda], with RADAU5's index-aware
+        error scaling (q to order 5, v to order 3; the velocity constraints hold to the
+        tolerance only). bench/results/bari.md compares them.
     events : callable ``event(t, q, v) -> float`` or a list of them, optional
         Zero crossings are located (SciPy's conventions: attributes ``terminal`` (bool)
         and ``direction``); the result gets ``t_events``, ``q_events``, ``v_events``
@@ -302,11 +321,24 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         raise TypeError("system must be a built-in name, conmech.constrained.builtin(...) or "
                         "a ConstrainedSystem")
     n = system.n
-    if method not in _METHODS:
+    if not isinstance(method, str) or method not in _METHODS:
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
+    implicit = method in ("RATTLE", "Radau", "RADAU5")
+    if projection is None:
+        projection = "position+velocity"
+    elif implicit:
+        raise ValueError(f"projection: method={method!r} keeps the constraints itself (no "
+                         f"projection applies); got projection={projection!r}")
     if projection not in PROJECTIONS:
         raise ValueError(f"projection must be one of {sorted(PROJECTIONS)}, got "
                          f"{projection!r}")
+    if dae_index is None:
+        dae_index = 2
+    elif method not in ("Radau", "RADAU5"):
+        raise ValueError(f"dae_index applies to method='Radau' only (got method={method!r})")
+    elif isinstance(dae_index, (bool, np.bool_)) or dae_index not in (2, 3):
+        raise ValueError(f"dae_index must be 2 (the stabilised index-2 form) or 3 (the "
+                         f"index-3 form), got {dae_index!r}")
     try:
         t0, tf = (float(x) for x in t_span)
     except (TypeError, ValueError) as exc:
@@ -369,6 +401,11 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
     settings = event_settings(events)
+    for i, (_, _, _, res) in enumerate(settings):
+        if res > 0:     # sampling inside the steps is solve_ivp's (not this driver's)
+            raise ValueError(f"events[{i}].resolution is not supported by constrained.solve (only "
+                             "by conmech.solve_ivp)")
+    settings = [s[:3] for s in settings]
     ne = len(settings)
     for i, (_, count, _) in enumerate(settings):
         if count > 1:
@@ -401,17 +438,19 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         ev_out.update(t=np.array(ev_t), q=np.array(ev_q), v=np.array(ev_v),
                       id=np.array(ev_id))
 
-    iopt = np.array([PROJECTIONS[projection], int(every), int(proj_max_iter), int(max_steps)],
-                    dtype=np.intc)
+    iopt = np.array([PROJECTIONS[projection], int(every), int(proj_max_iter), int(max_steps),
+                     int(dae_index)], dtype=np.intc)
     mstep = float(max_step) if np.isfinite(max_step) else np.finfo(float).max
     ropt = np.array([float(first_step or 0.0), mstep, float(alpha), float(beta),
                      float(proj_tol)])
     out = {}
 
-    def store(t, q, v, lam, reac, rp, rv, en, pw, n_, mm, nt):
-        out.update(t=np.array(t), q=np.array(q), v=np.array(v), lam=np.array(lam),
-                   reaction=np.array(reac), res_pos=np.array(rp), res_vel=np.array(rv),
-                   energy=np.array(en), power=np.array(pw))
+    def store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n_, mm, nt):
+        lam = np.array(lam)
+        out.update(t=np.array(t), q=np.array(q), v=np.array(v), a=np.array(acc), lam=lam,
+                   reaction=np.array(reac), reactions=np.array(cm) * lam[:, None, :],
+                   res_pos=np.array(rp), res_vel=np.array(rv), energy=np.array(en),
+                   power=np.array(pw))
 
     common = dict(n=n, t_span=np.array([t0, tf]), q0=q0, v0=v0, method=_METHODS[method],
                   rtol=float(rtol), atol=float(atol), iopt=iopt, ropt=ropt,
@@ -437,10 +476,13 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     m = system.n_hol + system.n_nh
     if not out:
         out = dict(t=np.zeros(0), q=np.zeros((n, 0)), v=np.zeros((n, 0)),
-                   lam=np.zeros((max(m, 1), 0)), reaction=np.zeros((n, 0)),
+                   a=np.zeros((n, 0)), lam=np.zeros((max(m, 1), 0)), reaction=np.zeros((n, 0)),
+                   reactions=np.zeros((max(m, 1), n, 0)),
                    res_pos=np.zeros(0), res_vel=np.zeros(0), energy=np.zeros(0),
                    power=np.zeros(0))
     out["lam"] = out["lam"][:m]
+    out["reactions"] = out["reactions"][:m]
+    out["accelerations"] = out["a"]
     if isinstance(system, ConstrainedSystem) and system.energy is not None:
         out["energy"] = np.array([float(system.energy(t, q.copy(), v.copy()))
                                   for t, q, v in zip(out["t"], out["q"].T, out["v"].T)])

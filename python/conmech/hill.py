@@ -25,6 +25,8 @@ from __future__ import annotations
 from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
+import math
+
 import numpy as np
 
 from . import _conmech
@@ -63,11 +65,13 @@ def _true_residuals(ms, kappa, y0s):
 
 
 def _check_float(value, name, positive=False, nonneg=False):
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
-    if not np.isfinite(v):
+    if not math.isfinite(v):
         raise ValueError(f"{name} must be finite")
     if positive and not v > 0:
         raise ValueError(f"{name} must be positive, got {v}")
@@ -114,9 +118,15 @@ class HillOrbit:
                  "stability_index", "c", "residual", "quarter_state", "nsteps", "iterations",
                  "nfev")
 
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
+    def __init__(self, m=None, kappa=None, y0=None, period=None, jacobi=None, monodromy=None,
+                 multipliers=None, stability_index=None, c=None, residual=None,
+                 quarter_state=None, nsteps=None, iterations=None, nfev=None):
+        self.m, self.kappa, self.y0, self.period, self.jacobi = m, kappa, y0, period, jacobi
+        self.monodromy, self.multipliers, self.stability_index = monodromy, multipliers, \
+            stability_index
+        self.c, self.residual, self.quarter_state, self.nsteps = c, residual, quarter_state, \
+            nsteps
+        self.iterations, self.nfev = iterations, nfev
 
     @property
     def initial_state(self):
@@ -172,7 +182,7 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     m = _check_float(m, "m", nonneg=True)
     kappa = _check_float(kappa, "kappa", positive=True)
     if guess is None:
-        use, g = 0, np.zeros(2)
+        use, g = 0, _NO_GUESS
     else:
         g = np.asarray(guess, dtype=float).ravel()
         if g.size != 2 or not np.all(np.isfinite(g)):
@@ -180,34 +190,38 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
         use = 1
     if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
         raise TypeError("nsteps must be an integer")
-    if not 0 <= int(nsteps) <= 100000:
+    if not 0 <= nsteps <= 100000:
         raise ValueError("nsteps must be in [0, 100000]")
-    closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
-    if int(max_nsteps) < max(int(nsteps), 20):
+    if isinstance(max_nsteps, (bool, np.bool_)) or not isinstance(max_nsteps,
+                                                                 (int, np.integer)):
+        raise TypeError("max_nsteps must be an integer")
+    if closure_tol != 1e-12:
+        closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
+    if max_nsteps < max(nsteps, 20):
         raise ValueError("max_nsteps must be >= nsteps (and >= 20)")
-    (y0, period, jacobi, mono, mr, mi, s, c, residual, quarter, nsu, iterations, nfev, info,
-     message) = _conmech.flat_hill_orbit(m, kappa, int(nsteps), int(bool(full_period)),
-                                         use, g, closure_tol, int(max_nsteps))
+    # the orbit and its independent closure check in one Fortran call
+    (y0, period, jacobi, mono, mult, s, c, residual, quarter, nsu, iterations, nfev,
+     res, scale, finite, info, message) = _conmech.flat_hill_orbit_checked(
+        m, kappa, nsteps, 1 if full_period else 0, use, g, closure_tol, max_nsteps)
     if info != 0:
         msg = _msg(message) or _STATUS.get(int(info), "failure")
         if info == -4:
             raise ValueError(msg)
         raise RuntimeError(msg)
-    y0 = np.array(y0)
-    res = float(_true_residuals(np.array([m]), kappa, y0[None, :])[0])
-    if not (res <= RESIDUAL_TOL*max(1.0, float(np.max(np.abs(y0))))):
+    if not res <= RESIDUAL_TOL*scale:
         raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
                            f"periodic to the tolerance (true residual {res:.3g} > "
                            f"{RESIDUAL_TOL:g}): Newton did not converge to the variation "
                            "orbit (a better guess or more nsteps is needed)")
-    if not (np.all(np.isfinite(mono)) and np.isfinite(s)):
+    if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
-    return HillOrbit(m=m, kappa=kappa, y0=y0, period=float(period),
-                     jacobi=float(jacobi), monodromy=np.array(mono),
-                     multipliers=np.asarray(mr) + 1j*np.asarray(mi),
-                     stability_index=float(s), c=float(c), residual=float(residual),
-                     quarter_state=np.array(quarter), nsteps=int(nsu),
-                     iterations=int(iterations), nfev=int(nfev))
+    return HillOrbit(m=m, kappa=kappa, y0=y0, period=period, jacobi=jacobi, monodromy=mono,
+                     multipliers=mult.T.view(np.complex128)[:, 0], stability_index=s, c=c,
+                     residual=residual,
+                     quarter_state=quarter, nsteps=nsu, iterations=iterations, nfev=nfev)
+
+
+_NO_GUESS = np.zeros(2)
 
 
 class HillFamily:

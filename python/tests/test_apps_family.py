@@ -96,7 +96,10 @@ def test_switch_at_the_branch_point(family, tmp_path):
     assert np.allclose(z**2, p - 2, atol=1e-9)           # closed form
     assert np.allclose(new[:, 2], 2*np.pi, atol=1e-9)
     assert max(closure(row) for row in new[1:]) < 1e-8
-    assert (tmp_path / "switched_special.csv").read_text().startswith("kind,index,p,")
+    # the switched branch's special points go to a file only when asked
+    assert not (tmp_path / "switched_special.csv").exists()
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["branch.csv", "special.csv",
+                                                          "switched.csv"]
     r = run(family, START + ["--switch", "2", "--switch-direction", "-1",
                              "--switch-points", "4", "--force",
                              "--switch-out", "mirror.csv", "--switch-special", "ms.csv"],
@@ -104,6 +107,7 @@ def test_switch_at_the_branch_point(family, tmp_path):
     assert r.returncode == 0, r.stderr
     _, mirror = table(tmp_path / "mirror.csv")
     assert mirror.shape[0] == 4 and np.all(mirror[1:, 11] < 0)     # z < 0
+    assert (tmp_path / "ms.csv").read_text().startswith("kind,index,p,")
     assert np.allclose(mirror[1:, 11]**2, mirror[1:, 1] - 2, atol=1e-9)
     assert closure(mirror[-1]) < 1e-8
 

@@ -8,6 +8,8 @@ one not called success has a printable message. Never garbage, never a crash (a 
 would kill the test run, which test.sh reports as a failure), never a hang (every call is
 bounded by max_steps / max_iter)."""
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -278,3 +280,316 @@ def test_fuzz_constrained(name, value, kind, after):
         if r.success:
             assert np.all(np.isfinite(r.q)) and np.all(np.isfinite(r.v))
             assert np.max(r.res_pos, initial=0.0) < 1e-6
+
+
+# ------------------------------------------------------------------ symbolic front end
+try:
+    import sympy
+except ImportError:           # conmech without its symbolic extra: nothing to fuzz here
+    sympy = None
+needs_sympy = pytest.mark.skipif(sympy is None, reason="sympy is not installed")
+if sympy is not None:
+    from conmech.symbolic.codegen import (check_source, generate,  # noqa: E402
+                                          private_procedures)
+    from conmech.symbolic.derive import derive_ode  # noqa: E402
+    _X, _V, _K = sympy.symbols("x v k")
+    junk_atom = st.one_of(
+        st.sampled_from([_X, _V, _K, sympy.I, sympy.nan, sympy.zoo, sympy.oo, -sympy.oo,
+                         sympy.pi, sympy.E, sympy.Integer(0), sympy.Rational(10 ** 400, 7),
+                         sympy.Rational(1, 10 ** 330),
+                         sympy.Rational(10 ** 20 + 1, 10 ** 19),
+                         sympy.Float("1e308"), sympy.Float("1e-320"), sympy.Symbol("zz"),
+                         sympy.Integral(_X, _X), sympy.Sum(_X / _K, (_K, 1, 2)),
+                         sympy.Function("g")(_X), sympy.Matrix([_X, _V]), "x + v", None, True,
+                         1j, [1.0], b"x", object()]),
+        st.floats(allow_nan=True, allow_infinity=True, width=64),
+        st.integers(-10 ** 400, 10 ** 400))
+    junk_expr = st.recursive(
+        junk_atom,
+        lambda inner: st.one_of(
+            st.builds(lambda a, b: _combine(a, b, "+"), inner, inner),
+            st.builds(lambda a, b: _combine(a, b, "*"), inner, inner),
+            st.builds(lambda a: _apply(a, sympy.sin), inner),
+            st.builds(lambda a: _apply(a, sympy.sqrt), inner)),
+        max_leaves=5)
+else:
+    junk_expr = st.none()
+
+
+def _combine(a, b, op):
+    try:
+        return a + b if op == "+" else a * b
+    except Exception:
+        return a
+
+
+def _apply(a, f):
+    try:
+        return f(a)
+    except Exception:
+        return a
+
+
+@needs_sympy
+@FUZZ
+@given(f=st.lists(junk_expr, min_size=0, max_size=3),
+       params=st.dictionaries(st.sampled_from(["k", "zz", "x", "k\n", "_k", "θ"]),
+                              junk_scalar, max_size=2))
+def test_fuzz_symbolic_front_end(f, params):
+    """Derivation and code generation of junk: a clean exception naming the problem, or a
+    record whose right-hand side is real, finite where sympy's is, and whose Fortran
+    passes the source check (one procedure per entry point, printable ASCII)."""
+    try:
+        d = derive_ode(f, [_X, _V], params)
+        src, entries = generate(d, model_values=d.param_values)
+    except (ValueError, TypeError) as exc:
+        check_text(str(exc), ascii_only=False)
+        return
+    c_names = [f"conmech_{e}" for e in entries] + [
+        "conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
+    check_source(src, c_names + private_procedures(entries), c_names)
+    assert len(d.f) == 2
+    for e in d.f:
+        assert not e.has(sympy.I, sympy.nan, sympy.zoo, sympy.oo, sympy.Integral, sympy.Sum)
+    assert all(np.isfinite(d.param_values))
+
+
+@needs_sympy
+def test_fuzz_symbolic_compiled_agree_with_sympy(tmp_path, monkeypatch):
+    """A sample of accepted random systems is compiled: the library's right-hand side
+    equals sympy's evaluation of the same expressions (no term dropped, none changed)."""
+    from conmech import symbolic
+    monkeypatch.setenv("CONMECH_CACHE", str(tmp_path / "cache"))
+    rng = np.random.default_rng(2024)
+    atoms = [_X, _V, _K, sympy.pi, sympy.Rational(3, 7), sympy.Rational(10 ** 20 + 1,
+                                                                          10 ** 19)]
+    done = 0
+    for trial in range(40):
+        def rand_expr(depth=0):
+            if depth > 2 or rng.random() < 0.3:
+                return atoms[rng.integers(len(atoms))]
+            a, b = rand_expr(depth + 1), rand_expr(depth + 1)
+            return [a + b, a * b, sympy.sin(a) * b, sympy.exp(-a ** 2) + b,
+                    a / (2 + b ** 2)][rng.integers(5)]
+        f = [rand_expr(), rand_expr()]
+        s = symbolic.ode_system(f, [_X, _V], params={_K: 1.5}, model_only=True)
+        fn = sympy.lambdify([_X, _V, _K], f, "math")
+        for _ in range(3):
+            y = rng.uniform(-2, 2, 2)
+            got = s.call("rhs", 0.0, y)
+            want = np.array(fn(y[0], y[1], 1.5), dtype=float)
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13)
+        done += 1
+        if done == 8:
+            break
+    assert done == 8
+
+
+# ------------------------------------------------------------------ model libraries and the cache
+def _good_library(tmp_path_factory):
+    from conmech import symbolic
+    d = tmp_path_factory.mktemp("fuzzlib")
+    s = symbolic.ode_system([_V, -_K * _X], [_X, _V], params={_K: 2.0})
+    return Path(symbolic.save_model(s, d / "good.so"))
+
+
+@pytest.fixture(scope="module")
+def good_library(tmp_path_factory):
+    import symbolic_seeds as seeds
+    seeds.use_test_cache(tmp_path_factory.getbasetemp())
+    return _good_library(tmp_path_factory)
+
+
+def _corruptions(data, rng, n):
+    """Damaged copies of an ELF shared library that no loader may map: truncations, random
+    bytes, and header fields (table offsets and counts, segment sizes) pointed outside."""
+    import struct
+    out = []
+    phoff, shoff = struct.unpack_from("<QQ", data, 32)
+    phnum, shnum = struct.unpack_from("<HH", data, 56)[0], struct.unpack_from("<H", data,
+                                                                               60)[0]
+    for _ in range(n):
+        kind = rng.integers(6)
+        b = bytearray(data)
+        if kind == 0:                                   # truncated anywhere
+            b = b[:rng.integers(0, len(data))]
+        elif kind == 1:                                 # random garbage, any size
+            b = bytearray(rng.integers(0, 256, rng.integers(0, 4096), dtype=np.uint8))
+        elif kind == 2:                                 # ELF magic, then garbage
+            b = bytearray(b"\x7fELF" + bytes(rng.integers(0, 256, rng.integers(0, 200),
+                                                           dtype=np.uint8)))
+        elif kind == 3:                                 # a table offset past the end
+            struct.pack_into("<Q", b, [32, 40][rng.integers(2)],
+                             len(data) + int(rng.integers(1, 1 << 40)))
+        elif kind == 4:                                 # a segment's file image past it
+            k = rng.integers(phnum)
+            struct.pack_into("<Q", b, phoff + 56 * k + [8, 32][rng.integers(2)],
+                             len(data) + int(rng.integers(1, 1 << 30)))
+        else:                                           # a section past the end
+            k = rng.integers(1, shnum)
+            struct.pack_into("<Q", b, shoff + 64 * k + 24, len(data) + int(rng.integers(
+                1, 1 << 30)))
+            struct.pack_into("<I", b, shoff + 64 * k + 4, 1)          # with contents
+        out.append(bytes(b))
+    return out
+
+
+@needs_sympy
+def test_fuzz_damaged_model_libraries_are_refused(good_library, tmp_path):
+    """200 damaged copies: the Python check refuses every one (nothing is mapped), and so
+    does the Fortran check of the programs (sweep --model, exit 2, no signal)."""
+    from conmech._elf import LibraryError, check_library
+    data = good_library.read_bytes()
+    check_library(good_library, ["conmech_model_info"])
+    rng = np.random.default_rng(7)
+    cases = _corruptions(data, rng, 200)
+    for k, b in enumerate(cases):
+        p = tmp_path / f"bad{k}.so"
+        p.write_bytes(b)
+        with pytest.raises(LibraryError):
+            check_library(p, ["conmech_model_info"])
+    import shutil
+    import subprocess
+    root = Path(__file__).resolve().parents[2]
+    if shutil.which("fpm") is None:
+        pytest.fail("fpm is not on PATH: run the tests through scripts/test.sh")
+    out = subprocess.run(["fpm", "run", "sweep", "--runner", "echo"], cwd=root,
+                         capture_output=True, text=True, check=True).stdout
+    exe = str(root / out.strip().splitlines()[-1].strip())
+    for k in range(0, 200, 5):
+        r = subprocess.run([exe, "--model", str(tmp_path / f"bad{k}.so"), "--y0", "1,0",
+                            "--vary", "y0:1", "--from", "0", "--to", "1", "--count", "2"],
+                           cwd=tmp_path, capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and "cannot load the model library" in r.stderr, \
+            (k, r.returncode, r.stderr)
+
+
+CACHE_FUZZ = """
+import json, os, random, shutil, sys, warnings
+import numpy as np, sympy as sp
+from conmech import symbolic
+base, work, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+x, v, k = sp.symbols("x v k")
+make = lambda: symbolic.ode_system([v, -k*x - v**3/5], [x, v], params={k: 2.0},
+                                   model_only=True)
+os.environ["CONMECH_CACHE"] = base
+ref = make().call("rhs", 0.3, [0.7, -0.2])
+rng = random.Random(99)
+for case in range(n):
+    shutil.rmtree(work, ignore_errors=True)
+    shutil.copytree(base, work)
+    os.environ["CONMECH_CACHE"] = work
+    so = [f for f in os.listdir(work) if f.endswith(".so")][0]
+    lib = os.path.join(work, so)
+    man = lib[:-3] + ".json"
+    data = open(lib, "rb").read()
+    kind = rng.randrange(8)
+    if kind == 0:
+        open(lib, "wb").write(data[:rng.randrange(len(data))])
+    elif kind == 1:
+        i = rng.randrange(len(data))
+        open(lib, "wb").write(data[:i] + bytes([data[i] ^ (1 << rng.randrange(8))]) + data[i+1:])
+    elif kind == 2:
+        open(lib, "wb").write(bytes(rng.randrange(256) for _ in range(rng.randrange(5000))))
+    elif kind == 3:
+        open(lib, "wb").write(b"")
+    elif kind == 4:
+        os.unlink(man)
+    elif kind == 5:
+        open(man, "w").write(json.dumps({"format": 1, "size": rng.randrange(10**6),
+                                         "sha256": "%064x" % rng.getrandbits(256)}))
+    elif kind == 6:
+        open(man, "wb").write(bytes(rng.randrange(256) for _ in range(rng.randrange(300))))
+    else:
+        open(lib, "ab").write(b"appended")
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        m = make()
+    got = m.call("rhs", 0.3, [0.7, -0.2])
+    assert np.array_equal(got, ref), (case, kind, got, ref)
+    assert not m.cache_hit and any("rebuilding" in str(x.message) for x in w), (case, kind)
+    left = [f for f in os.listdir(work) if f.startswith((".build-", ".tmp-"))]
+    assert not left, left
+print("OK", n)
+"""
+
+
+@needs_sympy
+def test_fuzz_damaged_cache_entries_are_rebuilt(tmp_path):
+    """Random damage to a cache entry (truncation, a flipped bit, garbage, an empty file,
+    appended bytes, a missing, forged or garbage manifest), 24 cases in one child process
+    (a SIGBUS would kill it and fail the test): every one is detected, rebuilt with a
+    warning, and gives the same numbers; no temporary file is left."""
+    import subprocess
+    import sys
+    base = tmp_path / "base"
+    r = subprocess.run([sys.executable, "-c", CACHE_FUZZ, str(base), str(tmp_path / "w"),
+                        "24"], capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0 and "OK 24" in r.stdout, (r.returncode, r.stderr[-3000:])
+
+
+FULL_FUZZ = """
+import os, sys, numpy as np, sympy as sp
+from conmech import symbolic
+cache = sys.argv[1]
+os.environ["CONMECH_CACHE"] = cache
+x, v = sp.symbols("x v")
+outcomes = []
+for i, free in enumerate([0, 512, 2048, 6144, 12288, 24576, 65536, 200000]):
+    filler = os.path.join(cache, "filler")
+    if os.path.exists(filler):
+        os.unlink(filler)
+    st = os.statvfs(cache)
+    room = st.f_bavail * st.f_frsize
+    with open(filler, "wb") as fh:
+        fh.write(b"\\0" * max(room - free, 0))
+    try:
+        s = symbolic.ode_system([v, -x - x**3/(i + 2)], [x, v], model_only=True)
+        assert np.allclose(s.call("rhs", 0.0, [1.0, 0.0]), [0.0, -1 - 1/(i + 2)])
+        outcomes.append("built")
+    except symbolic.CacheError as e:
+        assert "is full" in str(e) and "No space left on device" in str(e), str(e)
+        outcomes.append("full")
+    names = os.listdir(cache)
+    assert not [f for f in names if f.startswith((".build-", ".tmp-"))], names
+    for f in names:
+        if f.endswith(".so"):
+            assert f[:-3] + ".json" in names, (f, names)
+print("OUTCOMES", " ".join(outcomes))
+"""
+
+
+def _tmpfs_prefix():
+    import shutil
+    import subprocess
+    if shutil.which("unshare") is None:
+        return None
+    for pre in (["unshare", "-m"], ["unshare", "-rm"]):
+        r = subprocess.run(pre + ["sh", "-c", "d=$(mktemp -d) && mount -t tmpfs -o size=64k "
+                                              "tmpfs $d && umount $d && rmdir $d"],
+                           capture_output=True)
+        if r.returncode == 0:
+            return pre
+    return None
+
+
+@needs_sympy
+@pytest.mark.skipif(_tmpfs_prefix() is None, reason="no private mount namespace here "
+                    "(unshare -m / -rm refused); test_reliability_cache simulates full and "
+                    "read-only caches instead")
+def test_fuzz_cache_on_a_filling_tmpfs(tmp_path):
+    """Builds into a 1 MB tmpfs left with 0 .. 200 kB free: each either succeeds and runs
+    or says the cache is full; never a library without its manifest, never a partial
+    file."""
+    import subprocess
+    import sys
+    mnt = tmp_path / "mnt"
+    mnt.mkdir()
+    (tmp_path / "t.py").write_text(FULL_FUZZ)
+    cmd = (f"mount -t tmpfs -o size=1m,mode=0700 tmpfs {mnt} && "
+           f"{sys.executable} {tmp_path / 't.py'} {mnt}")
+    r = subprocess.run(_tmpfs_prefix() + ["sh", "-c", cmd], capture_output=True, text=True,
+                       timeout=900)
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = r.stdout.split("OUTCOMES")[1].split()
+    assert out[0] == "full" and out[-1] == "built", out

@@ -14,12 +14,19 @@
 !!     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
 !!     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
 !!     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
+!!     /* optional, constrained systems: hl = d(C^T lam)/dq (n x n), hv = d(C v + c0)/dq
+!!        ((n_hol + n_nh) x n); with forces_jac the exact Jacobian of Radau on them */
+!!     void constraint_hessian(double t, const double *q, const double *v,
+!!                             const double *lam, double *hl, double *hv, const double *p);
 !!     /* optional, generalized systems: M and Q in one call (shared subexpressions) */
 !!     void mass_forces(double t, const double *q, const double *v, double *M, double *Q,
 !!                      const double *p);
 !!     /* optional, generalized systems: the accelerations a = M^-1 Q directly (e.g. by the
 !!        articulated-body algorithm); non-finite entries where M is not positive definite */
 !!     void accel(double t, const double *q, const double *v, double *a, const double *p);
+!!     /* optional, generalized systems: a and its Jacobian jac = d a/d[q, v] (nd x 2nd) */
+!!     void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
+!!                    const double *p);
 !!
 !! Only `mass` and `forces` are required; a missing optional function falls back to the
 !! finite-difference default of the parent type (see conmech_constrained_system).
@@ -30,7 +37,8 @@ module conmech_c_mechanics
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_generalized, only: generalized_system
     use conmech_constrained_system, only: constrained_system, fd_phi_jac, fd_phi_t, &
-                                          fd_phi_gamma, fd_nh_gamma
+                                          fd_phi_gamma, fd_nh_gamma, fd_forces_jacobian, &
+                                          fd_constraint_hessian
     implicit none
     private
 
@@ -73,6 +81,13 @@ module conmech_c_mechanics
             real(c_double), intent(in) :: p(*)
             real(c_double) :: e
         end function c_energy_fn
+        subroutine c_hess_fn(t, q, v, lam, hl, hv, p) bind(c)
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: q(*), v(*), lam(*)
+            real(c_double), intent(out) :: hl(*), hv(*)
+            real(c_double), intent(in) :: p(*)
+        end subroutine c_hess_fn
         subroutine c_nh_fn(t, q, a, b, p) bind(c)
             import :: c_double
             real(c_double), value :: t
@@ -86,10 +101,14 @@ module conmech_c_mechanics
     type :: c_mech_pointers
         type(c_funptr) :: mass, forces, forces_jac, energy
         type(c_funptr) :: phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma
+        !> optional: the second derivatives of the constraints (constrained systems)
+        type(c_funptr) :: constraint_hessian = c_null_funptr
         !> optional: M and Q in one call (generalized systems)
         type(c_funptr) :: mass_forces = c_null_funptr
         !> optional: the accelerations a = M^-1 Q (generalized systems)
         type(c_funptr) :: accel = c_null_funptr
+        !> optional: a and d a/d[q, v] (generalized systems)
+        type(c_funptr) :: accel_jac = c_null_funptr
     end type c_mech_pointers
 
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
@@ -101,8 +120,11 @@ module conmech_c_mechanics
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
         procedure(c_mf_fn), pointer, nopass :: mf_f => null()
         procedure(c_qv_fn), pointer, nopass :: accel_f => null()
+        procedure(c_mf_fn), pointer, nopass :: accel_jac_f => null()
     contains
         procedure :: mass => cg_mass
+        procedure :: accelerations_jacobian => cg_accelerations_jacobian
+        procedure :: has_accelerations_jacobian => cg_has_accelerations_jacobian
         procedure :: accelerations => cg_accelerations
         procedure :: has_accelerations => cg_has_accelerations
         procedure :: mass_forces => cg_mass_forces
@@ -125,7 +147,13 @@ module conmech_c_mechanics
         procedure(c_qv_fn), pointer, nopass :: phi_gamma_f => null()
         procedure(c_nh_fn), pointer, nopass :: nh_f => null()
         procedure(c_qv_fn), pointer, nopass :: nh_gamma_f => null()
+        procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
+        procedure(c_hess_fn), pointer, nopass :: hess_f => null()
     contains
+        procedure :: forces_jacobian => cc_forces_jacobian
+        procedure :: has_forces_jacobian => cc_has_forces_jacobian
+        procedure :: constraint_hessian => cc_constraint_hessian
+        procedure :: has_constraint_hessian => cc_has_constraint_hessian
         procedure :: mass => cc_mass
         procedure :: forces => cc_forces
         procedure :: energy => cc_energy
@@ -173,6 +201,7 @@ contains
         if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
         if (c_associated(fp%mass_forces)) call c_f_procpointer(fp%mass_forces, sys%mf_f)
         if (c_associated(fp%accel)) call c_f_procpointer(fp%accel, sys%accel_f)
+        if (c_associated(fp%accel_jac)) call c_f_procpointer(fp%accel_jac, sys%accel_jac_f)
         call set_params(sys%p, params)
         info = CM_SUCCESS
         msg = "success"
@@ -220,6 +249,9 @@ contains
         if (c_associated(fp%phi_gamma)) call c_f_procpointer(fp%phi_gamma, sys%phi_gamma_f)
         if (c_associated(fp%nh_matrix)) call c_f_procpointer(fp%nh_matrix, sys%nh_f)
         if (c_associated(fp%nh_gamma)) call c_f_procpointer(fp%nh_gamma, sys%nh_gamma_f)
+        if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
+        if (c_associated(fp%constraint_hessian)) &
+            call c_f_procpointer(fp%constraint_hessian, sys%hess_f)
         call set_params(sys%p, params)
         info = CM_SUCCESS
         msg = "success"
@@ -260,6 +292,19 @@ contains
         class(c_generalized_system), intent(in) :: self
         cg_has_accelerations = associated(self%accel_f)
     end function cg_has_accelerations
+
+    subroutine cg_accelerations_jacobian(self, t, q, v, a, jac)
+        class(c_generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:), jac(:, :)
+        call self%accel_jac_f(t, q, v, a, jac, self%p)
+    end subroutine cg_accelerations_jacobian
+
+    logical function cg_has_accelerations_jacobian(self)
+        class(c_generalized_system), intent(in) :: self
+        cg_has_accelerations_jacobian = associated(self%accel_jac_f)
+    end function cg_has_accelerations_jacobian
 
     subroutine cg_forces(self, t, q, v, f)
         class(c_generalized_system), intent(in) :: self
@@ -401,5 +446,39 @@ contains
             call fd_nh_gamma(self, t, q, v, gam)
         end if
     end subroutine cc_nh_gamma
+
+    subroutine cc_forces_jacobian(self, t, q, v, a, r)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), a(:)
+        real(dp), intent(out) :: r(:, :)
+        if (associated(self%fjac_f)) then
+            call self%fjac_f(t, q, v, a, r, self%p)
+        else
+            call fd_forces_jacobian(self, t, q, v, a, r)
+        end if
+    end subroutine cc_forces_jacobian
+
+    logical function cc_has_forces_jacobian(self)
+        class(c_constrained_system), intent(in) :: self
+        cc_has_forces_jacobian = associated(self%fjac_f)
+    end function cc_has_forces_jacobian
+
+    subroutine cc_constraint_hessian(self, t, q, v, lam, hl, hv)
+        class(c_constrained_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:), lam(:)
+        real(dp), intent(out) :: hl(:, :), hv(:, :)
+        if (associated(self%hess_f) .and. self%n_hol + self%n_nh > 0) then
+            call self%hess_f(t, q, v, lam, hl, hv, self%p)
+        else
+            call fd_constraint_hessian(self, t, q, v, lam, hl, hv)
+        end if
+    end subroutine cc_constraint_hessian
+
+    logical function cc_has_constraint_hessian(self)
+        class(c_constrained_system), intent(in) :: self
+        cc_has_constraint_hessian = associated(self%hess_f)
+    end function cc_has_constraint_hessian
 
 end module conmech_c_mechanics

@@ -1,9 +1,9 @@
 !> Options and result of `constrained_solve`, and the ONE result builder of every
 !! constrained method: the outputs of the driver (states y = [q; v; ...] at the output
 !! times, the events) become the constrained result with its diagnostics at every output,
-!! from the acceleration-level KKT system: multipliers, reaction forces C^T lambda, the
-!! position and velocity residuals, the energy (if the system defines one) and the power of
-!! the reactions.
+!! from the acceleration-level KKT system: accelerations, multipliers, reaction forces
+!! C^T lambda, the position and velocity residuals, the energy (if the system defines one)
+!! and the power of the reactions.
 module conmech_constrained_result
     use conmech_kinds, only: dp
     use conmech_status
@@ -33,6 +33,10 @@ module conmech_constrained_result
         integer :: proj_max_iter = 10              !! simplified Newton iterations
         logical :: project_initial = .true.        !! make (q0, v0) consistent first
         logical :: save_steps = .true.             !! without t_eval: keep every step
+        !> Radau IIA's formulation: 2 the stabilised index-2 (GGL) form
+        !! (conmech_constrained_dae), 3 the index-3 form with the accelerations and
+        !! multipliers as algebraic variables (conmech_constrained_index3)
+        integer :: dae_index = 2
     end type constrained_options
 
     !> Result of `constrained_solve`: columns are output times.
@@ -43,6 +47,9 @@ module conmech_constrained_result
         integer :: nt = 0
         real(dp), allocatable :: t(:)              !! (nt)
         real(dp), allocatable :: q(:, :), v(:, :)  !! (n, nt)
+        !> (n, nt) accelerations q'' (from the KKT system at (t, q, v); with Baumgarte
+        !! stabilisation those of the stabilised equations)
+        real(dp), allocatable :: acc(:, :)
         real(dp), allocatable :: lam(:, :)         !! (n_hol + n_nh, nt) multipliers
         real(dp), allocatable :: reaction(:, :)    !! (n, nt) reaction forces C^T lambda
         real(dp), allocatable :: res_pos(:)        !! (nt) max |phi|
@@ -102,7 +109,7 @@ contains
         type(constrained_result), intent(inout) :: res
         integer, intent(in) :: n, m, nt
         res%nt = nt
-        allocate (res%t(nt), res%q(n, nt), res%v(n, nt), res%lam(m, nt), &
+        allocate (res%t(nt), res%q(n, nt), res%v(n, nt), res%acc(n, nt), res%lam(m, nt), &
                   res%reaction(n, nt), res%res_pos(nt), res%res_vel(nt), &
                   res%energy(nt), res%power(nt))
     end subroutine allocate_outputs
@@ -125,17 +132,13 @@ contains
     !! message, counters, events, and at every output the state and its diagnostics, the
     !! multipliers from `mech`'s KKT system (sys itself, or its copy with the mass
     !! factorised once; Baumgarte's acceleration constraint when alpha and beta are given).
-    !! With `mass0` (a method that needs a constant mass matrix), an output where M differs
-    !! from it makes the status CM_BAD_INPUT. A failed diagnostic sets the status of a run
-    !! that had succeeded.
-    subroutine build_constrained_result(res, ores, sys, mech, alpha, beta, mass0)
+    !! A failed diagnostic sets the status of a run that had succeeded.
+    subroutine build_constrained_result(res, ores, sys, mech, alpha, beta)
         type(constrained_result), intent(inout) :: res
         type(ode_result), intent(in) :: ores
         class(constrained_system), intent(in) :: sys, mech
         real(dp), intent(in), optional :: alpha, beta
-        real(dp), intent(in), optional :: mass0(:, :)
         real(dp) :: q(sys%n), v(sys%n), acc(sys%n), lam(sys%n_hol + sys%n_nh), t
-        real(dp), allocatable :: mt(:, :)
         integer :: n, m, j, inf2
         character(len=:), allocatable :: m2
         n = sys%n
@@ -146,7 +149,6 @@ contains
         res%naccept = ores%stats%naccept
         res%nreject = ores%stats%nreject
         call take_events(ores, n, res)
-        if (present(mass0)) allocate (mt(n, n))
         call allocate_outputs(res, n, m, ores%nt)
         do j = 1, ores%nt
             t = ores%t(j)
@@ -155,15 +157,6 @@ contains
             res%t(j) = t
             res%q(:, j) = q
             res%v(:, j) = v
-            if (present(mass0)) then
-                call sys%mass(t, q, mt)
-                if (any(abs(mt - mass0) > 1.0e-12_dp*maxval(abs(mass0))) .and. &
-                    res%status >= 0) then
-                    res%status = CM_BAD_INPUT
-                    res%message = "bad input: Radau on a constrained system needs a " &
-                                  //"constant mass matrix (use RATTLE or a projected method)"
-                end if
-            end if
             if (present(alpha) .and. present(beta)) then
                 call constrained_accel(mech, t, q, v, acc, lam, inf2, m2, alpha=alpha, &
                                        beta=beta)
@@ -174,6 +167,7 @@ contains
                 res%status = inf2
                 res%message = m2
             end if
+            res%acc(:, j) = acc
             res%lam(:, j) = lam
             call constraint_reaction(mech, t, q, lam, res%reaction(:, j))
             call constraint_residuals(sys, t, q, v, res%res_pos(j), res%res_vel(j))

@@ -21,8 +21,15 @@
 !! - RATTLE (METHOD_RATTLE, holonomic constraints, fixed step first_step;
 !!   conmech_rattle_stepper): constraints solved to round-off every step; t_eval points and
 !!   events on its side step from the grid point before (on the manifold to round-off).
-!! - Radau IIA (METHOD_RADAU5, adaptive) on the stabilised index-2 DAE [q, v, lambda, mu]
-!!   (conmech_constrained_dae): no drift and no projection; a constant mass matrix.
+!! - Radau IIA (METHOD_RADAU5, adaptive) on a DAE form of the equations (no drift, no
+!!   projection; any mass matrix M(t, q)): the stabilised index-2 (GGL) form [q, v,
+!!   lambda, mu] (options%dae_index = 2, the default; conmech_constrained_dae) or the
+!!   index-3 form [q, v, a, lambda] of the Bari test set (dae_index = 3;
+!!   conmech_constrained_index3), with the exact Jacobian where the system provides its
+!!   derivatives. Both need independent constraints: redundant constraints, or a singular
+!!   configuration at t0, are refused before the first step (as are RATTLE's).
+!! Every result holds the accelerations, multipliers and reaction forces at its outputs
+!! (conmech_constrained_result).
 !! A terminal event ends the run at the event state. The initial state is made consistent
 !! first (position then velocity projection; the distances moved are reported).
 module conmech_constrained_solver
@@ -37,7 +44,8 @@ module conmech_constrained_solver
     use conmech_constrained_system
     use conmech_constrained_result
     use conmech_constrained_ode, only: constrained_ode, projection_hook, consistent_initial
-    use conmech_constrained_dae, only: ggl_system, ggl_events, ggl_setup
+    use conmech_constrained_dae, only: ggl_system, dae_events, ggl_setup
+    use conmech_constrained_index3, only: index3_system, index3_setup
     use conmech_rattle_stepper, only: rattle_stepper
     implicit none
     private
@@ -86,6 +94,10 @@ contains
             msg = "bad input: every, proj_max_iter and proj_tol must be positive"
         else if (options%ode%method == METHOD_RATTLE .and. sys%n_nh /= 0) then
             msg = "bad input: RATTLE handles holonomic constraints only (n_nh = 0)"
+        else if (options%ode%method == METHOD_RADAU5 .and. options%dae_index /= 2 .and. &
+                 options%dae_index /= 3) then
+            msg = "bad input: dae_index must be 2 (the stabilised index-2 form) or 3 (the "// &
+                  "index-3 form) for Radau"
         else
             info = CM_SUCCESS
         end if
@@ -117,6 +129,18 @@ contains
             call empty_constrained_result(res, n, m, CM_BAD_INPUT, "bad input: the "// &
                                           "constraint Jacobian is zero at the initial "// &
                                           "state (rank 0): the constraints cannot be enforced")
+            return
+        end if
+        if (m > 0 .and. res%rank < m .and. (options%ode%method == METHOD_RADAU5 .or. &
+                                            options%ode%method == METHOD_RATTLE)) then
+            call empty_constrained_result(res, n, m, CM_BAD_INPUT, &
+                                          "bad input: "//method_label()//" needs "// &
+                                          "independent constraints, but at the initial "// &
+                                          "state their rank is "//itoa(res%rank)// &
+                                          " of "//itoa(m)//" (redundant constraints or "// &
+                                          "a singular configuration); the projected "// &
+                                          "methods (the default DOP853) handle it with "// &
+                                          "minimum-norm multipliers")
             return
         end if
 
@@ -186,32 +210,95 @@ contains
             call add_projections(rs%wk%nproj, rs%wk%proj_iter, rs%wk%proj_iter_max)
         end subroutine solve_rattle
 
-        !> Radau IIA on the stabilised index-2 form (its mass matrix checked constant).
+        !> Radau IIA on the index-2 (GGL) or the index-3 form.
         subroutine solve_dae()
-            type(ggl_system) :: g
-            type(ggl_events) :: gev
+            type(ggl_system) :: g2
+            type(index3_system) :: g3
+            type(dae_events) :: gev
             type(radau_stepper) :: rstp
             type(ode_options) :: opt
             type(ode_result) :: ores
-            real(dp), allocatable :: y0(:), mass0(:, :)
-            call ggl_setup(sys, t_span(1), q, v, lam, g, y0, mass0, rstp)
+            real(dp), allocatable :: y0(:)
             opt = options%ode
             opt%dense_output = .false.
             opt%save_steps = options%save_steps
             if (allocated(opt%rtol_vec)) deallocate (opt%rtol_vec)
             if (allocated(opt%atol_vec)) deallocate (opt%atol_vec)
+            if (options%dae_index == 3) then
+                call index3_setup(sys, q, v, acc, lam, g3, y0, rstp)
+            else
+                call ggl_setup(sys, t_span(1), q, v, lam, opt%rtol, opt%atol, g2, y0, rstp, &
+                               opt%rtol_vec, opt%atol_vec)
+            end if
             if (present(events)) then
                 allocate (gev%inner, source=events)
                 gev%n = n
                 if (allocated(events%direction)) gev%direction = events%direction
                 if (allocated(events%terminal)) gev%terminal = events%terminal
-                call ode_solve(g, t_span, y0, opt, ores, t_eval=t_eval, events=gev, &
-                               stepper=rstp)
+                if (options%dae_index == 3) then
+                    call ode_solve(g3, t_span, y0, opt, ores, t_eval=t_eval, events=gev, &
+                                   stepper=rstp)
+                else
+                    call ode_solve(g2, t_span, y0, opt, ores, t_eval=t_eval, events=gev, &
+                                   stepper=rstp)
+                end if
+            else if (options%dae_index == 3) then
+                call ode_solve(g3, t_span, y0, opt, ores, t_eval=t_eval, stepper=rstp)
             else
-                call ode_solve(g, t_span, y0, opt, ores, t_eval=t_eval, stepper=rstp)
+                call ode_solve(g2, t_span, y0, opt, ores, t_eval=t_eval, stepper=rstp)
             end if
-            call build_constrained_result(res, ores, sys, sys, mass0=mass0)
+            call build_constrained_result(res, ores, sys, sys)
+            call explain_newton_failure(rstp%t, rstp%y(1:2*n))
         end subroutine solve_dae
+
+        !> A Newton failure of Radau: say why when it can be seen. (1) The constraints
+        !! have become dependent where the run stopped (a singular configuration, e.g. a
+        !! parallelogram linkage passing its flat position): Radau IIA needs independent
+        !! constraints all along. (2) Tolerances near round-off: velocities of size |v|
+        !! carry a round-off of about eps |v| (more where they couple); a component that
+        !! crosses zero with atol far below it cannot converge.
+        subroutine explain_newton_failure(ts, y)
+            real(dp), intent(in) :: ts
+            real(dp), intent(in) :: y(:)
+            character(len=12) :: b1, b2
+            real(dp) :: a_s(n), l_s(m)
+            integer :: rk, inf_s
+            if (res%status /= CM_STEP_TOO_SMALL) return
+            if (index(res%message, "Newton") == 0) return
+            if (m > 0) then
+                call constrained_accel(sys, ts, y(1:n), y(n + 1:2*n), a_s, l_s, inf_s, &
+                                       rank=rk)
+                if (rk < m) then
+                    res%message = res%message//"; the constraints have become dependent "// &
+                                  "there (rank "//itoa(rk)//" of "//itoa(m)//": a "// &
+                                  "singular configuration), which Radau IIA cannot pass; "// &
+                                  "the projected methods (the default DOP853) can"
+                    return
+                end if
+            end if
+            if (options%ode%atol >= 1.0e3_dp*epsilon(1.0_dp)*maxval(abs(y))) return
+            write (b1, '(es9.2)') options%ode%atol
+            write (b2, '(es9.2)') maxval(abs(y))
+            res%message = res%message//"; atol ="//trim(b1)//" is near the round-off of "// &
+                          "a state of size"//trim(b2)//": a larger atol lets the Newton "// &
+                          "iteration converge"
+        end subroutine explain_newton_failure
+
+        !> An integer as text.
+        function itoa(k) result(text)
+            integer, intent(in) :: k
+            character(len=:), allocatable :: text
+            character(len=16) :: tmp
+            write (tmp, '(i0)') k
+            text = trim(tmp)
+        end function itoa
+
+        !> The method's name for messages.
+        function method_label() result(label)
+            character(len=:), allocatable :: label
+            label = "RATTLE"
+            if (options%ode%method == METHOD_RADAU5) label = "Radau IIA"
+        end function method_label
 
         !> The projections of the run, after those of the consistent start.
         subroutine add_projections(nproj, iters_run, iters_max)

@@ -48,7 +48,9 @@
 !!   is dropped) by the five-point fourth-order second difference, step
 !!   eps^(1/6) max(|q|, |t|, 1)/max(|v|, 1) (error ~ eps^(2/3), about 1e-10 relative);
 !! - `nh_gamma`: -d/ds [A v + b](t + s, q + s v) by the five-point fourth-order first
-!!   difference, step eps^(1/5) max(|q|, |t|, 1)/max(|v|, 1) (error ~ 1e-12 relative).
+!!   difference, step eps^(1/5) max(|q|, |t|, 1)/max(|v|, 1) (error ~ 1e-12 relative);
+!! - `forces_jacobian`, `constraint_hessian` (the exact Jacobian of Radau IIA on the
+!!   constrained equations): central differences (submodule conmech_constrained_derivatives).
 module conmech_constrained_system
     use conmech_kinds, only: dp
     use conmech_status
@@ -68,6 +70,7 @@ module conmech_constrained_system
     !> The finite-difference defaults, for extensions that choose at run time (e.g. the
     !! Python layer) whether an analytic Jacobian / acceleration term exists.
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
+    public :: fd_forces_jacobian, fd_constraint_hessian
 
     interface fd_phi_jac
         module procedure cs_fd_phi_jac
@@ -81,6 +84,12 @@ module conmech_constrained_system
     interface fd_nh_gamma
         module procedure cs_fd_nh_gamma
     end interface fd_nh_gamma
+    interface fd_forces_jacobian
+        module procedure cs_fd_forces_jacobian
+    end interface fd_forces_jacobian
+    interface fd_constraint_hessian
+        module procedure cs_fd_constraint_hessian
+    end interface fd_constraint_hessian
 
     type, abstract :: constrained_system
         integer :: n = 0             !! number of (excessive) coordinates
@@ -109,6 +118,10 @@ module conmech_constrained_system
         procedure :: nh_matrix_band => cs_nh_matrix_band
         procedure :: energy => cs_no_energy
         procedure :: has_energy => cs_has_no_energy
+        procedure :: forces_jacobian => cs_fd_forces_jacobian
+        procedure :: has_forces_jacobian => cs_has_no_forces_jacobian
+        procedure :: constraint_hessian => cs_fd_constraint_hessian
+        procedure :: has_constraint_hessian => cs_has_no_constraint_hessian
     end type constrained_system
 
     abstract interface
@@ -174,6 +187,37 @@ module conmech_constrained_system
             integer, intent(out) :: info
             character(len=:), allocatable, intent(out) :: msg
         end subroutine project_velocity
+    end interface
+
+    ! Derivatives for implicit integrators (submodule conmech_constrained_derivatives):
+    ! the defaults are central differences; compiled systems override them.
+    interface
+        !> r = [dQ/dq - d(M a)/dq, dQ/dv] at (t, q, v) with a held fixed (n x 2n): the
+        !! Jacobian of the force balance M(q) a - Q(t, q, v). Default: central differences
+        !! of `forces` and `mass` (steps eps^(1/3) max(|x_j|, 1)).
+        module subroutine cs_fd_forces_jacobian(self, t, q, v, a, r)
+            class(constrained_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:), a(:)
+            real(dp), intent(out) :: r(:, :)
+        end subroutine cs_fd_forces_jacobian
+        !> The second derivatives of the constraints that a Newton iteration on the
+        !! constrained equations needs, at (t, q, v) and multipliers lam (n_hol + n_nh):
+        !! hl = d(C^T lam)/dq (n x n) and hv = d(C v + c0)/dq ((n_hol + n_nh) x n).
+        !! Default: central differences of the constraint matrix and offset.
+        module subroutine cs_fd_constraint_hessian(self, t, q, v, lam, hl, hv)
+            class(constrained_system), intent(in) :: self
+            real(dp), intent(in) :: t
+            real(dp), intent(in) :: q(:), v(:), lam(:)
+            real(dp), intent(out) :: hl(:, :), hv(:, :)
+        end subroutine cs_fd_constraint_hessian
+        !> The defaults are finite differences.
+        module logical function cs_has_no_forces_jacobian(self)
+            class(constrained_system), intent(in) :: self
+        end function cs_has_no_forces_jacobian
+        module logical function cs_has_no_constraint_hessian(self)
+            class(constrained_system), intent(in) :: self
+        end function cs_has_no_constraint_hessian
     end interface
 
     ! The banded paths (submodule conmech_constrained_system_band). Each sets ok = .false.

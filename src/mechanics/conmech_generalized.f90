@@ -19,6 +19,10 @@
 !! articulated-body algorithm, O(n) without a matrix) overrides `accelerations` and
 !! `has_accelerations`; `generalized_accel` (and with it the right-hand side) then calls it
 !! instead of `mass_forces` and the Cholesky solve, and checks that the result is finite.
+!! A system that also computes the Jacobian of its accelerations d a/d[q, v] directly
+!! (e.g. from the derivatives of the recursive algorithms with a tree-sparse
+!! factorisation) overrides `accelerations_jacobian` and `has_accelerations_jacobian`; the
+!! Jacobian of the first-order form then uses it, with no factorisation of M.
 module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
@@ -48,6 +52,8 @@ module conmech_generalized
         procedure :: has_forces_jacobian => gen_has_no_forces_jacobian
         procedure :: accelerations => gen_no_accelerations
         procedure :: has_accelerations => gen_has_no_accelerations
+        procedure :: accelerations_jacobian => gen_no_accelerations_jacobian
+        procedure :: has_accelerations_jacobian => gen_has_no_accelerations_jacobian
     end type generalized_system
 
     abstract interface
@@ -126,6 +132,23 @@ contains
         class(generalized_system), intent(in) :: self
         gen_has_no_accelerations = .false.
     end function gen_has_no_accelerations
+
+    !> The accelerations a and their Jacobian jac = d a/d[q, v] (ndof x 2 ndof) computed
+    !! directly, optional (`has_accelerations_jacobian`). The default is not defined (zeros;
+    !! the Jacobian then comes from `forces_jacobian` and a Cholesky factorisation of M).
+    subroutine gen_no_accelerations_jacobian(self, t, q, v, a, jac)
+        class(generalized_system), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp), intent(out) :: a(:), jac(:, :)
+        a = 0.0_dp
+        jac = 0.0_dp
+    end subroutine gen_no_accelerations_jacobian
+
+    logical function gen_has_no_accelerations_jacobian(self)
+        class(generalized_system), intent(in) :: self
+        gen_has_no_accelerations_jacobian = .false.
+    end function gen_has_no_accelerations_jacobian
 
     !> mm = M(t, q) and f = Q(t, q, v) in one call (what the right-hand side needs). The
     !! default calls `mass` and `forces`; a system that computes both faster together
@@ -284,7 +307,8 @@ contains
         if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine genode_rhs
 
-    !> Jacobian of y' = [v, M^{-1} Q]: exact when the system has `forces_jacobian`
+    !> Jacobian of y' = [v, M^{-1} Q]: exact when the system has
+    !! `accelerations_jacobian` ([0 I; d a/d[q, v]] directly) or `forces_jacobian`
     !! ([0 I; M^{-1} r], one Cholesky of M), else central differences.
     subroutine genode_jacobian(self, t, y, dfdy)
         class(generalized_ode), intent(in) :: self
@@ -294,6 +318,16 @@ contains
         real(dp) :: mm(self%mech%ndof, self%mech%ndof), a(self%mech%ndof)
         real(dp) :: r(self%mech%ndof, 2*self%mech%ndof)
         integer :: n, info, j
+        if (self%mech%has_accelerations_jacobian()) then
+            n = self%mech%ndof
+            dfdy = 0.0_dp
+            do j = 1, n
+                dfdy(j, n + j) = 1.0_dp
+            end do
+            call self%mech%accelerations_jacobian(t, y(1:n), y(n + 1:2*n), a, r)
+            dfdy(n + 1:2*n, :) = r
+            return
+        end if
         if (.not. self%mech%has_forces_jacobian()) then
             call ode_fd_jacobian(self, t, y, dfdy)
             return
@@ -318,7 +352,8 @@ contains
 
     logical function genode_has_jacobian(self)
         class(generalized_ode), intent(in) :: self
-        genode_has_jacobian = self%mech%has_forces_jacobian()
+        genode_has_jacobian = self%mech%has_forces_jacobian() &
+                              .or. self%mech%has_accelerations_jacobian()
     end function genode_has_jacobian
 
     !> Solve M q'' = Q from (q0, v0) on t_span with `ode_solve`; res%y = [q; v] (events

@@ -4,7 +4,8 @@
 !!   or the points of t_eval, from the stepper's continuous extension (or, in hit mode,
 !!   options%hit_t_eval, at step ends that land on them);
 !! - events located on the continuous extension (conmech_ode_event_locate), in time order,
-!!   a terminal one ending the run at its state (status CM_EVENT_STOP);
+!!   a terminal one ending the run at its state (status CM_EVENT_STOP); an event with a
+!!   `resolution` is also sampled inside each step, so that no two crossings cancel;
 !! - the step hook (`ode_step_hook`: after every accepted step, and at every event state),
 !!   which may change y (a projection onto a manifold), count or stop the run;
 !! - the dense solution (options%dense_output): the steps' polynomials, segment by segment;
@@ -19,7 +20,7 @@ module conmech_ode_driver
     use conmech_ode_dense, only: dense_init, dense_push
     use conmech_ode_result, only: ode_result, push_point, shrink_result
     use conmech_ode_stepper, only: ode_stepper, check_t_eval
-    use conmech_ode_event_locate, only: find_events
+    use conmech_ode_event_locate, only: find_events, check_events
     implicit none
     private
     public :: ode_drive
@@ -63,16 +64,12 @@ contains
             if (info /= CM_SUCCESS) return
         end if
         if (has_events) then
-            info = CM_BAD_INPUT
-            if (.not. allocated(events%terminal)) then
-                msg = "bad input: events%terminal must be allocated"
-                return
-            else if (size(events%terminal) /= size(events%direction)) then
-                msg = "bad input: events%terminal and events%direction differ in size"
-                return
-            end if
+            call check_events(events, info, msg)
+            if (info /= CM_SUCCESS) return
         end if
-        call stp%init(t0, tf, y, opt, info, msg)
+        ! tf may be infinite (SciPy's t_span = [t0, inf]): the run ends at a terminal
+        ! event, a hook's stop, or max_steps; fixed-step methods refuse it in their setup
+        call stp%init(t0, tf, y, opt, info, msg, allow_inf=.true.)
         if (info /= CM_SUCCESS) return
         if (present(res)) then
             if (.not. allocated(res%t)) allocate (res%t(0), res%y(n, 0))

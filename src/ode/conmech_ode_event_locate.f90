@@ -1,19 +1,60 @@
 !> Event location on the last step of any stepper: sign changes of the event functions
-!! between the step's ends (with each event's direction), each root found by Brent's method
-!! on the step's continuous extension (`eval_unit`, to near machine precision in t),
-!! reported in the order of time up to the first terminal one.
+!! (with each event's direction), each root found by Brent's method on the step's
+!! continuous extension (`eval_unit`, to near machine precision in t), reported in the
+!! order of time up to the first terminal one.
+!!
+!! By default an event is compared at the step's two ends only (SciPy's rule): one sign
+!! change per step and event, so two crossings inside one step cancel and are missed. An
+!! event with a `resolution` r > 0 (conmech_ode_system) is also sampled on the continuous
+!! extension at m - 1 interior points x = k/m, m = ceiling(|h|/r): every sign change
+!! between consecutive samples is located, so crossings more than r apart are all found.
+!! The samples cost event evaluations and evaluations of the extension, no evaluation of
+!! f and no change of the steps.
 module conmech_ode_event_locate
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
+    use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_events, ode_step_hook
     use conmech_ode_result, only: ode_result, push_event
     use conmech_ode_stepper, only: ode_stepper
     use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
-    public :: find_events
+    public :: find_events, check_events
+
+    !> the largest count of sub-intervals of one step (half the int64 range)
+    integer(int64), parameter :: M_MAX = ishft(huge(1_int64), -1)
 
 contains
+
+    !> Check the event settings: terminal and direction allocated with one entry per
+    !! event, resolution (if allocated) as many entries, each >= 0 and not NaN.
+    subroutine check_events(events, info, msg)
+        class(ode_events), intent(in) :: events
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        if (.not. allocated(events%terminal)) then
+            msg = "bad input: events%terminal must be allocated"
+        else if (size(events%terminal) /= size(events%direction)) then
+            msg = "bad input: events%terminal and events%direction differ in size"
+        else if (.not. resolution_ok()) then
+            msg = "bad input: events%resolution must have one entry per event, each >= 0"
+        else
+            info = CM_SUCCESS
+            msg = "success"
+        end if
+    contains
+        logical function resolution_ok()
+            resolution_ok = .true.
+            if (.not. allocated(events%resolution)) return
+            resolution_ok = size(events%resolution) == size(events%direction)
+            if (.not. resolution_ok) return
+            resolution_ok = .not. (any(ieee_is_nan(events%resolution)) .or. &
+                                   any(events%resolution < 0.0_dp))
+        end function resolution_ok
+    end subroutine check_events
 
     !> Locate the zero crossings of the event functions in the accepted step of stp
     !! (g_old: the functions at its start, updated to its end). Each event state is passed
@@ -32,37 +73,39 @@ contains
         character(len=:), allocatable, intent(inout) :: msg
         type(ode_result), intent(inout), optional :: res
         class(ode_step_hook), intent(inout), optional :: hook
-        real(dp) :: g_new(size(g_old)), ev_times(size(g_old)), ye(stp%n), posneg, te
-        integer :: ev_ids(size(g_old)), ne, ie, iev
-        integer :: i, j, nfound, order(size(g_old))
-        real(dp) :: tmin
-        logical :: cross
+        real(dp) :: g_new(size(g_old)), ye(stp%n), posneg, te, tmin
+        real(dp), allocatable :: ev_times(:)
+        integer, allocatable :: ev_ids(:), order(:)
+        integer :: ne, ie, iev, i, j, nfound
+        integer(int64) :: m
         info = CM_SUCCESS
         ne = size(g_old)
         posneg = stp%posneg
-        call events%eval(stp%t, stp%y, g_new)
         nfound = 0
+        ! the end first: the first call after t0 is always g at the first step's end
+        call events%eval(stp%t, stp%y, g_new)
+        m = sample_count(stp, events)
+        if (m > 1) then
+            call sampled_crossings(stp, events, m, g_old, g_new, ev_times, ev_ids, nfound, &
+                                   info, msg)
+            if (info /= CM_SUCCESS) return
+        end if
         do i = 1, ne
-            cross = .false.
-            if (g_old(i) < 0.0_dp .and. g_new(i) >= 0.0_dp .and. &
-                events%direction(i) >= 0) cross = .true.
-            if (g_old(i) > 0.0_dp .and. g_new(i) <= 0.0_dp .and. &
-                events%direction(i) <= 0) cross = .true.
-            if (cross) then
-                nfound = nfound + 1
-                ev_ids(nfound) = i
-                if (g_new(i) == 0.0_dp) then
-                    ev_times(nfound) = stp%t
-                else
-                    ev_times(nfound) = event_root(stp, events, i, g_old(i), g_new(i), info, &
-                                                  msg)
-                    if (info /= CM_SUCCESS) return
-                end if
+            if (m > 1 .and. resolved(events, i)) cycle
+            if (.not. crossing(g_old(i), g_new(i), events%direction(i))) cycle
+            if (g_new(i) == 0.0_dp) then
+                te = stp%t
+            else
+                te = event_root(stp, events, i, g_old(i), g_new(i), 0.0_dp, 1.0_dp, info, &
+                                msg)
+                if (info /= CM_SUCCESS) return
             end if
+            call add_root(ev_times, ev_ids, nfound, te, i)
         end do
         g_old = g_new
         if (nfound == 0) return
         ! order by time in the direction of integration (insertion sort, few events)
+        allocate (order(nfound))
         do i = 1, nfound
             order(i) = i
         end do
@@ -105,26 +148,131 @@ contains
         end do
     end subroutine find_events
 
-    !> Root of event ie on the continuous extension of the step (Brent's method in
-    !! x = (s - t_old)/h_done).
-    function event_root(stp, events, ie, ga, gb, info, msg) result(root)
+    !> A crossing from ga to gb that counts for an event of direction dir (SciPy's rule:
+    !! from strictly negative to >= 0 rising, from strictly positive to <= 0 falling).
+    pure logical function crossing(ga, gb, dir)
+        real(dp), intent(in) :: ga, gb
+        integer, intent(in) :: dir
+        crossing = (ga < 0.0_dp .and. gb >= 0.0_dp .and. dir >= 0) .or. &
+                   (ga > 0.0_dp .and. gb <= 0.0_dp .and. dir <= 0)
+    end function crossing
+
+    !> Whether event i is sampled inside the steps (a positive resolution).
+    pure logical function resolved(events, i)
+        class(ode_events), intent(in) :: events
+        integer, intent(in) :: i
+        resolved = .false.
+        if (allocated(events%resolution)) resolved = events%resolution(i) > 0.0_dp
+    end function resolved
+
+    !> Number of sub-intervals of the last step: ceiling(|h|/r) for the finest positive
+    !! resolution r (1: the step's ends only).
+    integer(int64) function sample_count(stp, events) result(m)
+        class(ode_stepper), intent(in) :: stp
+        class(ode_events), intent(in) :: events
+        real(dp) :: r, q
+        m = 1
+        if (.not. allocated(events%resolution)) return
+        r = minval(events%resolution, mask=events%resolution > 0.0_dp)
+        if (.not. (r > 0.0_dp .and. r < huge(1.0_dp))) return
+        q = abs(stp%h_done)/r
+        if (.not. q > 1.0_dp) return
+        if (q >= real(M_MAX, dp)) then
+            m = M_MAX
+        else
+            m = ceiling(q, int64)
+        end if
+    end function sample_count
+
+    !> The crossings of the resolved events between the m + 1 samples x = k/m of the
+    !! step's continuous extension (g_old at x = 0, g_new at x = 1), appended to
+    !! (ev_times, ev_ids).
+    subroutine sampled_crossings(stp, events, m, g_old, g_new, ev_times, ev_ids, nfound, &
+                                 info, msg)
+        class(ode_stepper), intent(inout) :: stp
+        class(ode_events), intent(in) :: events
+        integer(int64), intent(in) :: m
+        real(dp), intent(in) :: g_old(:), g_new(:)
+        real(dp), allocatable, intent(inout) :: ev_times(:)
+        integer, allocatable, intent(inout) :: ev_ids(:)
+        integer, intent(inout) :: nfound
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(inout) :: msg
+        real(dp) :: ga(size(g_old)), gb(size(g_old)), ye(stp%n), xa, xb, te
+        integer(int64) :: k
+        integer :: i
+        info = CM_SUCCESS
+        ga = g_old
+        xa = 0.0_dp
+        do k = 1, m
+            if (k < m) then
+                xb = real(k, dp)/real(m, dp)
+                call stp%eval_unit(xb, ye, info, msg)
+                if (info /= CM_SUCCESS) return
+                call events%eval(stp%t_old + xb*stp%h_done, ye, gb)
+            else
+                xb = 1.0_dp
+                gb = g_new
+            end if
+            do i = 1, size(g_old)
+                if (.not. resolved(events, i)) cycle
+                if (.not. crossing(ga(i), gb(i), events%direction(i))) cycle
+                if (k == m .and. gb(i) == 0.0_dp) then
+                    te = stp%t
+                else
+                    te = event_root(stp, events, i, ga(i), gb(i), xa, xb, info, msg)
+                    if (info /= CM_SUCCESS) return
+                end if
+                call add_root(ev_times, ev_ids, nfound, te, i)
+            end do
+            ga = gb
+            xa = xb
+        end do
+    end subroutine sampled_crossings
+
+    !> Append the root (te, i), growing the arrays by doubling.
+    pure subroutine add_root(ev_times, ev_ids, nfound, te, i)
+        real(dp), allocatable, intent(inout) :: ev_times(:)
+        integer, allocatable, intent(inout) :: ev_ids(:)
+        integer, intent(inout) :: nfound
+        real(dp), intent(in) :: te
+        integer, intent(in) :: i
+        real(dp), allocatable :: tt(:)
+        integer, allocatable :: ii(:)
+        if (.not. allocated(ev_times)) allocate (ev_times(4), ev_ids(4))
+        if (nfound == size(ev_times)) then
+            allocate (tt(2*nfound), ii(2*nfound))
+            tt(1:nfound) = ev_times
+            ii(1:nfound) = ev_ids
+            call move_alloc(tt, ev_times)
+            call move_alloc(ii, ev_ids)
+        end if
+        nfound = nfound + 1
+        ev_times(nfound) = te
+        ev_ids(nfound) = i
+    end subroutine add_root
+
+    !> Root of event ie between x = xa and x = xb of the step's continuous extension
+    !! (Brent's method on [xa, xb], ga and gb the event there).
+    function event_root(stp, events, ie, ga, gb, xa, xb, info, msg) result(root)
         class(ode_stepper), intent(inout) :: stp
         class(ode_events), intent(in) :: events
         integer, intent(in) :: ie
-        real(dp), intent(in) :: ga, gb
+        real(dp), intent(in) :: ga, gb, xa, xb
         integer, intent(out) :: info
         character(len=:), allocatable, intent(inout) :: msg
         real(dp) :: root
         type(brent_state) :: bs
         logical :: done
         integer :: it
-        real(dp) :: gv(size(events%direction)), ye(stp%n)
+        real(dp) :: gv(size(events%direction)), ye(stp%n), w
         info = CM_SUCCESS
-        call brent_init(bs, ga, gb, stp%t_old, stp%h_done)
+        w = xb - xa
+        call brent_init(bs, ga, gb, stp%t_old + xa*stp%h_done, w*stp%h_done)
         do it = 1, 200
             call brent_step(bs, done)
             if (done) exit
-            call stp%eval_unit(bs%b, ye, info, msg)
+            call stp%eval_unit(xa + bs%b*w, ye, info, msg)
             if (info /= CM_SUCCESS) exit
             call events%eval(bs%t + bs%b*bs%h, ye, gv)
             call brent_take(bs, gv(ie))

@@ -34,18 +34,20 @@
 !! walks through it.
 !! Everything is in the object: distinct steppers may run in distinct threads.
 module conmech_ode_stepper
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan, ieee_next_after
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, ode_stats
     use conmech_ode_dense, only: FORM_HAIRER, FORM_POWER, interp
-    use conmech_state_packer, only: state_packer, packer_write, packer_ready, packer_read
+    use conmech_state_packer, only: state_packer, packer_write, packer_ready, &
+        packer_attach_read, packer_attach_write
     implicit none
     private
 
     public :: ode_stepper, check_interval, check_first_step, tolerance_vectors, check_t_eval
-    public :: stepper_pack, stepper_unpack, stepper_init
+    public :: stepper_pack, stepper_pack_into, stepper_unpack, stepper_init, min_step_at
+    public :: MSG_STEP_TOO_SMALL
     public :: FORM_HAIRER, FORM_POWER
 
     !> Fixed positions of the common part of a packed state (1-based): reals r(PACK_R_*),
@@ -57,6 +59,13 @@ module conmech_ode_stepper
         PACK_I_FORM = 4, PACK_I_NFEV = 5, PACK_I_NJEV = 6, PACK_I_NLU = 7, &
         PACK_I_NACCEPT = 8, PACK_I_NREJECT = 9, PACK_I_LAST = 10
     integer, parameter, public :: PACK_W_Y = 1, PACK_W_YOLD = 2, PACK_W_FC = 3
+
+    character(len=*), parameter :: MSG_NOT_STARTED = "bad input: the packed state was "// &
+        "not started for this method (action 0 first) or has the wrong size"
+
+    !> The failure of an adaptive step below `min_step_at` (followed by the time).
+    character(len=*), parameter :: MSG_STEP_TOO_SMALL = "step size too small (the "// &
+        "required step size is less than 10 spacings between numbers) at t ="
 
     !> The state every stepper has, and the contract of its procedures.
     type, abstract :: ode_stepper
@@ -302,25 +311,50 @@ contains
         call stp%transfer_state(p)          ! write
     end subroutine stepper_pack
 
-    !> Rebuild stp from a state packed by `stepper_pack` for `method`; CM_BAD_INPUT when
-    !! (r, iv, w) does not hold a started state of this method and dimension.
+    !> Pack the whole state of stp into the caller's arrays in place (no count pass, no
+    !! allocation): sizes = [nr, ni, nw] of the state; info = CM_BAD_INPUT when it does not
+    !! fit (sizes are then what it needs, the arrays partly written).
+    subroutine stepper_pack_into(stp, r, iv, w, sizes, info)
+        class(ode_stepper), intent(inout) :: stp
+        real(dp), intent(inout), target, contiguous :: r(:)
+        integer, intent(inout), target, contiguous :: iv(:)
+        real(dp), intent(inout), target, contiguous :: w(:, :)
+        integer, intent(out) :: sizes(3)
+        integer, intent(out) :: info
+        type(state_packer) :: p
+        call packer_attach_write(p, r, iv, w)
+        call stp%transfer_state(p)
+        sizes = [p%nr, p%ni, p%nw]
+        info = p%info
+    end subroutine stepper_pack_into
+
+    !> Rebuild stp from a state packed by `stepper_pack` (or `stepper_pack_into`) for
+    !! `method`, read in place; CM_BAD_INPUT when (r, iv, w) does not hold a started state
+    !! of this method and dimension.
     subroutine stepper_unpack(stp, method, r, iv, w, info, msg)
         class(ode_stepper), intent(inout) :: stp
         integer, intent(in) :: method
-        real(dp), intent(in) :: r(:)
-        integer, intent(in) :: iv(:)
-        real(dp), intent(in) :: w(:, :)
+        real(dp), intent(in), target, contiguous :: r(:)
+        integer, intent(in), target, contiguous :: iv(:)
+        real(dp), intent(in), target, contiguous :: w(:, :)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         type(state_packer) :: p
         info = CM_BAD_INPUT
-        msg = "bad input: the packed state was not started for this method (action 0 "// &
-              "first) or has the wrong size"
-        if (size(iv) < PACK_I_LAST .or. size(w, 2) < PACK_W_FC) return
-        if (iv(PACK_I_METHOD) /= method .or. iv(PACK_I_N) /= size(w, 1)) return
-        call packer_read(p, r, iv, w)
+        if (size(iv) < PACK_I_LAST .or. size(w, 2) < PACK_W_FC) then
+            msg = MSG_NOT_STARTED
+            return
+        end if
+        if (iv(PACK_I_METHOD) /= method .or. iv(PACK_I_N) /= size(w, 1)) then
+            msg = MSG_NOT_STARTED
+            return
+        end if
+        call packer_attach_read(p, r, iv, w)
         call stp%transfer_state(p)
-        if (p%info /= CM_SUCCESS) return
+        if (p%info /= CM_SUCCESS) then
+            msg = MSG_NOT_STARTED
+            return
+        end if
         info = CM_SUCCESS
         msg = "success"
     end subroutine stepper_unpack
@@ -438,6 +472,15 @@ contains
         info = CM_SUCCESS
         msg = "success"
     end subroutine tolerance_vectors
+
+    !> The smallest step of the adaptive methods at t in the direction posneg: 10 times the
+    !! distance from t to the next double that way (SciPy's OdeSolver min_step). A step
+    !! proposed below it by the step control is raised to it once (SciPy's rule); an
+    !! attempt below it (after rejections, or a max_step below it) ends the run.
+    elemental real(dp) function min_step_at(t, posneg) result(hmin)
+        real(dp), intent(in) :: t, posneg
+        hmin = 10.0_dp*abs(ieee_next_after(t, posneg*huge(1.0_dp)) - t)
+    end function min_step_at
 
     !> Check t_eval: finite, inside t_span, sorted in the direction of integration.
     subroutine check_t_eval(t0, tf, t_eval, info, msg)

@@ -26,7 +26,10 @@
 !!
 !! Events are an extension of `ode_events`: `eval` fills g(1:n_events) at (t, y); the
 !! components `direction` (+1 rising only, -1 falling only, 0 both) and `terminal` say which
-!! zero crossings count and which stop the integration.
+!! zero crossings count and which stop the integration. The optional `resolution` sets, per
+!! event, the largest spacing in t at which the event is sampled on each step's continuous
+!! extension (0 or unallocated: only at the step's ends, SciPy's rule, which misses two
+!! crossings inside one step).
 module conmech_ode_system
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
@@ -87,6 +90,10 @@ module conmech_ode_system
     type, abstract :: ode_events
         integer, allocatable :: direction(:)   !! +1 rising, -1 falling, 0 both
         logical, allocatable :: terminal(:)    !! stop the integration at this event
+        !> largest spacing in t of the samples of the event on each step's continuous
+        !! extension, so that crossings farther apart than it are told apart (0 or
+        !! unallocated: the step's ends only, SciPy's rule)
+        real(dp), allocatable :: resolution(:)
     contains
         procedure(event_eval), deferred :: eval
         procedure :: n_events => events_count

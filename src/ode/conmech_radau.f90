@@ -1,6 +1,7 @@
 !> Radau IIA with a mass matrix through the one driver loop: `radau_solve`, the entry for
 !! M y' = f(t, y) with a constant, possibly singular M (differential-algebraic systems of
-!! index 1 and 2; the index-2 components get their error scaled by h, as RADAU5's NIND2).
+!! index up to 3; the error of index-k components is weighted by |h|^(k-1), as RADAU5's
+!! NIND2 and NIND3).
 !! Without M it is `ode_solve` with METHOD_RADAU5. The method itself: conmech_radau_stepper.
 module conmech_radau
     use conmech_kinds, only: dp
@@ -20,7 +21,7 @@ contains
     !! outputs as `ode_solve` (every accepted step, or t_eval interpolated on the collocation
     !! polynomial; dense output; events). res%stats counts nfev, njev, nlu, naccept,
     !! nreject.
-    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events, mass, index2)
+    subroutine radau_solve(sys, t_span, y0, opt, res, t_eval, events, mass, index2, dae_index)
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t_span(2)
         real(dp), intent(in) :: y0(:)
@@ -32,10 +33,13 @@ contains
         real(dp), intent(in), optional :: mass(:, :)
         !> the index-2 algebraic components (their error is scaled by h, as RADAU5)
         logical, intent(in), optional :: index2(:)
+        !> the index (1, 2 or 3) of every component (instead of index2)
+        integer, intent(in), optional :: dae_index(:)
         type(radau_stepper) :: stp
         type(ode_options) :: o
         if (present(mass)) stp%mass = mass
         if (present(index2)) stp%index2 = index2
+        if (present(dae_index)) stp%dae_index = dae_index
         o = opt
         o%method = METHOD_RADAU5
         call ode_solve(sys, t_span, y0, o, res, t_eval, events, stepper=stp)

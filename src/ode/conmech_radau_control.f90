@@ -104,16 +104,20 @@ contains
     !! QUOT1 <= hnew/h <= QUOT2.
     subroutine radau_next_step(s)
         type(radau_stepper), intent(inout) :: s
+        s%h_capped = abs(s%hnew) > s%hmax
         s%hnew = s%posneg*min(abs(s%hnew), s%hmax)
         if (s%reject) s%hnew = s%posneg*min(abs(s%hnew), abs(s%h))
         s%reject = .false.
-        s%need_jac = s%newt > 2 .and. s%theta > THET
+        ! a constant Jacobian is never re-evaluated (SciPy keeps the LU then as well)
+        s%need_jac = s%newt > 2 .and. s%theta > THET .and. .not. s%jstruct%constant
         if ((s%t + s%hnew - s%tf)*s%posneg >= 0.0_dp) then
             s%h = s%tf - s%t
             s%final_step = .true.
             s%need_lu = .true.
         else
-            if (.not. s%need_jac .and. s%hnew/s%h >= QUOT1 .and. s%hnew/s%h <= QUOT2) then
+            ! (h is kept only within hmax: a step raised to the smallest one may exceed it)
+            if (.not. s%need_jac .and. s%hnew/s%h >= QUOT1 .and. s%hnew/s%h <= QUOT2 .and. &
+                abs(s%h) <= s%hmax) then
                 s%need_lu = .false.
             else
                 s%h = s%hnew

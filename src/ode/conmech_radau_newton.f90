@@ -29,16 +29,24 @@ contains
         stats%nfev = stats%nfev + 1
     end subroutine radau_rhs
 
-    !> s%jac = df/dy at (s%t, s%y): the system's `jacobian` if it has one, else forward
-    !! differences with steps sqrt(eps max(1e-5, |y_j|)) (n evaluations; s%f0 = f(t, y)).
+    !> s%jac = df/dy at (s%t, s%y): the system's `jacobian` if it has one (a constant one,
+    !! s%jstruct%constant, is read and not counted in njev: SciPy's count), else forward
+    !! differences with steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, or one per group
+    !! of columns with a sparsity pattern; s%f0 = f(t, y)).
     subroutine radau_jacobian(s, sys)
         type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
         real(dp) :: delt, ysafe
         integer :: jj
-        s%st%njev = s%st%njev + 1
         if (sys%has_jacobian()) then
+            if (.not. s%jstruct%constant) s%st%njev = s%st%njev + 1
             call sys%jacobian(s%t, s%y, s%jac)
+            return
+        end if
+        s%st%njev = s%st%njev + 1
+        if (s%jstruct%grouped()) then
+            call s%jstruct%fd_jacobian(sys, s%t, s%y, s%f0, s%uround, s%jac, s%a2, s%a1, &
+                                       s%st%nfev)
             return
         end if
         do jj = 1, s%n

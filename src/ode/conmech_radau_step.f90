@@ -4,7 +4,8 @@
 !! control modules can work on the stepper's type.
 submodule(conmech_radau_stepper) conmech_radau_step
     use conmech_status
-    use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER
+    use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER, &
+        min_step_at, MSG_STEP_TOO_SMALL
     use conmech_radau_coefficients, only: NIT, THET
     use conmech_radau_collocation, only: radau_collocation_update
     use conmech_radau_newton, only: radau_rhs, radau_jacobian, radau_decompose, radau_newton
@@ -33,6 +34,21 @@ contains
             if (size(self%index2) /= n) then
                 msg = "bad input: index2 must have n elements"
                 return
+            end if
+        end if
+        if (allocated(self%dae_index)) then
+            if (size(self%dae_index) /= n) then
+                msg = "bad input: dae_index must have n elements"
+                return
+            else if (any(self%dae_index < 1 .or. self%dae_index > 3)) then
+                msg = "bad input: dae_index values must be 1, 2 or 3"
+                return
+            end if
+        else if (allocated(self%mass)) then
+            allocate (self%dae_index(n))
+            self%dae_index = 1
+            if (allocated(self%index2)) then
+                where (self%index2) self%dae_index = 2
             end if
         end if
         call tolerance_vectors(opt, n, self%rtolv, self%atolv, info, msg)
@@ -73,6 +89,7 @@ contains
         self%newton_failed = .false.
         self%f_ok = .true.
         self%final_step = .false.
+        self%h_capped = .false.
         self%faccon = 1.0_dp
         self%theta = THET
         self%hacc = 0.0_dp
@@ -108,21 +125,37 @@ contains
     !> Attempt steps until one is accepted (RADAU5's loop; `target` other than tf is not
     !! used: the step control decides, and the last step lands on tf).
     module procedure radau_step
-        real(dp) :: quot
+        real(dp) :: quot, hmin
         integer :: lainfo
+        logical :: first_try
         character(len=32) :: buf
 
         info = CM_SUCCESS
         if (self%f_stale) call self%refresh_f(sys)
+        first_try = .true.
         do
-            if (0.1_dp*abs(self%h) <= abs(self%t)*self%uround .or. &
+            ! SciPy's smallest step (below 10 eps |t|: the cheap test first); a proposed
+            ! step below it is raised to it once, an attempt below it ends the run
+            if (abs(self%h) <= 10.0_dp*self%uround*abs(self%t) .or. &
                 abs(self%h) < tiny(1.0_dp)) then
-                write (buf, '(es14.6)') self%t
-                info = CM_STEP_TOO_SMALL
-                msg = "step size too small at t ="//trim(buf)
-                if (self%newton_failed) msg = msg//" (the Newton iteration did not converge)"
-                return
+                hmin = min_step_at(self%t, self%posneg)
+                if (first_try .and. .not. self%h_capped .and. abs(self%h) < hmin .and. &
+                    abs(self%h) >= tiny(1.0_dp)) then
+                    ! raised, then cut at tf (a last step may be shorter, as SciPy's)
+                    self%h = self%posneg*hmin
+                    self%final_step = (self%t + self%h - self%tf)*self%posneg >= 0.0_dp
+                    if (self%final_step) self%h = self%tf - self%t
+                    self%need_lu = .true.
+                else if (abs(self%h) < hmin .or. abs(self%h) < tiny(1.0_dp)) then
+                    write (buf, '(es14.6)') self%t
+                    info = CM_STEP_TOO_SMALL
+                    msg = MSG_STEP_TOO_SMALL//trim(buf)
+                    if (self%newton_failed) msg = msg//" (the Newton iteration did not "// &
+                                                  "converge)"
+                    return
+                end if
             end if
+            first_try = .false.
             if (self%nsteps >= self%max_steps) then
                 write (buf, '(es14.6)') self%t
                 info = CM_TOO_MANY_STEPS
@@ -162,8 +195,9 @@ contains
             end if
             self%nsteps = self%nsteps + 1
             self%scal = self%scal0
-            if (allocated(self%index2)) then
-                where (self%index2) self%scal = self%scal0/abs(self%h)
+            if (allocated(self%dae_index)) then
+                where (self%dae_index == 2) self%scal = self%scal0/abs(self%h)
+                where (self%dae_index == 3) self%scal = self%scal0/self%h**2
             end if
 
             call radau_newton(self, sys)
@@ -218,7 +252,7 @@ contains
             self%t = self%t + self%h
         end if
         self%y = self%y + self%z3
-        self%caljac = .false.
+        self%caljac = self%jstruct%constant
         if (self%last) return
         call radau_next_step(self)
         ! f(t, y) and the scale of the next step: by refresh_f, after the driver's outputs

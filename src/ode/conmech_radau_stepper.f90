@@ -27,7 +27,12 @@
 !!   order 3, unless first_step is given.
 !! - Jacobian: the system's analytic `jacobian` if `has_jacobian()`, else forward
 !!   differences with Hairer's steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, counted in
-!!   nfev).
+!!   nfev; with a sparsity pattern in `jstruct`, one evaluation per Curtis-Powell-Reid
+!!   group of columns). A Jacobian declared constant (`jstruct%constant`, SciPy's constant
+!!   `jac`) is read once at the start and never re-evaluated; it counts no evaluation
+!!   (njev 0, as SciPy).
+!! - Smallest step: SciPy's (`min_step_at`, 10 spacings of t): a step proposed below it is
+!!   raised to it once; an attempt below it ends the run.
 !! - Continuous extension: the collocation polynomial (degree 3, power basis), on which the
 !!   driver finds t_eval points and events.
 !! - Failures: a Newton iteration that does not converge (or meets non-finite values)
@@ -35,10 +40,12 @@
 !!   a singular iteration matrix halves the step, five singular ones in a row end the run
 !!   (CM_SINGULAR).
 !! - Mass-matrix form M y' = f(t, y) with a constant, possibly singular M (differential-
-!!   algebraic systems of index 1 and 2, RADAU5's IMAS = 1): the components `mass` and
-!!   `index2` set before `init` (index-2 components get their error scaled by h, as
-!!   RADAU5's NIND2); the initial step is then 1e-6 unless given. The constrained layer
-!!   uses it for the stabilised index-2 formulation (conmech_constrained_dae).
+!!   algebraic systems of index up to 3, RADAU5's IMAS = 1): the components `mass` and
+!!   `dae_index` (or `index2`) set before `init`; the error (and the Newton increments) of
+!!   an index-k component are weighted by |h|^(k-1), as RADAU5's NIND2, NIND3; the initial
+!!   step is then 1e-6 unless given. The constrained layer uses it for the stabilised
+!!   index-2 formulation (conmech_constrained_dae) and the index-3 formulation with the
+!!   accelerations and multipliers as algebraic variables (conmech_constrained_index3).
 !! Counters: nfev, njev, nlu (each LU counts once: two per factorisation, as SciPy counts).
 !! This module holds the state and its packing; the step itself is the submodule
 !! conmech_radau_step, on conmech_radau_newton (Jacobian, LU, Newton) and
@@ -51,6 +58,7 @@ module conmech_radau_stepper
     use conmech_ode_stepper, only: ode_stepper
     use conmech_state_packer, only: state_packer
     use conmech_radau_collocation, only: radau_collocation_basis
+    use conmech_jacobian_structure, only: jacobian_structure
     implicit none
     private
 
@@ -64,8 +72,14 @@ module conmech_radau_stepper
         !! the caller before `init`; unallocated: M = I
         real(dp), allocatable :: mass(:, :)
         !> the index-2 algebraic components (their error is scaled by h, as RADAU5), set
-        !! with `mass`
+        !! with `mass` (shorthand for `dae_index` = 2 on them)
         logical, allocatable :: index2(:)
+        !> the differentiation index of each component (1, 2 or 3), set with `mass`: the
+        !! error of an index-k component is weighted by |h|^(k-1) (RADAU5's NIND2, NIND3)
+        integer, allocatable :: dae_index(:)
+        !> what is known of df/dy: constant, or a sparsity pattern for grouped
+        !! differences; set by the caller before `init`
+        type(jacobian_structure) :: jstruct
         real(dp) :: hmax = 0, uround = 0, fnewt = 0   !! largest |h|, roundoff, Newton tol.
         real(dp) :: faccon = 1, theta = 0     !! Newton contraction memory and rate
         real(dp) :: hacc = 0, erracc = 1      !! last accepted step and error (Gustafsson)
@@ -89,6 +103,7 @@ module conmech_radau_stepper
         logical :: converged = .false.        !! the last Newton iteration converged
         logical :: f_ok = .true.              !! f0 = f(t, y) is finite
         logical :: final_step = .false.       !! the step to attempt ends at tf
+        logical :: h_capped = .false.         !! h was cut to hmax after the last step
         real(dp), allocatable :: f0(:), scal(:), scal0(:), rtolv(:), atolv(:)
         real(dp), allocatable :: jac(:, :), e1(:, :)    !! J and the LU of gamma/h M - J
         complex(dp), allocatable :: e2(:, :)            !! LU of (alpha + i beta)/h M - J
@@ -183,6 +198,8 @@ contains
         call p%item(self%newton_failed)
         call p%item(self%f_ok)
         call p%item(self%final_step)
+        call p%item(self%h_capped)
+        call self%jstruct%transfer(p)
         call p%column(self%f0)
         call p%column(self%scal0)
         call p%column(self%rtolv)
@@ -196,9 +213,9 @@ contains
         call p%item(has_mass)
         if (has_mass) then
             call p%columns(self%mass, 1, n)
-            if (.not. p%reading()) idx = merge(1, 0, self%index2)
+            if (.not. p%reading()) idx = self%dae_index
             call p%ints(idx, n)
-            if (p%reading()) self%index2 = idx /= 0
+            if (p%reading()) self%dae_index = idx
         end if
         if (p%reading()) then
             call radau_allocate_work(self)

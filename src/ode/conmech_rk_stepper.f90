@@ -16,8 +16,10 @@
 !! next step, so that the last step's stages stay available for its dense output.
 !! Step-size control follows Hairer's dopri5.f/dop853.f: safety 0.9, step ratio bounds
 !! [0.2, 10] (DOPRI5, with Lund stabilisation beta = 0.04) and [1/3, 6] (DOP853,
-!! VERNER98), no growth right after a rejection, at most `max_steps` attempted steps,
-!! failure when 0.1|h| <= |t| eps. All state is in the object: thread-safe.
+!! VERNER98), no growth right after a rejection, at most `max_steps` attempted steps.
+!! The smallest step is SciPy's (`min_step_at`: 10 spacings of t): a step proposed below
+!! it is raised to it once, an attempt below it (after rejections, or when max_step is
+!! below it) ends the run. All state is in the object: thread-safe.
 module conmech_rk_stepper
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use, intrinsic :: iso_fortran_env, only: int64
@@ -27,10 +29,10 @@ module conmech_rk_stepper
     use conmech_ode_options, only: ode_options, METHOD_RK4, METHOD_DOPRI5, &
         METHOD_DOP853, METHOD_VERNER98
     use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
-        tolerance_vectors, FORM_HAIRER, FORM_POWER
+        tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL
     use conmech_state_packer, only: state_packer
-    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
-        verner98_tableau
+    use conmech_rk_tableaus, only: rk_tableau, set_dopri5_tableau, set_dop853_tableau, &
+        set_verner98_tableau
     use conmech_rk_kernels, only: rk4_attempt, dopri5_attempt, dop853_attempt, &
         verner_attempt
     implicit none
@@ -41,7 +43,9 @@ module conmech_rk_stepper
     type, extends(ode_stepper) :: rk_stepper
         integer :: ifsal = 0              !! column of k holding f at the step's end
         logical :: adaptive = .true.      !! false: fixed step (RK4)
-        type(rk_tableau) :: tab
+        !> the tableau (allocatable: a new stepper object, as every step of the Python
+        !! objects makes, copies no 6 kB template; set_method fills it in place)
+        type(rk_tableau), allocatable :: tab
         real(dp) :: hmax = 0.0_dp         !! largest |h|
         real(dp) :: h_fixed = 0.0_dp      !! RK4's step
         real(dp) :: safe = 0.9_dp, facc1 = 5.0_dp, facc2 = 0.1_dp, beta = 0.0_dp
@@ -52,6 +56,7 @@ module conmech_rk_stepper
         integer :: n_nonfinite = 0        !! consecutive non-finite error estimates
         logical :: reject = .false.       !! the previous attempt was rejected
         logical :: fsal_pending = .false. !! k(:, ifsal) is f(t, y), not yet in k(:, 1)
+        logical :: h_capped = .false.     !! h was cut to hmax after the last step
         real(dp), allocatable :: ynew(:), ytmp(:), sk(:)
         real(dp), allocatable :: rtol(:), atol(:)
         real(dp), allocatable :: k(:, :)  !! stages, (n, 21)
@@ -135,26 +140,27 @@ contains
         self%adaptive = .true.
         self%form = FORM_HAIRER
         self%beta = 0.0_dp
+        if (allocated(self%tab)) deallocate (self%tab)
+        allocate (self%tab)                 ! default-initialized: all zero
         select case (method)
         case (METHOD_RK4)
             self%adaptive = .false.
             self%nf = 3
-            self%tab = rk_tableau()
             self%tab%stages = 4
             self%ifsal = 13
         case (METHOD_DOPRI5)
-            self%tab = dopri5_tableau()
+            call set_dopri5_tableau(self%tab)
             self%nf = 4
             self%ifsal = 7
             self%facc1 = 1.0_dp/0.2_dp; self%facc2 = 1.0_dp/10.0_dp; self%beta = 0.04_dp
         case (METHOD_VERNER98)
-            self%tab = verner98_tableau()
+            call set_verner98_tableau(self%tab)
             self%nf = 8
             self%form = FORM_POWER
             self%ifsal = 17
             self%facc1 = 1.0_dp/0.333_dp; self%facc2 = 1.0_dp/6.0_dp
         case default
-            self%tab = dop853_tableau()
+            call set_dop853_tableau(self%tab)
             self%nf = 7
             self%ifsal = 13
             self%facc1 = 1.0_dp/0.333_dp; self%facc2 = 1.0_dp/6.0_dp
@@ -202,6 +208,7 @@ contains
         call p%item(self%n_nonfinite)
         call p%item(self%reject)
         call p%item(self%fsal_pending)
+        call p%item(self%h_capped)
         call p%column(self%rtol)
         call p%column(self%atol)
         call p%columns(self%k, 1, 21)
@@ -240,6 +247,7 @@ contains
         self%h_fixed = self%h
         self%facold = 1.0e-4_dp
         self%reject = .false.
+        self%h_capped = .false.
     end subroutine rk_start_impl
 
     !> Hairer's initial step size (hinit of dopri5.f / dop853.f), with scale-safe norms.
@@ -323,10 +331,10 @@ contains
         real(dp), intent(in) :: target
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        real(dp) :: err, fac11, fac, hnew, h_unclipped, t_new
+        real(dp) :: err, fac11, fac, hnew, h_unclipped, t_new, hmin
         real(dp), allocatable :: yswap(:)
         integer :: n
-        logical :: defer
+        logical :: defer, first_try
         character(len=32) :: buf
         n = self%n
         info = CM_SUCCESS
@@ -334,6 +342,7 @@ contains
             self%k(:, 1) = self%k(:, self%ifsal)
             self%fsal_pending = .false.
         end if
+        first_try = .true.
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
@@ -341,18 +350,31 @@ contains
                 msg = "too many steps: max_steps reached at t ="//trim(buf)
                 return
             end if
-            if (0.1_dp*abs(self%h) <= abs(self%t)*epsilon(1.0_dp) .or. &
-                abs(self%h) < tiny(1.0_dp)) then
-                write (buf, '(es14.6)') self%t
-                if (self%n_nonfinite > 0) then
-                    info = CM_NONFINITE
-                    msg = "non-finite values in the right-hand side near t ="//trim(buf)
-                else
-                    info = CM_STEP_TOO_SMALL
-                    msg = "step size too small at t ="//trim(buf)
+            ! the smallest step (SciPy's min_step <= 10 eps |t|: the cheap test first)
+            if (self%adaptive .and. (abs(self%h) <= 10.0_dp*epsilon(1.0_dp)*abs(self%t) &
+                                     .or. abs(self%h) < tiny(1.0_dp))) then
+                hmin = min_step_at(self%t, self%posneg)
+                if (first_try .and. .not. self%h_capped .and. self%n_nonfinite == 0) &
+                    self%h = self%posneg*max(abs(self%h), hmin)
+                if (abs(self%h) < hmin .or. abs(self%h) < tiny(1.0_dp)) then
+                    write (buf, '(es14.6)') self%t
+                    if (self%n_nonfinite > 0) then
+                        info = CM_NONFINITE
+                        msg = "non-finite values in the right-hand side near t ="//trim(buf)
+                    else
+                        info = CM_STEP_TOO_SMALL
+                        msg = MSG_STEP_TOO_SMALL//trim(buf)
+                    end if
+                    return
                 end if
+            else if (.not. self%adaptive .and. (0.1_dp*abs(self%h) <= abs(self%t)* &
+                                                epsilon(1.0_dp) .or. abs(self%h) < tiny(1.0_dp))) then
+                write (buf, '(es14.6)') self%t
+                info = CM_STEP_TOO_SMALL
+                msg = "step size too small at t ="//trim(buf)
                 return
             end if
+            first_try = .false.
             self%hit = .false.
             h_unclipped = self%h
             if (self%adaptive) then
@@ -455,7 +477,8 @@ contains
         self%t = t_new
         self%h_done = self%h
         if (self%adaptive) then
-            if (abs(hnew) > self%hmax) hnew = self%posneg*self%hmax
+            self%h_capped = abs(hnew) > self%hmax
+            if (self%h_capped) hnew = self%posneg*self%hmax
             if (self%reject) hnew = self%posneg*min(abs(hnew), abs(self%h))
         end if
         self%reject = .false.

@@ -12,6 +12,7 @@ module conmech_rk_tableaus
     implicit none
     private
     public :: rk_tableau, dopri5_tableau, dop853_tableau, verner98_tableau
+    public :: set_dopri5_tableau, set_dop853_tableau, set_verner98_tableau
 
     type :: rk_tableau
         integer :: stages = 0          !! stages of a step (without the FSAL stage)
@@ -28,8 +29,9 @@ module conmech_rk_tableaus
 contains
 
     !> Dormand-Prince 5(4), 7 stages with FSAL (stage 7 = f(t+h, y_new)).
-    pure function dopri5_tableau() result(t)
-        type(rk_tableau) :: t
+    !! Into t, default-initialized (all zero): no copy of the 6 kB tableau.
+    pure subroutine set_dopri5_tableau(t)
+        type(rk_tableau), intent(inout) :: t
         t%stages = 7
         t%order = 5
         t%c(1:7) = [0.0_dp, 0.2_dp, 0.3_dp, 0.8_dp, 8.0_dp/9.0_dp, 1.0_dp, 1.0_dp]
@@ -49,12 +51,19 @@ contains
                        87487479700.0_dp/32700410799.0_dp, -10690763975.0_dp/1880347072.0_dp, &
                        701980252875.0_dp/199316789632.0_dp, -1453857185.0_dp/822651844.0_dp, &
                        69997945.0_dp/29380423.0_dp]
+    end subroutine set_dopri5_tableau
+
+    !> The DOPRI5 tableau (set_dopri5_tableau on a fresh one).
+    pure function dopri5_tableau() result(t)
+        type(rk_tableau) :: t
+        call set_dopri5_tableau(t)
     end function dopri5_tableau
 
     !> Dormand-Prince 8(5,3): 12 stages, stage 13 = f(t+h, y_new) (FSAL),
     !! stages 14-16 for the 7th-order dense output.
-    pure function dop853_tableau() result(t)
-        type(rk_tableau) :: t
+    !! Into t, default-initialized (all zero): no copy of the 6 kB tableau.
+    pure subroutine set_dop853_tableau(t)
+        type(rk_tableau), intent(inout) :: t
         t%stages = 12
         t%order = 8
         t%c(1) = 0.0_dp
@@ -215,12 +224,19 @@ contains
         t%d(4, 15) = -0.39177261675615439165231486172e2_dp
         t%d(4, 16) = -0.14972683625798562581422125276e3_dp
         t%b(1:12) = t%a(13, 1:12)
+    end subroutine set_dop853_tableau
+
+    !> The DOP853 tableau (set_dop853_tableau on a fresh one).
+    pure function dop853_tableau() result(t)
+        type(rk_tableau) :: t
+        call set_dop853_tableau(t)
     end function dop853_tableau
 
     !> Verner's efficient 9(8) pair: 16 stages, stage 17 = f(t+h, y_new) (FSAL),
     !! stages 18-21 for the 8th-order interpolant. e = (8th-order - 9th-order) weights.
-    pure function verner98_tableau() result(t)
-        type(rk_tableau) :: t
+    !! Into t, default-initialized (all zero): no copy of the 6 kB tableau.
+    pure subroutine set_verner98_tableau(t)
+        type(rk_tableau), intent(inout) :: t
         t%stages = 16
         t%order = 9
         t%c(2) = 0.0346200000000000_dp
@@ -484,6 +500,12 @@ contains
         t%p(21, 7) = -2803.532946186995728195816710610623754886_dp
         t%p(21, 8) = 639.3667927298664381850782820513480638022_dp
         t%a(17, 1:16) = t%b(1:16)
+    end subroutine set_verner98_tableau
+
+    !> The VERNER98 tableau (set_verner98_tableau on a fresh one).
+    pure function verner98_tableau() result(t)
+        type(rk_tableau) :: t
+        call set_verner98_tableau(t)
     end function verner98_tableau
 
 end module conmech_rk_tableaus

@@ -17,6 +17,11 @@
 !! scalars r(:), integers iv(:) (logicals as 0/1) and columns w(n, :) of the state's
 !! dimension n: plain arrays that a caller (the Python stepper objects) keeps between calls,
 !! so that nothing is kept in Fortran.
+!!
+!! The packer either owns its arrays (`packer_write` + `packer_ready`, `packer_read`: the
+!! components r, iv, w) or works in place on the caller's (`packer_attach_read`,
+!! `packer_attach_write`: their capacity checked), which costs no allocation and no copy
+!! beyond the state's own: `stepper_unpack` and `stepper_pack_into` use it.
 module conmech_state_packer
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -28,16 +33,23 @@ module conmech_state_packer
     integer, parameter, public :: PACK_READ = 2    !! arrays -> state
 
     public :: state_packer, packer_write, packer_ready, packer_read
+    public :: packer_attach_read, packer_attach_write
 
     !> The arrays of a packed state and the position in them.
     type :: state_packer
         integer :: mode = PACK_COUNT
         integer :: n = 0                     !! length of the columns of w
         integer :: nr = 0, ni = 0, nw = 0    !! entries counted, written or read so far
-        integer :: info = CM_SUCCESS         !! CM_BAD_INPUT after reading past the end
+        !> CM_BAD_INPUT after reading past the end, or writing past the caller's capacity
+        !! (in place; the counts then go on: nr, ni, nw are the sizes needed)
+        integer :: info = CM_SUCCESS
         real(dp), allocatable :: r(:)        !! real scalars
         integer, allocatable :: iv(:)        !! integers and logicals
         real(dp), allocatable :: w(:, :)     !! columns of length n
+        logical :: inplace = .false.         !! the caller's arrays below, not r, iv, w
+        real(dp), pointer, contiguous :: rx(:) => null()
+        integer, pointer, contiguous :: ivx(:) => null()
+        real(dp), pointer, contiguous :: wx(:, :) => null()
     contains
         procedure, private :: item_real, item_int, item_logical
         generic :: item => item_real, item_int, item_logical
@@ -84,18 +96,57 @@ contains
         p%w = w
     end subroutine packer_read
 
+    !> A packer that reads the state from the caller's arrays in place (no copy); they
+    !! must stay while the packer is in use.
+    subroutine packer_attach_read(p, r, iv, w)
+        type(state_packer), intent(out) :: p
+        real(dp), intent(in), target, contiguous :: r(:)
+        integer, intent(in), target, contiguous :: iv(:)
+        real(dp), intent(in), target, contiguous :: w(:, :)
+        p%mode = PACK_READ
+        p%n = size(w, 1)
+        p%inplace = .true.
+        p%rx => r
+        p%ivx => iv
+        p%wx => w
+    end subroutine packer_attach_read
+
+    !> A packer that writes the state into the caller's arrays in place, their sizes the
+    !! capacity (p%info = CM_BAD_INPUT when the state does not fit; p%nr, p%ni, p%nw are
+    !! then the sizes it needs).
+    subroutine packer_attach_write(p, r, iv, w)
+        type(state_packer), intent(out) :: p
+        real(dp), intent(inout), target, contiguous :: r(:)
+        integer, intent(inout), target, contiguous :: iv(:)
+        real(dp), intent(inout), target, contiguous :: w(:, :)
+        p%mode = PACK_WRITE
+        p%n = size(w, 1)
+        p%inplace = .true.
+        p%rx => r
+        p%ivx => iv
+        p%wx => w
+    end subroutine packer_attach_write
+
     logical function packer_reading(p)
         class(state_packer), intent(in) :: p
         packer_reading = p%mode == PACK_READ
     end function packer_reading
 
     !> Take kr reals, ki integers and kw columns: true when they are there to move (write,
-    !! read); in count mode only counted (false); reading past the end sets info.
+    !! read); in count mode only counted (false); reading past the end sets info, and so
+    !! does writing in place past the caller's capacity (then only counted).
     logical function take(p, kr, ki, kw)
         class(state_packer), intent(inout) :: p
         integer, intent(in) :: kr, ki, kw
         take = p%mode /= PACK_COUNT
-        if (p%mode == PACK_READ) then
+        if (p%inplace) then
+            if (p%nr + kr > size(p%rx) .or. p%ni + ki > size(p%ivx) .or. &
+                p%nw + kw > size(p%wx, 2)) then
+                p%info = CM_BAD_INPUT
+                take = .false.
+                if (p%mode == PACK_READ) return
+            end if
+        else if (p%mode == PACK_READ) then
             if (p%nr + kr > size(p%r) .or. p%ni + ki > size(p%iv) .or. &
                 p%nw + kw > size(p%w, 2)) then
                 p%info = CM_BAD_INPUT
@@ -115,7 +166,13 @@ contains
         real(dp), intent(inout) :: x
         if (.not. take(p, 1, 0, 0)) return
         p%nr = p%nr + 1
-        if (p%mode == PACK_READ) then
+        if (p%inplace) then
+            if (p%mode == PACK_READ) then
+                x = p%rx(p%nr)
+            else
+                p%rx(p%nr) = x
+            end if
+        else if (p%mode == PACK_READ) then
             x = p%r(p%nr)
         else
             p%r(p%nr) = x
@@ -127,7 +184,13 @@ contains
         integer, intent(inout) :: k
         if (.not. take(p, 0, 1, 0)) return
         p%ni = p%ni + 1
-        if (p%mode == PACK_READ) then
+        if (p%inplace) then
+            if (p%mode == PACK_READ) then
+                k = p%ivx(p%ni)
+            else
+                p%ivx(p%ni) = k
+            end if
+        else if (p%mode == PACK_READ) then
             k = p%iv(p%ni)
         else
             p%iv(p%ni) = k
@@ -137,13 +200,10 @@ contains
     subroutine item_logical(p, l)
         class(state_packer), intent(inout) :: p
         logical, intent(inout) :: l
-        if (.not. take(p, 0, 1, 0)) return
-        p%ni = p%ni + 1
-        if (p%mode == PACK_READ) then
-            l = p%iv(p%ni) /= 0
-        else
-            p%iv(p%ni) = merge(1, 0, l)
-        end if
+        integer :: k
+        k = merge(1, 0, l)
+        call item_int(p, k)
+        if (p%mode == PACK_READ) l = k /= 0
     end subroutine item_logical
 
     !> A vector of length n as one column of w.
@@ -157,7 +217,13 @@ contains
                 if (size(a) /= p%n) deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(p%n))
-            a = p%w(:, p%nw)
+            if (p%inplace) then
+                a = p%wx(:, p%nw)
+            else
+                a = p%w(:, p%nw)
+            end if
+        else if (p%inplace) then
+            p%wx(:, p%nw) = a
         else
             p%w(:, p%nw) = a
         end if
@@ -173,10 +239,17 @@ contains
         if (.not. take(p, 0, 0, k)) return
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
-                if (size(a, 2) /= k .or. lbound(a, 2) /= lo) deallocate (a)
+                if (size(a, 1) /= p%n .or. size(a, 2) /= k .or. lbound(a, 2) /= lo) &
+                    deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(p%n, lo:hi))
-            a(:, lo:hi) = p%w(:, p%nw + 1:p%nw + k)
+            if (p%inplace) then
+                a(:, lo:hi) = p%wx(:, p%nw + 1:p%nw + k)
+            else
+                a(:, lo:hi) = p%w(:, p%nw + 1:p%nw + k)
+            end if
+        else if (p%inplace) then
+            p%wx(:, p%nw + 1:p%nw + k) = a(:, lo:hi)
         else
             p%w(:, p%nw + 1:p%nw + k) = a(:, lo:hi)
         end if
@@ -194,7 +267,13 @@ contains
                 if (size(a) /= m) deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(m))
-            a = p%iv(p%ni + 1:p%ni + m)
+            if (p%inplace) then
+                a = p%ivx(p%ni + 1:p%ni + m)
+            else
+                a = p%iv(p%ni + 1:p%ni + m)
+            end if
+        else if (p%inplace) then
+            p%ivx(p%ni + 1:p%ni + m) = a(1:m)
         else
             p%iv(p%ni + 1:p%ni + m) = a(1:m)
         end if
@@ -209,10 +288,19 @@ contains
         if (.not. take(p, 0, 0, 2*m)) return
         if (p%mode == PACK_READ) then
             if (allocated(a)) then
-                if (size(a, 2) /= m) deallocate (a)
+                if (size(a, 1) /= p%n .or. size(a, 2) /= m) deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(p%n, m))
-            a = cmplx(p%w(:, p%nw + 1:p%nw + m), p%w(:, p%nw + m + 1:p%nw + 2*m), kind=dp)
+            if (p%inplace) then
+                a = cmplx(p%wx(:, p%nw + 1:p%nw + m), p%wx(:, p%nw + m + 1:p%nw + 2*m), &
+                          kind=dp)
+            else
+                a = cmplx(p%w(:, p%nw + 1:p%nw + m), p%w(:, p%nw + m + 1:p%nw + 2*m), &
+                          kind=dp)
+            end if
+        else if (p%inplace) then
+            p%wx(:, p%nw + 1:p%nw + m) = real(a, dp)
+            p%wx(:, p%nw + m + 1:p%nw + 2*m) = aimag(a)
         else
             p%w(:, p%nw + 1:p%nw + m) = real(a, dp)
             p%w(:, p%nw + m + 1:p%nw + 2*m) = aimag(a)
@@ -231,7 +319,13 @@ contains
                 if (size(a) /= m) deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(m))
-            a = p%r(p%nr + 1:p%nr + m)
+            if (p%inplace) then
+                a = p%rx(p%nr + 1:p%nr + m)
+            else
+                a = p%r(p%nr + 1:p%nr + m)
+            end if
+        else if (p%inplace) then
+            p%rx(p%nr + 1:p%nr + m) = a(1:m)
         else
             p%r(p%nr + 1:p%nr + m) = a(1:m)
         end if
@@ -249,7 +343,13 @@ contains
                 if (size(a, 1) /= m1 .or. size(a, 2) /= m2) deallocate (a)
             end if
             if (.not. allocated(a)) allocate (a(m1, m2))
-            a = reshape(p%r(p%nr + 1:p%nr + m1*m2), [m1, m2])
+            if (p%inplace) then
+                a = reshape(p%rx(p%nr + 1:p%nr + m1*m2), [m1, m2])
+            else
+                a = reshape(p%r(p%nr + 1:p%nr + m1*m2), [m1, m2])
+            end if
+        else if (p%inplace) then
+            p%rx(p%nr + 1:p%nr + m1*m2) = reshape(a(1:m1, 1:m2), [m1*m2])
         else
             p%r(p%nr + 1:p%nr + m1*m2) = reshape(a(1:m1, 1:m2), [m1*m2])
         end if

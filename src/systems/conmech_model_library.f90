@@ -14,12 +14,16 @@
 !! conmech_c_mechanics, named conmech_rhs, conmech_jac (ode); conmech_mass,
 !! conmech_forces, conmech_forces_jac, conmech_energy (generalized and constrained);
 !! conmech_phi, conmech_phi_jac, conmech_phi_t, conmech_phi_gamma, conmech_nh_matrix,
-!! conmech_nh_gamma (constrained). Optional fast entries: conmech_jac_prod (ode: J x for a
+!! conmech_nh_gamma, optionally conmech_constraint_hessian (constrained). Optional fast
+!! entries: conmech_jac_prod (ode: J x for a
 !! block x, `set_c_jac_prod`, used by `integrate_stm`), conmech_mass_forces (M and Q in
 !! one call) and conmech_accel (a = M^-1 Q, `void accel(double t, const double *q, const
 !! double *v, double *a, const double *p)`) for generalized models. Missing optional
 !! functions fall back to finite differences (or to mass + forces). The library stays
-!! loaded for the life of the process.
+!! loaded for the life of the process. Before dlopen the file is checked
+!! (`conmech_library_check`: ELF headers, segments and sections within the file, the symbol
+!! conmech_model_info defined), so a truncated or foreign file is an error naming it, never
+!! a crash.
 module conmech_model_library
     use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_char, c_int, c_double, &
                                            c_null_char, c_associated, &
@@ -32,6 +36,7 @@ module conmech_model_library
     use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
+    use conmech_library_check, only: check_shared_library
     implicit none
     private
 
@@ -109,6 +114,18 @@ contains
         end do
     end function dl_message
 
+    !> The path as dlopen must see it to open this very file: a name without a slash
+    !! would be searched in the library path instead of the current directory.
+    function dl_path(path) result(p)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: p
+        if (index(path, "/") == 0) then
+            p = "./"//path
+        else
+            p = path
+        end if
+    end function dl_path
+
     type(c_funptr) function symbol(handle, name)
         type(c_ptr), intent(in) :: handle
         character(len=*), intent(in) :: name
@@ -130,8 +147,15 @@ contains
         integer(c_int) :: desc(6)
         character(kind=c_char) :: buf(4096)
         integer :: i, np
+        ! before dlopen: a truncated library would be mapped past its end (SIGBUS at the
+        ! first access); a foreign file is named as such
+        call check_shared_library(trim(path), ["conmech_model_info"], info, msg)
+        if (info /= CM_SUCCESS) then
+            msg = "cannot load the model library '"//trim(path)//"': "//msg
+            return
+        end if
         info = CM_BAD_INPUT
-        h = c_dlopen(trim(path)//c_null_char, RTLD_NOW)
+        h = c_dlopen(dl_path(trim(path))//c_null_char, RTLD_NOW)
         if (.not. c_associated(h)) then
             msg = "cannot load the model library '"//trim(path)//"': "//dl_message()
             return
@@ -192,6 +216,7 @@ contains
         lib%fp%phi_gamma = symbol(h, "conmech_phi_gamma")
         lib%fp%nh_matrix = symbol(h, "conmech_nh_matrix")
         lib%fp%nh_gamma = symbol(h, "conmech_nh_gamma")
+        lib%fp%constraint_hessian = symbol(h, "conmech_constraint_hessian")
         info = CM_SUCCESS
         msg = "success"
     end subroutine load_model

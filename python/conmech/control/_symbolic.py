@@ -124,7 +124,7 @@ def _compiled_input_matrix(plant, bmat, qs, pvals, m):
                      "    implicit none", "    integer, parameter :: dp = c_double",
                      "    public", "contains", ""] + proc
                     + ["end module conmech_control_input_matrix", ""])
-    path, _ = compile_source(src)
+    path, _ = compile_source(src, symbols=["input_matrix"])
     lib, addr = load(path, ["input_matrix"])
     return ControlledSystem(plant, input_matrix=addr["input_matrix"], n_inputs=m,
                             input_params=[pvals[nm] for nm in names], keep=lib)

@@ -270,6 +270,11 @@ def simulate(plant: ControlledSystem, law: Any, t_span: Sequence[float], x0: Arr
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{nm} must be positive and finite")
     settings = _event_settings(events)
+    for i, (_, _, _, res) in enumerate(settings):
+        if res > 0:     # sampling inside the steps is solve_ivp's (not this driver's)
+            raise ValueError(f"events[{i}].resolution is not supported by the closed-loop solve (only "
+                             "by conmech.solve_ivp)")
+    settings = [s[:3] for s in settings]
     for i, (e, count, d) in enumerate(settings):
         if count > 1:
             raise ValueError(f"events[{i}].terminal must be a bool here (stop at the "

@@ -333,10 +333,16 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     type(mech_plant) :: plant
     character(len=:), allocatable :: msg
     integer(c_int) :: counts(5)
+    ! no event resolution (SciPy's rule), no Jacobian structure (nnz = -1)
+    real(c_double) :: ev_res(max(ne, 1))
+    integer(c_int) :: sp_ptr(n + 1), sp_idx(1)
     nfev = 0
     naccept = 0
     nreject = 0
     dense_form = 0
+    ev_res = 0.0_c_double
+    sp_ptr = 1
+    sp_idx = 0
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
                      bpar(1:nbp), plant, info, msg)
     message = msg
@@ -347,8 +353,8 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     allocate (cl%plant, source=plant)
     cl%n_inputs = m
     call run_solve(cl, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
-                   dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, -1, sp_ptr, sp_idx, &
+                   events, store, counts, dense_form, info, message)
     nfev = counts(1)        ! counts: nfev, njev, nlu, naccept, nreject
     naccept = counts(4)
     nreject = counts(5)

@@ -77,7 +77,7 @@ subroutine flat_mech_initial_state(name, np, params, n, q0, v0, info)
 end subroutine flat_mech_initial_state
 
 !> Solve the built-in constrained system `name` (params as in conmech_systems_mech).
-!! iopt = [projection, every, proj_max_iter, max_steps]; ropt = [first_step, max_step,
+!! iopt = [projection, every, proj_max_iter, max_steps, dae_index]; ropt = [first_step, max_step,
 !! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank,
 !! proj_iter_max]; moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
 subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events, evstore, &
@@ -101,7 +101,7 @@ subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events
     real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
     integer(c_int), intent(in) :: method
     real(c_double), intent(in) :: rtol, atol
-    integer(c_int), intent(in) :: iopt(4)
+    integer(c_int), intent(in) :: iopt(5)
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
@@ -127,13 +127,14 @@ subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events
             real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
             integer(c_int), intent(in) :: ev_id(nev)
         end subroutine evstore
-        subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
+        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
             real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: q(n, nt), v(n, nt)
+            real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
             real(c_double), intent(in) :: lam(mm, nt)
             real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: cm(mm, n, nt)
             real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
         end subroutine store
     end interface
@@ -169,7 +170,7 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
     real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
     integer(c_int), intent(in) :: method
     real(c_double), intent(in) :: rtol, atol
-    integer(c_int), intent(in) :: iopt(4)
+    integer(c_int), intent(in) :: iopt(5)
     real(c_double), intent(in) :: ropt(5)
     integer(c_int), intent(in) :: neval
     real(c_double), intent(in) :: t_eval(max(neval, 1))
@@ -244,13 +245,14 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
             real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
             integer(c_int), intent(in) :: ev_id(nev)
         end subroutine evstore
-        subroutine store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)
+        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: n, mm, nt
             real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: q(n, nt), v(n, nt)
+            real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
             real(c_double), intent(in) :: lam(mm, nt)
             real(c_double), intent(in) :: reac(n, nt)
+            real(c_double), intent(in) :: cm(mm, n, nt)
             real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
         end subroutine store
     end interface

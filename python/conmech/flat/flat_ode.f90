@@ -73,12 +73,17 @@ end subroutine flat_system_dimension
 !! one, e.g. Radau; else forward differences).
 !! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
 !! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
-!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal. dense_form: form of the
-!! dense coefficients handed to `store` (1 Hairer's, 2 power basis, 0 none).
-!! counts = [nfev, njev, nlu, naccept, nreject].
+!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal; ev_res: each event's
+!! resolution (largest spacing of its samples inside a step; 0: the step's ends only, SciPy's
+!! rule). jac_const /= 0: the Jacobian is constant (read once, njev 0); nnz >= 0: the
+!! sparsity pattern of df/dy by columns, sp_ptr(n + 1) and rows sp_idx(1:nnz) (1-based), for
+!! differences by groups of columns (methods that use a Jacobian; nnz = -1: none).
+!! dense_form: form of the dense coefficients handed to `store` (1 Hairer's, 2 power basis,
+!! 0 none). counts = [nfev, njev, nlu, naccept, nreject].
 subroutine flat_solve_callback(fun, jac, events, store, n, t_span, y0, method, has_jac, &
                                rtol, atol, first_step, max_step, max_steps, dense, neval, &
-                               t_eval, ne, ev_dir, ev_term, counts, dense_form, info, message)
+                               t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
+                               sp_idx, counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_flat_ode_support, only: callback_jac_system, run_solve
     implicit none
@@ -92,6 +97,8 @@ subroutine flat_solve_callback(fun, jac, events, store, n, t_span, y0, method, h
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
 !f2py external fun, jac, events, store
@@ -136,8 +143,8 @@ subroutine flat_solve_callback(fun, jac, events, store, n, t_span, y0, method, h
     sys%n = n
     if (has_jac /= 0) sys%jac => jac
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
-                   dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
+                   sp_idx, events, store, counts, dense_form, info, message)
 end subroutine flat_solve_callback
 
 !> Solve y' = f(t, y) for the built-in (or compiled) system `name` with parameters `params`
@@ -146,8 +153,8 @@ end subroutine flat_solve_callback
 !! Python in the loop unless there are events. Other arguments as in flat_solve_callback.
 subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t_span, y0, &
                               method, rtol, atol, first_step, max_step, max_steps, dense, &
-                              neval, t_eval, ne, ev_dir, ev_term, counts, dense_form, info, &
-                              message)
+                              neval, t_eval, ne, ev_dir, ev_term, ev_res, nnz, sp_ptr, sp_idx, &
+                              counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -170,6 +177,8 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
 !f2py external events, store
@@ -213,6 +222,6 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
         return
     end if
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, events, store, counts, &
-                   dense_form, info, message)
+                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, nnz, sp_ptr, sp_idx, &
+                   events, store, counts, dense_form, info, message)
 end subroutine flat_solve_builtin

@@ -5,7 +5,10 @@
 !! flat_stepper_layout gives), copied in and out by every call, so that nothing is kept in
 !! Fortran between calls. action: 0 init at (t0, y0) and start, 1 one accepted step towards
 !! t_bound, 2 dense coefficients of the last step (in w), 3 the sizes [nr, ni, nw] (init
-!! only). Conventions as in flat_ode.f90.
+!! only). jac_const /= 0: a constant Jacobian (read once, not counted in njev); nnz >= 0:
+!! the sparsity pattern of df/dy by columns, sp_ptr(n + 1) and rows sp_idx(1:nnz)
+!! (1-based), for differences by groups of columns (methods that use a Jacobian; kept in
+!! the packed state; nnz = -1: none). Conventions as in flat_ode.f90.
 
 !> Positions (1-based) of the common part of a packed state: layout = [r: t, t_old,
 !! h_done; iv: nf, form, nfev, njev, nlu, naccept, nreject; w: y, first dense column].
@@ -23,8 +26,9 @@ end subroutine flat_stepper_layout
 !> One stepper action for a Python right-hand side fun(t, y) and, if has_jac /= 0, its
 !! Jacobian jac(t, y) -> (n, n) (methods that use one; else finite differences).
 subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y0, method, &
-                                 has_jac, rtol, atol, first_step, max_step, max_steps, r, iv, &
-                                 w, sizes, info, message)
+                                 has_jac, rtol, atol, first_step, max_step, max_steps, &
+                                 jac_const, nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, &
+                                 message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_flat_ode_support, only: callback_jac_system
     use conmech_flat_stepper_support, only: stepper_action
@@ -32,6 +36,7 @@ subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y
     integer(c_int), intent(in) :: action, n, nr, ni, nw, method, has_jac, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
     integer(c_int), intent(inout) :: iv(max(ni, 1))
     integer(c_int), intent(out) :: sizes(3), info
@@ -58,14 +63,16 @@ subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y
     sys%n = n
     if (has_jac /= 0) sys%jac => jac
     call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
-                        first_step, max_step, max_steps, r, iv, w, sizes, info, message)
+                        first_step, max_step, max_steps, jac_const, nnz, sp_ptr, sp_idx, r, &
+                        iv, w, sizes, info, message)
 end subroutine flat_stepper_callback
 
 !> One stepper action for the built-in (or compiled) system `name` with parameters
 !! params(1:np) (its own Jacobian where the method uses one).
 subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni, nw, t0, &
                                 t_bound, y0, method, rtol, atol, first_step, max_step, &
-                                max_steps, r, iv, w, sizes, info, message)
+                                max_steps, nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, &
+                                message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -82,6 +89,7 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni
     integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
     integer(c_int), intent(inout) :: iv(max(ni, 1))
     integer(c_int), intent(out) :: sizes(3), info
@@ -101,5 +109,32 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni
         return
     end if
     call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
-                        first_step, max_step, max_steps, r, iv, w, sizes, info, message)
+                        first_step, max_step, max_steps, 0, nnz, sp_ptr, sp_idx, r, iv, w, &
+                        sizes, info, message)
 end subroutine flat_stepper_builtin
+
+!> The Butcher tableau of an explicit Runge-Kutta method of the table (code; 12: SciPy's
+!! RK45, DOPRI5's tableau): a(21, 21), b(21), c(21) (zero beyond its stages; DOP853's b is
+!! its 8th-order weights, row 13 of a). Zero for a method without one.
+subroutine flat_rk_tableau(code, a, b, c)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_ode_options, only: METHOD_DOPRI5, METHOD_DOP853, METHOD_VERNER98
+    use conmech_rk_tableaus, only: rk_tableau, dopri5_tableau, dop853_tableau, &
+        verner98_tableau
+    use conmech_flat_ode_support, only: METHOD_RK45_SCIPY
+    implicit none
+    integer(c_int), intent(in) :: code
+    real(c_double), intent(out) :: a(21, 21), b(21), c(21)
+    type(rk_tableau) :: tb
+    select case (code)
+    case (METHOD_DOPRI5, METHOD_RK45_SCIPY)
+        tb = dopri5_tableau()
+    case (METHOD_DOP853)
+        tb = dop853_tableau()
+    case (METHOD_VERNER98)
+        tb = verner98_tableau()
+    end select
+    a = tb%a
+    b = tb%b
+    c = tb%c
+end subroutine flat_rk_tableau

@@ -11,7 +11,7 @@ import numpy as np
 from .. import _conmech
 from .._callback import Guard, as_result
 from .._native import NativeSystem
-from ._validate import _check_dim, _count, _msg, _raise, _state
+from ._validate import _check_dim, _count, _msg, _raise, _real, _state
 from .orbits import _METHODS, stable_tolerance
 
 _SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
@@ -122,11 +122,13 @@ def _param_index(system, param):
 
 
 def _range(value, name):
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a pair (low, high)") from None
-    if np.isnan(lo) or np.isnan(hi) or not lo <= hi:
+    """A pair (low, high) of reals, either end possibly infinite; TypeError/ValueError
+    naming the entry otherwise."""
+    if not (isinstance(value, (tuple, list, np.ndarray)) and len(value) == 2):
+        raise TypeError(f"{name} must be a pair (low, high)")
+    lo, hi = (float(v) if isinstance(v, (float, np.floating)) and np.isinf(v)
+              else _real(v, f"{name}[{i}]") for i, v in enumerate(value))
+    if not lo <= hi:
         raise ValueError(f"{name} must be a pair (low, high) with low <= high")
     return max(lo, -1e300), min(hi, 1e300)
 
@@ -179,15 +181,13 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     y0 = _state(y0)
     _check_dim(system, y0)
     n = y0.size
-    period = float(period)
-    if not period > 0:
-        raise ValueError("period must be positive")
-    if int(max_points) < 1:
-        raise ValueError("max_points must be >= 1")
+    period = _real(period, "period", 0.0, low_open=True)
+    max_points = _count(max_points, "max_points")
+    max_iter = _count(max_iter, "max_iter")
     for name, v in (("ds", ds), ("ds_min", ds_min), ("ds_max", ds_max), ("rtol", rtol),
-                    ("atol", atol), ("tol", tol), ("res_tol", res_tol)):
-        if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be positive and finite")
+                    ("atol", atol), ("tol", tol), ("res_tol", res_tol),
+                    ("locate_tol", locate_tol), ("period_factor", period_factor)):
+        _real(v, name, 0.0, low_open=True)
     if not rtol < 1:
         raise ValueError("rtol must be < 1")
     if not isinstance(method, str) or method not in _METHODS:
@@ -195,9 +195,11 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     segments = _count(segments, "segments", 1, 100000)
     degree = _count(degree, "degree", 1, 8)
     intervals = _count(intervals, "intervals", 2, 100000)
+    if p0 is not None:
+        p0 = _real(p0, "p0")
     if direction is None:
         dirn = 0
-    elif direction in (1, -1) or (isinstance(direction, (int, float)) and direction != 0):
+    elif _real(direction, "direction") != 0:
         dirn = 1 if direction > 0 else -1
     else:
         raise ValueError("direction must be +1, -1 or None (automatic)")

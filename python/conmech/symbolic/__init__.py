@@ -37,27 +37,32 @@ multibody trees: T and U from the bodies, the articulated-body accelerations),
 (the public constructors).
 """
 import ctypes
+import errno
 import hashlib
 import os
 import pickle
 import shutil
+import tempfile
 import time
 
 import numpy as np
 import sympy as sp
 
-from .build import CompileError, _conmech_version, cache_dir, compile_source, load
+from .build import (CacheError, CacheWarning, CompileError, _conmech_version, cache_dir,
+                    check_private, compile_source, load)
 from .codegen import CODEGEN_VERSION, generate
-from .derive import Derived, derive_constrained, derive_lagrangian, derive_ode
+from .derive import Derived, _as_value, derive_constrained, derive_lagrangian, derive_ode
 from .momenta import (FirstIntegrals, LagrangianSystem, Momenta, as_lagrangian_system,
                       first_integrals, momenta)
 
 __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledModel",
-           "CompileError", "cache_dir", "Derived", "compile_model", "model_of", "save_model",
-           "momenta", "first_integrals", "Momenta", "FirstIntegrals", "LagrangianSystem"]
+           "CompileError", "CacheError", "CacheWarning", "cache_dir", "Derived",
+           "compile_model", "model_of", "save_model", "momenta", "first_integrals", "Momenta",
+           "FirstIntegrals", "LagrangianSystem"]
 
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
+_V = ctypes.c_void_p
 # argument layouts of the C ABI (after t): number of input arrays, output arrays
 _SIG = {
     "rhs": ("in1", "out1"), "jac": ("in1", "out1"),
@@ -65,7 +70,10 @@ _SIG = {
     "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
     "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
     "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
+    "accel_jac": ("in2", "out2"),
 }
+# constrained systems: the second derivatives of the constraints (inputs q, v, lam)
+_SIG["constraint_hessian"] = ("in3", "out2")
 
 
 class CompiledModel:
@@ -93,52 +101,84 @@ class CompiledModel:
                 "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
                 "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
                 "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
-                "mass_forces": [(n, n), (n,)], "accel": [(n,)]}[entry]
+                "mass_forces": [(n, n), (n,)], "accel": [(n,)],
+                "constraint_hessian": [(n, n), (h + k, n)],
+                "accel_jac": [(n,), (n, 2 * n)]}[entry]
+
+    def _entry(self, entry):
+        """(ctypes function, number of input arrays, output shapes, returns a value) of an
+        entry point, built once per model and entry (pointers passed as addresses)."""
+        cache = self.__dict__.setdefault("_entries", {})
+        e = cache.get(entry)
+        if e is None:
+            if entry not in self.addresses:
+                raise ValueError(f"this model has no entry point '{entry}' "
+                                 f"(has: {', '.join(self.addresses)})")
+            if entry == "jac_prod":
+                fn = ctypes.CFUNCTYPE(None, _D, _V, ctypes.c_int, _V, _V, _V)(
+                    self.addresses[entry])
+                e = (fn, 2, [], False)
+            else:
+                shapes = self._shapes(entry)
+                n_in = int(_SIG[entry][0][2:])
+                ret = _SIG[entry][1] == "ret"
+                fn = ctypes.CFUNCTYPE(_D if ret else None, _D,
+                                      *([_V] * (n_in + len(shapes) + 1)))(
+                    self.addresses[entry])
+                e = (fn, n_in, shapes, ret)
+            cache[entry] = e
+        return e
+
+    def _params(self, params):
+        """The parameter array (the model's values when None), checked: real numbers, as
+        many as the model has."""
+        if params is None:
+            p = self.__dict__.get("_p0")
+            if p is None:
+                p = self._p0 = self._params(list(self.derived.param_values))
+            return p
+        names = self.derived.param_names
+        if not (isinstance(params, np.ndarray) and params.dtype == np.float64):
+            if isinstance(params, (str, bytes)) or any(
+                    isinstance(v, (bool, np.bool_, str, bytes))
+                    for v in np.ravel(np.asarray(params, dtype=object))):
+                raise TypeError(f"params must be {len(names)} real numbers")
+        p = np.ascontiguousarray(params, dtype=float)
+        if p.ndim != 1 or p.size != len(names):
+            raise ValueError(f"params must have {len(names)} values ({', '.join(names)})")
+        return p if p.size else np.zeros(1)
 
     def call(self, entry, t, *arrays, params=None):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
         (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
         parameters or `params`."""
-        if entry not in self.addresses:
-            raise ValueError(f"this model has no entry point '{entry}' "
-                             f"(has: {', '.join(self.addresses)})")
+        fn, n_in, shapes, ret = self._entry(entry)
         if entry == "jac_prod":
-            return self._call_jac_prod(t, *arrays, params=params)
-        p = np.ascontiguousarray(self.derived.param_values if params is None else params,
-                                 dtype=float)
-        if p.ndim != 1 or p.size != len(self.derived.param_names):
-            raise ValueError(f"params must have {len(self.derived.param_names)} values "
-                             f"({', '.join(self.derived.param_names)})")
-        if p.size == 0:
-            p = np.zeros(1)
-        n_in = int(_SIG[entry][0][2:])
+            return self._call_jac_prod(fn, t, *arrays, params=params)
+        p = self._params(params)
         if len(arrays) != n_in:
             raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
-        ins = [np.ascontiguousarray(a, dtype=float) for a in arrays]
         n = self.derived.n
-        for a in ins:
-            if a.shape != (n,):
-                raise ValueError(f"input arrays must have shape ({n},), got {a.shape}")
-        outs = [np.zeros(s, order="F") for s in self._shapes(entry)]
-        kind = _SIG[entry][1]
-        restype = _D if kind == "ret" else None
-        fn = ctypes.CFUNCTYPE(restype, _D, *([_P] * (len(ins) + len(outs) + 1)))(
-            self.addresses[entry])
-        ptr = [a.ctypes.data_as(_P) for a in ins + outs + [p]]
-        r = fn(float(t), *ptr)
-        if kind == "ret":
+        ins = []
+        for i, a in enumerate(arrays):
+            a = np.ascontiguousarray(a, dtype=float)
+            shape = (n,)
+            if entry == "constraint_hessian" and i == 2:      # the multipliers
+                shape = (self.derived.n_hol + self.derived.n_nh,)
+            if a.shape != shape:
+                raise ValueError(f"input arrays must have shape {shape}, got {a.shape}")
+            ins.append(a)
+        outs = [np.zeros(s, order="F") for s in shapes]
+        r = fn(float(t), *[a.ctypes.data for a in ins], *[o.ctypes.data for o in outs],
+               p.ctypes.data)
+        if ret:
             return float(r)
         return outs[0] if len(outs) == 1 else tuple(outs)
 
-    def _call_jac_prod(self, t, y, x, params=None):
+    def _call_jac_prod(self, fn, t, y, x, params=None):
         """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
         n = self.derived.n
-        p = np.ascontiguousarray(self.derived.param_values if params is None else params,
-                                 dtype=float)
-        if p.ndim != 1 or p.size != len(self.derived.param_names):
-            raise ValueError(f"params must have {len(self.derived.param_names)} values")
-        if p.size == 0:
-            p = np.zeros(1)
+        p = self._params(params)
         y = np.ascontiguousarray(y, dtype=float)
         x = np.asarray(x, dtype=float)
         vec = x.ndim == 1
@@ -146,10 +186,7 @@ class CompiledModel:
         if y.shape != (n,) or x.ndim != 2 or x.shape[0] != n or x.shape[1] < 1:
             raise ValueError(f"jac_prod needs y of shape ({n},) and x of shape ({n}, k)")
         jx = np.zeros(x.shape, order="F")
-        fn = ctypes.CFUNCTYPE(None, _D, _P, ctypes.c_int, _P, _P, _P)(
-            self.addresses["jac_prod"])
-        fn(float(t), y.ctypes.data_as(_P), x.shape[1], x.ctypes.data_as(_P),
-           jx.ctypes.data_as(_P), p.ctypes.data_as(_P))
+        fn(float(t), y.ctypes.data, x.shape[1], x.ctypes.data, jx.ctypes.data, p.ctypes.data)
         return jx.ravel() if vec else jx
 
 
@@ -158,7 +195,7 @@ def compile_model(derived, flags=None):
     t0 = time.perf_counter()
     src, entries = generate(derived)
     t1 = time.perf_counter()
-    path, hit = compile_source(src, flags)
+    path, hit = compile_source(src, flags, entries)
     t2 = time.perf_counter()
     lib, addr = load(path, entries)
     t3 = time.perf_counter()
@@ -171,16 +208,47 @@ def save_model(system, path, flags=None):
     description of ``conmech_model_library``: its kind, dimensions, parameter names and the
     system's current parameter values as defaults), for the Fortran programs
     (``sweep --model PATH``) and :func:`conmech.compiled.load_model`. The library is
-    compiled once (cached like the others) and copied atomically to ``path``."""
+    compiled once (cached like the others), copied to a temporary file beside ``path``,
+    checked, flushed to disk and renamed to ``path``: a failure (a full disk, a read-only
+    directory) raises OSError naming ``path`` and the cause, and leaves no partial file."""
     model = model_of(system)
-    values = [float(v) for v in np.asarray(system.params, dtype=float).ravel()]
-    src, _ = generate(model.derived, model_values=values)
-    lib_path, _ = compile_source(src, flags)
+    values = [float(v) for v in np.asarray(getattr(system, "params", None) if not
+                                           isinstance(system, CompiledModel) else
+                                           model.derived.param_values, dtype=float).ravel()]
+    src, entries = generate(model.derived, model_values=values)
+    lib_path, _ = compile_source(src, flags, entries + ["model_info", "model_params",
+                                                       "model_param_names"])
     path = os.fspath(path)
-    tmp = f"{path}.tmp{os.getpid()}"
-    shutil.copyfile(lib_path, tmp)
-    os.replace(tmp, path)
+    folder = os.path.dirname(os.path.abspath(path))
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=".tmp",
+                                   dir=folder)
+        with os.fdopen(fd, "wb") as out, open(lib_path, "rb") as inp:
+            shutil.copyfileobj(inp, out)
+            out.flush()
+            os.fsync(out.fileno())
+        os.chmod(tmp, 0o755 & ~_umask())
+        if os.path.getsize(tmp) != os.path.getsize(lib_path):
+            raise OSError(errno.EIO, "short copy")
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write the model library {path}: "
+                                 f"{exc.strerror or exc}") from None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
     return path
+
+
+def _umask():
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def model_of(system):
@@ -219,12 +287,13 @@ def _system(model):
         return as_lagrangian_system(compiled.generalized_system(
             d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
             energy=a.get("energy"), mass_forces=a.get("mass_forces"), accel=a.get("accel"),
-            **common))
+            accel_jac=a.get("accel_jac"), **common))
     return compiled.constrained_system(
         d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
         nh_matrix=a.get("nh_matrix"), nh_gamma=a.get("nh_gamma"), energy=a.get("energy"),
-        rheonomic=bool(d.rheonomic), **common)
+        rheonomic=bool(d.rheonomic), forces_jac=a.get("forces_jac"),
+        constraint_hessian=a.get("constraint_hessian"), **common)
 
 
 def _input_key(kind, inputs, params, options):
@@ -263,16 +332,22 @@ def _from_cache(key, params, flags):
     t0 = time.perf_counter()
     try:
         with open(path, "rb") as fh:
+            # unpickling runs code: only from a file nobody else can write
+            check_private(os.path.dirname(path), os.stat(os.path.dirname(path)))
+            check_private(path, os.fstat(fh.fileno()))
             d, src, entries, fl = pickle.load(fh)
-    except Exception:        # a stale or foreign entry: derive again
+    except CacheError:
+        raise
+    except Exception:        # a stale or corrupt entry: derive again
         return None
     if fl != (list(flags) if flags is not None else None):
         return None
-    d.param_values = [float(v) for v in params.values()]
-    if len(d.param_values) != len(d.param_names) or not np.all(np.isfinite(d.param_values)):
+    if len(params) != len(d.param_names):
         return None
+    # the same checks as the derivation: a value out of range is a ValueError naming it
+    d.param_values = [_as_value(n, v) for n, v in zip(d.param_names, params.values())]
     t1 = time.perf_counter()
-    lib_path, hit = compile_source(src, flags)
+    lib_path, hit = compile_source(src, flags, entries)
     t2 = time.perf_counter()
     lib, addr = load(lib_path, entries)
     t3 = time.perf_counter()
@@ -284,17 +359,20 @@ def _from_cache(key, params, flags):
 def _store(key, model, flags):
     path = _entry_path(key)
     d = model.derived
-    tmp = f"{path}.{os.getpid()}.tmp"
+    tmp = None
     try:
-        with open(tmp, "wb") as fh:
+        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=os.path.dirname(path))
+        with os.fdopen(fd, "wb") as fh:
             pickle.dump((d, model.source, list(model.addresses),
                          list(flags) if flags is not None else None), fh)
+        os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except Exception:        # the derivation cache is an optimisation only
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
 
 
 def _check_compiled_mass(model):
@@ -347,7 +425,8 @@ def ode_system(f, y, params=None, *, flags=None, model_only=False):
 
 
 def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simplify="auto",
-                      jacobian=True, flags=None, model_only=False, inputs=None):
+                      jacobian=True, mass=None, energy=None, flags=None, model_only=False,
+                      inputs=None):
     """A compiled system in generalized coordinates, M(t, q) q'' = Q(t, q, q'), derived from
     the Lagrangian L = T - U by Euler-Lagrange, with the exact Jacobian of the accelerations
     (forces_jac) and the energy (the Jacobi integral v . dL/dv - L).
@@ -374,15 +453,33 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
     jacobian : bool
         Generate the exact Jacobian of the accelerations (forces_jac); False saves
         derivation and compile time for large systems that are only integrated.
+    mass : square matrix, optional
+        The mass matrix M(t, q) given directly (symmetric, positive definite, free of the
+        velocities; ``L`` must then be None): the system is M q'' = Q with Q = ``forces``,
+        the complete generalized forces (velocity terms included), with the exact
+        Jacobian; ``energy`` (an expression in t, q, q') is optional.
     inputs : list, optional
         Control inputs: coordinates of q (one input each), input symbols appearing
         linearly in ``forces``, or a matrix B (ndof x m); then the result is a
         :class:`conmech.control.ControlledSystem` with M q'' = Q + B(q) u.
     """
     if inputs is not None:
+        if mass is not None:
+            raise ValueError("inputs= needs the Lagrangian L (not mass=)")
         from ..control._symbolic import controlled_lagrangian
         return controlled_lagrangian(L, q, params, forces, inputs, velocities=velocities,
                                      simplify=simplify, jacobian=jacobian, flags=flags)
+    if mass is not None:
+        from .direct import derive_direct
+        if L is not None:
+            raise ValueError("give either the Lagrangian L or mass= (then L=None)")
+        return _construct("direct", [sp.Matrix(mass), _tup(forces), _tup(q),
+                                     _tup(velocities), energy], params, (bool(jacobian),),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                bool(jacobian)),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (a Lagrangian defines its own energy)")
     return _construct("generalized", [L, _tup(q), _tup(forces), _tup(velocities)], params,
                       (simplify, bool(jacobian)),
                       lambda: derive_lagrangian(L, q, params, forces, velocities, simplify,
@@ -391,13 +488,30 @@ def lagrangian_system(L, q, params=None, forces=None, *, velocities=None, simpli
 
 
 def constrained_system(T, U, q, holonomic=(), nonholonomic=(), params=None, forces=None, *,
-                       velocities=None, simplify="auto", flags=None, model_only=False):
+                       velocities=None, simplify="auto", mass=None, energy=None, flags=None,
+                       model_only=False):
     """A compiled system in excessive coordinates for ``conmech.constrained.solve``:
     kinetic energy T, potential U, holonomic constraints phi(t, q) = 0 and non-holonomic
     constraints given as expressions linear in the velocities (A(t, q) q' + b(t, q) = 0).
     Derives M, Q, G = d phi/dq, phi_t, gamma_h, A, b, gamma_n and the energy T + U (Jacobi
     integral); rheonomic constraints (explicit t) are detected.
+
+    ``mass=`` gives the mass matrix M(t, q) directly instead of T (``T`` must then be
+    None): the forces are ``forces`` (complete, velocity terms included) minus dU/dq when
+    U is given (U may be None), and the energy is ``energy`` or v^T M v / 2 + U.
     """
+    if mass is not None:
+        from .direct import derive_direct
+        if T is not None:
+            raise ValueError("give either the kinetic energy T or mass= (then T=None)")
+        return _construct("direct_constrained",
+                          [sp.Matrix(mass), _tup(forces), _tup(q), _tup(velocities), energy,
+                           U, _tup(holonomic), _tup(nonholonomic)], params, (),
+                          lambda: derive_direct(mass, forces, q, params, velocities, energy,
+                                                True, list(holonomic), nonholonomic, U),
+                          flags, model_only)
+    if energy is not None:
+        raise ValueError("energy= goes with mass= (T and U define the energy)")
     return _construct("constrained", [T, U, _tup(q), _tup(holonomic), _tup(nonholonomic),
                                       _tup(forces), _tup(velocities)], params, (simplify,),
                       lambda: derive_constrained(T, U, q, holonomic, nonholonomic, params,
@@ -429,6 +543,16 @@ __all__ += ["Body", "planar_tree"]
 from .spatial import SpatialBody, spatial_tree  # noqa: E402
 
 __all__ += ["SpatialBody", "spatial_tree"]
+
+# closed loops on trees, forces at points of bodies, consistent initial states
+from .loops import Loop, PointForce, consistent_state  # noqa: E402
+
+__all__ += ["Loop", "PointForce", "consistent_state"]
+
+# robots from URDF files
+from .urdf import Robot, from_urdf, read_urdf  # noqa: E402
+
+__all__ += ["Robot", "from_urdf", "read_urdf"]
 
 # compiled events (Taylor series of g along each step, roots isolated: conmech_taylor_events)
 from .taylor_events import Event, event  # noqa: E402

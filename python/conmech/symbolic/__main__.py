@@ -67,11 +67,16 @@ def emit_file(model_path, out, name=None, module=None):
 
 
 def _write_atomic(path, text):
+    """Write through a temporary file and a rename; the file gets the mode of any new file
+    (0666 less the umask: 0644 usually), not mkstemp's private 0600."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent or ".", prefix=".emit_", suffix=".f90")
     try:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
+        mask = os.umask(0o022)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

@@ -12,10 +12,12 @@ parameter array ``p`` last)::
                   cm_forces_jac(t, q, v, a, R, p), real cm_energy(t, q, v, p),
                   cm_mass_forces(t, q, v, M, Q, p), and for planar trees
                   cm_accel(t, q, v, a, p) (see conmech.symbolic.tree)
-    constrained:  cm_mass, cm_forces, cm_energy, and as present cm_phi(t, q, c, p),
+    constrained:  cm_mass, cm_forces, cm_energy, cm_forces_jac (the force balance's
+                  Jacobian), and as present cm_phi(t, q, c, p),
                   cm_phi_jac(t, q, G, p), cm_phi_t(t, q, pt, p),
                   cm_phi_gamma(t, q, v, g, p), cm_nh_matrix(t, q, A, b, p),
-                  cm_nh_gamma(t, q, v, g, p)
+                  cm_nh_gamma(t, q, v, g, p), cm_constraint_hessian(t, q, v, lam, hl,
+                  hv, p) (see conmech.symbolic.constrained_jac)
 
 Each procedure's outputs share one common-subexpression elimination (sympy.cse). A
 generalized system derived in structured form (``Derived.struct``) computes the nonzero
@@ -32,31 +34,194 @@ a ``real(dp)`` literal (no integer division, no ``d0``).
 :class:`FortranPrinter` and :func:`assignments` are reusable by other emitters (e.g. a
 standalone module whose type extends conmech's system types).
 """
-import keyword
+import re
 
 import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
 __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
-           "trig_split", "ENTRY_POINTS", "product_terms", "product_lines"]
+           "trig_split", "ENTRY_POINTS", "product_terms", "product_lines", "comment_text",
+           "comment_lines", "string_constant", "check_source"]
 
 # C names of the entry points, per kind, with the name of conmech.compiled's argument
 ENTRY_POINTS = {
     "ode": ["rhs", "jac", "jac_prod"],
     "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces", "accel"],
     "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
-                    "nh_matrix", "nh_gamma"],
+                    "nh_matrix", "nh_gamma", "forces_jac", "constraint_hessian"],
 }
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "7"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
 #                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
 #                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed);
 #                         6: conmech_accel of planar trees (articulated-body algorithm)
 #                         7: conmech_taylor* (Taylor coefficients, conmech.symbolic.taylor)
+#                         8: constrained: conmech_forces_jac, conmech_constraint_hessian
+#                         9: user strings escaped (comments, parameter names as data)
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
+
+# ------------------------------------------------------------------ user strings
+# Every string a user gives (symbol, coordinate, parameter, body and joint names, file
+# names) reaches the generated Fortran only through these helpers: in a comment as printable
+# ASCII on one line (comment_text), in data as a character constant built from plain
+# characters and achar() codes (string_constant). check_source then refuses any source
+# with a character outside printable ASCII, an over-long line, or a procedure or C name
+# that is not one of the expected entry points, whatever produced it.
+
+_PLAIN = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                   "_ .,:;+-=()[]")
+
+
+def comment_text(text, limit=60):
+    """`text` as it may follow '!' in generated Fortran: one line of printable ASCII, every
+    other character (newlines, quotes and '&' included, for the reader's sake) written as a
+    \\x, \\u or \\U escape, cut to `limit` characters with '...'."""
+    out = []
+    for ch in str(text):
+        o = ord(ch)
+        if ch in _PLAIN or (32 < o < 127 and ch not in "\\\"'&!"):
+            out.append(ch)
+        elif o < 256:
+            out.append(f"\\x{o:02x}")
+        elif o < 65536:
+            out.append(f"\\u{o:04x}")
+        else:
+            out.append(f"\\U{o:08x}")
+    s = "".join(out)
+    return s if len(s) <= limit else s[:limit - 3] + "..."
+
+
+def comment_lines(text, prefix="!! ", width=96):
+    """Comment lines (each starting with `prefix`, at most `width` characters) holding
+    `text`, which must already be made safe by :func:`comment_text`."""
+    if any(not (32 <= ord(c) < 127) for c in text):
+        raise ValueError("comment_lines: text must be printable ASCII (use comment_text)")
+    words, lines, cur = text.split(" "), [], ""
+    room = width - len(prefix)
+    for w in words:
+        while len(w) > room:                  # an escaped name longer than a line
+            if cur:
+                lines.append(prefix + cur)
+                cur = ""
+            lines.append(prefix + w[:room])
+            w = w[room:]
+        if cur and len(cur) + 1 + len(w) > room:
+            lines.append(prefix + cur)
+            cur = w
+        else:
+            cur = (cur + " " + w) if cur else w
+    if cur:
+        lines.append(prefix + cur)
+    return lines
+
+
+def string_constant(text, indent="            "):
+    """Lines of a Fortran character constant expression equal to the UTF-8 bytes of
+    `text`: letters, digits, blanks and a few punctuation marks in quoted chunks, every
+    other byte as achar(code), joined by // with free-form continuations."""
+    parts, chunk = [], ""
+    for b in str(text).encode("utf-8"):
+        ch = chr(b)
+        if b < 128 and ch in _PLAIN:
+            chunk += ch
+            if len(chunk) >= 48:
+                parts.append(f'"{chunk}"')
+                chunk = ""
+        else:
+            if chunk:
+                parts.append(f'"{chunk}"')
+                chunk = ""
+            parts.append(f"achar({b})")
+    if chunk or not parts:
+        parts.append(f'"{chunk}"')
+    lines, cur = [], ""
+    for k, p in enumerate(parts):
+        piece = p + ("//" if k < len(parts) - 1 else "")
+        if cur and len(cur) + len(piece) > 72:
+            lines.append(indent + cur + " &")
+            cur = piece
+        else:
+            cur += piece
+    lines.append(indent + cur)
+    return lines
+
+
+_PROC = re.compile(r"^\s*(?:(?:pure|elemental|recursive|impure|module|real\s*\([^)]*\)|"
+                   r"integer(?:\s*\([^)]*\))?|logical|double\s+precision)\s+)*"
+                   r"(subroutine|function|entry)\s+(\w+)", re.IGNORECASE)
+_BIND = re.compile(r"bind\s*\(\s*c\s*(?:,\s*name\s*=\s*([\"'])([^\"']*)\1\s*)?\)",
+                   re.IGNORECASE)
+_END_PROC = re.compile(r"^\s*end\s+(subroutine|function)\b", re.IGNORECASE)
+
+
+def _code_part(line):
+    """The line without its comment (strings of generated code hold no '!': see
+    string_constant)."""
+    k = line.find("!")
+    return line if k < 0 else line[:k]
+
+
+_TREE_PROC = re.compile(r"^\s*(?:pure\s+)?subroutine\s+(tree_[a-z0-9_]+)\s*\(",
+                        re.I | re.M)
+
+
+def _c_names(entries, model_values):
+    """The C names a generated module binds: its entry points, and the model-library
+    description when it has default parameter values."""
+    names = [f"conmech_{e}" for e in entries]
+    if model_values is not None:
+        names += ["conmech_model_info", "conmech_model_params", "conmech_model_param_names"]
+    return names
+
+
+def private_procedures(entries, source=None):
+    """The internal (private, not C-bound) procedures the generated module defines beside
+    the entry points `entries`: the body that the quadruple-precision Taylor entry wraps,
+    and, given the `source` of a recursive tree, its passes (``tree_pos``, ``tree_vel``,
+    ... and their pieces: names the generator makes, never from user strings)."""
+    out = [f"conmech_{e}_body" for e in entries if e.endswith("taylor_qp")]
+    if source is not None:
+        out += sorted({m.lower() for m in _TREE_PROC.findall(source)})
+    return out
+
+
+def check_source(src, procedures, c_names=None, max_line=132):
+    """ValueError unless the generated source `src` is printable ASCII (plus newlines) with
+    lines of at most `max_line` characters, defines exactly the procedures named in
+    `procedures` (no other subroutine, function or entry), and binds to C only the names
+    in `c_names` (default: the procedure names); a last line of defence against a user
+    string reaching the code unescaped."""
+    allowed = {p.lower() for p in procedures}
+    c_allowed = set(procedures if c_names is None else c_names)
+    seen = []
+    for k, line in enumerate(src.split("\n"), 1):
+        bad = [c for c in line if not 32 <= ord(c) < 127]
+        if bad:
+            raise ValueError(f"generated Fortran line {k} holds the character {bad[0]!r}: "
+                             "a user string reached the code unescaped")
+        if len(line) > max_line:
+            raise ValueError(f"generated Fortran line {k} is longer than {max_line} "
+                             "characters")
+        code = _code_part(line)
+        if _END_PROC.match(code):
+            continue
+        m = _PROC.match(code)
+        if m:
+            name = m.group(2).lower()
+            if name not in allowed:
+                raise ValueError(f"generated Fortran line {k} defines an unexpected "
+                                 f"procedure '{m.group(2)}'")
+            seen.append(name)
+        for b in _BIND.finditer(code):
+            if not m or b.group(2) is None or b.group(2) not in c_allowed:
+                raise ValueError(f"generated Fortran line {k} binds an unexpected C name "
+                                 f"{b.group(2)!r}")
+    if sorted(seen) != sorted(allowed):
+        raise ValueError("generated Fortran defines the procedures "
+                         f"{sorted(seen)}, expected {sorted(allowed)}")
 
 
 class FortranPrinter(FCodePrinter):
@@ -71,7 +236,11 @@ class FortranPrinter(FCodePrinter):
         self._number_symbols = set()
 
     def _real(self, x):
-        s = repr(float(x))
+        try:
+            s = repr(float(x))
+        except OverflowError:
+            raise ValueError(f"the number {str(x)[:40]} is outside the range of double "
+                             "precision") from None
         if s in ("inf", "-inf", "nan"):
             raise ValueError(f"non-finite constant {x} in an expression")
         if "." not in s and "e" not in s:
@@ -93,6 +262,8 @@ class FortranPrinter(FCodePrinter):
     def _print_Rational(self, expr):
         # exact ratios of integers as a quotient of real literals (folded by the compiler)
         p, q = int(expr.p), int(expr.q)
+        if max(abs(p), q) >= 2**53:         # not exact as doubles: the rounded quotient
+            return self._real(float(expr))
         return f"({self._real(p)}/{self._real(q)})"
 
     def _print_Float(self, expr):
@@ -465,7 +636,7 @@ def _model_info(d, values):
     n_nh = getattr(d, "n_nh", 0) or 0
     rheo = int(bool(getattr(d, "rheonomic", False)))
     npar = len(d.params)
-    names = " ".join(d.param_names)
+    names = string_constant(" ".join(d.param_names), "            ")
     vals = ", ".join(FortranPrinter({})._real(float(v)) for v in values) or "0.0_dp"
     ind = "        "
     return [
@@ -483,7 +654,8 @@ def _model_info(d, values):
         'name="conmech_model_param_names")',
         f"{ind}integer(c_int), value, intent(in) :: n",
         f"{ind}character(kind=c_char), intent(out) :: buf(n)",
-        f'{ind}character(len=*), parameter :: names = "{names}"',
+        f"{ind}character(len=*), parameter :: names = &",
+        *names,
         f"{ind}integer :: i",
         f"{ind}buf = c_null_char",
         f"{ind}do i = 1, min(n - 1, len(names))",
@@ -494,14 +666,47 @@ def _model_info(d, values):
     ]
 
 
+def _constrained_derivative_procedures(printer, d, T, P, arr):
+    """The procedures conmech_forces_jac and (with constraints)
+    conmech_constraint_hessian of a constrained record: the exact Jacobian of Radau IIA on
+    its equations of motion."""
+    from .constrained_jac import constrained_derivatives
+    n = d.n
+    R, HL, HV, lam = constrained_derivatives(d)
+    QV = [T, arr("q", [n]), arr("v", [n])]
+    out = [_procedure(printer, "conmech_forces_jac", ["t", "q", "v", "a", "r", "p"],
+                      QV + [arr("a", [n]), arr("r", [n, 2 * n], "out"), P],
+                      [("r", R, True)])]
+    if HL is None:
+        return out
+    m = len(lam)
+    saved = printer.names
+    printer.names = {**saved, **{s: f"lam({i + 1})" for i, s in enumerate(lam)}}
+    try:
+        out.append(_procedure(printer, "conmech_constraint_hessian",
+                              ["t", "q", "v", "lam", "hl", "hv", "p"],
+                              QV + [arr("lam", [m]), arr("hl", [n, n], "out"),
+                                    arr("hv", [m, n], "out"), P],
+                              [("hl", HL, True), ("hv", HV, True)]))
+    finally:
+        printer.names = saved
+    return out
+
+
 def generate(d, module="conmech_symbolic_model", model_values=None):
     """Fortran source of the bind(C) module for the derived system `d`; returns
     (source, list of the entry points present, e.g. ["mass", "forces", ...]).
     With `model_values` (the default parameter values), the module also describes itself
     as a model library (conmech_model_info, conmech_model_params,
     conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`."""
-    if not module.isidentifier() or keyword.iskeyword(module):
-        raise ValueError(f"bad module name {module!r}")
+    if not isinstance(module, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", module):
+        raise ValueError(f"bad module name {module!r} (a Fortran name: a letter, then "
+                         "letters, digits or underscores; at most 63 characters)")
+    if hasattr(type(d), "generate_fortran"):     # a record that writes its own module
+        src, entries = d.generate_fortran(module, model_values)
+        c_names = _c_names(entries, model_values)
+        check_source(src, c_names + private_procedures(entries, src), c_names)
+        return src, entries
     pr = FortranPrinter(_names(d))
     n = d.n
     npar = max(len(d.params), 1)
@@ -590,10 +795,17 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                     QV + [arr("gam", [k], "out"), P],
                                     [("gam", d.gamma_n, False)]))
             entries += ["nh_matrix", "nh_gamma"]
-    names = ", ".join(getattr(d, "coord_names", [str(c) for c in d.coords]))
-    head = [
-        f"!> Generated by conmech.symbolic: {d.kind} system, coordinates {names};",
-        f"!! parameters p = [{', '.join(d.param_names)}]. Do not edit.",
+        if d.kind == "constrained":
+            procs += _constrained_derivative_procedures(pr, d, T, P, arr)
+            entries.append("forces_jac")
+            if d.n_hol or d.n_nh:
+                entries.append("constraint_hessian")
+    names = ", ".join(comment_text(c) for c in getattr(d, "coord_names",
+                                                         [str(c) for c in d.coords]))
+    pnames = ", ".join(comment_text(p) for p in d.param_names)
+    head = [f"!> Generated by conmech.symbolic: {d.kind} system."]
+    head += comment_lines(f"Coordinates {names}; parameters p = [{pnames}]. Do not edit.")
+    head += [
         f"module {module}",
         "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char, c_null_char, "
         "c_ptr, c_f_pointer",
@@ -601,9 +813,11 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
         "    implicit none",
         "    integer, parameter :: dp = c_double, qp = real128",
         "    public",
-        "contains",
-        "",
     ]
+    # the quadruple-precision Taylor entry wraps an internal body: private, so that the
+    # library exports conmech's C entry points only
+    internal = private_procedures(entries)
+    head += [f"    private :: {p}" for p in internal] + ["contains", ""]
     if model_values is not None:
         if len(model_values) != len(d.params):
             raise ValueError(f"{len(model_values)} parameter values for {len(d.params)} "
@@ -613,4 +827,6 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
     for p in procs:
         body += p
     src = "\n".join(head + body + [f"end module {module}", ""])
+    c_names = _c_names(entries, model_values)
+    check_source(src, c_names + internal, c_names)
     return src, entries

@@ -154,32 +154,101 @@ class Derived:
 # ------------------------------------------------------------------------------ helpers
 
 def _as_value(name, v):
+    """The float value of parameter `name`: a real number (int, float, a NumPy or sympy
+    real number); a bool, a string, a complex number or an expression is refused."""
     if v is None:
         raise ValueError(f"parameter '{name}' has no value")
+    if isinstance(v, (bool, np.bool_)):
+        raise TypeError(f"parameter '{name}' must be a real number, got {v!r}")
+    if isinstance(v, (str, bytes)):
+        raise ValueError(f"parameter '{name}' has no numeric value (got the string {v!r}: "
+                         "give a number)")
+    if isinstance(v, sp.Basic) and not (v.is_number and v.is_real):
+        raise ValueError(f"parameter '{name}' has no real numeric value (got {v!r})")
+    if isinstance(v, (complex, np.complexfloating)):
+        raise TypeError(f"parameter '{name}' must be a real number, got {v!r}")
     try:
         x = float(v)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"parameter '{name}' has no numeric value (got {v!r})") from None
     if not np.isfinite(x):
-        raise ValueError(f"parameter '{name}' must be finite (got {x})")
+        raise ValueError(f"parameter '{name}' must be finite (got {v!r})")
     return x
+
+
+# unevaluated operations that have no value at run time (compiled code evaluates numbers)
+_UNEVALUATED = (sp.Integral, sp.Sum, sp.Product, sp.Limit, sp.Subs, sp.Order)
+_DOUBLE_MAX = 1.7976931348623157e308
+
+
+def _check_entry(e, label):
+    """ValueError naming the entry `label` (e.g. f[1]) unless `e` can become real double
+    precision code: no complex number, no nan or infinity, no unevaluated integral, sum,
+    product or limit, every number within double range."""
+    if e.has(sp.nan):
+        raise ValueError(f"{label} contains nan (not a number): {e}")
+    if e.has(sp.zoo, sp.oo, sp.S.NegativeInfinity):
+        raise ValueError(f"{label} contains an infinity (oo or zoo, e.g. from a division "
+                         f"by zero): {e}")
+    if e.has(sp.I):
+        raise ValueError(f"{label} contains the imaginary unit I: conmech integrates real "
+                         "systems; write the real and imaginary parts as separate states "
+                         f"({e})")
+    for cls in _UNEVALUATED:
+        for a in e.atoms(cls):
+            raise ValueError(f"{label} contains the unevaluated {cls.__name__} {a}: "
+                             "evaluate it (.doit()) or write out what it stands for")
+    for a in e.atoms(sp.Number):
+        try:
+            x = abs(float(a))
+        except (OverflowError, TypeError, ValueError):
+            x = float("inf")
+        if not x <= _DOUBLE_MAX or (x == 0.0 and a != 0):
+            text = str(a)
+            if len(text) > 30:
+                text = (f"{text[:12]}... ({len(str(abs(a.p)))}-digit numerator, "
+                        f"{len(str(a.q))}-digit denominator)" if a.is_Rational
+                        else text[:30] + "...")
+            raise ValueError(f"{label} contains the number {text}, outside the range of "
+                             "double precision (magnitudes 5e-324 to 1.8e308)")
+    for a in e.atoms(sp.NumberSymbol):
+        if not a.is_real:
+            raise ValueError(f"{label} contains {a}, which is not a real number")
 
 
 def _sympify_list(exprs, what):
     if isinstance(exprs, sp.MatrixBase):
+        if min(exprs.shape) > 1:
+            raise ValueError(f"{what} is a {exprs.shape[0]} x {exprs.shape[1]} matrix: give "
+                             "a list or a column vector of scalar expressions")
         exprs = list(exprs)
+        single = False
     elif not isinstance(exprs, (list, tuple)):
         exprs = [exprs]
+        single = True
+    else:
+        single = False
     out = []
-    for e in exprs:
+    for i, e in enumerate(exprs):
+        label = what if single else f"{what}[{i}]"
+        if isinstance(e, (sp.MatrixBase, np.ndarray, list, tuple)) or getattr(
+                e, "is_Matrix", False):
+            raise ValueError(f"{label} is a matrix or a list, not a scalar expression "
+                             "(nested entries are not flattened: give one expression per "
+                             "entry)")
+        if isinstance(e, (bool, np.bool_)):
+            raise TypeError(f"{label}: {e!r} is a bool, not an expression")
         try:
             e = sp.sympify(e)
         except (sp.SympifyError, TypeError) as exc:
-            raise TypeError(f"{what}: cannot read {e!r} as a sympy expression") from exc
+            raise TypeError(f"{label}: cannot read {e!r} as a sympy expression") from exc
         if isinstance(e, sp.Equality):          # a constraint written as lhs == rhs
             e = e.lhs - e.rhs
+        if getattr(e, "is_Matrix", False):
+            raise ValueError(f"{label} is a matrix, not a scalar expression")
         if not isinstance(e, sp.Expr):
-            raise TypeError(f"{what}: {e!r} is not a scalar expression")
+            raise TypeError(f"{label}: {e!r} is not a scalar expression")
+        _check_entry(e, label)
         out.append(e)
     return out
 
@@ -312,7 +381,7 @@ def _resolve_params(params, exprs, known, t):
         else:
             raise TypeError(f"params key {k!r} must be a sympy Symbol or a string")
         if not name.isidentifier():
-            raise ValueError(f"parameter name '{name}' is not an identifier")
+            raise ValueError(f"parameter name {name!r} is not an identifier")
         if name in known_names:
             raise ValueError(f"'{name}' is a coordinate, a velocity or the time, not a "
                              "parameter")

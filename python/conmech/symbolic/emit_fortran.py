@@ -46,7 +46,8 @@ import re
 
 import sympy as sp
 
-from .codegen import FortranPrinter, assignments, product_lines, product_terms
+from .codegen import (FortranPrinter, assignments, check_source, comment_lines, comment_text,
+                      product_lines, product_terms)
 
 __all__ = ["emit", "fortran_name_check"]
 
@@ -57,6 +58,13 @@ _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energ
              "rhs", "jacobian", "has_jacobian", "self", "dp", "jacobian_product",
              "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian",
              "taylor_size", "taylor_jet"}
+# names the type may not take: Fortran's intrinsic types (C424 of Fortran 2008) and what the
+# emitted code takes from conmech and the intrinsic modules (a local name would hide them)
+_TYPE_TAKEN = {"real", "integer", "logical", "character", "complex", "doubleprecision",
+               "doublecomplex", "ode_system", "generalized_system", "constrained_system",
+               "cm_success", "mass_cholesky", "dpotrs", "ieee_value", "ieee_quiet_nan",
+               "ieee_arithmetic", "ieee_exceptions", "ieee_features", "iso_c_binding",
+               "iso_fortran_env"}
 _IND = "        "
 
 
@@ -69,18 +77,43 @@ def fortran_name_check(name, what):
     return name
 
 
-def _check_params(d):
-    seen = {}
-    for name in d.param_names:
-        fortran_name_check(name, "parameter")
+_FNAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,62}")
+
+
+def _component_names(d):
+    """The Fortran component name of each parameter: its own name when that is a Fortran
+    name (a clash with a name the generated code uses, or two names equal but for case, is
+    an error: rename in the model); a name that cannot be one (non-ASCII letters, a leading
+    underscore, longer than 40 characters) is mapped to a safe identifier (its letters and
+    digits, other characters as uXXXX, prefixed p_), the original kept in the component's
+    comment."""
+    seen, out = {}, []
+    valid = {n.lower() for n in d.param_names if _FNAME.fullmatch(n) and len(n) <= 40}
+    for i, name in enumerate(d.param_names):
         low = name.lower()
-        if low in _RESERVED:
-            raise ValueError(f"parameter '{name}' clashes with a name the generated code "
-                             "uses (rename it in the model)")
-        if low in seen:
-            raise ValueError(f"parameters '{seen[low]}' and '{name}' are the same name in "
-                             "Fortran (case-insensitive): rename one")
-        seen[low] = name
+        if _FNAME.fullmatch(name) and len(name) <= 40:
+            if low in _RESERVED:
+                raise ValueError(f"parameter '{name}' clashes with a name the generated code "
+                                 "uses (rename it in the model)")
+            if low in seen:
+                raise ValueError(f"parameters '{seen[low]}' and '{name}' are the same name "
+                                 "in Fortran (case-insensitive): rename one")
+            cand = name
+        else:
+            body = "".join(c if (c.isascii() and (c.isalnum() or c == "_")) else
+                           f"u{ord(c):x}" for c in name)
+            cand = f"p_{body}" if len(body) <= 30 else f"p{i + 1}"
+            while cand.lower() in seen or cand.lower() in valid or cand.lower() in _RESERVED:
+                cand += "_"
+        seen[cand.lower()] = name
+        out.append(cand)
+    return out
+
+
+def _code(line):
+    """A generated line without its comment (no string literal in emitted code holds '!')."""
+    k = line.find("!")
+    return line if k < 0 else line[:k]
 
 
 def _lit(x):
@@ -92,24 +125,12 @@ def _lit(x):
     return s + "_dp"
 
 
-def _wrap_comment(text, prefix="!! ", width=96):
-    words, lines, cur = text.split(), [], ""
-    for w in words:
-        if cur and len(prefix) + len(cur) + 1 + len(w) > width:
-            lines.append(prefix + cur)
-            cur = w
-        else:
-            cur = (cur + " " + w) if cur else w
-    if cur:
-        lines.append(prefix + cur)
-    return lines
-
-
 class _Emitter:
-    def __init__(self, d, name):
+    def __init__(self, d, name, comp):
         self.d = d
         self.name = name
         self.n = d.n
+        self.comp = comp
 
     def printer(self, state_in_y=False):
         d = self.d
@@ -120,7 +141,7 @@ class _Emitter:
             names[s] = f"y({self.n + i + 1})" if state_in_y else f"v({i + 1})"
         for i, s in enumerate(d.accels):
             names[s] = f"a({i + 1})"
-        for s, pn in zip(d.params, d.param_names):
+        for s, pn in zip(d.params, self.comp):
             names[s] = f"self%{pn}"
         return FortranPrinter(names)
 
@@ -192,10 +213,11 @@ def _logical_true(tname, pname, doc):
             f"    end function {pname}", ""]
 
 
-def _components(d):
+def _components(d, comp):
     out = []
-    for pn, pv in zip(d.param_names, d.param_values):
-        out.append(f"{_IND[:8]}real(dp) :: {pn} = {_lit(pv)}   !! parameter")
+    for pn, orig, pv in zip(comp, d.param_names, d.param_values):
+        note = "" if pn == orig else f" {comment_text(orig, 40)}"
+        out.append(f"{_IND[:8]}real(dp) :: {pn} = {_lit(pv)}   !! parameter{note}")
     return out
 
 
@@ -208,24 +230,47 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         raise TypeError("emit: expected a conmech.symbolic.derive.Derived record")
     if d.kind not in ("ode", "generalized", "constrained"):
         raise ValueError(f"emit: unknown kind {d.kind!r}")
+    if hasattr(type(d), "generate_fortran"):     # a tree built by the recursive algorithms
+        raise ValueError("emit: this tree was built by the recursive algorithms (bind(C) "
+                         "module only); for a standalone module use the Lagrangian route: "
+                         "conmech.symbolic.tree.derive_tree(...) or "
+                         "conmech.symbolic.spatial.derive_spatial_tree(...)")
     fortran_name_check(name, "type name")
     if len(name) > 40:
         raise ValueError(f"type name '{name}' is longer than 40 characters")
-    if keyword.iskeyword(name) or name.lower() in _RESERVED:
-        raise ValueError(f"type name '{name}' is reserved")
+    if keyword.iskeyword(name) or name.lower() in _RESERVED | _TYPE_TAKEN:
+        raise ValueError(f"type name '{name}' is reserved (an intrinsic type or module, or a "
+                         "name the generated code uses)")
     module = module or f"{name}_model"
     fortran_name_check(module, "module name")
     if module.lower() == name.lower():
         raise ValueError("the module and the type need different names")
-    _check_params(d)
-    em = _Emitter(d, name)
+    if keyword.iskeyword(module) or module.lower() in _RESERVED | _TYPE_TAKEN:
+        raise ValueError(f"module name '{module}' is reserved (an intrinsic type or module, "
+                         "or a name the generated code uses)")
+    for what, nm in (("type", name), ("module", module)):
+        if nm.lower().startswith("conmech"):
+            raise ValueError(f"{what} name '{nm}': names beginning with 'conmech' belong to "
+                             "the library's modules")
+    if d.kind == "generalized" and d.R is None:
+        raise ValueError("emit: the model was derived without its Jacobian (jacobian=False); "
+                         "the emitted type's exact Jacobian needs it: derive with "
+                         "jacobian=True")
+    comp = _component_names(d)
+    em = _Emitter(d, name, comp)
     n = d.n
-    coord_names = ", ".join(getattr(d, "coord_names", [str(c) for c in d.coords]))
-    params = ", ".join(f"{a} = {b!r}" for a, b in zip(d.param_names, d.param_values))
-    header = [f"!> {name}: {d.kind} system generated by conmech.symbolic from {source}."]
-    header += _wrap_comment(f"Coordinates: {coord_names}. Parameters (components with "
-                            f"defaults): {params or 'none'}. Generated code: do not edit; "
-                            "regenerate with python -m conmech.symbolic emit.")
+    coord_names = ", ".join(comment_text(c) for c in getattr(d, "coord_names",
+                                                              [str(c) for c in d.coords]))
+    params = ", ".join(f"{a} = {b!r}" for a, b in zip(comp, d.param_values))
+    rest = (f"Coordinates: {coord_names}. Parameters (components with defaults): "
+            f"{params or 'none'}. Generated code: do not edit; regenerate with python -m "
+            "conmech.symbolic emit.")
+    first = f"!> {name}: {d.kind} system generated by conmech.symbolic from"
+    src_name = comment_text(source, 80)
+    if len(first) + len(src_name) + 2 <= 100:
+        header = [f"{first} {src_name}."] + comment_lines(rest)
+    else:
+        header = [first] + comment_lines(f"{src_name}. {rest}")
     if d.kind == "ode":
         header += [f"!! Use: new_{name}() is an ode_system with the exact Jacobian (ode_solve,",
                    "!! integrate_stm and conmech's stability routines)."]
@@ -237,13 +282,13 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         header += [f"!! Use: new_{name}() is a constrained_system for constrained_solve."]
     lines = header + [f"module {module}", "    use conmech", "    implicit none",
                       "    private", ""]
-    body = []
+    body, helpers = [], []
     if d.kind == "ode":
         lines += [f"    public :: {name}, new_{name}",
                   f"    integer, parameter, public :: {name}_n = {n}   !! state dimension",
                   "", "    !> y' = f(t, y) with the exact Jacobian df/dy.",
                   f"    type, extends(ode_system) :: {name}"]
-        lines += _components(d)
+        lines += _components(d, comp)
         lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
                   f"        procedure :: jacobian => {name}_jacobian",
                   f"        procedure :: has_jacobian => {name}_has_jacobian",
@@ -254,7 +299,9 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         from .taylor import emitted_taylor
         tbind, tprocs, _ = emitted_taylor(name, d, pr.names)
         lines += tbind + [f"    end type {name}", ""]
-        body += _ctor(name, name, [], d)
+        # the type-bound taylor_jet calls one private helper per kind (system, variational)
+        helpers = [f"{name}_taylor{k}" for k in (0, 1)] if tprocs else []
+        body += _ctor(name, name, [], d, comp)
         body += em.proc("ode", name, f"{name}_rhs", ["t", "y", "dydt"],
                         [_decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out")], pr,
                         [("dydt", d.f, False)], "dydt = f(t, y).")
@@ -271,7 +318,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                   f"    integer, parameter, public :: {name}_ny = {2 * n}   !! y = [q, v]",
                   "", "    !> M(t, q) q'' = Q(t, q, q') (for generalized_solve).",
                   f"    type, extends(generalized_system) :: {mech}"]
-        lines += _components(d)
+        lines += _components(d, comp)
         lines += ["    contains", f"        procedure :: mass => {mech}_mass",
                   f"        procedure :: forces => {mech}_forces"]
         if d.energy is not None:
@@ -280,7 +327,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         lines += [f"    end type {mech}", "",
                   "    !> First-order form y = [q, v], y' = [v, M^-1 Q], exact Jacobian.",
                   f"    type, extends(ode_system) :: {name}"]
-        lines += _components(d)
+        lines += _components(d, comp)
         lines += ["    contains", f"        procedure :: rhs => {name}_rhs",
                   f"        procedure :: jacobian => {name}_jacobian",
                   f"        procedure :: has_jacobian => {name}_has_jacobian"]
@@ -289,8 +336,8 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         lines += [f"    end type {name}", ""]
         pr = em.printer()
         pry = em.printer(state_in_y=True)
-        body += _ctor(mech, mech, [f"s%ndof = {n}"], d)
-        body += _ctor(name, name, [], d)
+        body += _ctor(mech, mech, [f"s%ndof = {n}"], d, comp)
+        body += _ctor(name, name, [], d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
         body += em.proc("g", mech, f"{mech}_mass", ["t", "q", "mm"],
@@ -317,7 +364,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                   f"    integer, parameter, public :: {name}_n_nh = {d.n_nh}", "",
                   "    !> M q'' = Q + G^T lambda_h + A^T lambda_n with the constraints.",
                   f"    type, extends(constrained_system) :: {name}"]
-        lines += _components(d)
+        lines += _components(d, comp)
         procs = ["mass", "forces"]
         if d.energy is not None:
             procs += ["energy", "has_energy"]
@@ -330,7 +377,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         pr = em.printer()
         ctor = [f"s%n = {n}", f"s%n_hol = {d.n_hol}", f"s%n_nh = {d.n_nh}",
                 f"s%rheonomic = {'.true.' if d.rheonomic else '.false.'}"]
-        body += _ctor(name, name, ctor, d)
+        body += _ctor(name, name, ctor, d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
         body += em.proc("c", name, f"{name}_mass", ["t", "q", "mm"],
@@ -368,16 +415,28 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     for ln in src:
         if len(ln) > 100:
             raise RuntimeError(f"emit: generated line longer than 100 characters: {ln!r}")
-    return "\n".join(src)
+    text = "\n".join(src)
+    # the procedures are the type-bound ones and the constructors; no C binding at all
+    procs = [ln.split("=>")[1].strip() for ln in src if "procedure ::" in ln and "=>" in ln]
+    procs += [ln.split("function ")[1].split("(")[0] for ln in src
+              if ln.startswith("    function new_")]
+    procs += helpers
+    check_source(text, sorted(set(procs)), c_names=[], max_line=100)
+    # the module's name is a global name: no entity inside may take it
+    inner = "\n".join(_code(ln) for ln in src[1:-2] if not ln.startswith("module "))
+    if re.search(rf"(?<![%\w]){re.escape(module)}(?!\w)", inner, re.IGNORECASE):
+        raise ValueError(f"module name '{module}' is also a name inside the module (a "
+                         "procedure, constant or component): choose another")
+    return text
 
 
-def _ctor(tname, fname, sets, d):
+def _ctor(tname, fname, sets, d, comp):
     """Constructor function: dimensions and the default parameter values, assigned
     explicitly (gfortran does not always default-initialise a function result)."""
     lines = [f"    !> A {tname} with its dimensions set and the default parameters.",
              f"    function new_{fname}() result(s)", f"{_IND}type({tname}) :: s"]
     lines += [f"{_IND}{s}" for s in sets]
-    lines += [f"{_IND}s%{pn} = {_lit(pv)}" for pn, pv in zip(d.param_names, d.param_values)]
+    lines += [f"{_IND}s%{pn} = {_lit(pv)}" for pn, pv in zip(comp, d.param_values)]
     lines += [f"    end function new_{fname}", ""]
     return lines
 

@@ -912,8 +912,11 @@ def event_exprs(d, exprs):
             e = sp.sympify(e)
         except (sp.SympifyError, TypeError) as exc:
             raise TypeError(f"events[{i}]: cannot read {e!r} as a sympy expression") from exc
-        if not isinstance(e, sp.Expr):
+        if not isinstance(e, sp.Expr) or getattr(e, "is_Matrix", False):
             raise TypeError(f"events[{i}]: {e!r} is not a scalar expression")
+        # complex, non-finite, unevaluated or out-of-range entries: a ValueError naming it
+        from .derive import _check_entry
+        _check_entry(e, f"events[{i}]")
         sub = {}
         for s in e.free_symbols:
             if s.name == d.t.name:

@@ -80,7 +80,7 @@ def compile_events(d, exprs, flags=None):
     """Compile (or take from the cache) the series routine of the events `exprs` of the
     ode record `d`; returns {"fn": ctypes function, "address", "nw", "ne", "lib"}."""
     src = event_source(d, exprs)
-    path, _ = compile_source(src, flags)
+    path, _ = compile_source(src, flags, ["taylor_events", "taylor_events_info"])
     lib, addr = load(path, ["taylor_events", "taylor_events_info"])
     info = (ctypes.c_int*4)()
     lib.conmech_taylor_events_info(info)

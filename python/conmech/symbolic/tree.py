@@ -166,7 +166,7 @@ class _Code:
             return e
         if e in self.memo:
             return self.memo[e]
-        s = sp.Dummy(f"{name}{len(self.defs) + 1}", real=True)
+        s = sp.Dummy(f"{name}{len(self.defs) + 1}")
         self.defs.append((s, e))
         self.mine.add(s)
         self.memo[e] = s
@@ -177,8 +177,9 @@ class _Code:
         self.defs.append((s, "positive"))
 
 
-def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
-    """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs."""
+def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
+    """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs
+    (`trig`: {body name: (cos, sin) symbols} of the joint angles computed elsewhere)."""
     code = _Code()
     L = code.let
     n = len(order)
@@ -200,7 +201,10 @@ def _aba(order, index, data, qs, vs, tau_user, gravity, absolute):
         qd = vs[i] - vs[index[k]] if k is not None else vs[i]
         qd = L(qd, "qd")
         if b.joint == "revolute":
-            s, c = L(sp.sin(qrel), "s"), L(sp.cos(qrel), "c")
+            if trig is not None:
+                c, s = trig[b.name]
+            else:
+                s, c = L(sp.sin(qrel), "s"), L(sp.cos(qrel), "c")
             E = [[c, s], [-s, c]]
             rx, ry = at
             S = (1, 0, 0)
@@ -527,7 +531,8 @@ def derive_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
 
 
 def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="relative", *,
-                simplify="auto", jacobian=True, flags=None, model_only=False):
+                loops=None, point_forces=None, method="recursive", simplify="auto",
+                jacobian=True, flags=None, model_only=False):
     """A compiled planar multibody tree (see the module docstring for frames and
     conventions).
 
@@ -547,15 +552,29 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
     coordinates : {"relative", "absolute"}
         Revolute joints' angles relative to the parent, or the bodies' angles from the
         ground frame (prismatic coordinates are the slide in both).
+    loops : list of Loop, optional
+        Joints that close kinematic loops (:class:`conmech.symbolic.Loop`: revolute or
+        prismatic). The system is then a constrained system in the tree's coordinates for
+        :func:`conmech.constrained.solve` (see :mod:`conmech.symbolic.loops`).
+    point_forces : list of PointForce, optional
+        Forces at points of bodies (:class:`conmech.symbolic.PointForce`), mapped through
+        the points' Jacobians.
+    method : {"recursive", "lagrangian"}
+        "recursive" (default): M, Q and the exact Jacobian from the recursive algorithms
+        (:mod:`conmech.symbolic.recursive`; construction linear in the number of bodies);
+        "lagrangian": from T and U by the Lagrangian derivation (no loops or point forces).
     simplify, jacobian, flags, model_only
-        As in :func:`conmech.symbolic.lagrangian_system`.
+        As in :func:`conmech.symbolic.lagrangian_system` (``simplify``: Lagrangian route
+        only).
 
     Returns
     -------
     conmech.compiled.CompiledSystem
         A system in generalized coordinates, state y = [q, q'], whose right-hand side uses
         the articulated-body algorithm; mass matrix, forces, energy and the exact Jacobian
-        come from the Lagrangian (``model_only=True``: the :class:`CompiledModel`).
+        come from the recursive algorithms (or the Lagrangian); with ``loops`` a
+        ``conmech.compiled.CompiledConstrained`` (``model_only=True``: the
+        :class:`CompiledModel`).
 
     Examples
     --------
@@ -572,9 +591,17 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
     parts = build_tree(bodies, gravity, forces, coordinates, lazy=True)
     _check_leaves(parts["order"], parts["data"], params)
     q = parts["q"]
+    method, extra = _method_key(method, loops, point_forces)
+    if method == "recursive":
+        from .recursive import derive_recursive
 
-    def derive():
-        return _derive(parts, params, simplify, jacobian)
+        def derive():
+            return derive_recursive(parts, params, planar=True,
+                                    absolute=coordinates == "absolute", loops=loops,
+                                    jacobian=jacobian, point_forces=point_forces)
+    else:
+        def derive():
+            return _derive(parts, params, simplify, jacobian)
 
     body_key = sp.Tuple(*[sp.Tuple(*parts["data"][b.name][0], *parts["data"][b.name][1],
                                    parts["data"][b.name][2], *parts["data"][b.name][3],
@@ -582,9 +609,70 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
     topo = tuple((b.name, b.parent, b.joint) for b in parts["order"])
     # the key: the description (T and U follow from it; built only on a cache miss)
     return _construct("tree", [_tup(q), _tup(parts["forces"]), _tup(parts["gravity"]),
-                               body_key], params,
-                      (coordinates, simplify, bool(jacobian), topo), derive, flags,
-                      model_only)
+                               body_key] + extra, params,
+                      (coordinates, simplify, bool(jacobian), topo, method) + _loop_names(
+                          loops, point_forces), derive, flags, model_only)
+
+
+def _method_key(method, loops, point_forces):
+    """The checked method and the loops' and point forces' expressions for the cache key."""
+    if method not in ("recursive", "lagrangian"):
+        raise ValueError(f"method must be 'recursive' or 'lagrangian', got {method!r}")
+    if method == "lagrangian" and (loops or point_forces):
+        raise ValueError("loops and point forces need method='recursive'")
+    from .loops import Loop, PointForce
+    extra = []
+    for x in _as_list(loops, Loop):
+        if not isinstance(x, Loop):
+            raise TypeError(f"loops must be conmech.symbolic.Loop records, got "
+                            f"{type(x).__name__}")
+    for x in _as_list(point_forces, PointForce):
+        if not isinstance(x, PointForce):
+            raise TypeError(f"point_forces must be conmech.symbolic.PointForce records, got "
+                            f"{type(x).__name__}")
+    for lp in _as_list(loops, Loop):
+        extra.append(sp.Tuple(*[_tuple_of(x) for x in (lp.point_a, lp.point_b, lp.axis,
+                                                        lp.axis_b, lp.angle)]))
+    for pf in _as_list(point_forces, PointForce):
+        extra.append(sp.Tuple(_tuple_of(pf.point), _tuple_of(pf.force)))
+    if method == "recursive":
+        from .recursive import recursive_version
+        method = "recursive"
+        extra.append(sp.Symbol("recursive_" + recursive_version()))
+    return method, extra
+
+
+def _as_list(x, cls):
+    if x is None:
+        return []
+    if isinstance(x, cls):
+        return [x]
+    try:
+        return list(x)
+    except TypeError:
+        raise TypeError(f"expected a list of {cls.__name__} records") from None
+
+
+def _tuple_of(x):
+    """x (None, an expression or a sequence of them) as a sympy object for the key."""
+    if x is None:
+        return sp.Integer(0)
+    try:
+        return sp.Tuple(*[sp.sympify(e) for e in x])
+    except TypeError:
+        return sp.sympify(x)
+
+
+def _loop_names(loops, point_forces):
+    """The string parts of the loops and point forces (bodies, joints) for the key."""
+    from .loops import Loop, PointForce
+    out = []
+    for lp in _as_list(loops, Loop):
+        out.append(("loop", repr(lp.body_a), repr(lp.body_b), repr(lp.joint),
+                    repr(lp.name)))
+    for pf in _as_list(point_forces, PointForce):
+        out.append(("pf", repr(pf.body), repr(pf.frame)))
+    return tuple(out)
 
 
 def aba_lines(printer, d, target="a", ind="        "):

@@ -12,8 +12,11 @@
 !!     gamma(t, q, v, gam, n, mh)   G q'' = gam                 (if has_gamma, else FD)
 !!     nh(t, q, a, b, n, mn)        a(mn, n), b(mn): A q' + b = 0
 !!     nhgamma(t, q, v, gam, n, mn) A q'' = gam                 (if has_nh_gamma, else FD)
-!!     store(t, q, v, lam, reac, rp, rv, en, pw, n, mm, nt)  the result, once, at the end
-!!         (lam is (mm, nt), mm = max(n_hol + n_nh, 1); zero rows when there is no constraint)
+!!     store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)  the result, once, at
+!!         the end (acc (n, nt) the accelerations; lam is (mm, nt), mm = max(n_hol + n_nh,
+!!         1); cm (mm, n, nt) the constraint matrix C = [G; A] at every output, from which
+!!         the caller forms the generalized force C_i^T lam_i of each constraint; zero rows
+!!         when there is no constraint)
 module conmech_flat_mech_support
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
@@ -135,8 +138,8 @@ contains
     end subroutine cb_nh_gamma
 
     !> Run `constrained_solve` from plain arguments; the result goes to `store`.
-    !! first_step 0: automatic; neval 0: output at every accepted step. iopt(1:4) =
-    !! [projection, every, proj_max_iter, max_steps]; ropt(1:5) = [first_step, max_step,
+    !! first_step 0: automatic; neval 0: output at every accepted step. iopt(1:5) =
+    !! [projection, every, proj_max_iter, max_steps, dae_index]; ropt(1:5) = [first_step, max_step,
     !! alpha, beta, proj_tol]. stats(1:7) = [nfev, naccept, nreject, nproj, proj_iter, rank,
     !! proj_iter_max];
     !! moved(1:2) = [dq0, dv0]. Optional events (every method): ne functions of
@@ -150,7 +153,7 @@ contains
         real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
         integer(c_int), intent(in) :: method
         real(c_double), intent(in) :: rtol, atol
-        integer(c_int), intent(in) :: iopt(4)
+        integer(c_int), intent(in) :: iopt(5)
         real(c_double), intent(in) :: ropt(5)
         integer(c_int), intent(in) :: neval
         real(c_double), intent(in) :: t_eval(max(neval, 1))
@@ -167,8 +170,9 @@ contains
         type(callback_events) :: ev
         integer(c_int) :: nev_fun
         type(constrained_result) :: r
-        real(dp), allocatable :: lam(:, :)
-        integer(c_int) :: m, mm, nt, nn
+        real(dp), allocatable :: lam(:, :), cm(:, :, :)
+        real(dp), allocatable :: c0(:)
+        integer(c_int) :: m, mm, nt, nn, j
 
         stats = 0
         moved = 0.0_dp
@@ -186,6 +190,7 @@ contains
         opt%projection = iopt(1)
         opt%every = iopt(2)
         opt%proj_max_iter = iopt(3)
+        opt%dae_index = iopt(5)
         opt%alpha = ropt(3)
         opt%beta = ropt(4)
         opt%proj_tol = ropt(5)
@@ -212,8 +217,15 @@ contains
         allocate (lam(mm, max(nt, 1)))
         lam = 0.0_dp
         if (m > 0 .and. nt > 0) lam(1:m, 1:nt) = r%lam
-        if (nt > 0) call store(r%t, r%q, r%v, lam, r%reaction, r%res_pos, r%res_vel, &
-                               r%energy, r%power, nn, mm, nt)
+        allocate (cm(mm, n, max(nt, 1)), c0(mm))
+        cm = 0.0_dp
+        if (m > 0) then
+            do j = 1, nt
+                call constraint_matrix(sys, r%t(j), r%q(:, j), cm(1:m, :, j), c0(1:m))
+            end do
+        end if
+        if (nt > 0) call store(r%t, r%q, r%v, r%acc, lam, r%reaction, cm, r%res_pos, &
+                               r%res_vel, r%energy, r%power, nn, mm, nt)
         if (nev_fun > 0 .and. r%nev > 0) call evstore(r%ev_t, r%ev_q, r%ev_v, r%ev_id, nn, &
                                                       int(r%nev, c_int))
 

@@ -17,13 +17,16 @@
 module conmech_flat_ode_support
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system, ode_events
-    use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOPRI5
+    use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOPRI5, &
+        ode_stepper
+    use conmech_ode_methods, only: new_stepper
+    use conmech_radau_stepper, only: radau_stepper
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
-    public :: scipy_first_step
+    public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
     !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
@@ -92,16 +95,43 @@ contains
         dst = src
     end subroutine copy_message
 
+    !> What the caller knows of df/dy, on a fresh stepper of a method that uses it (Radau):
+    !! constant (jac_const /= 0: read once, never re-evaluated, not counted in njev), and
+    !! the sparsity pattern (nnz >= 0: column pointers sp_ptr(1:n + 1), rows sp_idx(1:nnz),
+    !! 1-based) for differences by groups of columns. Other methods ignore both.
+    subroutine set_jacobian_structure(s, n, jac_const, nnz, sp_ptr, sp_idx, info, msg)
+        class(ode_stepper), intent(inout) :: s
+        integer(c_int), intent(in) :: n, jac_const, nnz, sp_ptr(:), sp_idx(:)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(inout) :: msg
+        info = CM_SUCCESS
+        select type (s)
+        type is (radau_stepper)
+            s%jstruct%constant = jac_const /= 0
+            if (nnz >= 0) then
+                if (size(sp_ptr) < n + 1 .or. size(sp_idx) < nnz) then
+                    info = CM_BAD_INPUT
+                    msg = "bad input: jac_sparsity: arrays too short"
+                    return
+                end if
+                call s%jstruct%set_pattern(n, sp_ptr(1:n + 1), sp_idx(1:nnz), info, msg)
+            end if
+        end select
+    end subroutine set_jacobian_structure
+
     !> Solve with `ode_solve` (any method of the table) from plain arguments and pass the
     !! result to `store`; counts = [nfev, njev, nlu, naccept, nreject].
     !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
     !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
-    !! t_eval, ev_dir, ev_term have at least one element (f2py cannot pass empty ones).
+    !! t_eval, ev_dir, ev_term, ev_res have at least one element (f2py cannot pass empty
+    !! ones). ev_res: each event's resolution (0: SciPy's rule, the step's ends only).
+    !! jac_const, nnz, sp_ptr, sp_idx: `set_jacobian_structure`.
     !! dense_form: the polynomial form of the dense coefficients (dense_solution%form of
     !! conmech_ode_solver: 1 Hairer's, 2 power basis; 0 without dense output).
     subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
-                         max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, events, store, &
-                         counts, dense_form, info, message)
+                         max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
+                         jac_const, nnz, sp_ptr, sp_idx, events, store, counts, dense_form, &
+                         info, message)
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: n
         real(c_double), intent(in) :: t_span(2)
@@ -113,6 +143,8 @@ contains
         real(c_double), intent(in) :: t_eval(max(neval, 1))
         integer(c_int), intent(in) :: ne
         integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+        real(c_double), intent(in) :: ev_res(max(ne, 1))
+        integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
         external :: events, store
         integer(c_int), intent(out) :: counts(5), dense_form, info
         character(len=*), intent(out) :: message
@@ -120,8 +152,10 @@ contains
         type(ode_options) :: opt
         type(ode_result) :: res
         type(callback_events) :: ev
+        class(ode_stepper), allocatable :: stp
+        character(len=:), allocatable :: msg
         real(c_double) :: empty1(0), empty3(n, 1, 0)
-        integer :: nseg, nf1
+        integer :: nseg, nf1, sinfo
         integer(c_int) :: nfev
 
         nfev = 0
@@ -143,6 +177,14 @@ contains
         opt%max_step = max_step
         opt%max_steps = max_steps
         opt%dense_output = dense /= 0
+        call new_stepper(opt%method, stp, sinfo, msg)
+        if (sinfo == CM_SUCCESS) call set_jacobian_structure(stp, n, jac_const, nnz, sp_ptr, &
+                                                             sp_idx, sinfo, msg)
+        if (sinfo /= CM_SUCCESS) then
+            info = sinfo
+            call copy_message(msg, message)
+            return
+        end if
         if (method == METHOD_RK45_SCIPY .and. .not. first_step > 0.0_c_double) then
             call scipy_first_step(sys, t_span, y0, max(rtol, 100.0_dp*epsilon(1.0_dp)), &
                                   atol, max_step, 4, opt%first_step, nfev)
@@ -153,16 +195,19 @@ contains
             ev%ne = ne
             ev%direction = ev_dir(1:ne)
             ev%terminal = ev_term(1:ne) /= 0
+            ev%resolution = ev_res(1:ne)
             if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev)
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev, &
+                               stepper=stp)
             else
-                call ode_solve(sys, t_span, y0, opt, res, events=ev)
+                call ode_solve(sys, t_span, y0, opt, res, events=ev, stepper=stp)
             end if
         else
             if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval))
+                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), &
+                               stepper=stp)
             else
-                call ode_solve(sys, t_span, y0, opt, res)
+                call ode_solve(sys, t_span, y0, opt, res, stepper=stp)
             end if
         end if
 

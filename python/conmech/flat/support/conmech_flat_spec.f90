@@ -10,7 +10,7 @@
 !!     spec(6:15) function addresses (0 = absent):
 !!         ode:          6 rhs, 7 jac
 !!         generalized:  6 mass, 7 forces, 8 forces_jac, 9 energy
-!!         constrained:  6 mass, 7 forces, 8 (unused), 9 energy, 10 phi, 11 phi_jac,
+!!         constrained:  6 mass, 7 forces, 8 forces_jac, 9 energy, 10 phi, 11 phi_jac,
 !!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
 !!     spec(16) (optional, generalized) mass_forces: M and Q in one call
 !!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
@@ -19,6 +19,8 @@
 !!         columns, taylor_var (the variational system), its work columns
 !!     spec(23:26) (optional, ode) the same written out for one order (set_c_taylor_fixed):
 !!         taylor, its order, taylor_var, its order
+!!     spec(27) (optional, constrained) constraint_hessian: d(C^T lam)/dq, d(C v + c0)/dq
+!!     spec(28) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -78,6 +80,8 @@ contains
         fp%nh_gamma = fptr(spec(15))
         if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
         if (size(spec) >= 17) fp%accel = fptr(spec(17))
+        if (size(spec) >= 27) fp%constraint_hessian = fptr(spec(27))
+        if (size(spec) >= 28) fp%accel_jac = fptr(spec(28))
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).

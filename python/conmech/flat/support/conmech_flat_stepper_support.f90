@@ -10,10 +10,10 @@ module conmech_flat_stepper_support
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NONFINITE
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_DOPRI5
-    use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack
-    use conmech_state_packer, only: state_packer
+    use conmech_ode_stepper, only: ode_stepper, stepper_pack_into, stepper_unpack
     use conmech_ode_methods, only: new_stepper
-    use conmech_flat_ode_support, only: METHOD_RK45_SCIPY, scipy_first_step, copy_message
+    use conmech_flat_ode_support, only: METHOD_RK45_SCIPY, scipy_first_step, copy_message, &
+        set_jacobian_structure
     implicit none
     private
     public :: stepper_action
@@ -32,21 +32,25 @@ contains
     !! method METHOD_RK45_SCIPY (12): DOPRI5 with SciPy's step control (no Lund
     !! stabilisation) and, without first_step, SciPy's initial step (its two evaluations
     !! counted in nfev), as solve_ivp(method="RK45") runs it.
+    !! jac_const /= 0: the Jacobian is constant (read once; methods that use one);
+    !! nnz >= 0: the sparsity pattern of df/dy by columns (sp_ptr(n + 1), sp_idx(nnz), 1-based)
+    !! for grouped differences; both are kept in the packed state.
+    !! The state is read from and written back into (r, iv, w) in place.
     subroutine stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, &
-                              atol, first_step, max_step, max_steps, r, iv, w, sizes, info, &
-                              message)
+                              atol, first_step, max_step, max_steps, jac_const, nnz, sp_ptr, &
+                              sp_idx, r, iv, w, sizes, info, message)
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
         real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
         real(c_double), intent(in) :: first_step, max_step
-        real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
-        integer(c_int), intent(inout) :: iv(max(ni, 1))
+        integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
+        real(c_double), intent(inout), target :: r(max(nr, 1)), w(n, max(nw, 1))
+        integer(c_int), intent(inout), target :: iv(max(ni, 1))
         integer(c_int), intent(out) :: sizes(3)
         integer(c_int), intent(out) :: info
         character(len=*), intent(out) :: message
         class(ode_stepper), allocatable :: s
         type(ode_options) :: opt
-        type(state_packer) :: p
         character(len=:), allocatable :: msg
         integer :: inf, code
         integer(c_int) :: nfev0
@@ -84,12 +88,10 @@ contains
                                           max_step, 4, opt%first_step, nfev0)
                 end if
             end if
-            call s%init(t0, t_bound, y0, opt, inf, msg, allow_inf=.true.)
+            call set_jacobian_structure(s, n, jac_const, nnz, sp_ptr, sp_idx, inf, msg)
+            if (inf == CM_SUCCESS) call s%init(t0, t_bound, y0, opt, inf, msg, allow_inf=.true.)
             if (action == ACTION_SIZES) then
-                if (inf == CM_SUCCESS) then
-                    call stepper_pack(s, p)
-                    sizes = [p%nr, p%ni, p%nw]
-                end if
+                if (inf == CM_SUCCESS) call write_back(count_only=.true.)
             else
                 if (inf == CM_SUCCESS .and. t_bound /= t0) call s%start(sys, inf, msg)
                 if (allocated(s%y)) then
@@ -124,19 +126,21 @@ contains
 
     contains
 
-        !> The packed state into (r, iv, w) (CM_BAD_INPUT if they are too small).
-        subroutine write_back()
-            call stepper_pack(s, p)
-            sizes = [p%nr, p%ni, p%nw]
-            if (p%nr > nr .or. p%ni > ni .or. p%nw > nw) then
+        !> The packed state into (r, iv, w) in place (CM_BAD_INPUT if they are too small);
+        !! count_only: only the sizes (into zero-capacity arrays).
+        subroutine write_back(count_only)
+            logical, intent(in), optional :: count_only
+            integer :: pinfo
+            if (present(count_only)) then
+                call stepper_pack_into(s, r(1:0), iv(1:0), w(:, 1:0), sizes, pinfo)
+                return
+            end if
+            call stepper_pack_into(s, r(1:nr), iv(1:ni), w(:, 1:nw), sizes, pinfo)
+            if (pinfo /= CM_SUCCESS) then
                 inf = CM_BAD_INPUT
                 msg = "bad input: the state arrays are smaller than the stepper's state " &
                       //"(ACTION_SIZES gives the sizes)"
-                return
             end if
-            r(1:p%nr) = p%r(1:p%nr)
-            iv(1:p%ni) = p%iv(1:p%ni)
-            w(:, 1:p%nw) = p%w(:, 1:p%nw)
         end subroutine write_back
 
     end subroutine stepper_action
