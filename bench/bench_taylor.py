@@ -7,6 +7,11 @@ steps are printed beside the times.
 
     python bench/bench_taylor.py [--repeat 7] [--problems kepler arenstorf pcr3bp pendulum]
                                  [--brouwer]  (energy over 1e4 Kepler periods, a plot)
+                                 [--breakdown] (one Kepler period at 1e-12: where the time
+                                                goes, results/taylor_breakdown.md)
+
+Instruction counts (repeatable on a loaded machine) of the Fortran integration alone:
+bash bench/callgrind_taylor.sh.
 """
 import argparse
 import os
@@ -173,6 +178,64 @@ def brouwer(path_png):
           f"eps sqrt(steps) = {np.finfo(float).eps*np.sqrt(r.naccept):.2e})")
 
 
+def breakdown(rounds, path):
+    """One Kepler period (e = 0.9) at rtol = atol = 1e-12: solve_ivp's time for TAYLOR and
+    DOP853, the flat Fortran call alone (system built from its spec, integration, result
+    arrays handed back: no Python around it), solve_ivp over a tiny span (its per-call
+    cost) and heyoka's propagate_until, interleaved in one process (min over rounds)."""
+    from conmech import _conmech, _ivp
+    from conmech._taylor import with_fixed_order
+    pr = problems()["kepler"]
+    kep = symbolic.ode_system(pr["f"], pr["y"])
+    y0 = np.array(pr["y0"], dtype=float)
+    T = pr["T"]
+    rt = np.full(4, 1e-12)
+
+    def flat(method, system, tf=T):
+        kw = dict(t_span=np.array([0.0, tf]), y0=y0, first_step=0.0, neval=0,
+                  t_eval=_ivp._PAD, ne=0, ev_dir=_ivp._PADI, ev_term=_ivp._PADI,
+                  method=_ivp._METHOD_CODES[method], rtol=rt, atol=rt, max_step=1e300,
+                  max_steps=100000, dense=0)
+        args = system._flat_args()
+        return lambda: _conmech.flat_solve_builtin(*args, lambda t, y: _ivp._PAD,
+                                                   lambda *a: None, **kw)
+
+    def ivp(method, tf=T):
+        return lambda: conmech.solve_ivp(kep, (0, tf), y0, method=method, rtol=1e-12,
+                                         atol=1e-12)
+    fs = {"solve_ivp TAYLOR": ivp("TAYLOR"), "solve_ivp DOP853": ivp("DOP853"),
+          "flat call TAYLOR (written out)": flat("TAYLOR", with_fixed_order(kep, 1e-12,
+                                                                              1e-12)),
+          "flat call TAYLOR (loops)": flat("TAYLOR", kep),
+          "flat call DOP853": flat("DOP853", kep),
+          "solve_ivp DOP853, span 1e-9 (per-call cost)": ivp("DOP853", 1e-9),
+          "flat call DOP853, span 1e-9": flat("DOP853", kep, 1e-9)}
+    if hy is not None:
+        run = heyoka_runner(pr, 1e-12)
+        fs["heyoka propagate_until"] = run
+    for f in fs.values():
+        f()
+    best = {k: np.inf for k in fs}
+    for _ in range(rounds):
+        for k, f in fs.items():
+            for _ in range(20):
+                a = time.perf_counter()
+                f()
+                best[k] = min(best[k], time.perf_counter() - a)
+    load = os.getloadavg()
+    lines = [f"One Kepler period (e = 0.9), rtol = atol = 1e-12; min over {rounds} interleaved "
+             f"rounds of 20 calls; load average {load[0]:.1f} (provisional: re-measure on a "
+             "quiet machine).", "", "| call | time (us) | / solve_ivp DOP853 |", "|---|---|---|"]
+    ref = best["solve_ivp DOP853"]
+    for k, v in best.items():
+        lines.append(f"| {k} | {v*1e6:.1f} | {v/ref:.2f} |")
+    text = "\n".join(lines)
+    print(text)
+    if path:
+        with open(path, "w") as fh:
+            fh.write(text + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
@@ -182,7 +245,11 @@ def main():
                     default=[1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-16])
     ap.add_argument("--out", default=os.path.join(RESULTS, "taylor.md"))
     ap.add_argument("--brouwer", action="store_true")
+    ap.add_argument("--breakdown", action="store_true")
     args = ap.parse_args()
+    if args.breakdown:
+        breakdown(15, os.path.join(RESULTS, "taylor_breakdown.md"))
+        return
     prs = problems()
     allrows = {name: work_precision(name, prs[name], args.repeat, args.tols)
                for name in args.problems}

@@ -29,8 +29,10 @@ def message_text(message):
     if isinstance(message, np.ndarray):
         message = message.tobytes()
     if isinstance(message, (bytes, bytearray)):
-        message = bytes(message).split(b"\0", 1)[0].decode("ascii", "replace")
-    text = str(message)
+        message = bytes(message).split(b"\0", 1)[0].rstrip().decode("ascii", "replace")
+    text = str(message).strip()
+    if text.isascii() and text.isprintable():      # the usual case: no copy per character
+        return text
     return "".join(c if c.isascii() and c.isprintable() else "?" for c in text).strip()
 
 

@@ -20,6 +20,7 @@ from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSoluti
 from ._implicit import jacobian_callback, is_sparse, sparsity_pattern
 from ._methods import METHODS, RK45_SCIPY, method_info
 from ._stepper import method_code
+from ._taylor import with_fixed_order
 from ._native import NativeSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
@@ -33,6 +34,7 @@ _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45
 # solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
 # (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
 _RK45_SCIPY = RK45_SCIPY
+_TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
@@ -344,6 +346,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         # SciPy would integrate for ever: nothing ends such a run but a failure
         raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
                          "end the integration")
+    if builtin and code == _TAYLOR and getattr(fun, "taylor", None):   # written out
+        fun = with_fixed_order(fun, rtol, atol)
     problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
                    t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
                    settings=settings, vectorized=bool(vectorized))
@@ -647,7 +651,7 @@ class _Run:
             res["t"] = t.copy()
             res["y"] = y.reshape(n, t.size).copy()
             res["ev"] = [(int(i) - 1, float(te), ev_y.reshape(n, -1)[:, k].copy())
-                         for k, (te, i) in enumerate(zip(ev_t, ev_id))]
+                         for k, (te, i) in enumerate(zip(ev_t, ev_id))] if ev_t.size else []
             if ts.size:
                 res["dense"] = (ts.copy(), hs.copy(), coef.reshape(n, -1, ts.size).copy())
 
@@ -677,7 +681,7 @@ class _Run:
                 jac_const=self.jac_const, **kw)
         if self.failure:
             self.guard.fail(self.failure[0])
-        nfev, njev, nlu, naccept, nreject = (int(c) for c in counts)
+        nfev, njev, nlu, naccept, nreject = counts.tolist()
         self.njev += njev
         self.nlu += nlu
         self.first_segment = False
@@ -685,7 +689,7 @@ class _Run:
         res.setdefault("y", y_a[:, None].copy())
         res.setdefault("ev", [])
         res.setdefault("dense", None)
-        res.update(nfev=int(nfev), naccept=int(naccept), nreject=int(nreject),
+        res.update(nfev=nfev, naccept=naccept, nreject=nreject,
                    form=int(form), info=int(info), message=message_text(message))
         return res
 
@@ -709,8 +713,11 @@ def _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, dense_output, form, sta
     ts = [s["t"] for s in segs]
     ys = [s["y"] if s["y"] is not None else np.repeat(y0[:, None], s["t"].size, axis=1)
           for s in segs]
-    t = np.concatenate(ts) if ts else np.array([t0])
-    y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
+    if len(segs) == 1:      # one segment (no terminal event restarted it): its own arrays
+        t, y = ts[0], ys[0]
+    else:
+        t = np.concatenate(ts) if ts else np.array([t0])
+        y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
     if tf == t0 and not with_t_eval:
         # SciPy's solver makes one (empty) step: t = [t0, t0]
         t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)

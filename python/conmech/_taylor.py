@@ -1,11 +1,106 @@
-"""Taylor's method with compiled events, for :func:`conmech.solve_ivp` (method "TAYLOR"
-with events made by :func:`conmech.symbolic.event`): the events of one call are compiled
-together (cached) and located by the Taylor stepper with no Python in the loop."""
+"""Taylor's method in :func:`conmech.solve_ivp` (method "TAYLOR") for systems made by
+:mod:`conmech.symbolic`:
+
+- the recurrences written out for the run's order (no loops: the coefficients in
+  registers, every multiply-add scheduled at once), compiled on first use of an order and
+  cached like the model; they give the loop version's coefficients to the last bit, so a
+  run takes the same steps with either;
+- compiled events (made by :func:`conmech.symbolic.event`): the events of one call are
+  compiled together (cached) and located by the Taylor stepper with no Python in the loop.
+"""
+import math
+
 import numpy as np
 
 from . import _conmech
 
-__all__ = ["run_compiled_events"]
+__all__ = ["run_compiled_events", "taylor_order", "with_fixed_order"]
+
+#: written-out code is generated up to this many history products per expansion (beyond,
+#: the loop version runs: the source and its compile time grow as order**2)
+FIXED_MAX_TERMS = 40000
+
+
+def taylor_order(eps):
+    """Jorba and Zou's order ceil(-ln(eps)/2 + 1), at least 2 (conmech_taylor_core's
+    taylor_order, the same arithmetic)."""
+    return max(2, math.ceil(-0.5*math.log(max(eps, 2.2250738585072014e-308)) + 1.0))
+
+
+def with_fixed_order(fun, rtol, atol):
+    """`fun` with its Taylor recurrences written out for the order the tolerances give
+    (rtol, atol: scalars or the per-component arrays handed to Fortran), when `fun` is an
+    ode system made by conmech.symbolic; else `fun` itself. The library is compiled once
+    per model and order (cached on disk) and kept with the model; the system is kept per
+    `fun` object and order (the last 64), so a repeated call is two dictionary look-ups."""
+    r = float(rtol) if type(rtol) is float else float(np.min(rtol))
+    a = float(atol) if type(atol) is float else float(np.min(atol))
+    eps = max(r, 2.220446049250313e-16, a)       # the stepper's: rtol >= the round-off
+    order = _ORDERS.get(eps)
+    if order is None:
+        order = taylor_order(eps)
+        if len(_ORDERS) < 256:
+            _ORDERS[eps] = order
+    hit = _SYSTEMS.get((id(fun), order))
+    if hit is not None and hit[0] is fun:
+        return hit[1]
+    if fun.taylor.get("order") == order:
+        return fun
+    from .symbolic import model_of
+    try:
+        model = model_of(fun)
+    except TypeError:
+        return fun
+    out = _fixed_system(fun, model, order)
+    if len(_SYSTEMS) >= 64:       # systems made and dropped in a loop: keep the last ones
+        _SYSTEMS.clear()
+    _SYSTEMS[(id(fun), order)] = (fun, out)     # fun kept alive: its id stays its own
+    return out
+
+
+_ORDERS = {}
+_SYSTEMS = {}
+
+
+def _fixed_system(fun, model, order):
+    d = model.derived
+    if "jet" not in fun.taylor:
+        return fun
+    if getattr(d, "kind", None) != "ode":
+        return fun
+    libs = model.__dict__.setdefault("_taylor_fixed_libs", {})
+    if order not in libs:
+        libs[order] = _fixed_library(d, order)
+    lib = libs[order]
+    if lib is None:
+        return fun
+    return fun.with_taylor(jet_fixed=lib.conmech_taylor_fixed, order=order)
+
+
+def _fixed_library(d, order):
+    import ctypes
+    from .symbolic import build
+    from .symbolic.taylor import TaylorUnsupported, ode_decompositions, fixed_order_source
+    dec, _, _ = ode_decompositions(d, variational=False)
+    if dec is None:
+        return None
+    nhist = sum(1 for op in dec.ops for _ in range(_history_sums(op.kind)))
+    if nhist*order*(order - 1)//2 > FIXED_MAX_TERMS:
+        return None
+    try:
+        path, _ = build.compile_source(fixed_order_source(d, order, variational=False))
+    except (TaylorUnsupported, build.CompileError):
+        return None         # the loop version runs (same coefficients, a little slower)
+    return ctypes.CDLL(path)
+
+
+def _history_sums(kind):
+    """History sums per operation of the decomposition (conmech.symbolic.taylor's
+    recipes): none for linear combinations and time, two for powers and sine/cosine
+    pairs, one otherwise."""
+    if kind in ("lin", "time"):
+        return 0
+    return 2 if kind in ("pow", "sincos", "sinhcosh") else 1
 
 
 def _library(fun, evs):

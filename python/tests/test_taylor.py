@@ -9,6 +9,8 @@
   plain integration at rtol 1e-6) found to 1e-14;
 - the variational system by the same recurrences: the STM agrees with DOP853's;
 - batches: an ensemble member is its own solve_ivp run bit for bit;
+- the recurrences written out for one order (what solve_ivp runs) give the loop version's
+  coefficients bit for bit;
 - quadruple precision: Arenstorf's orbit closes to 1e-25 (published period and initial
   velocity to 30 digits, Hairer-Norsett-Wanner I, II.0);
 - clear errors for systems without Taylor code.
@@ -268,3 +270,39 @@ def test_emitted_kepler_module_is_regenerated_identically():
     assert (name, module) == ("kepler_sym", "taylor_kepler_model")
     assert src == out.read_text()
     assert "procedure :: taylor_jet => kepler_sym_taylor_jet" in src
+
+
+def test_written_out_recurrences_are_the_loops_bit_for_bit(arenstorf):
+    """solve_ivp runs the recurrences written out for its order (no loops): the same
+    coefficients, to the last bit, as the loop version (and so the same steps as the
+    batch routine), for powers, quotients and sine/cosine pairs."""
+    from conmech._taylor import taylor_order, with_fixed_order
+    a, b, p, q = sp.symbols("a b p q")
+    dd = a - b
+    den = 3 - sp.cos(2*dd)
+    pend = symbolic.ode_system(
+        [p, q, (-3*sp.sin(a) - sp.sin(a - 2*b) - 2*sp.sin(dd)*(q**2 + p**2*sp.cos(dd)))/den,
+         2*sp.sin(dd)*(2*p**2 + 2*sp.cos(a) + q**2*sp.cos(dd))/den], [a, b, p, q])
+    for system, y in ((arenstorf, [0.994, 0.01, 0.02, -2.0]), (pend, [1.2, -0.4, 0.3, 0.1])):
+        for tol in (1e-6, 1e-12):
+            order = taylor_order(tol)
+            fixed = with_fixed_order(system, tol, tol)
+            assert fixed.taylor["order"] == order and fixed is not system
+            assert with_fixed_order(system, tol, tol) is fixed      # kept with the model
+            tay = fixed.taylor
+            fn = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)(
+                conmech.compiled.function_address(tay["jet_fixed"]))
+            w = np.zeros((tay["nw"], order + 1))
+            w[:4, 0] = y
+            pr = np.ascontiguousarray(system.params if system.params.size else np.zeros(1))
+            fn(0.0, order, w.ctypes.data_as(_P), pr.ctypes.data_as(_P))
+            loop = jet(system, y, order)
+            assert np.all(np.isfinite(loop)) and np.array_equal(w[:4], loop)
+        # the same functions without the model behind them: solve_ivp runs the loop version
+        plain = conmech.compiled.ode_system(
+            4, int(system.spec[5]), jac=int(system.spec[6]), params=tuple(system.params),
+            taylor={"jet": int(system.spec[18]), "nw": int(system.spec[19])})
+        assert with_fixed_order(plain, 1e-12, 1e-12) is plain
+        r1 = conmech.solve_ivp(system, (0, 2.0), y, method="TAYLOR", rtol=1e-12, atol=1e-12)
+        r2 = conmech.solve_ivp(plain, (0, 2.0), y, method="TAYLOR", rtol=1e-12, atol=1e-12)
+        assert r1.success and r1.naccept == r2.naccept and np.array_equal(r1.y, r2.y)

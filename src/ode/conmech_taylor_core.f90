@@ -62,20 +62,23 @@ contains
         if (rho < huge(1.0_dp)) rho = rho*decay
     end function taylor_rho
 
-    !> y(t + h) = sum_k c(k, i) h^k and its derivative dy (Horner).
+    !> y(t + h) = sum_k c(k, i) h^k and its derivative dy (Horner; the derivative from the
+    !! same pass, d_k = y_(k+1) + h d_(k+1): two multiply-adds per order, no weights).
     pure subroutine taylor_eval_step(n, p, c, h, ynew, dy)
         integer, intent(in) :: n, p
         real(dp), intent(in) :: c(0:, :), h
         real(dp), intent(out) :: ynew(n), dy(n)
+        real(dp) :: yv, dv
         integer :: i, k
         do i = 1, n
-            ynew(i) = c(p, i)
-            dy(i) = real(p, dp)*c(p, i)
-            do k = p - 1, 1, -1
-                ynew(i) = c(k, i) + h*ynew(i)
-                dy(i) = real(k, dp)*c(k, i) + h*dy(i)
+            yv = c(p, i)
+            dv = 0.0_dp
+            do k = p - 1, 0, -1
+                dv = yv + h*dv
+                yv = c(k, i) + h*yv
             end do
-            ynew(i) = c(0, i) + h*ynew(i)
+            ynew(i) = yv
+            dy(i) = dv
         end do
     end subroutine taylor_eval_step
 
@@ -83,7 +86,8 @@ contains
     !! scales at the step's start (a rounding floor of 16 eps |y| is added).
     pure real(dp) function taylor_check(n, p, h, ynew, dy, f1, e) result(err)
         integer, intent(in) :: n, p
-        real(dp), intent(in) :: h, ynew(n), dy(n), f1(n), e(n)
+        real(dp), intent(in) :: h, ynew(n), dy(n), e(n)
+        real(dp), intent(in) :: f1(:)    ! assumed shape: a row of the expansion, no copy
         real(dp) :: c, d
         integer :: i
         c = 16.0_dp*epsilon(1.0_dp)

@@ -25,7 +25,6 @@
 !! All state is in the object (thread-safe). nfev counts the expansions (one per step,
 !! plus one at the start and one per rejected step).
 module conmech_taylor_stepper
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
@@ -103,7 +102,7 @@ contains
         end if
         self%t_lo = 0.0_dp
         self%hmax = min(abs(opt%max_step), abs(tf - t0))
-        if (.not. ieee_is_finite(self%hmax)) self%hmax = huge(1.0_dp)
+        if (.not. self%hmax <= huge(1.0_dp)) self%hmax = huge(1.0_dp)   ! Inf or NaN
         self%first_step = opt%first_step
         self%max_steps = opt%max_steps
         self%nsteps = 0
@@ -218,8 +217,8 @@ contains
         integer :: p
         character(len=32) :: buf
         real(dp), allocatable :: tmp(:, :)
+        ! msg is set on failure only (as the Runge-Kutta steppers): no allocation per step
         info = CM_SUCCESS
-        msg = "success"
         p = self%order
         h = self%h
         self%last = .false.
@@ -331,10 +330,16 @@ contains
         self%f_stale = .false.
     end subroutine taylor_refresh
 
+    !> f at the current point finite (comparisons: the module does not use ieee_arithmetic,
+    !! whose procedures save and restore the floating-point state on every call).
     logical function taylor_f_finite(self)
         class(taylor_stepper), intent(in) :: self
-        taylor_f_finite = .false.
-        if (allocated(self%jet)) taylor_f_finite = all(ieee_is_finite(self%jet(1, 1:self%n)))
+        integer :: i
+        taylor_f_finite = allocated(self%jet)
+        if (.not. taylor_f_finite) return
+        do i = 1, self%n
+            if (.not. abs(self%jet(1, i)) <= huge(1.0_dp)) taylor_f_finite = .false.
+        end do
     end function taylor_f_finite
 
     !> The whole state, for step-by-step use (the state parts of both expansions; the
@@ -391,6 +396,7 @@ contains
         integer, intent(in), optional :: kind
         type(taylor_stepper) :: stp
         character(len=32) :: buf
+        character(len=:), allocatable :: smsg
         stats = ode_stats()
         if (present(kind)) stp%kind = kind
         call stp%init(t0, t1, y, opt, info, msg)
@@ -401,8 +407,11 @@ contains
             return
         end if
         do
-            call stp%step(sys, t1, info, msg)
-            if (info /= CM_SUCCESS) exit
+            call stp%step(sys, t1, info, smsg)        ! smsg: set on failure only
+            if (info /= CM_SUCCESS) then
+                msg = smsg
+                exit
+            end if
             if (.not. stp%f_finite()) then
                 info = CM_NONFINITE
                 write (buf, '(es14.6)') stp%t

@@ -605,17 +605,11 @@ class _Recipe:
         self.s0, self.hist, self.cur, self.accs, self.invs = s0, hist, cur, accs, invs
 
 
-def _sum_tree(terms, zero):
-    """A balanced sum of the terms (shorter dependency chains than left to right)."""
-    if not terms:
-        return zero
-    while len(terms) > 1:
-        nxt = [f"({terms[i]} + {terms[i + 1]})" for i in range(0, len(terms) - 1, 2)]
-        if len(terms) % 2:
-            nxt.append(terms[-1])
-        terms = nxt
-    t = terms[0]
-    return t[1:-1] if t.startswith("(") and t.endswith(")") else t
+def _sum_seq(terms, zero):
+    """The terms summed left to right: the order of the loop version's history sums
+    (h = 0; h = h + term_j, j = 1 .. k - 1), so the written-out routine and the loop give
+    the same coefficients to the last bit (compiled without -ffast-math)."""
+    return " + ".join(terms) if terms else zero
 
 
 def _decls(names, typ, ind):
@@ -631,8 +625,9 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     the parameters to. kind "dp" or "qp"; batch > 0: w(batch, 0:order, nw), t(batch);
     given: the state columns are inputs of orders 0..order and the operations are computed
     up to `order` (the outputs as columns ``dec.out_cols``), else the ODE recursion.
-    fixed: an order p to write out (no loops, literal indices and constants, the history
-    sums as balanced trees); the procedure must then be called with order = p."""
+    fixed: an order p to write out (no loops, literal indices and constants, the values in
+    scalars, the history sums in the loop's order); the procedure must then be called with
+    order = p."""
     pp = _Printer(dec, names, batch > 0, kind)
     if fixed is not None:
         pp.scalars = set()
@@ -697,7 +692,7 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
         E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
         for h, lft, rgt in rc.hist:
             terms = [f"{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)]
-            body += _wrap(f"{h} = {_sum_tree(terms, zero)}", ind)
+            body += _wrap(f"{h} = {_sum_seq(terms, zero)}", ind)
         for f in rc.cur:
             body += _wrap(f(E), ind)
         if not given:
