@@ -338,17 +338,21 @@ def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=
                        energy=None, rheonomic: bool = False,
                        params: Sequence[float] | dict = (), param_names: Sequence[str] = (),
                        keep=None, name: str = "compiled", *, forces_jac=None,
-                       constraint_hessian=None) -> CompiledConstrained:
+                       constraint_hessian=None, redundant: bool = False
+                       ) -> CompiledConstrained:
     """A constrained system in excessive coordinates from compiled functions: ``n``
     coordinates, ``n_hol`` holonomic constraints phi(t, q) = 0 and ``n_nh`` Pfaffian
     constraints A(t, q) q' + b(t, q) = 0. Missing phi_jac, phi_t, phi_gamma, nh_gamma
     fall back to finite differences (phi_t only when ``rheonomic``); so do the optional
     ``forces_jac`` and ``constraint_hessian`` (the derivatives behind the Jacobian of
-    ``method="Radau"``; see the module's signatures)."""
+    ``method="Radau"``; see the module's signatures). ``redundant=True`` admits n_hol +
+    n_nh >= n: constraints known to be dependent, as the loop equations of an
+    over-constrained mechanism (Bricard's: as many as its joint coordinates, one degree
+    of freedom), whose motion the rank-revealing KKT solve finds."""
     n = _count(n, "n", 1)
     n_hol = _count(n_hol, "n_hol", 0)
     n_nh = _count(n_nh, "n_nh", 0)
-    if n_hol + n_nh >= n:
+    if n_hol + n_nh >= n and not redundant:
         raise ValueError(f"n_hol + n_nh = {n_hol + n_nh} constraints leave no motion for "
                          f"n = {n} coordinates")
     if mass is None or forces is None:

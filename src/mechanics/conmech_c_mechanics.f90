@@ -219,9 +219,12 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         info = CM_BAD_INPUT
-        if (n < 1 .or. n_hol < 0 .or. n_nh < 0 .or. n_hol + n_nh >= n) then
+        ! as many constraints as coordinates, or more, is legitimate when they are
+        ! redundant (an over-constrained mechanism such as Bricard's: the rank-revealing
+        ! KKT solve finds its motion); the caller decides whether to allow it
+        if (n < 1 .or. n_hol < 0 .or. n_nh < 0) then
             msg = "bad input: a compiled constrained system needs n >= 1 coordinates and " &
-                  //"0 <= n_hol + n_nh < n constraints"
+                  //"n_hol, n_nh >= 0 constraints"
             return
         end if
         if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then

@@ -293,7 +293,8 @@ def _system(model):
         phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
         nh_matrix=a.get("nh_matrix"), nh_gamma=a.get("nh_gamma"), energy=a.get("energy"),
         rheonomic=bool(d.rheonomic), forces_jac=a.get("forces_jac"),
-        constraint_hessian=a.get("constraint_hessian"), **common)
+        constraint_hessian=a.get("constraint_hessian"),
+        redundant=bool(getattr(d, "loops", None)), **common)
 
 
 def _input_key(kind, inputs, params, options):
