@@ -313,7 +313,9 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     Raises
     ------
     ValueError, TypeError
-        On bad input (the message names the argument).
+        On bad input (the message names the argument); ValueError also when the loops
+        of a mechanism (a symbolic tree with ``loops=``) cannot close at q0: the message
+        names the loop (its joint, bodies and points) and the residual.
     """
     if isinstance(system, str):
         system = BuiltinConstrained(system, params)
@@ -473,6 +475,16 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     info = int(info)
     if info == _CM_BAD_INPUT:
         raise ValueError(message)
+    if info < 0 and message.startswith("inconsistent initial position"):
+        # a mechanism whose loops cannot close at q0: say which loop (a bad input, not a
+        # failed integration)
+        try:
+            from .symbolic.loops import closure_error
+        except ImportError:         # no sympy: no symbolic mechanism either
+            closure_error = None
+        err = closure_error(system, q0, t0) if closure_error is not None else None
+        if err is not None:
+            raise err
     m = system.n_hol + system.n_nh
     if not out:
         out = dict(t=np.zeros(0), q=np.zeros((n, 0)), v=np.zeros((n, 0)),

@@ -39,8 +39,6 @@ def test_a04_bricard_one_dof_energy_and_two_cuts_agree():
         assert abs(E[0] + 3*9.81) <= 1e-12
         assert np.max(np.abs(E - E[0])) <= 1e-8*abs(E[0])
         p3[cut] = iftomm.a04_p3(r.q)
-        # P3 stays 1 m from the joint A = (1, 0, 0)... and O-A does not move off its circle
-        assert np.allclose(np.linalg.norm(p3[cut] - [[1], [0], [0]], axis=0)[0], 1.0)
     assert np.allclose(p3["E"][:, 0], [1.0, -1.0, 0.0], atol=1e-15)
     # the mechanism really moves (P3 travels more than a metre) ...
     assert np.max(np.linalg.norm(p3["E"] - p3["E"][:, :1], axis=0)) > 1.0

@@ -318,6 +318,30 @@ def test_consistent_state():
         symbolic.consistent_state(mech, [1.2, 0.4])
 
 
+def test_a_loop_that_cannot_close_is_a_value_error_naming_it():
+    """A four-bar (crank 1, coupler and rocker 0.6, pivots 1.2 apart) cannot take the crank
+    angle pi (the coupler and rocker reach 1.2, the crank tip is 2.2 from the rocker's
+    pivot): consistent_state and constrained.solve raise ValueError naming the loop's joint,
+    bodies and points and the residual, before any step."""
+    mech, _ = fourbar("absolute", (1.0, 0.6, 0.6, 1.2))
+    model = symbolic.model_of(mech)
+    where = (r"loop 0 \(coupler-crank2\) \(revolute joint of 'coupler' at \(l2, 0\) = "
+             r"\(0\.6, 0\) and 'crank2' at \(l3, 0\) = \(0\.6, 0\)\)")
+    with pytest.raises(ValueError, match=where + ".*residual"):
+        symbolic.consistent_state(mech, [np.pi, 0.0, 0.0], independent=[0])
+    # the same crank angle reachable from a closing position: fine
+    q, _ = symbolic.consistent_state(mech, [0.5, 1.0, 2.0], independent=[0])
+    assert np.max(np.abs(model.call("phi", 0.0, q))) <= 1e-12
+    # the pivots 4 apart: no position closes the loop; solve says so instead of
+    # returning success=False
+    far = mech.with_params(d=4.0)
+    q0 = np.array([0.3, 0.2, 0.1])
+    res = np.max(np.abs(model.call("phi", 0.0, q0, params=np.asarray(far.params))))
+    with pytest.raises(ValueError, match=where + f" cannot close at the initial positions "
+                       rf"q0 \(residual {res:.3g};"):
+        constrained.solve(far, (0, 1), q0, [0.0, 0.0, 0.0])
+
+
 def test_bad_loops():
     phi1, psi = dynamicsymbols("phi1 psi")
     m, l = sp.symbols("m l")
