@@ -394,8 +394,10 @@ def _check_compiled_mass(model):
                          "coordinate has no kinetic energy, or the coordinates are dependent")
 
 
-def _construct(kind, inputs, params, options, derive, flags, model_only):
-    """Derive (or take the derivation from the cache), compile (or load), wrap."""
+def _construct(kind, inputs, params, options, derive, flags, model_only, description=None):
+    """Derive (or take the derivation from the cache), compile (or load), wrap.
+    `description`: the key of the cheap description (symbolic/description.py) to record
+    for the next construction of the same system."""
     t0 = time.perf_counter()
     params = {} if params is None else params
     key = _input_key(kind, inputs, params, options)
@@ -409,6 +411,9 @@ def _construct(kind, inputs, params, options, derive, flags, model_only):
             _check_compiled_mass(model)
         if key:
             _store(key, model, flags)
+    if description and key:
+        from .description import store_description
+        store_description(description, key, params)
     model.times["total"] = time.perf_counter() - t0
     return model if model_only else _system(model)
 

@@ -503,7 +503,7 @@ def derive_spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None,
 
 def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=None,
                  point_forces=None, method="recursive", simplify="auto", jacobian=True,
-                 flags=None, model_only=False):
+                 flags=None, model_only=False, _description=None):
     """A compiled spatial multibody tree (see the module docstring of
     ``conmech.symbolic.spatial`` for frames and conventions).
 
@@ -554,7 +554,16 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=N
         sys = spatial_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, 0, -g))
     """
     from . import _construct, _tup
+    from .description import description_hit, tree_description_key
     from .tree import _loop_names, _method_key
+    # a second construction of the same description loads the model, deriving nothing
+    if _description is None:
+        _description = tree_description_key(
+            "spatial_tree", bodies, params, gravity, forces, loops, point_forces,
+            (method, simplify, jacobian), flags)
+        hit = description_hit(_description, flags, model_only, params or {})
+        if hit is not None:
+            return hit
     parts = build_spatial_tree(bodies, gravity, forces, lazy=True)
     _check_bodies(parts["order"], parts["data"], params)
     method, extra = _method_key(method, loops, point_forces)
@@ -573,4 +582,5 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=N
                                        _tup(list(parts["gravity"])), _body_key(parts)]
                       + extra, params,
                       (simplify, bool(jacobian), topo, method)
-                      + _loop_names(loops, point_forces), derive, flags, model_only)
+                      + _loop_names(loops, point_forces), derive, flags, model_only,
+                      _description)

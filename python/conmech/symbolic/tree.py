@@ -588,6 +588,13 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
                           coordinates="absolute")
     """
     from . import _construct, _tup
+    from .description import description_hit, tree_description_key
+    # a second construction of the same description loads the model, deriving nothing
+    dkey = tree_description_key("tree", bodies, params, gravity, forces, loops,
+                                point_forces, (coordinates, method, simplify, jacobian), flags)
+    hit = description_hit(dkey, flags, model_only, params or {})
+    if hit is not None:
+        return hit
     parts = build_tree(bodies, gravity, forces, coordinates, lazy=True)
     _check_leaves(parts["order"], parts["data"], params)
     q = parts["q"]
@@ -611,7 +618,7 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
     return _construct("tree", [_tup(q), _tup(parts["forces"]), _tup(parts["gravity"]),
                                body_key] + extra, params,
                       (coordinates, simplify, bool(jacobian), topo, method) + _loop_names(
-                          loops, point_forces), derive, flags, model_only)
+                          loops, point_forces), derive, flags, model_only, dkey)
 
 
 def _method_key(method, loops, point_forces):

@@ -159,8 +159,17 @@ class Robot:
 
 def from_urdf(source, allow_massless=False, **kw):
     """Read the URDF `source` (a path or the XML text) and build its compiled spatial
-    tree: ``read_urdf(source, allow_massless).system(**kw)`` (see :meth:`Robot.system`)."""
-    return read_urdf(source, allow_massless).system(**kw)
+    tree: ``read_urdf(source, allow_massless).system(**kw)`` (see :meth:`Robot.system`).
+    A second call with the same document and arguments (in any process) loads the
+    compiled model from the cache without parsing into sympy or deriving anything
+    (:mod:`conmech.symbolic.description`)."""
+    from .description import description_hit, urdf_description_key
+    text, origin = _text(source)
+    dkey = urdf_description_key(text, allow_massless, kw)
+    hit = description_hit(dkey, kw.get("flags"), bool(kw.get("model_only", False)))
+    if hit is not None:
+        return hit
+    return read_urdf(text, allow_massless, origin).system(_description=dkey, **kw)
 
 
 def _text(source):
@@ -272,7 +281,7 @@ def _moved(inert, R, p):
     return (m, p + R @ c, R @ I @ R.T)
 
 
-def read_urdf(source, allow_massless=False):
+def read_urdf(source, allow_massless=False, _source_name=None):
     """Parse and validate a URDF document (a path or the XML text); returns a
     :class:`Robot` (see the module docstring). Every problem is a ValueError naming the
     element, found before anything is derived."""
@@ -280,6 +289,7 @@ def read_urdf(source, allow_massless=False):
     from sympy.physics.mechanics import dynamicsymbols
     from .spatial import SpatialBody
     text, origin_name = _text(source)
+    origin_name = _source_name or origin_name
     try:
         root_el = ET.fromstring(text)
     except ET.ParseError as exc:
