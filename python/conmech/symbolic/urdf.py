@@ -162,7 +162,7 @@ def from_urdf(source, allow_massless=False, **kw):
     tree: ``read_urdf(source, allow_massless).system(**kw)`` (see :meth:`Robot.system`).
     A second call with the same document and arguments (in any process) loads the
     compiled model from the cache without parsing into sympy or deriving anything
-    (:mod:`conmech.symbolic.description`)."""
+    (``conmech.symbolic.description``)."""
     from .description import description_hit, urdf_description_key
     text, origin = _text(source)
     dkey = urdf_description_key(text, allow_massless, kw)
