@@ -67,3 +67,42 @@ def test_a05_governor_two_derivations_and_angular_momentum():
     x = s["recursive"]
     assert x[0] == 0.5 and np.max(x[:20]) > 0.7
     assert 0.49 < np.min(x) and np.max(x) < 0.75
+
+
+def test_a04_joint_reaction_is_the_loop_equations_generalized_force():
+    """joint_reactions on Bricard's mechanism (cut at E: rod5 to the ground by a revolute
+    joint): the force and moment on rod5, in its frame, put back in the world and mapped
+    through the five joints of its chain (virtual work omega_j . ((x - p_j) x F + M)),
+    are the loop's generalized force G^T lambda of the compiled constraint Jacobian; the
+    moment is normal to the joint axis."""
+    from conmech import compiled, symbolic
+    p = iftomm.a04_bricard("E")
+    r = constrained.solve(p.system, (0, 2), p.q0, p.v0, rtol=1e-10, atol=1e-10,
+                          t_eval=np.linspace(0, 2, 5))
+    assert r.success, r.message
+    (j,) = symbolic.joint_reactions(p.system, r).values()
+    assert (j.kind, j.body_a, j.body_b) == ("revolute", "rod5", None)
+    assert j.force.shape == (3, 5) and j.moment.shape == (3, 5)
+
+    def rot(u, a):
+        K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]], float)
+        return np.eye(3) + np.sin(a)*K + (1 - np.cos(a))*K @ K
+    axes = [(0, 1, 0), (0, 0, 1), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+    steps = [(0, 0, 0), (1, 0, 0), (0, -1, 0), (0, 0, 1), (-1, 0, 0)]
+    for k in range(r.t.size):
+        q = r.q[:, k]
+        R, pos, Rs, ps = np.eye(3), np.zeros(3), [], []
+        for ax, st, qj in zip(axes, steps, q):
+            pos = pos + R @ np.array(st, float)
+            R = R @ rot(ax, qj)
+            Rs.append(R)
+            ps.append(pos)
+        x = ps[-1] + Rs[-1] @ np.array([0.0, 1.0, 0.0])            # the joint E on rod5
+        F, M = Rs[-1] @ j.force[:, k], Rs[-1] @ j.moment[:, k]
+        Q = [(Rj @ np.array(ax, float)) @ (np.cross(x - pj, F) + M)
+             for Rj, pj, ax in zip(Rs, ps, axes)]
+        G = compiled.evaluate(p.system, r.t[k], q, r.v[:, k])["G"]
+        ref = G.T @ r.lam[:, k]
+        assert np.max(np.abs(Q - ref)) <= 1e-9*max(1.0, np.max(np.abs(ref)))
+        assert abs(j.moment[:, k] @ np.array([1.0, 0.0, 0.0])) <= 1e-12*max(
+            1.0, np.max(np.abs(j.moment[:, k])))

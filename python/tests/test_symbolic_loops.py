@@ -113,6 +113,44 @@ def test_multipliers_are_the_joint_force():
         assert rel(r.lam[:, k], ref) <= 1e-9
 
 
+def test_joint_reactions_in_the_joint_frame():
+    """joint_reactions: the loop force of a generic four-bar on the coupler, in the
+    coupler's frame, is the Newton-Euler force (world components) turned by the coupler's
+    angle; with relative coordinates (the coupler's frame then composed of two joint
+    rotations) the same along the same motion."""
+    L = (1.0, 1.3, 1.1, 1.5)
+    te = np.linspace(0, 2, 9)
+    out = {}
+    for coordinates in ("absolute", "relative"):
+        mech, _ = fourbar(coordinates, L)
+        qa, va = symbolic.consistent_state(fourbar("absolute", L)[0], [1.2, 0.4, 1.0],
+                                           [2.0, 0, 0], independent=[0])
+        q0, v0 = qa.copy(), va.copy()
+        if coordinates == "relative":
+            q0[1], v0[1] = qa[1] - qa[0], va[1] - va[0]
+        r = constrained.solve(mech, (0, 2), q0, v0, t_eval=te, rtol=1e-11, atol=1e-11)
+        assert r.success
+        jr = symbolic.joint_reactions(mech, r)
+        assert list(jr) == ["loop 0 (coupler-crank2)"]
+        j = jr["loop 0 (coupler-crank2)"]
+        assert (j.kind, j.body_a, j.body_b, j.moment) == ("revolute", "coupler", "crank2",
+                                                          None)
+        assert j.force.shape == (2, te.size) and j.rows == slice(0, 2)
+        out[coordinates] = j.force
+        if coordinates == "absolute":
+            for k in range(te.size):
+                q, v = r.q[:, k], r.v[:, k]
+                ev = compiled.evaluate(mech, r.t[k], q, v)
+                a = np.linalg.solve(ev["M"], ev["Q"] + ev["G"].T @ r.lam[:, k])
+                f = newton_euler_reaction(q, v, a, L)          # world components
+                c, s_ = np.cos(q[1]), np.sin(q[1])
+                assert rel(j.force[:, k], [c*f[0] + s_*f[1], -s_*f[0] + c*f[1]]) <= 1e-9
+    assert rel(out["relative"], out["absolute"]) <= 1e-8
+    with pytest.raises(ValueError, match="result: its q must have 3 rows"):
+        symbolic.joint_reactions(mech, type("R", (), {"q": np.zeros((2, 1)),
+                                                      "lam": np.zeros((2, 1))})())
+
+
 def slider_crank_reference(r_, l_, m1, m2, m3, g, th0, w0, t_eval):
     """The slider-crank in its one coordinate theta (crank angle), by the Lagrangian of the
     exact kinematics: slider x = r cos th + sqrt(l^2 - r^2 sin^2 th) on the x axis."""

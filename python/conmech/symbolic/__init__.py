@@ -555,6 +555,11 @@ from .loops import Loop, PointForce, consistent_state  # noqa: E402
 
 __all__ += ["Loop", "PointForce", "consistent_state"]
 
+# the loop joints' reactions, per joint, in the joint's frame
+from .reactions import JointReaction, joint_reactions  # noqa: E402
+
+__all__ += ["JointReaction", "joint_reactions"]
+
 # robots from URDF files
 from .urdf import Robot, from_urdf, read_urdf  # noqa: E402
 
