@@ -9,8 +9,8 @@ Here the key is taken from the description as the user gives it, before any of t
 
 - a tree (:func:`~conmech.symbolic.planar_tree`, :func:`~conmech.symbolic.spatial_tree`):
   every field of every body, the gravity, the forces, the loops and point forces, the
-  parameter names (in order), the options (coordinates, method, simplify, jacobian,
-  flags);
+  parameters (names and values, in order), the options (coordinates, method, simplify,
+  jacobian, flags);
 - a URDF robot (:func:`~conmech.symbolic.from_urdf`): the document's text and every
   argument of the call;
 
@@ -20,9 +20,11 @@ recursive generator's modules) and of conmech. Sympy objects enter through ``sre
 of another kind) makes the description uncacheable and the construction takes the
 ordinary path. A description entry, ``conmech_desc_DKEY.json``, written after a successful
 construction, names the derivation-cache entry and the parameter values it was built with
-(for a robot: the values its URDF sets, such as damping); the parameter values of a tree
-are the caller's at every hit (run-time values, not part of the key). Entries are
-trusted only as the rest of the cache (owned by the user, writable by nobody else).
+(for a robot: the values its URDF sets, such as damping). A tree's parameter values are
+part of its key (new values take the ordinary path once, which checks them, e.g. for a
+negative mass, and finds the derivation in the derivation cache); ``with_params`` changes
+them without any construction. Entries are trusted only as the rest of the cache (owned by
+the user, writable by nobody else).
 """
 import hashlib
 import json
@@ -74,8 +76,11 @@ def _digest(kind, parts):
 
 
 def _param_names(params):
-    """The parameter names in order, or _NotPlain when the values are not plain numbers
-    (then the ordinary path reports the problem)."""
+    """The parameter names and values in order, or _NotPlain when the values are not
+    plain numbers (then the ordinary path reports the problem). The values are part of
+    the key although the generated code does not depend on them: the checks of the
+    ordinary path that depend on them (a negative mass, a leaf without inertia) then run
+    for every new set of values."""
     import numpy as np
     import sympy as sp
     if params is None:
@@ -92,6 +97,7 @@ def _param_names(params):
             raise _NotPlain("params key")
         if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
             raise _NotPlain("params value")
+        names.append(repr(float(v)))
     return tuple(names)
 
 
