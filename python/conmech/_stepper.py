@@ -31,7 +31,7 @@ from . import _conmech
 from ._callback import Guard, as_result, message_text
 from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput
 from ._checks import initial_state, real_scalar, tolerance
-from ._implicit import jacobian_callback, sparsity_pattern
+from ._implicit import jacobian_callback, sparsity_pattern, is_sparse
 from ._methods import BY_NAME, RK45_SCIPY, method_info
 from ._native import NativeSystem
 
@@ -92,7 +92,8 @@ class Stepper:
         differences (counted in nfev). Not with a built-in system.
     jac_sparsity : array_like, sparse matrix or None
         Methods that use a Jacobian, without ``jac``: the structure of df/dy for finite
-        differences by groups of columns (Curtis-Powell-Reid).
+        differences by groups of columns (Curtis-Powell-Reid); with n >= 100 and at most
+        10% of the entries in it (or a constant sparse ``jac``), Radau's LUs are sparse.
     method : str
         Only for ``Stepper`` itself: the method's name in the table.
     """
@@ -123,7 +124,9 @@ class Stepper:
             jac = extraneous.pop("jac", None)
             sparsity = extraneous.pop("jac_sparsity", None)
             if jac is not None:
-                sparsity = None        # SciPy: the pattern only serves finite differences
+                # SciPy: the pattern only serves finite differences; a constant sparse jac
+                # gives its own, for the sparse LUs
+                sparsity = jac if is_sparse(jac) and not callable(jac) else None
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
@@ -212,6 +215,8 @@ class Stepper:
         m = y.size
         self._w = np.zeros((m, 1), order="F")
         self._w[:, 0] = y
+        if self._complex and sparsity is jac:
+            sparsity = None
         nnz, ptr, idx = sparsity_pattern(sparsity, m) if sparsity is not None else \
             (-1, None, np.zeros(1, dtype=np.intc))
         self._pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
@@ -419,7 +424,8 @@ class Radau(Stepper):
 
     Parameters as :class:`Stepper`, with ``jac`` (callable ``jac(t, y) -> (n, n)``, a
     constant matrix, or None: forward differences counted in nfev; not with a built-in
-    system, which has its own) and ``jac_sparsity`` (only None: dense Jacobians).
+    system, which has its own) and ``jac_sparsity`` (grouped differences, and sparse LUs
+    for n >= 100 at most 10% dense).
     """
     _code = BY_NAME["RADAU5"].code
     order = 5
