@@ -268,19 +268,16 @@ class Stepper:
     def _positional(self, action):
         """The flat routine and its positional arguments for a step or a dense output:
         built once (the state arrays r, iv, w are updated in place, so the same objects
-        serve every call); f2py parses positional arguments much faster than ~25 keywords,
-        which is most of the Python cost of a step."""
+        serve every call). The step routines take only the method, the system and the
+        state (the tolerances, t_bound and the Jacobian's structure are in the state):
+        f2py's conversion of each argument is most of the Python cost of a step."""
         nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
-        head = (action, nr, ni, nw, 0.0, self.t_bound, self._y0, self._code)
-        tol = (self._rtol, self._atol, self._first_step, self._max_step, self._max_steps)
-        pat = (self._pattern["nnz"], self._pattern["sp_ptr"], self._pattern["sp_idx"])
-        state = (self._r, self._iv, self._w)
+        state = (nr, ni, nw, self._r, self._iv, self._w)
         if self._builtin:
-            return (_conmech.flat_stepper_builtin,
-                    self.fun._flat_args() + head + tol + pat + state)
-        return (_conmech.flat_stepper_callback,
-                (self._rhs, self._jac_cb) + head + (self._has_jac,) + tol +
-                (self._jac_const,) + pat + state)
+            return (_conmech.flat_stepper_step_builtin,
+                    self.fun._flat_args() + (action, self._code) + state)
+        return (_conmech.flat_stepper_step_callback,
+                (self._rhs, self._jac_cb, action, self._code, self._has_jac) + state)
 
     def _call(self, action):
         if action == _STEP or action == _DENSE:
