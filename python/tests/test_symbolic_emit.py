@@ -184,16 +184,17 @@ def test_fpm_example_user_ball_agrees_with_builtin():
 
 
 # ------------------------------------------------------------------ names shared with conmech
-def _fpm_module_dir():
-    """The directory of conmech.mod in fpm's build (built if needed)."""
+def _installed_library(prefix):
+    """conmech's library and its module files, installed by scripts/install.sh the way a
+    user of another build system gets them (fpm's build tree keeps modules and library in
+    directories named by different hashes, so pairing them by date can mix two builds)."""
     if shutil.which("fpm") is None:
         pytest.fail("fpm is not on PATH: run the tests through scripts/test.sh")
-    r = subprocess.run(["fpm", "build"], cwd=ROOT, capture_output=True, text=True,
-                       timeout=900)
+    r = subprocess.run(["bash", str(ROOT / "scripts" / "install.sh"), "--prefix", str(prefix),
+                        "--library-only"], cwd=ROOT, capture_output=True, text=True,
+                       timeout=1800)
     assert r.returncode == 0, r.stdout + r.stderr
-    mods = sorted(ROOT.glob("build/gfortran_*/conmech.mod"), key=lambda p: p.stat().st_mtime)
-    assert mods, "fpm build left no conmech.mod"
-    return mods[-1].parent
+    return prefix / "include", prefix / "lib" / "libconmech.a"
 
 
 @pytest.mark.parametrize("kind", ["ode", "generalized"])
@@ -228,13 +229,10 @@ def test_names_shared_with_conmech_compile(tmp_path, kind):
         "    if (.not. r%success) error stop 1\n"
         "    print '(2es24.16)', r%y(:, r%nt)\n"
         "end program main\n")
-    moddir = _fpm_module_dir()
-    lib = sorted(ROOT.glob("build/gfortran_*/conmech/libconmech.a"),
-                 key=lambda p: p.stat().st_mtime)[::-1]
-    assert lib, "fpm build left no libconmech.a"
+    moddir, lib = _installed_library(tmp_path / "prefix")
     exe = tmp_path / "main"
     r = subprocess.run(["gfortran", f"-I{moddir}", "-J", str(tmp_path), "clash_model.f90",
-                        "main.f90", str(lib[0]), "-llapack", "-lblas", "-o", str(exe)],
+                        "main.f90", str(lib), "-llapack", "-lblas", "-o", str(exe)],
                        cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
