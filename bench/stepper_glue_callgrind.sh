@@ -3,7 +3,7 @@
 # built-in Kepler system, no Python right-hand side: what is left is the Python and f2py
 # glue plus the Fortran step), by callgrind on the installed package of a virtualenv:
 # (I(K2 steps) - I(K1 steps))/(K2 - K1), which cancels start-up and imports. The Fortran
-# step alone is read from the same profile (flat_stepper_builtin_, inclusive).
+# step alone is read from the same profile (flat_stepper_step_builtin_, inclusive).
 # Usage (repository root): bash bench/stepper_glue_callgrind.sh [PYTHON] [K1] [K2]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,8 +24,10 @@ run() {  # run K -> "total fortran"
         >/dev/null 2>&1
     local tot fort
     tot=$(grep -E '^(summary|totals):' "$tmp/cg.$1" | head -1 | awk '{print $2}')
+    # the step routine: flat_stepper_step_builtin (or flat_stepper_builtin, older builds)
     fort=$(callgrind_annotate --inclusive=yes "$tmp/cg.$1" 2>/dev/null \
-        | grep -m1 'flat_stepper_builtin_ ' | awk '{gsub(",", "", $1); print $1}')
+        | grep -m1 -E 'flat_stepper_(step_)?builtin_ ' | awk '{gsub(",", "", $1); print $1}' \
+        || true)
     echo "$tot ${fort:-0}"
 }
 read -r t1 f1 < <(run "$k1")

@@ -4,7 +4,7 @@
 !! Use: new_arenstorf_sym() is an ode_system with the exact Jacobian (ode_solve,
 !! integrate_stm and conmech's stability routines).
 module arenstorf_model
-    use conmech
+    use conmech, only: dp, ode_system
     implicit none
     private
 

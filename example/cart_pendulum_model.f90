@@ -4,7 +4,7 @@
 !! Use: new_cart_pendulum_sym() is an ode_system (y = [q, v]) with the exact Jacobian;
 !! new_cart_pendulum_sym_mech() a generalized_system for generalized_solve.
 module cart_pendulum_model
-    use conmech
+    use conmech, only: dp, CM_SUCCESS, ode_system, generalized_system, mass_cholesky
     implicit none
     private
 

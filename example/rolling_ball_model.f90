@@ -4,7 +4,7 @@
 !! conmech.symbolic emit.
 !! Use: new_rolling_ball_sym() is a constrained_system for constrained_solve.
 module rolling_ball_model
-    use conmech
+    use conmech, only: dp, constrained_system
     implicit none
     private
 

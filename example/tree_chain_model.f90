@@ -5,7 +5,7 @@
 !! Use: new_tree_chain_sym() is an ode_system (y = [q, v]) with the exact Jacobian;
 !! new_tree_chain_sym_mech() a generalized_system for generalized_solve.
 module tree_chain_model
-    use conmech
+    use conmech, only: dp, CM_SUCCESS, ode_system, generalized_system, mass_cholesky
     implicit none
     private
 

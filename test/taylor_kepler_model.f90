@@ -4,7 +4,7 @@
 !! Use: new_kepler_sym() is an ode_system with the exact Jacobian (ode_solve,
 !! integrate_stm and conmech's stability routines).
 module taylor_kepler_model
-    use conmech
+    use conmech, only: dp, ode_system
     implicit none
     private
 

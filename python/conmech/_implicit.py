@@ -3,9 +3,10 @@ constant, dense or a scipy.sparse matrix) and ``jac_sparsity`` for the flat rout
 solve_ivp and of the steppers.
 
 Sparse matrices are recognised by their interface (``toarray``, ``tocsc``), so conmech
-needs no SciPy; they are converted to dense arrays (the LU factorisations of Radau are
-dense LAPACK ones). ``jac_sparsity`` gives the structure for finite differences by groups
-of columns (Curtis-Powell-Reid, done in Fortran: conmech_jacobian_structure).
+needs no SciPy; their values reach Fortran as dense arrays. ``jac_sparsity`` (or the
+pattern of a constant sparse ``jac``) gives the structure for finite differences by groups
+of columns (Curtis-Powell-Reid, done in Fortran: conmech_jacobian_structure) and, for
+n >= 100 at most 10% dense, Radau's sparse LU path (conmech_radau_sparse).
 """
 import math
 

@@ -186,7 +186,12 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         Used by method="Radau": ``jac(t, y, *args) -> (n, n)`` (a dense array or a
         scipy.sparse matrix) or a constant matrix (dense or sparse: read once, njev 0, as
         SciPy); None: forward differences (n evaluations of fun per Jacobian, or one per
-        group of columns with ``jac_sparsity``). The LU factorisations are dense (LAPACK).
+        group of columns with ``jac_sparsity``). With a sparsity structure (``jac_sparsity``,
+        or a constant sparse ``jac``), n >= 100 and at most 10% of the n^2 entries in it,
+        the two LU factorisations per step are sparse (Gilbert-Peierls with a reverse
+        Cuthill-McKee column order, J kept on its pattern: work and memory grow with the
+        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable returning a
+        sparse matrix is converted to a dense one (dense LUs).
         The other methods validate it and warn that it has no effect, as SciPy's
         explicit ones.
     **options
@@ -310,6 +315,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                       f"{', '.join(f'`{k}`' for k in unused)}.", stacklevel=2)
     if not info.uses_jacobian or jac is not None:
         sparsity = None        # SciPy: jac_sparsity only serves finite differences
+        if info.uses_jacobian and is_sparse(jac):
+            sparsity = jac     # a constant sparse jac: its pattern for the sparse LUs
     pattern = sparsity_pattern(sparsity, n) if sparsity is not None and n else None
     if vectorized not in (True, False, 0, 1) or isinstance(vectorized, float):
         raise TypeError("vectorized must be a bool")

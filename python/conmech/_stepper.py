@@ -31,7 +31,7 @@ from . import _conmech
 from ._callback import Guard, as_result, message_text
 from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput
 from ._checks import initial_state, real_scalar, tolerance
-from ._implicit import jacobian_callback, sparsity_pattern
+from ._implicit import jacobian_callback, sparsity_pattern, is_sparse
 from ._methods import BY_NAME, RK45_SCIPY, method_info
 from ._native import NativeSystem
 
@@ -92,7 +92,8 @@ class Stepper:
         differences (counted in nfev). Not with a built-in system.
     jac_sparsity : array_like, sparse matrix or None
         Methods that use a Jacobian, without ``jac``: the structure of df/dy for finite
-        differences by groups of columns (Curtis-Powell-Reid).
+        differences by groups of columns (Curtis-Powell-Reid); with n >= 100 and at most
+        10% of the entries in it (or a constant sparse ``jac``), Radau's LUs are sparse.
     method : str
         Only for ``Stepper`` itself: the method's name in the table.
     """
@@ -123,7 +124,9 @@ class Stepper:
             jac = extraneous.pop("jac", None)
             sparsity = extraneous.pop("jac_sparsity", None)
             if jac is not None:
-                sparsity = None        # SciPy: the pattern only serves finite differences
+                # SciPy: the pattern only serves finite differences; a constant sparse jac
+                # gives its own, for the sparse LUs
+                sparsity = jac if is_sparse(jac) and not callable(jac) else None
         if extraneous:
             warnings.warn("The following arguments have no effect for a chosen solver: "
                           + ", ".join(f"`{x}`" for x in extraneous), stacklevel=2)
@@ -212,6 +215,8 @@ class Stepper:
         m = y.size
         self._w = np.zeros((m, 1), order="F")
         self._w[:, 0] = y
+        if self._complex and sparsity is jac:
+            sparsity = None
         nnz, ptr, idx = sparsity_pattern(sparsity, m) if sparsity is not None else \
             (-1, None, np.zeros(1, dtype=np.intc))
         self._pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
@@ -263,19 +268,16 @@ class Stepper:
     def _positional(self, action):
         """The flat routine and its positional arguments for a step or a dense output:
         built once (the state arrays r, iv, w are updated in place, so the same objects
-        serve every call); f2py parses positional arguments much faster than ~25 keywords,
-        which is most of the Python cost of a step."""
+        serve every call). The step routines take only the method, the system and the
+        state (the tolerances, t_bound and the Jacobian's structure are in the state):
+        f2py's conversion of each argument is most of the Python cost of a step."""
         nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
-        head = (action, nr, ni, nw, 0.0, self.t_bound, self._y0, self._code)
-        tol = (self._rtol, self._atol, self._first_step, self._max_step, self._max_steps)
-        pat = (self._pattern["nnz"], self._pattern["sp_ptr"], self._pattern["sp_idx"])
-        state = (self._r, self._iv, self._w)
+        state = (nr, ni, nw, self._r, self._iv, self._w)
         if self._builtin:
-            return (_conmech.flat_stepper_builtin,
-                    self.fun._flat_args() + head + tol + pat + state)
-        return (_conmech.flat_stepper_callback,
-                (self._rhs, self._jac_cb) + head + (self._has_jac,) + tol +
-                (self._jac_const,) + pat + state)
+            return (_conmech.flat_stepper_step_builtin,
+                    self.fun._flat_args() + (action, self._code) + state)
+        return (_conmech.flat_stepper_step_callback,
+                (self._rhs, self._jac_cb, action, self._code, self._has_jac) + state)
 
     def _call(self, action):
         if action == _STEP or action == _DENSE:
@@ -419,7 +421,8 @@ class Radau(Stepper):
 
     Parameters as :class:`Stepper`, with ``jac`` (callable ``jac(t, y) -> (n, n)``, a
     constant matrix, or None: forward differences counted in nfev; not with a built-in
-    system, which has its own) and ``jac_sparsity`` (only None: dense Jacobians).
+    system, which has its own) and ``jac_sparsity`` (grouped differences, and sparse LUs
+    for n >= 100 at most 10% dense).
     """
     _code = BY_NAME["RADAU5"].code
     order = 5

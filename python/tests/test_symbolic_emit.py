@@ -18,7 +18,7 @@ sp = pytest.importorskip("sympy")
 import conmech  # noqa: E402
 from conmech import stability, systems  # noqa: E402
 from conmech.symbolic.__main__ import emit_file, main  # noqa: E402
-from conmech.symbolic.derive import derive_constrained, derive_lagrangian  # noqa: E402
+from conmech.symbolic.derive import derive_constrained, derive_lagrangian, derive_ode  # noqa: E402,E501
 from conmech.symbolic.emit_fortran import emit  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -181,3 +181,68 @@ def test_fpm_example_user_ball_agrees_with_builtin():
     assert value(out, "parabola x = u t + a t^2/2:")[0] < 1e-10
     assert max(value(out, "constraint residuals (pos, vel):", 2)) < 1e-12
     assert value(out, "energy drift:")[0] < 1e-10
+
+
+# ------------------------------------------------------------------ names shared with conmech
+def _installed_library(prefix):
+    """conmech's library and its module files, installed by scripts/install.sh the way a
+    user of another build system gets them (fpm's build tree keeps modules and library in
+    directories named by different hashes, so pairing them by date can mix two builds)."""
+    if shutil.which("fpm") is None:
+        pytest.fail("fpm is not on PATH: run the tests through scripts/test.sh")
+    r = subprocess.run(["bash", str(ROOT / "scripts" / "install.sh"), "--prefix", str(prefix),
+                        "--library-only"], cwd=ROOT, capture_output=True, text=True,
+                       timeout=1800)
+    assert r.returncode == 0, r.stdout + r.stderr
+    return prefix / "include", prefix / "lib" / "libconmech.a"
+
+
+@pytest.mark.parametrize("kind", ["ode", "generalized"])
+def test_names_shared_with_conmech_compile(tmp_path, kind):
+    """A system called ode_solve (a conmech procedure) with parameters called radau_solve
+    and ode_options: the module imports only what it uses from conmech, so it compiles,
+    and a program that uses both conmech and the model still reaches conmech's
+    ode_solve through a rename."""
+    x, v = sp.symbols("x xd")
+    k, c = sp.symbols("radau_solve ode_options")
+    if kind == "ode":
+        d = derive_ode([v, -k * x - c * v], [x, v], params={k: 2.0, c: 0.1})
+    else:
+        d = derive_lagrangian(v ** 2 / 2 - k * x ** 2 / 2, [x], velocities=[v],
+                              params={k: 2.0, c: 0.1})
+    src = emit(d, "ode_solve", module="clash_model")
+    uses = [ln for ln in src.splitlines() if ln.strip().startswith("use conmech")]
+    assert uses[0].strip().startswith("use conmech, only:")
+    (tmp_path / "clash_model.f90").write_text(src)
+    (tmp_path / "main.f90").write_text(
+        "program main\n"
+        "    use conmech, only: dp, ode_options, ode_result, conmech_ode_solve => ode_solve\n"
+        "    use clash_model, only: ode_solve, new_ode_solve\n"
+        "    implicit none\n"
+        "    type(ode_solve) :: s\n"
+        "    type(ode_options) :: opt\n"
+        "    type(ode_result) :: r\n"
+        "    real(dp) :: y(2)\n"
+        "    s = new_ode_solve()\n"
+        "    y = [1.0_dp, 0.0_dp]\n"
+        "    call conmech_ode_solve(s, [0.0_dp, 1.0_dp], y, opt, r)\n"
+        "    if (.not. r%success) error stop 1\n"
+        "    print '(2es24.16)', r%y(:, r%nt)\n"
+        "end program main\n")
+    moddir, lib = _installed_library(tmp_path / "prefix")
+    exe = tmp_path / "main"
+    r = subprocess.run(["gfortran", f"-I{moddir}", "-J", str(tmp_path), "clash_model.f90",
+                        "main.f90", str(lib), "-llapack", "-lblas", "-o", str(exe)],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    y1 = [float(s) for s in out.stdout.split()]
+    # exact solution of the damped (ode) or undamped (Lagrangian) oscillator at t = 1
+    w = np.sqrt(2.0)
+    if kind == "ode":
+        wd = np.sqrt(2.0 - 0.05 ** 2)
+        exact = np.exp(-0.05) * (np.cos(wd) + 0.05 / wd * np.sin(wd))
+    else:
+        exact = np.cos(w)
+    assert abs(y1[0] - exact) < 1e-4

@@ -21,12 +21,22 @@ module conmech_jacobian_structure
     implicit none
     private
 
-    public :: jacobian_structure
+    public :: jacobian_structure, LU_AUTO, LU_DENSE, LU_SPARSE
+
+    !> The linear algebra of an implicit method with a sparsity pattern: chosen by the
+    !! dimension and the density of the pattern (conmech_radau_sparse's rule) ...
+    integer, parameter :: LU_AUTO = 0
+    !> ... dense LAPACK factorisations always ...
+    integer, parameter :: LU_DENSE = 1
+    !> ... or sparse ones always.
+    integer, parameter :: LU_SPARSE = 2
 
     !> The structure of df/dy known to the caller.
     type :: jacobian_structure
         !> df/dy is a constant matrix (the system's `jacobian` is read once)
         logical :: constant = .false.
+        !> dense or sparse factorisations with a pattern (LU_AUTO, LU_DENSE, LU_SPARSE)
+        integer :: lu = LU_AUTO
         integer :: n = 0                       !! dimension (0: no sparsity pattern)
         integer :: ngroups = 0                 !! Curtis-Powell-Reid groups (0: dense)
         integer, allocatable :: col_ptr(:)     !! (n + 1) start of each column in row_idx
@@ -41,6 +51,10 @@ module conmech_jacobian_structure
         procedure :: grouped => structure_grouped
         !> Forward differences of f by groups of columns into jac.
         procedure :: fd_jacobian => structure_fd_jacobian
+        !> Forward differences of f by groups of columns into the values on the pattern.
+        procedure :: fd_values => structure_fd_values
+        !> The entries of a dense matrix on the pattern.
+        procedure :: gather => structure_gather
         !> Pack or unpack (conmech_state_packer).
         procedure :: transfer => structure_transfer
     end type jacobian_structure
@@ -160,11 +174,56 @@ contains
         end do
     end subroutine structure_fd_jacobian
 
+    !> jval(k) = df_i/dy_j for the k-th entry (i, j) of the pattern (column by column), by
+    !! the grouped forward differences of `fd_jacobian` (the same quotients, no n x n
+    !! array).
+    subroutine structure_fd_values(self, sys, t, y, f0, uround, jval, yw, fw, nfev)
+        class(jacobian_structure), intent(in) :: self
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t, y(:), f0(:), uround
+        real(dp), intent(out) :: jval(:)
+        real(dp), intent(inout) :: yw(:), fw(:)
+        integer, intent(inout) :: nfev
+        integer :: g, p, j, k
+        real(dp) :: delt
+        yw = y
+        do g = 1, self%ngroups
+            do p = self%gptr(g), self%gptr(g + 1) - 1
+                j = self%gcols(p)
+                yw(j) = y(j) + sqrt(uround*max(1.0e-5_dp, abs(y(j))))
+            end do
+            call sys%rhs(t, yw, fw)
+            nfev = nfev + 1
+            do p = self%gptr(g), self%gptr(g + 1) - 1
+                j = self%gcols(p)
+                delt = sqrt(uround*max(1.0e-5_dp, abs(y(j))))
+                do k = self%col_ptr(j), self%col_ptr(j + 1) - 1
+                    jval(k) = (fw(self%row_idx(k)) - f0(self%row_idx(k)))/delt
+                end do
+                yw(j) = y(j)
+            end do
+        end do
+    end subroutine structure_fd_values
+
+    !> jval(k) = a(i, j) for the k-th entry (i, j) of the pattern.
+    subroutine structure_gather(self, a, jval)
+        class(jacobian_structure), intent(in) :: self
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: jval(:)
+        integer :: j, k
+        do j = 1, self%n
+            do k = self%col_ptr(j), self%col_ptr(j + 1) - 1
+                jval(k) = a(self%row_idx(k), j)
+            end do
+        end do
+    end subroutine structure_gather
+
     subroutine structure_transfer(self, p)
         class(jacobian_structure), intent(inout) :: self
         type(state_packer), intent(inout) :: p
         integer :: nnz
         call p%item(self%constant)
+        call p%item(self%lu)
         call p%item(self%n)
         call p%item(self%ngroups)
         if (self%ngroups == 0) return

@@ -1,7 +1,8 @@
 !> The stage system of a Radau IIA step, solved by RADAU5's simplified Newton iteration
 !! (Hairer & Wanner, Solving ODEs II, section IV.8): counted right-hand side evaluations,
 !! the Jacobian (analytic, or forward differences with Hairer's steps), the real LU of
-!! gamma/h M - J and the complex LU of (alpha + i beta)/h M - J (LAPACK dgetrf/zgetrf),
+!! gamma/h M - J and the complex LU of (alpha + i beta)/h M - J (LAPACK dgetrf/zgetrf, or
+!! sparse ones on the sparse path: conmech_radau_sparse),
 !! and the iteration on the transformed stage increments with the contraction control.
 module conmech_radau_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -37,13 +38,26 @@ contains
         type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
         real(dp) :: delt, ysafe
+        real(dp), allocatable :: jfull(:, :)
         integer :: jj
         if (sys%has_jacobian()) then
             if (.not. s%jstruct%constant) s%st%njev = s%st%njev + 1
-            call sys%jacobian(s%t, s%y, s%jac)
+            if (s%sparse) then
+                ! the system gives J dense: its entries on the pattern
+                allocate (jfull(s%n, s%n))
+                call sys%jacobian(s%t, s%y, jfull)
+                call s%jstruct%gather(jfull, s%jval)
+            else
+                call sys%jacobian(s%t, s%y, s%jac)
+            end if
             return
         end if
         s%st%njev = s%st%njev + 1
+        if (s%sparse) then
+            call s%jstruct%fd_values(sys, s%t, s%y, s%f0, s%uround, s%jval, s%a2, s%a1, &
+                                     s%st%nfev)
+            return
+        end if
         if (s%jstruct%grouped()) then
             call s%jstruct%fd_jacobian(sys, s%t, s%y, s%f0, s%uround, s%jac, s%a2, s%a1, &
                                        s%st%nfev)
@@ -66,10 +80,18 @@ contains
         integer, intent(out) :: linfo
         real(dp) :: fac1
         complex(dp) :: sig
-        integer :: ii, n
+        integer :: ii, n, info2
         n = s%n
         fac1 = GAM0/s%h
         sig = cmplx(ALPH/s%h, BETA/s%h, kind=dp)
+        if (s%sparse) then
+            call s%slu%decompose(s%jval, fac1, sig, linfo, info2)
+            s%st%nlu = s%st%nlu + 1
+            if (linfo /= 0) return
+            s%st%nlu = s%st%nlu + 1
+            linfo = info2
+            return
+        end if
         if (allocated(s%mass)) then
             s%e1 = fac1*s%mass - s%jac
             s%e2 = sig*s%mass - s%jac
@@ -140,8 +162,13 @@ contains
                 s%zc(i) = cmplx(s2 - alphn*s%b2(i) + betan*s%b3(i), &
                                 s3 - alphn*s%b3(i) - betan*s%b2(i), kind=dp)
             end do
-            call dgetrs('N', n, 1, s%e1, n, s%ip1, s%z1, n, linfo)
-            call zgetrs('N', n, 1, s%e2, n, s%ip2, s%zc, n, linfo)
+            if (s%sparse) then
+                call s%slu%solve_real(s%z1)
+                call s%slu%solve_complex(s%zc)
+            else
+                call dgetrs('N', n, 1, s%e1, n, s%ip1, s%z1, n, linfo)
+                call zgetrs('N', n, 1, s%e2, n, s%ip2, s%zc, n, linfo)
+            end if
             s%z2 = real(s%zc, dp)
             s%z3 = aimag(s%zc)
             s%newt = s%newt + 1

@@ -7,6 +7,8 @@ submodule(conmech_radau_stepper) conmech_radau_step
     use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER, &
         min_step_at, MSG_STEP_TOO_SMALL
     use conmech_radau_coefficients, only: NIT, THET
+    use conmech_jacobian_structure, only: LU_AUTO, LU_SPARSE
+    use conmech_radau_sparse, only: SPARSE_MIN_N, SPARSE_MAX_DENSITY
     use conmech_radau_collocation, only: radau_collocation_update
     use conmech_radau_newton, only: radau_rhs, radau_jacobian, radau_decompose, radau_newton
     use conmech_radau_control, only: radau_initial_step, radau_estimate_error, &
@@ -16,7 +18,7 @@ submodule(conmech_radau_stepper) conmech_radau_step
 contains
 
     module procedure radau_setup
-        integer :: n
+        integer :: n, m
         n = self%n
         call check_first_step(self, opt, info, msg)
         if (info /= CM_SUCCESS) return
@@ -56,10 +58,29 @@ contains
 
         self%nf = 3
         self%form = FORM_POWER
-        if (allocated(self%jac)) deallocate (self%jac, self%e1, self%e2, self%f0, &
-                                             self%scal0, self%ip1, self%ip2)
-        allocate (self%jac(n, n), self%e1(n, n), self%e2(n, n), self%f0(n), self%scal0(n), &
-                  self%ip1(n), self%ip2(n))
+        ! the sparse path: a pattern, no mass matrix, and the caller's choice or the rule
+        ! (n >= SPARSE_MIN_N, at most SPARSE_MAX_DENSITY of the entries in the pattern)
+        self%sparse = .false.
+        if (self%jstruct%grouped() .and. .not. allocated(self%mass)) then
+            select case (self%jstruct%lu)
+            case (LU_SPARSE)
+                self%sparse = .true.
+            case (LU_AUTO)
+                self%sparse = n >= SPARSE_MIN_N .and. real(size(self%jstruct%row_idx) + n, &
+                    dp) <= SPARSE_MAX_DENSITY*real(n, dp)**2
+            end select
+        end if
+        if (allocated(self%jac)) deallocate (self%jac, self%e1, self%e2, self%ip1, self%ip2)
+        if (allocated(self%f0)) deallocate (self%f0, self%scal0)
+        allocate (self%f0(n), self%scal0(n))
+        if (self%sparse) then
+            allocate (self%jac(0, 0), self%e1(0, 0), self%e2(0, 0), self%ip1(0), self%ip2(0))
+            self%jval = [(0.0_dp, m = 1, size(self%jstruct%row_idx))]
+            call self%slu%build(self%jstruct)
+        else
+            allocate (self%jac(n, n), self%e1(n, n), self%e2(n, n), self%ip1(n), self%ip2(n))
+            self%jval = [real(dp) ::]
+        end if
         call radau_allocate_work(self)
         self%jac = 0.0_dp
         self%e1 = 0.0_dp
@@ -164,7 +185,8 @@ contains
             end if
             if (self%need_jac) then
                 call radau_jacobian(self, sys)
-                if (.not. all(ieee_is_finite(self%jac))) then
+                if (.not. (all(ieee_is_finite(self%jac)) .and. &
+                           all(ieee_is_finite(self%jval)))) then
                     write (buf, '(es14.6)') self%t
                     info = CM_NONFINITE
                     msg = "non-finite Jacobian at t ="//trim(buf)

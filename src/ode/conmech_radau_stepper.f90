@@ -5,7 +5,10 @@
 !! - Simplified Newton iteration on the transformed stage system: with the eigenvalues
 !!   gamma and alpha +- i beta of the inverse Radau matrix, one real LU of
 !!   (gamma/h M - J) and one complex LU of ((alpha + i beta)/h M - J), both of size n
-!!   (LAPACK dgetrf/zgetrf). Convergence control by the contraction rate theta as
+!!   (LAPACK dgetrf/zgetrf; with a sparsity pattern in `jstruct`, n >= 100 and at most 10%
+!!   of the entries in the pattern, or jstruct%lu = LU_SPARSE: sparse LUs with a reverse
+!!   Cuthill-McKee column order, conmech_radau_sparse, and J kept on its pattern).
+!!   Convergence control by the contraction rate theta as
 !!   RADAU5: at most 7 iterations, stop when theta/(1 - theta) |dW| <= fnewt, a step
 !!   reduction when the predicted error after the remaining iterations is too large.
 !! - Error estimate (I - h gamma0 J)^{-1}(f0 + (e1 z1 + e2 z2 + e3 z3)/h), refined by one
@@ -58,7 +61,9 @@ module conmech_radau_stepper
     use conmech_ode_stepper, only: ode_stepper
     use conmech_state_packer, only: state_packer
     use conmech_radau_collocation, only: radau_collocation_basis
+    use conmech_radau_coefficients, only: GAM0, ALPH, BETA
     use conmech_jacobian_structure, only: jacobian_structure
+    use conmech_radau_sparse, only: radau_sparse_lu
     implicit none
     private
 
@@ -105,6 +110,11 @@ module conmech_radau_stepper
         logical :: final_step = .false.       !! the step to attempt ends at tf
         logical :: h_capped = .false.         !! h was cut to hmax after the last step
         real(dp), allocatable :: f0(:), scal(:), scal0(:), rtolv(:), atolv(:)
+        !> the sparse path: J on its pattern (jval) and sparse LUs (slu) instead of the
+        !! dense jac, e1, e2 (conmech_radau_sparse; chosen in `init`)
+        logical :: sparse = .false.
+        real(dp), allocatable :: jval(:)                !! J's values on its pattern
+        type(radau_sparse_lu) :: slu                    !! the sparse iteration matrices
         real(dp), allocatable :: jac(:, :), e1(:, :)    !! J and the LU of gamma/h M - J
         complex(dp), allocatable :: e2(:, :)            !! LU of (alpha + i beta)/h M - J
         integer, allocatable :: ip1(:), ip2(:)          !! pivots of e1, e2
@@ -204,11 +214,17 @@ contains
         call p%column(self%scal0)
         call p%column(self%rtolv)
         call p%column(self%atolv)
-        call p%columns(self%jac, 1, n)
-        call p%columns(self%e1, 1, n)
-        call p%complex_columns(self%e2, n)
-        call p%ints(self%ip1, n)
-        call p%ints(self%ip2, n)
+        call p%item(self%sparse)
+        if (self%sparse) then
+            call transfer_sparse(self, p)
+        else
+            call p%columns(self%jac, 1, n)
+            call p%columns(self%e1, 1, n)
+            call p%complex_columns(self%e2, n)
+            call p%ints(self%ip1, n)
+            call p%ints(self%ip2, n)
+            if (p%reading()) self%jval = [real(dp) ::]
+        end if
         has_mass = allocated(self%mass)
         call p%item(has_mass)
         if (has_mass) then
@@ -222,6 +238,35 @@ contains
             call radau_collocation_basis(self%cvec, self%pmat)
         end if
     end subroutine radau_transfer
+
+    !> The sparse path's state: J's values (in columns of length n); on reading, the
+    !! pattern and, if the factors were current, the factorisations again (the same
+    !! numbers: they depend on J and h only; not counted in nlu).
+    subroutine transfer_sparse(self, p)
+        class(radau_stepper), intent(inout) :: self
+        type(state_packer), intent(inout) :: p
+        real(dp), allocatable :: tmp(:, :)
+        integer :: n, nnz, m, i1, i2
+        n = self%n
+        nnz = size(self%jstruct%row_idx)
+        m = (nnz + n - 1)/n
+        if (.not. p%reading()) then
+            tmp = reshape(self%jval, [n, m], pad=[0.0_dp])
+        end if
+        if (m > 0) call p%columns(tmp, 1, m)
+        if (p%reading()) then
+            if (m > 0) then
+                self%jval = reshape(tmp, [nnz])
+            else
+                allocate (self%jval(0))
+            end if
+            call self%slu%build(self%jstruct)
+            if (.not. allocated(self%jac)) allocate (self%jac(0, 0), self%e1(0, 0), &
+                                                     self%e2(0, 0), self%ip1(0), self%ip2(0))
+            if (.not. self%need_lu) call self%slu%decompose(self%jval, GAM0/self%h, &
+                cmplx(ALPH/self%h, BETA/self%h, kind=dp), i1, i2)
+        end if
+    end subroutine transfer_sparse
 
     !> f(t, y) and the scale again after a step hook changed y.
     subroutine radau_refresh_f(self, sys)

@@ -1,8 +1,9 @@
 """Standalone Fortran modules from symbolic models, for fpm projects and batch codes.
 
 :func:`emit` turns a :class:`~conmech.symbolic.derive.Derived` record into the source of one
-self-contained Fortran module that needs only ``use conmech`` (no Python, no C ABI, no
-shared library): the parameters are components of the type with their values as defaults.
+self-contained Fortran module that needs only ``use conmech, only: ...`` (the names it
+uses; no Python, no C ABI, no shared library): the parameters are components of the type
+with their values as defaults.
 
 - ode (``derive_ode``): ``type, extends(ode_system) :: NAME`` with ``rhs``, the exact
   ``jacobian`` (``has_jacobian`` true) and the Jacobian product ``jacobian_product`` /
@@ -66,6 +67,12 @@ _TYPE_TAKEN = {"real", "integer", "logical", "character", "complex", "doubleprec
                "ieee_arithmetic", "ieee_exceptions", "ieee_features", "iso_c_binding",
                "iso_fortran_env"}
 _IND = "        "
+# what generated code may take from conmech: the module imports exactly the ones it uses
+# (`use conmech, only:`), so that a type, a constant or a parameter of the model may share a
+# name with any other entity of conmech (a system called ode_solve, a parameter called
+# radau_solve) without a clash
+_FROM_CONMECH = ("dp", "CM_SUCCESS", "ode_system", "generalized_system",
+                 "constrained_system", "mass_cholesky")
 
 
 def fortran_name_check(name, what):
@@ -280,7 +287,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                    "generalized_solve."]
     else:
         header += [f"!! Use: new_{name}() is a constrained_system for constrained_solve."]
-    lines = header + [f"module {module}", "    use conmech", "    implicit none",
+    lines = header + [f"module {module}", "    use conmech, only: @", "    implicit none",
                       "    private", ""]
     body, helpers = [], []
     if d.kind == "ode":
@@ -412,6 +419,11 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                             qvdecl + [_decl("gam", [":"], "out")], pr,
                             [("gam", d.gamma_n, False)], "gamma_n = -d/dt [A v + b].")
     src = lines + ["contains", ""] + body + [f"end module {module}", ""]
+    code = "\n".join(_code(ln) for ln in src)
+    used = [nm for nm in _FROM_CONMECH
+            if re.search(rf"(?<![%\w]){nm}(?!\w)", code, re.IGNORECASE)]
+    src = [f"    use conmech, only: {', '.join(used)}" if ln == "    use conmech, only: @"
+           else ln for ln in src]
     for ln in src:
         if len(ln) > 100:
             raise RuntimeError(f"emit: generated line longer than 100 characters: {ln!r}")
