@@ -76,8 +76,9 @@ contains
 
     !> y(t + h) = sum_k c(k, i) h^k and its derivative dy (Horner; the derivative from the
     !! same pass, d_k = y_(k+1) + h d_(k+1): two multiply-adds per order, no weights).
-    !! Explicit shapes: the compiler sees unit stride along k (a third of the instructions
-    !! of the assumed-shape form).
+    !! Explicit shapes (no stride arithmetic of an assumed-shape dummy); the two chains of
+    !! one component are still dependent, so this is about 2 x (p + 1) multiply-adds plus
+    !! loads per component.
     pure subroutine taylor_eval_step(n, p, c, h, ynew, dy)
         integer, intent(in) :: n, p
         real(dp), intent(in) :: c(0:p, n), h
