@@ -194,6 +194,8 @@ def breakdown(rounds, path):
     def flat(method, system, tf=T):
         kw = dict(t_span=np.array([0.0, tf]), y0=y0, first_step=0.0, neval=0,
                   t_eval=_ivp._PAD, ne=0, ev_dir=_ivp._PADI, ev_term=_ivp._PADI,
+                  ev_res=_ivp._PAD, nnz=-1, sp_ptr=np.zeros(5, dtype=np.intc),
+                  sp_idx=_ivp._PADI,
                   method=_ivp._METHOD_CODES[method], rtol=rt, atol=rt, max_step=1e300,
                   max_steps=100000, dense=0)
         args = system._flat_args()

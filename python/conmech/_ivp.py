@@ -353,8 +353,11 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         # SciPy would integrate for ever: nothing ends such a run but a failure
         raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
                          "end the integration")
-    if builtin and code == _TAYLOR and getattr(fun, "taylor", None):   # written out
-        fun = with_fixed_order(fun, rtol, atol)
+    if builtin and code == _TAYLOR:
+        if getattr(fun, "taylor", None):        # the recurrences written out for the order
+            fun = with_fixed_order(fun, rtol, atol)
+        else:
+            _refuse_taylor(fun)
     problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
                    t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
                    settings=settings, vectorized=bool(vectorized))
@@ -371,6 +374,25 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                   atol=np.concatenate([atol_v, atol_v]))
     res = _solve(problem, common, h0, None, None)
     return _complex_result(res, n)
+
+
+def _refuse_taylor(fun):
+    """ValueError naming why a compiled system has no Taylor recurrences, when the model
+    says so (a generalized system M(q) q'' = Q); other systems are refused by the Fortran
+    stepper with its own message."""
+    from .symbolic import model_of
+    try:
+        kind = getattr(model_of(fun).derived, "kind", None)
+    except TypeError:
+        return
+    if kind == "generalized":
+        raise ValueError(
+            "method TAYLOR: a generalized system M(q) q'' = Q (symbolic.lagrangian_system) "
+            "has no Taylor recurrences: its accelerations come from a linear solve with "
+            "M(q) at every evaluation, and the recurrences of that solve are not generated. "
+            "Use method DOP853 or VERNER98, or write the first-order system with explicit "
+            "accelerations (q'' = M(q)^-1 Q, e.g. sympy's M.LUsolve(Q)) as "
+            "symbolic.ode_system")
 
 
 def _check_jac_value(jac, n):

@@ -259,6 +259,17 @@ def test_methods_without_taylor_code_are_refused():
         stability.stm(f, (0, 1), [1.0, 0.0], method="TAYLOR")
 
 
+def test_generalized_system_is_refused_with_the_reason():
+    """A Lagrangian system's accelerations come from a linear solve with M(q): the refusal
+    names it (and the same system integrates with DOP853)."""
+    t = sp.Symbol("t")
+    a = sp.Function("a")(t)
+    pend = symbolic.lagrangian_system(sp.Rational(1, 2)*sp.diff(a, t)**2 + sp.cos(a), [a])
+    with pytest.raises(ValueError, match="M\\(q\\) q'' = Q.*linear solve"):
+        conmech.solve_ivp(pend, (0, 1), [0.5, 0.0], method="TAYLOR")
+    assert conmech.solve_ivp(pend, (0, 1), [0.5, 0.0], method="DOP853").success
+
+
 def test_emitted_kepler_module_is_regenerated_identically():
     """test/taylor_kepler_model.f90 (used by the Fortran test test_taylor) is the emitted
     module of example/models/kepler.py."""

@@ -34,21 +34,32 @@ contains
         real(dp), intent(in) :: y(n), rtol(n), atol(n)
         real(dp), intent(out) :: e(n)
         real(dp) :: y1, y2
-        y1 = maxval(abs(y(1:nb)))
-        e(1:nb) = max(atol(1:nb), rtol(1:nb)*y1)
+        integer :: i
+        y1 = 0.0_dp
+        do i = 1, nb
+            y1 = max(y1, abs(y(i)))
+        end do
+        do i = 1, nb
+            e(i) = max(atol(i), rtol(i)*y1, tiny(1.0_dp))
+        end do
         if (n > nb) then
-            y2 = maxval(abs(y(nb + 1:n)))
-            e(nb + 1:n) = max(atol(nb + 1:n), rtol(nb + 1:n)*y2)
+            y2 = 0.0_dp
+            do i = nb + 1, n
+                y2 = max(y2, abs(y(i)))
+            end do
+            do i = nb + 1, n
+                e(i) = max(atol(i), rtol(i)*y2, tiny(1.0_dp))
+            end do
         end if
-        e = max(e, tiny(1.0_dp))
     end subroutine taylor_scales
 
     !> Jorba and Zou's step (unsigned; huge when the last two coefficients vanish) from the
-    !! coefficients c(0:p, 1:n) and the scales e; decay = exp(-2 - 0.7/(p - 1)).
+    !! coefficients c(0:p, 1:n) and the scales e; decay = exp(-2 - 0.7/(p - 1)). The smaller
+    !! of the two radii is taken in the logarithm: two logarithms and one exponential.
     pure real(dp) function taylor_rho(n, p, c, e, eps, decay) result(rho)
         integer, intent(in) :: n, p
-        real(dp), intent(in) :: c(0:, :), e(n), eps, decay
-        real(dp) :: s1, s2
+        real(dp), intent(in) :: c(0:p, n), e(n), eps, decay
+        real(dp) :: s1, s2, l
         integer :: i
         s1 = 0.0_dp
         s2 = 0.0_dp
@@ -56,17 +67,21 @@ contains
             s1 = max(s1, abs(c(p - 1, i))/e(i))
             s2 = max(s2, abs(c(p, i))/e(i))
         end do
+        l = huge(1.0_dp)
+        if (s1 > 0.0_dp) l = -log(s1*eps)/real(p - 1, dp)
+        if (s2 > 0.0_dp) l = min(l, -log(s2*eps)/real(p, dp))
         rho = huge(1.0_dp)
-        if (s1 > 0.0_dp) rho = exp(-log(s1*eps)/real(p - 1, dp))
-        if (s2 > 0.0_dp) rho = min(rho, exp(-log(s2*eps)/real(p, dp)))
-        if (rho < huge(1.0_dp)) rho = rho*decay
+        if (l < log(huge(1.0_dp))) rho = exp(l)*decay
     end function taylor_rho
 
     !> y(t + h) = sum_k c(k, i) h^k and its derivative dy (Horner; the derivative from the
     !! same pass, d_k = y_(k+1) + h d_(k+1): two multiply-adds per order, no weights).
+    !! Explicit shapes (no stride arithmetic of an assumed-shape dummy); the two chains of
+    !! one component are still dependent, so this is about 2 x (p + 1) multiply-adds plus
+    !! loads per component.
     pure subroutine taylor_eval_step(n, p, c, h, ynew, dy)
         integer, intent(in) :: n, p
-        real(dp), intent(in) :: c(0:, :), h
+        real(dp), intent(in) :: c(0:p, n), h
         real(dp), intent(out) :: ynew(n), dy(n)
         real(dp) :: yv, dv
         integer :: i, k
