@@ -27,15 +27,13 @@ subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, clos
     character(len=256), intent(out) :: message
     type(hill_orbit) :: orb
     type(hill_orbit_options) :: opt
+    real(c_double), allocatable :: g(:)
     if (nsteps > 0) opt%nsteps = nsteps
     if (closure_tol > 0.0_c_double) opt%closure_tol = closure_tol
     if (max_nsteps > 0) opt%max_nsteps = max_nsteps
     opt%full_period = full_period /= 0
-    if (use_guess /= 0) then
-        call hill_variation_orbit(m, kappa, orb, opt, guess)
-    else
-        call hill_variation_orbit(m, kappa, orb, opt)
-    end if
+    if (use_guess /= 0) g = guess
+    call hill_variation_orbit(m, kappa, orb, opt, g)   ! unallocated g: no guess
     y0 = orb%y0
     period = orb%period
     jacobi = orb%jacobi
@@ -106,15 +104,13 @@ subroutine flat_hill_family(nm, ms, kappa, nsteps, chunk_size, y0s, jacobis, mon
     integer(c_int), intent(out) :: nsteps_used(nm), infos(nm), iters(nm)
     type(hill_orbit), allocatable :: orbs(:)
     type(hill_orbit_options) :: opt
+    integer, allocatable :: chunk
     integer :: i
     if (nsteps > 0) opt%nsteps = nsteps
     opt%eigenvalues = .false.
     allocate (orbs(nm))
-    if (chunk_size > 0) then
-        call hill_family(ms, kappa, orbs, opt, chunk_size=chunk_size)
-    else
-        call hill_family(ms, kappa, orbs, opt)
-    end if
+    if (chunk_size > 0) chunk = chunk_size
+    call hill_family(ms, kappa, orbs, opt, chunk_size=chunk)   ! unallocated: the default
     do i = 1, nm
         residuals(i) = orbs(i)%residual
         quarters(:, i) = orbs(i)%quarter_state
