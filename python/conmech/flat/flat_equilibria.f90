@@ -19,10 +19,8 @@ subroutine flat_equilibrium_structure(name, np, params, nspec, spec, fun, jfun, 
     use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
     use conmech_support_equilibria, only: unpack_structure
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y(n), t, tol
     real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
     real(c_double), intent(out) :: family(n, n), drift(n, n)
     integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block

@@ -16,10 +16,8 @@ subroutine flat_eq_continuation(name, np, params, nspec, spec, ip, fun, jfun, so
     use conmech_flat_system, only: flat_param_system
     use conmech_support_families, only: run_eq_continuation
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, ip, source, n, iopt(4), mp, nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), p0, y0(n), ropt(11)
+    integer(c_int), intent(in) :: n, iopt(4), mp
+    real(c_double), intent(in) :: y0(n), ropt(11)
     integer(c_int), intent(out) :: npts, nunst(mp), iters(mp), nsp, spi(5, 64), info
     real(c_double), intent(out) :: pp(mp), ys(n, mp), wr(n, mp), wi(n, mp), psi(3, mp)
     real(c_double), intent(out) :: res(mp), spr(8, 64), sp_y(n, 64), sp_wr(n, 64)
@@ -55,10 +53,8 @@ subroutine flat_hopf(name, np, params, nspec, spec, ip, fun, jfun, source, p0, n
     use conmech_flat_system, only: flat_param_system
     use conmech_support_families, only: run_hopf
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, ip, source, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), p0, t, y(n), l1_tol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t, y(n), l1_tol
     real(c_double), intent(out) :: out(7), q(2*n), adj(2*n)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message

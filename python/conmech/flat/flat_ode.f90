@@ -96,10 +96,6 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
     use conmech_flat_system, only: flat_system, SOURCE_SPEC
     use conmech_flat_ode_support, only: run_solve, copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)

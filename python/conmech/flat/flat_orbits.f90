@@ -15,11 +15,9 @@ subroutine flat_po(name, np, params, nspec, spec, fun, jfun, source, n, y0, peri
     use conmech_flat_system, only: flat_system
     use conmech_support_orbits, only: run_periodic_orbit
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source, n, kind, mode, nfree, ntg, free_time
+    integer(c_int), intent(in) :: n, kind, mode, nfree, ntg, free_time
     integer(c_int), intent(in) :: max_iter, nk
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, period_factor, rtol, atol
+    real(c_double), intent(in) :: y0(n), period, period_factor, rtol, atol
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), iopt(5)
     real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), merr(n)
     real(c_double), intent(out) :: accuracy, nodes(n, nk), node_times(nk), residual

@@ -189,10 +189,8 @@ subroutine flat_stm(name, np, params, nspec, spec, fun, jfun, source, n, y0, t0,
     use conmech_flat_system, only: flat_system
     use conmech_variational, only: integrate_stm
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), t0, t1, rtol, atol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y0(n), t0, t1, rtol, atol
     real(c_double), intent(out) :: y1(n), phi(n, n)
     integer(c_int), intent(out) :: nfev, info
     character(len=256), intent(out) :: message
@@ -339,10 +337,8 @@ subroutine flat_find_equilibrium(name, np, params, nspec, spec, fun, jfun, sourc
     use conmech_flat_system, only: flat_system
     use conmech_equilibria, only: find_equilibrium
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source, n, max_iter
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    integer(c_int), intent(in) :: n, max_iter
+    real(c_double), intent(in) :: y(n), t, tol
     real(c_double), intent(out) :: yout(n)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message

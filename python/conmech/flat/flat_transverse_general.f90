@@ -32,11 +32,8 @@ subroutine flat_transverse_general(name, np, params, nspec, spec, fun, jfun, sou
     use conmech_support_transverse_general, only: system_and_model, pack_frame, &
                                                   callback_energy_model
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source, has_energy, n, energy_mode, full, nt
+    integer(c_int), intent(in) :: has_energy, n, energy_mode, full, nt
     integer(c_int), intent(in) :: kmax
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     real(c_double), intent(in) :: y0(n), period, rtol, atol, t(nt)
     integer(c_int), intent(out) :: k, reduced, nfev, kind, info
     real(c_double), intent(out) :: closure, drift, defect
