@@ -93,11 +93,9 @@ subroutine flat_degrees_of_freedom(name, np, params, nspec, spec, n, t, q, proje
     use conmech_degrees_of_freedom, only: dof_result, degrees_of_freedom
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n, project
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), t, q(n), rank_tol
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: n, project
+    real(c_double), intent(in) :: t, q(n), rank_tol
     real(c_double), intent(out) :: qout(n), residual
     integer(c_int), intent(out) :: rank_h, rank_nh, dof, velocity_dof, info
     character(len=256), intent(out) :: message

@@ -84,10 +84,9 @@ subroutine flat_system_energy(name, np, params, nspec, spec, n, t, y, e, info, m
     use conmech_flat_spec, only: spec_system
     use conmech_system_energy, only: system_energy
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), t, y(n)
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t, y(n)
     real(c_double), intent(out) :: e
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message

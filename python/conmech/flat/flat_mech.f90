@@ -14,11 +14,7 @@ subroutine flat_mech_info(name, np, params, nspec, spec, kind, n, mh, mn, info, 
                                  KIND_CONSTRAINED
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(out) :: kind, n, mh, mn, info
     character(len=256), intent(out) :: message
     class(constrained_system), allocatable :: cs
@@ -94,10 +90,8 @@ subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces,
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_mech_support, only: callback_constrained, run_constrained
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, source
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: source
     integer(c_int), intent(in) :: has_jac, has_gamma, has_nh_gamma, rheonomic, mh, mn
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
