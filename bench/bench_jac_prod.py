@@ -11,7 +11,7 @@ Jacobian (J formed, then multiplied), and the built-in arenstorf (hand-written p
         one process; every variant's monodromy is checked against the others.
     python bench/bench_jac_prod.py save LIB.so
         write the symbolic system as a model library (no sympy needed to run it)
-    valgrind --tool=callgrind --toggle-collect='flat_stm_builtin*' \\
+    valgrind --tool=callgrind --toggle-collect='flat_stm_' \\
         python bench/bench_jac_prod.py one prod|dense|builtin --lib LIB.so
         one period of one variant: instructions inside the Fortran STM integration only
 """

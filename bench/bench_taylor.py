@@ -198,9 +198,9 @@ def breakdown(rounds, path):
                   sp_idx=_ivp._PADI,
                   method=_ivp._METHOD_CODES[method], rtol=rt, atol=rt, max_step=1e300,
                   max_steps=100000, dense=0)
-        args = system._flat_args()
-        return lambda: _conmech.flat_solve_builtin(*args, lambda t, y: _ivp._PAD,
-                                                   lambda *a: None, **kw)
+        args = system._system_args()
+        return lambda: _conmech.flat_solve(*args, lambda t, y: _ivp._PAD, lambda *a: None,
+                                           jac_const=0, **kw)
 
     def ivp(method, tf=T):
         return lambda: conmech.solve_ivp(kep, (0, tf), y0, method=method, rtol=1e-12,

@@ -21,7 +21,7 @@ from ._implicit import jacobian_callback, is_sparse, sparsity_pattern
 from ._methods import METHODS, RK45_SCIPY, method_info
 from ._stepper import method_code
 from ._taylor import with_fixed_order
-from ._native import NativeSystem
+from ._native import _NO_SPEC, NativeSystem
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
 
@@ -702,12 +702,12 @@ class _Run:
                 self.fun, [st[0] for st in self.settings], store, kw_taylor,
                 self.zero_at_start)
         elif self.builtin:
-            counts, form, info, message = _conmech.flat_solve_builtin(
-                *self.fun._flat_args(), events_cb, store, **kw)
+            counts, form, info, message = _conmech.flat_solve(
+                *self.fun._system_args(), events_cb, store, jac_const=0, **kw)
         else:
-            counts, form, info, message = _conmech.flat_solve_callback(
-                self.rhs, self.jac_cb, events_cb, store, has_jac=self.has_jac,
-                jac_const=self.jac_const, **kw)
+            counts, form, info, message = _conmech.flat_solve(
+                "", 0, _PAD, 0, _NO_SPEC, self.rhs, self.jac_cb, 2 if self.has_jac else 1,
+                events_cb, store, jac_const=self.jac_const, **kw)
         if self.failure:
             self.guard.fail(self.failure[0])
         nfev, njev, nlu, naccept, nreject = counts.tolist()

@@ -20,6 +20,13 @@ from ._builtin_table import PARAMS, POSITIVE_PARAMS, RANGE_PARAMS
 _PAD = np.zeros(1)
 _NO_SPEC = np.zeros(1, dtype=np.int64)   # spec kind 0: a built-in system, by name
 
+
+def _unused_callback(t, y):
+    """The placeholder call-back of the flat argument set where a role has no Python
+    function (f2py needs a callable for every call-back argument; conmech_flat_system
+    never calls it)."""
+    raise RuntimeError("a placeholder call-back of the flat layer was called")
+
 __all__ = ["NativeSystem", "BuiltinSystem", "check_params"]
 
 
@@ -54,6 +61,11 @@ class NativeSystem:
         p = self.params if self.params.size else _PAD
         nspec = self.spec.size if self.spec is not _NO_SPEC else 0
         return self.name, self.params.size, p, nspec, self.spec
+
+    def _system_args(self):
+        """The one system argument set of the flat routines (conmech_flat_system): the
+        leading arguments above, no Python call-backs, source 0."""
+        return (*self._flat_args(), _unused_callback, _unused_callback, 0)
 
     @property
     def parameters(self):

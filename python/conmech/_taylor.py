@@ -117,7 +117,7 @@ def _library(fun, evs):
 
 def run_compiled_events(fun, evs, store, kw, zero_at_start):
     """One segment of solve_ivp with compiled events: the flat call, returning (counts,
-    form, info, message) like flat_solve_builtin (counts of 5)."""
+    form, info, message) like flat_solve (counts of 5)."""
     from .symbolic.taylor_events import DEGREE
     lib = _library(fun, evs)
     ne = len(evs)

@@ -5,33 +5,56 @@ loaded with ctypes, numba ``cfunc``, ``scipy.LowLevelCallable``).
 The C signatures (matrices column-major, ``p`` the run-time parameter array, so that one
 compiled function serves every parameter value)::
 
-    void rhs(double t, const double *y, double *dydt, const double *p);      /* n       */
-    void jac(double t, const double *y, double *dfdy, const double *p);      /* n x n   */
-    /* optional: jx = J(t, y) x for an n x k block x (column-major) */
+    /* <generated: tools/generate_slots.py signatures> from the table conmech._slot_table */
+    /* first-order systems (kind 'ode', n states) */
+    /* dydt = f(t, y; p) */
+    void rhs(double t, const double *y, double *dydt, const double *p);
+    /* df/dy (column-major); without it finite differences (optional) */
+    void jac(double t, const double *y, double *dfdy, const double *p);
+    /* jx = J(t, y) x for an n x ncol block x (optional) */
     void jac_prod(double t, const double *y, int k, const double *x, double *jx,
                   const double *p);
-    /* M(t, q) q'' = Q(t, q, q'), ndof coordinates */
-    void mass(double t, const double *q, double *M, const double *p);        /* nd x nd */
+    /* mechanical systems (nd coordinates, M(t, q) q'' = Q(t, q, q')) */
+    /* the mass matrix M(t, q) */
+    void mass(double t, const double *q, double *M, const double *p);
+    /* the forces Q(t, q, q') */
     void forces(double t, const double *q, const double *v, double *Q, const double *p);
+    /* [dQ/dq - d(M a)/dq, dQ/dv], the Jacobian of the force balance at accelerations a
+       (optional) */
     void forces_jac(double t, const double *q, const double *v, const double *a,
-                    double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv], nd x 2nd */
+                    double *R, const double *p);
+    /* the energy (a first integral) (optional) */
     double energy(double t, const double *q, const double *v, const double *p);
-    /* optional: a = M^-1 Q, and a with its Jacobian d a/d[q, v] (nd x 2nd) */
+    /* M and Q in one call (shared subexpressions) (optional) */
+    void mass_forces(double t, const double *q, const double *v, double *M, double *Q,
+                     const double *p);
+    /* the accelerations a = M^-1 Q directly (e.g. the articulated-body algorithm);
+       non-finite where M is not positive definite (optional) */
     void accel(double t, const double *q, const double *v, double *a, const double *p);
+    /* a and its Jacobian d a/d[q, v] (ndof x 2 ndof) (optional) */
     void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
                    const double *p);
-    /* constrained systems (n coordinates): mass, forces, energy as above, and */
-    void phi(double t, const double *q, double *c, const double *p);         /* n_hol   */
-    void phi_jac(double t, const double *q, double *G, const double *p);     /* n_hol x n */
-    void phi_t(double t, const double *q, double *pt, const double *p);      /* n_hol   */
-    void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
+    /* constrained systems (n coordinates; mass, forces, forces_jac, energy
+       as above) */
+    /* the holonomic constraints phi(t, q) (n_hol; required when n_hol > 0) (optional) */
+    void phi(double t, const double *q, double *c, const double *p);
+    /* G = dphi/dq (n_hol x n) (optional) */
+    void phi_jac(double t, const double *q, double *G, const double *p);
+    /* dphi/dt (rheonomic constraints) (optional) */
+    void phi_t(double t, const double *q, double *pt, const double *p);
+    /* gamma_h = -d/dt [G v + phi_t] at fixed v (optional) */
+    void phi_gamma(double t, const double *q, const double *v, double *g,
+                   const double *p);
+    /* the Pfaffian constraints A(t, q) q' + b(t, q) = 0 (required when n_nh > 0)
+       (optional) */
     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
+    /* gamma_n = -d/dt [A v + b] at fixed v (optional) */
     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
-    /* optional, constrained: the Jacobian of the force balance (forces_jac above, n x 2n)
-       and hl = d(C^T lam)/dq (n x n), hv = d(C v + c0)/dq (m x n), m = n_hol + n_nh:
-       together the exact Jacobian of Radau IIA on the constrained equations */
+    /* hl = d(C^T lam)/dq, hv = d(C v + c0)/dq: with forces_jac the exact Jacobian of
+       Radau IIA on the constrained equations (optional) */
     void constraint_hessian(double t, const double *q, const double *v, const double *lam,
                             double *hl, double *hv, const double *p);
+    /* </generated> */
 
 with ``gamma_h = -d/dt [G v + phi_t]`` and ``gamma_n = -d/dt [A v + b]`` at fixed v (the
 acceleration-level right-hand sides of ``G q'' = gamma_h``, ``A q'' = gamma_n``). A missing
@@ -54,6 +77,7 @@ import os
 import numpy as np
 
 from . import _conmech
+from . import _slot_table as _table
 from ._native import NativeSystem
 from .constrained import NativeConstrained
 
@@ -61,18 +85,12 @@ __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSy
            "CompiledConstrained", "evaluate", "function_address", "load_model",
            "library_taylor"]
 
-_KIND_ODE, _KIND_GEN, _KIND_CON = 1, 2, 3
-_SPEC_SIZE = 28
-_SLOTS = {"rhs": 6, "jac": 7, "mass": 6, "forces": 7, "forces_jac": 8, "energy": 9,
-          "phi": 10, "phi_jac": 11, "phi_t": 12, "phi_gamma": 13, "nh_matrix": 14,
-          "nh_gamma": 15, "mass_forces": 16, "accel": 17, "jac_prod": 18,
-          "constraint_hessian": 27, "accel_jac": 28}
-# Taylor coefficients (conmech_flat_spec: 19 taylor, 20 its work columns, 21 taylor_var,
-# 22 its columns, 23 taylor written out for one order, 24 that order, 25/26 the same for
-# taylor_var)
-_TAYLOR_SLOTS = {"jet": 19, "nw": 20, "var": 21, "nw_var": 22, "jet_fixed": 23,
-                 "order": 24, "var_fixed": 25, "order_var": 26}
-_TAYLOR_FUNCS = ("jet", "var", "jet_fixed", "var_fixed")
+_KIND_ODE, _KIND_GEN, _KIND_CON = (_table.KIND_ODE, _table.KIND_GENERALIZED,
+                                   _table.KIND_CONSTRAINED)
+_SPEC_SIZE = _table.SPEC_SIZE
+_SLOTS = _table.SLOTS                   # function entries by name (conmech_<name>)
+_TAYLOR_SLOTS = _table.TAYLOR_SLOTS     # the Taylor entries of the ``taylor`` dict
+_TAYLOR_FUNCS = _table.TAYLOR_FUNCS
 
 
 def function_address(f, what: str = "function") -> int:
@@ -155,7 +173,8 @@ def _count(value, what, low):
 
 def _make_spec(kind, n, n_hol, n_nh, rheonomic, funcs):
     spec = np.zeros(_SPEC_SIZE, dtype=np.int64)
-    spec[0:5] = [kind, n, n_hol, n_nh, int(bool(rheonomic))]
+    for (_, slot), v in zip(_table.HEADER, (kind, n, n_hol, n_nh, int(bool(rheonomic)))):
+        spec[slot - 1] = v
     for key, f in funcs.items():
         spec[_SLOTS[key] - 1] = function_address(f, key)
     return spec
@@ -485,18 +504,13 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     if len(names) != npar:
         names = tuple(f"p{i}" for i in range(npar))
     params = dict(zip(names, list(p)[:npar]))
-    fn = {k: getattr(lib, "conmech_" + k, None) for k in _SLOTS}
+    kind_name = {v: k for k, v in _table.KINDS.items()}[kind]
+    fn = {k: getattr(lib, "conmech_" + k, None) for k in _table.ENTRY_POINTS[kind_name]}
     name = name or str(path)
     if kind == _KIND_ODE:
-        return ode_system(n, fn["rhs"], fn["jac"], params=params, keep=lib, name=name,
-                          jac_prod=fn["jac_prod"], taylor=library_taylor(lib))
+        return ode_system(n, params=params, keep=lib, name=name, taylor=library_taylor(lib),
+                          **fn)
     if kind == _KIND_GEN:
-        return generalized_system(n, fn["mass"], fn["forces"], fn["forces_jac"], fn["energy"],
-                                  params=params, keep=lib, name=name,
-                                  mass_forces=fn["mass_forces"], accel=fn["accel"],
-                                  accel_jac=fn["accel_jac"])
-    return constrained_system(n, fn["mass"], fn["forces"], n_hol, n_nh, fn["phi"],
-                              fn["phi_jac"], fn["phi_t"], fn["phi_gamma"], fn["nh_matrix"],
-                              fn["nh_gamma"], fn["energy"], bool(rheo), params=params, keep=lib,
-                              name=name, forces_jac=fn["forces_jac"],
-                              constraint_hessian=fn["constraint_hessian"])
+        return generalized_system(n, params=params, keep=lib, name=name, **fn)
+    return constrained_system(n, n_hol=n_hol, n_nh=n_nh, rheonomic=bool(rheo), params=params,
+                              keep=lib, name=name, **fn)

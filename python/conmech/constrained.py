@@ -29,7 +29,7 @@ from ._builtin_table import CONSTRAINED_NAMES
 from ._callback import Guard, as_result, message_text
 from ._checks import event_settings
 from ._methods import BY_NAME
-from ._native import _NO_SPEC, check_params
+from ._native import _NO_SPEC, _unused_callback, check_params
 
 __all__ = ["solve", "builtin", "NativeConstrained", "BuiltinConstrained",
            "ConstrainedSystem", "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS",
@@ -459,16 +459,17 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
                   neval=t_ev.size, t_eval=t_ev if t_ev.size else _PAD, ne=ne,
                   ev_dir=ev_dir, ev_term=ev_term)
     if isinstance(system, NativeConstrained):
-        stats, moved, info, message = _conmech.flat_constrained_builtin(
-            *system._flat_args(), store, events_cb, evstore, **common)
+        guard = None
+        sargs = (*system._flat_args(), 0) + (_unused_callback,) * 7 + (0, 0, 0, 0, 0, 0)
     else:
         guard = Guard()
-        cb = system._callbacks(guard)
-        stats, moved, info, message = _conmech.flat_constrained_callback(
-            cb[0], cb[1], cb[2], cb[3], cb[4], cb[5], cb[6], int(system.jac is not None),
-            int(system.gamma is not None), int(system.nh_gamma is not None),
-            int(system.rheonomic), system.n_hol, system.n_nh, store, events_cb, evstore,
-            **common)
+        sargs = ("", 0, _PAD, 0, _NO_SPEC, 1, *system._callbacks(guard),
+                 int(system.jac is not None), int(system.gamma is not None),
+                 int(system.nh_gamma is not None), int(system.rheonomic), system.n_hol,
+                 system.n_nh)
+    stats, moved, info, message = _conmech.flat_constrained(*sargs, store, events_cb,
+                                                            evstore, **common)
+    if guard is not None:
         guard.check()
     ev_guard.check()
     message = message_text(message)

@@ -3,39 +3,54 @@
 !! (`c_constrained_system`). The C signatures (column-major matrices, `p` the run-time
 !! parameters):
 !!
+!!     /* <generated: tools/generate_slots.py mechanics signatures> */
+!!     /* the mass matrix M(t, q) */
 !!     void mass(double t, const double *q, double *M, const double *p);
+!!     /* the forces Q(t, q, q') */
 !!     void forces(double t, const double *q, const double *v, double *Q, const double *p);
+!!     /* [dQ/dq - d(M a)/dq, dQ/dv], the Jacobian of the force balance at accelerations a
+!!        (optional) */
 !!     void forces_jac(double t, const double *q, const double *v, const double *a,
-!!                     double *R, const double *p);   /* [dQ/dq - d(M a)/dq, dQ/dv] */
+!!                     double *R, const double *p);
+!!     /* the energy (a first integral) (optional) */
 !!     double energy(double t, const double *q, const double *v, const double *p);
+!!     /* the holonomic constraints phi(t, q) (n_hol; required when n_hol > 0) (optional) */
 !!     void phi(double t, const double *q, double *c, const double *p);
+!!     /* G = dphi/dq (n_hol x n) (optional) */
 !!     void phi_jac(double t, const double *q, double *G, const double *p);
+!!     /* dphi/dt (rheonomic constraints) (optional) */
 !!     void phi_t(double t, const double *q, double *pt, const double *p);
-!!     void phi_gamma(double t, const double *q, const double *v, double *g, const double *p);
+!!     /* gamma_h = -d/dt [G v + phi_t] at fixed v (optional) */
+!!     void phi_gamma(double t, const double *q, const double *v, double *g,
+!!                    const double *p);
+!!     /* the Pfaffian constraints A(t, q) q' + b(t, q) = 0 (required when n_nh > 0)
+!!        (optional) */
 !!     void nh_matrix(double t, const double *q, double *A, double *b, const double *p);
+!!     /* gamma_n = -d/dt [A v + b] at fixed v (optional) */
 !!     void nh_gamma(double t, const double *q, const double *v, double *g, const double *p);
-!!     /* optional, constrained systems: hl = d(C^T lam)/dq (n x n), hv = d(C v + c0)/dq
-!!        ((n_hol + n_nh) x n); with forces_jac the exact Jacobian of Radau on them */
-!!     void constraint_hessian(double t, const double *q, const double *v,
-!!                             const double *lam, double *hl, double *hv, const double *p);
-!!     /* optional, generalized systems: M and Q in one call (shared subexpressions) */
+!!     /* M and Q in one call (shared subexpressions) (optional) */
 !!     void mass_forces(double t, const double *q, const double *v, double *M, double *Q,
 !!                      const double *p);
-!!     /* optional, generalized systems: the accelerations a = M^-1 Q directly (e.g. by the
-!!        articulated-body algorithm); non-finite entries where M is not positive definite */
+!!     /* the accelerations a = M^-1 Q directly (e.g. the articulated-body algorithm);
+!!        non-finite where M is not positive definite (optional) */
 !!     void accel(double t, const double *q, const double *v, double *a, const double *p);
-!!     /* optional, generalized systems: a and its Jacobian jac = d a/d[q, v] (nd x 2nd) */
+!!     /* hl = d(C^T lam)/dq, hv = d(C v + c0)/dq: with forces_jac the exact Jacobian of
+!!        Radau IIA on the constrained equations (optional) */
+!!     void constraint_hessian(double t, const double *q, const double *v, const double *lam,
+!!                             double *hl, double *hv, const double *p);
+!!     /* a and its Jacobian d a/d[q, v] (ndof x 2 ndof) (optional) */
 !!     void accel_jac(double t, const double *q, const double *v, double *a, double *jac,
 !!                    const double *p);
+!!     /* </generated> */
 !!
 !! Only `mass` and `forces` are required; a missing optional function falls back to the
 !! finite-difference default of the parent type (see conmech_constrained_system).
 module conmech_c_mechanics
-    use, intrinsic :: iso_c_binding, only: c_double, c_funptr, c_associated, &
-                                           c_f_procpointer, c_null_funptr
+    use, intrinsic :: iso_c_binding, only: c_double, c_associated, c_f_procpointer
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_generalized, only: generalized_system
+    use conmech_c_entries, only: c_mech_pointers
     use conmech_constrained_system, only: constrained_system, fd_phi_jac, fd_phi_t, &
                                           fd_phi_gamma, fd_nh_gamma, fd_forces_jacobian, &
                                           fd_constraint_hessian
@@ -96,20 +111,6 @@ module conmech_c_mechanics
             real(c_double), intent(in) :: p(*)
         end subroutine c_nh_fn
     end interface
-
-    !> The C function pointers of a compiled mechanical system (null where absent).
-    type :: c_mech_pointers
-        type(c_funptr) :: mass, forces, forces_jac, energy
-        type(c_funptr) :: phi, phi_jac, phi_t, phi_gamma, nh_matrix, nh_gamma
-        !> optional: the second derivatives of the constraints (constrained systems)
-        type(c_funptr) :: constraint_hessian = c_null_funptr
-        !> optional: M and Q in one call (generalized systems)
-        type(c_funptr) :: mass_forces = c_null_funptr
-        !> optional: the accelerations a = M^-1 Q (generalized systems)
-        type(c_funptr) :: accel = c_null_funptr
-        !> optional: a and d a/d[q, v] (generalized systems)
-        type(c_funptr) :: accel_jac = c_null_funptr
-    end type c_mech_pointers
 
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
     type, extends(generalized_system) :: c_generalized_system

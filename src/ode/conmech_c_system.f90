@@ -4,11 +4,15 @@
 !! The C signatures (column-major matrices, `p` the run-time parameter array, so that one
 !! compiled function serves every parameter value):
 !!
-!!     void rhs(double t, const double *y, double *dydt, const double *p);   /* n     */
-!!     void jac(double t, const double *y, double *dfdy, const double *p);   /* n x n */
-!!     /* optional: jx = J(t, y) x for an n x k block x (column-major) */
+!!     /* <generated: tools/generate_slots.py ode signatures> */
+!!     /* dydt = f(t, y; p) */
+!!     void rhs(double t, const double *y, double *dydt, const double *p);
+!!     /* df/dy (column-major); without it finite differences (optional) */
+!!     void jac(double t, const double *y, double *dfdy, const double *p);
+!!     /* jx = J(t, y) x for an n x ncol block x (optional) */
 !!     void jac_prod(double t, const double *y, int k, const double *x, double *jx,
 !!                   const double *p);
+!!     /* </generated> */
 !!
 !! `c_ode_system` holds the function pointers and the parameters; it is an `ode_system`,
 !! so every integrator and every stability routine runs on it with no Python in the loop.

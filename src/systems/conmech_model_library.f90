@@ -11,16 +11,16 @@
 !!     void conmech_model_param_names(char *buf, int len);  /* blank-separated names */
 !!
 !! and the functions of its kind with the signatures of conmech_c_system /
-!! conmech_c_mechanics, named conmech_rhs, conmech_jac (ode); conmech_mass,
-!! conmech_forces, conmech_forces_jac, conmech_energy (generalized and constrained);
-!! conmech_phi, conmech_phi_jac, conmech_phi_t, conmech_phi_gamma, conmech_nh_matrix,
-!! conmech_nh_gamma, optionally conmech_constraint_hessian (constrained). Optional fast
-!! entries: conmech_jac_prod (ode: J x for a
-!! block x, `set_c_jac_prod`, used by `integrate_stm`), conmech_mass_forces (M and Q in
-!! one call) and conmech_accel (a = M^-1 Q, `void accel(double t, const double *q, const
-!! double *v, double *a, const double *p)`) for generalized models. Missing optional
-!! functions fall back to finite differences (or to mass + forces). The library stays
-!! loaded for the life of the process. Before dlopen the file is checked
+!! conmech_c_mechanics, named conmech_<entry> after the table of compiled functions
+!! (python/conmech/_slot_table.py, conmech_c_entries): conmech_rhs, conmech_jac (ode);
+!! conmech_mass, conmech_forces, conmech_forces_jac, conmech_energy (generalized and
+!! constrained); conmech_phi, conmech_phi_jac, conmech_phi_t, conmech_phi_gamma,
+!! conmech_nh_matrix, conmech_nh_gamma, optionally conmech_constraint_hessian
+!! (constrained). Optional fast entries: conmech_jac_prod (ode: J x for a block x,
+!! `set_c_jac_prod`, used by `integrate_stm`), conmech_mass_forces (M and Q in one call),
+!! conmech_accel (a = M^-1 Q) and conmech_accel_jac (a and d a/d[q, v]) for generalized
+!! models. Missing optional functions fall back to finite differences (or to mass +
+!! forces). The library stays loaded for the life of the process. Before dlopen the file is checked
 !! (`conmech_library_check`: ELF headers, segments and sections within the file, the symbol
 !! conmech_model_info defined), so a truncated or foreign file is an error naming it, never
 !! a crash.
@@ -36,6 +36,7 @@ module conmech_model_library
     use conmech_c_system, only: c_ode_system, make_c_ode, set_c_jac_prod
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
+    use conmech_c_entries, only: N_MECH_ENTRIES, MECH_ENTRY_NAMES, set_mech_entry
     use conmech_library_check, only: check_shared_library
     implicit none
     private
@@ -204,19 +205,9 @@ contains
         lib%rhs = symbol(h, "conmech_rhs")
         lib%jac = symbol(h, "conmech_jac")
         lib%jac_prod = symbol(h, "conmech_jac_prod")
-        lib%fp%accel = symbol(h, "conmech_accel")
-        lib%fp%mass_forces = symbol(h, "conmech_mass_forces")
-        lib%fp%mass = symbol(h, "conmech_mass")
-        lib%fp%forces = symbol(h, "conmech_forces")
-        lib%fp%forces_jac = symbol(h, "conmech_forces_jac")
-        lib%fp%energy = symbol(h, "conmech_energy")
-        lib%fp%phi = symbol(h, "conmech_phi")
-        lib%fp%phi_jac = symbol(h, "conmech_phi_jac")
-        lib%fp%phi_t = symbol(h, "conmech_phi_t")
-        lib%fp%phi_gamma = symbol(h, "conmech_phi_gamma")
-        lib%fp%nh_matrix = symbol(h, "conmech_nh_matrix")
-        lib%fp%nh_gamma = symbol(h, "conmech_nh_gamma")
-        lib%fp%constraint_hessian = symbol(h, "conmech_constraint_hessian")
+        do i = 1, N_MECH_ENTRIES
+            call set_mech_entry(lib%fp, i, symbol(h, "conmech_"//trim(MECH_ENTRY_NAMES(i))))
+        end do
         info = CM_SUCCESS
         msg = "success"
     end subroutine load_model

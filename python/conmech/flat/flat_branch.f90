@@ -1,29 +1,26 @@
 !> Flat f2py layer of the continuation of periodic orbits (conmech_continuation): built-in
 !! and compiled systems continued in one of their parameters, Python right-hand sides
-!! fun(t, y, p, dydt, n); single shooting, multiple shooting or collocation; an optional
+!! fun(t, y, p, dydt, n) with an optional Jacobian (the parametric argument set of
+!! conmech_flat_system); single shooting, multiple shooting or collocation; an optional
 !! Python energy(y, p, e, n) for the energy range. Options packed as in run_continuation
 !! (conmech_support_cont); the branch in arrays of mp points (npts used) and at most 64
 !! special points with their located flag, test value, closure and parameter bracket.
 
-!> Continuation of a periodic orbit of a built-in or compiled system in params(ip).
-subroutine flat_branch_builtin(name, np, params, nspec, spec, ip, n, y0, period, ropt, iopt, &
-                               nfree, free_idx, ntg, targets, ntang, tang, mp, energy, npts, &
-                               pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, &
-                               sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, &
-                               sp_located, sp_test, sp_closure, sp_bracket, direction, info, &
-                               message)
+!> Continuation of a periodic orbit of the system of the parametric flat argument set
+!! (conmech_flat_system: a built-in or compiled system in params(ip), or a Python
+!! fun(t, y, p, dydt, n), with or without jfun, from p0).
+subroutine flat_branch(name, np, params, nspec, spec, ip, fun, jfun, source, p0, n, y0, &
+                       period, ropt, iopt, nfree, free_idx, ntg, targets, ntang, tang, mp, &
+                       energy, npts, pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, &
+                       sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, sp_mi, sp_s, sp_located, &
+                       sp_test, sp_closure, sp_bracket, direction, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_param_system, only: builtin_param_system, make_param_system, &
-                                    make_compiled_param_system
-    use conmech_flat_spec, only: spec_system, spec_kind, KIND_BUILTIN
+    use conmech_flat_system, only: flat_param_system
     use conmech_support_cont, only: run_continuation, callback_energy
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, ip, n, iopt(16), nfree, ntg, mp
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), period, ropt(15)
+    integer(c_int), intent(in) :: n, iopt(16), nfree, ntg, mp
+    real(c_double), intent(in) :: y0(n), period, ropt(15)
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
     real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
     integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64)
@@ -34,6 +31,7 @@ subroutine flat_branch_builtin(name, np, params, nspec, spec, ip, n, y0, period,
     real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64), sp_test(64), sp_closure(64)
     real(c_double), intent(out) :: sp_bracket(2, 64)
     character(len=256), intent(out) :: message
+    include "flat_param_args.inc"
 !f2py external energy
     interface
         subroutine energy(y, p, e, n)
@@ -43,82 +41,24 @@ subroutine flat_branch_builtin(name, np, params, nspec, spec, ip, n, y0, period,
             real(c_double), intent(out) :: e
         end subroutine energy
     end interface
-    type(builtin_param_system) :: sys
+    class(ode_system), allocatable :: sys
     type(callback_energy) :: en
-    class(ode_system), allocatable :: inner
+    real(c_double) :: pstart
     character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
     direction = 1
-    if (spec_kind(nspec, spec) == KIND_BUILTIN) then
-        call make_param_system(name, params(1:np), ip, sys, info, msg)
-    else      ! (no BLOCK construct: f2py reads this file)
-        call spec_system(name, params(1:np), nspec, spec, inner, info, msg)
-        if (info == 0) call make_compiled_param_system(inner, params(1:np), ip, sys, info, &
-                                                       msg)
-    end if
+    call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
+                           sys, pstart, info, msg)
     if (info /= 0) then
         message = msg
         return
     end if
     en%f => energy
     en%n = n
-    call run_continuation(sys, n, y0, period, params(max(ip, 1)), ropt, iopt, nfree, &
-                          free_idx, ntg, &
+    call run_continuation(sys, n, y0, period, pstart, ropt, iopt, nfree, free_idx, ntg, &
                           targets, ntang, tang, mp, en, npts, pp, per, ys, mr, mi, merr, acc, &
                           s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, &
                           sp_mr, sp_mi, sp_s, sp_located, sp_test, sp_closure, sp_bracket, &
                           direction, info, message)
-end subroutine flat_branch_builtin
-
-!> As flat_branch_builtin for a Python right-hand side fun(t, y, p, dydt, n) from the
-!! parameter value p0 (finite-difference Jacobian).
-subroutine flat_branch_callback(fun, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, &
-                                targets, ntang, tang, mp, energy, npts, pp, per, ys, mr, mi, &
-                                merr, acc, s, psi, res, iters, nsp, sp_kind, sp_index, sp_p, &
-                                sp_per, sp_y, sp_mr, sp_mi, sp_s, sp_located, sp_test, &
-                                sp_closure, sp_bracket, direction, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_support_cont, only: callback_param_system, run_continuation, callback_energy
-    implicit none
-    integer(c_int), intent(in) :: n, iopt(16), nfree, ntg, mp
-    real(c_double), intent(in) :: y0(n), period, p0, ropt(15)
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
-    real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio
-    integer(c_int), intent(out) :: npts, iters(mp), nsp, sp_kind(64), sp_index(64)
-    integer(c_int), intent(out) :: sp_located(64), direction, info
-    real(c_double), intent(out) :: pp(mp), per(mp), ys(n, mp), mr(n, mp), mi(n, mp)
-    real(c_double), intent(out) :: merr(n, mp), acc(mp), s(mp), psi(4, mp), res(mp)
-    real(c_double), intent(out) :: sp_p(64), sp_per(64), sp_y(n, 64), sp_mr(n, 64)
-    real(c_double), intent(out) :: sp_mi(n, 64), sp_s(64), sp_test(64), sp_closure(64)
-    real(c_double), intent(out) :: sp_bracket(2, 64)
-    character(len=256), intent(out) :: message
-!f2py external fun, energy
-    interface
-        subroutine fun(t, y, p, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t, p
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-        subroutine energy(y, p, e, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: y(n), p
-            real(c_double), intent(out) :: e
-        end subroutine energy
-    end interface
-    type(callback_param_system) :: sys
-    type(callback_energy) :: en
-    sys%f => fun
-    sys%n = n
-    sys%p = p0
-    en%f => energy
-    en%n = n
-    call run_continuation(sys, n, y0, period, p0, ropt, iopt, nfree, free_idx, ntg, targets, &
-                          ntang, tang, mp, en, npts, pp, per, ys, mr, mi, merr, acc, s, psi, &
-                          res, iters, nsp, sp_kind, sp_index, sp_p, sp_per, sp_y, sp_mr, &
-                          sp_mi, sp_s, sp_located, sp_test, sp_closure, sp_bracket, &
-                          direction, info, message)
-end subroutine flat_branch_callback
+end subroutine flat_branch

@@ -237,7 +237,7 @@ subroutine flat_control_law_eval(name, np, params, nspec, spec, nd, m, bmat, bad
     use conmech_status, only: CM_SUCCESS
     use conmech_mech_plant, only: mech_plant
     use conmech_control_system, only: feedback_law
-    use conmech_support_control, only: build_plant, build_law
+    use conmech_support_control, only: build_plant_law
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, nx
@@ -247,26 +247,14 @@ subroutine flat_control_law_eval(name, np, params, nspec, spec, nd, m, bmat, bad
     real(c_double), intent(out) :: us(m, nx)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
-!f2py external pylaw
-    interface
-        subroutine pylaw(t, x, u, n, m)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, m
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: x(n)
-            real(c_double), intent(out) :: u(m)
-        end subroutine pylaw
-    end interface
+    include "flat_control_law.inc"
     type(mech_plant) :: plant
     class(feedback_law), allocatable :: law
     character(len=:), allocatable :: msg
     integer :: i
     us = 0.0_c_double
-    call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
-    if (info /= CM_SUCCESS) return
-    call build_law(ilaw, rlaw(1:nrl), nrl, pylaw, plant, n, law, info, msg)
+    call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, msg)
     message = msg
     if (info /= CM_SUCCESS) return
     do i = 1, nx
@@ -287,7 +275,7 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     use conmech_control_system, only: closed_loop
     use conmech_mech_plant, only: mech_plant
     use conmech_flat_ode_support, only: run_solve
-    use conmech_support_control, only: build_plant, build_law
+    use conmech_support_control, only: build_plant_law
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n
@@ -300,35 +288,8 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: nfev, naccept, nreject, dense_form, info
     character(len=256), intent(out) :: message
-!f2py external pylaw, events, store
-    interface
-        subroutine pylaw(t, x, u, n, m)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, m
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: x(n)
-            real(c_double), intent(out) :: u(m)
-        end subroutine pylaw
-        subroutine events(t, y, g, n, ne)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, ne
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: g(ne)
-        end subroutine events
-        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: y(n, nt)
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_y(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-            real(c_double), intent(in) :: ts(nseg)
-            real(c_double), intent(in) :: hs(nseg)
-            real(c_double), intent(in) :: coef(n, nf1, nseg)
-        end subroutine store
-    end interface
+    include "flat_control_law.inc"
+    include "flat_solve_callbacks.inc"
     type(closed_loop) :: cl
     type(mech_plant) :: plant
     character(len=:), allocatable :: msg
@@ -343,11 +304,8 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     ev_res = 0.0_c_double
     sp_ptr = 1
     sp_idx = 0
-    call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
-    if (info /= CM_SUCCESS) return
-    call build_law(ilaw, rlaw(1:nrl), nrl, pylaw, plant, n, cl%law, info, msg)
+    call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, cl%law, info, msg)
     message = msg
     if (info /= CM_SUCCESS) return
     allocate (cl%plant, source=plant)
@@ -370,7 +328,7 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_mech_plant, only: mech_plant
     use conmech_control_system, only: feedback_law
-    use conmech_support_control, only: build_plant, build_law, project_states
+    use conmech_support_control, only: build_plant_law, project_states
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, k, nx
@@ -380,16 +338,7 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
     real(c_double), intent(out) :: taus(nx), xis(k, nx), dists(nx)
     integer(c_int), intent(out) :: nfail, info
     character(len=256), intent(out) :: message
-!f2py external pylaw
-    interface
-        subroutine pylaw(t, x, u, n, m)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, m
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: x(n)
-            real(c_double), intent(out) :: u(m)
-        end subroutine pylaw
-    end interface
+    include "flat_control_law.inc"
     type(mech_plant) :: plant
     class(feedback_law), allocatable :: law
     character(len=:), allocatable :: msg
@@ -397,11 +346,8 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
     xis = 0.0_c_double
     dists = 0.0_c_double
     nfail = 0
-    call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
-    if (info /= CM_SUCCESS) return
-    call build_law(ilaw, rlaw(1:nrl), nrl, pylaw, plant, n, law, info, msg)
+    call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, msg)
     message = msg
     if (info /= CM_SUCCESS) return
     call project_states(law, xs, taus, xis, dists, nfail, info, msg)
@@ -431,7 +377,7 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     use conmech_orbital_stabilisation, only: orbital_design_result, orbital_design
     use conmech_ode_solver, only: ode_options
     use conmech_variational, only: integrate_stm
-    use conmech_support_control, only: build_plant, build_law
+    use conmech_support_control, only: build_plant_law
     implicit none
     character(len=*), intent(in) :: name
     integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, k, ng, nt, ntab
@@ -444,16 +390,7 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     real(c_double), intent(out) :: periodicity, min_eig, rtab(ntab), fmr(n), fmi(n), closure
     integer(c_int), intent(out) :: passes, info
     character(len=256), intent(out) :: message
-!f2py external pylaw
-    interface
-        subroutine pylaw(t, x, u, n, m)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, m
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: x(n)
-            real(c_double), intent(out) :: u(m)
-        end subroutine pylaw
-    end interface
+    include "flat_control_law.inc"
     type(mech_plant) :: plant
     class(feedback_law), allocatable :: nominal
     type(transverse_options) :: topt
@@ -482,11 +419,8 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     min_eig = 0.0_c_double
     closure = 0.0_c_double
     passes = 0
-    call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
-    if (info /= CM_SUCCESS) return
-    call build_law(ilaw, rlaw(1:nrl), nrl, pylaw, plant, n, nominal, info, msg)
+    call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, nominal, info, msg)
     message = msg
     if (info /= CM_SUCCESS) return
     if (n /= 2*nd .or. k /= n - 1 .or. ntab /= 1 + 3*n*(ng + 1) + 2*n*k*(ng + 1) + &

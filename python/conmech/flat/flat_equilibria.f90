@@ -5,34 +5,32 @@
 !! c_double/c_int explicit-shape arrays, an `info` code and a message. Nothing is saved
 !! between calls; nothing stops or prints.
 !!
-!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n), jac(t, y, dfdy, n).
+!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n), jfun(t, y, dfdy, n).
 
-!> Full equilibrium analysis of a built-in or compiled system (by name / spec) at y.
-subroutine flat_equilibrium_structure_builtin(name, np, params, nspec, spec, n, y, t, tol, &
-                                              jac, wr, wi, kind, saddle, residual, analytic, &
-                                              zero_mult, largest_block, secular_freq, &
-                                              family_dim, family, ndrift, drift, info, &
-                                              message)
+!> Full equilibrium analysis at y of the system given by the one flat argument set
+!! (conmech_flat_system).
+subroutine flat_equilibrium_structure(name, np, params, nspec, spec, fun, jfun, source, n, y, &
+                                      t, tol, jac, wr, wi, kind, saddle, residual, analytic, &
+                                      zero_mult, largest_block, secular_freq, family_dim, &
+                                      family, ndrift, drift, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
+    use conmech_flat_system, only: flat_system
     use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
     use conmech_support_equilibria, only: unpack_structure
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y(n), t, tol
     real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
     real(c_double), intent(out) :: family(n, n), drift(n, n)
     integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
     integer(c_int), intent(out) :: family_dim, ndrift, info
     character(len=256), intent(out) :: message
+    include "flat_system_args.inc"
     class(ode_system), allocatable :: sys
     type(equilibrium_result) :: e
     character(len=:), allocatable :: msg
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
     if (info /= 0) then
         message = msg
         return
@@ -41,90 +39,7 @@ subroutine flat_equilibrium_structure_builtin(name, np, params, nspec, spec, n, 
     call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
                           largest_block, secular_freq, family_dim, family, ndrift, drift, &
                           info, message)
-end subroutine flat_equilibrium_structure_builtin
-
-!> As flat_equilibrium_structure_builtin for a Python right-hand side (FD Jacobian).
-subroutine flat_equilibrium_structure_callback(fun, n, y, t, tol, jac, wr, wi, kind, saddle, &
-                                               residual, analytic, zero_mult, largest_block, &
-                                               secular_freq, family_dim, family, ndrift, &
-                                               drift, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system
-    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
-    use conmech_support_equilibria, only: unpack_structure
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: y(n), t, tol
-    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
-    real(c_double), intent(out) :: family(n, n), drift(n, n)
-    integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
-    integer(c_int), intent(out) :: family_dim, ndrift, info
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_system) :: sys
-    type(equilibrium_result) :: e
-    sys%f => fun
-    sys%n = n
-    call analyze_equilibrium(sys, y, e, t, tol)
-    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
-                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
-                          info, message)
-end subroutine flat_equilibrium_structure_callback
-
-!> As flat_equilibrium_structure_builtin for a Python right-hand side and Jacobian.
-subroutine flat_equilibrium_structure_callback_jac(fun, jac_fun, n, y, t, tol, jac, wr, wi, &
-                                                   kind, saddle, residual, analytic, &
-                                                   zero_mult, largest_block, secular_freq, &
-                                                   family_dim, family, ndrift, drift, info, &
-                                                   message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_jac_system
-    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
-    use conmech_support_equilibria, only: unpack_structure
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: y(n), t, tol
-    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual, secular_freq
-    real(c_double), intent(out) :: family(n, n), drift(n, n)
-    integer(c_int), intent(out) :: kind, saddle, analytic, zero_mult, largest_block
-    integer(c_int), intent(out) :: family_dim, ndrift, info
-    character(len=256), intent(out) :: message
-!f2py external fun, jac_fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-        subroutine jac_fun(t, y, dfdy, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dfdy(n, n)
-        end subroutine jac_fun
-    end interface
-    type(callback_jac_system) :: sys
-    type(equilibrium_result) :: e
-    sys%f => fun
-    sys%jac => jac_fun
-    sys%n = n
-    call analyze_equilibrium(sys, y, e, t, tol)
-    call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
-                          largest_block, secular_freq, family_dim, family, ndrift, drift, &
-                          info, message)
-end subroutine flat_equilibrium_structure_callback_jac
+end subroutine flat_equilibrium_structure
 
 !> Eigenvalues, Jordan structure and classification of a plain n x n matrix (no family).
 subroutine flat_classify_matrix(n, a, tol, wr, wi, kind, saddle, zero_mult, largest_block, &
@@ -178,11 +93,9 @@ subroutine flat_degrees_of_freedom(name, np, params, nspec, spec, n, t, q, proje
     use conmech_degrees_of_freedom, only: dof_result, degrees_of_freedom
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n, project
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), t, q(n), rank_tol
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: n, project
+    real(c_double), intent(in) :: t, q(n), rank_tol
     real(c_double), intent(out) :: qout(n), residual
     integer(c_int), intent(out) :: rank_h, rank_nh, dof, velocity_dof, info
     character(len=256), intent(out) :: message

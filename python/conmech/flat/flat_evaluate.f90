@@ -11,11 +11,7 @@ subroutine flat_evaluate_ode(name, np, params, nspec, spec, n, t, y, f, jac, ana
     use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t, y(n)
     real(c_double), intent(out) :: f(n), jac(n, n)
@@ -55,11 +51,7 @@ subroutine flat_evaluate_mech(name, np, params, nspec, spec, kind, n, mh, mn, t,
     use conmech_flat_spec, only: spec_constrained, spec_generalized
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(in) :: kind, n, mh, mn
     real(c_double), intent(in) :: t, q(n), v(n)
     real(c_double), intent(out) :: mm(n, n), qf(n), energy

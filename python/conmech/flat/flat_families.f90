@@ -3,143 +3,76 @@
 !! circular restricted three-body problem (conventions: see flat_ode.f90; the Python side
 !! is conmech.stability.equilibrium_continuation, conmech.systems, conmech.cr3bp).
 
-!> Continuation of the equilibrium y0 of a built-in or compiled system in its parameter ip
-!! (1-based) from params(ip); see conmech_support_families::run_eq_continuation for ropt,
-!! iopt and the packed outputs.
-subroutine flat_eq_continuation_builtin(name, np, params, nspec, spec, ip, n, y0, ropt, &
-                                        iopt, mp, npts, pp, ys, wr, wi, psi, nunst, res, &
-                                        iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, &
-                                        sp_a, info, message)
+!> Continuation of the equilibrium y0 of the system of the parametric flat argument set
+!! (conmech_flat_system: a built-in or compiled system in its parameter ip, 1-based, from
+!! params(ip); or a Python fun(t, y, p, dydt, n) from p0); see
+!! conmech_support_families::run_eq_continuation for ropt, iopt and the packed outputs.
+subroutine flat_eq_continuation(name, np, params, nspec, spec, ip, fun, jfun, source, p0, n, &
+                                y0, ropt, iopt, mp, npts, pp, ys, wr, wi, psi, nunst, res, &
+                                iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, sp_a, info, &
+                                message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_param_system, only: builtin_param_system, make_param_system, &
-                                    make_compiled_param_system
-    use conmech_flat_spec, only: spec_system, spec_kind, KIND_BUILTIN
+    use conmech_flat_system, only: flat_param_system
     use conmech_support_families, only: run_eq_continuation
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, ip, n, iopt(4), mp, nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), ropt(11)
+    integer(c_int), intent(in) :: n, iopt(4), mp
+    real(c_double), intent(in) :: y0(n), ropt(11)
     integer(c_int), intent(out) :: npts, nunst(mp), iters(mp), nsp, spi(5, 64), info
     real(c_double), intent(out) :: pp(mp), ys(n, mp), wr(n, mp), wi(n, mp), psi(3, mp)
     real(c_double), intent(out) :: res(mp), spr(8, 64), sp_y(n, 64), sp_wr(n, 64)
     real(c_double), intent(out) :: sp_wi(n, 64), sp_q(2*n, 64), sp_a(2*n, 64)
     character(len=256), intent(out) :: message
-    type(builtin_param_system) :: sys
-    class(ode_system), allocatable :: inner
+    include "flat_param_args.inc"
+    class(ode_system), allocatable :: sys
+    real(c_double) :: pstart
     character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
-    if (spec_kind(nspec, spec) == KIND_BUILTIN) then
-        call make_param_system(name, params(1:np), ip, sys, info, msg)
-    else      ! (no BLOCK construct: f2py reads this file)
-        call spec_system(name, params(1:np), nspec, spec, inner, info, msg)
-        if (info == 0) call make_compiled_param_system(inner, params(1:np), ip, sys, info, &
-                                                       msg)
-    end if
+    call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
+                           sys, pstart, info, msg)
     if (info /= 0) then
         message = msg
         return
     end if
-    call run_eq_continuation(sys, n, y0, params(ip), ropt, iopt, mp, npts, pp, ys, wr, wi, &
-                             psi, nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, &
-                             sp_a, info, message)
-end subroutine flat_eq_continuation_builtin
-
-!> As flat_eq_continuation_builtin for a Python right-hand side fun(t, y, p, dydt, n) from
-!! the parameter value p0 (finite-difference Jacobian).
-subroutine flat_eq_continuation_callback(fun, n, y0, p0, ropt, iopt, mp, npts, pp, ys, wr, &
-                                         wi, psi, nunst, res, iters, nsp, spi, spr, sp_y, &
-                                         sp_wr, sp_wi, sp_q, sp_a, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_support_cont, only: callback_param_system
-    use conmech_support_families, only: run_eq_continuation
-    implicit none
-    integer(c_int), intent(in) :: n, iopt(4), mp
-    real(c_double), intent(in) :: y0(n), p0, ropt(11)
-    integer(c_int), intent(out) :: npts, nunst(mp), iters(mp), nsp, spi(5, 64), info
-    real(c_double), intent(out) :: pp(mp), ys(n, mp), wr(n, mp), wi(n, mp), psi(3, mp)
-    real(c_double), intent(out) :: res(mp), spr(8, 64), sp_y(n, 64), sp_wr(n, 64)
-    real(c_double), intent(out) :: sp_wi(n, 64), sp_q(2*n, 64), sp_a(2*n, 64)
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, p, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t, p
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_param_system) :: sys
-    sys%f => fun
-    sys%n = n
-    sys%p = p0
-    call run_eq_continuation(sys, n, y0, p0, ropt, iopt, mp, npts, pp, ys, wr, wi, psi, &
+    call run_eq_continuation(sys, n, y0, pstart, ropt, iopt, mp, npts, pp, ys, wr, wi, psi, &
                              nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, sp_a, &
                              info, message)
-end subroutine flat_eq_continuation_callback
+end subroutine flat_eq_continuation
 
 !> The first Lyapunov coefficient at the equilibrium y (time t) of a built-in or compiled
-!! system: out = [omega, re_lambda, l1, scale, l1_error, criticality, exact], q and adj as
-!! [real; imaginary] parts (see conmech_support_families::run_hopf).
-subroutine flat_hopf_builtin(name, np, params, nspec, spec, n, t, y, l1_tol, out, q, adj, &
-                             info, message)
+!! system (ip < 0: no parameter) or of a Python fun(t, y, p, dydt, n) at the parameter p0
+!! (the parametric flat argument set, conmech_flat_system): out = [omega, re_lambda, l1,
+!! scale, l1_error, criticality, exact], q and adj as [real; imaginary] parts (see
+!! conmech_support_families::run_hopf).
+subroutine flat_hopf(name, np, params, nspec, spec, ip, fun, jfun, source, p0, n, t, y, &
+                     l1_tol, out, q, adj, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
+    use conmech_flat_system, only: flat_param_system
     use conmech_support_families, only: run_hopf
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), t, y(n), l1_tol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t, y(n), l1_tol
     real(c_double), intent(out) :: out(7), q(2*n), adj(2*n)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
+    include "flat_param_args.inc"
     class(ode_system), allocatable :: sys
+    real(c_double) :: pstart
     character(len=:), allocatable :: msg
     out = 0.0_c_double
     q = 0.0_c_double
     adj = 0.0_c_double
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
+                           sys, pstart, info, msg)
     if (info /= CM_SUCCESS) then
         message = msg
         return
     end if
     call run_hopf(sys, n, t, y, l1_tol, out, q, adj, info, message)
-end subroutine flat_hopf_builtin
-
-!> As flat_hopf_builtin for a Python right-hand side fun(t, y, p, dydt, n) at parameter p.
-subroutine flat_hopf_callback(fun, n, p, t, y, l1_tol, out, q, adj, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_support_cont, only: callback_param_system
-    use conmech_support_families, only: run_hopf
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: p, t, y(n), l1_tol
-    real(c_double), intent(out) :: out(7), q(2*n), adj(2*n)
-    integer(c_int), intent(out) :: info
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, p, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t, p
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_param_system) :: sys
-    sys%f => fun
-    sys%n = n
-    sys%p = p
-    call run_hopf(sys, n, t, y, l1_tol, out, q, adj, info, message)
-end subroutine flat_hopf_callback
+end subroutine flat_hopf
 
 !> The energy (first integral) of a built-in or compiled system at (t, y); info -4 with a
 !! message if it has none (conmech_system_energy).
@@ -151,10 +84,9 @@ subroutine flat_system_energy(name, np, params, nspec, spec, n, t, y, e, info, m
     use conmech_flat_spec, only: spec_system
     use conmech_system_energy, only: system_energy
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, n
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), t, y(n)
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t, y(n)
     real(c_double), intent(out) :: e
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message

@@ -14,11 +14,7 @@ subroutine flat_mech_info(name, np, params, nspec, spec, kind, n, mh, mn, info, 
                                  KIND_CONSTRAINED
     use conmech_flat_ode_support, only: copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(out) :: kind, n, mh, mn, info
     character(len=256), intent(out) :: message
     class(constrained_system), allocatable :: cs
@@ -76,95 +72,26 @@ subroutine flat_mech_initial_state(name, np, params, n, q0, v0, info)
     v0 = v
 end subroutine flat_mech_initial_state
 
-!> Solve the built-in constrained system `name` (params as in conmech_systems_mech).
-!! iopt = [projection, every, proj_max_iter, max_steps, dae_index]; ropt = [first_step, max_step,
-!! alpha, beta, proj_tol]; stats = [nfev, naccept, nreject, nproj, proj_iter, rank,
-!! proj_iter_max]; moved = [dq0, dv0]. The result goes to store (see conmech_flat_mech_support).
-subroutine flat_constrained_builtin(name, np, params, nspec, spec, store, events, evstore, &
-                                    n, t_span, q0, v0, method, &
-                                    rtol, atol, iopt, ropt, neval, t_eval, ne, ev_dir, &
-                                    ev_term, stats, moved, info, message)
+!> Solve a constrained system: built-in or compiled (source 0: `name` / `spec`, see
+!! conmech_flat_spec; the Python callables are never called) or given by Python callables
+!! (source 1; see conmech_flat_mech_support for their conventions). has_jac, has_gamma,
+!! has_nh_gamma, rheonomic: 0 or 1 (source 1); without an analytic Jacobian or
+!! acceleration term the documented finite differences are used.
+subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces, phi, jac, &
+                            gamma, nh, nhgamma, has_jac, has_gamma, has_nh_gamma, rheonomic, &
+                            mh, mn, store, events, evstore, n, t_span, q0, v0, method, rtol, &
+                            atol, iopt, ropt, neval, t_eval, ne, ev_dir, ev_term, stats, moved, &
+                            info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system, only: constrained_system
     use conmech_flat_spec, only: spec_constrained
     use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_mech_support, only: run_constrained
-    implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
-    integer(c_int), intent(in) :: method
-    real(c_double), intent(in) :: rtol, atol
-    integer(c_int), intent(in) :: iopt(5)
-    real(c_double), intent(in) :: ropt(5)
-    integer(c_int), intent(in) :: neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: stats(7)
-    real(c_double), intent(out) :: moved(2)
-    integer(c_int), intent(out) :: info
-    character(len=256), intent(out) :: message
-!f2py external store, events, evstore
-    interface
-        subroutine events(t, y, g, n2, ne)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n2, ne
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n2)
-            real(c_double), intent(out) :: g(ne)
-        end subroutine events
-        subroutine evstore(ev_t, ev_q, ev_v, ev_id, n, nev)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nev
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-        end subroutine evstore
-        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mm, nt
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
-            real(c_double), intent(in) :: lam(mm, nt)
-            real(c_double), intent(in) :: reac(n, nt)
-            real(c_double), intent(in) :: cm(mm, n, nt)
-            real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
-        end subroutine store
-    end interface
-    class(constrained_system), allocatable :: cs
-    character(len=:), allocatable :: msg
-    stats = 0
-    moved = 0.0_dp
-    call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
-    call run_constrained(cs, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
-                         t_eval, store, stats, moved, info, message, ne, ev_dir, ev_term, &
-                         events, evstore)
-end subroutine flat_constrained_builtin
-
-!> Solve a constrained system given by Python callables (see conmech_flat_mech_support
-!! for their conventions). has_jac, has_gamma, has_nh_gamma, rheonomic: 0 or 1; without
-!! an analytic Jacobian or acceleration term the documented finite differences are used.
-subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma, has_jac, &
-                                     has_gamma, has_nh_gamma, rheonomic, mh, mn, store, &
-                                     events, evstore, n, &
-                                     t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
-                                     t_eval, ne, ev_dir, ev_term, stats, moved, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_status, only: CM_BAD_INPUT
-    use conmech_flat_ode_support, only: copy_message
     use conmech_flat_mech_support, only: callback_constrained, run_constrained
     implicit none
+    include "flat_spec_args.inc"
+    integer(c_int), intent(in) :: source
     integer(c_int), intent(in) :: has_jac, has_gamma, has_nh_gamma, rheonomic, mh, mn
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
@@ -256,29 +183,40 @@ subroutine flat_constrained_callback(mass, forces, phi, jac, gamma, nh, nhgamma,
             real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
         end subroutine store
     end interface
-    type(callback_constrained) :: sys
+    class(constrained_system), allocatable :: cs
+    type(callback_constrained) :: cb
+    character(len=:), allocatable :: msg
     stats = 0
-    moved = 0.0
-    if (n < 1 .or. mh < 0 .or. mn < 0) then
-        info = CM_BAD_INPUT
-        call copy_message("bad input: n must be >= 1, n_hol and n_nh >= 0", message)
-        return
+    moved = 0.0_dp
+    if (source == 0) then
+        call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
+        if (info /= CM_SUCCESS) then
+            call copy_message(msg, message)
+            return
+        end if
+    else
+        if (n < 1 .or. mh < 0 .or. mn < 0) then
+            info = CM_BAD_INPUT
+            call copy_message("bad input: n must be >= 1, n_hol and n_nh >= 0", message)
+            return
+        end if
+        cb%n = n
+        cb%n_hol = mh
+        cb%n_nh = mn
+        cb%rheonomic = rheonomic /= 0
+        cb%has_jac = has_jac /= 0
+        cb%has_gamma = has_gamma /= 0
+        cb%has_nh_gamma = has_nh_gamma /= 0
+        cb%fmass => mass
+        cb%fforces => forces
+        cb%fphi => phi
+        cb%fjac => jac
+        cb%fgamma => gamma
+        cb%fnh => nh
+        cb%fnhgamma => nhgamma
+        allocate (cs, source=cb)
     end if
-    sys%n = n
-    sys%n_hol = mh
-    sys%n_nh = mn
-    sys%rheonomic = rheonomic /= 0
-    sys%has_jac = has_jac /= 0
-    sys%has_gamma = has_gamma /= 0
-    sys%has_nh_gamma = has_nh_gamma /= 0
-    sys%fmass => mass
-    sys%fforces => forces
-    sys%fphi => phi
-    sys%fjac => jac
-    sys%fgamma => gamma
-    sys%fnh => nh
-    sys%fnhgamma => nhgamma
-    call run_constrained(sys, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
+    call run_constrained(cs, n, t_span, q0, v0, method, rtol, atol, iopt, ropt, neval, &
                          t_eval, store, stats, moved, info, message, ne, ev_dir, ev_term, &
                          events, evstore)
-end subroutine flat_constrained_callback
+end subroutine flat_constrained

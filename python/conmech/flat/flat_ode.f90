@@ -68,9 +68,13 @@ subroutine flat_system_dimension(name, n)
     n = system_dimension(name)
 end subroutine flat_system_dimension
 
-!> Solve y' = fun(t, y) for a Python right-hand side (f2py callback) with any method of
-!! the table and, if has_jac /= 0, a Python Jacobian jac(t, y) -> (n, n) (methods that use
-!! one, e.g. Radau; else forward differences).
+!> Solve y' = f(t, y) with any method of the table for the system of the one flat argument
+!! set (conmech_flat_system): a built-in system `name` with parameters `params` (see
+!! conmech_systems::make_system; params has at least one element, np of them are used) or
+!! a compiled one (`spec`), with its analytic Jacobian where the method uses one (no Python
+!! in the loop unless there are events); or a Python right-hand side fun(t, y) (f2py
+!! callback) with, for source 2, a Python Jacobian jfun(t, y) -> (n, n) (else forward
+!! differences).
 !! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
 !! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
 !! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal; ev_res: each event's
@@ -80,93 +84,18 @@ end subroutine flat_system_dimension
 !! differences by groups of columns (methods that use a Jacobian; nnz = -1: none).
 !! dense_form: form of the dense coefficients handed to `store` (1 Hairer's, 2 power basis,
 !! 0 none). counts = [nfev, njev, nlu, naccept, nreject].
-subroutine flat_solve_callback(fun, jac, events, store, n, t_span, y0, method, has_jac, &
-                               rtol, atol, first_step, max_step, max_steps, dense, neval, &
-                               t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
-                               sp_idx, counts, dense_form, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_jac_system, run_solve
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2)
-    real(c_double), intent(in) :: y0(n)
-    integer(c_int), intent(in) :: method, has_jac
-    real(c_double), intent(in) :: rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    real(c_double), intent(in) :: ev_res(max(ne, 1))
-    integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
-    integer(c_int), intent(out) :: counts(5), dense_form, info
-    character(len=256), intent(out) :: message
-!f2py external fun, jac, events, store
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-        subroutine jac(t, y, dfdy, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dfdy(n, n)
-        end subroutine jac
-        subroutine events(t, y, g, n, ne)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, ne
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: g(ne)
-        end subroutine events
-        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: y(n, nt)
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_y(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-            real(c_double), intent(in) :: ts(nseg)
-            real(c_double), intent(in) :: hs(nseg)
-            real(c_double), intent(in) :: coef(n, nf1, nseg)
-        end subroutine store
-    end interface
-    type(callback_jac_system) :: sys
-
-    sys%f => fun
-    sys%n = n
-    if (has_jac /= 0) sys%jac => jac
-    call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
-                   sp_idx, events, store, counts, dense_form, info, message)
-end subroutine flat_solve_callback
-
-!> Solve y' = f(t, y) for the built-in (or compiled) system `name` with parameters `params`
-!! (see conmech_systems::make_system; params has at least one element, np of them are
-!! used; its analytic Jacobian where the method uses one, else forward differences): no
-!! Python in the loop unless there are events. Other arguments as in flat_solve_callback.
-subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t_span, y0, &
-                              method, rtol, atol, first_step, max_step, max_steps, dense, &
-                              neval, t_eval, ne, ev_dir, ev_term, ev_res, nnz, sp_ptr, sp_idx, &
-                              counts, dense_form, info, message)
+subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, store, n, &
+                      t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
+                      dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, &
+                      sp_ptr, sp_idx, counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_dimension
+    use conmech_flat_system, only: flat_system, SOURCE_SPEC
     use conmech_flat_ode_support, only: run_solve, copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2)
     real(c_double), intent(in) :: y0(n)
@@ -178,50 +107,33 @@ subroutine flat_solve_builtin(name, np, params, nspec, spec, events, store, n, t
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     real(c_double), intent(in) :: ev_res(max(ne, 1))
-    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
+    integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
-!f2py external events, store
-    interface
-        subroutine events(t, y, g, n, ne)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, ne
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: g(ne)
-        end subroutine events
-        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: y(n, nt)
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_y(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-            real(c_double), intent(in) :: ts(nseg)
-            real(c_double), intent(in) :: hs(nseg)
-            real(c_double), intent(in) :: coef(n, nf1, nseg)
-        end subroutine store
-    end interface
+    include "flat_system_args.inc"
+    include "flat_solve_callbacks.inc"
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
     character(len=24) :: buf
 
     counts = 0
     dense_form = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
+    call flat_system(name, real(params(1:np), dp), nspec, spec, fun, jfun, source, n, sys, &
+                     info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
     end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        write (buf, '(i0)') spec_dimension(name, nspec, spec)
-        call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
-                          //trim(name)//"'", message)
-        return
+    if (source == SOURCE_SPEC) then
+        if (spec_dimension(name, nspec, spec) /= n) then
+            info = CM_BAD_INPUT
+            write (buf, '(i0)') spec_dimension(name, nspec, spec)
+            call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
+                              //trim(name)//"'", message)
+            return
+        end if
     end if
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
-                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, nnz, sp_ptr, sp_idx, &
-                   events, store, counts, dense_form, info, message)
-end subroutine flat_solve_builtin
+                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
+                   sp_idx, events, store, counts, dense_form, info, message)
+end subroutine flat_solve

@@ -1,12 +1,12 @@
 !> Flat f2py layer of the stability layer: Hill's variation orbit and family, transverse
-!! linearisation, equilibria, state transition matrices for built-in systems (by name) and
-!! Python callbacks, Hill's equation. Periodic orbits: flat_orbits.f90; continuation:
-!! flat_branch.f90.
+!! linearisation, equilibria, state transition matrices (for any system given by the one
+!! flat argument set of conmech_flat_system), Hill's equation. Periodic orbits:
+!! flat_orbits.f90; continuation: flat_branch.f90.
 !! Plain subroutines, c_double/c_int explicit-shape arrays, an `info` code and a message.
 !! Nothing is saved between calls; nothing stops or prints.
 !!
-!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n); phi(t, p) for Hill's
-!! equation.
+!! Callback conventions (as in flat_ode.f90): fun(t, y, dydt, n), jfun(t, y, dfdy, n);
+!! phi(t, p) for Hill's equation.
 
 !> Hill's variation orbit with its monodromy (see conmech_hill_orbit).
 !! use_guess /= 0: Newton starts from guess = (x0, v0). full_period /= 0: monodromy by
@@ -27,15 +27,13 @@ subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, clos
     character(len=256), intent(out) :: message
     type(hill_orbit) :: orb
     type(hill_orbit_options) :: opt
+    real(c_double), allocatable :: g(:)
     if (nsteps > 0) opt%nsteps = nsteps
     if (closure_tol > 0.0_c_double) opt%closure_tol = closure_tol
     if (max_nsteps > 0) opt%max_nsteps = max_nsteps
     opt%full_period = full_period /= 0
-    if (use_guess /= 0) then
-        call hill_variation_orbit(m, kappa, orb, opt, guess)
-    else
-        call hill_variation_orbit(m, kappa, orb, opt)
-    end if
+    if (use_guess /= 0) g = guess
+    call hill_variation_orbit(m, kappa, orb, opt, g)   ! unallocated g: no guess
     y0 = orb%y0
     period = orb%period
     jacobi = orb%jacobi
@@ -106,15 +104,13 @@ subroutine flat_hill_family(nm, ms, kappa, nsteps, chunk_size, y0s, jacobis, mon
     integer(c_int), intent(out) :: nsteps_used(nm), infos(nm), iters(nm)
     type(hill_orbit), allocatable :: orbs(:)
     type(hill_orbit_options) :: opt
+    integer, allocatable :: chunk
     integer :: i
     if (nsteps > 0) opt%nsteps = nsteps
     opt%eigenvalues = .false.
     allocate (orbs(nm))
-    if (chunk_size > 0) then
-        call hill_family(ms, kappa, orbs, opt, chunk_size=chunk_size)
-    else
-        call hill_family(ms, kappa, orbs, opt)
-    end if
+    if (chunk_size > 0) chunk = chunk_size
+    call hill_family(ms, kappa, orbs, opt, chunk_size=chunk)   ! unallocated: the default
     do i = 1, nm
         residuals(i) = orbs(i)%residual
         quarters(:, i) = orbs(i)%quarter_state
@@ -169,67 +165,6 @@ subroutine flat_hill_transverse(m, kappa, y0, rtol, nt, t, states, phi, mono2, h
     end if
 end subroutine flat_hill_transverse
 
-!> Equilibrium analysis of a built-in system at y.
-subroutine flat_equilibrium_builtin(name, np, params, nspec, spec, n, y, t, tol, jac, wr, wi, &
-                                    kind, saddle, &
-                                    residual, analytic, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
-    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
-    use conmech_support_stab, only: unpack_eq
-    implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
-    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual
-    integer(c_int), intent(out) :: kind, saddle, analytic, info
-    character(len=256), intent(out) :: message
-    class(ode_system), allocatable :: sys
-    type(equilibrium_result) :: e
-    character(len=:), allocatable :: msg
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
-    call analyze_equilibrium(sys, y, e, t, tol)
-    call unpack_eq(e, n, jac, wr, wi, kind, saddle, residual, analytic, info, message)
-end subroutine flat_equilibrium_builtin
-
-!> Equilibrium analysis of a Python right-hand side fun(t, y, dydt, n) (FD Jacobian).
-subroutine flat_equilibrium_callback(fun, n, y, t, tol, jac, wr, wi, kind, saddle, residual, &
-                                     analytic, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system
-    use conmech_equilibria, only: equilibrium_result, analyze_equilibrium
-    use conmech_support_stab, only: unpack_eq
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: y(n), t, tol
-    real(c_double), intent(out) :: jac(n, n), wr(n), wi(n), residual
-    integer(c_int), intent(out) :: kind, saddle, analytic, info
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_system) :: sys
-    type(equilibrium_result) :: e
-    sys%f => fun
-    sys%n = n
-    call analyze_equilibrium(sys, y, e, t, tol)
-    call unpack_eq(e, n, jac, wr, wi, kind, saddle, residual, analytic, info, message)
-end subroutine flat_equilibrium_callback
-
 !> Lagrange-Dirichlet test on a symmetric Hessian (dsyev).
 subroutine flat_lagrange_dirichlet(n, hess, tol, stable, w, info)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
@@ -244,24 +179,22 @@ subroutine flat_lagrange_dirichlet(n, hess, tol, stable, w, info)
     stable = merge(1, 0, st)
 end subroutine flat_lagrange_dirichlet
 
-!> State and state transition matrix of a built-in system from t0 to t1 (DOP853).
-subroutine flat_stm_builtin(name, np, params, nspec, spec, n, y0, t0, t1, rtol, atol, y1, phi, &
-                            nfev, info, &
-                            message)
+!> State and state transition matrix from t0 to t1 (DOP853) of the system given by the one
+!! flat argument set (conmech_flat_system).
+subroutine flat_stm(name, np, params, nspec, spec, fun, jfun, source, n, y0, t0, t1, rtol, &
+                    atol, y1, phi, nfev, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_stats
-    use conmech_flat_spec, only: spec_system
+    use conmech_flat_system, only: flat_system
     use conmech_variational, only: integrate_stm
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    real(c_double), intent(in) :: params(max(np, 1)), y0(n), t0, t1, rtol, atol
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: y0(n), t0, t1, rtol, atol
     real(c_double), intent(out) :: y1(n), phi(n, n)
     integer(c_int), intent(out) :: nfev, info
     character(len=256), intent(out) :: message
+    include "flat_system_args.inc"
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
     type(ode_options) :: opt
@@ -273,7 +206,7 @@ subroutine flat_stm_builtin(name, np, params, nspec, spec, n, y0, t0, t1, rtol, 
     do i = 1, n
         phi(i, i) = 1.0_c_double
     end do
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
     if (info /= 0) then
         message = msg
         return
@@ -283,48 +216,7 @@ subroutine flat_stm_builtin(name, np, params, nspec, spec, n, y0, t0, t1, rtol, 
     call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
     nfev = st%nfev
     message = msg
-end subroutine flat_stm_builtin
-
-!> State and STM for a Python right-hand side (FD Jacobian).
-subroutine flat_stm_callback(fun, n, y0, t0, t1, rtol, atol, y1, phi, nfev, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_ode_solver, only: ode_options, ode_stats
-    use conmech_flat_ode_support, only: callback_system
-    use conmech_variational, only: integrate_stm
-    implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: y0(n), t0, t1, rtol, atol
-    real(c_double), intent(out) :: y1(n), phi(n, n)
-    integer(c_int), intent(out) :: nfev, info
-    character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_system) :: sys
-    type(ode_options) :: opt
-    type(ode_stats) :: st
-    character(len=:), allocatable :: msg
-    integer :: i
-    sys%f => fun
-    sys%n = n
-    y1 = y0
-    phi = 0.0_c_double
-    do i = 1, n
-        phi(i, i) = 1.0_c_double
-    end do
-    opt%rtol = rtol
-    opt%atol = atol
-    call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
-    nfev = st%nfev
-    message = msg
-end subroutine flat_stm_callback
+end subroutine flat_stm
 
 !> Hill's equation N'' + Phi(t) N = 0 with Phi given by ns samples over one period.
 subroutine flat_hill_equation_samples(ns, p, period, rtol, mono, half_trace, det, info, message)
@@ -436,39 +328,13 @@ subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, 
     info = CM_SUCCESS
 end subroutine flat_transverse_callback
 
-!> Newton's method for an equilibrium f(t, y) = 0 of a built-in system from the guess y.
-subroutine flat_find_equilibrium_builtin(name, np, params, nspec, spec, n, y, t, tol, &
-                                         max_iter, yout, info, &
-                                         message)
+!> Newton's method for an equilibrium f(t, y) = 0 from the guess y, for the system given by
+!! the one flat argument set (conmech_flat_system).
+subroutine flat_find_equilibrium(name, np, params, nspec, spec, fun, jfun, source, n, y, t, &
+                                 tol, max_iter, yout, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
-    use conmech_equilibria, only: find_equilibrium
-    implicit none
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, n, max_iter
-    real(c_double), intent(in) :: params(max(np, 1)), y(n), t, tol
-    real(c_double), intent(out) :: yout(n)
-    integer(c_int), intent(out) :: info
-    character(len=256), intent(out) :: message
-    class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
-    yout = y
-    call spec_system(name, params(1:np), nspec, spec, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
-    call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
-    message = msg
-end subroutine flat_find_equilibrium_builtin
-
-!> As flat_find_equilibrium_builtin for a Python right-hand side (FD Jacobian).
-subroutine flat_find_equilibrium_callback(fun, n, y, t, tol, max_iter, yout, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_system
+    use conmech_flat_system, only: flat_system
     use conmech_equilibria, only: find_equilibrium
     implicit none
     integer(c_int), intent(in) :: n, max_iter
@@ -476,21 +342,15 @@ subroutine flat_find_equilibrium_callback(fun, n, y, t, tol, max_iter, yout, inf
     real(c_double), intent(out) :: yout(n)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
-!f2py external fun
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-    end interface
-    type(callback_system) :: sys
+    include "flat_system_args.inc"
+    class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
-    sys%f => fun
-    sys%n = n
     yout = y
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
+    if (info /= 0) then
+        message = msg
+        return
+    end if
     call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
     message = msg
-end subroutine flat_find_equilibrium_callback
+end subroutine flat_find_equilibrium

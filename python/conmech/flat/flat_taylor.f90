@@ -6,7 +6,7 @@
 !! series used to isolate their roots; ne events with directions ev_dir (+1 rising, -1
 !! falling, 0 both) and terminal flags ev_term; ev_zero /= 0: the event is taken as zero
 !! at t0 (a run continued from its root). Other arguments and `store` as in
-!! flat_solve_builtin; counts = [nfev, njev, nlu, naccept, nreject, steps shortened to
+!! flat_solve; counts = [nfev, njev, nlu, naccept, nreject, steps shortened to
 !! separate two roots of an event].
 subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0, rtol, &
                              atol, first_step, max_step, max_steps, dense, neval, t_eval, &
@@ -74,7 +74,7 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
 end subroutine flat_solve_taylor
 
 !> State and STM by Taylor's method on the variational system's own recurrences (a
-!! compiled system whose spec has taylor_var); as flat_stm_builtin otherwise.
+!! compiled system whose spec has taylor_var); as flat_stm otherwise.
 subroutine flat_stm_taylor(name, np, params, nspec, spec, n, y0, t0, t1, rtol, atol, y1, phi, &
                            nfev, naccept, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int

@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import _conmech  # noqa: F401
 from .._callback import Guard, as_result, message_text
-from .._native import NativeSystem
+from .._native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
 
 def _msg(message):
     return message_text(message)
@@ -88,6 +88,19 @@ def _callback(fun, n, y0, t0, jac=None):
     rhs = g.wrap(fun, 2, (n,), "fun")
     dfdy = g.wrap(jac, 2, (n, n), "jac") if jac is not None else None
     return g, rhs, dfdy
+
+
+def _system_args(system, n, y0, t0, jac=None):
+    """(guard, args): the one system argument set of the flat routines (name, np, params,
+    nspec, spec, fun, jfun, source; see conmech_flat_system) for a built-in or compiled
+    system (guard None) or a Python right-hand side with its optional Jacobian (guarded,
+    probed at (t0, y0) by :func:`_callback`)."""
+    if isinstance(system, NativeSystem):
+        return None, system._system_args()
+    g, rhs, dfdy = _callback(system, n, y0, t0, jac)
+    if dfdy is None:
+        return g, ("", 0, _PAD, 0, _NO_SPEC, rhs, _unused_callback, 1)
+    return g, ("", 0, _PAD, 0, _NO_SPEC, rhs, dfdy, 2)
 
 
 def _check_dim(system, y):

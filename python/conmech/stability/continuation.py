@@ -11,6 +11,7 @@ import numpy as np
 from .. import _conmech
 from .._callback import Guard, as_result
 from .._native import NativeSystem
+from .._native import _NO_SPEC, _PAD, _unused_callback
 from ._validate import _check_dim, _count, _msg, _raise, _real, _state
 from .orbits import _METHODS, stable_tolerance
 
@@ -279,8 +280,8 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                 params[ip] = float(p0)
             pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
         name, _, _, nspec, spec = system._flat_args()
-        out = _conmech.flat_branch_builtin(name, npar, params, nspec, spec,
-                                           ip + 1, y0, period, *args)
+        sargs = (name, npar, params, nspec, spec, ip + 1, _unused_callback,
+                 _unused_callback, 0, 0.0)
     else:
         if not callable(system):
             raise TypeError("system must be a conmech.systems.NativeSystem or a callable "
@@ -301,7 +302,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                 g.fail(exc)
                 return nans
         if jac is None:
-            out = _conmech.flat_branch_callback(rhs, y0, period, float(p0), *args)
+            sargs = ("", 0, _PAD, 0, _NO_SPEC, 0, rhs, _unused_callback, 1, float(p0))
         else:
             nanj = np.full((n, n), np.nan)
 
@@ -314,8 +315,9 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                 except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
                     g.fail(exc)
                     return nanj
-            out = _conmech.flat_branch_callback_jac(rhs, jrhs, y0, period, float(p0), *args)
+            sargs = ("", 0, _PAD, 0, _NO_SPEC, 0, rhs, jrhs, 2, float(p0))
         pname = param if isinstance(param, str) else "p"
+    out = _conmech.flat_branch(*sargs, y0, period, *args)
     g.check()
     (npts, pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, sk, si, sp_p, sp_per,
      sp_y, sp_mr, sp_mi, sp_s, sp_loc, sp_test, sp_clo, sp_br, dirout, info, message) = out

@@ -9,8 +9,9 @@ import numpy as np
 
 from .. import _conmech
 from .._builtin_table import STATE_NAMES
-from .._native import BuiltinSystem, NativeSystem
-from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state
+from .._native import BuiltinSystem
+from ._validate import (_check_dim, _no_jac_for_builtin, _raise, _real, _state,
+                        _system_args)
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate",
           5: "unstable (secular drift)", 6: "stable (family of equilibria)"}
@@ -153,14 +154,9 @@ def equilibrium(system: Any, y: ArrayLike, t: float = 0.0, tol: float = 1e-8,
     _no_jac_for_builtin(system, jac)
     n = y.size
     njev = 0
-    if isinstance(system, NativeSystem):
-        out = _conmech.flat_equilibrium_structure_builtin(*system._flat_args(), y, t, tol)
-    else:
-        g, rhs, dfdy = _callback(system, n, y, t, jac)
-        if dfdy is None:
-            out = _conmech.flat_equilibrium_structure_callback(rhs, y, t, tol)
-        else:
-            out = _conmech.flat_equilibrium_structure_callback_jac(rhs, dfdy, y, t, tol)
+    g, sargs = _system_args(system, n, y, t, jac)
+    out = _conmech.flat_equilibrium_structure(*sargs, y, t, tol)
+    if g is not None:
         g.check()
         njev = g.count("jac")
     (jmat, wr, wi, kind, saddle, residual, analytic, zero_mult, block, sfreq, fdim, fam,
@@ -303,13 +299,10 @@ def find_equilibrium(system: Any, guess: ArrayLike, t: float = 0.0, tol: float =
     _check_dim(system, y)
     if not (np.isfinite(tol) and tol > 0) or int(max_iter) < 1:
         raise ValueError("tol must be positive and max_iter >= 1")
-    if isinstance(system, NativeSystem):
-        yout, info, message = _conmech.flat_find_equilibrium_builtin(
-            *system._flat_args(), y, float(t), float(tol), int(max_iter))
-    else:
-        g, rhs, _ = _callback(system, y.size, y, float(t))
-        yout, info, message = _conmech.flat_find_equilibrium_callback(
-            rhs, y, float(t), float(tol), int(max_iter))
+    g, sargs = _system_args(system, y.size, y, float(t))
+    yout, info, message = _conmech.flat_find_equilibrium(*sargs, y, float(t), float(tol),
+                                                         int(max_iter))
+    if g is not None:
         g.check()
     if info != 0:
         _raise(info, message)

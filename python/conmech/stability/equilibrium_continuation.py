@@ -11,6 +11,7 @@ import numpy as np
 from .. import _conmech
 from .._callback import Guard, as_result
 from .._native import NativeSystem
+from .._native import _NO_SPEC, _PAD, _unused_callback
 from ._validate import _check_dim, _count, _msg, _raise, _real, _state
 from .continuation import Branch, _param_index, continuation
 
@@ -190,8 +191,8 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
         if not lo <= params[ip] <= hi:
             raise ValueError(f"the start value {pname} = {params[ip]:g} is outside p_range")
         name, _, _, nspec, spec = system._flat_args()
-        out = _conmech.flat_eq_continuation_builtin(name, params.size, params, nspec, spec,
-                                                    ip + 1, y0, ropt, iopt, max_points)
+        sargs = (name, params.size, params, nspec, spec, ip + 1, _unused_callback,
+                 _unused_callback, 0, 0.0)
     else:
         if p0 is None:
             raise ValueError("p0 (the start value of the parameter) is needed for a callable")
@@ -200,15 +201,16 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
             raise ValueError(f"the start value p0 = {p0:g} is outside p_range")
         g, rhs = _param_rhs(system, n, y0, p0)
         if jac is None:
-            out = _conmech.flat_eq_continuation_callback(rhs, y0, p0, ropt, iopt, max_points)
+            sargs = ("", 0, _PAD, 0, _NO_SPEC, 0, rhs, _unused_callback, 1, p0)
         else:
             as_result(jac(0.0, y0.copy(), float(p0)), (n, n), "jac")
             cbj = g.wrap(lambda tt, y, pa: jac(tt, y, float(pa[0])), 3, (n, n), "jac")
 
             def jrhs(tt, y, p):
                 return cbj(tt, y, np.array([p], dtype=float))
-            out = _conmech.flat_eq_continuation_callback_jac(rhs, jrhs, y0, p0, ropt, iopt,
-                                                             max_points)
+            sargs = ("", 0, _PAD, 0, _NO_SPEC, 0, rhs, jrhs, 2, p0)
+    out = _conmech.flat_eq_continuation(*sargs, y0, ropt, iopt, max_points)
+    if not isinstance(system, NativeSystem):
         g.check()
         pname = param if isinstance(param, str) else "p"
     (npts, pp, ys, wr, wi, psi, nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q,
@@ -265,15 +267,16 @@ def first_lyapunov_coefficient(system: Any, y: ArrayLike, p: float | None = None
                 raise ValueError("param is needed with p for a built-in system")
             params[_param_index(system, param)] = _real(p, "p")
         name, _, _, nspec, spec = system._flat_args()
-        out, q, adj, info, message = _conmech.flat_hopf_builtin(
-            name, params.size, params if params.size else np.zeros(1), nspec, spec, t, y,
-            l1_tol)
+        sargs = (name, params.size, params if params.size else _PAD, nspec, spec, -1,
+                 _unused_callback, _unused_callback, 0, 0.0)
     else:
         if p is None:
             raise ValueError("p (the parameter value) is needed for a callable fun(t, y, p)")
         p = _real(p, "p")
         g, rhs = _param_rhs(system, n, y, p)
-        out, q, adj, info, message = _conmech.flat_hopf_callback(rhs, p, t, y, l1_tol)
+        sargs = ("", 0, _PAD, 0, _NO_SPEC, 0, rhs, _unused_callback, 1, p)
+    out, q, adj, info, message = _conmech.flat_hopf(*sargs, t, y, l1_tol)
+    if not isinstance(system, NativeSystem):
         g.check()
     if info != 0:
         if info == -4:

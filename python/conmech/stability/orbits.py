@@ -11,8 +11,7 @@ import numpy as np
 
 from .. import _conmech
 from .._ivp import solve_ivp
-from .._native import NativeSystem
-from ._validate import (_callback, _check_dim, _count, _no_jac_for_builtin, _raise, _real,
+from ._validate import (_check_dim, _count, _no_jac_for_builtin, _raise, _real, _system_args,
                         _state, _tols)
 
 class PeriodicOrbit:
@@ -108,14 +107,9 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     args = (y0, period, kind, mode, nfree, fr, ntg, tg, int(bool(free_time)),
             period_factor, rtol, atol, max_iter, iopt, nk)
     njev = 0
-    if isinstance(system, NativeSystem):
-        out = _conmech.flat_po_builtin(*system._flat_args(), *args)
-    else:
-        g, rhs, dfdy = _callback(system, y0.size, y0, 0.0, jac)
-        if dfdy is None:
-            out = _conmech.flat_po_callback(rhs, *args)
-        else:
-            out = _conmech.flat_po_callback_jac(rhs, dfdy, *args)
+    g, sargs = _system_args(system, y0.size, y0, 0.0, jac)
+    out = _conmech.flat_po(*sargs, *args)
+    if g is not None:
         g.check()
         njev = g.count("jac")
     (y0o, po, mono, mr, mi, merr, accuracy, deflated, nodes, node_times, nnodes, residual,

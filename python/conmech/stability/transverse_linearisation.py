@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import _conmech
 from .._callback import Guard, as_result
-from .._native import NativeSystem
+from .._native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
 from ..constrained import NativeConstrained
 from ._validate import _raise, _real, _state
 
@@ -182,10 +182,9 @@ def transverse_linearisation(system: Any, orbit: Any, period: float | None = Non
         if kmax < 1:
             raise ValueError("the system has no transverse coordinate (N - 1 - constraints "
                              "< 1)")
-        out = _conmech.flat_transverse_general_system(*system._flat_args(), y0, per, rtol,
-                                                      atol, mode, full, tt, kmax)
-        (k, reduced, closure, drift, defect, mono, mr, mi, fmono, fre, fim, holo, xs, qs, as_,
-         phis, psis, nfev, kind, info, message) = out
+        g = None
+        sargs = (*system._flat_args(), _unused_callback, _unused_callback, 0,
+                 _unused_callback, 0)
     elif callable(system):
         if jac is not None and not callable(jac):
             raise TypeError("jac must be a callable jac(t, y) -> (n, n), or None")
@@ -203,16 +202,16 @@ def transverse_linearisation(system: Any, orbit: Any, period: float | None = Non
         kmax = n - 1
         if kmax < 1:
             raise ValueError("y0 must have at least 2 components")
-        out = _conmech.flat_transverse_general_callback(
-            rhs, dfdy, eg, int(jac is not None), int(energy_gradient is not None), y0, per,
-            rtol, atol, mode, full, tt, kmax)
-        g.check()
-        (k, reduced, closure, drift, defect, mono, mr, mi, fmono, fre, fim, holo, xs, qs, as_,
-         phis, psis, nfev, info, message) = out
-        kind = 0
+        sargs = ("", 0, _PAD, 0, _NO_SPEC, rhs, dfdy, 1 if jac is None else 2, eg,
+                 int(energy_gradient is not None))
     else:
         raise TypeError("system must be a conmech system (built-in, compiled, symbolic, "
                         "constrained) or a callable fun(t, y)")
+    out = _conmech.flat_transverse_general(*sargs, y0, per, rtol, atol, mode, full, tt, kmax)
+    if g is not None:
+        g.check()
+    (k, reduced, closure, drift, defect, mono, mr, mi, fmono, fre, fim, holo, xs, qs, as_,
+     phis, psis, nfev, kind, info, message) = out
     if info != 0:
         _raise(info, message)
     k = int(k)

@@ -9,7 +9,8 @@ import numpy as np
 
 from .. import _conmech
 from .._native import NativeSystem
-from ._validate import _callback, _check_dim, _no_jac_for_builtin, _raise, _real, _state, _tols
+from ._validate import (_check_dim, _no_jac_for_builtin, _raise, _real, _state,
+                        _system_args, _tols)
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
         atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
@@ -40,19 +41,12 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
                              "(conmech.symbolic.ode_system), not a Python function")
         y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(
             *system._flat_args(), y0, t0, t1, rtol, atol)
-    elif isinstance(system, NativeSystem):
-        y1, phi, nfev, info, message = _conmech.flat_stm_builtin(
-            *system._flat_args(), y0, t0, t1, rtol, atol)
     else:
-        g, rhs, dfdy = _callback(system, y0.size, y0, t0, jac)
-        if dfdy is None:
-            y1, phi, nfev, info, message = _conmech.flat_stm_callback(
-                rhs, y0, t0, t1, rtol, atol)
-        else:
-            y1, phi, nfev, info, message = _conmech.flat_stm_callback_jac(
-                rhs, dfdy, y0, t0, t1, rtol, atol)
-        g.check()
-        njev = g.count("jac")
+        g, sargs = _system_args(system, y0.size, y0, t0, jac)
+        y1, phi, nfev, info, message = _conmech.flat_stm(*sargs, y0, t0, t1, rtol, atol)
+        if g is not None:
+            g.check()
+            njev = g.count("jac")
     if info < 0:
         _raise(info, message)
     if full_output:

@@ -48,6 +48,7 @@ import time
 import numpy as np
 import sympy as sp
 
+from .. import _slot_table as _table
 from .build import (CacheError, CacheWarning, CompileError, _conmech_version, cache_dir,
                     check_private, compile_source, load)
 from .codegen import CODEGEN_VERSION, generate
@@ -63,18 +64,6 @@ __all__ = ["ode_system", "lagrangian_system", "constrained_system", "CompiledMod
 _D = ctypes.c_double
 _P = ctypes.POINTER(ctypes.c_double)
 _V = ctypes.c_void_p
-# argument layouts of the C ABI (after t): number of input arrays, output arrays
-_SIG = {
-    "rhs": ("in1", "out1"), "jac": ("in1", "out1"),
-    "mass": ("in1", "out1"), "forces": ("in2", "out1"), "forces_jac": ("in3", "out1"),
-    "energy": ("in2", "ret"), "phi": ("in1", "out1"), "phi_jac": ("in1", "out1"),
-    "phi_t": ("in1", "out1"), "phi_gamma": ("in2", "out1"), "nh_matrix": ("in1", "out2"),
-    "nh_gamma": ("in2", "out1"), "mass_forces": ("in2", "out2"), "accel": ("in2", "out1"),
-    "accel_jac": ("in2", "out2"),
-}
-# constrained systems: the second derivatives of the constraints (inputs q, v, lam)
-_SIG["constraint_hessian"] = ("in3", "out2")
-
 
 class CompiledModel:
     """A derived system compiled and loaded: the library, the entry-point addresses, the
@@ -96,14 +85,7 @@ class CompiledModel:
 
     def _shapes(self, entry):
         d = self.derived
-        n, h, k = d.n, d.n_hol, d.n_nh
-        return {"rhs": [(n,)], "jac": [(n, n)], "mass": [(n, n)], "forces": [(n,)],
-                "forces_jac": [(n, 2 * n)], "energy": [], "phi": [(h,)],
-                "phi_jac": [(h, n)], "phi_t": [(h,)], "phi_gamma": [(h,)],
-                "nh_matrix": [(k, n), (k,)], "nh_gamma": [(k,)],
-                "mass_forces": [(n, n), (n,)], "accel": [(n,)],
-                "constraint_hessian": [(n, n), (h + k, n)],
-                "accel_jac": [(n,), (n, 2 * n)]}[entry]
+        return _table.shapes(entry, d.n, d.n_hol, d.n_nh)
 
     def _entry(self, entry):
         """(ctypes function, number of input arrays, output shapes, returns a value) of an
@@ -120,8 +102,8 @@ class CompiledModel:
                 e = (fn, 2, [], False)
             else:
                 shapes = self._shapes(entry)
-                n_in = int(_SIG[entry][0][2:])
-                ret = _SIG[entry][1] == "ret"
+                n_in = _table.BY_NAME[entry].inputs
+                ret = _table.returns_value(entry)
                 fn = ctypes.CFUNCTYPE(_D if ret else None, _D,
                                       *([_V] * (n_in + len(shapes) + 1)))(
                     self.addresses[entry])

@@ -39,17 +39,15 @@ import re
 import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
+from .. import _slot_table as _table
+
 __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
            "trig_split", "ENTRY_POINTS", "product_terms", "product_lines", "comment_text",
            "comment_lines", "string_constant", "check_source"]
 
-# C names of the entry points, per kind, with the name of conmech.compiled's argument
-ENTRY_POINTS = {
-    "ode": ["rhs", "jac", "jac_prod"],
-    "generalized": ["mass", "forces", "forces_jac", "energy", "mass_forces", "accel"],
-    "constrained": ["mass", "forces", "energy", "phi", "phi_jac", "phi_t", "phi_gamma",
-                    "nh_matrix", "nh_gamma", "forces_jac", "constraint_hessian"],
-}
+# C names of the entry points (conmech_<name>) per kind, the names of conmech.compiled's
+# arguments: the table of compiled functions
+ENTRY_POINTS = _table.ENTRY_POINTS
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
 CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;

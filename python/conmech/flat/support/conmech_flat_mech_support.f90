@@ -167,7 +167,8 @@ contains
         external :: events, evstore
         optional :: events, evstore
         type(constrained_options) :: opt
-        type(callback_events) :: ev
+        type(callback_events), allocatable :: ev
+        real(dp), allocatable :: te(:)
         integer(c_int) :: nev_fun
         type(constrained_result) :: r
         real(dp), allocatable :: lam(:, :), cm(:, :, :)
@@ -197,15 +198,16 @@ contains
         nev_fun = 0
         if (present(ne)) nev_fun = ne
         if (nev_fun > 0) then
+            allocate (ev)
             ev%g => events
             ev%n = 2*n
             ev%ne = nev_fun
             ev%direction = ev_dir(1:nev_fun)
             ev%terminal = ev_term(1:nev_fun) /= 0
-            call dispatch(ev)
-        else
-            call dispatch()
         end if
+        if (neval > 0) te = t_eval(1:neval)
+        ! the optional arguments once: an unallocated actual argument is an absent one
+        call constrained_solve(sys, t_span, q0, v0, opt, r, te, events=ev)
         info = r%status
         call copy_message(r%message, message)
         stats = [r%nfev, r%naccept, r%nreject, r%nproj, r%proj_iter, r%rank, r%proj_iter_max]
@@ -228,20 +230,6 @@ contains
                                r%res_vel, r%energy, r%power, nn, mm, nt)
         if (nev_fun > 0 .and. r%nev > 0) call evstore(r%ev_t, r%ev_q, r%ev_v, r%ev_id, nn, &
                                                       int(r%nev, c_int))
-
-    contains
-
-        !> constrained_solve (every method), with t_eval if given and the events if present.
-        subroutine dispatch(evs)
-            class(ode_events), intent(in), optional :: evs
-            if (neval > 0) then
-                call constrained_solve(sys, t_span, q0, v0, opt, r, t_eval(1:neval), &
-                                       events=evs)
-            else
-                call constrained_solve(sys, t_span, q0, v0, opt, r, events=evs)
-            end if
-        end subroutine dispatch
-
     end subroutine run_constrained
 
 end module conmech_flat_mech_support

@@ -151,7 +151,8 @@ contains
 
         type(ode_options) :: opt
         type(ode_result) :: res
-        type(callback_events) :: ev
+        type(callback_events), allocatable :: ev
+        real(dp), allocatable :: te(:)
         class(ode_stepper), allocatable :: stp
         character(len=:), allocatable :: msg
         real(c_double) :: empty1(0), empty3(n, 1, 0)
@@ -190,26 +191,17 @@ contains
                                   atol, max_step, 4, opt%first_step, nfev)
         end if
         if (ne > 0) then
+            allocate (ev)
             ev%g => events
             ev%n = n
             ev%ne = ne
             ev%direction = ev_dir(1:ne)
             ev%terminal = ev_term(1:ne) /= 0
             ev%resolution = ev_res(1:ne)
-            if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev, &
-                               stepper=stp)
-            else
-                call ode_solve(sys, t_span, y0, opt, res, events=ev, stepper=stp)
-            end if
-        else
-            if (neval > 0) then
-                call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), &
-                               stepper=stp)
-            else
-                call ode_solve(sys, t_span, y0, opt, res, stepper=stp)
-            end if
         end if
+        if (neval > 0) te = t_eval(1:neval)
+        ! the optional arguments once: an unallocated actual argument is an absent one
+        call ode_solve(sys, t_span, y0, opt, res, t_eval=te, events=ev, stepper=stp)
 
         counts = [nfev + res%stats%nfev, res%stats%njev, res%stats%nlu, res%stats%naccept, &
                   res%stats%nreject]

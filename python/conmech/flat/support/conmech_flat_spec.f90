@@ -3,24 +3,34 @@
 !! A spec is an integer(c_int64_t) array that describes a compiled system (see
 !! conmech/compiled.py, which writes it):
 !!
-!!     spec(1) kind: 0 none (use the built-in `name`), 1 first-order ode, 2 generalized
-!!             coordinates, 3 constrained (excessive coordinates)
+!!     <generated: tools/generate_slots.py spec layout>
+!!     spec(1) kind: 0 none (the built-in `name`), 1 ode, 2 generalized, 3 constrained
 !!     spec(2) n (ode: state dimension; generalized: ndof; constrained: coordinates)
 !!     spec(3) n_hol    spec(4) n_nh    spec(5) rheonomic (0/1)
-!!     spec(6:15) function addresses (0 = absent):
-!!         ode:          6 rhs, 7 jac
-!!         generalized:  6 mass, 7 forces, 8 forces_jac, 9 energy
-!!         constrained:  6 mass, 7 forces, 8 forces_jac, 9 energy, 10 phi, 11 phi_jac,
-!!                       12 phi_t, 13 phi_gamma, 14 nh_matrix, 15 nh_gamma
-!!     spec(16) (optional, generalized) mass_forces: M and Q in one call
-!!     spec(17) (optional, generalized) accel: a = M^-1 Q in one call
-!!     spec(18) (optional, ode) jac_prod: J x for an n x k block x (set_c_jac_prod)
-!!     spec(19:22) (optional, ode) Taylor coefficients (set_c_taylor): taylor, its work
-!!         columns, taylor_var (the variational system), its work columns
-!!     spec(23:26) (optional, ode) the same written out for one order (set_c_taylor_fixed):
-!!         taylor, its order, taylor_var, its order
-!!     spec(27) (optional, constrained) constraint_hessian: d(C^T lam)/dq, d(C v + c0)/dq
-!!     spec(28) (optional, generalized) accel_jac: a and d a/d[q, v] in one call
+!!     spec(6) rhs (ode); mass (generalized/constrained)
+!!     spec(7) jac (ode, optional); forces (generalized/constrained)
+!!     spec(8) forces_jac (generalized/constrained, optional)
+!!     spec(9) energy (generalized/constrained, optional)
+!!     spec(10) phi (constrained, optional)
+!!     spec(11) phi_jac (constrained, optional)
+!!     spec(12) phi_t (constrained, optional)
+!!     spec(13) phi_gamma (constrained, optional)
+!!     spec(14) nh_matrix (constrained, optional)
+!!     spec(15) nh_gamma (constrained, optional)
+!!     spec(16) mass_forces (generalized, optional)
+!!     spec(17) accel (generalized, optional)
+!!     spec(18) jac_prod (ode, optional)
+!!     spec(19) jet (ode, optional)
+!!     spec(20) nw (ode, optional)
+!!     spec(21) var (ode, optional)
+!!     spec(22) nw_var (ode, optional)
+!!     spec(23) jet_fixed (ode, optional)
+!!     spec(24) order (ode, optional)
+!!     spec(25) var_fixed (ode, optional)
+!!     spec(26) order_var (ode, optional)
+!!     spec(27) constraint_hessian (constrained, optional)
+!!     spec(28) accel_jac (generalized, optional)
+!!     </generated>
 !!
 !! Every flat routine that takes a built-in `name` also takes `nspec, spec`: the same
 !! routine then runs built-in and compiled systems alike.
@@ -37,14 +47,24 @@ module conmech_flat_spec
                                 set_c_taylor_fixed
     use conmech_c_mechanics, only: c_generalized_system, c_constrained_system, &
                                    c_mech_pointers, make_c_generalized, make_c_constrained
+    use conmech_c_entries, only: SPEC_KIND_BUILTIN, SPEC_KIND_ODE, SPEC_KIND_GENERALIZED, &
+                                 SPEC_KIND_CONSTRAINED, N_MECH_ENTRIES, MECH_ENTRY_SLOTS, &
+                                 set_mech_entry, SLOT_KIND, SLOT_N, SLOT_N_HOL, SLOT_N_NH, &
+                                 SLOT_RHEONOMIC, SLOT_RHS, SLOT_JAC, SLOT_JAC_PROD, &
+                                 SLOT_TAYLOR_JET, SLOT_TAYLOR_NW, SLOT_TAYLOR_VAR, &
+                                 SLOT_TAYLOR_NW_VAR, SLOT_TAYLOR_JET_FIXED, SLOT_TAYLOR_ORDER, &
+                                 SLOT_TAYLOR_VAR_FIXED, SLOT_TAYLOR_ORDER_VAR, SLOT_NH_GAMMA
     implicit none
     private
     public :: KIND_BUILTIN, KIND_ODE, KIND_GENERALIZED, KIND_CONSTRAINED, SPEC_SIZE
     public :: spec_kind, spec_system, spec_generalized, spec_constrained, spec_dimension
 
-    integer, parameter :: KIND_BUILTIN = 0, KIND_ODE = 1, KIND_GENERALIZED = 2, &
-                          KIND_CONSTRAINED = 3
-    integer, parameter :: SPEC_SIZE = 15
+    integer, parameter :: KIND_BUILTIN = SPEC_KIND_BUILTIN, KIND_ODE = SPEC_KIND_ODE, &
+                          KIND_GENERALIZED = SPEC_KIND_GENERALIZED, &
+                          KIND_CONSTRAINED = SPEC_KIND_CONSTRAINED
+    !> the shortest spec of a compiled system: up to the last function every kind has a
+    !! slot for (later slots are read when the spec is long enough)
+    integer, parameter :: SPEC_SIZE = SLOT_NH_GAMMA
 
 contains
 
@@ -53,7 +73,7 @@ contains
         integer, intent(in) :: nspec
         integer(c_int64_t), intent(in) :: spec(:)
         spec_kind = KIND_BUILTIN
-        if (nspec >= SPEC_SIZE) spec_kind = int(spec(1))
+        if (nspec >= SPEC_SIZE) spec_kind = int(spec(SLOT_KIND))
     end function spec_kind
 
     type(c_funptr) function fptr(addr)
@@ -65,23 +85,15 @@ contains
         end if
     end function fptr
 
+    !> The mechanical entries of a spec (those its length holds; the others null).
     function mech_pointers(spec) result(fp)
         integer(c_int64_t), intent(in) :: spec(:)
         type(c_mech_pointers) :: fp
-        fp%mass = fptr(spec(6))
-        fp%forces = fptr(spec(7))
-        fp%forces_jac = fptr(spec(8))
-        fp%energy = fptr(spec(9))
-        fp%phi = fptr(spec(10))
-        fp%phi_jac = fptr(spec(11))
-        fp%phi_t = fptr(spec(12))
-        fp%phi_gamma = fptr(spec(13))
-        fp%nh_matrix = fptr(spec(14))
-        fp%nh_gamma = fptr(spec(15))
-        if (size(spec) >= 16) fp%mass_forces = fptr(spec(16))
-        if (size(spec) >= 17) fp%accel = fptr(spec(17))
-        if (size(spec) >= 27) fp%constraint_hessian = fptr(spec(27))
-        if (size(spec) >= 28) fp%accel_jac = fptr(spec(28))
+        integer :: k
+        do k = 1, N_MECH_ENTRIES
+            if (size(spec) >= MECH_ENTRY_SLOTS(k)) &
+                call set_mech_entry(fp, k, fptr(spec(MECH_ENTRY_SLOTS(k))))
+        end do
     end function mech_pointers
 
     !> State dimension of the first-order system (built-in by name, or from the spec).
@@ -91,9 +103,9 @@ contains
         integer(c_int64_t), intent(in) :: spec(:)
         select case (spec_kind(nspec, spec))
         case (KIND_ODE)
-            spec_dimension = int(spec(2))
+            spec_dimension = int(spec(SLOT_N))
         case (KIND_GENERALIZED)
-            spec_dimension = 2*int(spec(2))
+            spec_dimension = 2*int(spec(SLOT_N))
         case (KIND_BUILTIN)
             spec_dimension = system_dimension(name)
         case default
@@ -116,14 +128,17 @@ contains
         case (KIND_ODE)
             block
                 type(c_ode_system) :: s
-                call make_c_ode(int(spec(2)), fptr(spec(6)), fptr(spec(7)), params, s, &
-                                info, msg)
-                if (size(spec) >= 18) call set_c_jac_prod(s, fptr(spec(18)))
-                if (size(spec) >= 22) call set_c_taylor(s, fptr(spec(19)), int(spec(20)), &
-                                                        fptr(spec(21)), int(spec(22)))
-                if (size(spec) >= 26) call set_c_taylor_fixed(s, fptr(spec(23)), &
-                                                              int(spec(24)), &
-                                                              fptr(spec(25)), int(spec(26)))
+                call make_c_ode(int(spec(SLOT_N)), fptr(spec(SLOT_RHS)), fptr(spec(SLOT_JAC)), &
+                                params, s, info, msg)
+                if (size(spec) >= SLOT_JAC_PROD) call set_c_jac_prod(s, fptr(spec(SLOT_JAC_PROD)))
+                if (size(spec) >= SLOT_TAYLOR_NW_VAR) &
+                    call set_c_taylor(s, fptr(spec(SLOT_TAYLOR_JET)), int(spec(SLOT_TAYLOR_NW)), &
+                                      fptr(spec(SLOT_TAYLOR_VAR)), int(spec(SLOT_TAYLOR_NW_VAR)))
+                if (size(spec) >= SLOT_TAYLOR_ORDER_VAR) &
+                    call set_c_taylor_fixed(s, fptr(spec(SLOT_TAYLOR_JET_FIXED)), &
+                                            int(spec(SLOT_TAYLOR_ORDER)), &
+                                            fptr(spec(SLOT_TAYLOR_VAR_FIXED)), &
+                                            int(spec(SLOT_TAYLOR_ORDER_VAR)))
                 if (info == CM_SUCCESS) allocate (sys, source=s)
             end block
         case (KIND_GENERALIZED)
@@ -160,8 +175,8 @@ contains
         case (KIND_GENERALIZED)
             block
                 type(c_generalized_system) :: s
-                call make_c_generalized(int(spec(2)), mech_pointers(spec), params, s, info, &
-                                        msg)
+                call make_c_generalized(int(spec(SLOT_N)), mech_pointers(spec), params, s, &
+                                        info, msg)
                 if (info == CM_SUCCESS) allocate (mech, source=s)
             end block
         case default
@@ -185,9 +200,9 @@ contains
         case (KIND_CONSTRAINED)
             block
                 type(c_constrained_system) :: s
-                call make_c_constrained(int(spec(2)), int(spec(3)), int(spec(4)), &
-                                        spec(5) /= 0, mech_pointers(spec), params, s, info, &
-                                        msg)
+                call make_c_constrained(int(spec(SLOT_N)), int(spec(SLOT_N_HOL)), &
+                                        int(spec(SLOT_N_NH)), spec(SLOT_RHEONOMIC) /= 0, &
+                                        mech_pointers(spec), params, s, info, msg)
                 if (info == CM_SUCCESS) allocate (cs, source=s)
             end block
         case default

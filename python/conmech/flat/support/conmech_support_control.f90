@@ -30,7 +30,7 @@ module conmech_support_control
     implicit none
     private
     public :: callback_law, c_law, zero_law, build_plant, build_vhc, build_law, law_rsize
-    public :: project_states
+    public :: project_states, build_plant_law
 
     !> u from an external procedure law(t, x, u, n, m).
     type, extends(feedback_law) :: callback_law
@@ -130,6 +130,27 @@ contains
         info = CM_SUCCESS
         msg = "success"
     end subroutine build_plant
+
+    !> The plant and the feedback law of one flat control argument set (the plant by
+    !! build_plant, the law by build_law): info and msg of the first that fails.
+    subroutine build_plant_law(name, params, nspec, spec, nd, m, bmat, baddr, bpar, ilaw, &
+                               rlaw, nrl, pylaw, n, plant, law, info, msg)
+        character(len=*), intent(in) :: name
+        real(dp), intent(in) :: params(:), bmat(:, :), bpar(:)
+        integer, intent(in) :: nspec, nd, m
+        integer(c_int64_t), intent(in) :: spec(:), baddr
+        integer(c_int64_t), intent(in) :: ilaw(:)
+        real(dp), intent(in) :: rlaw(:)
+        integer, intent(in) :: nrl, n
+        external :: pylaw
+        type(mech_plant), intent(out) :: plant
+        class(feedback_law), allocatable, intent(out) :: law
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        call build_plant(name, params, nspec, spec, nd, m, bmat, baddr, bpar, plant, info, msg)
+        if (info /= CM_SUCCESS) return
+        call build_law(ilaw, rlaw, nrl, pylaw, plant, n, law, info, msg)
+    end subroutine build_plant_law
 
     !> The virtual constraint of a kind-3 law (ilaw(3:5), rlaw from its start).
     subroutine build_vhc(ilaw, rlaw, n, con, used)

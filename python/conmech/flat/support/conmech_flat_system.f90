@@ -1,0 +1,143 @@
+!> The one system argument set of the flat layer: every flat routine that runs on a
+!! first-order system takes
+!!
+!!     name, np, params, nspec, spec, fun, jfun, source
+!!
+!! and hands them to `flat_system`, which builds the `ode_system` once:
+!!
+!!     source = SOURCE_SPEC     a built-in system by `name` or a compiled one from `spec`
+!!                              (conmech_flat_spec); `fun` and `jfun` are never called
+!!     source = SOURCE_FUN      a Python right-hand side fun(t, y, dydt, n), Jacobian by
+!!                              finite differences; `jfun` is never called
+!!     source = SOURCE_FUN_JAC  fun and its exact Jacobian jfun(t, y, dfdy, n)
+!!
+!! The routines that continue in a parameter take the parametric set
+!!
+!!     name, np, params, nspec, spec, ip, fun, jfun, source, p0
+!!
+!! (`flat_param_system`): the built-in or compiled system continued in params(ip), or
+!! fun(t, y, p, dydt, n) with jfun(t, y, p, dfdy, n) at the parameter value p0.
+!!
+!! f2py has no optional call-back argument (an omitted one is looked up as a module
+!! attribute and fails), so the Python side always passes two callables and says with
+!! `source` which of them are real; the placeholders cost one argument conversion per call,
+!! never a call.
+module conmech_flat_system
+    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+    use conmech_kinds, only: dp
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_ode_system, only: ode_system
+    use conmech_flat_spec, only: spec_system
+    use conmech_flat_ode_support, only: callback_system, callback_jac_system
+    use conmech_flat_spec, only: spec_kind, KIND_BUILTIN
+    use conmech_param_system, only: builtin_param_system, make_param_system, &
+                                    make_compiled_param_system
+    use conmech_support_cont, only: callback_param_system, callback_param_jac_system
+    implicit none
+    private
+    public :: flat_system, flat_param_system, SOURCE_SPEC, SOURCE_FUN, SOURCE_FUN_JAC
+
+    integer(c_int), parameter :: SOURCE_SPEC = 0, SOURCE_FUN = 1, SOURCE_FUN_JAC = 2
+
+contains
+
+    !> The first-order system of dimension n described by one flat argument set (above).
+    subroutine flat_system(name, params, nspec, spec, fun, jfun, source, n, sys, info, msg)
+        character(len=*), intent(in) :: name
+        real(dp), intent(in) :: params(:)
+        integer, intent(in) :: nspec
+        integer(c_int64_t), intent(in) :: spec(:)
+        procedure() :: fun, jfun
+        integer(c_int), intent(in) :: source, n
+        class(ode_system), allocatable, intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = 0
+        msg = "success"
+        select case (source)
+        case (SOURCE_SPEC)
+            call spec_system(name, params, nspec, spec, sys, info, msg)
+        case (SOURCE_FUN)
+            block
+                type(callback_system) :: s
+                s%f => fun
+                s%n = n
+                allocate (sys, source=s)
+            end block
+        case (SOURCE_FUN_JAC)
+            block
+                type(callback_jac_system) :: s
+                s%f => fun
+                s%jac => jfun
+                s%n = n
+                allocate (sys, source=s)
+            end block
+        case default
+            info = CM_BAD_INPUT
+            msg = "bad input: unknown system source"
+        end select
+    end subroutine flat_system
+
+    !> The system of the parametric flat argument set (above) and the parameter value it
+    !! starts from (params(ip), or p0 for Python functions). ip < 0 with a built-in or
+    !! compiled system: the system itself, with no parameter (p_start = p0).
+    subroutine flat_param_system(name, params, nspec, spec, ip, fun, jfun, source, n, p0, &
+                                 sys, p_start, info, msg)
+        character(len=*), intent(in) :: name
+        real(dp), intent(in) :: params(:)
+        integer, intent(in) :: nspec
+        integer(c_int64_t), intent(in) :: spec(:)
+        integer(c_int), intent(in) :: ip, source, n
+        procedure() :: fun, jfun
+        real(dp), intent(in) :: p0
+        class(ode_system), allocatable, intent(out) :: sys
+        real(dp), intent(out) :: p_start
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = 0
+        msg = "success"
+        p_start = p0
+        select case (source)
+        case (SOURCE_SPEC)
+            if (ip < 0) then
+                call spec_system(name, params, nspec, spec, sys, info, msg)
+                return
+            end if
+            block
+                type(builtin_param_system) :: b
+                class(ode_system), allocatable :: inner
+                if (spec_kind(nspec, spec) == KIND_BUILTIN) then
+                    call make_param_system(name, params, ip, b, info, msg)
+                else
+                    call spec_system(name, params, nspec, spec, inner, info, msg)
+                    if (info == 0) call make_compiled_param_system(inner, params, ip, b, &
+                                                                   info, msg)
+                end if
+                if (info /= 0) return
+                if (size(params) > 0) p_start = params(max(ip, 1))
+                allocate (sys, source=b)
+            end block
+        case (SOURCE_FUN)
+            block
+                type(callback_param_system) :: s
+                s%f => fun
+                s%n = n
+                s%p = p0
+                allocate (sys, source=s)
+            end block
+        case (SOURCE_FUN_JAC)
+            block
+                type(callback_param_jac_system) :: s
+                s%f => fun
+                s%jf => jfun
+                s%n = n
+                s%p = p0
+                allocate (sys, source=s)
+            end block
+        case default
+            info = CM_BAD_INPUT
+            msg = "bad input: unknown system source"
+        end select
+    end subroutine flat_param_system
+
+end module conmech_flat_system
