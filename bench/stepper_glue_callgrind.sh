@@ -24,8 +24,8 @@ run() {  # run K -> "total fortran"
         >/dev/null 2>&1
     local tot fort
     tot=$(grep -E '^(summary|totals):' "$tmp/cg.$1" | head -1 | awk '{print $2}')
-    fort=$(callgrind_annotate --inclusive=yes "$tmp/cg.$1" 2>/dev/null \
-        | grep -m1 'flat_stepper_builtin_ ' | awk '{gsub(",", "", $1); print $1}')
+    fort=$(callgrind_annotate --inclusive=yes --threshold=100 "$tmp/cg.$1" 2>/dev/null \
+        | grep -m1 'flat_stepper_builtin_ ' | awk '{gsub(",", "", $1); print $1}' || true)
     echo "$tot ${fort:-0}"
 }
 read -r t1 f1 < <(run "$k1")
