@@ -25,7 +25,7 @@ run() {  # run K -> "total fortran"
     local tot fort
     tot=$(grep -E '^(summary|totals):' "$tmp/cg.$1" | head -1 | awk '{print $2}')
     # the step routine: flat_stepper_step_builtin (or flat_stepper_builtin, older builds)
-    fort=$(callgrind_annotate --inclusive=yes "$tmp/cg.$1" 2>/dev/null \
+    fort=$(callgrind_annotate --inclusive=yes --threshold=100 "$tmp/cg.$1" 2>/dev/null \
         | grep -m1 -E 'flat_stepper_(step_)?builtin_ ' | awk '{gsub(",", "", $1); print $1}' \
         || true)
     echo "$tot ${fort:-0}"
