@@ -1,4 +1,4 @@
-/* Test systems with conmech's C signatures (python/conmech/compiled.py). */
+/* Test systems with conmech's C signatures (python/conmech/mechanics/compiled.py). */
 #include <math.h>
 
 /* Kepler, y = [x, y, vx, vy], p = [mu] */
