@@ -44,9 +44,6 @@ __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
 C_HILL = 1.0715832774160     #: Hill's perigee constant for M_HILL
 
-_NOT_PERIODIC = -7     #: family status: Newton stopped on a state that is not periodic
-
-
 #: An orbit is accepted only if its true residual max(|x(pi/2)|, |y'(pi/2)|), from an
 #: independent adaptive integration (DOP853, tolerance 1e-12), is below this.
 RESIDUAL_TOL = 1e-8
