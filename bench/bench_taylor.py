@@ -183,8 +183,9 @@ def breakdown(rounds, path):
     DOP853, the flat Fortran call alone (system built from its spec, integration, result
     arrays handed back: no Python around it), solve_ivp over a tiny span (its per-call
     cost) and heyoka's propagate_until, interleaved in one process (min over rounds)."""
-    from conmech import _conmech, _ivp
-    from conmech._taylor import with_fixed_order
+    from conmech import _conmech
+    from conmech.ivp import solve as _ivp
+    from conmech.ivp.taylor import with_fixed_order
     pr = problems()["kepler"]
     kep = symbolic.ode_system(pr["f"], pr["y"])
     y0 = np.array(pr["y0"], dtype=float)

@@ -21,7 +21,7 @@ PY="${PYTHON:-python3}"
 "$PY" - "$TOL" >"$tmp/fixed_source.f90" <<'PYEOF'
 import sys, sympy as sp
 from conmech import symbolic
-from conmech._taylor import taylor_order
+from conmech.ivp.taylor import taylor_order
 from conmech.symbolic import model_of
 from conmech.symbolic.taylor import fixed_order_source
 x, y, u, v = sp.symbols("x y u v")
@@ -30,7 +30,7 @@ kep = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
 print(fixed_order_source(model_of(kep).derived, taylor_order(float(sys.argv[1])),
                          variational=False))
 PYEOF
-order=$("$PY" -c "from conmech._taylor import taylor_order; print(taylor_order($TOL))")
+order=$("$PY" -c "from conmech.ivp.taylor import taylor_order; print(taylor_order($TOL))")
 sed "s/FIXED_ORDER_VALUE/$order/" bench/taylor_callgrind/kepler_fixed_jet.f90 >"$tmp/kepler_fixed_jet.f90"
 gfortran $FF -I"$tmp/cm/include" -J "$tmp" test/taylor_kepler_model.f90 "$tmp/fixed_source.f90" \
     "$tmp/kepler_fixed_jet.f90" bench/taylor_callgrind/bench_taylor.f90 -L"$libdir" -lconmech \

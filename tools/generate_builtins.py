@@ -15,9 +15,10 @@ included, the registries are written: the parameter table (conmech_systems_param
 names, defaults), make_system and system_dimension (conmech_systems), make_generalized,
 make_constrained and the default initial states (conmech_systems_mech), the modules that
 gather the types (conmech_systems_basic, _generalized, _constrained), and the Python side
-(python/conmech/_builtin_table.py: parameters, validity, state names; systems.py: one
-factory per system). The output is deterministic; python/tests/test_builtin_systems.py
-regenerates it into a temporary folder and compares byte for byte.
+(python/conmech/_core/builtin_table.py: parameters, validity, state names;
+python/conmech/mechanics/systems.py: one factory per system). The output is deterministic;
+python/tests/test_builtin_systems.py regenerates it into a temporary folder and compares
+byte for byte.
 """
 import argparse
 import difflib
@@ -1042,8 +1043,8 @@ def systems_py(models):
            "tools/generate_builtins.py", "derives its Fortran and writes the registries and "
            "this module (see the guide's page", '"Adding a built-in system").', ""]
     out += textwrap.wrap(PY_NOTE, 92) + ['"""']
-    out += ["from ._builtin_table import POSITIVE_PARAMS, RANGE_PARAMS, STATE_NAMES  "
-            "# noqa: F401", "from ._native import _NO_SPEC, BuiltinSystem, NativeSystem, "
+    out += ["from .._core.builtin_table import POSITIVE_PARAMS, RANGE_PARAMS, STATE_NAMES  "
+            "# noqa: F401", "from .._core.native import _NO_SPEC, BuiltinSystem, NativeSystem, "
             "check_params  # noqa: F401", "from .constrained import BuiltinConstrained", ""]
     names = ["NativeSystem", "BuiltinSystem"] + [m.name for m in allm]
     out += wrap_py("__all__ = [" + ", ".join(pq(n) for n in names) + "]", "")
@@ -1073,8 +1074,8 @@ def generate(models=None):
     files["src/systems/conmech_systems_params.f90"] = params_module(models)
     (files["src/systems/conmech_systems.f90"],
      files["src/systems/conmech_systems_mech.f90"]) = registry_modules(models)
-    files["python/conmech/_builtin_table.py"] = table_module(models)
-    files["python/conmech/systems.py"] = systems_py(models)
+    files["python/conmech/_core/builtin_table.py"] = table_module(models)
+    files["python/conmech/mechanics/systems.py"] = systems_py(models)
     return files
 
 

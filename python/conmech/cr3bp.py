@@ -31,12 +31,13 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 import numpy as np
 
 from . import _conmech
-from . import systems as _systems
-from ._ivp import solve_ivp
+from .mechanics import systems as _systems
+from .ivp.solve import solve_ivp
 from .stability import lyapunov_family as _lyapunov_family
 from .stability import normal_modes, stm, switch_branch_point, symmetric_orbit
 from .stability.continuation import Branch, SpecialPoint
-from .stability._validate import _real
+from ._core.validate import _real
+from ._core.result import Record
 
 __all__ = ["MU_EARTH_MOON", "LibrationPoints", "libration_points", "jacobi",
            "lyapunov_family", "HaloBifurcation", "halo_bifurcation", "halo_family",
@@ -131,7 +132,7 @@ def lyapunov_family(mu: float = MU_EARTH_MOON, point: str = "L1", kind: str = "p
     return _lyapunov_family(sysm, y_eq, mode=_mode_of(sysm, y_eq, kind), **options)
 
 
-class HaloBifurcation:
+class HaloBifurcation(Record):
     """The halo bifurcation orbit of a planar Lyapunov family (:func:`halo_bifurcation`):
     jacobi (its Jacobi constant C), period, y0 (its state at the x-axis crossing, [x0, 0,
     0, 0, vy, 0]), x0, vertical (y1'(T/2), the test: 0 there), half_trace (of the vertical
@@ -140,10 +141,6 @@ class HaloBifurcation:
 
     __slots__ = ("jacobi", "period", "y0", "x0", "vertical", "half_trace", "residual",
                  "located", "iterations", "mu", "point")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         return (f"HaloBifurcation({self.point}, jacobi={self.jacobi!r}, period="

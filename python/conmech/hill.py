@@ -1,7 +1,7 @@
 """Hill's lunar problem: the variation orbit, its monodromy and the perigee constant.
 
-Hill's equations (seed 000), in the frame rotating with the Sun, time scaled so that the
-synodic month is 2 pi::
+Hill's equations, as in the lecture notes: in the frame rotating with the Sun, time scaled so
+that the synodic month is 2 pi::
 
     x'' - 2 m y' = dF/dx,   y'' + 2 m x' = dF/dy,   F = kappa/r + (3/2) m^2 x^2
 
@@ -30,10 +30,11 @@ import math
 import numpy as np
 
 from . import _conmech
-from ._callback import message_text
 from .stability.continuation import SpecialKind
 from .stability.variational import stm as _stm
-from .systems import hill_spatial as _hill_spatial
+from .mechanics.systems import hill_spatial as _hill_spatial
+from ._core.result import StatusRecord
+from ._core.status import raise_status
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
            "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
@@ -43,18 +44,9 @@ __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
 M_HILL = 0.080848933808312   #: Hill's (1877) value of m = n'/(n - n')
 C_HILL = 1.0715832774160     #: Hill's perigee constant for M_HILL
 
-_NOT_PERIODIC = -7     #: family status: Newton stopped on a state that is not periodic
-_STATUS = {0: "success", -4: "bad input", -5: "singular Newton matrix",
-           -6: "Newton did not converge", _NOT_PERIODIC: "true residual above RESIDUAL_TOL"}
-
-
 #: An orbit is accepted only if its true residual max(|x(pi/2)|, |y'(pi/2)|), from an
 #: independent adaptive integration (DOP853, tolerance 1e-12), is below this.
 RESIDUAL_TOL = 1e-8
-
-
-def _msg(message):
-    return message_text(message)
 
 
 def _true_residuals(ms, kappa, y0s):
@@ -205,10 +197,7 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
      res, scale, finite, info, message) = _conmech.flat_hill_orbit_checked(
         m, kappa, nsteps, 1 if full_period else 0, use, g, closure_tol, max_nsteps)
     if info != 0:
-        msg = _msg(message) or _STATUS.get(int(info), "failure")
-        if info == -4:
-            raise ValueError(msg)
-        raise RuntimeError(msg)
+        raise_status(info, message)
     if not res <= RESIDUAL_TOL*scale:
         raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
                            f"periodic to the tolerance (true residual {res:.3g} > "
@@ -225,7 +214,7 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
 _NO_GUESS = np.zeros(2)
 
 
-class HillFamily:
+class HillFamily(StatusRecord):
     """The family of variation orbits over m (arrays indexed like ``ms``).
 
     Attributes: ms, y0 (n, 4), jacobi, monodromy (n, 4, 4), stability_index, c (nan past
@@ -239,14 +228,6 @@ class HillFamily:
 
     __slots__ = ("ms", "kappa", "y0", "jacobi", "monodromy", "stability_index", "c",
                  "residual", "quarter_state", "nsteps", "status", "iterations", "special")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
-    @property
-    def success(self):
-        return self.status == 0
 
     def __len__(self):
         return len(self.ms)
@@ -273,10 +254,7 @@ def _locate(ma, ya, mb, yb, kappa, target, mtol):
         float(ma), np.array([ya[0], ya[3]]), float(mb), np.array([yb[0], yb[3]]), kappa,
         float(target), float(mtol))
     if info != 0:
-        msg = _msg(message)
-        if info == -4:
-            raise ValueError(msg)
-        raise RuntimeError(msg)
+        raise_status(info, message)
     return {"m": float(m_star), "y0": np.array([u[0], 0.0, 0.0, u[1]]),
             "stability_index": float(s), "c": float(c), "residual": float(res)}
 
@@ -338,8 +316,8 @@ def family(ms: ArrayLike, kappa: float = 1.0, nsteps: int = 0, chunk_size: int =
 
 
 def transverse(orbit: HillOrbit, t: ArrayLike | None = None, rtol: float = 1e-13) -> dict:
-    """Transverse linearisation along a variation orbit (seed 000): the normal deviation N
-    obeys Hill's equation N'' + Phi(t) N = 0,
+    """Transverse linearisation along a variation orbit (as in the lecture notes): the normal
+    deviation N obeys Hill's equation N'' + Phi(t) N = 0,
     Phi = 3 (omega + m)^2 + m^2 - n^T H n, omega = n . grad F/|v| - 2 m.
 
     Returns a dict: monodromy (2, 2) over 2 pi, half_trace (= the orbit's stability_index),
@@ -356,7 +334,7 @@ def transverse(orbit: HillOrbit, t: ArrayLike | None = None, rtol: float = 1e-13
     states, phi, mono2, ht, c, info, message = _conmech.flat_hill_transverse(
         orbit.m, orbit.kappa, orbit.y0, float(rtol), tt)
     if info != 0:
-        raise RuntimeError(_msg(message))
+        raise_status(info, message)
     out = {"monodromy": np.array(mono2), "half_trace": float(ht), "c": float(c)}
     if t is not None:
         out["states"] = np.array(states)

@@ -1,4 +1,4 @@
-"""Families of symmetric periodic orbits of Hill's problem in Hénon's units (issue 9).
+"""Families of symmetric periodic orbits of Hill's problem in Hénon's units.
 
 Hénon (1969, "Numerical exploration of the restricted problem. V. Hill's case: periodic
 orbits and their stability", A&A 1, 223) writes Hill's problem without parameters,
@@ -31,7 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import stability, systems
+from . import stability
+from .ivp.solve import solve_ivp
+from .mechanics import systems
 
 __all__ = ["system", "gamma", "X_L1", "GAMMA_L", "PERIOD_L", "lyapunov_orbit",
            "satellite_orbit", "family", "on_axis", "orbit_at_gamma"]
@@ -121,7 +123,6 @@ def on_axis(y0, period: float, rtol: float = 1e-12, side: int = 1) -> np.ndarray
     farthest to the right (``side`` = +1) or to the left (-1) (for an orbit symmetric about
     the axis x' = 0 there), from an integration over a period and a quarter (so that a
     crossing at the start or the end of the period is not missed) with an event on y."""
-    from ._ivp import solve_ivp
     y0 = stability._state(y0)
     if y0.size != 4:
         raise ValueError("y0 must be [x, y, x', y']")

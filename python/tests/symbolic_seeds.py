@@ -33,7 +33,7 @@ def pendulum_angle():
 def cart_pendulum():
     x, th = dynamicsymbols("x theta")
     M, m, l, g = _syms("M m l g")
-    # seed 000: theta from the upward vertical, bob at (x + l sin th, l cos th)
+    # theta from the upward vertical, bob at (x + l sin th, l cos th)
     xb, yb = x + l*sp.sin(th), l*sp.cos(th)
     T = M*D(x)**2/2 + m*(D(xb)**2 + D(yb)**2)/2
     U = m*g*yb
@@ -53,7 +53,7 @@ def double_pendulum():
 def atwood():
     y1 = dynamicsymbols("y1")
     m1, m2, g, L = _syms("m1 m2 g L")
-    # seed 001: y measured downward, y2 = L - y1
+    # y measured downward, y2 = L - y1
     y2 = L - y1
     T = (m1*D(y1)**2 + m2*D(y2)**2)/2
     U = -m1*g*y1 - m2*g*y2
@@ -94,7 +94,7 @@ def three_springs():
 def bead_hoop():
     th = dynamicsymbols("theta")
     m, R, w, g = _syms("m R omega g")
-    # seed 001: hoop spinning at omega about the vertical, bead at angle th from the bottom
+    # hoop spinning at omega about the vertical, bead at angle th from the bottom
     T = m*(R**2*D(th)**2 + w**2*R**2*sp.sin(th)**2)/2
     U = -m*g*R*sp.cos(th)
     return T - U, [th]
@@ -167,7 +167,7 @@ def rod_two_masses():
     g, l = _syms("g l")
     T = (D(x1)**2 + D(y1)**2 + D(x2)**2 + D(y2)**2)/2     # unit masses
     U = g*(y1 + y2)
-    # seed 000: the velocity of the rod's centre stays along the rod
+    # the velocity of the rod's centre stays along the rod
     nh = (x2 - x1)*(D(y1) + D(y2)) - (y2 - y1)*(D(x1) + D(x2))
     return dict(T=T, U=U, q=[x1, y1, x2, y2],
                 holonomic=[((x2 - x1)**2 + (y2 - y1)**2 - l**2)/2], nonholonomic=[nh])

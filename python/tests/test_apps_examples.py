@@ -1,6 +1,6 @@
 """Every example in example/ runs once (`fpm run --example NAME`) and says what it should.
 
-The examples are what a newcomer reads first; CI runs each of them (issue 12, item 7).
+The examples are what a newcomer reads first; CI runs each of them.
 Examples added later are picked up by name and checked to run cleanly; the ones known here
 are also checked against a published or closed-form value.
 """

@@ -1,4 +1,4 @@
-"""Branch switching at a branch point and Neimark-Sacker points from Python (issue 9).
+"""Branch switching at a branch point and Neimark-Sacker points from Python.
 
 Closed forms by construction (normal forms on the cycle x = cos t, y = sin t, period
 2 pi, multipliers known exactly): Kuznetsov, Elements of Applied Bifurcation Theory

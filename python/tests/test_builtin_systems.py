@@ -149,7 +149,7 @@ def test_capabilities_follow_the_models():
 
 
 def test_python_table_and_factories():
-    from conmech import _builtin_table as table
+    from conmech._core import builtin_table as table
     assert list(table.PARAMS) == list(table.KINDS)
     for name, params in table.PARAMS.items():
         factory = getattr(systems, name)
@@ -241,9 +241,11 @@ def test_a_system_added_through_the_generator_builds_and_runs(tmp_path):
     models = generator.bm.load_all()
     models["generalized"].append(toy)
     files = generator.generate(models)
-    assert "def bead_parabola(m=1.0, g=9.81, c=2.0):" in files["python/conmech/systems.py"]
-    compile(files["python/conmech/systems.py"], "systems.py", "exec")
-    assert '"bead_parabola": {0: "m", 2: "c"}' in files["python/conmech/_builtin_table.py"]
+    systems_py = files["python/conmech/mechanics/systems.py"]
+    assert "def bead_parabola(m=1.0, g=9.81, c=2.0):" in systems_py
+    compile(files["python/conmech/mechanics/systems.py"], "systems.py", "exec")
+    table_py = files["python/conmech/_core/builtin_table.py"]
+    assert '"bead_parabola": {0: "m", 2: "c"}' in table_py
     proj = tmp_path / "proj"
     shutil.copytree(ROOT / "src", proj / "src")
     for rel, text in files.items():

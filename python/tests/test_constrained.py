@@ -198,7 +198,8 @@ def test_plot_helpers(tmp_path):
 
 def test_generalized_seed_systems_in_solve_ivp():
     """The generalized seed systems are compiled built-ins of solve_ivp: the cart pendulum
-    conserves P = 2 x' + cos(th) th' and follows x(t) = -sin(th)/2 + C0 + C1 t (seed 000)."""
+    conserves P = 2 x' + cos(th) th' and follows x(t) = -sin(th)/2 + C0 + C1 t (as in the
+    lecture notes)."""
     from conmech import systems
     y0 = [0.3, 2.5, 0.4, 1.0]
     t = np.linspace(0, 5, 51)

@@ -1,4 +1,4 @@
-"""Equilibria of constrained systems on their constraint manifold (issue 9): Newton on
+"""Equilibria of constrained systems on their constraint manifold: Newton on
 Q(q, 0) + G^T lambda = 0, phi(q) = 0; classification by the reduced linearisation on the
 tangent space; Lagrange-Dirichlet from the potential restricted to the manifold."""
 import numpy as np
@@ -57,7 +57,7 @@ def _hoop(W, g=9.81, R=0.5, m=1.0):
 
 
 def test_bead_on_spinning_hoop_against_closed_forms():
-    """REFERENCE.md (seed 001): the off-axis equilibria cos th* = g/(R W^2) exist when
+    """The lecture notes: the off-axis equilibria cos th* = g/(R W^2) exist when
     W^2 > g/R and oscillate at W sin th*; the bottom is stable iff W^2 < g/R (then with
     the frequency sqrt(g/R - W^2))."""
     g, R = 9.81, 0.5

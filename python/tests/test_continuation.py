@@ -1,4 +1,4 @@
-"""Pseudo-arclength continuation of periodic orbits and their special points (issue 9).
+"""Pseudo-arclength continuation of periodic orbits and their special points.
 
 The period-doubling, branch-point and Neimark-Sacker points against closed forms are
 tested in Fortran (test/test_continuation.f90, a 7-dimensional normal form); here the

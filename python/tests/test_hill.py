@@ -149,7 +149,7 @@ def test_equilibria():
     e = stability.equilibrium(systems.pendulum(g=g), [np.pi, 0])
     assert e.kind == "unstable" and e.saddle
 
-    def cart(t, y):   # reduced cart-pendulum dynamics (seed 000)
+    def cart(t, y):   # reduced cart-pendulum dynamics (the lecture notes)
         th, w = y
         return [w, (g*np.sin(th) - 0.5*np.cos(th)*np.sin(th)*w**2)/(1 - 0.5*np.cos(th)**2)]
     up = stability.equilibrium(cart, [0, 0])
@@ -262,7 +262,7 @@ def test_family_threads_give_the_same_orbits():
     assert np.array_equal(out["1"], out["2"])
 
 
-# ------------------------------------------------ honest accuracy along the family (issue 9)
+# ------------------------------------------------ honest accuracy along the family
 
 def _true_closure(m, y0):
     """Independent check: the closure |(x, y')(T/4)| by conmech's adaptive Verner 9(8) at

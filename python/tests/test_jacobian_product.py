@@ -1,4 +1,4 @@
-"""The built-ins' structure-aware Jacobian products (issue 10) seen from Python: the STM
+"""The built-ins' structure-aware Jacobian products seen from Python: the STM
 of the built-in Arenstorf and Hill systems (integrate_stm through their own J x) agrees
 with the 20 variational equations written out in NumPy and integrated as a plain system
 (an independent path). Arenstorf's built-in used a finite-difference J before (~1.5e-6)."""

@@ -1,7 +1,7 @@
-"""Hamilton's principle along computed motions (seed 001): the action S = integral of L dt
-by quadrature on the dense output, its first variation (zero on a motion, for variations
-with fixed ends), its second variation (closed forms for the harmonic oscillator; the sign
-change at the conjugate point T = pi/omega)."""
+"""Hamilton's principle along computed motions (the lecture notes): the action
+S = integral of L dt by quadrature on the dense output, its first variation (zero on a
+motion, for variations with fixed ends), its second variation (closed forms for the
+harmonic oscillator; the sign change at the conjugate point T = pi/omega)."""
 import numpy as np
 import pytest
 import sympy as sp

@@ -1,6 +1,6 @@
-"""D'Alembert's route (seed 002): positions u_k(q, t), applied forces X_k, the equations
-sum (m u'' - X) . du/dq_s = 0 and the generalized forces Q_s = sum X . du/dq_s; the notes'
-pendulum and double pendulum reproduce the Lagrangian route; non-conservative and
+"""D'Alembert's route (the lecture notes): positions u_k(q, t), applied forces X_k, the
+equations sum (m u'' - X) . du/dq_s = 0 and the generalized forces Q_s = sum X . du/dq_s;
+the notes' pendulum and double pendulum reproduce the Lagrangian route; non-conservative and
 time-dependent Cartesian forces; a planar body; the degrees of freedom n = 3N - R of every
 built-in constrained system."""
 import numpy as np
@@ -147,8 +147,8 @@ def test_rank_deficient_mapping():
 # --------------------------------------------------------------- degrees of freedom
 
 #: (dof, velocity dof) of every built-in constrained system: coordinates minus independent
-#: holonomic constraints; Pfaffian constraints reduce only the velocities (seed 002; the
-#: rubber ball's 2 = seed 001's count of its independent motions)
+#: holonomic constraints; Pfaffian constraints reduce only the velocities (the rubber
+#: ball's 2 is the lecture notes' count of its independent motions)
 BUILTIN_DOF = {"pendulum_xy": (1, 1), "rod_two_masses": (3, 2), "double_pendulum_xy": (2, 2),
                "atwood_xy": (1, 1), "pendulum_moving_xy": (1, 1), "yoyo": (1, 1),
                "skate": (3, 2), "rolling_disk": (4, 2), "rolling_ball": (5, 2)}

@@ -1,4 +1,4 @@
-"""Equilibria with Jordan structure and in families (seed 000's cart pendulum: lines of
+"""Equilibria with Jordan structure and in families (the lecture notes' cart pendulum: lines of
 equilibria in x; 'any of the downward equilibria is unstable as well' because x drifts,
 while the reduced dynamics has a centre at theta = pi)."""
 import numpy as np

@@ -1,6 +1,6 @@
 """Generalized momenta, generalized forces, cyclic coordinates and first integrals of
-symbolic Lagrangian systems, against the lecture notes' closed forms (seed 000: the cart
-pendulum's P = 2 x' + cos(theta) theta' and energy; seed 001: the free particle's p_x, p_y,
+symbolic Lagrangian systems, against the lecture notes' closed forms (the cart
+pendulum's P = 2 x' + cos(theta) theta' and energy; the free particle's p_x, p_y,
 the polar particle's angular momentum m r^2 theta' and radial force, the bead on the hoop's
 Jacobi integral)."""
 import numpy as np

@@ -1,8 +1,8 @@
 """Routh reduction against the lecture notes' closed forms: the cart pendulum's reduced
 dynamics (1 - cos^2/2) theta'' + cos sin theta'^2/2 - g sin = 0, its integral E_red, its
 linearisations z'' -+ 2 g z = 0, the reconstruction x(t) = -1/2 sin theta + C0 + C1 t
-(seed 000); the bead on a freely spinning hoop, whose reduced (amended) potential has the
-notes' stationary point cos(theta) = g/(R Omega^2) (seed 001)."""
+(the lecture notes); the bead on a freely spinning hoop, whose reduced (amended)
+potential has the notes' stationary point cos(theta) = g/(R Omega^2)."""
 import numpy as np
 import pytest
 import sympy as sp

@@ -49,7 +49,7 @@ def test_pendulum_exact():
 
 
 def test_pendulum_seed_form_with_dt():
-    """u_x du_x + (u_y - L) du_y + 0 dt (seed 002): exact, integral the circle."""
+    """u_x du_x + (u_y - L) du_y + 0 dt (the lecture notes): exact, integral the circle."""
     ux, uy, L = sp.symbols("u_x u_y L", real=True)
     coeffs = [ux, uy - L, 0]
     res = pfaffian(coeffs, [ux, uy, t])
@@ -148,7 +148,7 @@ def test_three_variables_common_factor():
 
 
 def test_rheonomic_yoyo_constraint_with_dt():
-    """du + r dtheta - (vh + ah t) dt = 0 (seed 002's yo-yo, linear in u): exact."""
+    """du + r dtheta - (vh + ah t) dt = 0 (the lecture notes' yo-yo, linear in u): exact."""
     u, th, r, vh, ah = sp.symbols("u theta r v_h a_h", real=True)
     coeffs = [1, r, -(vh + ah * t)]
     res = pfaffian(coeffs, [u, th, t])

@@ -1,4 +1,4 @@
-"""Reliability (issue 13): no wrong result called success, every input validated, callbacks
+"""Reliability: no wrong result called success, every input validated, callbacks
 of every kind handled alike (exception re-raised unchanged, no leak, clean messages).
 
 The 13 cases of the issue are named regression tests here (test_case_*)."""
@@ -13,7 +13,7 @@ import pytest
 
 import conmech
 from conmech import constrained, hill, stability, systems
-from conmech._callback import Guard, as_result, message_text
+from conmech._core.callback import Guard, as_result, message_text
 
 G = 9.81
 

@@ -34,7 +34,7 @@ sp = pytest.importorskip("sympy")
 
 import symbolic_seeds as seeds  # noqa: E402
 from conmech import compiled, symbolic  # noqa: E402
-from conmech._elf import LibraryError, check_library  # noqa: E402
+from conmech._core.elf import LibraryError, check_library  # noqa: E402
 from conmech.symbolic import build  # noqa: E402
 from conmech.symbolic.codegen import (check_source, comment_text, generate,  # noqa: E402
                                       private_procedures)
@@ -347,7 +347,7 @@ def test_save_model_leaves_no_partial_file(tmp_path, monkeypatch, model_lib):
     def boom(src, dst, *a, **k):
         dst.write(b"partial")
         raise OSError(errno.ENOSPC, "No space left on device")
-    monkeypatch.setattr(symbolic.shutil, "copyfileobj", boom)
+    monkeypatch.setattr(symbolic.pipeline.shutil, "copyfileobj", boom)
     with pytest.raises(OSError, match="cannot write the model library .*No space left"):
         symbolic.save_model(sys_, out / "m.so")
     assert os.listdir(out) == []

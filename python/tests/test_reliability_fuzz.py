@@ -1,4 +1,4 @@
-"""Fuzzing the Python API with hypothesis (issue 13): >= 1,000 bad inputs in total,
+"""Fuzzing the Python API with hypothesis: >= 1,000 bad inputs in total,
 deterministic (derandomize=True, no example database), bounded, a few seconds.
 
 The property everywhere: a call either raises a clean exception (ValueError, TypeError or
@@ -438,7 +438,7 @@ def _corruptions(data, rng, n):
 def test_fuzz_damaged_model_libraries_are_refused(good_library, tmp_path):
     """200 damaged copies: the Python check refuses every one (nothing is mapped), and so
     does the Fortran check of the programs (sweep --model, exit 2, no signal)."""
-    from conmech._elf import LibraryError, check_library
+    from conmech._core.elf import LibraryError, check_library
     data = good_library.read_bytes()
     check_library(good_library, ["conmech_model_info"])
     rng = np.random.default_rng(7)

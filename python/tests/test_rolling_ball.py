@@ -1,7 +1,7 @@
-"""The rolling rubber ball on a plane (seed 001), built in as ``rolling_ball``: closed forms
-(straight line / parabola, rotation about a fixed axis, friction force as the multiplier),
-constraints and energy, and agreement with the same system derived symbolically from its T,
-U and constraints (conmech.symbolic.derive) to 1e-10."""
+"""The rolling rubber ball on a plane (the lecture notes), built in as ``rolling_ball``:
+closed forms (straight line / parabola, rotation about a fixed axis, friction force as the
+multiplier), constraints and energy, and agreement with the same system derived
+symbolically from its T, U and constraints (conmech.symbolic.derive) to 1e-10."""
 import math
 
 import numpy as np

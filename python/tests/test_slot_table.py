@@ -1,4 +1,4 @@
-"""The table of compiled functions (python/conmech/_slot_table.py) is the one definition:
+"""The table of compiled functions (python/conmech/_core/slot_table.py) is the one definition:
 the Fortran side and the signature text are generated from it by tools/generate_slots.py.
 
 - the committed files are what the table gives (--check), and --check finds a stale file;
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from conmech import _slot_table as table
+from conmech._core import slot_table as table
 from conmech import compiled
 from conmech.symbolic import codegen
 
@@ -100,7 +100,7 @@ TOY = """    Entry("toy", 29, _G,
 def test_a_toy_entry_added_to_the_table_reaches_every_generated_place(tmp_path):
     tree = _tree(tmp_path / "tree")
     toy_table = tmp_path / "toy_table.py"
-    source = (ROOT / "python" / "conmech" / "_slot_table.py").read_text()
+    source = (ROOT / "python" / "conmech" / "_core" / "slot_table.py").read_text()
     end = "\n)\n\n#: the length of a full spec"
     assert source.count(end) == 1
     toy_table.write_text(source.replace(end, "\n" + TOY.rstrip("\n") + end))
@@ -117,7 +117,7 @@ def test_a_toy_entry_added_to_the_table_reaches_every_generated_place(tmp_path):
     assert "type(c_funptr) :: toy = c_null_funptr" in module
     assert "fp%toy = f" in module and '"toy"]' in module
     decl = "void toy(double t, const double *q, const double *v, double *a, const double *p);"
-    for rel in ("python/conmech/compiled.py", "src/mechanics/conmech_c_mechanics.f90"):
+    for rel in ("python/conmech/mechanics/compiled.py", "src/mechanics/conmech_c_mechanics.f90"):
         assert decl in (tree / rel).read_text(), rel
     assert "spec(29) toy (generalized, optional)" in (
         tree / "python/conmech/flat/support/conmech_flat_spec.f90").read_text()

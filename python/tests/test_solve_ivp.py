@@ -422,7 +422,8 @@ def test_nested_solve_inside_fun():
 def test_method_codes_match_the_fortran_names():
     # solve_ivp's names are the Fortran method table's (names and aliases, the
     # constrained-only RATTLE excepted), each with the code Fortran's lookup gives
-    from conmech import _conmech, _ivp
+    from conmech import _conmech
+    from conmech.ivp import solve as _ivp
     fortran_names = ["RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "Vern9", "Radau", "RADAU5",
                      "GAUSS4", "GAUSS6"]
     for name in fortran_names:

@@ -108,7 +108,7 @@ def test_chain_code_needs_2n_trigonometric_calls():
     # energy conserved along a motion (checks M and Q together)
     import conmech
     y0 = np.concatenate([np.linspace(0.9, 0.3, n), np.zeros(n)])
-    sysm = symbolic._system(mod)
+    sysm = symbolic.pipeline._system(mod)
     r = conmech.solve_ivp(sysm, (0, 3), y0, rtol=1e-12, atol=1e-12)
     assert r.success
     e = [mod.call("energy", 0.0, r.y[:n, k], r.y[n:, k]) for k in (0, -1)]
@@ -200,7 +200,7 @@ def test_mass_forces_in_one_call_equals_the_separate_calls():
         assert np.max(np.abs(Mb - Ms)) <= 1e-15*np.max(np.abs(Ms))
         assert np.max(np.abs(Qb - Qs)) <= 1e-14*np.max(np.abs(Qs))
     y0 = np.concatenate([np.linspace(0.9, 0.3, n), np.zeros(n)])
-    both = symbolic._system(mod)
+    both = symbolic.pipeline._system(mod)
     d, a = mod.derived, mod.addresses
     sep = compiled.generalized_system(n, a["mass"], a["forces"], params=tuple(d.param_values),
                                       param_names=tuple(d.param_names), keep=mod)

@@ -287,7 +287,7 @@ def test_written_out_recurrences_are_the_loops_bit_for_bit(arenstorf):
     """solve_ivp runs the recurrences written out for its order (no loops): the same
     coefficients, to the last bit, as the loop version (and so the same steps as the
     batch routine), for powers, quotients and sine/cosine pairs."""
-    from conmech._taylor import taylor_order, with_fixed_order
+    from conmech.ivp.taylor import taylor_order, with_fixed_order
     a, b, p, q = sp.symbols("a b p q")
     dd = a - b
     den = 3 - sp.cos(2*dd)

@@ -29,11 +29,11 @@
 !! (`section_products`): S = 1 - 8 s t, c = 1 + (2/pi) atan(sqrt(min(s,t)/max(s,t))), to
 !! ~1e-14 for every m.
 !!
-!! Transverse linearisation (seed 000): with tangent tau = v/|v|, normal n = (-tau_y, tau_x),
-!! V = |v|, H the Hessian of F and omega = n.grad F / V - 2 m (the turning rate of the
-!! tangent), the normal deviation of an isoenergetic (delta I = 0) perturbation obeys
-!! N'' + Phi(t) N = 0 with Phi = 3 (omega + m)^2 + m^2 - n^T H n. Its 2 x 2 monodromy over
-!! 2 pi has the non-trivial multipliers of the 4 x 4 monodromy.
+!! Transverse linearisation (as in the lecture notes): with tangent tau = v/|v|,
+!! normal n = (-tau_y, tau_x), V = |v|, H the Hessian of F and omega = n.grad F / V - 2 m
+!! (the turning rate of the tangent), the normal deviation of an isoenergetic (delta I = 0)
+!! perturbation obeys N'' + Phi(t) N = 0 with Phi = 3 (omega + m)^2 + m^2 - n^T H n. Its
+!! 2 x 2 monodromy over 2 pi has the non-trivial multipliers of the 4 x 4 monodromy.
 !!
 !! Thread safety: no saved state (the family over m, in parallel: conmech_hill_family).
 module conmech_hill_orbit

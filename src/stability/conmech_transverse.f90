@@ -1,5 +1,5 @@
-!> Transverse linearisation (seed 000) of a periodic orbit of any autonomous two-degree-of-
-!! freedom system of the form
+!> Transverse linearisation (as in the lecture notes) of a periodic orbit of any autonomous
+!! two-degree-of-freedom system of the form
 !!
 !!     q'' = -grad V(q) + 2 Omega J q',   J = [0 -1; 1 0],   E = |q'|^2/2 + V(q)
 !!

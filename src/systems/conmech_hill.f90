@@ -1,4 +1,4 @@
-!> Hill's lunar problem (seed 000): the restricted three-body problem in Hill's form,
+!> Hill's lunar problem (the lecture notes): the restricted three-body problem in Hill's form,
 !!
 !!     x'' - 2 m y' = dF/dx,   y'' + 2 m x' = dF/dy,   F = kappa/r + (3/2) m^2 x^2,
 !!

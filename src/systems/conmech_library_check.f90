@@ -17,7 +17,7 @@
 !! The message returned is the reason alone ("truncated: segment 2 ends at byte 8524, the
 !! file has 7000"); callers name the file.
 !!
-!! The Python package makes the same checks (conmech/_elf.py) before ctypes loads a model.
+!! The Python package makes the same checks (conmech/_core/elf.py) before ctypes loads a model.
 module conmech_library_check
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT

@@ -27,6 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from ..symbolic import constrained_system
+
 __all__ = ["Problem", "andrews", "car_axis", "mescd"]
 
 
@@ -95,7 +97,6 @@ def andrews(flags=None):
     Theta, gamma, Phi, delta, Omega, epsilon; T = v^T M(q) v / 2 with the test set's mass
     matrix, U the spring's c0 (L - l0)^2 / 2, the driving torque mom on beta, the six
     loop-closure constraints)."""
-    from ..symbolic import constrained_system
     P = {k: sp.Symbol(k) for k in ANDREWS_PARAMS}
     globals_ = P
     (m1, m2, m3, m4, m5, m6, m7, xa, ya, xb, yb, xc, yc, c0, i1, i2, i3, i4, i5, i6, i7,
@@ -161,7 +162,6 @@ def car_axis(flags=None):
     k g in U, the constraints xb(t) xl + yb(t) yl = 0 (the axle is perpendicular to the
     left spring's anchor direction, yb = r sin(w t), xb = sqrt(L^2 - yb^2): rheonomic) and
     (xl - xr)^2 + (yl - yr)^2 = L^2."""
-    from ..symbolic import constrained_system
     t = sp.Symbol("t")
     eps, Mm, L, L0, r, w, g = sp.symbols("eps M L L0 r w g")
     q = sp.symbols("xl yl xr yr")

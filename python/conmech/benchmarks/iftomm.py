@@ -29,6 +29,7 @@ constructions of each mechanism instead (python/tests/test_iftomm_spatial.py).
 import numpy as np
 import sympy as sp
 
+from ..symbolic import constrained_system
 from .bari import Problem
 
 __all__ = ["a01_pendulum", "a01_exact", "A01_PARAMS", "a02_n_four_bar", "a02_exact", "A02_PARAMS",
@@ -42,7 +43,6 @@ def a01_pendulum(flags=None):
     """A01 in Cartesian coordinates q = (x, y): T = m |v|^2 / 2, U = m g y and the link
     constraint (x^2 + y^2 - L^2) / 2 = 0; released at rest from (L, 0), t in [0, 2000].
     The Problem's q_ref and v_ref are the closed form at t = 2000 (:func:`a01_exact`)."""
-    from ..symbolic import constrained_system
     m, L, g = sp.symbols("m L g")
     x, y = sp.symbols("x y")
     vx, vy = sp.symbols("x_d y_d")
@@ -96,7 +96,6 @@ def a02_n_four_bar(N=40, flags=None):
     of freedom instantaneously), twice per revolution: :func:`a02_exact` is its closed
     form. The Problem's q_ref, v_ref are the position and velocity of B0 (not q) from the
     closed form at t = 20."""
-    from ..symbolic import constrained_system
     m, L, g = sp.symbols("m L g")
     phi = sp.symbols(f"phi0:{N + 1}")
     psi = sp.symbols(f"psi1:{N + 1}")

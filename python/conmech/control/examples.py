@@ -16,7 +16,7 @@ Each returns (plant, constraint). The symbolic ones are compiled once into the c
 """
 from __future__ import annotations
 
-from .. import systems
+from ..mechanics import systems
 from .plant import ControlledSystem
 from .vhc import VirtualConstraint
 
@@ -37,6 +37,7 @@ def pendubot(k=-0.8, g=9.81):
     U = t4 g cos q1 + t5 g cos(q1 + q2) (q1 the shoulder from the upright, q2 the elbow
     relative), torque on q1. Constraint q1 = k q2 (phase q2): for k in about (-1, -0.55)
     the upright is a centre of the reduced dynamics."""
+    # sympy (conmech.symbolic's) is an optional dependency: imported for this example only
     import sympy as sp
     from sympy.physics.mechanics import dynamicsymbols
     from .. import symbolic
@@ -57,6 +58,7 @@ def double_pendulum_cart(c1=-1.5, c2=0.0, M=1.0, m1=0.5, m2=0.5, l1=0.5, l2=0.5,
     cart and the torque tau at the elbow (generalized forces [F, -tau, tau]); the shoulder
     is passive. Constraint x = c1 theta1, theta2 = c2 theta1 (phase theta1): with the
     defaults the second link stays upright while the first swings, and the cart follows."""
+    # sympy (conmech.symbolic's) is an optional dependency: imported for this example only
     import sympy as sp
     from sympy.physics.mechanics import dynamicsymbols
     from .. import symbolic

@@ -10,10 +10,10 @@ import math
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result, message_text
-from .._ivp import DenseOutput, OdeResult, _event_settings, _METHOD_CODES
-from ..compiled import function_address
-from .._native import NativeSystem
+from .._core.callback import Guard, as_result, message_text
+from ..ivp.solve import DenseOutput, OdeResult, _event_settings, _METHOD_CODES
+from .._core.native import NativeSystem, function_address
+from .._core.status import BAD_INPUT, raise_status
 
 __all__ = ["ControlledSystem", "FeedbackLaw", "PythonLaw", "CompiledLaw", "ZeroLaw",
            "simulate"]
@@ -21,13 +21,6 @@ __all__ = ["ControlledSystem", "FeedbackLaw", "PythonLaw", "CompiledLaw", "ZeroL
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
 _NO_PY = None
-
-
-def _raise(info, message):
-    msg = message_text(message)
-    if info == -4:
-        raise ValueError(msg)
-    raise RuntimeError(msg)
 
 
 class ControlledSystem:
@@ -125,7 +118,7 @@ class ControlledSystem:
         dx, bx, info, message = _conmech.flat_control_plant_eval(
             **self._flat(), t=float(t), x=x, u=u)
         if info != 0:
-            _raise(info, message)
+            raise_status(info, message)
         return np.array(dx), np.array(bx)
 
     def __repr__(self):
@@ -231,7 +224,7 @@ def evaluate_law(plant, law, t, x):
         xs=np.asfortranarray(xs.T))
     g.check()
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     us = np.array(us).T
     return us[0] if one else us
 
@@ -314,8 +307,8 @@ def simulate(plant: ControlledSystem, law: Any, t_span: Sequence[float], x0: Arr
         ev_dir=np.array([s[2] for s in settings], dtype=np.intc) if ne else _PADI,
         ev_term=np.array([int(s[1] > 0) for s in settings], dtype=np.intc) if ne else _PADI)
     g.check()
-    if info == -4:
-        _raise(info, message)
+    if info == BAD_INPUT:
+        raise_status(info, message)
     t = out.get("t", np.array([t0]))
     y = out.get("y", x0[:, None].copy())
     res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None, nfev=int(nfev),

@@ -8,13 +8,14 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result
-from .plant import _raise
+from .._core.callback import Guard, as_result
+from .._core.result import Record
+from .._core.status import raise_status
 
 __all__ = ["PeriodicRiccati", "periodic_riccati", "check_weights"]
 
 
-class PeriodicRiccati:
+class PeriodicRiccati(Record):
     """Result of :func:`periodic_riccati`.
 
     Attributes: t (nt,), P (nt, k, k) the stabilising periodic solution, K (nt, m, k) the
@@ -27,10 +28,6 @@ class PeriodicRiccati:
 
     __slots__ = ("t", "P", "K", "closed_loop_multipliers", "closed_loop_monodromy",
                  "hamiltonian_multipliers", "periodicity", "min_eigenvalue", "passes")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
 
 def check_weights(Q, R, k, m):
@@ -93,7 +90,7 @@ def periodic_riccati(A: Callable, B: Callable, period: float, Q: ArrayLike | Non
     g.check()
     (ps, ks, hmr, hmi, cmr, cmi, clm, periodicity, min_eig, passes, info, message) = out
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     return PeriodicRiccati(t=tt, P=np.moveaxis(np.array(ps), 2, 0),
                            K=np.moveaxis(np.array(ks), 2, 0),
                            closed_loop_multipliers=np.asarray(cmr) + 1j*np.asarray(cmi),

@@ -8,10 +8,11 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard
-from .plant import ControlledSystem, FeedbackLaw, _as_law, _law_args, _raise
+from .._core.callback import Guard
+from .plant import ControlledSystem, FeedbackLaw, _as_law, _law_args
 from .riccati import check_weights
 from .vhc import ReducedOrbit
+from .._core.status import raise_status
 
 __all__ = ["TransverseLQR", "orbital_stabilisation"]
 
@@ -71,7 +72,7 @@ class TransverseLQR(FeedbackLaw):
         g.check()
         taus, xis, dists, nfail, info, message = out
         if info != 0:
-            _raise(info, message)
+            raise_status(info, message)
         taus, xis, dists = np.array(taus), np.array(xis).T, np.array(dists)
         return (taus[0], xis[0], dists[0]) if one else (taus, xis, dists)
 
@@ -154,7 +155,7 @@ def orbital_stabilisation(plant: ControlledSystem, orbit: Any, nominal: Any = No
     (as_, bs, ps, ks, omr, omi, gev, hmr, hmi, cmr, cmi, periodicity, min_eig, passes, rtab,
      fmr, fmi, closure, info, message) = out
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     samples = dict(t=tt, A=np.moveaxis(np.array(as_), 2, 0), B=np.moveaxis(np.array(bs), 2, 0),
                    P=np.moveaxis(np.array(ps), 2, 0), K=np.moveaxis(np.array(ks), 2, 0),
                    open_loop_multipliers=np.asarray(omr) + 1j*np.asarray(omi),

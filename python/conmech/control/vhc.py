@@ -12,7 +12,9 @@ import math
 import numpy as np
 
 from .. import _conmech
-from .plant import ControlledSystem, FeedbackLaw, _raise
+from .plant import ControlledSystem, FeedbackLaw
+from .._core.result import Record
+from .._core.status import raise_status
 
 __all__ = ["VirtualConstraint", "ReducedDynamics", "ReducedOrbit", "VHCFeedback"]
 
@@ -202,7 +204,7 @@ class VirtualConstraint:
         out = _conmech.flat_control_vhc(**self.plant._flat(), **self._flat(), thetas=th)
         al, be, ga, ph, d1, d2, info, message = out
         if info != 0:
-            _raise(info, message)
+            raise_status(info, message)
         scal = np.ndim(theta) == 0
         res = (np.array(al), np.array(be), np.array(ga), np.array(ph).T, np.array(d1).T,
                np.array(d2).T)
@@ -256,7 +258,7 @@ class VHCFeedback(FeedbackLaw):
         return ilaw, rlaw, None
 
 
-class ReducedOrbit:
+class ReducedOrbit(Record):
     """A periodic solution of the reduced dynamics (an oscillation between the turning
     points theta_min and theta_max, theta' = 0 there).
 
@@ -270,10 +272,6 @@ class ReducedOrbit:
 
     __slots__ = ("theta0", "theta_min", "theta_max", "period", "period_quadrature",
                  "quadrature_error", "alpha_range", "x0", "t", "states", "constraint")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     @property
     def y0(self):
@@ -315,7 +313,7 @@ class ReducedDynamics:
                                             atol=float(atol))
         ys, nev, ev_t, ev_y, info, message = out
         if info < 0:
-            _raise(info, message)
+            raise_status(info, message)
         res = (te, np.array(ys).T)
         if events:
             return res + (np.array(ev_t)[:nev], np.array(ev_y).T[:nev])
@@ -334,7 +332,7 @@ class ReducedDynamics:
             **self._args(), theta0=float(theta0), e0=float(dtheta0)**2, thetas=th,
             stop_at_zero=int(bool(stop_at_zero)), rtol=float(rtol), atol=float(atol))
         if info != 0:
-            _raise(info, message)
+            raise_status(info, message)
         es = np.array(es)
         if stop_at_zero:
             return es, (float(tz) if found else None)

@@ -58,7 +58,7 @@ from .constrained_orbits import (ConstrainedBranch, ConstrainedOrbit, ManifoldCh
                                  constrained_continuation, constrained_periodic_orbit,
                                  constrained_symmetric_orbit)
 # validators used by sibling modules (hill_families)
-from ._validate import _real, _state  # noqa: F401
+from .._core.validate import _real, _state  # noqa: F401
 
 __all__ = ["Equilibrium", "RelativeEquilibrium", "PeriodicOrbit", "Branch", "SpecialPoint",
            "SpecialKind", "continuation", "transverse", "transverse_linearisation",

@@ -25,17 +25,18 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..compiled import CompiledConstrained, evaluate
-from ..constrained import ConstrainedSystem, NativeConstrained, builtin
+from ..mechanics.compiled import CompiledConstrained, evaluate
+from ..mechanics.constrained import ConstrainedSystem, NativeConstrained, builtin
 from .equilibria import equilibrium, lagrange_dirichlet, potential_hessian
-from ._validate import _real, _state
+from .._core.validate import _real, _state
+from .._core.result import Record
 
 __all__ = ["ConstrainedEquilibrium", "constrained_equilibrium", "constrained_equilibria"]
 
 _RHEONOMIC_BUILTINS = ("pendulum_moving_xy", "yoyo")
 
 
-class ConstrainedEquilibrium:
+class ConstrainedEquilibrium(Record):
     """Result of :func:`constrained_equilibrium`: q, lam (multipliers), residual (max of
     |Q + G^T lam| and |phi| at the point, evaluated afresh), iterations, tangent (n, k)
     orthonormal basis of the tangent space, mass_reduced, stiffness_reduced (-Z^T K Z),
@@ -49,10 +50,6 @@ class ConstrainedEquilibrium:
                  "stiffness_reduced", "damping_reduced", "eigenvalues", "kind", "saddle",
                  "frequencies", "hessian_reduced", "hessian_eigenvalues",
                  "lagrange_dirichlet")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     @property
     def stable(self):

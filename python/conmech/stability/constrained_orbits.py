@@ -32,12 +32,13 @@ from typing import Any, Sequence  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ..compiled import CompiledConstrained, evaluate
-from ..constrained import ConstrainedSystem, NativeConstrained, builtin
-from ..constrained import solve as _constrained_solve
+from ..mechanics.compiled import CompiledConstrained, evaluate
+from ..mechanics.constrained import ConstrainedSystem, NativeConstrained, builtin
+from ..mechanics.constrained import solve as _constrained_solve
 from .continuation import continuation
 from .orbits import periodic_orbit, symmetric_orbit
-from ._validate import _real, _state
+from .._core.validate import _real, _state
+from .._core.result import Record
 
 __all__ = ["ManifoldChart", "ConstrainedOrbit", "ConstrainedBranch",
            "constrained_periodic_orbit", "constrained_symmetric_orbit",
@@ -297,7 +298,7 @@ class ManifoldChart:
         return out
 
 
-class ConstrainedOrbit:
+class ConstrainedOrbit(Record):
     """A periodic orbit on a constraint manifold: q0, v0 (the excessive state at t = 0),
     period, multipliers (the 2k multipliers of the motion on the manifold, from the
     reduced orbit; the 2m constraint directions are removed by the chart, see the module
@@ -310,10 +311,6 @@ class ConstrainedOrbit:
     __slots__ = ("q0", "v0", "period", "multipliers", "multiplier_error", "stable",
                  "stable_tol", "residual", "constrained_residual", "manifold_residual",
                  "removed_trivial", "chart", "reduced")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         return (f"ConstrainedOrbit(period={self.period!r}, q0={self.q0.tolist()!r}, "
@@ -392,16 +389,12 @@ def constrained_symmetric_orbit(system: Any, q0, v0, free: Sequence[int],
     return _wrap(chart, orb, rtol, atol)
 
 
-class ConstrainedBranch:
+class ConstrainedBranch(Record):
     """A family of periodic orbits on a constraint manifold: branch (the
     :class:`~conmech.stability.Branch` of the chart's system: p, period, multipliers,
     special points, ...), q0 and v0 ((N, n): the excessive states of its points), chart."""
 
     __slots__ = ("branch", "q0", "v0", "chart")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __len__(self):
         return len(self.branch)

@@ -9,11 +9,12 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result
-from .._native import NativeSystem
-from .._native import _NO_SPEC, _PAD, _unused_callback
-from ._validate import _check_dim, _count, _msg, _raise, _real, _state
+from .._core.callback import Guard, as_result
+from .._core.native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
+from .._core.validate import _check_dim, _count, _msg, _real, _state
 from .orbits import _METHODS, stable_tolerance
+from .._core.result import Record, StatusRecord
+from .._core.status import raise_status
 
 _SPECIAL = {1: "fold", 2: "branch point", 3: "period doubling", 4: "Neimark-Sacker"}
 _REASONS = {1: "a trial's corrector failed", 2: "a trial left the branch (another branch "
@@ -47,7 +48,7 @@ class SpecialKind(str):
                 else f"{str.__repr__(self)} ({self.alias})")
 
 
-class SpecialPoint:
+class SpecialPoint(Record):
     """A special point of a branch: kind (a :class:`SpecialKind`: 'fold', 'branch point',
     'period doubling', 'Neimark-Sacker'; 'S=+1'/'S=-1' also match for conservative planar
     orbits), index (between branch points index and index + 1), p, period, y0,
@@ -62,16 +63,12 @@ class SpecialPoint:
     __slots__ = ("kind", "index", "p", "period", "y0", "multipliers", "stability_index",
                  "located", "test", "residual", "p_bracket", "message")
 
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
     def __repr__(self):
         loc = "" if self.located else ", not located"
         return f"SpecialPoint({self.kind!r}, p={self.p!r}, index={self.index}{loc})"
 
 
-class Branch:
+class Branch(StatusRecord):
     """A branch of periodic orbits from :func:`continuation`.
 
     Arrays over the points: p (parameter), period, y0 (N, n), multipliers (N, n) complex
@@ -92,14 +89,6 @@ class Branch:
                  "residual", "iterations", "energy", "special", "status", "message",
                  "param", "conservative", "kernel_ratio", "multiplier_error", "accuracy",
                  "stable_tol", "direction", "method")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
-    @property
-    def success(self):
-        return self.status == 0
 
     def __len__(self):
         return len(self.p)
@@ -323,7 +312,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
      sp_y, sp_mr, sp_mi, sp_s, sp_loc, sp_test, sp_clo, sp_br, dirout, info, message) = out
     npts = int(npts)
     if npts == 0:
-        _raise(info, message)
+        raise_status(info, message)
     k = slice(0, npts)
     mult = (np.asarray(mr)[:, k] + 1j*np.asarray(mi)[:, k]).T.copy()
     merr = np.array(merr[:, k]).T.copy()

@@ -8,10 +8,12 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._builtin_table import STATE_NAMES
-from .._native import BuiltinSystem
-from ._validate import (_check_dim, _no_jac_for_builtin, _raise, _real, _state,
-                        _system_args)
+from .._core.builtin_table import STATE_NAMES
+from .._core.native import BuiltinSystem, NativeSystem
+from .._core.validate import (_callback, _check_dim, _no_jac_for_builtin, _real, _state,
+                              _system_args)
+from .._core.result import Record
+from .._core.status import BAD_INPUT, raise_status
 
 _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate",
           5: "unstable (secular drift)", 6: "stable (family of equilibria)"}
@@ -19,7 +21,7 @@ _KINDS = {1: "asymptotically stable", 2: "centre", 3: "unstable", 4: "degenerate
 EQUILIBRIUM_RTOL = 1e-8
 
 
-class Equilibrium:
+class Equilibrium(Record):
     """Result of :func:`equilibrium`.
 
     Attributes: ``y``, ``jacobian``, ``eigenvalues`` (complex), ``kind``, ``saddle``,
@@ -45,10 +47,6 @@ class Equilibrium:
                  "njev", "zero_multiplicity", "largest_block", "secular_frequency", "drift",
                  "drift_names", "family_dim", "family", "state_names", "relative")
 
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
     @property
     def stable(self):
         """Linearly stable (asymptotically stable, centre, or stable on an attracting
@@ -63,7 +61,7 @@ class Equilibrium:
         return f"Equilibrium(kind={self.kind!r}, eigenvalues={self.eigenvalues!r}{extra})"
 
 
-class RelativeEquilibrium:
+class RelativeEquilibrium(Record):
     """Stability of an equilibrium relative to first integrals and its family of
     equilibria (:func:`equilibrium` with ``integrals``): the linearisation induced on the
     integrals' level set modulo the family (``jacobian`` = W^T J W, ``basis`` W, n x m),
@@ -75,10 +73,6 @@ class RelativeEquilibrium:
 
     __slots__ = ("jacobian", "basis", "eigenvalues", "kind", "saddle", "integrals",
                  "lagrange_dirichlet", "energy_eigenvalues")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     @property
     def stable(self):
@@ -162,7 +156,7 @@ def equilibrium(system: Any, y: ArrayLike, t: float = 0.0, tol: float = 1e-8,
     (jmat, wr, wi, kind, saddle, residual, analytic, zero_mult, block, sfreq, fdim, fam,
      ndrift, drift, info, message) = out
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     # a classification is only meaningful at an equilibrium: check the true residual
     jmax = float(np.max(np.abs(jmat), initial=0.0))
     scale = max(1.0, jmax*max(1.0, float(np.max(np.abs(y)))))
@@ -250,7 +244,7 @@ def _relative(system, e, t, tol, integrals):
     ar, w, m, info, message = _conmech.flat_relative_linearization(
         k, d, np.asfortranarray(e.jacobian), gpad, fpad)
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     m = int(m)
     if m == 0:
         return None
@@ -259,7 +253,7 @@ def _relative(system, e, t, tol, integrals):
     wr, wi, kind, saddle, zm, block, sfreq, ndrift, drift, info, message = \
         _conmech.flat_classify_matrix(np.asfortranarray(ar), tol)
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     ld, ew = None, None
     if hess is not None:
         hr = w.T @ np.asarray(hess, dtype=float) @ w
@@ -279,7 +273,7 @@ def lagrange_dirichlet(hessian: ArrayLike, tol: float = 1e-10) -> tuple:
     if not np.all(np.isfinite(h)):
         raise ValueError("hessian must be finite")
     stable, w, info = _conmech.flat_lagrange_dirichlet(h, float(tol))
-    if info == -4:
+    if info == BAD_INPUT:
         raise ValueError("hessian must be symmetric")
     if info != 0:
         raise RuntimeError("dsyev failed")
@@ -305,7 +299,7 @@ def find_equilibrium(system: Any, guess: ArrayLike, t: float = 0.0, tol: float =
     if g is not None:
         g.check()
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     e = equilibrium(system, np.array(yout), t=t, tol=classify_tol, integrals=integrals)
     if not e.residual <= max(np.sqrt(tol), 1e-8)*max(1.0, np.max(np.abs(e.y))):
         raise RuntimeError(f"find_equilibrium: residual {e.residual:.3g} at the root")

@@ -36,8 +36,8 @@ from typing import Any, Callable  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._native import NativeSystem
-from ._validate import _real
+from .._core.native import NativeSystem
+from .._core.validate import _real
 from .continuation import _param_index
 from .equilibrium_continuation import (EquilibriumBranch, EquilibriumSpecialPoint,
                                        equilibrium_continuation)

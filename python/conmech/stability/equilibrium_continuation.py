@@ -9,11 +9,12 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result
-from .._native import NativeSystem
-from .._native import _NO_SPEC, _PAD, _unused_callback
-from ._validate import _check_dim, _count, _msg, _raise, _real, _state
+from .._core.callback import Guard, as_result
+from .._core.native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
+from .._core.validate import _check_dim, _count, _msg, _real, _state
 from .continuation import Branch, _param_index, continuation
+from .._core.result import Record, StatusRecord
+from .._core.status import raise_status
 
 __all__ = ["EquilibriumBranch", "EquilibriumSpecialPoint", "HopfNormalForm",
            "equilibrium_continuation", "first_lyapunov_coefficient", "hopf_orbits"]
@@ -24,7 +25,7 @@ _REASON = {0: "located", 1: "the corrector failed inside the bracket",
            2: "the iterations ran out before the tolerances were met"}
 
 
-class HopfNormalForm:
+class HopfNormalForm(Record):
     """The normal-form data of a Hopf point (:func:`first_lyapunov_coefficient`): omega
     (the pair +-i omega), re_lambda (the real part of that pair at the point), l1 (first
     Lyapunov coefficient, Kuznetsov's normalisation <q, q> = 1, <p, q> = 1), l1_error (its
@@ -36,10 +37,6 @@ class HopfNormalForm:
     __slots__ = ("omega", "re_lambda", "l1", "scale", "l1_error", "criticality", "q",
                  "adjoint", "exact_jacobian")
 
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
     @property
     def period(self):
         """2 pi / omega: the period of the orbits born at the point."""
@@ -50,7 +47,7 @@ class HopfNormalForm:
                 f"criticality={self.criticality!r})")
 
 
-class EquilibriumSpecialPoint:
+class EquilibriumSpecialPoint(Record):
     """A special point of an :class:`EquilibriumBranch`: kind ('fold' or 'Hopf'), index
     (between the branch points index and index + 1), p, y (an equilibrium: its
     ``residual`` max|f| is that of the returned state), eigenvalues, located (the test
@@ -65,10 +62,6 @@ class EquilibriumSpecialPoint:
                  "bracket", "residual", "omega", "l1", "l1_error", "l1_scale", "criticality",
                  "q", "adjoint", "param")
 
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
     @property
     def period(self):
         return 2.0*np.pi/self.omega if self.omega else None
@@ -79,7 +72,7 @@ class EquilibriumSpecialPoint:
                 f"located={self.located}{extra})")
 
 
-class EquilibriumBranch:
+class EquilibriumBranch(StatusRecord):
     """A branch of equilibria from :func:`equilibrium_continuation`.
 
     Arrays over the points: p, y (N, n), eigenvalues (N, n) complex, n_unstable
@@ -92,14 +85,6 @@ class EquilibriumBranch:
 
     __slots__ = ("p", "y", "eigenvalues", "n_unstable", "stable", "tests", "residual",
                  "iterations", "special", "status", "message", "param")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
-
-    @property
-    def success(self):
-        return self.status == 0
 
     def __len__(self):
         return len(self.p)
@@ -217,7 +202,7 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
      sp_a, info, message) = out
     npts = int(npts)
     if npts == 0:
-        _raise(info, message)
+        raise_status(info, message)
     k = slice(0, npts)
     eig = (np.asarray(wr)[:, k] + 1j*np.asarray(wi)[:, k]).T.copy()
     tests = np.array(psi[:, k]).T.copy()
@@ -279,9 +264,7 @@ def first_lyapunov_coefficient(system: Any, y: ArrayLike, p: float | None = None
     if not isinstance(system, NativeSystem):
         g.check()
     if info != 0:
-        if info == -4:
-            raise ValueError(_msg(message))
-        raise RuntimeError(_msg(message))
+        raise_status(info, message)
     omega, re_l, l1, scale, err, crit, exact = (float(v) for v in out)
     return HopfNormalForm(omega=omega, re_lambda=re_l, l1=l1, scale=scale, l1_error=err,
                           criticality=_CRIT.get(int(crit)),

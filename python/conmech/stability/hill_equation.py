@@ -7,12 +7,13 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result
-from ._validate import _raise, _real
+from .._core.callback import Guard, as_result
+from .._core.result import DictResult
+from .._core.validate import _real
+from .._core.status import raise_status
 
-class HillEquationResult(dict):
+class HillEquationResult(DictResult):
     """dict with monodromy (2, 2), half_trace, det, multipliers, stable."""
-    __getattr__ = dict.__getitem__
 
 
 def _band_limited(p):
@@ -60,7 +61,7 @@ def hill_equation(phi: Callable[[float], float] | ArrayLike, period: float,
         p = _band_limited(p)
         mono, ht, det, info, message = _conmech.flat_hill_equation_samples(p, period, rtol)
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     mono = np.array(mono)
     return HillEquationResult(monodromy=mono, half_trace=float(ht), det=float(det),
                               multipliers=np.linalg.eigvals(mono),

@@ -8,12 +8,13 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
-from ..compiled import CompiledSystem, evaluate
-from .._native import NativeSystem
-from ._validate import _count, _real, _state
+from ..mechanics.compiled import CompiledSystem, evaluate
+from .._core.native import NativeSystem
+from .._core.validate import _count, _real, _state
 from .continuation import Branch, continuation
 from .equilibria import equilibrium, find_equilibrium
 from .variational import stm
+from .._core.result import Record
 
 __all__ = ["NormalModes", "normal_modes", "LyapunovFamily", "lyapunov_family"]
 
@@ -24,7 +25,7 @@ ELLIPTIC_RTOL = 1e-7
 RESONANCE_TOL = 1e-6
 
 
-class NormalModes:
+class NormalModes(Record):
     """The linearisation of a conservative system at an equilibrium
     (:func:`normal_modes`): y_eq (the equilibrium state), eigenvalues (all), omega (the
     frequencies of the elliptic pairs +-i omega, ascending: mode 0 is the slowest), vectors
@@ -36,10 +37,6 @@ class NormalModes:
 
     __slots__ = ("y_eq", "eigenvalues", "omega", "vectors", "left", "resonant", "hyperbolic",
                  "jacobian")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     @property
     def periods(self):

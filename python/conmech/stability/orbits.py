@@ -10,11 +10,14 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._ivp import solve_ivp
-from ._validate import (_check_dim, _count, _no_jac_for_builtin, _raise, _real, _system_args,
-                        _state, _tols)
+from ..ivp.solve import solve_ivp
+from .._core.native import NativeSystem
+from .._core.validate import (_callback, _check_dim, _count, _no_jac_for_builtin, _real,
+                              _state, _system_args, _tols)
+from .._core.result import Record
+from .._core.status import raise_status
 
-class PeriodicOrbit:
+class PeriodicOrbit(Record):
     """Result of the orbit solvers: y0, period, monodromy (the formed product of the
     segment STMs, for reference), multipliers (complex, from the segments by the periodic
     eigenvalue method, never eig of the formed product), multiplier_error (an estimate of
@@ -30,10 +33,6 @@ class PeriodicOrbit:
     __slots__ = ("y0", "period", "monodromy", "multipliers", "stability_index", "residual",
                  "iterations", "njev", "method", "multiplier_error", "accuracy", "stable",
                  "stable_tol", "nodes", "node_times")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     @property
     def exponents(self):
@@ -115,7 +114,7 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     (y0o, po, mono, mr, mi, merr, accuracy, deflated, nodes, node_times, nnodes, residual,
      iterations, info, message) = out
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     mono = np.array(mono)
     if not (np.all(np.isfinite(mono)) and np.all(np.isfinite(y0o)) and np.isfinite(po)):
         raise RuntimeError("the orbit or its monodromy is not finite")

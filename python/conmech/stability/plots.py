@@ -20,8 +20,8 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
-from .._ivp import solve_ivp
-from .._native import BuiltinSystem, NativeSystem
+from ..ivp.solve import solve_ivp
+from .._core.native import BuiltinSystem, NativeSystem
 from .continuation import Branch
 from .equilibrium_continuation import EquilibriumBranch
 

@@ -8,7 +8,8 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from ._validate import _raise, _state
+from .._core.validate import _state
+from .._core.status import raise_status
 
 def transverse(potential: Callable[..., Any], y0: ArrayLike, period: float, omega: float = 0.0,
                t: ArrayLike | None = None, rtol: float = 1e-12) -> dict:
@@ -55,7 +56,7 @@ def transverse(potential: Callable[..., Any], y0: ArrayLike, period: float, omeg
     phi, m2, ht, det, closure, m4, info, message = _conmech.flat_transverse_callback(
         pot, float(omega), y0, period, float(rtol), ttx)
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     m2 = np.array(m2)
     m4 = np.array(m4)
     out = {"monodromy": m2, "half_trace": float(ht), "det": float(det),

@@ -9,17 +9,19 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._callback import Guard, as_result
-from .._native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
-from ..constrained import NativeConstrained
-from ._validate import _raise, _real, _state
+from .._core.callback import Guard, as_result
+from .._core.native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
+from ..mechanics.constrained import NativeConstrained
+from .._core.validate import _real, _state
+from .._core.result import Record
+from .._core.status import raise_status
 
 __all__ = ["TransverseLinearisation", "transverse_linearisation", "nontrivial_multipliers"]
 
 _ENERGY = {"none": 0, False: 0, "auto": 1, None: 1, "required": 2, True: 2}
 
 
-class TransverseLinearisation:
+class TransverseLinearisation(Record):
     """Result of :func:`transverse_linearisation`.
 
     Attributes
@@ -52,10 +54,6 @@ class TransverseLinearisation:
                  "monodromy", "multipliers", "full_monodromy", "full_multipliers",
                  "nontrivial", "agreement", "holonomy", "closure", "energy_drift",
                  "frame_defect", "hill_phi", "hill_psi", "nfev", "kind")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         mu = ", ".join(f"{m:.6g}" for m in self.multipliers)
@@ -213,7 +211,7 @@ def transverse_linearisation(system: Any, orbit: Any, period: float | None = Non
     (k, reduced, closure, drift, defect, mono, mr, mi, fmono, fre, fim, holo, xs, qs, as_,
      phis, psis, nfev, kind, info, message) = out
     if info != 0:
-        _raise(info, message)
+        raise_status(info, message)
     k = int(k)
     mu = np.asarray(mr)[:k] + 1j*np.asarray(mi)[:k]
     res = dict(y0=y0, period=per, dimension=k, reduced=bool(reduced), t=tt,

@@ -8,9 +8,10 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech
-from .._native import NativeSystem
-from ._validate import (_check_dim, _no_jac_for_builtin, _raise, _real, _state,
-                        _system_args, _tols)
+from .._core.native import NativeSystem
+from .._core.validate import (_callback, _check_dim, _no_jac_for_builtin, _real, _state,
+                              _system_args, _tols)
+from .._core.status import raise_status
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
         atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
@@ -48,7 +49,7 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
             g.check()
             njev = g.count("jac")
     if info < 0:
-        _raise(info, message)
+        raise_status(info, message)
     if full_output:
         return np.array(y1), np.array(phi), {"nfev": int(nfev), "njev": njev}
     return np.array(y1), np.array(phi)

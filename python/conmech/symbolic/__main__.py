@@ -16,6 +16,7 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+from .pipeline import model_of
 
 
 def load_model(path):
@@ -38,7 +39,6 @@ def load_model(path):
         obj = obj()
     if not isinstance(obj, Derived) and not hasattr(obj, "derived"):
         try:   # a compiled system made by conmech.symbolic (lagrangian_system, ...)
-            from . import model_of
             obj = model_of(obj)
         except (ImportError, TypeError):
             pass

@@ -40,7 +40,7 @@ import subprocess
 import tempfile
 import warnings
 
-from .._elf import LibraryError, check_bytes, read_regular
+from .._core.elf import LibraryError, check_bytes, read_regular
 
 __all__ = ["CompileError", "CacheError", "CacheWarning", "cache_dir", "compile_source",
            "load", "library_path", "FFLAGS", "compiler", "verify_entry"]

@@ -39,7 +39,7 @@ import re
 import sympy as sp
 from sympy.printing.fortran import FCodePrinter
 
-from .. import _slot_table as _table
+from .._core import slot_table as _table
 
 __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prepare",
            "trig_split", "ENTRY_POINTS", "product_terms", "product_lines", "comment_text",

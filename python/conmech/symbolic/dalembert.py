@@ -1,6 +1,6 @@
 """D'Alembert's route to the equations of motion: positions of particles (and planar
 bodies) as functions of the generalized coordinates, applied forces of any kind, and the
-projection of the dynamic equilibrium onto the admissible directions (seed 002):
+projection of the dynamic equilibrium onto the admissible directions (the lecture notes):
 
     sum_k (m_k u_k'' - X_k) . du_k/dq_s + (I_k phi_k'' - tau_k) dphi_k/dq_s = 0,
     s = 1 .. n,
@@ -29,7 +29,7 @@ coordinates); otherwise L = T and Q_applied act as non-conservative forces.
 import numpy as np
 import sympy as sp
 
-from . import _construct, _system
+from .pipeline import _construct, _system
 from .derive import (Derived, _ae, _cheap_simplify, _check_no_accel, _Coords, _realify,
                      _resolve_params, _subs_all, _sympify_list, _unify_time)
 from .momenta import LagrangianSystem, is_zero, to_user

@@ -40,6 +40,7 @@ import numpy as np
 import sympy as sp
 
 from .recursive import _add, _cross, _dot
+from .pipeline import model_of
 
 __all__ = ["Loop", "PointForce", "consistent_state"]
 
@@ -423,7 +424,6 @@ def consistent_state(system, q0, v0=None, independent=None, tol=1e-12, max_iter=
     minimum-norm correction of q0 and v0). Returns (q, v). A loop that cannot close (no
     solution near q0 for the given independent coordinates, e.g. links too short to
     reach): ValueError naming the loop and its residual."""
-    from . import model_of
     model = model_of(system)
     d = model.derived
     if d.kind != "constrained" or not getattr(d, "loops", None):

@@ -1,7 +1,7 @@
 """Generalized momenta, generalized forces, cyclic coordinates and first integrals of a
 symbolic Lagrangian system.
 
-The lecture notes (seed 001) call dL/dq' the generalized momenta and dL/dq the generalized
+The lecture notes call dL/dq' the generalized momenta and dL/dq the generalized
 forces ("may not have units of force/momenta"), and note: if L does not depend on q_i, the
 Euler-Lagrange equation reads d/dt dL/dq_i' = 0 and dL/dq_i' is conserved. For a system
 made by :func:`conmech.symbolic.lagrangian_system` (or a planar or spatial tree) this
@@ -31,7 +31,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
-from .. import compiled
+from ..mechanics import compiled
 from .build import compile_source, load
 from .codegen import (FortranPrinter, _names, _procedure, check_source, comment_lines,
                       comment_text)

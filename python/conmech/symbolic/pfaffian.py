@@ -1,6 +1,6 @@
 """Exactness of Pfaffian constraints: holonomic (integrable) or non-holonomic.
 
-A Pfaffian constraint (seed 002) is the differential form
+A Pfaffian constraint (the lecture notes) is the differential form
 
     omega = a_1(q, t) dq_1 + ... + a_n(q, t) dq_n + a_0(q, t) dt = 0.
 
@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 from typing import Dict, Optional, Sequence, Tuple
 
 import sympy as sp
+from .pipeline import model_of
 
 __all__ = ["PfaffianResult", "PfaffianSystemResult", "pfaffian", "pfaffian_system",
            "pfaffian_of", "pfaffian_from_velocities", "exterior_derivative", "wedge",
@@ -565,7 +566,6 @@ def pfaffian_of(system) -> PfaffianSystemResult:
     d = system
     if not hasattr(d, "kind"):
         try:
-            from . import model_of
             d = model_of(system).derived
         except (ImportError, TypeError):
             raise TypeError("pfaffian_of: expected a Derived record or a conmech.symbolic "

@@ -55,6 +55,7 @@ data).
 import sympy as sp
 
 from .derive import Derived
+from .._core.result import Record
 
 __all__ = ["TreeDerived", "derive_recursive", "Code"]
 
@@ -205,7 +206,7 @@ def _iadd(I1, I2, L):
 
 # ------------------------------------------------------------------ the normalised tree
 
-class Joint:
+class Joint(Record):
     """One body and its joint, in world-frame terms (topological order): parent index (-1:
     the ground), kind, joint placement (at, rot), axis, mass, com, inertia about the COM
     (3x3 or None), the user's coordinate index `col` and, for absolute planar angles, the
@@ -213,10 +214,6 @@ class Joint:
 
     __slots__ = ("name", "parent", "kind", "at", "rot", "axis", "mass", "com", "inertia",
                  "col", "ka")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
 
 _I3 = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]

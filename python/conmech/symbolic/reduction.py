@@ -26,7 +26,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
-from . import lagrangian_system
+from .constructors import lagrangian_system
 from .derive import _quadratic_parts
 from .momenta import LagrangianSystem, _build, analysis, is_zero, to_user
 from .quadrature import cumulative_dense

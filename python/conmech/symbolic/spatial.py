@@ -32,6 +32,7 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from .tree import _Code, _check_tree, _derive, _expr, _force_list, _forces_at
+from .pipeline import _construct, _tup
 
 __all__ = ["SpatialBody", "spatial_tree", "build_spatial_tree", "derive_spatial_tree"]
 
@@ -553,7 +554,7 @@ def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=N
                               mass=m, com=(0, 0, -l))]
         sys = spatial_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, 0, -g))
     """
-    from . import _construct, _tup
+    from .pipeline import _construct, _tup
     from .description import description_hit, tree_description_key
     from .tree import _loop_names, _method_key
     # a second construction of the same description loads the model, deriving nothing

@@ -19,6 +19,7 @@ import sympy as sp
 
 from .build import compile_source, load
 from .taylor import event_exprs, event_source
+from .pipeline import model_of
 
 __all__ = ["Event", "event", "compile_events", "DEGREE"]
 
@@ -37,7 +38,6 @@ class Event:
     Calling it evaluates g(t, y) with the system's parameters (compiled on first call)."""
 
     def __init__(self, system, expr, terminal=False, direction=0):
-        from . import model_of
         self.model = model_of(system)
         if self.model.derived.kind != "ode":
             raise ValueError("compiled events need a first-order system made by "
@@ -98,7 +98,6 @@ def compiled_events(fun, events):
         list(events)
     if not evs or not all(isinstance(e, Event) for e in evs):
         return None
-    from . import model_of
     try:
         model = model_of(fun)
     except TypeError:

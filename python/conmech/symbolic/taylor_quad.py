@@ -17,7 +17,8 @@ from decimal import Decimal, localcontext
 import numpy as np
 
 from .. import _conmech
-from .._callback import message_text
+from .._core.callback import message_text
+from .._core.native import function_address
 
 __all__ = ["reference", "QuadResult", "to_pair", "from_pair"]
 
@@ -75,7 +76,6 @@ def reference(system, t_span, y0, tol=1e-30, params=None, max_steps=1_000_000):
     if not taylor or taylor.get("qp") is None:
         raise ValueError("the system has no quadruple-precision Taylor code (a system from "
                          "conmech.symbolic.ode_system with a smooth right-hand side)")
-    from ..compiled import function_address
     n = system.dimension
     y0 = list(y0)
     if len(y0) != n:

@@ -587,7 +587,7 @@ def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
         sys = planar_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, -g),
                           coordinates="absolute")
     """
-    from . import _construct, _tup
+    from .pipeline import _construct, _tup
     from .description import description_hit, tree_description_key
     # a second construction of the same description loads the model, deriving nothing
     dkey = tree_description_key("tree", bodies, params, gravity, forces, loops,

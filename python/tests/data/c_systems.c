@@ -1,4 +1,4 @@
-/* Test systems with conmech's C signatures (python/conmech/compiled.py). */
+/* Test systems with conmech's C signatures (python/conmech/mechanics/compiled.py). */
 #include <math.h>
 
 /* Kepler, y = [x, y, vx, vy], p = [mu] */
@@ -15,7 +15,7 @@ void kepler_jac(double t, const double *y, double *J, const double *p) {
     J[3 + 4*0] = p[0]*3*x*yy/r5;         J[3 + 4*1] = p[0]*(3*yy*yy/r5 - 1/r3);
 }
 
-/* cart pendulum (seed 000, theta from the upright), q = [x, th], p = [M, m, l, g] */
+/* cart pendulum (the lecture notes, theta from the upright), q = [x, th], p = [M, m, l, g] */
 void cart_mass(double t, const double *q, double *M, const double *p) {
     double c = cos(q[1]);
     M[0] = p[0] + p[1]; M[1] = p[1]*p[2]*c; M[2] = p[1]*p[2]*c; M[3] = p[1]*p[2]*p[2];

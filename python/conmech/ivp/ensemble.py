@@ -39,14 +39,14 @@ import numbers
 
 import numpy as np
 
-from . import _conmech
-from ._ivp import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
-from ._ivp import solve_ivp as _solve_ivp
-from ._native import NativeSystem
+from .. import _conmech
+from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
+from .solve import solve_ivp as _solve_ivp
+from .._core.native import NativeSystem, function_address
+from .._core.status import BAD_INPUT
 
 __all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
 
-_CM_BAD_INPUT = -4
 _NOT_RUN = -99
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
@@ -204,7 +204,6 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress):
 def _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps, nthreads):
     """The members in batches of the generated width, batches in OpenMP threads (each
     member's steps are those of its solve_ivp run, bit for bit)."""
-    from .compiled import function_address
     taylor = system.taylor
     n = system.dimension
     y0m = np.broadcast_to(y0a, (m, n)) if y0a.shape[0] == 1 else y0a
@@ -452,7 +451,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         if not isinstance(message, str) else message.strip()
     info = int(info)
     codes = np.asarray(codes, dtype=int)
-    if info == _CM_BAD_INPUT and (codes == _CM_BAD_INPUT).all():
+    if info == BAD_INPUT and (codes == BAD_INPUT).all():
         raise ValueError(message)
     status = np.where(codes >= 0, codes, -1)
     status[codes == _NOT_RUN] = -2

@@ -1,4 +1,4 @@
-"""Argument checks and status mapping shared by the stability routines: each raises a
+"""Argument checks shared by the stability routines and their neighbours: each raises a
 ValueError/TypeError naming the argument."""
 from __future__ import annotations
 
@@ -8,18 +8,11 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
 from .. import _conmech  # noqa: F401
-from .._callback import Guard, as_result, message_text
-from .._native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
+from .callback import Guard, as_result, message_text
+from .native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
 
 def _msg(message):
     return message_text(message)
-
-
-def _raise(info, message):
-    msg = _msg(message)
-    if info == -4:
-        raise ValueError(msg)
-    raise RuntimeError(msg)
 
 
 def _state(y, name="y0"):

@@ -5,8 +5,8 @@ known here (and to :func:`conmech.solve_ivp` and :class:`conmech.Stepper`) witho
 Python edit."""
 from dataclasses import dataclass
 
-from . import _conmech
-from ._callback import message_text
+from .. import _conmech
+from .._core.callback import message_text
 
 __all__ = ["MethodInfo", "METHODS", "BY_NAME", "RK45_SCIPY", "method_info"]
 

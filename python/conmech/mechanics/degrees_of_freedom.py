@@ -7,7 +7,7 @@
   Pfaffian (non-holonomic) constraints do not reduce the degrees of freedom; they reduce
   the independent velocities: ``velocity_dof`` = n - rank [G; A] (the rubber ball rolling
   without slip and spin: 5 degrees of freedom of its configuration, 2 independent
-  velocities, seed 001's count).
+  velocities, the lecture notes' count).
 - A system in generalized coordinates (built-in, compiled or symbolic): its number of
   coordinates (the holonomic constraints are eliminated).
 - A first-order system without mechanical structure: None.
@@ -16,14 +16,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _conmech
-from ._callback import message_text
-from ._native import NativeSystem
+from .. import _conmech
+from .._core.callback import message_text
+from .._core.native import NativeSystem
+from .._core.status import BAD_INPUT
+from .._core.result import Record
 
 __all__ = ["DegreesOfFreedom", "degrees_of_freedom"]
 
 
-class DegreesOfFreedom:
+class DegreesOfFreedom(Record):
     """Result of :func:`degrees_of_freedom`: ``n`` (coordinates), ``n_hol``, ``n_nh``
     (constraints given), ``rank_h``, ``rank_nh`` (independent ones), ``redundant``
     (n_hol + n_nh - rank_h - rank_nh), ``dof`` (n - rank_h), ``velocity_dof``
@@ -32,10 +34,6 @@ class DegreesOfFreedom:
 
     __slots__ = ("n", "n_hol", "n_nh", "rank_h", "rank_nh", "redundant", "dof",
                  "velocity_dof", "q", "residual")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         return (f"DegreesOfFreedom(dof={self.dof}, velocity_dof={self.velocity_dof}, n={self.n}, "
@@ -100,7 +98,7 @@ def _constrained_dof(system, q, t, project, rank_tol):
                                     - int(rank_nh), dof=int(dof), velocity_dof=int(vdof),
                                     q=np.array(qout), residual=float(residual))
         last = message_text(message)
-        if info == -4:
+        if info == BAD_INPUT:
             raise ValueError(last)
     raise RuntimeError(f"degrees_of_freedom: {last} (pass q, a configuration on or near the "
                        "constraint manifold)")

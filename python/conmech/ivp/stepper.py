@@ -27,13 +27,14 @@ import warnings
 
 import numpy as np
 
-from . import _conmech
-from ._callback import Guard, as_result, message_text
-from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput
-from ._checks import initial_state, real_scalar, tolerance
-from ._implicit import jacobian_callback, sparsity_pattern, is_sparse
-from ._methods import BY_NAME, RK45_SCIPY, method_info
-from ._native import NativeSystem
+from .. import _conmech
+from .._core.callback import Guard, as_result, message_text
+from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput
+from .._core.checks import initial_state, real_scalar, tolerance
+from .implicit import jacobian_callback, sparsity_pattern, is_sparse
+from .methods import BY_NAME, RK45_SCIPY, method_info
+from .._core.native import NativeSystem
+from .._core.status import BAD_INPUT
 
 __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4", "Radau",
            "Gauss", "Gauss4", "Gauss6", "method_code", "ConstantDenseOutput"]
@@ -42,7 +43,6 @@ __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4
  _W_Y, _W_FC) = (int(v) - 1 for v in _conmech.flat_stepper_layout())
 _START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
 assert (_I_NJEV, _I_NLU) == (_I_NFEV + 1, _I_NFEV + 2)   # read as one slice
-_CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
 _NO_LIMIT = 2**31 - 1
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
@@ -231,14 +231,14 @@ class Stepper:
             self._jac_cb, self._has_jac, self._jac_const = jacobian_callback(
                 jac, m, (), self._failure)
         info_, message, sizes = self._call(_SIZES)
-        if info_ == _CM_BAD_INPUT:
+        if info_ == BAD_INPUT:
             raise ValueError(message)
         self._r = np.zeros(max(int(sizes[0]), 1))
         self._iv = np.zeros(max(int(sizes[1]), 1), dtype=np.intc)
         self._w = np.zeros((m, max(int(sizes[2]), 1)), order="F")
         self._sizes = tuple(int(s) for s in sizes)
         info_, message, _ = self._call(_START)
-        if info_ == _CM_BAD_INPUT:
+        if info_ == BAD_INPUT:
             raise ValueError(message)
         if info_ < 0:
             self._pending = message      # reported by the first step(), as SciPy would

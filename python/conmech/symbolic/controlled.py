@@ -1,14 +1,20 @@
 """``symbolic.lagrangian_system(L, q, ..., inputs=...)``: a :class:`ControlledSystem` from a
 Lagrangian, with B(q) u in the equations M q'' = Q + B u (B compiled when it depends on q).
+
+Two steps around the uncontrolled derivation: :func:`input_matrix` reads B and the forces
+at u = 0 from ``inputs``; the plant is derived from L with those forces; then
+:func:`controlled_system` attaches B (a constant matrix, or compiled code for B(q)).
 """
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
-from .plant import ControlledSystem
+from ..control.plant import ControlledSystem
+from .build import compile_source, load
+from .codegen import FortranPrinter, _procedure
 
-__all__ = ["controlled_lagrangian"]
+__all__ = ["input_matrix", "controlled_system"]
 
 
 def _as_list(x):
@@ -19,8 +25,8 @@ def _as_list(x):
     return [x]
 
 
-def controlled_lagrangian(L, q, params, forces, inputs, **options):
-    """The plant M q'' = Q + B u from L (see :func:`conmech.symbolic.lagrangian_system`).
+def input_matrix(q, forces, inputs):
+    """(B, forces at u = 0) of M q'' = Q + B u (:func:`conmech.symbolic.lagrangian_system`).
 
     ``inputs`` is one of
     - a list of coordinates (elements of ``q``): each gets its own input (a force or torque
@@ -30,7 +36,6 @@ def controlled_lagrangian(L, q, params, forces, inputs, **options):
       those at u = 0;
     - a sympy Matrix B (ndof x m) in the coordinates and parameters.
     A B that depends on q is compiled with the model (``void B(t, q, b, p)``)."""
-    from ..symbolic import lagrangian_system
     qs = _as_list(q)
     n = len(qs)
     if isinstance(inputs, sp.MatrixBase):
@@ -71,8 +76,15 @@ def controlled_lagrangian(L, q, params, forces, inputs, **options):
         else:
             raise ValueError("inputs must be coordinates of q, input symbols appearing in "
                              "forces, or a matrix B")
+    return bmat, f0
+
+
+def controlled_system(plant, bmat, q, params):
+    """The :class:`ControlledSystem` of ``plant`` (derived with the forces at u = 0) and the
+    input matrix ``bmat`` from :func:`input_matrix`."""
+    qs = _as_list(q)
+    n = len(qs)
     m = bmat.shape[1]
-    plant = lagrangian_system(L, q, params, f0, **options)
     pvals = {}
     for k, v in (params or {}).items():
         pvals[k.name if isinstance(k, sp.Symbol) else str(k)] = float(v)
@@ -100,8 +112,6 @@ def controlled_lagrangian(L, q, params, forces, inputs, **options):
 
 def _compiled_input_matrix(plant, bmat, qs, pvals, m):
     """Generate and compile ``conmech_input_matrix(t, q, b, p)`` for a q-dependent B."""
-    from ..symbolic.codegen import FortranPrinter, _procedure
-    from ..symbolic.build import compile_source, load
     n = len(qs)
     names = list(pvals)
     psyms = [sp.Symbol(f"__p{i}") for i in range(len(names))]

@@ -12,16 +12,18 @@ import warnings
 
 import numpy as np
 
-from . import _conmech
-from ._callback import Guard, as_result, message_text
-from ._checks import event_settings as _event_settings, initial_state as _initial_state, \
+from .. import _conmech
+from .._core.callback import Guard, as_result, message_text
+from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
     real_scalar as _real_scalar, tolerance as _tolerance
-from ._dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSolution
-from ._implicit import jacobian_callback, is_sparse, sparsity_pattern
-from ._methods import METHODS, RK45_SCIPY, method_info
-from ._stepper import method_code
-from ._taylor import with_fixed_order
-from ._native import _NO_SPEC, NativeSystem
+from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSolution
+from .implicit import jacobian_callback, is_sparse, sparsity_pattern
+from .methods import METHODS, RK45_SCIPY, method_info
+from .stepper import method_code
+from .taylor import run_compiled_events, with_fixed_order
+from .._core.native import _NO_SPEC, NativeSystem
+from .._core.result import DictResult
+from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
 
@@ -39,7 +41,6 @@ _MESSAGES = {
     0: "The solver successfully reached the end of the integration interval.",
     1: "A termination event occurred.",
 }
-_CM_BAD_INPUT = -4
 _HUGE = np.finfo(float).max
 # no step limit (SciPy has none): the largest count the Fortran counters hold
 _NO_LIMIT = 2**31 - 1
@@ -52,21 +53,12 @@ _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support int
                     "in a complex domain.")
 
 
-class OdeResult(dict):
+class OdeResult(DictResult):
     """Result of :func:`solve_ivp`: a dict whose keys are also attributes (as SciPy's).
 
     Keys: t, y, sol, t_events, y_events, nfev, njev, nlu, status, message, success,
     and conmech's extras naccept, nreject.
     """
-
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError as exc:
-            raise AttributeError(name) from exc
-
-    __setattr__ = dict.__setitem__
-    __delattr__ = dict.__delitem__
 
     def __repr__(self):
         keys = ("message", "success", "status", "t", "y", "sol", "t_events", "y_events",
@@ -80,9 +72,6 @@ class OdeResult(dict):
             lines.append(f"{k.rjust(width)}: {v!r}" if not isinstance(v, str) else
                          f"{k.rjust(width)}: {v}")
         return "\n".join(lines)
-
-    def __dir__(self):
-        return list(self.keys())
 
 
 class _StopAtStart(Exception):
@@ -538,7 +527,7 @@ def _solve(problem, common, h0, jac, pattern):
         nreject += out["nreject"]
         form = out["form"] or form
         info, message = out["info"], out["message"]
-        if info == _CM_BAD_INPUT and not stop_at_start:
+        if info == BAD_INPUT and not stop_at_start:
             raise ValueError(message)
         if stop_at_start:
             # SciPy: a terminal event zero at t0, moving in its direction, stops there
@@ -695,7 +684,6 @@ class _Run:
         if self.builtin and ne and _compiled_events(self.fun, common["method"], self.settings):
             # Taylor's method with events from conmech.symbolic.event: no Python in the loop
             # (no sampling inside the steps: _compiled_events requires resolution 0)
-            from ._taylor import run_compiled_events
             kw_taylor = {k: v for k, v in kw.items()
                          if k not in ("ev_res", "nnz", "sp_ptr", "sp_idx")}
             counts, form, info, message = run_compiled_events(
@@ -731,7 +719,8 @@ def _compiled_events(fun, code, settings):
         return False
     if any(st[3] > 0 for st in settings):
         return False
-    from .symbolic.taylor_events import compiled_events
+    # conmech.symbolic needs sympy, an optional dependency: imported on this path only
+    from ..symbolic.taylor_events import compiled_events
     return compiled_events(fun, [st[0] for st in settings]) is not None
 
 

@@ -12,10 +12,12 @@ first-order system that runs in Fortran: the flat layer reaches it by a registry
 The constrained systems have the same split (:class:`conmech.constrained.NativeConstrained`,
 ``BuiltinConstrained``, ``CompiledConstrained``).
 """
+import ctypes
+
 import numpy as np
 
-from . import _conmech
-from ._builtin_table import PARAMS, POSITIVE_PARAMS, RANGE_PARAMS
+from .. import _conmech
+from .builtin_table import PARAMS, POSITIVE_PARAMS, RANGE_PARAMS
 
 _PAD = np.zeros(1)
 _NO_SPEC = np.zeros(1, dtype=np.int64)   # spec kind 0: a built-in system, by name
@@ -27,7 +29,8 @@ def _unused_callback(t, y):
     never calls it)."""
     raise RuntimeError("a placeholder call-back of the flat layer was called")
 
-__all__ = ["NativeSystem", "BuiltinSystem", "check_params"]
+
+__all__ = ["NativeSystem", "BuiltinSystem", "check_params", "function_address"]
 
 
 def check_params(name, params):
@@ -156,3 +159,35 @@ class BuiltinSystem(NativeSystem):
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
         return f"conmech.systems.{self.name}({args})"
+
+
+def function_address(f, what: str = "function") -> int:
+    """The address of a compiled function: an int, a ctypes function pointer or
+    ``c_void_p``, a numba ``cfunc`` (its ``address``) or a ``scipy.LowLevelCallable``.
+    None gives 0 (absent)."""
+    if f is None:
+        return 0
+    if isinstance(f, bool):
+        raise TypeError(f"{what} must be a compiled function or an address, got a bool")
+    if isinstance(f, (int, np.integer)):
+        addr = int(f)
+    elif isinstance(f, ctypes._CFuncPtr):
+        addr = ctypes.cast(f, ctypes.c_void_p).value or 0
+    elif isinstance(f, ctypes.c_void_p):
+        addr = f.value or 0
+    elif type(f).__name__ == "LowLevelCallable":
+        cap = tuple.__getitem__(f, 0)   # the PyCapsule (a LowLevelCallable is a tuple)
+        get_name = ctypes.pythonapi.PyCapsule_GetName
+        get_name.restype, get_name.argtypes = ctypes.c_char_p, [ctypes.py_object]
+        get_ptr = ctypes.pythonapi.PyCapsule_GetPointer
+        get_ptr.restype, get_ptr.argtypes = ctypes.c_void_p, [ctypes.py_object,
+                                                              ctypes.c_char_p]
+        addr = get_ptr(cap, get_name(cap)) or 0
+    elif isinstance(getattr(f, "address", None), int):      # numba cfunc
+        addr = f.address
+    else:
+        raise TypeError(f"{what} must be an address (int), a ctypes function, a numba "
+                        f"cfunc or a scipy.LowLevelCallable, got {type(f).__name__}")
+    if addr <= 0:
+        raise ValueError(f"{what} is a null function pointer")
+    return addr

@@ -5,7 +5,7 @@ loaded with ctypes, numba ``cfunc``, ``scipy.LowLevelCallable``).
 The C signatures (matrices column-major, ``p`` the run-time parameter array, so that one
 compiled function serves every parameter value)::
 
-    /* <generated: tools/generate_slots.py signatures> from the table conmech._slot_table */
+    /* <generated: tools/generate_slots.py signatures> from the table conmech._core.slot_table */
     /* first-order systems (kind 'ode', n states) */
     /* dydt = f(t, y; p) */
     void rhs(double t, const double *y, double *dydt, const double *p);
@@ -76,9 +76,11 @@ import os
 
 import numpy as np
 
-from . import _conmech
-from . import _slot_table as _table
-from ._native import NativeSystem
+from .. import _conmech
+from .._core import slot_table as _table
+from .._core.elf import LibraryError, check_library
+from .._core.native import NativeSystem, function_address
+from .._core.status import raise_status
 from .constrained import NativeConstrained
 
 __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
@@ -91,38 +93,6 @@ _SPEC_SIZE = _table.SPEC_SIZE
 _SLOTS = _table.SLOTS                   # function entries by name (conmech_<name>)
 _TAYLOR_SLOTS = _table.TAYLOR_SLOTS     # the Taylor entries of the ``taylor`` dict
 _TAYLOR_FUNCS = _table.TAYLOR_FUNCS
-
-
-def function_address(f, what: str = "function") -> int:
-    """The address of a compiled function: an int, a ctypes function pointer or
-    ``c_void_p``, a numba ``cfunc`` (its ``address``) or a ``scipy.LowLevelCallable``.
-    None gives 0 (absent)."""
-    if f is None:
-        return 0
-    if isinstance(f, bool):
-        raise TypeError(f"{what} must be a compiled function or an address, got a bool")
-    if isinstance(f, (int, np.integer)):
-        addr = int(f)
-    elif isinstance(f, ctypes._CFuncPtr):
-        addr = ctypes.cast(f, ctypes.c_void_p).value or 0
-    elif isinstance(f, ctypes.c_void_p):
-        addr = f.value or 0
-    elif type(f).__name__ == "LowLevelCallable":
-        cap = tuple.__getitem__(f, 0)   # the PyCapsule (a LowLevelCallable is a tuple)
-        get_name = ctypes.pythonapi.PyCapsule_GetName
-        get_name.restype, get_name.argtypes = ctypes.c_char_p, [ctypes.py_object]
-        get_ptr = ctypes.pythonapi.PyCapsule_GetPointer
-        get_ptr.restype, get_ptr.argtypes = ctypes.c_void_p, [ctypes.py_object,
-                                                              ctypes.c_char_p]
-        addr = get_ptr(cap, get_name(cap)) or 0
-    elif isinstance(getattr(f, "address", None), int):      # numba cfunc
-        addr = f.address
-    else:
-        raise TypeError(f"{what} must be an address (int), a ctypes function, a numba "
-                        f"cfunc or a scipy.LowLevelCallable, got {type(f).__name__}")
-    if addr <= 0:
-        raise ValueError(f"{what} is a null function pointer")
-    return addr
 
 
 def _real(name, v):
@@ -390,9 +360,7 @@ def constrained_system(n: int, mass, forces, n_hol: int = 0, n_nh: int = 0, phi=
 
 def _check(info, message):
     if info != 0:
-        msg = bytes(message).decode("ascii", "replace").strip() if not isinstance(
-            message, str) else message.strip()
-        raise ValueError(msg)
+        raise_status(info, message)
 
 
 def evaluate(system: Any, t: float, y: ArrayLike, v: ArrayLike | None = None) -> dict:
@@ -472,7 +440,6 @@ def load_model(path, name: str | None = None) -> CompiledSystem | CompiledConstr
     Taylor routines ``conmech_taylor``, ``conmech_taylor_info``, ... of
     :func:`library_taylor`). The Fortran programs load the same libraries (``sweep
     --model``, conmech_model_library)."""
-    from ._elf import LibraryError, check_library
     path = os.fspath(path)
     try:
         # before dlopen: a truncated library would be mapped past its end (SIGBUS at the

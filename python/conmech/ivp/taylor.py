@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from . import _conmech
+from .. import _conmech
 
 __all__ = ["run_compiled_events", "taylor_order", "with_fixed_order"]
 
@@ -46,7 +46,9 @@ def with_fixed_order(fun, rtol, atol):
         return hit[1]
     if fun.taylor.get("order") == order:
         return fun
-    from .symbolic import model_of
+    # conmech.symbolic (sympy, an optional dependency) is imported on the Taylor paths
+    # only, where the system was made by it
+    from ..symbolic.pipeline import model_of
     try:
         model = model_of(fun)
     except TypeError:
@@ -79,8 +81,8 @@ def _fixed_system(fun, model, order):
 
 def _fixed_library(d, order):
     import ctypes
-    from .symbolic import build
-    from .symbolic.taylor import TaylorUnsupported, ode_decompositions, fixed_order_source
+    from ..symbolic import build    # sympy: see with_fixed_order
+    from ..symbolic.taylor import TaylorUnsupported, ode_decompositions, fixed_order_source
     dec, _, _ = ode_decompositions(d, variational=False)
     if dec is None:
         return None
@@ -104,8 +106,8 @@ def _history_sums(kind):
 
 
 def _library(fun, evs):
-    from .symbolic import model_of
-    from .symbolic.taylor_events import compile_events, expressions
+    from ..symbolic.pipeline import model_of    # sympy: see with_fixed_order
+    from ..symbolic.taylor_events import compile_events, expressions
     model = model_of(fun)
     cache = model.__dict__.setdefault("_taylor_event_libs", {})
     exprs = expressions(evs)
@@ -118,7 +120,7 @@ def _library(fun, evs):
 def run_compiled_events(fun, evs, store, kw, zero_at_start):
     """One segment of solve_ivp with compiled events: the flat call, returning (counts,
     form, info, message) like flat_solve (counts of 5)."""
-    from .symbolic.taylor_events import DEGREE
+    from ..symbolic.taylor_events import DEGREE
     lib = _library(fun, evs)
     ne = len(evs)
     zero = np.array([int(i in zero_at_start) for i in range(ne)], dtype=np.intc)

@@ -23,13 +23,15 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import numpy as np
 
-from . import _conmech
+from .. import _conmech
 from . import degrees_of_freedom as _dof
-from ._builtin_table import CONSTRAINED_NAMES
-from ._callback import Guard, as_result, message_text
-from ._checks import event_settings
-from ._methods import BY_NAME
-from ._native import _NO_SPEC, _unused_callback, check_params
+from .._core.builtin_table import CONSTRAINED_NAMES
+from .._core.callback import Guard, as_result, message_text
+from .._core.checks import event_settings
+from ..ivp.methods import BY_NAME
+from .._core.native import _NO_SPEC, _unused_callback, check_params
+from .._core.result import DictResult
+from .._core.status import BAD_INPUT
 
 __all__ = ["solve", "builtin", "NativeConstrained", "BuiltinConstrained",
            "ConstrainedSystem", "ConstrainedResult", "BUILTIN_NAMES", "PROJECTIONS",
@@ -43,12 +45,11 @@ PROJECTIONS = {"none": 0, "velocity": 1, "position+velocity": 2, "baumgarte": 3}
 # the methods of the Fortran table that constrained_solve runs (codes from the table)
 _METHODS = {name: BY_NAME[name.upper()].code for name in (
     "RK4", "DOPRI5", "RK45", "DOP853", "VERNER98", "VERN9", "RATTLE", "Radau", "RADAU5")}
-_CM_BAD_INPUT = -4
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
 
 
-class ConstrainedResult(dict):
+class ConstrainedResult(DictResult):
     """Result of :func:`solve` (a dict whose keys are also attributes).
 
     Keys: ``t`` (nt,), ``q``, ``v`` and the accelerations ``a`` (also ``accelerations``)
@@ -66,17 +67,6 @@ class ConstrainedResult(dict):
     ``message``, ``success``; with ``events``: ``t_events``, ``q_events``, ``v_events``
     (one array per event function; states (k, n)).
     """
-
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError as exc:
-            raise AttributeError(name) from exc
-
-    __setattr__ = dict.__setitem__
-
-    def __dir__(self):
-        return list(self.keys())
 
     def __repr__(self):
         return (f"ConstrainedResult(success={self.success}, message={self.message!r}, "
@@ -474,7 +464,7 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     ev_guard.check()
     message = message_text(message)
     info = int(info)
-    if info == _CM_BAD_INPUT:
+    if info == BAD_INPUT:
         raise ValueError(message)
     if info < 0 and message.startswith("inconsistent initial position"):
         # a mechanism whose loops cannot close at q0: say which loop (a bad input, not a

@@ -1,0 +1,368 @@
+"""The derive-compile-cache pipeline behind conmech.symbolic's constructors.
+
+A construction is keyed by its inputs (expressions, parameter names, options): a key found
+in the on-disk cache (``$CONMECH_CACHE``, default ``~/.cache/conmech``) loads the library
+built before; otherwise the expressions are derived (``derive.py``), the Fortran emitted
+(``codegen.py``), compiled and loaded (``build.py``), the result stored under the key. The
+:class:`CompiledModel` holds the derivation, the source, the library and the entry points;
+:func:`_system` wraps it as a ``conmech.compiled`` system that the integrators and the
+stability routines run with no Python in the loop.
+"""
+import ctypes
+import errno
+import hashlib
+import os
+import pickle
+import shutil
+import tempfile
+import time
+
+import numpy as np
+import sympy as sp
+
+from ..mechanics import compiled
+from .._core import slot_table as _table
+from .build import (CacheError, _conmech_version, cache_dir, check_private, compile_source,
+                    load)
+from .codegen import CODEGEN_VERSION, generate
+from .derive import _as_value, singular_everywhere
+from .momenta import as_lagrangian_system
+
+__all__ = ["CompiledModel", "compile_model", "save_model", "model_of"]
+
+_D = ctypes.c_double
+_P = ctypes.POINTER(ctypes.c_double)
+_V = ctypes.c_void_p
+
+
+class CompiledModel:
+    """A derived system compiled and loaded: the library, the entry-point addresses, the
+    generated source, and timings (``times``: derive, generate, compile_or_load, load;
+    ``cache_hit``). :meth:`call` evaluates an entry point through ctypes (for tests)."""
+
+    def __init__(self, derived, source, path, lib, addresses, cache_hit, times):
+        self.derived = derived
+        self.source = source
+        self.path = path
+        self.lib = lib
+        self.addresses = addresses
+        self.cache_hit = cache_hit
+        self.times = times
+
+    @property
+    def kind(self):
+        return self.derived.kind
+
+    def _shapes(self, entry):
+        d = self.derived
+        return _table.shapes(entry, d.n, d.n_hol, d.n_nh)
+
+    def _entry(self, entry):
+        """(ctypes function, number of input arrays, output shapes, returns a value) of an
+        entry point, built once per model and entry (pointers passed as addresses)."""
+        cache = self.__dict__.setdefault("_entries", {})
+        e = cache.get(entry)
+        if e is None:
+            if entry not in self.addresses:
+                raise ValueError(f"this model has no entry point '{entry}' "
+                                 f"(has: {', '.join(self.addresses)})")
+            if entry == "jac_prod":
+                fn = ctypes.CFUNCTYPE(None, _D, _V, ctypes.c_int, _V, _V, _V)(
+                    self.addresses[entry])
+                e = (fn, 2, [], False)
+            else:
+                shapes = self._shapes(entry)
+                n_in = _table.BY_NAME[entry].inputs
+                ret = _table.returns_value(entry)
+                fn = ctypes.CFUNCTYPE(_D if ret else None, _D,
+                                      *([_V] * (n_in + len(shapes) + 1)))(
+                    self.addresses[entry])
+                e = (fn, n_in, shapes, ret)
+            cache[entry] = e
+        return e
+
+    def _params(self, params):
+        """The parameter array (the model's values when None), checked: real numbers, as
+        many as the model has."""
+        if params is None:
+            p = self.__dict__.get("_p0")
+            if p is None:
+                p = self._p0 = self._params(list(self.derived.param_values))
+            return p
+        names = self.derived.param_names
+        if not (isinstance(params, np.ndarray) and params.dtype == np.float64):
+            if isinstance(params, (str, bytes)) or any(
+                    isinstance(v, (bool, np.bool_, str, bytes))
+                    for v in np.ravel(np.asarray(params, dtype=object))):
+                raise TypeError(f"params must be {len(names)} real numbers")
+        p = np.ascontiguousarray(params, dtype=float)
+        if p.ndim != 1 or p.size != len(names):
+            raise ValueError(f"params must have {len(names)} values ({', '.join(names)})")
+        return p if p.size else np.zeros(1)
+
+    def call(self, entry, t, *arrays, params=None):
+        """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
+        (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
+        parameters or `params`."""
+        fn, n_in, shapes, ret = self._entry(entry)
+        if entry == "jac_prod":
+            return self._call_jac_prod(fn, t, *arrays, params=params)
+        p = self._params(params)
+        if len(arrays) != n_in:
+            raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
+        n = self.derived.n
+        ins = []
+        for i, a in enumerate(arrays):
+            a = np.ascontiguousarray(a, dtype=float)
+            shape = (n,)
+            if entry == "constraint_hessian" and i == 2:      # the multipliers
+                shape = (self.derived.n_hol + self.derived.n_nh,)
+            if a.shape != shape:
+                raise ValueError(f"input arrays must have shape {shape}, got {a.shape}")
+            ins.append(a)
+        outs = [np.zeros(s, order="F") for s in shapes]
+        r = fn(float(t), *[a.ctypes.data for a in ins], *[o.ctypes.data for o in outs],
+               p.ctypes.data)
+        if ret:
+            return float(r)
+        return outs[0] if len(outs) == 1 else tuple(outs)
+
+    def _call_jac_prod(self, fn, t, y, x, params=None):
+        """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
+        n = self.derived.n
+        p = self._params(params)
+        y = np.ascontiguousarray(y, dtype=float)
+        x = np.asarray(x, dtype=float)
+        vec = x.ndim == 1
+        x = np.asfortranarray(x.reshape(n, -1) if vec else x)
+        if y.shape != (n,) or x.ndim != 2 or x.shape[0] != n or x.shape[1] < 1:
+            raise ValueError(f"jac_prod needs y of shape ({n},) and x of shape ({n}, k)")
+        jx = np.zeros(x.shape, order="F")
+        fn(float(t), y.ctypes.data, x.shape[1], x.ctypes.data, jx.ctypes.data, p.ctypes.data)
+        return jx.ravel() if vec else jx
+
+
+def compile_model(derived, flags=None):
+    """Generate, compile (or take from the cache) and load the Fortran of `derived`."""
+    t0 = time.perf_counter()
+    src, entries = generate(derived)
+    t1 = time.perf_counter()
+    path, hit = compile_source(src, flags, entries)
+    t2 = time.perf_counter()
+    lib, addr = load(path, entries)
+    t3 = time.perf_counter()
+    times = {"generate": t1 - t0, "compile_or_load": t2 - t1, "load": t3 - t2}
+    return CompiledModel(derived, src, path, lib, addr, hit, times)
+
+
+def save_model(system, path, flags=None):
+    """Write the system as a model library to ``path`` (a shared library with the model
+    description of ``conmech_model_library``: its kind, dimensions, parameter names and the
+    system's current parameter values as defaults), for the Fortran programs
+    (``sweep --model PATH``) and :func:`conmech.compiled.load_model`. The library is
+    compiled once (cached like the others), copied to a temporary file beside ``path``,
+    checked, flushed to disk and renamed to ``path``: a failure (a full disk, a read-only
+    directory) raises OSError naming ``path`` and the cause, and leaves no partial file."""
+    model = model_of(system)
+    values = [float(v) for v in np.asarray(getattr(system, "params", None) if not
+                                           isinstance(system, CompiledModel) else
+                                           model.derived.param_values, dtype=float).ravel()]
+    src, entries = generate(model.derived, model_values=values)
+    lib_path, _ = compile_source(src, flags, entries + ["model_info", "model_params",
+                                                       "model_param_names"])
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=".tmp",
+                                   dir=folder)
+        with os.fdopen(fd, "wb") as out, open(lib_path, "rb") as inp:
+            shutil.copyfileobj(inp, out)
+            out.flush()
+            os.fsync(out.fileno())
+        os.chmod(tmp, 0o755 & ~_umask())
+        if os.path.getsize(tmp) != os.path.getsize(lib_path):
+            raise OSError(errno.EIO, "short copy")
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write the model library {path}: "
+                                 f"{exc.strerror or exc}") from None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+    return path
+
+
+def _umask():
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def model_of(system):
+    """The :class:`CompiledModel` (derived expressions, source, library) behind a system
+    made by this module (also after ``with_params``)."""
+    keep = getattr(system, "_keep", None)
+    if isinstance(system, CompiledModel):
+        return system
+    if isinstance(keep, tuple) and keep and isinstance(keep[0], CompiledModel):
+        return keep[0]
+    raise TypeError("not a system made by conmech.symbolic")
+
+
+def _system(model):
+    """The conmech.compiled system for a model."""
+    d = model.derived
+    a = model.addresses
+    common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model,
+                  name="symbolic")
+    if d.kind == "ode":
+        return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
+                                   taylor=compiled.library_taylor(model.lib), **common)
+    if d.kind == "generalized":
+        return as_lagrangian_system(compiled.generalized_system(
+            d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
+            energy=a.get("energy"), mass_forces=a.get("mass_forces"), accel=a.get("accel"),
+            accel_jac=a.get("accel_jac"), **common))
+    return compiled.constrained_system(
+        d.n, a["mass"], a["forces"], n_hol=d.n_hol, n_nh=d.n_nh, phi=a.get("phi"),
+        phi_jac=a.get("phi_jac"), phi_t=a.get("phi_t"), phi_gamma=a.get("phi_gamma"),
+        nh_matrix=a.get("nh_matrix"), nh_gamma=a.get("nh_gamma"), energy=a.get("energy"),
+        rheonomic=bool(d.rheonomic), forces_jac=a.get("forces_jac"),
+        constraint_hessian=a.get("constraint_hessian"),
+        redundant=bool(getattr(d, "loops", None)), **common)
+
+
+def _input_key(kind, inputs, params, options):
+    """Key of a construction's inputs (expressions, parameter names, options), or None when
+    the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
+    if not isinstance(params, dict):
+        return None
+    names = []
+    for k, v in params.items():
+        if isinstance(k, sp.Symbol):
+            names.append(k.name)
+        elif isinstance(k, str):
+            names.append(k)
+        else:
+            return None
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+            return None
+    try:
+        text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
+                            for x in inputs], names, options, CODEGEN_VERSION,
+                     _conmech_version()))
+    except (sp.SympifyError, TypeError, AttributeError):
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _entry_path(key):
+    return os.path.join(cache_dir(), f"conmech_{key}.derived.pickle")
+
+
+def _from_cache(key, params, flags):
+    """The model from the derivation cache (derived record + source), or None."""
+    path = _entry_path(key)
+    if not os.path.isfile(path):
+        return None
+    t0 = time.perf_counter()
+    try:
+        with open(path, "rb") as fh:
+            # unpickling runs code: only from a file nobody else can write
+            check_private(os.path.dirname(path), os.stat(os.path.dirname(path)))
+            check_private(path, os.fstat(fh.fileno()))
+            d, src, entries, fl = pickle.load(fh)
+    except CacheError:
+        raise
+    except Exception:        # a stale or corrupt entry: derive again
+        return None
+    if fl != (list(flags) if flags is not None else None):
+        return None
+    if len(params) != len(d.param_names):
+        return None
+    # the same checks as the derivation: a value out of range is a ValueError naming it
+    d.param_values = [_as_value(n, v) for n, v in zip(d.param_names, params.values())]
+    t1 = time.perf_counter()
+    lib_path, hit = compile_source(src, flags, entries)
+    t2 = time.perf_counter()
+    lib, addr = load(lib_path, entries)
+    t3 = time.perf_counter()
+    times = {"derive": 0.0, "derived_cache": t1 - t0, "generate": 0.0,
+             "compile_or_load": t2 - t1, "load": t3 - t2}
+    return CompiledModel(d, src, lib_path, lib, addr, hit, times)
+
+
+def _store(key, model, flags):
+    path = _entry_path(key)
+    d = model.derived
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=os.path.dirname(path))
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump((d, model.source, list(model.addresses),
+                         list(flags) if flags is not None else None), fh)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except Exception:        # the derivation cache is an optimisation only
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+
+
+def _check_compiled_mass(model):
+    """Large systems: the singularity check of the mass matrix on the compiled code (random
+    states, the given and perturbed parameter values)."""
+    rng = np.random.default_rng(12345)
+    d = model.derived
+
+    def mass_at(trial):
+        p = np.asarray(d.param_values, float)
+        if trial:
+            p = np.where(p != 0, p*rng.uniform(0.7, 1.3, p.size), rng.uniform(0.5, 1.5, p.size))
+        with np.errstate(all="ignore"):
+            return model.call("mass", rng.uniform(0.3, 1.3), rng.uniform(-1, 1, d.n), params=p)
+    if singular_everywhere(mass_at, d.n, rng):
+        raise ValueError("the mass matrix is singular at every sampled state (det M = 0): a "
+                         "coordinate has no kinetic energy, or the coordinates are dependent")
+
+
+def _construct(kind, inputs, params, options, derive, flags, model_only, description=None):
+    """Derive (or take the derivation from the cache), compile (or load), wrap.
+    `description`: the key of the cheap description (symbolic/description.py) to record
+    for the next construction of the same system."""
+    t0 = time.perf_counter()
+    params = {} if params is None else params
+    key = _input_key(kind, inputs, params, options)
+    model = _from_cache(key, params, flags) if key else None
+    if model is None:
+        d = derive()
+        t1 = time.perf_counter()
+        model = compile_model(d, flags)
+        model.times["derive"] = t1 - t0
+        if d.kind != "ode" and d.n > 4:
+            _check_compiled_mass(model)
+        if key:
+            _store(key, model, flags)
+    if description and key:
+        from .description import store_description
+        store_description(description, key, params)
+    model.times["total"] = time.perf_counter() - t0
+    return model if model_only else _system(model)
+
+
+def _tup(x):
+    """A sympy Tuple of a list of expressions (for the input key)."""
+    if x is None:
+        return None
+    if isinstance(x, sp.MatrixBase):
+        x = list(x)
+    if isinstance(x, (list, tuple)):
+        return sp.Tuple(*x)
+    return x
