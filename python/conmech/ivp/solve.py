@@ -369,7 +369,7 @@ def _refuse_taylor(fun):
     """ValueError naming why a compiled system has no Taylor recurrences, when the model
     says so (a generalized system M(q) q'' = Q); other systems are refused by the Fortran
     stepper with its own message."""
-    from .symbolic import model_of
+    from ..symbolic import model_of
     try:
         kind = getattr(model_of(fun).derived, "kind", None)
     except TypeError:

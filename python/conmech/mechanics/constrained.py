@@ -470,7 +470,7 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         # a mechanism whose loops cannot close at q0: say which loop (a bad input, not a
         # failed integration)
         try:
-            from .symbolic.loops import closure_error
+            from ..symbolic.loops import closure_error
         except ImportError:         # no sympy: no symbolic mechanism either
             closure_error = None
         err = closure_error(system, q0, t0) if closure_error is not None else None
