@@ -49,6 +49,11 @@ _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
 _PAD.flags.writeable = False
 _PADI.flags.writeable = False
+_EMPTY = np.zeros(0)
+_EMPTY.flags.writeable = False
+# the room for the points of a run returned without a call-back (_solve_native): numbers
+# of t and y (4 kB; a run with more points hands them over through a call-back)
+_OUT_DOUBLES = 512
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -314,7 +319,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
 
     # ---------------------------------------------------------------- t_eval
     if t_eval is None:
-        t_ev = _PAD[:0]
+        t_ev = _EMPTY
     else:
         try:
             t_ev = np.asarray(t_eval)
@@ -347,6 +352,10 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
             fun = with_fixed_order(fun, rtol, atol)
         else:
             _refuse_taylor(fun)
+    if builtin and not settings and not dense_output and jac is None and pattern is None:
+        # the common case (a compiled system, nothing called back): one Fortran call
+        return _solve_native(fun, t0, tf, y0, t_ev, t_eval is not None, code, rtol_v,
+                             atol_v, h0, hmax, int(max_steps))
     problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
                    t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
                    settings=settings, vectorized=bool(vectorized))
@@ -565,6 +574,49 @@ def _solve(problem, common, h0, jac, pattern):
 
     return _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, problem["dense"], form,
                      status, message, nfev, naccept, nreject)
+
+
+def _solve_native(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax,
+                  max_steps):
+    """solve_ivp of a built-in or compiled system without events or dense output (checked
+    arguments): the result of :func:`_solve` for such a run, from one call of
+    flat_solve_native, which returns the points in arrays sized here (t_eval's length,
+    else room for _OUT_DOUBLES numbers) and calls ``store`` back only when a run has more."""
+    n = y0.size
+    neval = t_ev.size
+    cap = neval if with_t_eval else max(_OUT_DOUBLES // (n + 1), 2)
+    out = []
+
+    def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
+        # more points than cap: the arrays wrap Fortran memory that is freed on return
+        out.append(t.copy())
+        out.append(y.reshape(n, t.size).copy())
+
+    t_out, y_out, nt, counts, info, message = _conmech.flat_solve_native(
+        *fun._flat_args(), store, t0, tf, y0, code, rtol, atol, h0, hmax,
+        max_steps, neval, t_ev if neval else _PAD, cap)
+    info = int(info)
+    if info == BAD_INPUT:
+        raise ValueError(message_text(message))
+    if nt < 0:
+        t, y = out
+    elif nt > 0:
+        t, y = t_out[:nt].copy(), y_out[:, :nt].copy()
+    else:               # no point stored: a run refused before its first step
+        t, y = np.array([t0]), y0[:, None].copy()
+    if tf == t0 and not with_t_eval:
+        # SciPy's solver makes one (empty) step: t = [t0, t0]
+        t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)
+    elif with_t_eval and t.size == 0:
+        t, y = [], []          # SciPy's lists when no point of t_eval was reached
+    nfev, njev, nlu, naccept, nreject = counts.tolist()
+    if info >= 0:
+        status, message = info, _MESSAGES.get(info) or message_text(message)
+    else:
+        status, message = -1, message_text(message)
+    return OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None, nfev=nfev,
+                     njev=njev, nlu=nlu, status=status, message=message,
+                     success=status >= 0, naccept=naccept, nreject=nreject)
 
 
 def _drop_first_point(out, with_t_eval):

@@ -26,6 +26,7 @@ module conmech_flat_ode_support
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
+    public :: solve_into, store_result
     public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
@@ -148,21 +149,53 @@ contains
         external :: events, store
         integer(c_int), intent(out) :: counts(5), dense_form, info
         character(len=*), intent(out) :: message
+        type(ode_result) :: res
+
+        dense_form = 0
+        call solve_into(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
+                        max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
+                        jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events)
+        if (.not. allocated(res%t)) return          ! refused before any integration
+        call store_result(res, n, dense /= 0, store, dense_form)
+    end subroutine run_solve
+
+    !> The integration of `run_solve` without the transfer of its outputs: `ode_solve` from
+    !! plain arguments (arguments as there) into res; counts = [nfev, njev, nlu, naccept,
+    !! nreject]; info and message the run's status (res%t unallocated when the arguments
+    !! were refused before the run). `events` may be absent when ne = 0.
+    subroutine solve_into(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
+                          max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
+                          jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events)
+        class(ode_system), intent(in) :: sys
+        integer(c_int), intent(in) :: n
+        real(c_double), intent(in) :: t_span(2)
+        real(c_double), intent(in) :: y0(n)
+        integer(c_int), intent(in) :: method
+        real(c_double), intent(in) :: rtol(n), atol(n)
+        real(c_double), intent(in) :: first_step, max_step
+        integer(c_int), intent(in) :: max_steps, dense, neval
+        real(c_double), intent(in) :: t_eval(max(neval, 1))
+        integer(c_int), intent(in) :: ne
+        integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+        real(c_double), intent(in) :: ev_res(max(ne, 1))
+        integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
+        type(ode_result), intent(out) :: res
+        integer(c_int), intent(out) :: counts(5), info
+        character(len=*), intent(out) :: message
+        external :: events
+        optional :: events
 
         type(ode_options) :: opt
-        type(ode_result) :: res
         type(callback_events), allocatable :: ev
         real(dp), allocatable :: te(:)
         class(ode_stepper), allocatable :: stp
         character(len=:), allocatable :: msg
-        real(c_double) :: empty1(0), empty3(n, 1, 0)
-        integer :: nseg, nf1, sinfo
+        integer :: sinfo
         integer(c_int) :: nfev
 
         nfev = 0
         counts = 0
-        dense_form = 0
-        if (n < 1 .or. neval < 0 .or. ne < 0) then
+        if (n < 1 .or. neval < 0 .or. ne < 0 .or. (ne > 0 .and. .not. present(events))) then
             info = CM_BAD_INPUT
             call copy_message("bad input: array sizes must be positive", message)
             return
@@ -207,10 +240,22 @@ contains
                   res%stats%nreject]
         info = res%status
         call copy_message(res%message, message)
+    end subroutine solve_into
 
+    !> Hand the whole result of a run to `store` (conventions of `run_solve`); dense_form
+    !! as there.
+    subroutine store_result(res, n, dense, store, dense_form)
+        type(ode_result), intent(in) :: res
+        integer(c_int), intent(in) :: n
+        logical, intent(in) :: dense
+        external :: store
+        integer(c_int), intent(out) :: dense_form
+        real(c_double) :: empty1(0), empty3(n, 1, 0)
+        integer :: nseg, nf1
         nseg = 0
         nf1 = 1
-        if (opt%dense_output .and. allocated(res%sol%ts)) then
+        dense_form = 0
+        if (dense .and. allocated(res%sol%ts)) then
             nseg = res%sol%nseg
             nf1 = res%sol%nf + 1
             dense_form = res%sol%form
@@ -225,7 +270,7 @@ contains
                        res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), empty1, empty1, &
                        empty3, n, res%nt, res%nev, 0, 1)
         end if
-    end subroutine run_solve
+    end subroutine store_result
 
     !> SciPy's initial step (scipy.integrate._ivp.common.select_initial_step, Hairer's
     !! heuristic with RMS norms): two right-hand side evaluations, counted in nfev.

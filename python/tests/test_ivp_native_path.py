@@ -1,0 +1,99 @@
+"""solve_ivp's short path for a compiled system (no events, no dense output: one Fortran
+call, points returned without a call-back when they fit) gives the result of the general
+path bit for bit: same points, states, counts, status and message. The general path (the
+segments, the callbacks and the store call-back of flat_solve) is what solve_ivp ran for
+such a call before the short path, reached here by standing in for the short path."""
+import numpy as np
+import pytest
+
+import conmech
+from conmech.ivp import solve as solve_mod
+
+KEPLER_Y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
+
+
+def _general(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax, max_steps):
+    problem = dict(fun=fun, builtin=True, args=(), t0=t0, tf=tf, y0=y0, t_ev=t_ev,
+                   with_t_eval=with_t_eval, dense=False, settings=[], vectorized=False)
+    common = dict(method=code, rtol=rtol, atol=atol, max_step=hmax, max_steps=max_steps,
+                  dense=0)
+    return solve_mod._solve(problem, common, h0, None, None)
+
+
+def _both(fun, t_span, y0, **kw):
+    fast = conmech.solve_ivp(fun, t_span, y0, **kw)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(solve_mod, "_solve_native", _general)
+        full = conmech.solve_ivp(fun, t_span, y0, **kw)
+    return fast, full
+
+
+def _same(fast, full):
+    assert fast.t_events is None and full.t_events is None
+    for key in ("status", "message", "success", "nfev", "njev", "nlu", "naccept",
+                "nreject"):
+        assert fast[key] == full[key], key
+    assert fast.sol is None
+    if isinstance(full.t, list):
+        assert fast.t == [] and fast.y == []
+        return
+    assert fast.t.shape == full.t.shape and np.array_equal(fast.t, full.t)
+    assert fast.y.shape == full.y.shape and np.array_equal(fast.y, full.y)
+    assert fast.y.flags.c_contiguous and fast.y.flags.writeable
+
+
+@pytest.mark.parametrize("method", ["RK45", "DOPRI5", "DOP853", "VERNER98", "Radau"])
+def test_short_run_identical(method):
+    fast, full = _both(conmech.systems.kepler(1.0), (0.0, 0.3), KEPLER_Y0, method=method,
+                       rtol=1e-8, atol=1e-10)
+    assert fast.status == 0 and fast.t.size >= 3
+    _same(fast, full)
+
+
+def test_more_points_than_the_room_identical():
+    # more points than the arrays of the single call hold: handed over by the call-back
+    k = conmech.systems.kepler(1.0)
+    fast, full = _both(k, (0.0, 20.0), KEPLER_Y0, method="DOP853", rtol=1e-11, atol=1e-11)
+    assert fast.t.size > solve_mod._OUT_DOUBLES // 5
+    _same(fast, full)
+
+
+def test_t_eval_backwards_and_fixed_step_identical():
+    k = conmech.systems.kepler(1.0)
+    _same(*_both(k, (0.0, 5.0), KEPLER_Y0, method="DOP853",
+                 t_eval=np.linspace(0.0, 5.0, 11), rtol=1e-9))
+    _same(*_both(k, (2.0, -1.0), KEPLER_Y0, method="VERNER98", rtol=1e-9, atol=1e-9))
+    _same(*_both(k, (0.0, 1.0), KEPLER_Y0, method="GAUSS6", first_step=0.1))
+    _same(*_both(k, (0.0, 1.0), KEPLER_Y0, method="RK4", first_step=0.05))
+
+
+def test_zero_span_failure_and_stiff_identical():
+    k = conmech.systems.kepler(1.0)
+    fast, full = _both(k, (1.0, 1.0), KEPLER_Y0, method="DOP853")
+    assert fast.t.tolist() == [1.0, 1.0]
+    _same(fast, full)
+    fast, full = _both(k, (0.0, 10.0), KEPLER_Y0, method="DOP853", max_steps=5)
+    assert fast.status == -1 and fast.message
+    _same(fast, full)
+    vdp = conmech.systems.vanderpol(mu=1000.0)
+    fast, full = _both(vdp, (0.0, 3000.0), [2.0, 0.0], method="Radau", rtol=1e-6,
+                       atol=1e-6)
+    assert fast.njev > 0 and fast.nlu > 0
+    _same(fast, full)
+
+
+def test_bad_input_raises_the_same():
+    k = conmech.systems.kepler(1.0)
+    for kw in (dict(method="RK4"), dict(rtol=-1.0), dict(max_step=0.0),
+               dict(method="TAYLOR")):
+        with pytest.raises(ValueError) as fast:
+            conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(solve_mod, "_solve_native", _general)
+            with pytest.raises(ValueError) as full:
+                conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
+        assert str(fast.value) == str(full.value)
+    with pytest.raises(ValueError, match="finite"):
+        conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.nan, 0.0, 1.0])
+    with pytest.raises(ValueError, match="finite"):
+        conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.inf] + [0.0] * 2)
