@@ -52,8 +52,8 @@ _PADI.flags.writeable = False
 _EMPTY = np.zeros(0)
 _EMPTY.flags.writeable = False
 # the room for the points of a run returned without a call-back (_solve_native): numbers
-# of t and y (4 kB; a run with more points hands them over through a call-back)
-_OUT_DOUBLES = 512
+# of t and y (2 kB; a run with more points hands them over through a call-back)
+_OUT_DOUBLES = 256
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -234,7 +234,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                             "parameters to the factory in conmech.systems")
     else:
         args = ()
-    unknown = [k for k in options if k not in _OPTION_NAMES]
+    unknown = [k for k in options if k not in _OPTION_NAMES] if options else ()
     if unknown:
         raise TypeError(f"solve_ivp() got unexpected keyword arguments: {', '.join(unknown)}")
 
@@ -247,12 +247,11 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     elif not isinstance(method, str):
         raise TypeError(f"method must be a string, one of {', '.join(_METHODS)}")
     else:
-        code = _METHOD_CODES.get(method.upper(), 0)
+        upper = method.upper()
+        code = _RK45_SCIPY if upper == "RK45" else _METHOD_CODES.get(upper, 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
-    if isinstance(method, str) and method.upper() == "RK45":
-        code = _RK45_SCIPY
-    elif isinstance(method, type) and method.__module__.startswith("scipy.integrate") \
+    if isinstance(method, type) and method.__module__.startswith("scipy.integrate") \
             and method.__name__ == "RK45":
         code = _RK45_SCIPY      # SciPy's own RK45: its step control, as the name "RK45"
     info = method_info(code)
@@ -299,7 +298,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     elif not 1 <= max_steps <= _NO_LIMIT:
         raise ValueError("max_steps must be positive (and below 2**31)")
     sparsity = options.get("jac_sparsity")
-    unused = sorted(k for k in options if not (k == "jac_sparsity" and info.uses_jacobian))
+    unused = sorted(k for k in options if not (k == "jac_sparsity" and info.uses_jacobian)) \
+        if options else []
     if jac is not None and not info.uses_jacobian:
         unused.append("jac")
         _check_jac_value(jac, n)
