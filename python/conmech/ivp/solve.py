@@ -52,8 +52,8 @@ _PADI.flags.writeable = False
 _EMPTY = np.zeros(0)
 _EMPTY.flags.writeable = False
 # the room for the points of a run returned without a call-back (_solve_native): numbers
-# of t and y (2 kB; a run with more points hands them over through a call-back)
-_OUT_DOUBLES = 256
+# of t and y (8 kB; a run with more points hands them over through a call-back)
+_OUT_DOUBLES = 1024
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 

@@ -198,6 +198,7 @@ class Stepper:
         self._r = np.zeros(1)
         self._iv = np.zeros(1, dtype=np.intc)
         self._cached = {}
+        self._step_call = None
         if n == 0:
             # nothing to integrate: SciPy's solver evaluates fun once and finishes at the
             # first step (t = t_bound)
@@ -338,10 +339,20 @@ class Stepper:
             self.status = "finished"
             return None
         t = self.t
-        info, message, _ = self._call(_STEP)
-        if info != 0:
-            self.status = "failed"
-            return message
+        # the step's call inlined (its routine and arguments built once): a step of a
+        # compiled system is a few microseconds, of which Python's calls are a good part
+        call = self._step_call
+        if call is None:
+            call = self._step_call = self._positional(_STEP)
+        sizes, info, message = call[0](*call[1])
+        if info or self._failure or self._guard.error is not None:
+            info, message, _ = self._after(_STEP, sizes, info, message)
+            if info != 0:
+                self.status = "failed"
+                return message
+        else:
+            self.nfev, self.njev, self.nlu = self._iv[_I_NFEV:_I_NLU + 1].tolist()
+            self.t = self._r.item(_R_T)
         self.t_old = t
         if self.direction*(self.t - self.t_bound) >= 0:
             self.status = "finished"
