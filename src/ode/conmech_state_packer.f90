@@ -164,6 +164,18 @@ contains
     subroutine item_real(p, x)
         class(state_packer), intent(inout) :: p
         real(dp), intent(inout) :: x
+        ! in place with room (every step of the Python steppers): straight to the entry
+        if (p%inplace .and. p%info == CM_SUCCESS .and. p%mode /= PACK_COUNT) then
+            if (p%nr < size(p%rx)) then
+                p%nr = p%nr + 1
+                if (p%mode == PACK_READ) then
+                    x = p%rx(p%nr)
+                else
+                    p%rx(p%nr) = x
+                end if
+                return
+            end if
+        end if
         if (.not. take(p, 1, 0, 0)) return
         p%nr = p%nr + 1
         if (p%inplace) then
@@ -182,6 +194,17 @@ contains
     subroutine item_int(p, k)
         class(state_packer), intent(inout) :: p
         integer, intent(inout) :: k
+        if (p%inplace .and. p%info == CM_SUCCESS .and. p%mode /= PACK_COUNT) then
+            if (p%ni < size(p%ivx)) then
+                p%ni = p%ni + 1
+                if (p%mode == PACK_READ) then
+                    k = p%ivx(p%ni)
+                else
+                    p%ivx(p%ni) = k
+                end if
+                return
+            end if
+        end if
         if (.not. take(p, 0, 1, 0)) return
         p%ni = p%ni + 1
         if (p%inplace) then
