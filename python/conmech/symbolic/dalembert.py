@@ -30,8 +30,10 @@ import numpy as np
 import sympy as sp
 
 from .pipeline import _construct, _system
-from .derive import (Derived, _ae, _cheap_simplify, _check_no_accel, _Coords, _realify,
-                     _resolve_params, _subs_all, _sympify_list, _unify_time)
+from .inputs import (_ae, _check_no_accel, _Coords, _realify, _resolve_params, _subs_all,
+                     _sympify_list, _unify_time)
+from .record import Derived
+from .simplify import _cheap_simplify
 from .momenta import LagrangianSystem, is_zero, to_user
 
 __all__ = ["dalembert_system", "DAlembertSystem", "derive_dalembert"]

@@ -12,8 +12,9 @@ coordinates, v^T M v / 2 + U).
 """
 import sympy as sp
 
-from .derive import (Derived, _ae, _check_mass, _check_no_accel, _Coords, _realify,
-                     _resolve_params, _subs_all, _sympify_list, _unify_time)
+from .inputs import (_ae, _check_mass, _check_no_accel, _Coords, _realify, _resolve_params,
+                     _subs_all, _sympify_list, _unify_time)
+from .record import Derived
 
 __all__ = ["derive_direct"]
 

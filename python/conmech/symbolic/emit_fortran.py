@@ -47,8 +47,11 @@ import re
 
 import sympy as sp
 
-from .codegen import (FortranPrinter, assignments, check_source, comment_lines, comment_text,
-                      product_lines, product_terms)
+from .record import Derived
+from .taylor import emitted_taylor
+from .printer import FortranPrinter, assignments, product_lines, product_terms
+from .source_text import check_source, comment_lines, comment_text
+from .tree_print import aba_lines
 
 __all__ = ["emit", "fortran_name_check"]
 
@@ -232,7 +235,6 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     """Fortran source (str) of a standalone module for the derived system `d` whose main
     type is called `name` (module `module`, default NAME_model). `source` is named in the
     header comment (e.g. the model file)."""
-    from .derive import Derived
     if not isinstance(d, Derived):
         raise TypeError("emit: expected a conmech.symbolic.derive.Derived record")
     if d.kind not in ("ode", "generalized", "constrained"):
@@ -303,7 +305,6 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                   f"        procedure :: rhs_jacobian_product => {name}_rhs_jacobian_product",
                   f"        procedure :: has_jacobian_product => {name}_has_jacobian_product"]
         pr = em.printer()
-        from .taylor import emitted_taylor
         tbind, tprocs, _ = emitted_taylor(name, d, pr.names)
         lines += tbind + [f"    end type {name}", ""]
         # the type-bound taylor_jet calls one private helper per kind (system, variational)
@@ -501,7 +502,6 @@ def _gen_rhs(em, name, pry, d):
     n = d.n
     if getattr(d, "aba", None) is not None:
         # a planar tree (conmech.symbolic.planar_tree): the articulated-body algorithm
-        from .tree import aba_lines
         decl, lines = aba_lines(pry, d, "a", _IND)
         return (["    !> y' = [v, a], a = M^-1 Q by the articulated-body algorithm (O(n), no "
                  "matrix;", "    !! non-finite if M is not positive definite).",

@@ -39,7 +39,9 @@ ValueError naming the loop that cannot close).
 import numpy as np
 import sympy as sp
 
-from .recursive import _add, _cross, _dot
+from .kinematics import _add, _cross, _dot, relative
+from .printer import _decl_temps, assignments
+from .tree_print import SC_DECL, pos_call
 from .pipeline import model_of
 
 __all__ = ["Loop", "PointForce", "consistent_state"]
@@ -322,7 +324,6 @@ class _LoopCode:
                 self.G.append(row)
                 # the relative angle: theta = sum of the relative revolute angles on the path
                 if qrel is None:
-                    from .recursive import relative
                     qrel = relative(joints, d.coords)
                 row, th = {}, 0
                 for sgn, k in ((1, kb_), (-1, ka_)):
@@ -365,11 +366,9 @@ class _LoopCode:
         return out
 
     def procedures(self, em, n, npar):
-        from .codegen import assignments, _decl_temps
         I = "        "
         T = f"{I}real(dp), value, intent(in) :: t"
         P = f"{I}real(dp), intent(in) :: p({npar})"
-        from .tree_fortran import SC_DECL, pos_call
         W = f"{I}type(tree_work) :: w\n{SC_DECL}"
         h = len(self.phi)
         out = []
@@ -552,7 +551,6 @@ def closure_error(system, q0, t0=0.0):
     ValueError that names the loop with the largest residual and that residual. Used by
     :func:`conmech.constrained.solve` when the initial projection onto the loop
     constraints fails."""
-    from . import model_of
     try:
         model = model_of(system)
     except TypeError:

@@ -31,6 +31,13 @@ import os
 import xml.etree.ElementTree as ET
 
 import numpy as np
+import sympy as sp
+from sympy.physics.mechanics import dynamicsymbols
+
+from .description import urdf_description_key
+from .description_lookup import description_hit
+from .spatial import SpatialBody
+from .trees import spatial_tree
 
 __all__ = ["Robot", "UrdfJoint", "read_urdf", "from_urdf"]
 
@@ -104,9 +111,6 @@ class Robot:
             Further keyword arguments, passed to :func:`conmech.symbolic.spatial_tree`
             (method, jacobian, loops, point_forces, flags, model_only, ...).
         """
-        import sympy as sp
-        from .spatial import spatial_tree
-        from sympy.physics.mechanics import dynamicsymbols
         t = dynamicsymbols._t
         n = len(self.joints)
         vals = {}
@@ -163,7 +167,6 @@ def from_urdf(source, allow_massless=False, **kw):
     A second call with the same document and arguments (in any process) loads the
     compiled model from the cache without parsing into sympy or deriving anything
     (``conmech.symbolic.description``)."""
-    from .description import description_hit, urdf_description_key
     text, origin = _text(source)
     dkey = urdf_description_key(text, allow_massless, kw)
     hit = description_hit(dkey, kw.get("flags"), bool(kw.get("model_only", False)))
@@ -285,9 +288,6 @@ def read_urdf(source, allow_massless=False, _source_name=None):
     """Parse and validate a URDF document (a path or the XML text); returns a
     :class:`Robot` (see the module docstring). Every problem is a ValueError naming the
     element, found before anything is derived."""
-    import sympy as sp
-    from sympy.physics.mechanics import dynamicsymbols
-    from .spatial import SpatialBody
     text, origin_name = _text(source)
     origin_name = _source_name or origin_name
     try:
@@ -444,7 +444,6 @@ def _num(x):
     """A number for the bodies' data: exact 0, 1 and -1 where the value is one of them to
     round-off (cos(pi/2) = 6e-17 of an rpy rotation would otherwise cost multiplications
     in the generated code), else the float."""
-    import sympy as sp
     for k in (0, 1, -1):
         if abs(x - k) <= 1e-14:
             return sp.Integer(k)
