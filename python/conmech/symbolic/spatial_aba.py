@@ -3,7 +3,7 @@ definitions (3-D joints about an axis, Rodrigues' rotation; the planar version i
 :mod:`conmech.symbolic.tree_aba`)."""
 import sympy as sp
 
-from .tree_aba import _Code
+from .tree_aba import _Code, _check_pivot
 
 
 def _mm(A, B):
@@ -89,12 +89,7 @@ def _spatial_aba(order, index, data, qs, vs, tau, g, trig=None):
         IA, pA, S = sym6(kb["IA"], "ia"), lv(kb["pA"], "pa"), kb["S"]
         U = lv(_mv(IA, S), "u")
         D = L(sp.Add(*[x*y for x, y in zip(S, U)]), "d", force=True)
-        if D.is_Number:
-            if not D > 0:
-                raise ValueError(f"body '{b.name}': the articulated inertia of its joint is "
-                                 f"{D}: the mass matrix is not positive definite")
-        else:
-            code.positive(D)
+        _check_pivot(code, D, b.name)
         Dinv = L(1/D, "di")
         u = L(tau[index[b.name]] - sp.Add(*[x*y for x, y in zip(S, pA)]), "uu")
         kb.update(U=U, Dinv=Dinv, u=u)

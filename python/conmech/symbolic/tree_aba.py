@@ -5,6 +5,19 @@ and tree_aba evaluate."""
 import sympy as sp
 
 
+
+def _check_pivot(code, D, body):
+    """The articulated inertia D of the joint of `body`: a number must be positive (else the
+    mass matrix is not positive definite: ValueError naming the body), an expression is
+    marked as a pivot that the generated code checks."""
+    if D.is_Number:
+        if not D > 0:
+            raise ValueError(f"body '{body}': the articulated inertia of its joint is "
+                             f"{D}: the mass matrix is not positive definite")
+    else:
+        code.positive(D)
+
+
 def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
     """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs
     (`trig`: {body name: (cos, sin) symbols} of the joint angles computed elsewhere)."""
@@ -75,12 +88,7 @@ def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
         S = sp.Matrix(kb["S"])
         U = [L(x, "u") for x in IA*S]
         D = L(sum(S[j]*U[j] for j in range(3)), "d", force=True)
-        if D.is_Number:
-            if not D > 0:
-                raise ValueError(f"body '{b.name}': the articulated inertia of its joint is "
-                                 f"{D}: the mass matrix is not positive definite")
-        else:
-            code.positive(D)
+        _check_pivot(code, D, b.name)
         Dinv = L(1/D, "di")
         u = L(tau[b.name] - sum(S[j]*pA[j] for j in range(3)), "uu")
         kb.update(U=U, Dinv=Dinv, u=u)
