@@ -30,6 +30,9 @@ import hashlib
 import json
 import os
 
+import numpy as np
+import sympy as sp
+
 from .build import _conmech_version, _write_atomic, cache_dir
 from .codegen import CODEGEN_VERSION
 
@@ -44,8 +47,6 @@ class _NotPlain(Exception):
 def _plain(x):
     """A canonical, process-independent representation of x (nested tuples of tagged
     strings); _NotPlain for what has none."""
-    import numpy as np
-    import sympy as sp
     if x is None or isinstance(x, (bool, str)):
         return (type(x).__name__, x)
     if isinstance(x, (int, np.integer)):
@@ -80,8 +81,6 @@ def _param_names(params):
     the key although the generated code does not depend on them: the checks of the
     ordinary path that depend on them (a negative mass, a leaf without inertia) then run
     for every new set of values."""
-    import numpy as np
-    import sympy as sp
     if params is None:
         return ()
     if not isinstance(params, dict):

@@ -3,6 +3,7 @@ trigonometric clean-up (sin^2 + cos^2 = 1, products of sines and cosines into co
 differences), the split of L into its parts quadratic, linear and free in the velocities, and
 the regrouping of sums by their state-dependent factors (parameters collected in front)."""
 import sympy as sp
+from sympy.simplify.fu import TR10i
 
 
 def _cheap_simplify(expr, fixed=None):
@@ -11,7 +12,6 @@ def _cheap_simplify(expr, fixed=None):
     With `fixed` (the parameter symbols), the terms are first grouped by their factors that
     are not parameters, each group's coefficient a placeholder for TR10i (few terms, fast)
     and then put back with its common factors pulled out (:func:`_collect_params`)."""
-    from sympy.simplify.fu import TR10i
     e = sp.expand(expr)
     e = e.replace(lambda u: u.is_Pow and u.exp == 2 and isinstance(u.base, sp.sin),
                   lambda u: 1 - sp.cos(u.base.args[0])**2)

@@ -28,6 +28,7 @@ inertias 6x6 symmetric; D_i = S_i^T IA_i S_i is checked positive: otherwise the 
 not finite and the integration stops with success=False); gravity enters as the
 acceleration of the ground.
 """
+import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 from sympy.physics.mechanics import dynamicsymbols
@@ -125,7 +126,6 @@ def _check_bodies(order, data, params):
     rotation, an inertia that is not symmetric or not positive semi-definite, negative
     masses, and leaves that would make M singular -- wherever the parameter values decide
     it."""
-    import numpy as np
     vals = _param_values(params)
     has_child = {b.parent for b in order}
     for b in order:
