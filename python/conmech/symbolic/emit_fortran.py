@@ -348,16 +348,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         body += _ctor(name, name, [], d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
-        body += em.proc("g", mech, f"{mech}_mass", ["t", "q", "mm"],
-                        qdecl + [_decl("mm", [":", ":"], "out")], pr,
-                        [("mm", d.M, True)], "mm = M(t, q).")
-        body += em.proc("g", mech, f"{mech}_forces", ["t", "q", "v", "f"],
-                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
-                        "f = Q(t, q, v).")
-        if d.energy is not None:
-            body += em.proc("g", mech, f"{mech}_energy", ["t", "q", "v"], qvdecl, pr, [],
-                            "The energy (Jacobi integral).", result=("e", d.energy))
-            body += _logical_true(mech, f"{mech}_has_energy", "The energy is defined.")
+        body += _mass_forces_energy(em, "g", mech, qdecl, pr, d, "The energy (Jacobi integral).")
         body += _gen_rhs(em, name, pry, d)
         body += _gen_jac(em, name, pry, d)
         body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
@@ -388,16 +379,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         body += _ctor(name, name, ctor, d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
-        body += em.proc("c", name, f"{name}_mass", ["t", "q", "mm"],
-                        qdecl + [_decl("mm", [":", ":"], "out")], pr, [("mm", d.M, True)],
-                        "mm = M(t, q).")
-        body += em.proc("c", name, f"{name}_forces", ["t", "q", "v", "f"],
-                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
-                        "f = Q(t, q, v).")
-        if d.energy is not None:
-            body += em.proc("c", name, f"{name}_energy", ["t", "q", "v"], qvdecl, pr, [],
-                            "The energy.", result=("e", d.energy))
-            body += _logical_true(name, f"{name}_has_energy", "The energy is defined.")
+        body += _mass_forces_energy(em, "c", name, qdecl, pr, d, "The energy.")
         if d.n_hol:
             body += em.proc("c", name, f"{name}_phi", ["t", "q", "c"],
                             qdecl + [_decl("c", [":"], "out")], pr, [("c", d.phi, False)],
@@ -496,6 +478,23 @@ def _mass_solve(n, nrhs, rhs_name):
             f"{_IND}else",
             f"{_IND}    call dpotrs('U', {n}, {nrhs}, mm, {n}, {rhs_name}, {n}, info)",
             f"{_IND}end if"]
+
+
+def _mass_forces_energy(em, kind, owner, qdecl, pr, d, energy_doc):
+    """The type-bound mass matrix, forces and (when defined) energy procedures of the
+    mechanical type `owner` (kind "g": generalized, "c": constrained)."""
+    qvdecl = qdecl + [_decl("v", [":"])]
+    out = em.proc(kind, owner, f"{owner}_mass", ["t", "q", "mm"],
+                  qdecl + [_decl("mm", [":", ":"], "out")], pr, [("mm", d.M, True)],
+                  "mm = M(t, q).")
+    out += em.proc(kind, owner, f"{owner}_forces", ["t", "q", "v", "f"],
+                   qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
+                   "f = Q(t, q, v).")
+    if d.energy is not None:
+        out += em.proc(kind, owner, f"{owner}_energy", ["t", "q", "v"], qvdecl, pr, [],
+                       energy_doc, result=("e", d.energy))
+        out += _logical_true(owner, f"{owner}_has_energy", "The energy is defined.")
+    return out
 
 
 def _gen_rhs(em, name, pry, d):

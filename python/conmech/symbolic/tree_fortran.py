@@ -15,7 +15,7 @@ import sympy as sp
 
 from .library_info import _model_info
 from .loops import loop_code
-from .printer import FortranPrinter, _decl_temps, _wrap
+from .printer import FortranPrinter, _decl_temps, _names, _wrap
 from .kinematics import Code, point_force_code, pos_pass, relative, vel_pass
 from .tree_pairs import FIXED, straight_pairs
 from .spatial_aba import _spatial_aba
@@ -109,15 +109,7 @@ class Emit:
     loads of earlier passes as their work-record targets."""
 
     def __init__(self, d, loads, cidx):
-        names = {d.t: "t"}
-        for i, s in enumerate(d.coords):
-            names[s] = f"q({i + 1})"
-        for i, s in enumerate(d.speeds):
-            names[s] = f"v({i + 1})"
-        for i, s in enumerate(d.accels):
-            names[s] = f"a({i + 1})"
-        for i, s in enumerate(d.params):
-            names[s] = f"p({i + 1})"
+        names = _names(d)
         self.cidx = cidx
         for s, tgt in loads.items():
             names[s] = self.target(tgt)

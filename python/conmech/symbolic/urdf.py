@@ -134,31 +134,33 @@ class Robot:
                 s = sp.Symbol(f"tau{k + 1}")
                 vals[s] = 0.0
                 fl[k] += s
-        elif isinstance(torques, dict):
-            for key, e in torques.items():
-                fl[slot(key, "torques")] += sp.sympify(e)
-        elif torques is not None:
-            tl = list(torques)
-            if len(tl) != n:
-                raise ValueError(f"torques has {len(tl)} entries for {n} movable joints")
-            fl = [a + sp.sympify(b) for a, b in zip(fl, tl)]
+        else:
+            fl = _add_loads(fl, torques, "torques", slot)
         if damping:
             for k, j in enumerate(self.joints):
                 if j.damping:
                     c = sp.Symbol(f"c{k + 1}")
                     vals[c] = float(j.damping)
                     fl[k] -= c*self.coordinates[k].diff(t)
-        if isinstance(forces, dict):
-            for key, e in forces.items():
-                fl[slot(key, "forces")] += sp.sympify(e)
-        elif forces is not None:
-            ex = list(forces)
-            if len(ex) != n:
-                raise ValueError(f"forces has {len(ex)} entries for {n} movable joints")
-            fl = [a + sp.sympify(b) for a, b in zip(fl, ex)]
+        fl = _add_loads(fl, forces, "forces", slot)
         for k, v in (params or {}).items():
             vals[k] = v
         return spatial_tree(self.bodies, vals, gravity=gravity, forces=fl, **kw)
+
+
+def _add_loads(fl, loads, what, slot):
+    """The generalized forces `fl` (one per movable joint) plus the user's `loads`: a dict
+    naming joints (their slots by `slot`), a sequence with one entry per joint, or None."""
+    if isinstance(loads, dict):
+        for key, e in loads.items():
+            fl[slot(key, what)] += sp.sympify(e)
+        return fl
+    if loads is None:
+        return fl
+    ex = list(loads)
+    if len(ex) != len(fl):
+        raise ValueError(f"{what} has {len(ex)} entries for {len(fl)} movable joints")
+    return [a + sp.sympify(b) for a, b in zip(fl, ex)]
 
 
 def from_urdf(source, allow_massless=False, **kw):
