@@ -26,6 +26,7 @@ module conmech_flat_ode_support
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
+    public :: store_result
     public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
@@ -155,8 +156,7 @@ contains
         real(dp), allocatable :: te(:)
         class(ode_stepper), allocatable :: stp
         character(len=:), allocatable :: msg
-        real(c_double) :: empty1(0), empty3(n, 1, 0)
-        integer :: nseg, nf1, sinfo
+        integer :: sinfo
         integer(c_int) :: nfev
 
         nfev = 0
@@ -208,9 +208,23 @@ contains
         info = res%status
         call copy_message(res%message, message)
 
+        call store_result(res, opt%dense_output, n, store, dense_form)
+    end subroutine run_solve
+
+    !> Hand the result `res` to `store` (the calling convention above): its outputs, its
+    !! events and, when `dense` and the run made them, its dense-output segments, whose form
+    !! goes to dense_form (left as it is without them).
+    subroutine store_result(res, dense, n, store, dense_form)
+        type(ode_result), intent(in) :: res
+        logical, intent(in) :: dense
+        integer(c_int), intent(in) :: n
+        external :: store
+        integer(c_int), intent(inout) :: dense_form
+        real(c_double) :: empty1(0), empty3(n, 1, 0)
+        integer :: nseg, nf1
         nseg = 0
         nf1 = 1
-        if (opt%dense_output .and. allocated(res%sol%ts)) then
+        if (dense .and. allocated(res%sol%ts)) then
             nseg = res%sol%nseg
             nf1 = res%sol%nf + 1
             dense_form = res%sol%form
@@ -225,7 +239,7 @@ contains
                        res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), empty1, empty1, &
                        empty3, n, res%nt, res%nev, 0, 1)
         end if
-    end subroutine run_solve
+    end subroutine store_result
 
     !> SciPy's initial step (scipy.integrate._ivp.common.select_initial_step, Hairer's
     !! heuristic with RMS norms): two right-hand side evaluations, counted in nfev.
