@@ -58,8 +58,8 @@ import sympy as sp
 
 from .euler_lagrange import _energy, _euler_lagrange
 from .inputs import (_ae, _as_value, _check_entry, _check_mass, _check_no_accel,  # noqa: F401
-                     _Coords, _realify, _resolve_params, _subs_all, _sympify_list,
-                     _unify_time, singular_everywhere)
+                     _Coords, _mechanical_inputs, _realify, _resolve_params, _subs_all,
+                     _sympify_list, _unify_time, singular_everywhere)
 from .lagrangian import _forces_list, derive_lagrangian
 from .record import Derived
 from .simplify import _maybe_simplify, _quadratic_parts  # noqa: F401
@@ -104,12 +104,7 @@ def derive_constrained(T, U, q, holonomic=(), nonholonomic=(), params=None, forc
     if len(base) != n + 2:
         raise ValueError("T and U must be single expressions")
     exprs = _unify_time(base + hol + nh, t)
-    exprs = c.convert(exprs, "the expressions")
-    _check_no_accel(exprs, c)
-    known = list(c.plain) + list(c.speeds)
-    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
-    exprs = _subs_all(exprs, sub)
-    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t, "the expressions")
     Tp, Up, fq = exprs[0], exprs[1], exprs[2:2 + n]
     hol = exprs[2 + n:2 + n + len(hol)]
     nh = exprs[2 + n + len(hol):]

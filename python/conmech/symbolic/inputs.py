@@ -351,3 +351,18 @@ def _check_no_accel(exprs, c):
         if e.free_symbols & acc:
             raise ValueError("the expressions must not contain accelerations (second "
                              "derivatives of the coordinates)")
+
+
+def _mechanical_inputs(exprs, c, params, t, what):
+    """The expressions of a mechanical system in the derivation's plain real symbols:
+    converted from functions of time (`c`: the coordinates and velocities; `what` names the
+    expressions in errors), checked free of accelerations, the parameters resolved by name
+    (every other free symbol is an error) and substituted. Returns (exprs, t, parameter
+    symbols, their names, their values)."""
+    exprs = c.convert(exprs, what)
+    _check_no_accel(exprs, c)
+    known = list(c.plain) + list(c.speeds)
+    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
+    exprs = _subs_all(exprs, sub)
+    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    return exprs, t, psyms, names, values

@@ -330,6 +330,7 @@ def _vadd(a, b, L):
 
 
 def _path_to_root(joints, k):
+    """The joint k and its ancestors' joints, up to the root."""
     out = []
     while k >= 0:
         out.append(k)

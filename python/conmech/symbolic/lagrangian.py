@@ -4,8 +4,7 @@ coordinates, with Q and its Jacobian R in the structured form that the compiled 
 import sympy as sp
 
 from .euler_lagrange import _d, _energy, _euler_lagrange, _mass
-from .inputs import (_ae, _check_mass, _check_no_accel, _Coords, _realify, _resolve_params,
-                     _subs_all, _sympify_list, _unify_time)
+from .inputs import _ae, _check_mass, _Coords, _mechanical_inputs, _sympify_list, _unify_time
 from .record import Derived
 from .simplify import _collect_params, _maybe_simplify
 
@@ -150,12 +149,7 @@ def derive_lagrangian(L, q, params=None, forces=None, velocities=None, simplify=
     exprs = _unify_time(_sympify_list(L, "L") + _forces_list(forces, n), t)
     if len(exprs) != n + 1:
         raise ValueError("L must be a single expression")
-    exprs = c.convert(exprs, "L")
-    _check_no_accel(exprs, c)
-    known = list(c.plain) + list(c.speeds)
-    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
-    exprs = _subs_all(exprs, sub)
-    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t, "L")
     parts = []
     Lp, fq = _maybe_simplify(exprs[0], simplify, c.speeds, parts,
                              set(psyms) if structured else None), exprs[1:]

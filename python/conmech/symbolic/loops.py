@@ -39,7 +39,7 @@ ValueError naming the loop that cannot close).
 import numpy as np
 import sympy as sp
 
-from .kinematics import _add, _cross, _dot, relative
+from .kinematics import _add, _cross, _dot, _path_to_root, relative
 from .printer import _decl_temps, assignments
 from .tree_print import SC_DECL, pos_call
 from .pipeline import model_of
@@ -223,14 +223,6 @@ def count_rows(items):
     return sum(it["rows"] for it in items)
 
 
-def _path(joints, k):
-    out = []
-    while k >= 0:
-        out.append(k)
-        k = joints[k].parent
-    return out
-
-
 def _pad(x):
     return list(x) + [0]*(3 - len(x))
 
@@ -268,7 +260,7 @@ class _LoopCode:
         def jcols(k, x):
             """{j: d x / d qrel_j} for the joints on body k's path."""
             return {j: _add(lpos[j]["S"][3:], _cross(lpos[j]["S"][:3], x))
-                    for j in _path(joints, k)}
+                    for j in _path_to_root(joints, k)}
 
         def vector(k, u):
             """World vector u fixed in body k: value, rate, bias second derivative."""
@@ -319,7 +311,7 @@ class _LoopCode:
                     row[j] = row.get(j, 0) + _dot(col, nw)
                 for j, col in ca.items():
                     row[j] = row.get(j, 0) - _dot(col, nw)
-                for j in (_path(joints, ka_) if ka_ >= 0 else []):
+                for j in (_path_to_root(joints, ka_) if ka_ >= 0 else []):
                     row[j] = row.get(j, 0) + _dot(dd, _cross(lpos[j]["S"][:3], nw))
                 self.G.append(row)
                 # the relative angle: theta = sum of the relative revolute angles on the path
@@ -327,7 +319,7 @@ class _LoopCode:
                     qrel = relative(joints, d.coords)
                 row, th = {}, 0
                 for sgn, k in ((1, kb_), (-1, ka_)):
-                    for j in (_path(joints, k) if k >= 0 else []):
+                    for j in (_path_to_root(joints, k) if k >= 0 else []):
                         if joints[j].kind == "revolute":
                             row[j] = row.get(j, 0) + sgn
                             th += sgn*qrel[j]
@@ -343,9 +335,9 @@ class _LoopCode:
                     self.phi.append(_dot(u, w))
                     self.gamma.append(-(_dot(udd, w) + 2*_dot(ud, wd) + _dot(u, wdd)))
                     row = {}
-                    for j in (_path(joints, ka_) if ka_ >= 0 else []):
+                    for j in (_path_to_root(joints, ka_) if ka_ >= 0 else []):
                         row[j] = row.get(j, 0) + _dot(_cross(lpos[j]["S"][:3], u), w)
-                    for j in (_path(joints, kb_) if kb_ >= 0 else []):
+                    for j in (_path_to_root(joints, kb_) if kb_ >= 0 else []):
                         row[j] = row.get(j, 0) + _dot(u, _cross(lpos[j]["S"][:3], w))
                     self.G.append(row)
         # columns in the user's coordinates: G_user = G_rel T (absolute planar angles)

@@ -59,7 +59,7 @@ import sympy as sp
 
 from sympy.physics.mechanics import dynamicsymbols
 
-from .inputs import _Coords, _check_no_accel, _realify, _resolve_params, _subs_all, _unify_time
+from .inputs import _Coords, _mechanical_inputs, _unify_time
 from .kinematics import Code, joints_planar, joints_spatial  # noqa: F401
 from .loops import count_rows, prepare_loops, prepare_point_forces
 from .record import Derived
@@ -174,12 +174,7 @@ def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=T
     pf_items = prepare_point_forces(point_forces, order, planar)
     pf_slots = [[put(x) for x in item["exprs"]] for item in pf_items]
     exprs = _unify_time(flat, t)
-    exprs = c.convert(exprs, "the tree's description")
-    _check_no_accel(exprs, c)
-    psyms, names, values, sub = _resolve_params(params, exprs, list(c.plain) + list(c.speeds),
-                                                t)
-    exprs = _subs_all(exprs, sub)
-    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t, "the tree's description")
     geometry = set(range(len(flat))) - set(f_slots) - {i for s in pf_slots for i in s}
     qv = set(c.plain) | set(c.speeds) | {t}
     for i in geometry:
