@@ -174,7 +174,8 @@ def derive_recursive(parts, params, planar, absolute=False, loops=(), jacobian=T
     pf_items = prepare_point_forces(point_forces, order, planar)
     pf_slots = [[put(x) for x in item["exprs"]] for item in pf_items]
     exprs = _unify_time(flat, t)
-    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t, "the tree's description")
+    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t,
+                                                        "the tree's description")
     geometry = set(range(len(flat))) - set(f_slots) - {i for s in pf_slots for i in s}
     qv = set(c.plain) | set(c.speeds) | {t}
     for i in geometry:
