@@ -424,6 +424,7 @@ def henon_gamma(m, jacobi, kappa=1.0):
 
 def plot_orbit(orbit, ax=None, npoints=401):
     """The orbit in the rotating frame (matplotlib)."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots()
@@ -441,6 +442,7 @@ def plot_orbit(orbit, ax=None, npoints=401):
 
 def plot_multipliers(orbit, ax=None):
     """Floquet multipliers of the monodromy on the unit circle (matplotlib)."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots()
@@ -461,6 +463,7 @@ def plot_multipliers(orbit, ax=None):
 def plot_family(fam, ax=None):
     """Stability index S and perigee constant c along a family, the located stability
     changes (S = +-1) marked (matplotlib)."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots()

@@ -28,8 +28,10 @@ constructions of each mechanism instead (python/tests/test_iftomm_spatial.py).
 """
 import numpy as np
 import sympy as sp
+from scipy.special import ellipj, ellipk
+from sympy.physics.mechanics import dynamicsymbols
 
-from ..symbolic import constrained_system
+from ..symbolic import Loop, SpatialBody, constrained_system, spatial_tree
 from .bari import Problem
 
 __all__ = ["a01_pendulum", "a01_exact", "A01_PARAMS", "a02_n_four_bar", "a02_exact", "A02_PARAMS",
@@ -62,7 +64,6 @@ def a01_exact(t):
     """The closed-form motion of A01 at the times t: positions (2, nt) and velocities
     (2, nt) of the point, from Jacobi's elliptic functions (the argument reduced modulo
     the period 4K, so long times keep their accuracy)."""
-    from scipy.special import ellipj, ellipk
     p = A01_PARAMS
     L, g = p["L"], p["g"]
     w = np.sqrt(g / L)
@@ -139,7 +140,6 @@ def a02_exact(t, N=40):
     + N)/((N + 1)/3 + N), released inverted with theta' = -1/L and going over the top:
     theta = 2 am(K(k) - W t / 2 | k) with W^2 = theta'(0)^2 + 4 w^2 and k = 4 w^2 / W^2
     (Jacobi's amplitude, the argument reduced modulo 2K)."""
-    from scipy.special import ellipj, ellipk
     p = A02_PARAMS
     L, g = p["L"], p["g"]
     w2 = g / L * ((N + 1) / 2 + N) / ((N + 1) / 3 + N)
@@ -198,8 +198,6 @@ def a04_bricard(cut="E", flags=None):
     angles of rods 1..5 (their parent joints), all 0 at the start. Returns a
     :class:`~conmech.benchmarks.bari.Problem` whose references are None: no published
     numbers of the reference solution were reachable (its plots only)."""
-    from ..symbolic import Loop, SpatialBody, spatial_tree
-    from sympy.physics.mechanics import dynamicsymbols
     if cut not in ("E", "B"):
         raise ValueError(f"cut must be 'E' or 'B', got {cut!r}")
     m, L, a, g = sp.symbols("m L a g")
@@ -286,8 +284,6 @@ def a05_governor(method="recursive", flags=None):
     :class:`~conmech.benchmarks.bari.Problem` (system for :func:`conmech.solve_ivp`,
     state [q, q']) whose references are None: no published numbers of s(t) were
     reachable (its plot only)."""
-    from ..symbolic import SpatialBody, spatial_tree
-    from sympy.physics.mechanics import dynamicsymbols
     t = dynamicsymbols._t
     phi, s, th1, th2 = dynamicsymbols("phi s theta1 theta2")
     rho, mb, K, C, L0, g = sp.symbols("rho m_ball K C L0 g")

@@ -10,6 +10,7 @@ __all__ = ["plot_orbit", "perturbed_runs", "plot_convergence", "plot_multipliers
 
 
 def _axes(ax, figsize=(6, 4)):
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots(figsize=figsize)

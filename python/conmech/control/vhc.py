@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import math
 
 import numpy as np
+from scipy.fft import dct
 
 from .. import _conmech
 from .plant import ControlledSystem, FeedbackLaw
@@ -23,7 +24,7 @@ _PAD = np.zeros(1)
 
 
 def _sympy():
-    try:
+    try:   # sympy is optional: imported only for a constraint given as an expression
         import sympy as sp
     except ImportError:   # pragma: no cover (sympy is a dependency of the symbolic extra)
         raise ImportError("a sympy expression needs sympy (pip install sympy)") from None
@@ -137,7 +138,6 @@ class VirtualConstraint:
         d2 = [sp.lambdify(th, sp.diff(e, th, 2), "numpy") for e in exprs]
         cheb = np.polynomial.chebyshev
         rows = []
-        from scipy.fft import dct
         npts = 128
         xk = np.cos(np.pi*(np.arange(npts) + 0.5)/npts)
         for f in fs:
@@ -487,6 +487,7 @@ class ReducedDynamics:
         """Plot reduced solutions (theta, theta') from the start points (theta, theta')
         for t in [0, t_max] (stopping where alpha vanishes), the chosen orbit (thick), the
         equilibria, and the lines where alpha = 0; returns the axes."""
+        # matplotlib is optional: imported only when a figure is drawn
         import matplotlib.pyplot as plt
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4.5))

@@ -24,7 +24,7 @@ subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_ensemble, only: ode_ensemble, ensemble_options, ensemble_result, &
         crossing_events
     use conmech_flat_ode_support, only: copy_message
@@ -73,7 +73,6 @@ subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y
     type(callback_progress), allocatable :: pg
     real(dp), allocatable :: te(:)
     character(len=:), allocatable :: msg
-    character(len=24) :: buf
     logical :: with_events
     integer :: kk
 
@@ -106,16 +105,10 @@ subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y
                           message)
         return
     end if
-    call spec_system(name, real(params(1:np, 1), dp), nspec, spec, sys, info, msg)
+    call spec_system_of_size(name, real(params(1:np, 1), dp), nspec, spec, n, "", sys, info, &
+                             msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        write (buf, '(i0)') spec_dimension(name, nspec, spec)
-        call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
-                          //trim(name)//"'", message)
         return
     end if
 

@@ -8,7 +8,7 @@ subroutine flat_evaluate_ode(name, np, params, nspec, spec, n, t, y, f, jac, ana
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: copy_message
     implicit none
     include "flat_spec_args.inc"
@@ -22,14 +22,10 @@ subroutine flat_evaluate_ode(name, np, params, nspec, spec, n, t, y, f, jac, ana
     f = 0.0_dp
     jac = 0.0_dp
     analytic = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
+    call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, &
+                             "bad input: y has the wrong size for the system", sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        call copy_message("bad input: y has the wrong size for the system", message)
         return
     end if
     call sys%rhs(t, y, f)

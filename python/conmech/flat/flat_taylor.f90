@@ -16,7 +16,7 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_taylor_support, only: run_taylor_solve
     implicit none
@@ -57,14 +57,10 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
 
     counts = 0
     dense_form = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
+    call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, &
+                             "bad input: y0 does not match the system's dimension", sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        call copy_message("bad input: y0 does not match the system's dimension", message)
         return
     end if
     call run_taylor_solve(sys, n, t_span, y0, rtol, atol, first_step, max_step, max_steps, &

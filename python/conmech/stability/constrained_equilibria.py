@@ -27,7 +27,7 @@ import numpy as np
 
 from ..mechanics.compiled import CompiledConstrained, evaluate
 from ..mechanics.constrained import ConstrainedSystem, NativeConstrained, builtin
-from .equilibria import equilibrium, lagrange_dirichlet, potential_hessian
+from .equilibria import equilibrium, lagrange_dirichlet, multistart, potential_hessian
 from .._core.validate import _real, _state
 from .._core.result import Record
 
@@ -259,18 +259,8 @@ def constrained_equilibria(system: Any, guesses, t: float = 0.0,
     (k, n) (e.g. :func:`conmech.stability.grid` points near the manifold); failures are
     skipped, duplicates (max-norm distance <= dedup_tol max(1, |q|)) removed. Sorted by
     q."""
-    gs = np.asarray(guesses, dtype=float)
-    if gs.ndim != 2 or gs.shape[0] == 0:
-        raise ValueError("guesses must be a non-empty (k, n) array")
-    found = []
-    for g in gs:
-        try:
-            e = constrained_equilibrium(system, g, t=t, potential=potential, tol=tol,
-                                        classify_tol=classify_tol)
-        except RuntimeError:
-            continue
-        if not any(np.max(np.abs(e.q - f.q)) <= dedup_tol*max(1.0, np.max(np.abs(f.q)))
-                   for f in found):
-            found.append(e)
+    found = multistart(guesses, lambda g: constrained_equilibrium(
+        system, g, t=t, potential=potential, tol=tol, classify_tol=classify_tol),
+        lambda e, f: np.max(np.abs(e.q - f.q)) <= dedup_tol*max(1.0, np.max(np.abs(f.q))))
     found.sort(key=lambda e: tuple(e.q))
     return found

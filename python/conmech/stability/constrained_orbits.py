@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any, Sequence  # noqa: F401 (annotations)
 
 import numpy as np
+import scipy.linalg
 
 from .. import _conmech
 from ..mechanics.compiled import CompiledConstrained, evaluate
@@ -148,7 +149,6 @@ class ManifoldChart:
         self.tol = _real(tol, "tol", 0.0, 1e-3, low_open=True)
         g = self._fun(q_ref, np.zeros(n))[3]
         if independent is None:
-            import scipy.linalg
             _, r, piv = scipy.linalg.qr(g, pivoting=True, mode="economic")
             if abs(r[m - 1, m - 1]) <= 1e-10*max(abs(r[0, 0]), 1e-300):
                 raise ValueError("q_ref: the constraint Jacobian is rank deficient there "

@@ -314,19 +314,28 @@ def equilibria(system: Any, guesses: ArrayLike, t: float = 0.0, tol: float = 1e-
     the same straight family (their difference lies along the family's tangent, e.g. the
     cart at any x) reported once, with ``family_dim``. Guesses whose Newton fails are
     skipped. Returns a list of :class:`Equilibrium`, sorted by y."""
-    g = np.asarray(guesses, dtype=float)
-    if g.ndim != 2 or g.shape[0] == 0:
+    found = multistart(guesses, lambda y: find_equilibrium(
+        system, y, t=t, tol=tol, classify_tol=classify_tol, integrals=integrals),
+        lambda e, f: _same(e, f, dedup_tol))
+    found.sort(key=lambda e: tuple(e.y))
+    return found
+
+
+def multistart(guesses, solve, same):
+    """The distinct results of ``solve(g)`` over the rows g of the (k, n) array `guesses`,
+    in the order found: a guess whose Newton iteration fails (RuntimeError) is skipped, a
+    result that is ``same(e, f)`` as one found before is dropped."""
+    gs = np.asarray(guesses, dtype=float)
+    if gs.ndim != 2 or gs.shape[0] == 0:
         raise ValueError("guesses must be a non-empty (k, n) array")
     found = []
-    for y in g:
+    for g in gs:
         try:
-            e = find_equilibrium(system, y, t=t, tol=tol, classify_tol=classify_tol,
-                                 integrals=integrals)
+            e = solve(g)
         except RuntimeError:
             continue
-        if not any(_same(e, f, dedup_tol) for f in found):
+        if not any(same(e, f) for f in found):
             found.append(e)
-    found.sort(key=lambda e: tuple(e.y))
     return found
 
 

@@ -126,6 +126,7 @@ def plot_branch(branch, ax=None, y="stability_index", label_special=True, x=None
     :func:`stable_orbits` (``tol``; the tolerance is shown in the legend), for equilibria
     no eigenvalue with a positive real part. Special points are numbered and listed in
     the legend. Returns the axes."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if not isinstance(branch, (Branch, EquilibriumBranch)):
         raise TypeError("branch must be a Branch or an EquilibriumBranch")
@@ -246,6 +247,7 @@ def plot_multipliers(branch, ax=None, view="log", color="p"):
     to 1e8 stay in view, dotted circles mark the decades |mu| = 10^(+-k) (the outer ones
     labelled: 10^-k is the mirror of 10^k);
     ``view='linear'``: the plain complex plane. Returns the axes."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     if not isinstance(branch, Branch):
         raise TypeError("plot_multipliers needs a Branch of periodic orbits")
@@ -322,6 +324,7 @@ def plot_orbits(system, branch, ax=None, coords=(0, 1), n_orbits=15, indices=Non
     branch points ``indices``; each is integrated over its period (DOP853, ``rtol``).
     ``colorbar``: draw one (several families on one axes: draw it once, or none and a
     legend from ``label``). Returns the axes."""
+    # matplotlib is optional: imported only when a figure is drawn
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
     if not isinstance(branch, Branch):

@@ -47,9 +47,10 @@ from .pipeline import CompiledModel, compile_model, model_of, save_model
 from .pfaffian import (PfaffianResult, PfaffianSystemResult, pfaffian,
                        pfaffian_from_velocities, pfaffian_of, pfaffian_system)
 # planar multibody trees (articulated-body algorithm)
-from .tree import Body, planar_tree
+from .tree import Body
+from .trees import planar_tree, spatial_tree
 # spatial (3-D) multibody trees (spatial articulated-body algorithm)
-from .spatial import SpatialBody, spatial_tree
+from .spatial import SpatialBody
 # closed loops on trees, forces at points of bodies, consistent initial states
 from .loops import Loop, PointForce, consistent_state
 # the loop joints' reactions, per joint, in the joint's frame

@@ -16,12 +16,13 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+from .emit_fortran import emit
 from .pipeline import model_of
+from .record import Derived
 
 
 def load_model(path):
     """(Derived record, name or None) from a model file."""
-    from .derive import Derived
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"model file '{path}' does not exist")
@@ -58,7 +59,6 @@ def _default_name(out):
 
 def emit_file(model_path, out, name=None, module=None):
     """Generate the Fortran source for a model file; returns (source, name, module)."""
-    from .emit_fortran import emit
     d, mname = load_model(model_path)
     name = name or mname or _default_name(out)
     module = module or Path(out).stem

@@ -12,7 +12,7 @@ import sympy as sp
 
 from ..control.plant import ControlledSystem
 from .build import compile_source, load
-from .codegen import FortranPrinter, _procedure
+from .printer import FortranPrinter, _procedure
 
 __all__ = ["input_matrix", "controlled_system"]
 

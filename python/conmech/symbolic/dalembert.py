@@ -30,8 +30,9 @@ import numpy as np
 import sympy as sp
 
 from .pipeline import _construct, _system
-from .derive import (Derived, _ae, _cheap_simplify, _check_no_accel, _Coords, _realify,
-                     _resolve_params, _subs_all, _sympify_list, _unify_time)
+from .inputs import _ae, _Coords, _mechanical_inputs, _sympify_list, _unify_time
+from .record import Derived
+from .simplify import _cheap_simplify
 from .momenta import LagrangianSystem, is_zero, to_user
 
 __all__ = ["dalembert_system", "DAlembertSystem", "derive_dalembert"]
@@ -134,12 +135,7 @@ def derive_dalembert(mapping, masses, forces, q, params=None, angles=None, inert
     flat = [e for u in U for e in _sympify_list(u, "mapping")] + m + \
         [e for x in X for e in _sympify_list(x, "forces")] + phi + inert + tau
     flat = _unify_time(flat, t)
-    flat = c.convert(flat, "the expressions")
-    _check_no_accel(flat, c)
-    known = list(c.plain) + list(c.speeds)
-    psyms, names, values, sub = _resolve_params(params, flat, known, t)
-    flat = _subs_all(flat, sub)
-    flat, t, psyms = _realify(flat, t, c, psyms)
+    flat, t, psyms, names, values = _mechanical_inputs(flat, c, params, t, "the expressions")
     q_, v_ = c.plain, c.speeds
     pos = 0
     Us = []

@@ -29,10 +29,15 @@ the user, writable by nobody else).
 import hashlib
 import json
 import os
-import time
 
-__all__ = ["tree_description_key", "urdf_description_key", "description_hit",
-           "store_description"]
+import numpy as np
+import sympy as sp
+
+from .build import _conmech_version, _write_atomic, cache_dir
+from .codegen import CODEGEN_VERSION
+
+__all__ = ["tree_description_key", "urdf_description_key", "store_description",
+           "recursive_version"]
 
 
 class _NotPlain(Exception):
@@ -42,8 +47,6 @@ class _NotPlain(Exception):
 def _plain(x):
     """A canonical, process-independent representation of x (nested tuples of tagged
     strings); _NotPlain for what has none."""
-    import numpy as np
-    import sympy as sp
     if x is None or isinstance(x, (bool, str)):
         return (type(x).__name__, x)
     if isinstance(x, (int, np.integer)):
@@ -64,9 +67,6 @@ def _plain(x):
 
 
 def _versions():
-    from .build import _conmech_version
-    from .codegen import CODEGEN_VERSION
-    from .recursive import recursive_version
     return (CODEGEN_VERSION, recursive_version(), _conmech_version())
 
 
@@ -81,8 +81,6 @@ def _param_names(params):
     the key although the generated code does not depend on them: the checks of the
     ordinary path that depend on them (a negative mass, a leaf without inertia) then run
     for every new set of values."""
-    import numpy as np
-    import sympy as sp
     if params is None:
         return ()
     if not isinstance(params, dict):
@@ -141,42 +139,7 @@ def urdf_description_key(text, allow_massless, kw):
 
 
 def _entry(dkey):
-    from .build import cache_dir
     return os.path.join(cache_dir(), f"conmech_desc_{dkey}.json")
-
-
-def description_hit(dkey, flags, model_only, params=None):
-    """The system (``model_only``: the CompiledModel) stored under the description key,
-    loaded without any derivation, or None. `params`: the caller's parameter values (a
-    tree's); None: the values stored with the entry (a robot's)."""
-    if dkey is None:
-        return None
-    from .pipeline import _from_cache, _system
-    from .build import _read_json
-    t0 = time.perf_counter()
-    path = _entry(dkey)
-    if not os.path.isfile(path):
-        return None
-    info = _read_json(path)
-    if not isinstance(info, dict):
-        return None
-    key, stored = info.get("key"), info.get("params")
-    if not (isinstance(key, str) and len(key) == 64 and
-            all(c in "0123456789abcdef" for c in key)):
-        return None
-    if params is None:
-        if not (isinstance(stored, list) and all(
-                isinstance(p, list) and len(p) == 2 and isinstance(p[0], str) and
-                isinstance(p[1], (int, float)) and not isinstance(p[1], bool)
-                for p in stored)):
-            return None
-        params = {name: value for name, value in stored}
-    model = _from_cache(key, params, flags)
-    if model is None:
-        return None
-    model.times["description"] = model.times["derived_cache"]   # the marker of this path
-    model.times["total"] = time.perf_counter() - t0
-    return model if model_only else _system(model)
 
 
 def store_description(dkey, key, params):
@@ -184,7 +147,6 @@ def store_description(dkey, key, params):
     parameter values `params` (a dict); best effort (an optimisation only)."""
     if dkey is None or key is None:
         return
-    from .build import _write_atomic
     try:
         values = [[k if isinstance(k, str) else k.name, float(v)]
                   for k, v in (params or {}).items()]
@@ -192,3 +154,24 @@ def store_description(dkey, key, params):
         _write_atomic(_entry(dkey), data, 0o644)
     except (OSError, AttributeError, TypeError, ValueError):
         pass
+
+
+_VERSION = []
+
+
+def recursive_version():
+    """A digest of the modules that generate the recursive code (part of the
+    derivation-cache key: a change of the generator invalidates cached derivations)."""
+    if not _VERSION:
+        h = hashlib.sha256()
+        here = os.path.dirname(os.path.abspath(__file__))
+        for name in ("recursive.py", "kinematics.py", "tree_aba.py", "spatial_aba.py",
+                     "tree_fortran.py", "tree_pairs.py", "tree_print.py", "tree_user.py",
+                     "loops.py", "tree.py", "spatial.py"):
+            try:
+                with open(os.path.join(here, name), "rb") as fh:
+                    h.update(fh.read())
+            except OSError:
+                h.update(name.encode())
+        _VERSION.append(h.hexdigest()[:16])
+    return _VERSION[0]

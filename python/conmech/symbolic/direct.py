@@ -12,8 +12,8 @@ coordinates, v^T M v / 2 + U).
 """
 import sympy as sp
 
-from .derive import (Derived, _ae, _check_mass, _check_no_accel, _Coords, _realify,
-                     _resolve_params, _subs_all, _sympify_list, _unify_time)
+from .inputs import _ae, _check_mass, _Coords, _mechanical_inputs, _sympify_list, _unify_time
+from .record import Derived
 
 __all__ = ["derive_direct"]
 
@@ -48,12 +48,7 @@ def derive_direct(M, Q, q, params=None, velocities=None, energy=None, jacobian=T
     extra = [sp.sympify(energy)] if energy is not None else []
     Ul = [sp.sympify(U)] if U is not None else []
     exprs = _unify_time(list(M) + Ql + hol + nh + extra + Ul, t)
-    exprs = c.convert(exprs, "the expressions")
-    _check_no_accel(exprs, c)
-    known = list(c.plain) + list(c.speeds)
-    psyms, names, values, sub = _resolve_params(params, exprs, known, t)
-    exprs = _subs_all(exprs, sub)
-    exprs, t, psyms = _realify(exprs, t, c, psyms)
+    exprs, t, psyms, names, values = _mechanical_inputs(exprs, c, params, t, "the expressions")
     k = 0
     M = sp.Matrix(n, n, exprs[:n*n])
     k = n*n

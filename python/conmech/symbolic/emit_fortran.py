@@ -47,8 +47,11 @@ import re
 
 import sympy as sp
 
-from .codegen import (FortranPrinter, assignments, check_source, comment_lines, comment_text,
-                      product_lines, product_terms)
+from .record import Derived
+from .taylor import emitted_taylor
+from .printer import FortranPrinter, assignments, product_lines, product_terms
+from .source_text import check_source, comment_lines, comment_text
+from .tree_print import aba_lines
 
 __all__ = ["emit", "fortran_name_check"]
 
@@ -232,7 +235,6 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
     """Fortran source (str) of a standalone module for the derived system `d` whose main
     type is called `name` (module `module`, default NAME_model). `source` is named in the
     header comment (e.g. the model file)."""
-    from .derive import Derived
     if not isinstance(d, Derived):
         raise TypeError("emit: expected a conmech.symbolic.derive.Derived record")
     if d.kind not in ("ode", "generalized", "constrained"):
@@ -303,7 +305,6 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
                   f"        procedure :: rhs_jacobian_product => {name}_rhs_jacobian_product",
                   f"        procedure :: has_jacobian_product => {name}_has_jacobian_product"]
         pr = em.printer()
-        from .taylor import emitted_taylor
         tbind, tprocs, _ = emitted_taylor(name, d, pr.names)
         lines += tbind + [f"    end type {name}", ""]
         # the type-bound taylor_jet calls one private helper per kind (system, variational)
@@ -347,16 +348,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         body += _ctor(name, name, [], d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
-        body += em.proc("g", mech, f"{mech}_mass", ["t", "q", "mm"],
-                        qdecl + [_decl("mm", [":", ":"], "out")], pr,
-                        [("mm", d.M, True)], "mm = M(t, q).")
-        body += em.proc("g", mech, f"{mech}_forces", ["t", "q", "v", "f"],
-                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
-                        "f = Q(t, q, v).")
-        if d.energy is not None:
-            body += em.proc("g", mech, f"{mech}_energy", ["t", "q", "v"], qvdecl, pr, [],
-                            "The energy (Jacobi integral).", result=("e", d.energy))
-            body += _logical_true(mech, f"{mech}_has_energy", "The energy is defined.")
+        body += _mass_forces_energy(em, "g", mech, qdecl, pr, d, "The energy (Jacobi integral).")
         body += _gen_rhs(em, name, pry, d)
         body += _gen_jac(em, name, pry, d)
         body += _logical_true(name, f"{name}_has_jacobian", "The Jacobian is exact.")
@@ -387,16 +379,7 @@ def emit(d, name, module=None, source="a conmech.symbolic model"):
         body += _ctor(name, name, ctor, d, comp)
         qdecl = [_decl("t"), _decl("q", [":"])]
         qvdecl = qdecl + [_decl("v", [":"])]
-        body += em.proc("c", name, f"{name}_mass", ["t", "q", "mm"],
-                        qdecl + [_decl("mm", [":", ":"], "out")], pr, [("mm", d.M, True)],
-                        "mm = M(t, q).")
-        body += em.proc("c", name, f"{name}_forces", ["t", "q", "v", "f"],
-                        qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
-                        "f = Q(t, q, v).")
-        if d.energy is not None:
-            body += em.proc("c", name, f"{name}_energy", ["t", "q", "v"], qvdecl, pr, [],
-                            "The energy.", result=("e", d.energy))
-            body += _logical_true(name, f"{name}_has_energy", "The energy is defined.")
+        body += _mass_forces_energy(em, "c", name, qdecl, pr, d, "The energy.")
         if d.n_hol:
             body += em.proc("c", name, f"{name}_phi", ["t", "q", "c"],
                             qdecl + [_decl("c", [":"], "out")], pr, [("c", d.phi, False)],
@@ -497,11 +480,27 @@ def _mass_solve(n, nrhs, rhs_name):
             f"{_IND}end if"]
 
 
+def _mass_forces_energy(em, kind, owner, qdecl, pr, d, energy_doc):
+    """The type-bound mass matrix, forces and (when defined) energy procedures of the
+    mechanical type `owner` (kind "g": generalized, "c": constrained)."""
+    qvdecl = qdecl + [_decl("v", [":"])]
+    out = em.proc(kind, owner, f"{owner}_mass", ["t", "q", "mm"],
+                  qdecl + [_decl("mm", [":", ":"], "out")], pr, [("mm", d.M, True)],
+                  "mm = M(t, q).")
+    out += em.proc(kind, owner, f"{owner}_forces", ["t", "q", "v", "f"],
+                   qvdecl + [_decl("f", [":"], "out")], pr, [("f", d.Q, False)],
+                   "f = Q(t, q, v).")
+    if d.energy is not None:
+        out += em.proc(kind, owner, f"{owner}_energy", ["t", "q", "v"], qvdecl, pr, [],
+                       energy_doc, result=("e", d.energy))
+        out += _logical_true(owner, f"{owner}_has_energy", "The energy is defined.")
+    return out
+
+
 def _gen_rhs(em, name, pry, d):
     n = d.n
     if getattr(d, "aba", None) is not None:
         # a planar tree (conmech.symbolic.planar_tree): the articulated-body algorithm
-        from .tree import aba_lines
         decl, lines = aba_lines(pry, d, "a", _IND)
         return (["    !> y' = [v, a], a = M^-1 Q by the articulated-body algorithm (O(n), no "
                  "matrix;", "    !! non-finite if M is not positive definite).",

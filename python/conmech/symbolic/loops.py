@@ -39,7 +39,9 @@ ValueError naming the loop that cannot close).
 import numpy as np
 import sympy as sp
 
-from .recursive import _add, _cross, _dot
+from .kinematics import _add, _cross, _dot, _path_to_root, relative
+from .printer import _decl_temps, assignments
+from .tree_print import SC_DECL, pos_call
 from .pipeline import model_of
 
 __all__ = ["Loop", "PointForce", "consistent_state"]
@@ -221,14 +223,6 @@ def count_rows(items):
     return sum(it["rows"] for it in items)
 
 
-def _path(joints, k):
-    out = []
-    while k >= 0:
-        out.append(k)
-        k = joints[k].parent
-    return out
-
-
 def _pad(x):
     return list(x) + [0]*(3 - len(x))
 
@@ -266,7 +260,7 @@ class _LoopCode:
         def jcols(k, x):
             """{j: d x / d qrel_j} for the joints on body k's path."""
             return {j: _add(lpos[j]["S"][3:], _cross(lpos[j]["S"][:3], x))
-                    for j in _path(joints, k)}
+                    for j in _path_to_root(joints, k)}
 
         def vector(k, u):
             """World vector u fixed in body k: value, rate, bias second derivative."""
@@ -317,16 +311,15 @@ class _LoopCode:
                     row[j] = row.get(j, 0) + _dot(col, nw)
                 for j, col in ca.items():
                     row[j] = row.get(j, 0) - _dot(col, nw)
-                for j in (_path(joints, ka_) if ka_ >= 0 else []):
+                for j in (_path_to_root(joints, ka_) if ka_ >= 0 else []):
                     row[j] = row.get(j, 0) + _dot(dd, _cross(lpos[j]["S"][:3], nw))
                 self.G.append(row)
                 # the relative angle: theta = sum of the relative revolute angles on the path
                 if qrel is None:
-                    from .recursive import relative
                     qrel = relative(joints, d.coords)
                 row, th = {}, 0
                 for sgn, k in ((1, kb_), (-1, ka_)):
-                    for j in (_path(joints, k) if k >= 0 else []):
+                    for j in (_path_to_root(joints, k) if k >= 0 else []):
                         if joints[j].kind == "revolute":
                             row[j] = row.get(j, 0) + sgn
                             th += sgn*qrel[j]
@@ -342,9 +335,9 @@ class _LoopCode:
                     self.phi.append(_dot(u, w))
                     self.gamma.append(-(_dot(udd, w) + 2*_dot(ud, wd) + _dot(u, wdd)))
                     row = {}
-                    for j in (_path(joints, ka_) if ka_ >= 0 else []):
+                    for j in (_path_to_root(joints, ka_) if ka_ >= 0 else []):
                         row[j] = row.get(j, 0) + _dot(_cross(lpos[j]["S"][:3], u), w)
-                    for j in (_path(joints, kb_) if kb_ >= 0 else []):
+                    for j in (_path_to_root(joints, kb_) if kb_ >= 0 else []):
                         row[j] = row.get(j, 0) + _dot(u, _cross(lpos[j]["S"][:3], w))
                     self.G.append(row)
         # columns in the user's coordinates: G_user = G_rel T (absolute planar angles)
@@ -365,11 +358,9 @@ class _LoopCode:
         return out
 
     def procedures(self, em, n, npar):
-        from .codegen import assignments, _decl_temps
         I = "        "
         T = f"{I}real(dp), value, intent(in) :: t"
         P = f"{I}real(dp), intent(in) :: p({npar})"
-        from .tree_fortran import SC_DECL, pos_call
         W = f"{I}type(tree_work) :: w\n{SC_DECL}"
         h = len(self.phi)
         out = []
@@ -552,7 +543,6 @@ def closure_error(system, q0, t0=0.0):
     ValueError that names the loop with the largest residual and that residual. Used by
     :func:`conmech.constrained.solve` when the initial projection onto the loop
     constraints fails."""
-    from . import model_of
     try:
         model = model_of(system)
     except TypeError:

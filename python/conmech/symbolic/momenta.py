@@ -33,8 +33,8 @@ from sympy.physics.mechanics import dynamicsymbols
 
 from ..mechanics import compiled
 from .build import compile_source, load
-from .codegen import (FortranPrinter, _names, _procedure, check_source, comment_lines,
-                      comment_text)
+from .printer import FortranPrinter, _names, _procedure
+from .source_text import check_source, comment_lines, comment_text
 
 __all__ = ["Momenta", "FirstIntegrals", "LagrangianSystem", "momenta", "first_integrals",
            "as_lagrangian_system", "to_user"]

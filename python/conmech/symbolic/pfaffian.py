@@ -43,6 +43,8 @@ Example (the seed's pendulum, and the rolling coin):
 from __future__ import annotations
 
 import itertools
+import signal
+import threading
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Sequence, Tuple
 
@@ -389,8 +391,6 @@ class _time_limit:
         self.active = False
 
     def __enter__(self):
-        import signal
-        import threading
         if (self.seconds and hasattr(signal, "setitimer")
                 and threading.current_thread() is threading.main_thread()):
             def _raise(signum, frame):
@@ -402,7 +402,6 @@ class _time_limit:
 
     def __exit__(self, *exc):
         if self.active:
-            import signal
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, self.old)
         return exc[0] is _TimeUp

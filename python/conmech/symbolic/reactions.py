@@ -23,6 +23,9 @@ parent's turned by the joint's fixed rotation, then by the joint angle about its
 import numpy as np
 import sympy as sp
 
+from .kinematics import relative
+from .pipeline import model_of
+
 __all__ = ["JointReaction", "joint_reactions"]
 
 
@@ -55,8 +58,6 @@ def joint_reactions(system, result):
     """{loop label: :class:`JointReaction`} for a tree with loops (``planar_tree`` /
     ``spatial_tree`` with ``loops=``) and a result of :func:`conmech.constrained.solve`
     on it (its ``q`` and ``lam``)."""
-    from . import model_of
-    from .recursive import relative
     d = model_of(system).derived
     if d.kind != "constrained" or not getattr(d, "loops", None):
         raise ValueError("system: joint_reactions needs a tree with closed loops (loops=...)")

@@ -27,7 +27,7 @@ import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
 from .constructors import lagrangian_system
-from .derive import _quadratic_parts
+from .simplify import _quadratic_parts
 from .momenta import LagrangianSystem, _build, analysis, is_zero, to_user
 from .quadrature import cumulative_dense
 

@@ -28,13 +28,15 @@ inertias 6x6 symmetric; D_i = S_i^T IA_i S_i is checked positive: otherwise the 
 not finite and the integration stops with success=False); gravity enters as the
 acceleration of the ground.
 """
+import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
+from sympy.physics.mechanics import dynamicsymbols
 
-from .tree import _Code, _check_tree, _derive, _expr, _force_list, _forces_at
-from .pipeline import _construct, _tup
+from .spatial_aba import _rodrigues, _spatial_aba
+from .tree import _check_tree, _derive, _expr, _force_list, _forces_at
 
-__all__ = ["SpatialBody", "spatial_tree", "build_spatial_tree", "derive_spatial_tree"]
+__all__ = ["SpatialBody", "build_spatial_tree", "derive_spatial_tree"]
 
 
 class SpatialBody:
@@ -124,7 +126,6 @@ def _check_bodies(order, data, params):
     rotation, an inertia that is not symmetric or not positive semi-definite, negative
     masses, and leaves that would make M singular -- wherever the parameter values decide
     it."""
-    import numpy as np
     vals = _param_values(params)
     has_child = {b.parent for b in order}
     for b in order:
@@ -168,12 +169,6 @@ def _check_bodies(order, data, params):
                              "would be singular")
 
 
-def _rodrigues(k, c, s):
-    """The rotation by the angle with cosine c and sine s about the unit axis k."""
-    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return c*sp.eye(3) + s*K + (1 - c)*(k*k.T)
-
-
 def _cross(a, b):
     return sp.Matrix([a[1]*b[2] - a[2]*b[1], a[2]*b[0] - a[0]*b[2], a[0]*b[1] - a[1]*b[0]])
 
@@ -189,7 +184,6 @@ def build_spatial_tree(bodies, gravity=(0, 0, 0), forces=None, lazy=False):
     algorithm's straight-line code in plain symbols). Used by :func:`spatial_tree`; useful
     to inspect T and U or to derive the same system with
     :func:`conmech.symbolic.lagrangian_system`."""
-    from sympy.physics.mechanics import dynamicsymbols
     t = dynamicsymbols._t
     bodies = [bodies] if isinstance(bodies, SpatialBody) else list(bodies)
     order, coords = _check_tree(bodies, t, SpatialBody)
@@ -332,166 +326,6 @@ def _kinetic_compact(order, data, t):
     return sp.Add(*T)
 
 
-def _mm(A, B):
-    """A B for matrices as lists of rows (sympy entries; no Matrix overhead)."""
-    return [[sp.Add(*[A[i][k]*B[k][j] for k in range(len(B))]) for j in range(len(B[0]))]
-            for i in range(len(A))]
-
-
-def _mv(A, x):
-    return [sp.Add(*[A[i][k]*x[k] for k in range(len(x))]) for i in range(len(A))]
-
-
-def _lcross(a, b):
-    return [a[1]*b[2] - a[2]*b[1], a[2]*b[0] - a[0]*b[2], a[0]*b[1] - a[1]*b[0]]
-
-
-def _spatial_aba(order, index, data, qs, vs, tau, g, trig=None):
-    """(defs, accelerations) of the spatial articulated-body algorithm (matrices as lists
-    of rows: the construction cost is the arithmetic, not sympy's matrix machinery;
-    `trig`: {body name: (cos, sin) symbols} of the joint angles computed elsewhere)."""
-    code = _Code()
-    L = code.let
-
-    def lv(vec, name="b"):
-        return [L(e, name) for e in vec]
-
-    def sym6(M, name):
-        out = [[None]*6 for _ in range(6)]
-        for r in range(6):
-            for c in range(r, 6):
-                out[r][c] = out[c][r] = L(M[r][c], name)
-        return out
-
-    def lst(M):
-        return [[M[i, j] for j in range(M.shape[1])] for i in range(M.shape[0])]
-    kin = {}
-    # ---- pass 1: transforms, velocities, bias terms
-    for b in order:
-        i = index[b.name]
-        at, rot, k, m, com, Ic = data[b.name]
-        at, rot, k, com, Ic = list(at), lst(rot), list(k), list(com), lst(Ic)
-        qd = vs[i]
-        if b.joint == "revolute":
-            if trig is not None:
-                c, s = trig[b.name]
-            else:
-                c, s = L(sp.cos(qs[i]), "c"), L(sp.sin(qs[i]), "s")
-            Rk = lst(_rodrigues(sp.Matrix(k), c, s))
-            Erel = [[L(e, "e") for e in row] for row in _mm(rot, Rk)]
-            r = at
-            S = k + [0, 0, 0]
-        else:
-            Erel = rot
-            rk = _mv(rot, k)
-            r = lv([at[j] + rk[j]*qs[i] for j in range(3)], "r")
-            S = [0, 0, 0] + k
-        E = [[Erel[j][i_] for j in range(3)] for i_ in range(3)]
-        X = (E, r)
-        vp = [0]*6 if b.parent is None else kin[b.parent]["v"]
-        v = lv([x + y*qd for x, y in zip(_xm(X, vp), S)], "v")
-        w, vl = v[:3], v[3:]
-        sq = [x*qd for x in S]
-        cw, cv1, cv2 = _lcross(w, sq[:3]), _lcross(w, sq[3:]), _lcross(vl, sq[:3])
-        cb = lv(cw + [cv1[j] + cv2[j] for j in range(3)], "cb")
-        # the spatial inertia about the body's origin, in body coordinates
-        cx = [[0, -com[2], com[1]], [com[2], 0, -com[0]], [-com[1], com[0], 0]]
-        cc = sp.Add(*[x*x for x in com])
-        I6 = [[0]*6 for _ in range(6)]
-        for r_ in range(3):
-            for c_ in range(3):
-                I6[r_][c_] = Ic[r_][c_] + m*((cc if r_ == c_ else 0) - com[r_]*com[c_])
-                I6[r_][3 + c_] = m*cx[r_][c_]
-                I6[3 + r_][c_] = m*cx[c_][r_]
-                I6[3 + r_][3 + c_] = m if r_ == c_ else 0
-        I6 = sym6(I6, "ii")
-        h = lv(_mv(I6, v), "h")
-        p1, p2, p3 = _lcross(w, h[:3]), _lcross(vl, h[3:]), _lcross(w, h[3:])
-        pA = [p1[j] + p2[j] for j in range(3)] + p3
-        kin[b.name] = dict(X=X, S=S, v=v, c=cb, IA=I6, pA=pA)
-    # ---- pass 2: articulated inertias and bias forces, leaves first
-    for b in reversed(order):
-        kb = kin[b.name]
-        IA, pA, S = sym6(kb["IA"], "ia"), lv(kb["pA"], "pa"), kb["S"]
-        U = lv(_mv(IA, S), "u")
-        D = L(sp.Add(*[x*y for x, y in zip(S, U)]), "d", force=True)
-        if D.is_Number:
-            if not D > 0:
-                raise ValueError(f"body '{b.name}': the articulated inertia of its joint is "
-                                 f"{D}: the mass matrix is not positive definite")
-        else:
-            code.positive(D)
-        Dinv = L(1/D, "di")
-        u = L(tau[index[b.name]] - sp.Add(*[x*y for x, y in zip(S, pA)]), "uu")
-        kb.update(U=U, Dinv=Dinv, u=u)
-        if b.parent is None:
-            continue
-        # Ia S = 0 exactly: for a motion subspace along a coordinate axis (S = e_k, the
-        # usual joint axes) row and column k of Ia vanish and pa_k = tau (written so:
-        # fewer products below, and exact zeros instead of rounding residues)
-        unit = [j for j, x in enumerate(S) if x != 0]
-        k = unit[0] if len(unit) == 1 and S[unit[0]] == 1 else None
-        Ia = sym6([[0 if k in (r_, c_) else IA[r_][c_] - U[r_]*U[c_]*Dinv
-                    for c_ in range(6)] for r_ in range(6)], "ja")
-        uD = L(u*Dinv)
-        Iac = _mv(Ia, kb["c"])
-        pa = lv([tau[index[b.name]] if j == k else pA[j] + Iac[j] + U[j]*uD
-                 for j in range(6)], "pb")
-        E, r = kb["X"]
-        Er = _mm(E, [[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
-        Xm = [[0]*6 for _ in range(6)]
-        for r_ in range(3):
-            for c_ in range(3):
-                Xm[r_][c_] = E[r_][c_]
-                Xm[3 + r_][3 + c_] = E[r_][c_]
-                Xm[3 + r_][c_] = -Er[r_][c_]
-        Xm = [[L(e, "x") for e in row] for row in Xm]
-        Y = [[L(e, "y") for e in row] for row in _mm(Ia, Xm)]
-        XmT = [[Xm[j][i_] for j in range(6)] for i_ in range(6)]
-        Z = _mm(XmT, Y)
-        par = kin[b.parent]
-        par["IA"] = [[par["IA"][r_][c_] + Z[min(r_, c_)][max(r_, c_)] for c_ in range(6)]
-                     for r_ in range(6)]
-        f = _xtf(kb["X"], pa)
-        par["pA"] = [par["pA"][j] + f[j] for j in range(6)]
-    # ---- pass 3: accelerations, root first
-    acc = [None]*len(order)
-    for b in order:
-        kb = kin[b.name]
-        ap = [0, 0, 0] + [-x for x in g] if b.parent is None else kin[b.parent]["a"]
-        a1 = lv([x + y for x, y in zip(_xm(kb["X"], ap), kb["c"])], "ac")
-        qdd = L((kb["u"] - sp.Add(*[x*y for x, y in zip(kb["U"], a1)]))*kb["Dinv"], "qdd")
-        kb["a"] = lv([x + y*qdd for x, y in zip(a1, kb["S"])], "ac")
-        acc[index[b.name]] = qdd
-    return code.defs, acc
-
-
-def _xm(X, m):
-    """Motion vector [omega; v] from the parent's into the child's coordinates."""
-    E, r = X
-    w, v = list(m[:3]), list(m[3:])
-    wr = _lcross(w, r)
-    return _mv(E, w) + _mv(E, [v[j] + wr[j] for j in range(3)])
-
-
-def _xtf(X, f):
-    """Force vector [n; f] from the child's into the parent's coordinates (X^T f)."""
-    E, r = X
-    ET = [[E[j][i] for j in range(3)] for i in range(3)]
-    fp = _mv(ET, list(f[3:]))
-    n = _mv(ET, list(f[:3]))
-    rf = _lcross(r, fp)
-    return [n[j] + rf[j] for j in range(3)] + fp
-
-
-def _body_key(parts):
-    out = []
-    for b in parts["order"]:
-        at, rot, axis, m, com, Ic = parts["data"][b.name]
-        out.append(sp.Tuple(*at, *rot, *axis, m, *com, *Ic))
-    return sp.Tuple(*out)
-
-
 def derive_spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None,
                         simplify="auto", jacobian=True):
     """The derived record (:class:`~conmech.symbolic.derive.Derived`) of a spatial tree,
@@ -501,87 +335,3 @@ def derive_spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None,
     _check_bodies(parts["order"], parts["data"], params)
     return _derive(parts, params, simplify, jacobian)
 
-
-def spatial_tree(bodies, params=None, gravity=(0, 0, 0), forces=None, *, loops=None,
-                 point_forces=None, method="recursive", simplify="auto", jacobian=True,
-                 flags=None, model_only=False, _description=None):
-    """A compiled spatial multibody tree (see the module docstring of
-    ``conmech.symbolic.spatial`` for frames and conventions).
-
-    Parameters
-    ----------
-    bodies : list of SpatialBody
-        The bodies; the coordinates are their ``q`` in this order.
-    params : dict
-        {Symbol or name: value}: every symbol of the geometry, masses, inertias, gravity
-        and forces. Run-time values: ``system.with_params(...)`` does not recompile.
-    gravity : 3 expressions
-        The gravitational acceleration in the ground frame, e.g. ``(0, 0, -g)``.
-    forces : list or dict, optional
-        Generalized forces (joint torques or forces, dampers, springs, motors) in t, the
-        coordinates and their derivatives: one per coordinate, or {body name or
-        coordinate: force}.
-    loops : list of Loop, optional
-        Joints that close kinematic loops (:class:`conmech.symbolic.Loop`: spherical or
-        revolute); the system is then a constrained system in the tree's coordinates.
-    point_forces : list of PointForce, optional
-        Forces at points of bodies, mapped through the points' Jacobians.
-    method : {"recursive", "lagrangian"}
-        "recursive" (default): M, Q and the exact Jacobian of the accelerations from the
-        recursive algorithms (construction linear in the number of bodies); "lagrangian":
-        from T and U by the Lagrangian derivation.
-    simplify, jacobian, flags, model_only
-        As in :func:`conmech.symbolic.lagrangian_system`.
-
-    Returns
-    -------
-    conmech.compiled.CompiledSystem
-        A system in generalized coordinates, state y = [q, q'], whose right-hand side uses
-        the spatial articulated-body algorithm; mass matrix, forces, energy and the exact
-        Jacobian (``accel_jac``: d a/d[q, v] without a LAPACK factorisation) come from the
-        recursive algorithms; with ``loops`` a constrained system (``model_only=True``:
-        the CompiledModel).
-
-    Examples
-    --------
-    A spherical double pendulum of two links (the second joint's axis tilted)::
-
-        q1, q2 = dynamicsymbols("q1 q2")
-        m, l, g = sp.symbols("m l g")
-        bodies = [SpatialBody("a", None, "revolute", q1, axis=(1, 0, 0), mass=m,
-                              com=(0, 0, -l)),
-                  SpatialBody("b", "a", "revolute", q2, axis=(0, 1, 0), at=(0, 0, -l),
-                              mass=m, com=(0, 0, -l))]
-        sys = spatial_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, 0, -g))
-    """
-    from .pipeline import _construct, _tup
-    from .description import description_hit, tree_description_key
-    from .tree import _loop_names, _method_key
-    # a second construction of the same description loads the model, deriving nothing
-    if _description is None:
-        _description = tree_description_key(
-            "spatial_tree", bodies, params, gravity, forces, loops, point_forces,
-            (method, simplify, jacobian), flags)
-        hit = description_hit(_description, flags, model_only, params or {})
-        if hit is not None:
-            return hit
-    parts = build_spatial_tree(bodies, gravity, forces, lazy=True)
-    _check_bodies(parts["order"], parts["data"], params)
-    method, extra = _method_key(method, loops, point_forces)
-    if method == "recursive":
-        from .recursive import derive_recursive
-
-        def derive():
-            return derive_recursive(parts, params, planar=False, loops=loops,
-                                    jacobian=jacobian, point_forces=point_forces)
-    else:
-        def derive():
-            return _derive(parts, params, simplify, jacobian)
-
-    topo = tuple((b.name, b.parent, b.joint) for b in parts["order"])
-    return _construct("spatial_tree", [_tup(parts["q"]), _tup(parts["forces"]),
-                                       _tup(list(parts["gravity"])), _body_key(parts)]
-                      + extra, params,
-                      (simplify, bool(jacobian), topo, method)
-                      + _loop_names(loops, point_forces), derive, flags, model_only,
-                      _description)

@@ -32,8 +32,13 @@ by tau_rel = L^-T Q (subtree sums) and the accelerations accumulated in the last
 """
 import sympy as sp
 from sympy.core.function import AppliedUndef
+from sympy.physics.mechanics import dynamicsymbols
 
-__all__ = ["Body", "planar_tree", "build_tree", "derive_tree"]
+from .lagrangian import derive_lagrangian
+from .tree_aba import _aba
+from .tree_print import aba_lines, accel_procedure  # noqa: F401
+
+__all__ = ["Body", "build_tree", "derive_tree"]
 
 _JOINTS = ("revolute", "prismatic")
 
@@ -148,166 +153,6 @@ def _rot(th, x, y):
     return c*x - s*y, s*x + c*y
 
 
-class _Code:
-    """Straight-line code: a list of (Dummy, expression) definitions; numbers and single
-    symbols are propagated instead of defined."""
-
-    def __init__(self):
-        self.defs = []
-        self.mine = set()
-        self.memo = {}
-
-    def let(self, e, name="b", force=False):
-        e = sp.sympify(e)
-        if force and not e.is_Number and e not in self.mine:
-            pass
-        elif e.is_Number or e.is_Symbol or (e.is_Mul and len(e.args) == 2 and e.args[0] == -1
-                                          and e.args[1].is_Symbol):
-            return e
-        if e in self.memo:
-            return self.memo[e]
-        s = sp.Dummy(f"{name}{len(self.defs) + 1}")
-        self.defs.append((s, e))
-        self.mine.add(s)
-        self.memo[e] = s
-        return s
-
-    def positive(self, s):
-        """Mark s (a defined symbol) as a pivot that must be positive."""
-        self.defs.append((s, "positive"))
-
-
-def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
-    """(defs, accelerations) of the articulated-body algorithm in the plain symbols qs, vs
-    (`trig`: {body name: (cos, sin) symbols} of the joint angles computed elsewhere)."""
-    code = _Code()
-    L = code.let
-    n = len(order)
-    # nearest revolute ancestor (absolute coordinates)
-    byname = {b.name: b for b in order}
-
-    def rev_anc(b):
-        p = b.parent
-        while p is not None and byname[p].joint != "revolute":
-            p = byname[p].parent
-        return p
-    kin = {}
-    # ---- pass 1: transforms, velocities, bias terms
-    for b in order:
-        i = index[b.name]
-        at, axis, m, com, inertia = data[b.name]
-        k = rev_anc(b) if absolute and b.joint == "revolute" else None
-        qrel = qs[i] - qs[index[k]] if k is not None else qs[i]
-        qd = vs[i] - vs[index[k]] if k is not None else vs[i]
-        qd = L(qd, "qd")
-        if b.joint == "revolute":
-            if trig is not None:
-                c, s = trig[b.name]
-            else:
-                s, c = L(sp.sin(qrel), "s"), L(sp.cos(qrel), "c")
-            E = [[c, s], [-s, c]]
-            rx, ry = at
-            S = (1, 0, 0)
-        else:
-            E = [[1, 0], [0, 1]]
-            rx, ry = L(at[0] + qs[i]*axis[0]), L(at[1] + qs[i]*axis[1])
-            S = (0, axis[0], axis[1])
-        bx = L(-E[0][0]*ry + E[0][1]*rx)
-        by = L(-E[1][0]*ry + E[1][1]*rx)
-        X = (bx, by, E)
-        if b.parent is None:
-            vp = (0, 0, 0)
-        else:
-            vp = kin[b.parent]["v"]
-        w, vx, vy = _xm(X, vp)
-        v = (L(w + S[0]*qd, "w"), L(vx + S[1]*qd, "vx"), L(vy + S[2]*qd, "vy"))
-        sq = [S[0]*qd, S[1]*qd, S[2]*qd]
-        cb = (0, L(v[2]*sq[0] - v[0]*sq[2]), L(-v[1]*sq[0] + v[0]*sq[1]))
-        cx, cy = com
-        Ic = L(inertia + m*(cx**2 + cy**2)) if m != 0 or inertia != 0 else 0
-        I3 = sp.Matrix([[Ic, -m*cy, m*cx], [-m*cy, m, 0], [m*cx, 0, m]])
-        h = I3*sp.Matrix(v)
-        h = [L(x) for x in h]
-        pA = [-v[2]*h[1] + v[1]*h[2], -v[0]*h[2], v[0]*h[1]]
-        kin[b.name] = dict(X=X, S=S, v=v, c=cb, IA=I3, pA=[sp.sympify(x) for x in pA],
-                           k=k, qrel=qrel)
-    # ---- generalized forces of the joints
-    tau = {b.name: tau_user[index[b.name]] for b in order}
-    if absolute:
-        for b in reversed(order):
-            kb = kin[b.name]["k"]
-            if kb is not None:
-                tau[kb] = tau[kb] + tau[b.name]
-    # ---- pass 2: articulated inertias and bias forces, leaves first
-    for b in reversed(order):
-        kb = kin[b.name]
-        IA = kb["IA"]
-        IA = sp.Matrix(3, 3, lambda r, c_: L(IA[min(r, c_), max(r, c_)], "ia"))
-        pA = [L(x, "pa") for x in kb["pA"]]
-        S = sp.Matrix(kb["S"])
-        U = [L(x, "u") for x in IA*S]
-        D = L(sum(S[j]*U[j] for j in range(3)), "d", force=True)
-        if D.is_Number:
-            if not D > 0:
-                raise ValueError(f"body '{b.name}': the articulated inertia of its joint is "
-                                 f"{D}: the mass matrix is not positive definite")
-        else:
-            code.positive(D)
-        Dinv = L(1/D, "di")
-        u = L(tau[b.name] - sum(S[j]*pA[j] for j in range(3)), "uu")
-        kb.update(U=U, Dinv=Dinv, u=u)
-        if b.parent is None:
-            continue
-        if b.joint == "revolute":    # Ia S = 0 exactly: the first row and column vanish
-            Ia = sp.Matrix(3, 3, lambda r, c_: 0 if r == 0 or c_ == 0 else
-                           IA[r, c_] - U[r]*U[c_]*Dinv)
-        else:
-            Ia = sp.Matrix(3, 3, lambda r, c_: IA[r, c_] - U[r]*U[c_]*Dinv)
-        Ia = sp.Matrix(3, 3, lambda r, c_: L(Ia[min(r, c_), max(r, c_)]))
-        c = kb["c"]
-        uD = L(u*Dinv)
-        pa = [pA[r] + sum(Ia[r, j]*c[j] for j in range(3)) + U[r]*uD for r in range(3)]
-        if b.joint == "revolute":   # exactly: pA_0 + D u / D = tau
-            pa[0] = tau[b.name]
-        pa = [L(x) for x in pa]
-        bx, by, E = kb["X"]
-        Xm = sp.Matrix([[1, 0, 0], [bx, E[0][0], E[0][1]], [by, E[1][0], E[1][1]]])
-        Y = (Ia*Xm).applyfunc(lambda e: L(e))
-        Z = Xm.T*Y
-        par = kin[b.parent]
-        par["IA"] = sp.Matrix(3, 3, lambda r, c_: par["IA"][r, c_] + Z[min(r, c_), max(r, c_)])
-        f = _xtf(kb["X"], pa)
-        par["pA"] = [par["pA"][j] + f[j] for j in range(3)]
-    # ---- pass 3: accelerations, root first
-    gx, gy = gravity
-    acc_out = [None]*n
-    for b in order:
-        kb = kin[b.name]
-        ap = (0, -gx, -gy) if b.parent is None else kin[b.parent]["a"]
-        a1 = _xm(kb["X"], ap)
-        a1 = [L(a1[j] + kb["c"][j], "ac") for j in range(3)]
-        qdd = L((kb["u"] - sum(kb["U"][j]*a1[j] for j in range(3)))*kb["Dinv"], "qdd")
-        kb["a"] = [L(a1[j] + kb["S"][j]*qdd, "ac") for j in range(3)]
-        if kb["k"] is not None:
-            qdd = L(qdd + acc_out[index[kb["k"]]], "qdd")
-        acc_out[index[b.name]] = qdd
-    return code.defs, acc_out
-
-
-def _xm(X, m):
-    """Motion vector from the parent's into the child's coordinates."""
-    bx, by, E = X
-    w, vx, vy = m
-    return (w, bx*w + E[0][0]*vx + E[0][1]*vy, by*w + E[1][0]*vx + E[1][1]*vy)
-
-
-def _xtf(X, f):
-    """Force vector from the child's into the parent's coordinates (X^T f)."""
-    bx, by, E = X
-    n_, fx, fy = f
-    return (n_ + bx*fx + by*fy, E[0][0]*fx + E[1][0]*fy, E[0][1]*fx + E[1][1]*fy)
-
-
 def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy=False):
     """The pieces of a planar tree without compiling: a dict with ``L``, ``T``, ``U`` (in
     the dynamicsymbols; with ``lazy`` None, computed by ``energies()`` when needed), ``q``
@@ -317,7 +162,6 @@ def build_tree(bodies, gravity=(0, 0), forces=None, coordinates="relative", lazy
     coordinate). Used by :func:`planar_tree`; useful to inspect T and U."""
     if coordinates not in ("relative", "absolute"):
         raise ValueError(f"coordinates must be 'relative' or 'absolute', got {coordinates!r}")
-    from sympy.physics.mechanics import dynamicsymbols
     t = dynamicsymbols._t
     bodies = [bodies] if isinstance(bodies, Body) else list(bodies)
     order, coords = _check_tree(bodies, t)
@@ -389,7 +233,6 @@ def _forces_at(fl, coords, qs, vs):
     """The generalized forces `fl` with the coordinates and their rates replaced by the
     symbols `qs`, `vs` of the generated code (a force that still depends on another
     function of t, or on an acceleration, is refused)."""
-    from sympy.physics.mechanics import dynamicsymbols
     t = dynamicsymbols._t
     sub = {qi.diff(t): vs[i] for i, qi in enumerate(coords)}
     sub.update({qi: qs[i] for i, qi in enumerate(coords)})
@@ -488,7 +331,6 @@ def _check_leaves(order, data, params):
 
 def _derive(parts, params, simplify, jacobian):
     """The Derived record of the tree's Lagrangian with the ABA code attached (d.aba)."""
-    from .derive import derive_lagrangian
     L = parts["L"]
     if L is None:
         T, U = parts["energies"]()
@@ -529,198 +371,3 @@ def derive_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="r
     _check_leaves(parts["order"], parts["data"], params)
     return _derive(parts, params, simplify, jacobian)
 
-
-def planar_tree(bodies, params=None, gravity=(0, 0), forces=None, coordinates="relative", *,
-                loops=None, point_forces=None, method="recursive", simplify="auto",
-                jacobian=True, flags=None, model_only=False):
-    """A compiled planar multibody tree (see the module docstring for frames and
-    conventions).
-
-    Parameters
-    ----------
-    bodies : list of Body
-        The bodies; the coordinates are their ``q`` in this order.
-    params : dict
-        {Symbol or name: value}: every symbol of the geometry, masses, gravity and forces.
-        Run-time values: ``system.with_params(...)`` does not recompile.
-    gravity : pair of expressions
-        The gravitational acceleration in the ground frame, e.g. ``(0, -g)``.
-    forces : list or dict, optional
-        Generalized forces (joint torques, dampers, springs, motors) in t, the coordinates
-        and their derivatives: one per coordinate, or {body name or coordinate: force}.
-        With absolute coordinates they are the generalized forces of the absolute angles.
-    coordinates : {"relative", "absolute"}
-        Revolute joints' angles relative to the parent, or the bodies' angles from the
-        ground frame (prismatic coordinates are the slide in both).
-    loops : list of Loop, optional
-        Joints that close kinematic loops (:class:`conmech.symbolic.Loop`: revolute or
-        prismatic). The system is then a constrained system in the tree's coordinates for
-        :func:`conmech.constrained.solve` (see :mod:`conmech.symbolic.loops`).
-    point_forces : list of PointForce, optional
-        Forces at points of bodies (:class:`conmech.symbolic.PointForce`), mapped through
-        the points' Jacobians.
-    method : {"recursive", "lagrangian"}
-        "recursive" (default): M, Q and the exact Jacobian from the recursive algorithms
-        (:mod:`conmech.symbolic.recursive`; construction linear in the number of bodies);
-        "lagrangian": from T and U by the Lagrangian derivation (no loops or point forces).
-    simplify, jacobian, flags, model_only
-        As in :func:`conmech.symbolic.lagrangian_system` (``simplify``: Lagrangian route
-        only).
-
-    Returns
-    -------
-    conmech.compiled.CompiledSystem
-        A system in generalized coordinates, state y = [q, q'], whose right-hand side uses
-        the articulated-body algorithm; mass matrix, forces, energy and the exact Jacobian
-        come from the recursive algorithms (or the Lagrangian); with ``loops`` a
-        ``conmech.compiled.CompiledConstrained`` (``model_only=True``: the
-        :class:`CompiledModel`).
-
-    Examples
-    --------
-    A double pendulum of point masses (absolute angles from the downward vertical)::
-
-        th1, th2 = dynamicsymbols("th1 th2")
-        m, l, g = sp.symbols("m l g")
-        bodies = [Body("a", None, "revolute", th1, mass=m, com=(0, -l)),
-                  Body("b", "a", "revolute", th2, at=(0, -l), mass=m, com=(0, -l))]
-        sys = planar_tree(bodies, {m: 1, l: 1, g: 9.81}, gravity=(0, -g),
-                          coordinates="absolute")
-    """
-    from .pipeline import _construct, _tup
-    from .description import description_hit, tree_description_key
-    # a second construction of the same description loads the model, deriving nothing
-    dkey = tree_description_key("tree", bodies, params, gravity, forces, loops,
-                                point_forces, (coordinates, method, simplify, jacobian), flags)
-    hit = description_hit(dkey, flags, model_only, params or {})
-    if hit is not None:
-        return hit
-    parts = build_tree(bodies, gravity, forces, coordinates, lazy=True)
-    _check_leaves(parts["order"], parts["data"], params)
-    q = parts["q"]
-    method, extra = _method_key(method, loops, point_forces)
-    if method == "recursive":
-        from .recursive import derive_recursive
-
-        def derive():
-            return derive_recursive(parts, params, planar=True,
-                                    absolute=coordinates == "absolute", loops=loops,
-                                    jacobian=jacobian, point_forces=point_forces)
-    else:
-        def derive():
-            return _derive(parts, params, simplify, jacobian)
-
-    body_key = sp.Tuple(*[sp.Tuple(*parts["data"][b.name][0], *parts["data"][b.name][1],
-                                   parts["data"][b.name][2], *parts["data"][b.name][3],
-                                   parts["data"][b.name][4]) for b in parts["order"]])
-    topo = tuple((b.name, b.parent, b.joint) for b in parts["order"])
-    # the key: the description (T and U follow from it; built only on a cache miss)
-    return _construct("tree", [_tup(q), _tup(parts["forces"]), _tup(parts["gravity"]),
-                               body_key] + extra, params,
-                      (coordinates, simplify, bool(jacobian), topo, method) + _loop_names(
-                          loops, point_forces), derive, flags, model_only, dkey)
-
-
-def _method_key(method, loops, point_forces):
-    """The checked method and the loops' and point forces' expressions for the cache key."""
-    if method not in ("recursive", "lagrangian"):
-        raise ValueError(f"method must be 'recursive' or 'lagrangian', got {method!r}")
-    if method == "lagrangian" and (loops or point_forces):
-        raise ValueError("loops and point forces need method='recursive'")
-    from .loops import Loop, PointForce
-    extra = []
-    for x in _as_list(loops, Loop):
-        if not isinstance(x, Loop):
-            raise TypeError(f"loops must be conmech.symbolic.Loop records, got "
-                            f"{type(x).__name__}")
-    for x in _as_list(point_forces, PointForce):
-        if not isinstance(x, PointForce):
-            raise TypeError(f"point_forces must be conmech.symbolic.PointForce records, got "
-                            f"{type(x).__name__}")
-    for lp in _as_list(loops, Loop):
-        extra.append(sp.Tuple(*[_tuple_of(x) for x in (lp.point_a, lp.point_b, lp.axis,
-                                                        lp.axis_b, lp.angle)]))
-    for pf in _as_list(point_forces, PointForce):
-        extra.append(sp.Tuple(_tuple_of(pf.point), _tuple_of(pf.force)))
-    if method == "recursive":
-        from .recursive import recursive_version
-        method = "recursive"
-        extra.append(sp.Symbol("recursive_" + recursive_version()))
-    return method, extra
-
-
-def _as_list(x, cls):
-    if x is None:
-        return []
-    if isinstance(x, cls):
-        return [x]
-    try:
-        return list(x)
-    except TypeError:
-        raise TypeError(f"expected a list of {cls.__name__} records") from None
-
-
-def _tuple_of(x):
-    """x (None, an expression or a sequence of them) as a sympy object for the key."""
-    if x is None:
-        return sp.Integer(0)
-    try:
-        return sp.Tuple(*[sp.sympify(e) for e in x])
-    except TypeError:
-        return sp.sympify(x)
-
-
-def _loop_names(loops, point_forces):
-    """The string parts of the loops and point forces (bodies, joints) for the key."""
-    from .loops import Loop, PointForce
-    out = []
-    for lp in _as_list(loops, Loop):
-        out.append(("loop", repr(lp.body_a), repr(lp.body_b), repr(lp.joint),
-                    repr(lp.name)))
-    for pf in _as_list(point_forces, PointForce):
-        out.append(("pf", repr(pf.body), repr(pf.frame)))
-    return tuple(out)
-
-
-def aba_lines(printer, d, target="a", ind="        "):
-    """(declarations, statements) of the straight-line articulated-body code ``d.aba``
-    assigning the accelerations to ``target(1..n)``, printed with `printer` (whose names
-    map the coordinates, velocities and parameters). A pivot that is not positive (or NaN)
-    is set to 0, so that its inverse and the accelerations are infinite or NaN (the
-    integrators then stop with a non-finite status); no ieee_arithmetic (its procedure
-    entry and exit would cost ~90 instructions per call)."""
-    from .codegen import _decl_temps, _wrap, prepare
-    defs, acc = d.aba
-    names = {s: f"b{k + 1}" for k, (s, e) in enumerate(
-        (s, e) for s, e in defs if not isinstance(e, str))}
-    saved = printer.names
-    printer.names = {**saved, **names}
-    body = []
-    try:
-        for s, e in defs:
-            if isinstance(e, str):      # "positive": the pivot check
-                nm = names[s]
-                body.append(f"{ind}if (.not. ({nm} > 0.0_dp)) {nm} = 0.0_dp")
-            else:
-                body += _wrap(f"{names[s]} = {printer._print(prepare(e))}", ind)
-        for i, e in enumerate(acc):
-            body += _wrap(f"{target}({i + 1}) = {printer._print(prepare(sp.sympify(e)))}",
-                          ind)
-    finally:
-        printer.names = saved
-    return _decl_temps(list(names.values()), ind), body
-
-
-def accel_procedure(printer, d, cname="conmech_accel"):
-    """Fortran lines of the bind(C) subroutine ``cname(t, q, v, a, p)`` that evaluates the
-    articulated-body accelerations (:func:`aba_lines`)."""
-    n = d.n
-    npar = max(len(d.params), 1)
-    ind = "        "
-    decl, body = aba_lines(printer, d, "a", ind)
-    head = [f'    subroutine {cname}(t, q, v, a, p) bind(C, name="{cname}")',
-            f"{ind}real(dp), value, intent(in) :: t",
-            f"{ind}real(dp), intent(in) :: q({n}), v({n})",
-            f"{ind}real(dp), intent(out) :: a({n})",
-            f"{ind}real(dp), intent(in) :: p({npar})"]
-    return head + decl + body + [f"    end subroutine {cname}", ""]

@@ -13,10 +13,14 @@ generated identifiers come from indices only.
 """
 import sympy as sp
 
-from .codegen import FortranPrinter, _decl_temps, _model_info, _wrap
-from .recursive import Code, pos_pass, relative, vel_pass
+from .library_info import _model_info
+from .loops import loop_code
+from .printer import FortranPrinter, _decl_temps, _names, _wrap
+from .kinematics import Code, point_force_code, pos_pass, relative, vel_pass
 from .tree_pairs import FIXED, straight_pairs
-from .tree_print import IND as _IND, fast_print, proc as _proc
+from .spatial_aba import _spatial_aba
+from .tree_aba import _aba
+from .tree_print import IND as _IND, SC_DECL, fast_print, pos_call, proc as _proc
 from .tree_user import has_user_jac, user_forces, user_jac
 
 __all__ = ["generate_tree"]
@@ -105,15 +109,7 @@ class Emit:
     loads of earlier passes as their work-record targets."""
 
     def __init__(self, d, loads, cidx):
-        names = {d.t: "t"}
-        for i, s in enumerate(d.coords):
-            names[s] = f"q({i + 1})"
-        for i, s in enumerate(d.speeds):
-            names[s] = f"v({i + 1})"
-        for i, s in enumerate(d.accels):
-            names[s] = f"a({i + 1})"
-        for i, s in enumerate(d.params):
-            names[s] = f"p({i + 1})"
+        names = _names(d)
         self.cidx = cidx
         for s, tgt in loads.items():
             names[s] = self.target(tgt)
@@ -288,7 +284,6 @@ def chunked(em, name, args, decls, blocks, prefix, size=None):
 
 def generate_tree(d, module="conmech_symbolic_model", model_values=None):
     """(source, entry points) of the Fortran module of a :class:`TreeDerived` record."""
-    from .loops import loop_code
     joints = d.joints
     n = nb = len(joints)
     npar = max(len(d.params), 1)
@@ -379,7 +374,6 @@ def generate_tree(d, module="conmech_symbolic_model", model_values=None):
                    [f"{_IND}real(dp), intent(in) :: t, q({n}), v({n}), a({n}), p({npar})",
                     f"{_IND}type(tree_work), intent(inout) :: w",
                     f"{_IND}logical, intent(in) :: deriv"], blocks, "u")
-    from .recursive import point_force_code
     pfc = point_force_code(d)
     out += user_forces(d, em, pfc)
     if jac:
@@ -481,8 +475,6 @@ def _with_zeros(pairs, arrays, nb, act):
 def _aba_proc(d, em, trig, pfc=None):
     """tree_aba(t, q, v, sc, a, p): the articulated-body accelerations (tree.py /
     spatial.py) on the sines and cosines sc; conmech_accel computes them and calls it."""
-    from .tree import _aba
-    from .spatial import _spatial_aba
     n, npar = d.n, max(len(d.params), 1)
     order = d.aba_order
     index = {name: J.col for name, J in zip(d.order_names, d.joints)}
@@ -512,14 +504,6 @@ def _aba_proc(d, em, trig, pfc=None):
                  em.trig_lines + [f"{_IND}call tree_aba(t, q, v, sc, a, p)"],
                  "conmech_accel")
     return out
-
-
-SC_DECL = f"{_IND}real(dp) :: sc(2, nb)"
-
-
-def pos_call(em, I=_IND):
-    """The statements that evaluate the sines and cosines and the position pass."""
-    return em.trig_lines + [f"{I}call tree_pos(t, q, sc, p, w)"]
 
 
 def _entries(d, n, npar, absolute, jac, constrained, lc, em):

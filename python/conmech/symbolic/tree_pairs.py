@@ -2,7 +2,7 @@
 mass matrix (composite rigid bodies), the derivatives of inverse dynamics, the tree-sparse
 L^T D L factorisation of M and its solve, the maps of absolute angles; as loops over the
 parent array (:data:`FIXED`) or, for small trees, written out (:func:`straight_pairs`)."""
-from .codegen import _wrap
+from .printer import _wrap
 from .tree_print import IND as _IND
 
 __all__ = ["FIXED", "straight_pairs"]

@@ -2,9 +2,9 @@
 and cosines printed directly) for the generated code of trees."""
 import sympy as sp
 
-from .codegen import prepare
+from .printer import _decl_temps, _wrap, prepare
 
-__all__ = ["fast_print", "IND", "proc"]
+__all__ = ["fast_print", "IND", "proc", "aba_lines", "accel_procedure", "SC_DECL", "pos_call"]
 
 #: the indentation of statements inside a module procedure
 IND = "        "
@@ -82,3 +82,54 @@ def _num(x, pr):
     else:
         txt = pr._print(x)
     return f"({txt})" if txt.startswith("-") else txt
+
+
+def aba_lines(printer, d, target="a", ind="        "):
+    """(declarations, statements) of the straight-line articulated-body code ``d.aba``
+    assigning the accelerations to ``target(1..n)``, printed with `printer` (whose names
+    map the coordinates, velocities and parameters). A pivot that is not positive (or NaN)
+    is set to 0, so that its inverse and the accelerations are infinite or NaN (the
+    integrators then stop with a non-finite status); no ieee_arithmetic (its procedure
+    entry and exit would cost ~90 instructions per call)."""
+    defs, acc = d.aba
+    names = {s: f"b{k + 1}" for k, (s, e) in enumerate(
+        (s, e) for s, e in defs if not isinstance(e, str))}
+    saved = printer.names
+    printer.names = {**saved, **names}
+    body = []
+    try:
+        for s, e in defs:
+            if isinstance(e, str):      # "positive": the pivot check
+                nm = names[s]
+                body.append(f"{ind}if (.not. ({nm} > 0.0_dp)) {nm} = 0.0_dp")
+            else:
+                body += _wrap(f"{names[s]} = {printer._print(prepare(e))}", ind)
+        for i, e in enumerate(acc):
+            body += _wrap(f"{target}({i + 1}) = {printer._print(prepare(sp.sympify(e)))}",
+                          ind)
+    finally:
+        printer.names = saved
+    return _decl_temps(list(names.values()), ind), body
+
+
+def accel_procedure(printer, d, cname="conmech_accel"):
+    """Fortran lines of the bind(C) subroutine ``cname(t, q, v, a, p)`` that evaluates the
+    articulated-body accelerations (:func:`aba_lines`)."""
+    n = d.n
+    npar = max(len(d.params), 1)
+    ind = "        "
+    decl, body = aba_lines(printer, d, "a", ind)
+    head = [f'    subroutine {cname}(t, q, v, a, p) bind(C, name="{cname}")',
+            f"{ind}real(dp), value, intent(in) :: t",
+            f"{ind}real(dp), intent(in) :: q({n}), v({n})",
+            f"{ind}real(dp), intent(out) :: a({n})",
+            f"{ind}real(dp), intent(in) :: p({npar})"]
+    return head + decl + body + [f"    end subroutine {cname}", ""]
+
+
+SC_DECL = f"{IND}real(dp) :: sc(2, nb)"
+
+
+def pos_call(em, I=IND):
+    """The statements that evaluate the sines and cosines and the position pass."""
+    return em.trig_lines + [f"{I}call tree_pos(t, q, sc, p, w)"]

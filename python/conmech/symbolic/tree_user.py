@@ -2,7 +2,8 @@
 their Jacobian, as procedures of the generated code."""
 import sympy as sp
 
-from .codegen import _decl_temps, assignments
+from .kinematics import forward_diff
+from .printer import _decl_temps, assignments
 from .tree_print import IND as _IND, fast_print, proc as _proc
 
 __all__ = ["user_forces", "has_user_jac", "user_jac"]
@@ -45,7 +46,6 @@ def user_jac(d, em, pfc):
     """tree_user_jac(t, q, v, p, xt): adds d(user forces)/d[q, v] (and that of the forces
     at points of bodies, by forward differentiation of their code) to the transposed
     Jacobian xt (variables x equations, topological order)."""
-    from .recursive import forward_diff
     n, npar = d.n, max(len(d.params), 1)
     topo = {J.col: k for k, J in enumerate(d.joints)}
     xs = list(d.coords) + list(d.speeds)

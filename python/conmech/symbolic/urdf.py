@@ -31,6 +31,13 @@ import os
 import xml.etree.ElementTree as ET
 
 import numpy as np
+import sympy as sp
+from sympy.physics.mechanics import dynamicsymbols
+
+from .description import urdf_description_key
+from .description_lookup import description_hit
+from .spatial import SpatialBody
+from .trees import spatial_tree
 
 __all__ = ["Robot", "UrdfJoint", "read_urdf", "from_urdf"]
 
@@ -104,9 +111,6 @@ class Robot:
             Further keyword arguments, passed to :func:`conmech.symbolic.spatial_tree`
             (method, jacobian, loops, point_forces, flags, model_only, ...).
         """
-        import sympy as sp
-        from .spatial import spatial_tree
-        from sympy.physics.mechanics import dynamicsymbols
         t = dynamicsymbols._t
         n = len(self.joints)
         vals = {}
@@ -130,31 +134,33 @@ class Robot:
                 s = sp.Symbol(f"tau{k + 1}")
                 vals[s] = 0.0
                 fl[k] += s
-        elif isinstance(torques, dict):
-            for key, e in torques.items():
-                fl[slot(key, "torques")] += sp.sympify(e)
-        elif torques is not None:
-            tl = list(torques)
-            if len(tl) != n:
-                raise ValueError(f"torques has {len(tl)} entries for {n} movable joints")
-            fl = [a + sp.sympify(b) for a, b in zip(fl, tl)]
+        else:
+            fl = _add_loads(fl, torques, "torques", slot)
         if damping:
             for k, j in enumerate(self.joints):
                 if j.damping:
                     c = sp.Symbol(f"c{k + 1}")
                     vals[c] = float(j.damping)
                     fl[k] -= c*self.coordinates[k].diff(t)
-        if isinstance(forces, dict):
-            for key, e in forces.items():
-                fl[slot(key, "forces")] += sp.sympify(e)
-        elif forces is not None:
-            ex = list(forces)
-            if len(ex) != n:
-                raise ValueError(f"forces has {len(ex)} entries for {n} movable joints")
-            fl = [a + sp.sympify(b) for a, b in zip(fl, ex)]
+        fl = _add_loads(fl, forces, "forces", slot)
         for k, v in (params or {}).items():
             vals[k] = v
         return spatial_tree(self.bodies, vals, gravity=gravity, forces=fl, **kw)
+
+
+def _add_loads(fl, loads, what, slot):
+    """The generalized forces `fl` (one per movable joint) plus the user's `loads`: a dict
+    naming joints (their slots by `slot`), a sequence with one entry per joint, or None."""
+    if isinstance(loads, dict):
+        for key, e in loads.items():
+            fl[slot(key, what)] += sp.sympify(e)
+        return fl
+    if loads is None:
+        return fl
+    ex = list(loads)
+    if len(ex) != len(fl):
+        raise ValueError(f"{what} has {len(ex)} entries for {len(fl)} movable joints")
+    return [a + sp.sympify(b) for a, b in zip(fl, ex)]
 
 
 def from_urdf(source, allow_massless=False, **kw):
@@ -163,7 +169,6 @@ def from_urdf(source, allow_massless=False, **kw):
     A second call with the same document and arguments (in any process) loads the
     compiled model from the cache without parsing into sympy or deriving anything
     (``conmech.symbolic.description``)."""
-    from .description import description_hit, urdf_description_key
     text, origin = _text(source)
     dkey = urdf_description_key(text, allow_massless, kw)
     hit = description_hit(dkey, kw.get("flags"), bool(kw.get("model_only", False)))
@@ -285,9 +290,6 @@ def read_urdf(source, allow_massless=False, _source_name=None):
     """Parse and validate a URDF document (a path or the XML text); returns a
     :class:`Robot` (see the module docstring). Every problem is a ValueError naming the
     element, found before anything is derived."""
-    import sympy as sp
-    from sympy.physics.mechanics import dynamicsymbols
-    from .spatial import SpatialBody
     text, origin_name = _text(source)
     origin_name = _source_name or origin_name
     try:
@@ -444,7 +446,6 @@ def _num(x):
     """A number for the bodies' data: exact 0, 1 and -1 where the value is one of them to
     round-off (cos(pi/2) = 6e-17 of an rpy rotation would otherwise cost multiplications
     in the generated code), else the float."""
-    import sympy as sp
     for k in (0, 1, -1):
         if abs(x - k) <= 1e-14:
             return sp.Integer(k)

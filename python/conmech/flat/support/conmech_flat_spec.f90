@@ -58,6 +58,7 @@ module conmech_flat_spec
     private
     public :: KIND_BUILTIN, KIND_ODE, KIND_GENERALIZED, KIND_CONSTRAINED, SPEC_SIZE
     public :: spec_kind, spec_system, spec_generalized, spec_constrained, spec_dimension
+    public :: spec_system_of_size
 
     integer, parameter :: KIND_BUILTIN = SPEC_KIND_BUILTIN, KIND_ODE = SPEC_KIND_ODE, &
                           KIND_GENERALIZED = SPEC_KIND_GENERALIZED, &
@@ -159,6 +160,29 @@ contains
             msg = "bad input: unknown kind of compiled system"
         end select
     end subroutine spec_system
+
+    !> The first-order system of `spec_system`, which must have n state variables: else
+    !! CM_BAD_INPUT with `size_msg`, or (size_msg = "") a message naming the size it needs.
+    subroutine spec_system_of_size(name, params, nspec, spec, n, size_msg, sys, info, msg)
+        character(len=*), intent(in) :: name
+        real(dp), intent(in) :: params(:)
+        integer, intent(in) :: nspec, n
+        integer(c_int64_t), intent(in) :: spec(:)
+        character(len=*), intent(in) :: size_msg
+        class(ode_system), allocatable, intent(out) :: sys
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        character(len=24) :: buf
+        call spec_system(name, params, nspec, spec, sys, info, msg)
+        if (info /= CM_SUCCESS .or. spec_dimension(name, nspec, spec) == n) return
+        info = CM_BAD_INPUT
+        if (len(size_msg) > 0) then
+            msg = size_msg
+        else
+            write (buf, '(i0)') spec_dimension(name, nspec, spec)
+            msg = "bad input: y0 must have size "//trim(buf)//" for the system '"//trim(name)//"'"
+        end if
+    end subroutine spec_system_of_size
 
     !> A generalized-coordinate system: built-in `name` or compiled (spec kind 2).
     subroutine spec_generalized(name, params, nspec, spec, mech, info, msg)

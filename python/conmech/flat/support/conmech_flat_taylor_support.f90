@@ -12,7 +12,7 @@ module conmech_flat_taylor_support
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     use conmech_taylor_stepper, only: taylor_stepper
     use conmech_taylor_events, only: taylor_events
-    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_ode_support, only: copy_message, store_result
     implicit none
     private
     public :: run_taylor_solve
@@ -44,8 +44,6 @@ contains
         type(ode_result) :: res
         type(taylor_events), target :: ev
         type(taylor_stepper) :: stp
-        real(c_double) :: empty1(0), empty3(n, 1, 0)
-        integer :: nseg, nf1
         type(c_funptr) :: fp
 
         counts = 0
@@ -85,23 +83,7 @@ contains
                   res%stats%nreject, ev%nsplit]
         info = res%status
         call copy_message(res%message, message)
-        nseg = 0
-        nf1 = 1
-        if (opt%dense_output .and. allocated(res%sol%ts)) then
-            nseg = res%sol%nseg
-            nf1 = res%sol%nf + 1
-            dense_form = res%sol%form
-        end if
-        if (nseg > 0) then
-            call store(res%t(1:res%nt), res%y(:, 1:res%nt), res%ev_t(1:res%nev), &
-                       res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), res%sol%ts(1:nseg), &
-                       res%sol%hs(1:nseg), res%sol%coef(:, :, 1:nseg), &
-                       n, res%nt, res%nev, nseg, nf1)
-        else
-            call store(res%t(1:res%nt), res%y(:, 1:res%nt), res%ev_t(1:res%nev), &
-                       res%ev_y(:, 1:res%nev), res%ev_id(1:res%nev), empty1, empty1, &
-                       empty3, n, res%nt, res%nev, 0, 1)
-        end if
+        call store_result(res, n, opt%dense_output, store, dense_form)
     end subroutine run_taylor_solve
 
 end module conmech_flat_taylor_support
