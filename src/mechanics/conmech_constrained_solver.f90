@@ -52,6 +52,7 @@ module conmech_constrained_solver
     use conmech_constrained_index3, only: index3_system, index3_setup
     use conmech_rattle_stepper, only: rattle_stepper
     use conmech_constrained_rows, only: row_subset, select_rows
+    use conmech_rank, only: singular_values
     implicit none
     private
 
@@ -275,28 +276,41 @@ contains
             call explain_newton_failure(rstp%t, rstp%y(1:2*n))
         end subroutine solve_dae
 
-        !> A Newton failure of Radau: say why when it can be seen. (1) The constraints
-        !! have become dependent where the run stopped (a singular configuration, e.g. a
-        !! parallelogram linkage passing its flat position): Radau IIA needs independent
-        !! constraints all along. (2) Tolerances near round-off: velocities of size |v|
+        !> A step-size failure of Radau: say why when it can be seen. (1) The constraints
+        !! are becoming dependent where the run stopped (a singular configuration ahead,
+        !! e.g. a parallelogram linkage approaching its flat position; seen as the
+        !! rank0-th singular value of the constraint Jacobian relative to the largest
+        !! fallen below a quarter of its value at the start): Radau IIA needs independent
+        !! constraints all along, and its steps shrink until they fail before it. (2) Tolerances near round-off: velocities of size |v|
         !! carry a round-off of about eps |v| (more where they couple); a component that
         !! crosses zero with atol far below it cannot converge.
         subroutine explain_newton_failure(ts, y)
             real(dp), intent(in) :: ts
             real(dp), intent(in) :: y(:)
             character(len=12) :: b1, b2
-            real(dp) :: a_s(n), l_s(m)
-            integer :: rk, inf_s
+            real(dp) :: c_s(m, n), c0_s(m), sv(min(m, n)), ratio, ratio0
+            integer :: inf_s
             if (res%status /= CM_STEP_TOO_SMALL) return
-            if (m > 0) then
-                call constrained_accel(sys, ts, y(1:n), y(n + 1:2*n), a_s, l_s, inf_s, &
-                                       rank=rk)
-                if (rk < rank0) then
-                    res%message = res%message//"; the constraints have become dependent "// &
-                                  "there (rank "//itoa(rk)//" of "//itoa(m)//", "// &
-                                  itoa(rank0)//" at the start: a "// &
-                                  "singular configuration), which Radau IIA cannot pass; "// &
-                                  "the projected methods (the default DOP853) can"
+            if (m > 0 .and. rank0 <= min(m, n)) then
+                ! the smallest of the rank0 leading singular values of the constraint
+                ! Jacobian relative to the largest, where the run stopped and at the start
+                call constraint_matrix(sys, ts, y(1:n), c_s, c0_s)
+                call singular_values(c_s, sv, inf_s)
+                ratio = sv(rank0)/max(sv(1), tiny(1.0_dp))
+                if (inf_s == CM_SUCCESS) then
+                    call constraint_matrix(sys, t_span(1), q, c_s, c0_s)
+                    call singular_values(c_s, sv, inf_s)
+                    ratio0 = sv(rank0)/max(sv(1), tiny(1.0_dp))
+                end if
+                if (inf_s == CM_SUCCESS .and. ratio <= 0.25_dp*ratio0) then
+                    write (b1, '(es9.2)') ratio
+                    write (b2, '(es9.2)') ratio0
+                    res%message = res%message//"; the constraints are becoming dependent "// &
+                                  "there (singular value "//itoa(rank0)//" of the "// &
+                                  "constraint Jacobian over the largest:"//trim(b1)// &
+                                  ", at the start"//trim(b2)//": a singular "// &
+                                  "configuration ahead), which Radau IIA cannot pass; "// &
+                                  "RATTLE and the projected methods (the default DOP853) can"
                     return
                 end if
             end if

@@ -172,6 +172,7 @@ contains
                     ! dependent rows treated as dependent
                     s2%q = wk%w
                     wk%dqsum = 0.0_dp
+                    if (attempt == 2) wk%nfallback = wk%nfallback + 1
                     inf = CM_SUCCESS
                 end if
                 if (inf /= CM_SUCCESS) then
@@ -193,7 +194,6 @@ contains
                 wk%nproj = wk%nproj + 1
                 if (inf == CM_SUCCESS) exit
             end do
-            if (attempt > 1) wk%nfallback = wk%nfallback + 1
             if (inf /= CM_SUCCESS) then
                 write (b2, '(es10.3)') rnorm
                 mg = "position constraints not solved: |phi| ="//trim(b2)// &
