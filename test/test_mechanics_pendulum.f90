@@ -253,6 +253,44 @@ program test_mechanics_pendulum
                            "redundant constraints: minimum-norm lambda splits evenly")
     end block
 
+    ! ------------------------------------ redundant constraints with RATTLE and Radau IIA
+    ! RATTLE's minimum-norm position and velocity solves, and Radau IIA on an independent
+    ! combination of the rows, give the motion of the single constraint
+    block
+        type(pendulum_twice) :: tw
+        type(constrained_options) :: o
+        type(constrained_result) :: r1, r2
+        real(dp) :: te(41)
+        integer :: k
+        tw%m = m; tw%g = g; tw%l = l
+        tw%n = 2; tw%n_hol = 2
+        te = t_eval(1:41)
+        do k = 1, 2
+            o = copt
+            if (k == 1) then
+                o%ode%method = METHOD_RATTLE
+                o%ode%first_step = 0.005_dp
+            else
+                o%ode%method = METHOD_RADAU5
+                o%ode%rtol = 1.0e-10_dp
+                o%ode%atol = 1.0e-10_dp
+            end if
+            call constrained_solve(cs, [0.0_dp, te(size(te))], [l*sin(th0), -l*cos(th0)], &
+                                   [0.0_dp, 0.0_dp], o, r1, te)
+            call constrained_solve(tw, [0.0_dp, te(size(te))], [l*sin(th0), -l*cos(th0)], &
+                                   [0.0_dp, 0.0_dp], o, r2, te)
+            call ts%check(r1%success .and. r2%success, "redundant rows, method "// &
+                          merge("RATTLE", "Radau ", k == 1)//": "//r2%message)
+            if (.not. (r1%success .and. r2%success)) cycle
+            call ts%check(r2%rank == 1, "redundant rows: rank 1")
+            call ts%check_less(maxval(abs(r2%q - r1%q)), merge(1.0e-11_dp, 1.0e-8_dp, k == 1), &
+                               "redundant rows: the motion of the single constraint")
+            call ts%check_less(maxval(r2%res_pos), 1.0e-10_dp, "redundant rows: both hold")
+            call ts%check_less(maxval(abs(r2%reaction - r1%reaction)), 1.0e-6_dp, &
+                               "redundant rows: the same reaction force")
+        end do
+    end block
+
     ! ---------------------------------------------------------------- FD defaults
     block
         type(pendulum_fd) :: pf

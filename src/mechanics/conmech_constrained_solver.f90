@@ -19,15 +19,19 @@
 !!   "none" or Baumgarte), so event states are on the constraints to `proj_tol` and the
 !!   event functions vanish there to the integration tolerance.
 !! - RATTLE (METHOD_RATTLE, holonomic constraints, fixed step first_step;
-!!   conmech_rattle_stepper): constraints solved to round-off every step; t_eval points and
-!!   events on its side step from the grid point before (on the manifold to round-off).
+!!   conmech_rattle_stepper): constraints solved to round-off every step (dependent rows in
+!!   the minimum-norm least-squares sense: redundant constraints are fine); t_eval points
+!!   and events on its side step from the grid point before (on the manifold to round-off).
 !! - Radau IIA (METHOD_RADAU5, adaptive) on a DAE form of the equations (no drift, no
 !!   projection; any mass matrix M(t, q)): the stabilised index-2 (GGL) form [q, v,
 !!   lambda, mu] (options%dae_index = 2, the default; conmech_constrained_dae) or the
 !!   index-3 form [q, v, a, lambda] of the Bari test set (dae_index = 3;
 !!   conmech_constrained_index3), with the exact Jacobian where the system provides its
-!!   derivatives. Both need independent constraints: redundant constraints, or a singular
-!!   configuration at t0, are refused before the first step (as are RATTLE's).
+!!   derivatives. Both need independent constraints: redundant ones (a rank deficiency
+!!   that persists along the motion) are reduced to an independent subset of rows
+!!   (conmech_constrained_rows) and the results evaluated on the full set; a singular
+!!   configuration at t0 (the rank grows a short way along the motion) is refused before
+!!   the first step.
 !! Every result holds the accelerations, multipliers and reaction forces at its outputs
 !! (conmech_constrained_result).
 !! A terminal event ends the run at the event state. The initial state is made consistent
@@ -47,6 +51,8 @@ module conmech_constrained_solver
     use conmech_constrained_dae, only: ggl_system, dae_events, ggl_setup
     use conmech_constrained_index3, only: index3_system, index3_setup
     use conmech_rattle_stepper, only: rattle_stepper
+    use conmech_constrained_rows, only: row_subset, select_rows
+    use conmech_rank, only: singular_values
     implicit none
     private
 
@@ -71,12 +77,15 @@ contains
         class(ode_events), intent(in), optional :: events
 
         real(dp), allocatable :: q(:), v(:), acc(:), lam(:)
-        integer :: n, m, info, iters
+        type(row_subset) :: sub
+        logical :: use_subset
+        integer :: n, m, info, iters, rank0
         character(len=:), allocatable :: msg
         character(len=32) :: buf
 
         n = sys%n
         m = sys%n_hol + sys%n_nh
+        use_subset = .false.
         ! ------------------------------------------------------------ validation
         ! (the integrator options and t_eval are checked by the driver)
         info = CM_BAD_INPUT
@@ -125,23 +134,23 @@ contains
             call empty_constrained_result(res, n, m, info, msg)
             return
         end if
+        rank0 = res%rank
         if (m > 0 .and. res%rank == 0) then
             call empty_constrained_result(res, n, m, CM_BAD_INPUT, "bad input: the "// &
                                           "constraint Jacobian is zero at the initial "// &
                                           "state (rank 0): the constraints cannot be enforced")
             return
         end if
-        if (m > 0 .and. res%rank < m .and. (options%ode%method == METHOD_RADAU5 .or. &
-                                            options%ode%method == METHOD_RATTLE)) then
-            call empty_constrained_result(res, n, m, CM_BAD_INPUT, &
-                                          "bad input: "//method_label()//" needs "// &
-                                          "independent constraints, but at the initial "// &
-                                          "state their rank is "//itoa(res%rank)// &
-                                          " of "//itoa(m)//" (redundant constraints or "// &
-                                          "a singular configuration); the projected "// &
-                                          "methods (the default DOP853) handle it with "// &
-                                          "minimum-norm multipliers")
-            return
+        if (m > 0 .and. res%rank < m .and. options%ode%method == METHOD_RADAU5) then
+            ! dependent rows: Radau runs on an independent subset when the deficiency is
+            ! structural (redundant constraints), refuses a singular configuration
+            call select_rows(sys, t_span(1), q, v, acc, res%rank, options%proj_tol, sub, &
+                             info, msg)
+            if (info /= CM_SUCCESS) then
+                call empty_constrained_result(res, n, m, info, msg)
+                return
+            end if
+            use_subset = .true.
         end if
 
         ! ------------------------------------------------------------ the method
@@ -149,7 +158,11 @@ contains
         case (METHOD_RATTLE)
             call solve_rattle()
         case (METHOD_RADAU5)
-            call solve_dae()
+            if (use_subset) then
+                call solve_dae(sub)
+            else
+                call solve_dae(sys)
+            end if
         case default
             call solve_projected()
         end select
@@ -208,27 +221,39 @@ contains
                            stepper=rs)
             call build_constrained_result(res, ores, sys, sys)
             call add_projections(rs%wk%nproj, rs%wk%proj_iter, rs%wk%proj_iter_max)
+            if (rs%wk%nfallback > 0) res%message = res%message//" ("// &
+                itoa(rs%wk%nfallback)//" position solves near a singular configuration "// &
+                "needed Newton with the constraint Jacobian at every iterate)"
         end subroutine solve_rattle
 
-        !> Radau IIA on the index-2 (GGL) or the index-3 form.
-        subroutine solve_dae()
+        !> Radau IIA on the index-2 (GGL) or the index-3 form of dsys (sys itself, or
+        !! sys restricted to independent rows); the results are evaluated on sys.
+        subroutine solve_dae(dsys)
+            class(constrained_system), intent(in) :: dsys
             type(ggl_system) :: g2
             type(index3_system) :: g3
             type(dae_events) :: gev
             type(radau_stepper) :: rstp
             type(ode_options) :: opt
             type(ode_result) :: ores
-            real(dp), allocatable :: y0(:)
+            real(dp), allocatable :: y0(:), lam_d(:)
+            integer :: inf_d
             opt = options%ode
             opt%dense_output = .false.
             opt%save_steps = options%save_steps
             if (allocated(opt%rtol_vec)) deallocate (opt%rtol_vec)
             if (allocated(opt%atol_vec)) deallocate (opt%atol_vec)
-            if (options%dae_index == 3) then
-                call index3_setup(sys, q, v, acc, lam, g3, y0, rstp)
+            allocate (lam_d(dsys%n_hol + dsys%n_nh))
+            if (use_subset) then
+                call constrained_accel(dsys, t_span(1), q, v, acc, lam_d, inf_d)
             else
-                call ggl_setup(sys, t_span(1), q, v, lam, opt%rtol, opt%atol, g2, y0, rstp, &
-                               opt%rtol_vec, opt%atol_vec)
+                lam_d = lam
+            end if
+            if (options%dae_index == 3) then
+                call index3_setup(dsys, q, v, acc, lam_d, g3, y0, rstp)
+            else
+                call ggl_setup(dsys, t_span(1), q, v, lam_d, opt%rtol, opt%atol, g2, y0, &
+                               rstp, opt%rtol_vec, opt%atol_vec)
             end if
             if (present(events)) then
                 allocate (gev%inner, source=events)
@@ -251,31 +276,45 @@ contains
             call explain_newton_failure(rstp%t, rstp%y(1:2*n))
         end subroutine solve_dae
 
-        !> A Newton failure of Radau: say why when it can be seen. (1) The constraints
-        !! have become dependent where the run stopped (a singular configuration, e.g. a
-        !! parallelogram linkage passing its flat position): Radau IIA needs independent
-        !! constraints all along. (2) Tolerances near round-off: velocities of size |v|
+        !> A step-size failure of Radau: say why when it can be seen. (1) The constraints
+        !! are becoming dependent where the run stopped (a singular configuration ahead,
+        !! e.g. a parallelogram linkage approaching its flat position; seen as the
+        !! rank0-th singular value of the constraint Jacobian relative to the largest
+        !! fallen below a quarter of its value at the start): Radau IIA needs independent
+        !! constraints all along, and its steps shrink until they fail before it. (2) Tolerances near round-off: velocities of size |v|
         !! carry a round-off of about eps |v| (more where they couple); a component that
         !! crosses zero with atol far below it cannot converge.
         subroutine explain_newton_failure(ts, y)
             real(dp), intent(in) :: ts
             real(dp), intent(in) :: y(:)
             character(len=12) :: b1, b2
-            real(dp) :: a_s(n), l_s(m)
-            integer :: rk, inf_s
+            real(dp) :: c_s(m, n), c0_s(m), sv(min(m, n)), ratio, ratio0
+            integer :: inf_s
             if (res%status /= CM_STEP_TOO_SMALL) return
-            if (index(res%message, "Newton") == 0) return
-            if (m > 0) then
-                call constrained_accel(sys, ts, y(1:n), y(n + 1:2*n), a_s, l_s, inf_s, &
-                                       rank=rk)
-                if (rk < m) then
-                    res%message = res%message//"; the constraints have become dependent "// &
-                                  "there (rank "//itoa(rk)//" of "//itoa(m)//": a "// &
-                                  "singular configuration), which Radau IIA cannot pass; "// &
-                                  "the projected methods (the default DOP853) can"
+            if (m > 0 .and. rank0 <= min(m, n)) then
+                ! the smallest of the rank0 leading singular values of the constraint
+                ! Jacobian relative to the largest, where the run stopped and at the start
+                call constraint_matrix(sys, ts, y(1:n), c_s, c0_s)
+                call singular_values(c_s, sv, inf_s)
+                ratio = sv(rank0)/max(sv(1), tiny(1.0_dp))
+                if (inf_s == CM_SUCCESS) then
+                    call constraint_matrix(sys, t_span(1), q, c_s, c0_s)
+                    call singular_values(c_s, sv, inf_s)
+                    ratio0 = sv(rank0)/max(sv(1), tiny(1.0_dp))
+                end if
+                if (inf_s == CM_SUCCESS .and. ratio <= 0.25_dp*ratio0) then
+                    write (b1, '(es9.2)') ratio
+                    write (b2, '(es9.2)') ratio0
+                    res%message = res%message//"; the constraints are becoming dependent "// &
+                                  "there (singular value "//itoa(rank0)//" of the "// &
+                                  "constraint Jacobian over the largest:"//trim(b1)// &
+                                  ", at the start"//trim(b2)//": a singular "// &
+                                  "configuration ahead), which Radau IIA cannot pass; "// &
+                                  "RATTLE and the projected methods (the default DOP853) can"
                     return
                 end if
             end if
+            if (index(res%message, "Newton") == 0) return
             if (options%ode%atol >= 1.0e3_dp*epsilon(1.0_dp)*maxval(abs(y))) return
             write (b1, '(es9.2)') options%ode%atol
             write (b2, '(es9.2)') maxval(abs(y))

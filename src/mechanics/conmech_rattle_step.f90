@@ -29,7 +29,7 @@ module conmech_rattle_step
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_lapack, only: dgetrs, dgetf2, dpotri
+    use conmech_lapack, only: dgetrs, dgetf2, dpotri, dgelsd
     use conmech_generalized, only: mass_cholesky
     use conmech_constrained_system, only: constrained_system
     use conmech_state_packer, only: state_packer
@@ -40,6 +40,14 @@ module conmech_rattle_step
     public :: rattle_state_transfer
 
     integer, parameter :: MASS_GENERAL = 0, MASS_DIAGONAL = 1, MASS_CONSTANT = 2
+    !> Relative size below which a singular value (or an LU pivot) of the constraint
+    !! matrix G M^-1 G^T counts as zero (the explicit methods' KKT solve uses the same).
+    real(dp), parameter :: RANK_TOL = 1.0e-11_dp
+    !> The coarser truncation of the second attempt of a position solve that failed
+    !! (rows nearly dependent: a step that lands close to a singular configuration).
+    real(dp), parameter :: COARSE_RANK_TOL = 1.0e-6_dp
+    !> A residual that stops decreasing below FLOOR_FACTOR proj_tol is round-off.
+    real(dp), parameter :: FLOOR_FACTOR = 100.0_dp
 
     !> The state at one grid point with what the next step reuses.
     type :: rattle_state
@@ -69,6 +77,9 @@ module conmech_rattle_step
         integer :: nproj = 0                !! position solves
         integer :: proj_iter = 0            !! their total iterations
         integer :: proj_iter_max = 0        !! the most iterations of one solve
+        !> position solves that needed the Newton iteration with G at every iterate
+        !! (steps landing close to a singular configuration)
+        integer :: nfallback = 0
     end type rattle_work
 
 contains
@@ -138,7 +149,7 @@ contains
         integer, intent(out) :: inf
         character(len=:), allocatable, intent(out) :: mg
         real(dp) :: t1, rnorm
-        integer :: it, kk, i, m
+        integer :: it, kk, i, m, attempt
         character(len=32) :: b2
         m = wk%m
         t1 = st%t + hs
@@ -149,37 +160,40 @@ contains
         wk%dqsum = 0.0_dp
         if (m > 0) then
             call sys%phi_jac(t1, s2%q, wk%gt)
-            ! pk = X S^{-1} (n x m) from S^T pk^T = X^T, S = G(q~) X
-            call schur_rows(m, wk%gt, st%x, wk%pt, wk%sm, wk%ipiv, inf)
-            if (inf /= CM_SUCCESS) then
-                mg = "singular constraint matrix G M^-1 G^T in the position solve " &
-                     //"(redundant constraints?)"
-                return
-            end if
-            inf = CM_NO_CONVERGENCE
-            do it = 1, wk%proj_max_iter + 1
-                call sys%phi(t1, s2%q, wk%ph)
-                rnorm = maxval(abs(wk%ph))
-                if (.not. rnorm < huge(1.0_dp)) exit
-                if (rnorm <= wk%proj_tol) then
+            wk%w = s2%q
+            do attempt = 1, merge(3, 1, m > 1)
+                if (attempt == 1) then
+                    ! pk = X S^{-1} (n x m) from S^T pk^T = X^T, S = G(q~) X
+                    call schur_rows(m, wk%gt, st%x, wk%pt, wk%sm, wk%ipiv, inf)
+                else
+                    ! near a singular configuration (rows almost dependent) the frozen
+                    ! matrix is a poor Newton matrix: again from the predictor, by Newton
+                    ! with G at every iterate (minimum-norm rows), then with the nearly
+                    ! dependent rows treated as dependent
+                    s2%q = wk%w
+                    wk%dqsum = 0.0_dp
+                    if (attempt == 2) wk%nfallback = wk%nfallback + 1
                     inf = CM_SUCCESS
-                    exit
                 end if
-                if (it > wk%proj_max_iter) exit
-                wk%dq = 0.0_dp
-                do i = 1, m
-                    wk%dq = wk%dq + wk%ph(i)*wk%pt(i, :)
-                end do
-                wk%dqsum = wk%dqsum + wk%dq
-                s2%q = s2%q - wk%dq
-                if (maxval(abs(wk%dq)) <= 4.0_dp*epsilon(1.0_dp)*maxval(abs(s2%q))) then
-                    inf = CM_SUCCESS
-                    exit
+                if (inf /= CM_SUCCESS) then
+                    mg = "the constraint matrix G M^-1 G^T of the position solve is " &
+                         //"zero (rank 0) or not finite"
+                    return
                 end if
+                select case (attempt)
+                case (1)
+                    call position_newton(sys, wk, t1, s2, st%x, 0.0_dp, it, rnorm, inf)
+                case (2)
+                    call position_newton(sys, wk, t1, s2, st%x, RANK_TOL, it, rnorm, inf)
+                case default
+                    call position_newton(sys, wk, t1, s2, st%x, COARSE_RANK_TOL, it, rnorm, &
+                                         inf)
+                end select
+                wk%proj_iter = wk%proj_iter + it
+                wk%proj_iter_max = max(wk%proj_iter_max, it)
+                wk%nproj = wk%nproj + 1
+                if (inf == CM_SUCCESS) exit
             end do
-            wk%proj_iter = wk%proj_iter + it
-            wk%proj_iter_max = max(wk%proj_iter_max, it)
-            wk%nproj = wk%nproj + 1
             if (inf /= CM_SUCCESS) then
                 write (b2, '(es10.3)') rnorm
                 mg = "position constraints not solved: |phi| ="//trim(b2)// &
@@ -196,7 +210,8 @@ contains
         if (m > 0) then
             call schur_rows(m, s2%g, s2%x, wk%pt, wk%sm, wk%ipiv, inf)
             if (inf /= CM_SUCCESS) then
-                mg = "singular constraint matrix G M^-1 G^T in the velocity solve"
+                mg = "the constraint matrix G M^-1 G^T of the velocity solve is zero " &
+                     //"(rank 0) or not finite"
                 return
             end if
         end if
@@ -231,6 +246,60 @@ contains
                  //"converge (or are not finite)"
         end if
     end subroutine rattle_step
+
+    !> The Newton iteration of the position solve from s2%q (the predictor) with the
+    !! rows wk%pt (simplified) or rows recomputed at every iterate: q <- q - pt^T phi(q) until max|phi| <= proj_tol, or the
+    !! correction is below the round-off of q, or the residual stops decreasing at a
+    !! round-off floor (<= FLOOR_FACTOR proj_tol; near dependent rows the round-off of the
+    !! corrections is amplified). A residual that grows above the floor is a divergence.
+    subroutine position_newton(sys, wk, t1, s2, xx, rcond, it, rnorm, inf)
+        class(constrained_system), intent(in) :: sys
+        type(rattle_work), intent(inout) :: wk
+        real(dp), intent(in) :: t1
+        type(rattle_state), intent(inout) :: s2
+        !> M_n^-1 G_n^T, the directions of the corrections
+        real(dp), intent(in) :: xx(:, :)
+        !> 0: the rows wk%pt as given (simplified Newton); > 0: Newton, the rows
+        !! recomputed at every iterate, singular values <= rcond sigma_max dropped
+        real(dp), intent(in) :: rcond
+        integer, intent(out) :: it, inf
+        real(dp), intent(out) :: rnorm
+        real(dp) :: rprev
+        integer :: i, inf2
+        inf = CM_NO_CONVERGENCE
+        rprev = huge(1.0_dp)
+        do it = 1, wk%proj_max_iter + 1
+            call sys%phi(t1, s2%q, wk%ph)
+            rnorm = maxval(abs(wk%ph))
+            if (.not. rnorm < huge(1.0_dp)) exit
+            if (rnorm <= wk%proj_tol) then
+                inf = CM_SUCCESS
+                exit
+            end if
+            if (rnorm >= rprev) then
+                if (rnorm <= FLOOR_FACTOR*wk%proj_tol) inf = CM_SUCCESS
+                exit
+            end if
+            if (rcond > 0.0_dp) then
+                call sys%phi_jac(t1, s2%q, wk%gt)
+                call min_norm_rows(wk%m, wk%n, wk%gt, xx, wk%pt, rcond, inf2)
+                if (inf2 /= CM_SUCCESS) exit
+            end if
+            if (it > wk%proj_max_iter) exit
+            rprev = rnorm
+            wk%dq = 0.0_dp
+            do i = 1, wk%m
+                wk%dq = wk%dq + wk%ph(i)*wk%pt(i, :)
+            end do
+            wk%dqsum = wk%dqsum + wk%dq
+            s2%q = s2%q - wk%dq
+            if (maxval(abs(wk%dq)) <= 4.0_dp*epsilon(1.0_dp)*maxval(abs(s2%q))) then
+                inf = CM_SUCCESS
+                exit
+            end if
+        end do
+        it = min(it, wk%proj_max_iter + 1)
+    end subroutine position_newton
 
     !> Pack or unpack one grid state (conmech_state_packer), allocated for the run of wk.
     subroutine rattle_state_transfer(wk, st, p)
@@ -329,7 +398,14 @@ contains
     end subroutine minv_times
 
     !> pt = S^{-T} X^T (m x n) for S = gg X (m x m, LU by dgetf2 in sm, ipiv; one
-    !! constraint: a division). inf = CM_SINGULAR when S is singular.
+    !! constraint: a division). inf = CM_SINGULAR when S is singular (one constraint
+    !! with a vanishing gradient). Dependent constraint rows (redundant constraints, or a
+    !! configuration where the rows lose rank) make S singular: the LU's smallest pivot
+    !! falls below RANK_TOL times the largest entry of S, and pt becomes the minimum-norm
+    !! least-squares rows (S^T)^+ X^T (dgelsd, singular values below RANK_TOL sigma_max
+    !! dropped): the Newton corrections act only in the span of the independent rows, and
+    !! a consistent set of dependent equations is solved exactly (their residuals are
+    !! combinations of the others').
     subroutine schur_rows(m, gg, xx, pt, sm, ipiv, inf)
         integer, intent(in) :: m
         real(dp), intent(in) :: gg(:, :), xx(:, :)
@@ -337,7 +413,7 @@ contains
         real(dp), intent(inout) :: sm(m, m)
         integer, intent(inout) :: ipiv(m)
         integer, intent(out) :: inf
-        real(dp) :: s1
+        real(dp) :: s1, smax, umin
         integer :: lainfo, i2, j2, n
         inf = CM_SUCCESS
         if (m == 1) then
@@ -355,14 +431,47 @@ contains
                 sm(i2, j2) = dot_product(gg(i2, :), xx(:, j2))
             end do
         end do
-        call dgetf2(m, m, sm, m, ipiv, lainfo)
-        if (lainfo /= 0) then
+        n = size(gg, 2)
+        smax = maxval(abs(sm))
+        if (.not. (smax > 0.0_dp .and. smax < huge(1.0_dp))) then
             inf = CM_SINGULAR
             return
         end if
-        n = size(gg, 2)
-        pt = transpose(xx)
-        call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
+        call dgetf2(m, m, sm, m, ipiv, lainfo)
+        umin = huge(1.0_dp)
+        do i2 = 1, m
+            umin = min(umin, abs(sm(i2, i2)))
+        end do
+        if (lainfo == 0 .and. umin > RANK_TOL*smax) then
+            pt = transpose(xx)
+            call dgetrs('T', m, n, sm, m, ipiv, pt, m, lainfo)
+            return
+        end if
+        call min_norm_rows(m, n, gg, xx, pt, RANK_TOL, inf)
     end subroutine schur_rows
+
+    !> pt = (S^T)^+ X^T for S = gg X with dependent rows (dgelsd, singular values
+    !! <= rcond sigma_max dropped; see schur_rows).
+    subroutine min_norm_rows(m, n, gg, xx, pt, rcond, inf)
+        integer, intent(in) :: m, n
+        real(dp), intent(in) :: gg(:, :), xx(:, :)
+        real(dp), intent(out) :: pt(:, :)
+        real(dp), intent(in) :: rcond
+        integer, intent(out) :: inf
+        real(dp), allocatable :: st(:, :), work(:), sv(:)
+        integer, allocatable :: iwork(:)
+        real(dp) :: wq(1)
+        integer :: iq(1), lwork, lainfo, rank
+        allocate (st(m, m), sv(m))
+        st = transpose(matmul(gg, xx))
+        pt = transpose(xx)
+        call dgelsd(m, m, n, st, m, pt, m, sv, rcond, rank, wq, -1, iq, lainfo)
+        lwork = max(1, int(wq(1)))
+        allocate (work(lwork), iwork(max(1, iq(1))))
+        st = transpose(matmul(gg, xx))
+        call dgelsd(m, m, n, st, m, pt, m, sv, rcond, rank, work, lwork, iwork, lainfo)
+        inf = CM_SUCCESS
+        if (lainfo /= 0 .or. rank == 0) inf = CM_SINGULAR
+    end subroutine min_norm_rows
 
 end module conmech_rattle_step

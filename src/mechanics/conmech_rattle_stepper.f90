@@ -247,6 +247,7 @@ contains
         call p%item(self%wk%nproj)
         call p%item(self%wk%proj_iter)
         call p%item(self%wk%proj_iter_max)
+        call p%item(self%wk%nfallback)
         do k = 1, 2
             call rattle_state_transfer(self%wk, self%grid(k), p)
         end do

@@ -260,9 +260,14 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         adaptive, rtol/atol) on a differential-algebraic form of the equations (see
         ``dae_index``): no drift and no projection; stiff forces and any mass matrix
         M(t, q) welcome; the Jacobian is exact for systems of :mod:`conmech.symbolic`
-        (central differences of M, Q and the constraints otherwise). RATTLE and Radau
-        need independent constraints: redundant ones, or a singular configuration at t0,
-        raise ValueError before the first step.
+        (central differences of M, Q and the constraints otherwise). Redundant
+        constraints (rows dependent all along the motion, e.g. Bricard's mechanism):
+        RATTLE solves its constraint equations in the minimum-norm least-squares sense;
+        Radau integrates an independent subset of the rows chosen at t0 (the results,
+        residuals and minimum-norm multipliers are those of the full set). A singular
+        configuration at t0 (rows dependent there only, e.g. a parallelogram linkage
+        flat): Radau raises ValueError before the first step (the projected methods pass
+        it).
     projection : "position+velocity" (the default of the explicit methods), "velocity",
         "baumgarte", "none"
         For the explicit methods only (RATTLE and Radau keep the constraints themselves:
