@@ -22,7 +22,8 @@ from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
 from .._core.native import _NO_SPEC, NativeSystem
-from .._core.result import DictResult
+from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
+from .result import _MESSAGES, OdeResult
 from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
@@ -37,10 +38,6 @@ _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45
 # (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
 _RK45_SCIPY = RK45_SCIPY
 _TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
-_MESSAGES = {
-    0: "The solver successfully reached the end of the integration interval.",
-    1: "A termination event occurred.",
-}
 _HUGE = np.finfo(float).max
 # no step limit (SciPy has none): the largest count the Fortran counters hold
 _NO_LIMIT = 2**31 - 1
@@ -51,32 +48,8 @@ _PAD.flags.writeable = False
 _PADI.flags.writeable = False
 _EMPTY = np.zeros(0)
 _EMPTY.flags.writeable = False
-# the room for the points of a run returned without a call-back (_solve_native): numbers
-# of t and y (8 kB; a run with more points hands them over through a call-back)
-_OUT_DOUBLES = 1024
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
-
-
-class OdeResult(DictResult):
-    """Result of :func:`solve_ivp`: a dict whose keys are also attributes (as SciPy's).
-
-    Keys: t, y, sol, t_events, y_events, nfev, njev, nlu, status, message, success,
-    and conmech's extras naccept, nreject.
-    """
-
-    def __repr__(self):
-        keys = ("message", "success", "status", "t", "y", "sol", "t_events", "y_events",
-                "nfev", "njev", "nlu")
-        width = max(map(len, keys)) + 1
-        lines = []
-        for k in keys:
-            v = self.get(k)
-            if isinstance(v, np.ndarray) and v.size > 6:
-                v = f"array of shape {v.shape}"
-            lines.append(f"{k.rjust(width)}: {v!r}" if not isinstance(v, str) else
-                         f"{k.rjust(width)}: {v}")
-        return "\n".join(lines)
 
 
 class _StopAtStart(Exception):
@@ -574,49 +547,6 @@ def _solve(problem, common, h0, jac, pattern):
 
     return _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, problem["dense"], form,
                      status, message, nfev, naccept, nreject)
-
-
-def _solve_native(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax,
-                  max_steps):
-    """solve_ivp of a built-in or compiled system without events or dense output (checked
-    arguments): the result of :func:`_solve` for such a run, from one call of
-    flat_solve_native, which returns the points in arrays sized here (t_eval's length,
-    else room for _OUT_DOUBLES numbers) and calls ``store`` back only when a run has more."""
-    n = y0.size
-    neval = t_ev.size
-    cap = neval if with_t_eval else max(_OUT_DOUBLES // (n + 1), 2)
-    out = []
-
-    def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
-        # more points than cap: the arrays wrap Fortran memory that is freed on return
-        out.append(t.copy())
-        out.append(y.reshape(n, t.size).copy())
-
-    t_out, y_out, nt, counts, info, message = _conmech.flat_solve_native(
-        *fun._flat_args(), store, t0, tf, y0, code, rtol, atol, h0, hmax,
-        max_steps, neval, t_ev if neval else _PAD, cap)
-    info = int(info)
-    if info == BAD_INPUT:
-        raise ValueError(message_text(message))
-    if nt < 0:
-        t, y = out
-    elif nt > 0:
-        t, y = t_out[:nt].copy(), y_out[:, :nt].copy()
-    else:               # no point stored: a run refused before its first step
-        t, y = np.array([t0]), y0[:, None].copy()
-    if tf == t0 and not with_t_eval:
-        # SciPy's solver makes one (empty) step: t = [t0, t0]
-        t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)
-    elif with_t_eval and t.size == 0:
-        t, y = [], []          # SciPy's lists when no point of t_eval was reached
-    nfev, njev, nlu, naccept, nreject = counts.tolist()
-    if info >= 0:
-        status, message = info, _MESSAGES.get(info) or message_text(message)
-    else:
-        status, message = -1, message_text(message)
-    return OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None, nfev=nfev,
-                     njev=njev, nlu=nlu, status=status, message=message,
-                     success=status >= 0, naccept=naccept, nreject=nreject)
 
 
 def _drop_first_point(out, with_t_eval):
