@@ -9,12 +9,21 @@ steps are printed beside the times.
                                  [--brouwer]  (energy over 1e4 Kepler periods, a plot)
                                  [--breakdown] (one Kepler period at 1e-12: where the time
                                                 goes, results/taylor_breakdown.md)
+                                 [--count [CASE ...]] (the same calls, Kepler and Arenstorf
+                                                at 1e-12, as callgrind instruction counts
+                                                per call: results/taylor_count.md)
 
 Instruction counts (repeatable on a loaded machine) of the Fortran integration alone:
-bash bench/callgrind_taylor.sh.
+bash bench/callgrind_taylor.sh; of the calls through Python (per call, the interpreter's
+start-up and the set-up cancelled: (I(3 calls) - I(1 call))/2 in two processes under
+valgrind): --count.
 """
 import argparse
 import os
+import re
+import subprocess
+import sys
+import tempfile
 import time
 
 import numpy as np
@@ -239,7 +248,89 @@ def breakdown(rounds, path):
             fh.write(text + "\n")
 
 
+def count_cases():
+    """{name: (description, make)}: make() returns the call whose instructions --count
+    measures (one period at rtol = atol = 1e-12; "flat" is the Fortran call alone, as in
+    --breakdown; "span 1e-9" is solve_ivp's per-call cost)."""
+    from conmech import _conmech
+    from conmech.ivp import solve as _ivp
+    from conmech.ivp.taylor import with_fixed_order
+    prs = problems()
+
+    def system(name):
+        pr = prs[name]
+        return symbolic.ode_system(pr["f"], pr["y"], params=pr["p"]), pr
+
+    def ivp(name, method, span=None):
+        def make():
+            sys_, pr = system(name)
+            tf = pr["T"] if span is None else span
+            return lambda: conmech.solve_ivp(sys_, (0, tf), pr["y0"], method=method,
+                                             rtol=1e-12, atol=1e-12)
+        return make
+
+    def flat(name, method):
+        def make():
+            sys_, pr = system(name)
+            if method == "TAYLOR":
+                sys_ = with_fixed_order(sys_, 1e-12, 1e-12)
+            rt = np.full(4, 1e-12)
+            kw = dict(t_span=np.array([0.0, pr["T"]]), y0=np.array(pr["y0"], dtype=float),
+                      first_step=0.0, neval=0, t_eval=_ivp._PAD, ne=0, ev_dir=_ivp._PADI,
+                      ev_term=_ivp._PADI, ev_res=_ivp._PAD, nnz=-1,
+                      sp_ptr=np.zeros(5, dtype=np.intc), sp_idx=_ivp._PADI,
+                      method=_ivp._METHOD_CODES[method], rtol=rt, atol=rt, max_step=1e300,
+                      max_steps=100000, dense=0)
+            args = sys_._system_args()
+            return lambda: _conmech.flat_solve(*args, lambda t, y: _ivp._PAD,
+                                               lambda *a: None, jac_const=0, **kw)
+        return make
+    out = {}
+    for name in ("kepler", "arenstorf"):
+        for m in ("TAYLOR", "DOP853"):
+            out[f"{name}_ivp_{m}"] = (f"{name}, solve_ivp {m}", ivp(name, m))
+            out[f"{name}_flat_{m}"] = (f"{name}, flat call {m}", flat(name, m))
+    for m in ("TAYLOR", "DOP853"):
+        out[f"kepler_span_{m}"] = (f"kepler, solve_ivp {m}, span 1e-9", ivp("kepler", m, 1e-9))
+    return out
+
+
+def _count(case, reps, tmp):
+    out = os.path.join(tmp, f"cg.{case}.{reps}")
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                    sys.executable, os.path.abspath(__file__), "--count-one", case, str(reps)],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    with open(out) as fh:
+        for line in fh:
+            m = re.match(r"(summary|totals): (\d+)", line)
+            if m:
+                return int(m.group(2))
+    raise RuntimeError(f"no instruction total in {out}")
+
+
+def count(names, path):
+    """Callgrind instructions per call of the count_cases (I(3) - I(1))/2."""
+    known = count_cases()
+    names = names or list(known)
+    lines = ["Instructions per call (callgrind, (I(3 calls) - I(1 call))/2 in two processes; "
+             "rtol = atol = 1e-12, one period)", "", "| call | instructions |", "|---|---|"]
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            per = (_count(name, 3, tmp) - _count(name, 1, tmp))//2
+            lines.append(f"| {known[name][0]} | {per:,} |")
+            print(lines[-1], flush=True)
+    if path:
+        with open(path, "w") as fh:
+            fh.write("\n".join(lines) + "\n")
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--count-one":
+        call = count_cases()[sys.argv[2]][1]()
+        call()                        # the first call's lazy set-up outside the count
+        for _ in range(int(sys.argv[3])):
+            call()
+        return
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--problems", nargs="*", default=["kepler", "arenstorf", "pcr3bp",
@@ -249,7 +340,12 @@ def main():
     ap.add_argument("--out", default=os.path.join(RESULTS, "taylor.md"))
     ap.add_argument("--brouwer", action="store_true")
     ap.add_argument("--breakdown", action="store_true")
+    ap.add_argument("--count", nargs="*", default=None)
     args = ap.parse_args()
+    if args.count is not None:
+        count(args.count, os.path.join(RESULTS, "taylor_count.md") if not args.count
+              else None)
+        return
     if args.breakdown:
         breakdown(15, os.path.join(RESULTS, "taylor_breakdown.md"))
         return
