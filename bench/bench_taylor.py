@@ -14,9 +14,8 @@ steps are printed beside the times.
                                                 per call: results/taylor_count.md)
 
 Instruction counts (repeatable on a loaded machine) of the Fortran integration alone:
-bash bench/callgrind_taylor.sh; of the calls through Python (per call, the interpreter's
-start-up and the set-up cancelled: (I(3 calls) - I(1 call))/2 in two processes under
-valgrind): --count.
+bash bench/callgrind_taylor.sh; of the calls through Python (per call, in one process under
+valgrind, the calls between two markers at which callgrind dumps its counts): --count.
 """
 import argparse
 import os
@@ -295,41 +294,74 @@ def count_cases():
     return out
 
 
-def _count(case, reps, tmp):
-    out = os.path.join(tmp, f"cg.{case}.{reps}")
-    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
-                    sys.executable, os.path.abspath(__file__), "--count-one", case, str(reps)],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    with open(out) as fh:
-        for line in fh:
-            m = re.match(r"(summary|totals): (\d+)", line)
-            if m:
-                return int(m.group(2))
-    raise RuntimeError(f"no instruction total in {out}")
+def _marker():
+    """A libc function Python does not call otherwise: callgrind dumps its counts at each
+    call (--dump-before), so the calls between two markers are counted alone."""
+    import ctypes
+    return ctypes.CDLL(None).getppid
 
 
-def count(names, path):
-    """Callgrind instructions per call of the count_cases (I(3) - I(1))/2."""
+def count_run(names, reps):
+    """(Run under valgrind.) For each case: one call (its lazy set-up), a marker, `reps`
+    calls, a marker; first an empty region (two markers) that measures the marker itself."""
+    mark = _marker()
+    known = count_cases()
+    calls = [known[n][1]() for n in names]
+    for c in calls:
+        c()
+    mark()
+    mark()                           # the region between these two: the marker's own cost
+    for c in calls:
+        c()
+        mark()
+        for _ in range(reps):
+            c()
+        mark()
+
+
+def count(names, path, reps=3):
+    """Callgrind instructions per call of the count_cases: one process under valgrind, a
+    profile part dumped at every marker (see count_run)."""
     known = count_cases()
     names = names or list(known)
-    lines = ["Instructions per call (callgrind, (I(3 calls) - I(1 call))/2 in two processes; "
-             "rtol = atol = 1e-12, one period)", "", "| call | instructions |", "|---|---|"]
     with tempfile.TemporaryDirectory() as tmp:
-        for name in names:
-            per = (_count(name, 3, tmp) - _count(name, 1, tmp))//2
-            lines.append(f"| {known[name][0]} | {per:,} |")
-            print(lines[-1], flush=True)
+        out = os.path.join(tmp, "cg.out")
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                        "--dump-before=*getppid*", sys.executable, os.path.abspath(__file__),
+                        "--count-run", str(reps)] + names,
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        parts = {}
+        for f in os.listdir(tmp):
+            m = re.match(r"cg\.out\.(\d+)$", f)
+            if m:
+                with open(os.path.join(tmp, f)) as fh:
+                    for line in fh:
+                        t = re.match(r"(summary|totals): (\d+)", line)
+                        if t:
+                            parts[int(m.group(1))] = int(t.group(2))
+                            break
+    if len(parts) < 2*len(names) + 3:
+        raise RuntimeError(f"callgrind wrote {len(parts)} profile parts, expected "
+                           f"{2*len(names) + 3}: the marker was not seen")
+    # dump k (1-based) ends the region before marker k: 1 = start-up, 2 = empty region,
+    # then per case: its set-up call (odd) and its `reps` calls (even)
+    empty = parts[2]
+    lines = [f"Instructions per call (callgrind, one process, the calls between two "
+             f"markers: {reps} calls, the marker's own {empty:,} subtracted; rtol = atol = "
+             "1e-12, one period)", "", "| call | instructions |", "|---|---|"]
+    for i, name in enumerate(names):
+        per = (parts[4 + 2*i] - empty)//reps
+        lines.append(f"| {known[name][0]} | {per:,} |")
+    text = "\n".join(lines)
+    print(text)
     if path:
         with open(path, "w") as fh:
-            fh.write("\n".join(lines) + "\n")
+            fh.write(text + "\n")
 
 
 def main():
-    if len(sys.argv) > 1 and sys.argv[1] == "--count-one":
-        call = count_cases()[sys.argv[2]][1]()
-        call()                        # the first call's lazy set-up outside the count
-        for _ in range(int(sys.argv[3])):
-            call()
+    if len(sys.argv) > 1 and sys.argv[1] == "--count-run":
+        count_run(sys.argv[3:], int(sys.argv[2]))
         return
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
