@@ -1,7 +1,7 @@
 """The description cache: a second construction of the same multibody tree or URDF robot,
 in a new process, loads its compiled model without deriving anything.
 
-The derivation cache of :func:`conmech.symbolic._construct` is keyed by the sympy inputs
+The derivation cache of :func:`conmech.symbolic.pipeline._construct` is keyed by the sympy inputs
 of a construction (the tree's validated bodies, forces and loops as sympy objects): for a
 tree or a robot, building those inputs (parsing the URDF into sympy records, validating
 the bodies, printing them for the key) costs more than loading the cached model itself.
@@ -64,10 +64,10 @@ def _plain(x):
 
 
 def _versions():
-    from .. import symbolic
     from .build import _conmech_version
+    from .codegen import CODEGEN_VERSION
     from .recursive import recursive_version
-    return (symbolic.CODEGEN_VERSION, recursive_version(), _conmech_version())
+    return (CODEGEN_VERSION, recursive_version(), _conmech_version())
 
 
 def _digest(kind, parts):
@@ -151,7 +151,7 @@ def description_hit(dkey, flags, model_only, params=None):
     tree's); None: the values stored with the entry (a robot's)."""
     if dkey is None:
         return None
-    from . import _from_cache, _system
+    from .pipeline import _from_cache, _system
     from .build import _read_json
     t0 = time.perf_counter()
     path = _entry(dkey)
