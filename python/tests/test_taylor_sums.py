@@ -8,7 +8,8 @@ into one weighted by ((r + 1) j - k).
   exponents, at even and odd orders;
 - the three forms the integrators use, the loop routine (``taylor["jet"]``), the routine
   written out for one order (solve_ivp) and the batch routine (ensemble.solve), give the
-  same coefficients to the last bit, at even and odd orders (the middle term of a square);
+  same coefficients to the last bit, at even and odd orders (the middle term of a square),
+  for squares, square roots, rational and parameter exponents;
 - the power columns need no column of j a[j]: the work array is one column narrower.
 """
 import ctypes
