@@ -9,12 +9,20 @@ steps are printed beside the times.
                                  [--brouwer]  (energy over 1e4 Kepler periods, a plot)
                                  [--breakdown] (one Kepler period at 1e-12: where the time
                                                 goes, results/taylor_breakdown.md)
+                                 [--count [CASE ...]] (the same calls, Kepler and Arenstorf
+                                                at 1e-12, as callgrind instruction counts
+                                                per call: results/taylor_count.md)
 
 Instruction counts (repeatable on a loaded machine) of the Fortran integration alone:
-bash bench/callgrind_taylor.sh.
+bash bench/callgrind_taylor.sh; of the calls through Python (per call, in one process under
+valgrind, the calls between two markers at which callgrind dumps its counts): --count.
 """
 import argparse
 import os
+import re
+import subprocess
+import sys
+import tempfile
 import time
 
 import numpy as np
@@ -239,7 +247,122 @@ def breakdown(rounds, path):
             fh.write(text + "\n")
 
 
+def count_cases():
+    """{name: (description, make)}: make() returns the call whose instructions --count
+    measures (one period at rtol = atol = 1e-12; "flat" is the Fortran call alone, as in
+    --breakdown; "span 1e-9" is solve_ivp's per-call cost)."""
+    from conmech import _conmech
+    from conmech.ivp import solve as _ivp
+    from conmech.ivp.taylor import with_fixed_order
+    prs = problems()
+
+    def system(name):
+        pr = prs[name]
+        return symbolic.ode_system(pr["f"], pr["y"], params=pr["p"]), pr
+
+    def ivp(name, method, span=None):
+        def make():
+            sys_, pr = system(name)
+            tf = pr["T"] if span is None else span
+            return lambda: conmech.solve_ivp(sys_, (0, tf), pr["y0"], method=method,
+                                             rtol=1e-12, atol=1e-12)
+        return make
+
+    def flat(name, method):
+        def make():
+            sys_, pr = system(name)
+            if method == "TAYLOR":
+                sys_ = with_fixed_order(sys_, 1e-12, 1e-12)
+            rt = np.full(4, 1e-12)
+            kw = dict(t_span=np.array([0.0, pr["T"]]), y0=np.array(pr["y0"], dtype=float),
+                      first_step=0.0, neval=0, t_eval=_ivp._PAD, ne=0, ev_dir=_ivp._PADI,
+                      ev_term=_ivp._PADI, ev_res=_ivp._PAD, nnz=-1,
+                      sp_ptr=np.zeros(5, dtype=np.intc), sp_idx=_ivp._PADI,
+                      method=_ivp._METHOD_CODES[method], rtol=rt, atol=rt, max_step=1e300,
+                      max_steps=100000, dense=0)
+            args = sys_._system_args()
+            return lambda: _conmech.flat_solve(*args, lambda t, y: _ivp._PAD,
+                                               lambda *a: None, jac_const=0, **kw)
+        return make
+    out = {}
+    for name in ("kepler", "arenstorf"):
+        for m in ("TAYLOR", "DOP853"):
+            out[f"{name}_ivp_{m}"] = (f"{name}, solve_ivp {m}", ivp(name, m))
+            out[f"{name}_flat_{m}"] = (f"{name}, flat call {m}", flat(name, m))
+    for m in ("TAYLOR", "DOP853"):
+        out[f"kepler_span_{m}"] = (f"kepler, solve_ivp {m}, span 1e-9", ivp("kepler", m, 1e-9))
+    return out
+
+
+def _marker():
+    """os.getppid: libc's getppid, which Python does not call otherwise: callgrind dumps its
+    counts at each call (--dump-before=getppid), so the calls between two markers are
+    counted alone."""
+    return os.getppid
+
+
+def count_run(names, reps):
+    """(Run under valgrind.) For each case: one call (its lazy set-up), a marker, `reps`
+    calls, a marker; first an empty region (two markers) that measures the marker itself."""
+    mark = _marker()
+    known = count_cases()
+    calls = [known[n][1]() for n in names]
+    for c in calls:
+        c()
+    mark()
+    mark()                           # the region between these two: the marker's own cost
+    for c in calls:
+        c()
+        mark()
+        for _ in range(reps):
+            c()
+        mark()
+
+
+def count(names, path, reps=3):
+    """Callgrind instructions per call of the count_cases: one process under valgrind, a
+    profile part dumped at every marker (see count_run)."""
+    known = count_cases()
+    names = names or list(known)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "cg.out")
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                        "--dump-before=getppid", sys.executable, os.path.abspath(__file__),
+                        "--count-run", str(reps)] + names,
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        parts = {}
+        for f in os.listdir(tmp):
+            m = re.match(r"cg\.out\.(\d+)$", f)
+            if m:
+                with open(os.path.join(tmp, f)) as fh:
+                    for line in fh:
+                        t = re.match(r"(summary|totals): (\d+)", line)
+                        if t:
+                            parts[int(m.group(1))] = int(t.group(2))
+                            break
+    if len(parts) < 2*len(names) + 2:       # one dump per marker (the rest: cg.out)
+        raise RuntimeError(f"callgrind wrote {len(parts)} profile parts, expected "
+                           f"{2*len(names) + 2}: the marker was not seen")
+    # dump k (1-based) ends the region before marker k: 1 = start-up, 2 = empty region,
+    # then per case: its set-up call (odd) and its `reps` calls (even)
+    empty = parts[2]
+    lines = [f"Instructions per call (callgrind, one process, the calls between two "
+             f"markers: {reps} calls, the marker's own {empty:,} subtracted; rtol = atol = "
+             "1e-12, one period)", "", "| call | instructions |", "|---|---|"]
+    for i, name in enumerate(names):
+        per = (parts[4 + 2*i] - empty)//reps
+        lines.append(f"| {known[name][0]} | {per:,} |")
+    text = "\n".join(lines)
+    print(text)
+    if path:
+        with open(path, "w") as fh:
+            fh.write(text + "\n")
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--count-run":
+        count_run(sys.argv[3:], int(sys.argv[2]))
+        return
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--problems", nargs="*", default=["kepler", "arenstorf", "pcr3bp",
@@ -249,7 +372,12 @@ def main():
     ap.add_argument("--out", default=os.path.join(RESULTS, "taylor.md"))
     ap.add_argument("--brouwer", action="store_true")
     ap.add_argument("--breakdown", action="store_true")
+    ap.add_argument("--count", nargs="*", default=None)
     args = ap.parse_args()
+    if args.count is not None:
+        count(args.count, os.path.join(RESULTS, "taylor_count.md") if not args.count
+              else None)
+        return
     if args.breakdown:
         breakdown(15, os.path.join(RESULTS, "taylor_breakdown.md"))
         return

@@ -2,15 +2,16 @@
 # Callgrind instruction counts per Kepler period (e = 0.9, rtol = atol = TOL, default 1e-12):
 # Taylor's method (the generated module test/taylor_kepler_model.f90) against DOP853 on the
 # same system, through ode_integrate (no storage) and ode_solve (every step stored, the path
-# of conmech.solve_ivp). valgrind cannot decode AVX-512: the library is built with
-# -march=znver3 (override with FFLAGS).
+# of conmech.solve_ivp). The library and the generated code are built with -O3 alone, the
+# flags of the Python package's release build and of the libraries conmech.symbolic compiles
+# (override with FFLAGS; valgrind cannot decode AVX-512, so not -march=native on such a CPU).
 # "fixed": the recurrences written out for the order (generated here with the installed
 # conmech package: PYTHON, default python3, e.g. .venv/bin/python).
 # Usage (from the repository root, with fpm and valgrind on PATH): bash bench/callgrind_taylor.sh [TOL]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 TOL="${1:-1e-12}"
-FF="${FFLAGS:--O3 -march=znver3 -funroll-loops}"
+FF="${FFLAGS:--O3}"
 tmp="${CALLGRIND_TMP:-$(mktemp -d)}"
 [ -n "${CALLGRIND_TMP:-}" ] || trap 'rm -rf "$tmp"' EXIT
 fpm install --prefix "$tmp/cm" --profile release --flag "$FF" >"$tmp/build.log" 2>&1 \

@@ -186,8 +186,8 @@ contains
         class(arenstorf_sym), intent(in) :: self
         integer, intent(in) :: kind
         arenstorf_sym_taylor_size = 0
-        if (kind == 0) arenstorf_sym_taylor_size = 21
-        if (kind == 1) arenstorf_sym_taylor_size = 76
+        if (kind == 0) arenstorf_sym_taylor_size = 19
+        if (kind == 1) arenstorf_sym_taylor_size = 74
     end function arenstorf_sym_taylor_size
 
     !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated recurrences).
@@ -197,9 +197,9 @@ contains
         integer, intent(in) :: kind, order, nw
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: w(0:order, nw)
-        if (kind == 0 .and. nw >= 21) then
+        if (kind == 0 .and. nw >= 19) then
             call arenstorf_sym_taylor0(self, t, order, w)
-        else if (kind == 1 .and. nw >= 76) then
+        else if (kind == 1 .and. nw >= 74) then
             call arenstorf_sym_taylor1(self, t, order, w)
         else
             w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -210,10 +210,10 @@ contains
         type(arenstorf_sym), intent(in) :: self
         real(dp), intent(in) :: t
         integer, intent(in) :: order
-        real(dp), intent(inout) :: w(0:order, 21)
+        real(dp), intent(inout) :: w(0:order, 19)
         real(dp) :: tc1, tc2
-        real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
-        real(dp) :: h11, iv1, iv2
+        real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, iv1
+        real(dp) :: iv2
         real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
@@ -253,39 +253,42 @@ contains
             h7 = 0.0_dp
             h8 = 0.0_dp
             h9 = 0.0_dp
-            h10 = 0.0_dp
-            h11 = 0.0_dp
             do j = 1, k - 1
+                h3 = h3 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 8)*w(k - j, 9)
+                h5 = h5 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 12)*w(k - j, 13)
+                h6 = h6 + w(j, 6)*w(k - j, 14)
+                h7 = h7 + w(j, 10)*w(k - j, 16)
+                h8 = h8 + w(j, 2)*w(k - j, 14)
+                h9 = h9 + w(j, 2)*w(k - j, 16)
+            end do
+            do j = 1, (k - 1)/2
                 h1 = h1 + w(j, 2)*w(k - j, 2)
                 h2 = h2 + w(j, 6)*w(k - j, 6)
-                h3 = h3 + w(j, 8)*w(k - j, 9)
-                h4 = h4 + w(j, 20)*w(k - j, 9)
-                h5 = h5 + w(j, 10)*w(k - j, 10)
-                h6 = h6 + w(j, 12)*w(k - j, 13)
-                h7 = h7 + w(j, 21)*w(k - j, 13)
-                h8 = h8 + w(j, 6)*w(k - j, 14)
-                h9 = h9 + w(j, 10)*w(k - j, 16)
-                h10 = h10 + w(j, 2)*w(k - j, 14)
-                h11 = h11 + w(j, 2)*w(k - j, 16)
+                h4 = h4 + w(j, 10)*w(k - j, 10)
             end do
+            h1 = 2.0_dp*h1
+            h2 = 2.0_dp*h2
+            h4 = 2.0_dp*h4
+            if (mod(k, 2) == 0) then
+                h1 = h1 + w(k/2, 2)*w(k/2, 2)
+                h2 = h2 + w(k/2, 6)*w(k/2, 6)
+                h4 = h4 + w(k/2, 10)*w(k/2, 10)
+            end if
             w(k, 5) = h1 + 2.0_dp*w(0, 2)*w(k, 2)
             w(k, 6) = w(k, 1)
             w(k, 7) = h2 + 2.0_dp*w(0, 6)*w(k, 6)
             w(k, 8) = w(k, 5) + w(k, 7)
-            w(k, 20) = fk*w(k, 8)
-            w(k, 9) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 8)*w(0, 9))*iv1
+            w(k, 9) = (h3*rk + (-3.0_dp/2.0_dp)*w(k, 8)*w(0, 9))*iv1
             w(k, 10) = w(k, 1)
-            w(k, 11) = h5 + 2.0_dp*w(0, 10)*w(k, 10)
+            w(k, 11) = h4 + 2.0_dp*w(0, 10)*w(k, 10)
             w(k, 12) = w(k, 5) + w(k, 11)
-            w(k, 21) = fk*w(k, 12)
-            w(k, 13) = (((-1.0_dp/2.0_dp)*h7 - fk*h6)*rk + (-3.0_dp/2.0_dp)*w(k, 12)*w(0,&
-                & 13))*iv2
+            w(k, 13) = (h5*rk + (-3.0_dp/2.0_dp)*w(k, 12)*w(0, 13))*iv2
             w(k, 14) = tc2*w(k, 9)
-            w(k, 15) = h8 + w(0, 6)*w(k, 14) + w(k, 6)*w(0, 14)
+            w(k, 15) = h6 + w(0, 6)*w(k, 14) + w(k, 6)*w(0, 14)
             w(k, 16) = tc1*w(k, 13)
-            w(k, 17) = h9 + w(0, 10)*w(k, 16) + w(k, 10)*w(0, 16)
-            w(k, 18) = h10 + w(0, 2)*w(k, 14) + w(k, 2)*w(0, 14)
-            w(k, 19) = h11 + w(0, 2)*w(k, 16) + w(k, 2)*w(0, 16)
+            w(k, 17) = h7 + w(0, 10)*w(k, 16) + w(k, 10)*w(0, 16)
+            w(k, 18) = h8 + w(0, 2)*w(k, 14) + w(k, 2)*w(0, 14)
+            w(k, 19) = h9 + w(0, 2)*w(k, 16) + w(k, 2)*w(0, 16)
             w(k + 1, 1) = rk1*(w(k, 3))
             w(k + 1, 2) = rk1*(w(k, 4))
             w(k + 1, 3) = rk1*(w(k, 1) + 2.0_dp*w(k, 4) - w(k, 15) - w(k, 17))
@@ -297,13 +300,13 @@ contains
         type(arenstorf_sym), intent(in) :: self
         real(dp), intent(in) :: t
         integer, intent(in) :: order
-        real(dp), intent(inout) :: w(0:order, 76)
+        real(dp), intent(inout) :: w(0:order, 74)
         real(dp) :: tc1, tc2, tc3, tc4, tc5
         real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
         real(dp) :: h11, h12, h13, h14, h15, h16, h17, h18, h19, h20
         real(dp) :: h21, h22, h23, h24, h25, h26, h27, h28, h29, h30
-        real(dp) :: h31, h32, h33, h34, h35, h36, h37, h38, h39, h40
-        real(dp) :: h41, h42, h43, iv1, iv2, iv3, iv4
+        real(dp) :: h31, h32, h33, h34, h35, h36, h37, h38, h39, iv1
+        real(dp) :: iv2, iv3, iv4
         real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
@@ -433,115 +436,111 @@ contains
             h37 = 0.0_dp
             h38 = 0.0_dp
             h39 = 0.0_dp
-            h40 = 0.0_dp
-            h41 = 0.0_dp
-            h42 = 0.0_dp
-            h43 = 0.0_dp
             do j = 1, k - 1
+                h3 = h3 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 24)*w(k - j, 25)
+                h5 = h5 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 28)*w(k - j, 29)
+                h6 = h6 + (((-3.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 24)*w(k - j, 30)
+                h7 = h7 + (((-3.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 28)*w(k - j, 31)
+                h8 = h8 + w(j, 26)*w(k - j, 31)
+                h9 = h9 + w(j, 2)*w(k - j, 22)
+                h10 = h10 + w(j, 33)*w(k - j, 34)
+                h11 = h11 + w(j, 2)*w(k - j, 32)
+                h12 = h12 + w(j, 37)*w(k - j, 38)
+                h13 = h13 + w(j, 22)*w(k - j, 40)
+                h14 = h14 + w(j, 32)*w(k - j, 42)
+                h15 = h15 + w(j, 2)*w(k - j, 40)
+                h16 = h16 + w(j, 2)*w(k - j, 31)
+                h17 = h17 + w(j, 42)*w(k - j, 45)
+                h18 = h18 + w(j, 21)*w(k - j, 33)
+                h19 = h19 + w(j, 21)*w(k - j, 31)
+                h20 = h20 + w(j, 22)*w(k - j, 49)
+                h21 = h21 + w(j, 26)*w(k - j, 51)
+                h22 = h22 + w(j, 2)*w(k - j, 49)
+                h23 = h23 + w(j, 2)*w(k - j, 51)
+                h24 = h24 + w(j, 6)*w(k - j, 55)
+                h25 = h25 + w(j, 5)*w(k - j, 57)
+                h26 = h26 + w(j, 5)*w(k - j, 59)
+                h27 = h27 + w(j, 6)*w(k - j, 61)
+                h28 = h28 + w(j, 10)*w(k - j, 55)
+                h29 = h29 + w(j, 9)*w(k - j, 57)
+                h30 = h30 + w(j, 9)*w(k - j, 59)
+                h31 = h31 + w(j, 10)*w(k - j, 61)
+                h32 = h32 + w(j, 14)*w(k - j, 55)
+                h33 = h33 + w(j, 13)*w(k - j, 57)
+                h34 = h34 + w(j, 13)*w(k - j, 59)
+                h35 = h35 + w(j, 14)*w(k - j, 61)
+                h36 = h36 + w(j, 18)*w(k - j, 55)
+                h37 = h37 + w(j, 17)*w(k - j, 57)
+                h38 = h38 + w(j, 17)*w(k - j, 59)
+                h39 = h39 + w(j, 18)*w(k - j, 61)
+            end do
+            do j = 1, (k - 1)/2
                 h1 = h1 + w(j, 2)*w(k - j, 2)
                 h2 = h2 + w(j, 22)*w(k - j, 22)
-                h3 = h3 + w(j, 24)*w(k - j, 25)
-                h4 = h4 + w(j, 75)*w(k - j, 25)
-                h5 = h5 + w(j, 26)*w(k - j, 26)
-                h6 = h6 + w(j, 28)*w(k - j, 29)
-                h7 = h7 + w(j, 76)*w(k - j, 29)
-                h8 = h8 + w(j, 24)*w(k - j, 30)
-                h9 = h9 + w(j, 75)*w(k - j, 30)
-                h10 = h10 + w(j, 28)*w(k - j, 31)
-                h11 = h11 + w(j, 76)*w(k - j, 31)
-                h12 = h12 + w(j, 26)*w(k - j, 31)
-                h13 = h13 + w(j, 2)*w(k - j, 22)
-                h14 = h14 + w(j, 33)*w(k - j, 34)
-                h15 = h15 + w(j, 2)*w(k - j, 32)
-                h16 = h16 + w(j, 37)*w(k - j, 38)
-                h17 = h17 + w(j, 22)*w(k - j, 40)
-                h18 = h18 + w(j, 32)*w(k - j, 42)
-                h19 = h19 + w(j, 2)*w(k - j, 40)
-                h20 = h20 + w(j, 2)*w(k - j, 31)
-                h21 = h21 + w(j, 42)*w(k - j, 45)
-                h22 = h22 + w(j, 21)*w(k - j, 33)
-                h23 = h23 + w(j, 21)*w(k - j, 31)
-                h24 = h24 + w(j, 22)*w(k - j, 49)
-                h25 = h25 + w(j, 26)*w(k - j, 51)
-                h26 = h26 + w(j, 2)*w(k - j, 49)
-                h27 = h27 + w(j, 2)*w(k - j, 51)
-                h28 = h28 + w(j, 6)*w(k - j, 55)
-                h29 = h29 + w(j, 5)*w(k - j, 57)
-                h30 = h30 + w(j, 5)*w(k - j, 59)
-                h31 = h31 + w(j, 6)*w(k - j, 61)
-                h32 = h32 + w(j, 10)*w(k - j, 55)
-                h33 = h33 + w(j, 9)*w(k - j, 57)
-                h34 = h34 + w(j, 9)*w(k - j, 59)
-                h35 = h35 + w(j, 10)*w(k - j, 61)
-                h36 = h36 + w(j, 14)*w(k - j, 55)
-                h37 = h37 + w(j, 13)*w(k - j, 57)
-                h38 = h38 + w(j, 13)*w(k - j, 59)
-                h39 = h39 + w(j, 14)*w(k - j, 61)
-                h40 = h40 + w(j, 18)*w(k - j, 55)
-                h41 = h41 + w(j, 17)*w(k - j, 57)
-                h42 = h42 + w(j, 17)*w(k - j, 59)
-                h43 = h43 + w(j, 18)*w(k - j, 61)
+                h4 = h4 + w(j, 26)*w(k - j, 26)
             end do
+            h1 = 2.0_dp*h1
+            h2 = 2.0_dp*h2
+            h4 = 2.0_dp*h4
+            if (mod(k, 2) == 0) then
+                h1 = h1 + w(k/2, 2)*w(k/2, 2)
+                h2 = h2 + w(k/2, 22)*w(k/2, 22)
+                h4 = h4 + w(k/2, 26)*w(k/2, 26)
+            end if
             w(k, 21) = h1 + 2.0_dp*w(0, 2)*w(k, 2)
             w(k, 22) = w(k, 1)
             w(k, 23) = h2 + 2.0_dp*w(0, 22)*w(k, 22)
             w(k, 24) = w(k, 21) + w(k, 23)
-            w(k, 75) = fk*w(k, 24)
-            w(k, 25) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 24)*w(0,&
-                & 25))*iv1
+            w(k, 25) = (h3*rk + (-3.0_dp/2.0_dp)*w(k, 24)*w(0, 25))*iv1
             w(k, 26) = w(k, 1)
-            w(k, 27) = h5 + 2.0_dp*w(0, 26)*w(k, 26)
+            w(k, 27) = h4 + 2.0_dp*w(0, 26)*w(k, 26)
             w(k, 28) = w(k, 21) + w(k, 27)
-            w(k, 76) = fk*w(k, 28)
-            w(k, 29) = (((-1.0_dp/2.0_dp)*h7 - fk*h6)*rk + (-3.0_dp/2.0_dp)*w(k, 28)*w(0,&
-                & 29))*iv2
-            w(k, 30) = (((-3.0_dp/2.0_dp)*h9 - fk*h8)*rk + (-5.0_dp/2.0_dp)*w(k, 24)*w(0,&
-                & 30))*iv3
-            w(k, 31) = (((-3.0_dp/2.0_dp)*h11 - fk*h10)*rk + (-5.0_dp/2.0_dp)*w(k, 28)*w(0,&
-                & 31))*iv4
-            w(k, 32) = h12 + w(0, 26)*w(k, 31) + w(k, 26)*w(0, 31)
+            w(k, 29) = (h5*rk + (-3.0_dp/2.0_dp)*w(k, 28)*w(0, 29))*iv2
+            w(k, 30) = (h6*rk + (-5.0_dp/2.0_dp)*w(k, 24)*w(0, 30))*iv3
+            w(k, 31) = (h7*rk + (-5.0_dp/2.0_dp)*w(k, 28)*w(0, 31))*iv4
+            w(k, 32) = h8 + w(0, 26)*w(k, 31) + w(k, 26)*w(0, 31)
             w(k, 33) = 3.0_dp*tc3*w(k, 30)
-            w(k, 34) = h13 + w(0, 2)*w(k, 22) + w(k, 2)*w(0, 22)
-            w(k, 35) = h14 + w(0, 33)*w(k, 34) + w(k, 33)*w(0, 34)
-            w(k, 36) = h15 + w(0, 2)*w(k, 32) + w(k, 2)*w(0, 32)
+            w(k, 34) = h9 + w(0, 2)*w(k, 22) + w(k, 2)*w(0, 22)
+            w(k, 35) = h10 + w(0, 33)*w(k, 34) + w(k, 33)*w(0, 34)
+            w(k, 36) = h11 + w(0, 2)*w(k, 32) + w(k, 2)*w(0, 32)
             w(k, 37) = 3.0_dp*w(k, 1)
             w(k, 38) = tc3*w(k, 30)
-            w(k, 39) = h16 + w(0, 37)*w(k, 38) + w(k, 37)*w(0, 38)
+            w(k, 39) = h12 + w(0, 37)*w(k, 38) + w(k, 37)*w(0, 38)
             w(k, 40) = -w(k, 39)
-            w(k, 41) = h17 + w(0, 22)*w(k, 40) + w(k, 22)*w(0, 40)
+            w(k, 41) = h13 + w(0, 22)*w(k, 40) + w(k, 22)*w(0, 40)
             w(k, 42) = -3.0_dp*tc1*w(k, 1)
-            w(k, 43) = h18 + w(0, 32)*w(k, 42) + w(k, 32)*w(0, 42)
-            w(k, 44) = h19 + w(0, 2)*w(k, 40) + w(k, 2)*w(0, 40)
-            w(k, 45) = h20 + w(0, 2)*w(k, 31) + w(k, 2)*w(0, 31)
-            w(k, 46) = h21 + w(0, 42)*w(k, 45) + w(k, 42)*w(0, 45)
-            w(k, 47) = h22 + w(0, 21)*w(k, 33) + w(k, 21)*w(0, 33)
-            w(k, 48) = h23 + w(0, 21)*w(k, 31) + w(k, 21)*w(0, 31)
+            w(k, 43) = h14 + w(0, 32)*w(k, 42) + w(k, 32)*w(0, 42)
+            w(k, 44) = h15 + w(0, 2)*w(k, 40) + w(k, 2)*w(0, 40)
+            w(k, 45) = h16 + w(0, 2)*w(k, 31) + w(k, 2)*w(0, 31)
+            w(k, 46) = h17 + w(0, 42)*w(k, 45) + w(k, 42)*w(0, 45)
+            w(k, 47) = h18 + w(0, 21)*w(k, 33) + w(k, 21)*w(0, 33)
+            w(k, 48) = h19 + w(0, 21)*w(k, 31) + w(k, 21)*w(0, 31)
             w(k, 49) = tc3*w(k, 25)
-            w(k, 50) = h24 + w(0, 22)*w(k, 49) + w(k, 22)*w(0, 49)
+            w(k, 50) = h20 + w(0, 22)*w(k, 49) + w(k, 22)*w(0, 49)
             w(k, 51) = tc1*w(k, 29)
-            w(k, 52) = h25 + w(0, 26)*w(k, 51) + w(k, 26)*w(0, 51)
-            w(k, 53) = h26 + w(0, 2)*w(k, 49) + w(k, 2)*w(0, 49)
-            w(k, 54) = h27 + w(0, 2)*w(k, 51) + w(k, 2)*w(0, 51)
+            w(k, 52) = h21 + w(0, 26)*w(k, 51) + w(k, 26)*w(0, 51)
+            w(k, 53) = h22 + w(0, 2)*w(k, 49) + w(k, 2)*w(0, 49)
+            w(k, 54) = h23 + w(0, 2)*w(k, 51) + w(k, 2)*w(0, 51)
             w(k, 55) = w(k, 35) + tc5*w(k, 36)
-            w(k, 56) = h28 + w(0, 6)*w(k, 55) + w(k, 6)*w(0, 55)
+            w(k, 56) = h24 + w(0, 6)*w(k, 55) + w(k, 6)*w(0, 55)
             w(k, 57) = -tc3*w(k, 25) - tc1*w(k, 29) - w(k, 41) - w(k, 43)
-            w(k, 58) = h29 + w(0, 5)*w(k, 57) + w(k, 5)*w(0, 57)
+            w(k, 58) = h25 + w(0, 5)*w(k, 57) + w(k, 5)*w(0, 57)
             w(k, 59) = -w(k, 44) - w(k, 46)
-            w(k, 60) = h30 + w(0, 5)*w(k, 59) + w(k, 5)*w(0, 59)
+            w(k, 60) = h26 + w(0, 5)*w(k, 59) + w(k, 5)*w(0, 59)
             w(k, 61) = -tc3*w(k, 25) - tc1*w(k, 29) + w(k, 47) + tc5*w(k, 48)
-            w(k, 62) = h31 + w(0, 6)*w(k, 61) + w(k, 6)*w(0, 61)
-            w(k, 63) = h32 + w(0, 10)*w(k, 55) + w(k, 10)*w(0, 55)
-            w(k, 64) = h33 + w(0, 9)*w(k, 57) + w(k, 9)*w(0, 57)
-            w(k, 65) = h34 + w(0, 9)*w(k, 59) + w(k, 9)*w(0, 59)
-            w(k, 66) = h35 + w(0, 10)*w(k, 61) + w(k, 10)*w(0, 61)
-            w(k, 67) = h36 + w(0, 14)*w(k, 55) + w(k, 14)*w(0, 55)
-            w(k, 68) = h37 + w(0, 13)*w(k, 57) + w(k, 13)*w(0, 57)
-            w(k, 69) = h38 + w(0, 13)*w(k, 59) + w(k, 13)*w(0, 59)
-            w(k, 70) = h39 + w(0, 14)*w(k, 61) + w(k, 14)*w(0, 61)
-            w(k, 71) = h40 + w(0, 18)*w(k, 55) + w(k, 18)*w(0, 55)
-            w(k, 72) = h41 + w(0, 17)*w(k, 57) + w(k, 17)*w(0, 57)
-            w(k, 73) = h42 + w(0, 17)*w(k, 59) + w(k, 17)*w(0, 59)
-            w(k, 74) = h43 + w(0, 18)*w(k, 61) + w(k, 18)*w(0, 61)
+            w(k, 62) = h27 + w(0, 6)*w(k, 61) + w(k, 6)*w(0, 61)
+            w(k, 63) = h28 + w(0, 10)*w(k, 55) + w(k, 10)*w(0, 55)
+            w(k, 64) = h29 + w(0, 9)*w(k, 57) + w(k, 9)*w(0, 57)
+            w(k, 65) = h30 + w(0, 9)*w(k, 59) + w(k, 9)*w(0, 59)
+            w(k, 66) = h31 + w(0, 10)*w(k, 61) + w(k, 10)*w(0, 61)
+            w(k, 67) = h32 + w(0, 14)*w(k, 55) + w(k, 14)*w(0, 55)
+            w(k, 68) = h33 + w(0, 13)*w(k, 57) + w(k, 13)*w(0, 57)
+            w(k, 69) = h34 + w(0, 13)*w(k, 59) + w(k, 13)*w(0, 59)
+            w(k, 70) = h35 + w(0, 14)*w(k, 61) + w(k, 14)*w(0, 61)
+            w(k, 71) = h36 + w(0, 18)*w(k, 55) + w(k, 18)*w(0, 55)
+            w(k, 72) = h37 + w(0, 17)*w(k, 57) + w(k, 17)*w(0, 57)
+            w(k, 73) = h38 + w(0, 17)*w(k, 59) + w(k, 17)*w(0, 59)
+            w(k, 74) = h39 + w(0, 18)*w(k, 61) + w(k, 18)*w(0, 61)
             w(k + 1, 1) = rk1*(w(k, 3))
             w(k + 1, 2) = rk1*(w(k, 4))
             w(k + 1, 3) = rk1*(w(k, 1) + 2.0_dp*w(k, 4) - w(k, 50) - w(k, 52))

@@ -149,8 +149,8 @@ contains
         class(kepler_sym), intent(in) :: self
         integer, intent(in) :: kind
         kepler_sym_taylor_size = 0
-        if (kind == 0) kepler_sym_taylor_size = 12
-        if (kind == 1) kepler_sym_taylor_size = 52
+        if (kind == 0) kepler_sym_taylor_size = 11
+        if (kind == 1) kepler_sym_taylor_size = 51
     end function kepler_sym_taylor_size
 
     !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated recurrences).
@@ -160,9 +160,9 @@ contains
         integer, intent(in) :: kind, order, nw
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: w(0:order, nw)
-        if (kind == 0 .and. nw >= 12) then
+        if (kind == 0 .and. nw >= 11) then
             call kepler_sym_taylor0(self, t, order, w)
-        else if (kind == 1 .and. nw >= 52) then
+        else if (kind == 1 .and. nw >= 51) then
             call kepler_sym_taylor1(self, t, order, w)
         else
             w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -173,9 +173,9 @@ contains
         type(kepler_sym), intent(in) :: self
         real(dp), intent(in) :: t
         integer, intent(in) :: order
-        real(dp), intent(inout) :: w(0:order, 12)
+        real(dp), intent(inout) :: w(0:order, 11)
         real(dp) :: tc1
-        real(dp) :: h1, h2, h3, h4, h5, h6, iv1
+        real(dp) :: h1, h2, h3, h4, h5, iv1
         real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
@@ -201,23 +201,28 @@ contains
             h3 = 0.0_dp
             h4 = 0.0_dp
             h5 = 0.0_dp
-            h6 = 0.0_dp
             do j = 1, k - 1
+                h3 = h3 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 7)*w(k - j, 8)
+                h4 = h4 + w(j, 1)*w(k - j, 9)
+                h5 = h5 + w(j, 2)*w(k - j, 9)
+            end do
+            do j = 1, (k - 1)/2
                 h1 = h1 + w(j, 1)*w(k - j, 1)
                 h2 = h2 + w(j, 2)*w(k - j, 2)
-                h3 = h3 + w(j, 7)*w(k - j, 8)
-                h4 = h4 + w(j, 12)*w(k - j, 8)
-                h5 = h5 + w(j, 1)*w(k - j, 9)
-                h6 = h6 + w(j, 2)*w(k - j, 9)
             end do
+            h1 = 2.0_dp*h1
+            h2 = 2.0_dp*h2
+            if (mod(k, 2) == 0) then
+                h1 = h1 + w(k/2, 1)*w(k/2, 1)
+                h2 = h2 + w(k/2, 2)*w(k/2, 2)
+            end if
             w(k, 5) = h1 + 2.0_dp*w(0, 1)*w(k, 1)
             w(k, 6) = h2 + 2.0_dp*w(0, 2)*w(k, 2)
             w(k, 7) = w(k, 5) + w(k, 6)
-            w(k, 12) = fk*w(k, 7)
-            w(k, 8) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 7)*w(0, 8))*iv1
+            w(k, 8) = (h3*rk + (-3.0_dp/2.0_dp)*w(k, 7)*w(0, 8))*iv1
             w(k, 9) = tc1*w(k, 8)
-            w(k, 10) = h5 + w(0, 1)*w(k, 9) + w(k, 1)*w(0, 9)
-            w(k, 11) = h6 + w(0, 2)*w(k, 9) + w(k, 2)*w(0, 9)
+            w(k, 10) = h4 + w(0, 1)*w(k, 9) + w(k, 1)*w(0, 9)
+            w(k, 11) = h5 + w(0, 2)*w(k, 9) + w(k, 2)*w(0, 9)
             w(k + 1, 1) = rk1*(w(k, 3))
             w(k + 1, 2) = rk1*(w(k, 4))
             w(k + 1, 3) = rk1*(-w(k, 10))
@@ -229,11 +234,11 @@ contains
         type(kepler_sym), intent(in) :: self
         real(dp), intent(in) :: t
         integer, intent(in) :: order
-        real(dp), intent(inout) :: w(0:order, 52)
+        real(dp), intent(inout) :: w(0:order, 51)
         real(dp) :: tc1, tc2
         real(dp) :: h1, h2, h3, h4, h5, h6, h7, h8, h9, h10
         real(dp) :: h11, h12, h13, h14, h15, h16, h17, h18, h19, h20
-        real(dp) :: h21, h22, h23, h24, h25, h26, h27, h28, iv1, iv2
+        real(dp) :: h21, h22, h23, h24, h25, h26, iv1, iv2
         real(dp) :: fk, rk, rk1
         integer :: k, j
         if (order < 1) return
@@ -322,72 +327,73 @@ contains
             h24 = 0.0_dp
             h25 = 0.0_dp
             h26 = 0.0_dp
-            h27 = 0.0_dp
-            h28 = 0.0_dp
             do j = 1, k - 1
+                h3 = h3 + (((-1.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 23)*w(k - j, 24)
+                h4 = h4 + (((-3.0_dp/2.0_dp))*real(j, dp) - fk)*w(j, 23)*w(k - j, 25)
+                h5 = h5 + w(j, 21)*w(k - j, 26)
+                h6 = h6 + w(j, 1)*w(k - j, 2)
+                h7 = h7 + w(j, 26)*w(k - j, 28)
+                h8 = h8 + w(j, 22)*w(k - j, 26)
+                h9 = h9 + w(j, 1)*w(k - j, 31)
+                h10 = h10 + w(j, 2)*w(k - j, 31)
+                h11 = h11 + w(j, 5)*w(k - j, 34)
+                h12 = h12 + w(j, 6)*w(k - j, 29)
+                h13 = h13 + w(j, 5)*w(k - j, 29)
+                h14 = h14 + w(j, 6)*w(k - j, 38)
+                h15 = h15 + w(j, 9)*w(k - j, 34)
+                h16 = h16 + w(j, 10)*w(k - j, 29)
+                h17 = h17 + w(j, 9)*w(k - j, 29)
+                h18 = h18 + w(j, 10)*w(k - j, 38)
+                h19 = h19 + w(j, 13)*w(k - j, 34)
+                h20 = h20 + w(j, 14)*w(k - j, 29)
+                h21 = h21 + w(j, 13)*w(k - j, 29)
+                h22 = h22 + w(j, 14)*w(k - j, 38)
+                h23 = h23 + w(j, 17)*w(k - j, 34)
+                h24 = h24 + w(j, 18)*w(k - j, 29)
+                h25 = h25 + w(j, 17)*w(k - j, 29)
+                h26 = h26 + w(j, 18)*w(k - j, 38)
+            end do
+            do j = 1, (k - 1)/2
                 h1 = h1 + w(j, 1)*w(k - j, 1)
                 h2 = h2 + w(j, 2)*w(k - j, 2)
-                h3 = h3 + w(j, 23)*w(k - j, 24)
-                h4 = h4 + w(j, 52)*w(k - j, 24)
-                h5 = h5 + w(j, 23)*w(k - j, 25)
-                h6 = h6 + w(j, 52)*w(k - j, 25)
-                h7 = h7 + w(j, 21)*w(k - j, 26)
-                h8 = h8 + w(j, 1)*w(k - j, 2)
-                h9 = h9 + w(j, 26)*w(k - j, 28)
-                h10 = h10 + w(j, 22)*w(k - j, 26)
-                h11 = h11 + w(j, 1)*w(k - j, 31)
-                h12 = h12 + w(j, 2)*w(k - j, 31)
-                h13 = h13 + w(j, 5)*w(k - j, 34)
-                h14 = h14 + w(j, 6)*w(k - j, 29)
-                h15 = h15 + w(j, 5)*w(k - j, 29)
-                h16 = h16 + w(j, 6)*w(k - j, 38)
-                h17 = h17 + w(j, 9)*w(k - j, 34)
-                h18 = h18 + w(j, 10)*w(k - j, 29)
-                h19 = h19 + w(j, 9)*w(k - j, 29)
-                h20 = h20 + w(j, 10)*w(k - j, 38)
-                h21 = h21 + w(j, 13)*w(k - j, 34)
-                h22 = h22 + w(j, 14)*w(k - j, 29)
-                h23 = h23 + w(j, 13)*w(k - j, 29)
-                h24 = h24 + w(j, 14)*w(k - j, 38)
-                h25 = h25 + w(j, 17)*w(k - j, 34)
-                h26 = h26 + w(j, 18)*w(k - j, 29)
-                h27 = h27 + w(j, 17)*w(k - j, 29)
-                h28 = h28 + w(j, 18)*w(k - j, 38)
             end do
+            h1 = 2.0_dp*h1
+            h2 = 2.0_dp*h2
+            if (mod(k, 2) == 0) then
+                h1 = h1 + w(k/2, 1)*w(k/2, 1)
+                h2 = h2 + w(k/2, 2)*w(k/2, 2)
+            end if
             w(k, 21) = h1 + 2.0_dp*w(0, 1)*w(k, 1)
             w(k, 22) = h2 + 2.0_dp*w(0, 2)*w(k, 2)
             w(k, 23) = w(k, 21) + w(k, 22)
-            w(k, 52) = fk*w(k, 23)
-            w(k, 24) = (((-1.0_dp/2.0_dp)*h4 - fk*h3)*rk + (-3.0_dp/2.0_dp)*w(k, 23)*w(0,&
-                & 24))*iv1
-            w(k, 25) = (((-3.0_dp/2.0_dp)*h6 - fk*h5)*rk + (-5.0_dp/2.0_dp)*w(k, 23)*w(0,&
-                & 25))*iv2
+            w(k, 24) = (h3*rk + (-3.0_dp/2.0_dp)*w(k, 23)*w(0, 24))*iv1
+            w(k, 25) = (h4*rk + (-5.0_dp/2.0_dp)*w(k, 23)*w(0, 25))*iv2
             w(k, 26) = tc2*w(k, 25)
-            w(k, 27) = h7 + w(0, 21)*w(k, 26) + w(k, 21)*w(0, 26)
-            w(k, 28) = h8 + w(0, 1)*w(k, 2) + w(k, 1)*w(0, 2)
-            w(k, 29) = h9 + w(0, 26)*w(k, 28) + w(k, 26)*w(0, 28)
-            w(k, 30) = h10 + w(0, 22)*w(k, 26) + w(k, 22)*w(0, 26)
+            w(k, 27) = h5 + w(0, 21)*w(k, 26) + w(k, 21)*w(0, 26)
+            w(k, 28) = h6 + w(0, 1)*w(k, 2) + w(k, 1)*w(0, 2)
+            w(k, 29) = h7 + w(0, 26)*w(k, 28) + w(k, 26)*w(0, 28)
+            w(k, 30) = h8 + w(0, 22)*w(k, 26) + w(k, 22)*w(0, 26)
             w(k, 31) = tc1*w(k, 24)
-            w(k, 32) = h11 + w(0, 1)*w(k, 31) + w(k, 1)*w(0, 31)
-            w(k, 33) = h12 + w(0, 2)*w(k, 31) + w(k, 2)*w(0, 31)
+            w(k, 32) = h9 + w(0, 1)*w(k, 31) + w(k, 1)*w(0, 31)
+            w(k, 33) = h10 + w(0, 2)*w(k, 31) + w(k, 2)*w(0, 31)
             w(k, 34) = -tc1*w(k, 24) + w(k, 27)
-            w(k, 35) = h13 + w(0, 5)*w(k, 34) + w(k, 5)*w(0, 34)
-            w(k, 36) = h14 + w(0, 6)*w(k, 29) + w(k, 6)*w(0, 29)
-            w(k, 37) = h15 + w(0, 5)*w(k, 29) + w(k, 5)*w(0, 29)
+            w(k, 35) = h11 + w(0, 5)*w(k, 34) + w(k, 5)*w(0, 34)
+            w(k, 36) = h12 + w(0, 6)*w(k, 29) + w(k, 6)*w(0, 29)
+            w(k, 37) = h13 + w(0, 5)*w(k, 29) + w(k, 5)*w(0, 29)
             w(k, 38) = -tc1*w(k, 24) + w(k, 30)
-            w(k, 39) = h16 + w(0, 6)*w(k, 38) + w(k, 6)*w(0, 38)
-            w(k, 40) = h17 + w(0, 9)*w(k, 34) + w(k, 9)*w(0, 34)
-            w(k, 41) = h18 + w(0, 10)*w(k, 29) + w(k, 10)*w(0, 29)
-            w(k, 42) = h19 + w(0, 9)*w(k, 29) + w(k, 9)*w(0, 29)
-            w(k, 43) = h20 + w(0, 10)*w(k, 38) + w(k, 10)*w(0, 38)
-            w(k, 44) = h21 + w(0, 13)*w(k, 34) + w(k, 13)*w(0, 34)
-            w(k, 45) = h22 + w(0, 14)*w(k, 29) + w(k, 14)*w(0, 29)
-            w(k, 46) = h23 + w(0, 13)*w(k, 29) + w(k, 13)*w(0, 29)
-            w(k, 47) = h24 + w(0, 14)*w(k, 38) + w(k, 14)*w(0, 38)
-            w(k, 48) = h25 + w(0, 17)*w(k, 34) + w(k, 17)*w(0, 34)
-            w(k, 49) = h26 + w(0, 18)*w(k, 29) + w(k, 18)*w(0, 29)
-            w(k, 50) = h27 + w(0, 17)*w(k, 29) + w(k, 17)*w(0, 29)
-            w(k, 51) = h28 + w(0, 18)*w(k, 38) + w(k, 18)*w(0, 38)
+            w(k, 39) = h14 + w(0, 6)*w(k, 38) + w(k, 6)*w(0, 38)
+            w(k, 40) = h15 + w(0, 9)*w(k, 34) + w(k, 9)*w(0, 34)
+            w(k, 41) = h16 + w(0, 10)*w(k, 29) + w(k, 10)*w(0, 29)
+            w(k, 42) = h17 + w(0, 9)*w(k, 29) + w(k, 9)*w(0, 29)
+            w(k, 43) = h18 + w(0, 10)*w(k, 38) + w(k, 10)*w(0, 38)
+            w(k, 44) = h19 + w(0, 13)*w(k, 34) + w(k, 13)*w(0, 34)
+            w(k, 45) = h20 + w(0, 14)*w(k, 29) + w(k, 14)*w(0, 29)
+            w(k, 46) = h21 + w(0, 13)*w(k, 29) + w(k, 13)*w(0, 29)
+            w(k, 47) = h22 + w(0, 14)*w(k, 38) + w(k, 14)*w(0, 38)
+            w(k, 48) = h23 + w(0, 17)*w(k, 34) + w(k, 17)*w(0, 34)
+            w(k, 49) = h24 + w(0, 18)*w(k, 29) + w(k, 18)*w(0, 29)
+            w(k, 50) = h25 + w(0, 17)*w(k, 29) + w(k, 17)*w(0, 29)
+            w(k, 51) = h26 + w(0, 18)*w(k, 38) + w(k, 18)*w(0, 38)
             w(k + 1, 1) = rk1*(w(k, 3))
             w(k + 1, 2) = rk1*(w(k, 4))
             w(k + 1, 3) = rk1*(-w(k, 32))

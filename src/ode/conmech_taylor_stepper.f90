@@ -262,14 +262,15 @@ contains
         call move_alloc(tmp, self%jold)
         self%st%naccept = self%st%naccept + 1
         self%t_old = self%t
-        self%y_old = self%y
+        ! sections, not whole allocatables: no reallocation check per step
+        self%y_old(1:self%n) = self%y(1:self%n)
         if (self%hit) then
             self%t = target
             self%t_lo = 0.0_dp
         else
             call taylor_add_time(self%t, self%t_lo, h)
         end if
-        self%y = self%ynew
+        self%y(1:self%n) = self%ynew(1:self%n)
         self%h_done = h
         self%dense_ready = .false.
         self%last = self%hit .and. target == self%tf

@@ -52,7 +52,7 @@ __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prep
 ENTRY_POINTS = _table.ENTRY_POINTS
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "11"  # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
 #                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
 #                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed);
@@ -60,6 +60,7 @@ CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;
 #                         7: conmech_taylor* (Taylor coefficients, conmech.symbolic.taylor)
 #                         8: constrained: conmech_forces_jac, conmech_constraint_hessian
 #                         9: user strings escaped (comments, parameter names as data)
+#                        11: Taylor: symmetric sums of squares, one weighted sum per power
 
 
 def _jac_prod_procedure(printer, d):

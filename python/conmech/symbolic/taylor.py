@@ -26,7 +26,11 @@ Every recurrence splits into a *history* sum over the coefficients of orders 1..
 known when order k starts) and a few *current* terms in the order-k coefficients of the
 operands. The generated code computes the history sums of all operations in ONE loop over
 j (independent accumulators: the multiply-adds pipeline instead of waiting on one chain),
-then the current terms in dependency order, then y^[k+1]:
+then the current terms in dependency order, then y^[k+1]. Two sums are cheaper than their
+textbook form: a square's (and a square root's) sum is symmetric, sum_{j=1..k-1} a[j]
+a[k-j] = 2 sum_{j<k/2} a[j] a[k-j] + a[k/2]^2 (k even), half the products in a second
+loop over j < k/2; a power's two sums (of a[j] c[k-j] and of j a[j] c[k-j]) are one sum
+weighted by ((r + 1) j - k), with no column of j a[j]:
 
     subroutine conmech_taylor(t, order, w, p) bind(C)     ! w(0:order, nw)
         w(0, 1:n) = y on entry; on exit w(0:order, 1:n) = y^[0..order]
@@ -47,7 +51,7 @@ from .codegen import FortranPrinter
 __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
            "variational_exprs", "TAYLOR_VERSION"]
 
-TAYLOR_VERSION = "1"
+TAYLOR_VERSION = "2"
 
 
 class TaylorUnsupported(ValueError):
@@ -97,8 +101,9 @@ class _Op:
         self.kind, self.out, self.args, self.data = kind, out, args, data or {}
 
 
-# kinds whose history sums weight the argument's coefficients by j
-_JWEIGHT = {"pow", "exp", "sincos", "sinhcosh", "tan", "tanh"}
+# kinds whose history sums weight the argument's coefficients by j (powers weight each
+# term by ((r + 1) j - k) in the sum itself: one sum instead of two)
+_JWEIGHT = {"exp", "sincos", "sinhcosh", "tan", "tanh"}
 _INVERSE = {"log": None, "atan": "1+a2", "asin": "sqrt(1-a2)", "acos": "-sqrt(1-a2)",
             "asinh": "sqrt(1+a2)", "acosh": "sqrt(a2-1)", "atanh": "1-a2"}
 _SMOOTH_FUNCS = {sp.exp: "exp", sp.log: "log", sp.sin: "sin", sp.cos: "cos",
@@ -466,11 +471,18 @@ def _wrap(line, ind):
     return w(line, ind)
 
 
+#: marks a symmetric history sum (a square): sum_{j=1..k-1} a[j] a[k-j] is computed as
+#: 2 sum_{j < k - j} a[j] a[k-j] + a[k/2]^2 (k even), half the multiply-adds
+_SYM = "sym"
+
+
 class _Recipe:
     """The statements of one decomposition, independent of how the orders are run: the
-    order-0 statements, the history terms (accumulator, left column, right column: the
-    term w(j, left) w(k - j, right), j = 1 .. k - 1) and the current-order statements
-    (functions of E: the order index k, its real fk and reciprocal rk as Fortran text)."""
+    order-0 statements, the history terms (accumulator, left column, right column, weight:
+    the term w(j, left) w(k - j, right), j = 1 .. k - 1; weight None: unweighted, _SYM: a
+    symmetric sum (left = right, see _SYM), else the Fortran text of (r + 1) for the
+    power weight ((r + 1) j - k)) and the current-order statements (functions of E: the
+    order index k, its real fk and reciprocal rk as Fortran text)."""
 
     def __init__(self, pp, given=False, order_name="order"):
         self.pp = pp
@@ -526,13 +538,13 @@ class _Recipe:
                 b = op.args[1]
                 h = acc()
                 s0.append(f"{W(0, o)} = {W(0, a)}*{W(0, b)}")
-                hist.append((h, a, b))
+                hist.append((h, a, b, None))
                 cur.append(lambda E, o=o, a=a, b=b, h=h: f"{W(E['k'], o)} = {h} + "
                            f"{W(0, a)}*{W(E['k'], b)} + {W(E['k'], a)}*{W(0, b)}")
             elif kind == "sq":
                 h = acc()
                 s0.append(f"{W(0, o)} = {W(0, a)}**2")
-                hist.append((h, a, a))
+                hist.append((h, a, a, _SYM))
                 two = pp.real(2)
                 cur.append(lambda E, o=o, a=a, h=h, two=two: f"{W(E['k'], o)} = {h} + "
                            f"{two}*{W(0, a)}*{W(E['k'], a)}")
@@ -542,7 +554,7 @@ class _Recipe:
                 s0.append(f"{iv} = {one}/{W(0, b)}")
                 num0 = W(0, a) if kind == "div" else pp.num(op.data["c"])
                 s0.append(f"{W(0, o)} = {num0}*{iv}")
-                hist.append((h, b, o))
+                hist.append((h, b, o, None))
                 cur.append(lambda E, o=o, a=a, b=b, h=h, iv=iv, dv=kind == "div":
                            f"{W(E['k'], o)} = ({W(E['k'], a) + ' - ' if dv else '-'}{h} - "
                            f"{W(E['k'], b)}*{W(0, o)})*{iv}")
@@ -550,25 +562,27 @@ class _Recipe:
                 h, iv = acc(), inv()
                 s0.append(f"{W(0, o)} = sqrt({W(0, a)})")
                 s0.append(f"{iv} = {pp.real(0.5)}/{W(0, o)}")
-                hist.append((h, o, o))
+                hist.append((h, o, o, _SYM))
                 cur.append(lambda E, o=o, a=a, h=h, iv=iv:
                            f"{W(E['k'], o)} = ({W(E['k'], a)} - {h})*{iv}")
             elif kind == "pow":
                 r = op.data["r"]
-                h, h2, iv = acc(), acc(), inv()
+                h, iv = acc(), inv()
                 s0.append(f"{W(0, o)} = {pp.pow_order0(W(0, a), r)}")
                 s0.append(f"{iv} = {one}/{W(0, a)}")
                 rs = pp.num(r)
                 rp1 = pp.num(sp.sympify(r) + 1) if sp.sympify(r).is_Number else \
                     f"({rs} + {one})"
-                hist += [(h, a, o), (h2, JC(a), o)]
-                cur.append(lambda E, o=o, a=a, h=h, h2=h2, iv=iv, rs=rs, rp1=rp1:
-                           f"{W(E['k'], o)} = (({rp1}*{h2} - {E['fk']}*{h})*{E['rk']} + "
+                # k a0 c[k] = sum_{j=1..k} ((r + 1) j - k) a[j] c[k-j]: the terms j < k in
+                # one weighted history sum, the term j = k (weight r k) current
+                hist.append((h, a, o, f"({rp1})"))
+                cur.append(lambda E, o=o, a=a, h=h, iv=iv, rs=rs:
+                           f"{W(E['k'], o)} = ({h}*{E['rk']} + "
                            f"{rs}*{W(E['k'], a)}*{W(0, o)})*{iv}")
             elif kind == "exp":
                 h = acc()
                 s0.append(f"{W(0, o)} = exp({W(0, a)})")
-                hist.append((h, JC(a), o))
+                hist.append((h, JC(a), o, None))
                 cur.append(lambda E, o=o, a=a, h=h: f"{W(E['k'], o)} = {h}*{E['rk']} + "
                            f"{W(E['k'], a)}*{W(0, o)}")
             elif kind in ("sincos", "sinhcosh"):
@@ -577,7 +591,7 @@ class _Recipe:
                 h, h2 = acc(), acc()
                 s0.append(f"{W(0, sn)} = {'sinh' if hy else 'sin'}({W(0, a)})")
                 s0.append(f"{W(0, cs)} = {'cosh' if hy else 'cos'}({W(0, a)})")
-                hist += [(h, JC(a), cs), (h2, JC(a), sn)]
+                hist += [(h, JC(a), cs, None), (h2, JC(a), sn, None)]
                 sg = "" if hy else "-"
                 cur.append(lambda E, sn=sn, cs=cs, a=a, h=h: f"{W(E['k'], sn)} = "
                            f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, cs)}")
@@ -587,7 +601,7 @@ class _Recipe:
                 g = op.args[1]
                 h = acc()
                 s0.append(f"{W(0, o)} = {kind}({W(0, a)})")
-                hist.append((h, JC(a), g))
+                hist.append((h, JC(a), g, None))
                 cur.append(lambda E, o=o, a=a, g=g, h=h: f"{W(E['k'], o)} = "
                            f"{h}*{E['rk']} + {W(E['k'], a)}*{W(0, g)}")
             elif kind.startswith("inv_"):
@@ -595,7 +609,7 @@ class _Recipe:
                 h, iv = acc(), inv()
                 s0.append(f"{W(0, o)} = {kind[4:]}({W(0, a)})")
                 s0.append(f"{iv} = {one}/{W(0, u)}")
-                hist.append((h, JC(o), u))
+                hist.append((h, JC(o), u, None))
                 cur.append(lambda E, o=o, a=a, h=h, iv=iv: f"{W(E['k'], o)} = "
                            f"({W(E['k'], a)} - {h}*{E['rk']})*{iv}")
             else:
@@ -610,6 +624,22 @@ def _sum_seq(terms, zero):
     (h = 0; h = h + term_j, j = 1 .. k - 1), so the written-out routine and the loop give
     the same coefficients to the last bit (compiled without -ffast-math)."""
     return " + ".join(terms) if terms else zero
+
+
+def _history_sum(pp, k, lft, rgt, wt):
+    """The history sum of order k written out (literal indices), the same operations in
+    the same order as the loop version's (see body_lines), so the same bits."""
+    W = pp.w
+    zero = f"0.0_{pp.kind}"
+    if wt is _SYM:
+        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in range(1, (k - 1)//2 + 1)]
+        out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
+        if k % 2 == 0:
+            mid = f"{W(k//2, lft)}*{W(k//2, lft)}"
+            out = f"{out} + {mid}" if out else mid
+        return out or zero
+    weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
+    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)], zero)
 
 
 def _decls(names, typ, ind):
@@ -664,11 +694,25 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
                 f"{ind}    rk = {one}/fk",
                 f"{ind}    rk1 = {one}/(fk + {one})"]
         loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
-        if rc.hist:
+        plain = [x for x in rc.hist if x[3] is not _SYM]
+        sym = [x for x in rc.hist if x[3] is _SYM]
+        if plain:
             loop.append(f"{ind}    do j = 1, k - 1")
-            for h, lft, rgt in rc.hist:
-                loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', rgt)}", ind + "        ")
+            for h, lft, rgt, wt in plain:
+                wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
+                loop += _wrap(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}",
+                              ind + "        ")
             loop.append(f"{ind}    end do")
+        if sym:       # squares: the pairs j < k - j once, doubled, and the middle term
+            loop.append(f"{ind}    do j = 1, (k - 1)/2")
+            for h, lft, _, _ in sym:
+                loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}", ind + "        ")
+            loop.append(f"{ind}    end do")
+            loop += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
+            loop.append(f"{ind}    if (mod(k, 2) == 0) then")
+            for h, lft, _, _ in sym:
+                loop += _wrap(f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}", ind + "        ")
+            loop.append(f"{ind}    end if")
         for f in rc.cur:
             loop += _wrap(f(E), ind + "    ")
         if not given:
@@ -690,9 +734,8 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     body = body[:1] + state_in + body[1:]
     for k in range(1, last + 1):
         E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
-        for h, lft, rgt in rc.hist:
-            terms = [f"{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)]
-            body += _wrap(f"{h} = {_sum_seq(terms, zero)}", ind)
+        for h, lft, rgt, wt in rc.hist:
+            body += _wrap(f"{h} = {_history_sum(pp, k, lft, rgt, wt)}", ind)
         for f in rc.cur:
             body += _wrap(f(E), ind)
         if not given:
