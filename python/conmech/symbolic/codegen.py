@@ -50,7 +50,7 @@ __all__ = ["CODEGEN_VERSION", "FortranPrinter", "assignments", "generate", "prep
 ENTRY_POINTS = _table.ENTRY_POINTS
 
 #: bump when the generated code or the derivation changes (invalidates the derivation cache)
-CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;
+CODEGEN_VERSION = "10"  # 2: conmech_* entry names, model-library description;
 #                         3: structured forces / Jacobian, sin and cos by angle addition;
 #                         4: conmech_mass_forces (M and Q in one call, shared subexpressions);
 #                         5: conmech_jac_prod (ode: J x for a block of columns, no J formed);
@@ -58,6 +58,7 @@ CODEGEN_VERSION = "9"   # 2: conmech_* entry names, model-library description;
 #                         7: conmech_taylor* (Taylor coefficients, conmech.symbolic.taylor)
 #                         8: constrained: conmech_forces_jac, conmech_constraint_hessian
 #                         9: user strings escaped (comments, parameter names as data)
+#                        10: Taylor recurrences in a library of their own, on first need
 
 _SQRT = sp.Function("conmech_sqrt")   # an unevaluated sqrt, so that b**(3/2) = cm_sqrt(b)**3
 
@@ -691,12 +692,18 @@ def _constrained_derivative_procedures(printer, d, T, P, arr):
     return out
 
 
-def generate(d, module="conmech_symbolic_model", model_values=None):
+def generate(d, module="conmech_symbolic_model", model_values=None, taylor=False):
     """Fortran source of the bind(C) module for the derived system `d`; returns
     (source, list of the entry points present, e.g. ["mass", "forces", ...]).
     With `model_values` (the default parameter values), the module also describes itself
     as a model library (conmech_model_info, conmech_model_params,
-    conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`."""
+    conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`.
+    With `taylor` an ode module also holds its Taylor recurrences (conmech_taylor* of
+    :mod:`conmech.symbolic.taylor`), as a model library written for other programs needs;
+    without, they are a library of their own compiled on first need
+    (:mod:`conmech.symbolic.taylor_library`): most calls never run Taylor's method, and
+    its recurrences (the system's and the variational system's, in double, batch and
+    quadruple precision) are most of the code to compile."""
     if not isinstance(module, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", module):
         raise ValueError(f"bad module name {module!r} (a Fortran name: a letter, then "
                          "letters, digits or underscores; at most 63 characters)")
@@ -725,12 +732,13 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                 [("dfdy", d.jac, True)]))
         procs.append(_jac_prod_procedure(pr, d))
         entries = ["rhs", "jac", "jac_prod"]
-        # Taylor coefficients of the solution (conmech.symbolic.taylor), when f is smooth
-        from .taylor import ode_taylor_lines
-        tl, te, _ = ode_taylor_lines(d, pr.names)
-        if tl:
-            procs.append(tl)
-            entries += te
+        if taylor:
+            # Taylor coefficients of the solution (conmech.symbolic.taylor), when f is smooth
+            from .taylor import ode_taylor_lines
+            tl, te, _ = ode_taylor_lines(d, pr.names)
+            if tl:
+                procs.append(tl)
+                entries += te
     else:
         Q1 = [T, arr("q", [n])]
         QV = Q1 + [arr("v", [n])]
