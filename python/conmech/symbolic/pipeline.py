@@ -357,6 +357,8 @@ def _construct(kind, inputs, params, options, derive, flags, model_only, descrip
             _check_compiled_mass(model)
         if key:
             _store(key, model, flags)
+    # the derivation cache's key, under which the Taylor library's source is kept too
+    model.cache_key = key
     if description and key:
         from .description import store_description
         store_description(description, key, params)

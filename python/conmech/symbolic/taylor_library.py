@@ -15,16 +15,21 @@ safe, and checked against its manifest before loading) and loads it. A second pr
 finds it there (a cache hit, no compiler run). The copies of a system made by
 ``with_params`` share the model and its Taylor library.
 """
+import json
+import os
+import tempfile
 import threading
 import time
 
-from .build import compile_source, load
+from .build import cache_dir, check_private, compile_source, load
 from .codegen import _names, check_source, private_procedures
 
 __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "MODULE"]
 
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
+
+_FORMAT = 1     # of the kept source (conmech_KEY.taylor.json)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -67,7 +72,14 @@ def taylor_library(model):
     state = model.__dict__.get("_taylor_state")
     if state is None:
         t0 = time.perf_counter()
-        src, entries, why = taylor_source(model.derived)
+        key = getattr(model, "cache_key", None)
+        found = _load_source(key) if key else None
+        if found is None:
+            src, entries, why = taylor_source(model.derived)
+            if key:
+                _store_source(key, src, entries, why)
+        else:
+            src, entries, why = found
         t1 = time.perf_counter()
         model.times["taylor_generate"] = t1 - t0
         if src is None:
@@ -82,6 +94,65 @@ def taylor_library(model):
         model._taylor_state = state
     model.taylor_reason = state[2]
     return state[1]
+
+
+def _source_path(key):
+    return os.path.join(cache_dir(), f"conmech_{key}.taylor.json")
+
+
+def _load_source(key):
+    """(source, entries, reason) kept beside the derivation of `key` (a process that finds
+    the model in the cache finds its Taylor source too, with no sympy work), or None. The
+    file is trusted as the cache's other files are (check_private), and the source is
+    checked as a generated one is."""
+    path = _source_path(key)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return None
+    try:
+        check_private(path, os.fstat(fd))
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            info = json.loads(fh.read().decode())
+        if info.get("format") != _FORMAT:
+            return None
+        src, entries, why = info["source"], info["entries"], info["reason"]
+        if src is None:
+            return (None, [], str(why)) if isinstance(why, str) else None
+        if not (isinstance(src, str) and isinstance(entries, list)
+                and all(isinstance(e, str) for e in entries)):
+            return None
+        internal = private_procedures(entries)
+        c_names = [f"conmech_{e}" for e in entries]
+        check_source(src, c_names + internal, c_names)
+        return src, entries, None
+    except (ValueError, KeyError, TypeError, AttributeError, UnicodeDecodeError, OSError):
+        return None         # stale or damaged: generated again
+    finally:
+        os.close(fd)
+
+
+def _store_source(key, src, entries, why):
+    """Keep the Taylor source beside the derivation of `key` (an optimisation only: a
+    failure to write it is ignored)."""
+    data = json.dumps({"format": _FORMAT, "source": src, "entries": list(entries),
+                       "reason": why}).encode()
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=cache_dir())
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, _source_path(key))
+        tmp = None
+    except OSError:
+        pass
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
 
 
 def lazy_taylor(model):
