@@ -64,10 +64,10 @@ def _plain(x):
 
 
 def _versions():
-    from .. import symbolic
     from .build import _conmech_version
+    from .codegen import CODEGEN_VERSION
     from .recursive import recursive_version
-    return (symbolic.CODEGEN_VERSION, recursive_version(), _conmech_version())
+    return (CODEGEN_VERSION, recursive_version(), _conmech_version())
 
 
 def _digest(kind, parts):
