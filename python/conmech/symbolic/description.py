@@ -151,7 +151,7 @@ def description_hit(dkey, flags, model_only, params=None):
     tree's); None: the values stored with the entry (a robot's)."""
     if dkey is None:
         return None
-    from . import _from_cache, _system
+    from .pipeline import _from_cache, _system
     from .build import _read_json
     t0 = time.perf_counter()
     path = _entry(dkey)

@@ -301,7 +301,9 @@ def _from_cache(key, params, flags):
     t3 = time.perf_counter()
     times = {"derive": 0.0, "derived_cache": t1 - t0, "generate": 0.0,
              "compile_or_load": t2 - t1, "load": t3 - t2}
-    return CompiledModel(d, src, lib_path, lib, addr, hit, times, flags)
+    model = CompiledModel(d, src, lib_path, lib, addr, hit, times, flags)
+    model.cache_key = key
+    return model
 
 
 def _store(key, model, flags):
