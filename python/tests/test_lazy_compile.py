@@ -9,6 +9,8 @@ In a fresh compile cache (each test its own):
   programs holds), and agrees with DOP853;
 - a second process finds the model and its Taylor library in the cache: no compilation
   (the cache's .so files unchanged, the build reported as a hit);
+- each part is built when a call needs it: a solve the double routine only, stm its
+  variational system, an ensemble the batch routine, taylor_quad the quadruple one;
 - the copies of with_params share the lazy library (built once); stm(method="TAYLOR"),
   compiled events and Taylor ensembles build it on their first use;
 - save_model writes a complete library (load_model finds its Taylor routines);
@@ -75,6 +77,8 @@ def test_dop853_leaves_no_taylor_library_and_taylor_builds_it(cache):
     assert res.success
     assert not system.taylor_pending and model.taylor_cache_hit is False
     assert model.taylor_path in _libraries(cache)
+    # a solve needs the double routine only: no batch, quadruple or variational code
+    assert set(model.taylor_paths) == {"core"}
     np.testing.assert_allclose(res.y[:, -1], ref.y[:, -1], rtol=0, atol=1e-9)
 
     # the same model compiled with its recurrences inside (one complete library): the
@@ -122,6 +126,7 @@ def test_with_params_shares_and_stm_builds(cache):
     y1d, phid = stability.stm(other, (0.0, 2.0), Y0)
     np.testing.assert_allclose(phi, phid, rtol=0, atol=1e-8)
     np.testing.assert_allclose(y1, y1d, rtol=0, atol=1e-10)
+    assert set(model.taylor_paths) == {"core", "var"}
     n = len(_libraries(cache))
     assert not system.taylor_pending        # the original's lazy set is the same one
     assert system.taylor["jet"] is other.taylor["jet"]
@@ -149,6 +154,7 @@ def test_events_and_ensemble_build_it(cache):
     y0s = np.array([[1.2, 0.0], [0.5, 0.1], [-0.3, 1.0]])
     ens = ensemble.solve(fresh, SPAN, y0s, method="TAYLOR", rtol=1e-12, atol=1e-12)
     assert ens.success and not fresh.taylor_pending
+    assert set(symbolic.model_of(fresh).taylor_paths) == {"core", "batch"}
     for k in range(3):
         one = conmech.solve_ivp(fresh, SPAN, y0s[k], method="TAYLOR", rtol=1e-12,
                                 atol=1e-12)
@@ -167,6 +173,15 @@ def test_save_model_keeps_the_taylor_routines(cache, tmp_path):
     a = conmech.solve_ivp(loaded, SPAN, Y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
     b = conmech.solve_ivp(system, SPAN, Y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(a.y[:, -1], b.y[:, -1], rtol=0, atol=1e-12)
+
+
+def test_quadruple_precision_part(cache):
+    model, system = _make()
+    from conmech.symbolic import taylor_quad
+    r = taylor_quad.reference(system, (0, "1"), ["1.2", "0"], tol=1e-25)
+    assert r.success and set(model.taylor_paths) == {"core", "qp"}
+    ref = conmech.solve_ivp(system, (0, 1.0), Y0, method="DOP853", rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(r.y_float, ref.y[:, -1], rtol=0, atol=1e-11)
 
 
 def test_non_smooth_model_has_no_taylor_library(cache):
@@ -189,13 +204,22 @@ def test_lazy_taylor_builds_once_and_retries_after_a_failure():
             raise build.CompileError("no compiler")
         return None
 
-    lazy = LazyTaylor(build_fails_first)
+    def build_part(part):
+        if part == "core":
+            return build_fails_first()
+        raise AssertionError("no part is built for a system without recurrences")
+
+    lazy = LazyTaylor(build_part)
     with pytest.raises(build.CompileError):
         lazy.get()
     assert not lazy.built
-    assert lazy.get() is None and lazy.built
+    assert lazy.get("var") is None and lazy.built and not lazy.has("var")
     assert lazy.get() is None and len(calls) == 2
+    parts = []
+    two = LazyTaylor(lambda part: parts.append(part) or {part: 1})
+    assert two.get() == {"core": 1} and two.get("var", "var") == {"core": 1, "var": 1}
+    assert two.get("var") == {"core": 1, "var": 1} and parts == ["core", "var"]
     with pytest.raises(TypeError):
         LazyTaylor(42)
     with pytest.raises(TypeError):
-        LazyTaylor(lambda: 42).get()
+        LazyTaylor(lambda part: 42).get()

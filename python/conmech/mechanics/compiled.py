@@ -184,37 +184,49 @@ def _taylor_spec(spec, taylor):
 
 class LazyTaylor:
     """The Taylor entries of a system (the ``taylor`` dict of :func:`ode_system`, or None),
-    made by ``build()`` when first asked for: :mod:`conmech.symbolic` compiles a model's
-    Taylor recurrences only when a call runs Taylor's method. Built once (under a lock, so
-    that threads asking together build once); a failed build raises and is tried again at
-    the next request."""
+    made when first asked for, part by part: ``build(part)`` returns the entries of a part
+    ("core": ``jet`` and ``nw``; others, e.g. "var", "batch", "qp", their own entries), or
+    None when the system has no Taylor recurrences. :mod:`conmech.symbolic` compiles a
+    model's Taylor code only when a call runs Taylor's method, and only the part it needs.
+    Each part is built once (under a lock, so that threads asking together build once); a
+    failed build raises and is tried again at the next request."""
 
-    __slots__ = ("_build", "_value", "_done", "_lock")
+    __slots__ = ("_build", "_value", "_parts", "_lock")
 
     def __init__(self, build):
         if not callable(build):
-            raise TypeError("LazyTaylor needs a callable that returns the taylor dict")
+            raise TypeError("LazyTaylor needs a callable that returns the taylor entries")
         self._build = build
         self._value = None
-        self._done = False
+        self._parts = set()
         self._lock = threading.Lock()
 
     @property
     def built(self):
-        """Whether the entries have been made."""
-        return self._done
+        """Whether the core entries have been made."""
+        return "core" in self._parts
 
-    def get(self):
-        """The taylor dict (None when the system has no Taylor recurrences)."""
-        if not self._done:
+    def has(self, part):
+        """Whether `part` has been made."""
+        return part in self._parts
+
+    def get(self, *parts):
+        """The taylor dict with the core and `parts` (and those made before), or None when
+        the system has no Taylor recurrences."""
+        for part in ("core",) + parts:
+            if part in self._parts:
+                continue
+            if part != "core" and self._value is None:
+                break
             with self._lock:
-                if not self._done:
-                    value = self._build()
-                    if value is not None and not isinstance(value, dict):
-                        raise TypeError("the Taylor build must return a dict or None")
-                    self._value = dict(value) if value else None
-                    self._done = True
-                    self._build = None
+                if part in self._parts:
+                    continue
+                value = self._build(part)
+                if value is not None and not isinstance(value, dict):
+                    raise TypeError("the Taylor build must return a dict or None")
+                if value:
+                    self._value = dict(self._value or {}, **value)
+                self._parts.add(part)
         return self._value
 
 
@@ -242,18 +254,24 @@ class CompiledSystem(NativeSystem):
 
     @property
     def taylor(self):
-        """The Taylor entries (a dict) or None. A lazy set (:class:`LazyTaylor`) is built
-        here, at the first access, and its entries written into ``spec`` (shared with the
+        """The Taylor entries (a dict) or None. A lazy set (:class:`LazyTaylor`) makes its
+        core here, at the first access, and its entries go into ``spec`` (shared with the
         copies of :meth:`with_params`, which share the lazy set too): the Taylor paths
         (``solve_ivp(method="TAYLOR")``, ``stm(method="TAYLOR")``, ensembles) read this
-        attribute before they hand ``spec`` to Fortran."""
+        attribute, or call :meth:`taylor_parts`, before they hand ``spec`` to Fortran."""
+        return self.taylor_parts()
+
+    def taylor_parts(self, *parts):
+        """The Taylor entries with the lazy `parts` made ("var": the variational system,
+        for stm; "batch": ensembles; "qp": quadruple precision), their entries in
+        ``spec``; the entries as they are for a system given them at construction."""
         t = self._taylor
-        if isinstance(t, LazyTaylor):
-            value = t.get()
-            if value:
-                _taylor_spec(self.spec, value)
-            self._taylor = t = value
-        return t
+        if not isinstance(t, LazyTaylor):
+            return t
+        value = t.get(*parts)
+        if value and (parts or not self.spec[_TAYLOR_SLOTS["jet"] - 1]):
+            _taylor_spec(self.spec, value)
+        return value
 
     @property
     def taylor_pending(self):
