@@ -8,13 +8,14 @@ arm7.urdf) and a spatial chain of 30 revolute links (symbolic.spatial_tree, the 
 bench_spatial_tree.py). Each construction runs in its own process with its own fresh
 CONMECH_CACHE, so that nothing is shared between runs; --python compares interpreters
 (``LABEL=PYTHON[:PYTHONPATH]``: e.g. this branch's interpreter with and without a copy
-of the package as it was before, on PYTHONPATH) in the same run, interleaved. Reported per system and interpreter: the wall-clock seconds of the whole
-construction (median and min of --repeat), its compile-only part (model.times
-compile_or_load) and the cache hit in a second process; the load average from
-`uptime` before and after.
+of the package as it was before, on PYTHONPATH) in the same run, interleaved. Reported
+per system and interpreter: the wall-clock seconds of the whole construction (median and min of --repeat), its compile-only part (model.times
+compile_or_load) and the cache hit in a second process; with --taylor, for the ode
+systems, the first TAYLOR solve after a cold construction (what it compiles then); the load
+average before and after.
 
 Usage:  python bench/bench_construction.py [--python LABEL=PYTHON[:PYTHONPATH] ...]
-                                           [--repeat 3]
+                                           [--repeat 3] [--taylor]
                                            [--systems arenstorf kepler arm7 chain30]
 """
 import argparse
@@ -64,9 +65,21 @@ else:
     g = sp.Symbol("g")
     model = symbolic.spatial_tree(bodies, {g: 9.81}, gravity=(0, 0, -g), model_only=True)
 total = time.perf_counter() - t0
+first_taylor = None
+if which in ("arenstorf", "kepler") and "--taylor" in sys.argv:
+    # the first Taylor solve after the construction: what it compiles then (the
+    # recurrences written out for its order; and with lazy Taylor code, its library)
+    import conmech
+    system = symbolic.pipeline._system(model)
+    y0 = [0.994, 0.0, 0.0, -2.00158510637908252240537862224] if which == "arenstorf" \
+        else [0.5, 0.0, 0.0, 3.0**0.5]
+    t1 = time.perf_counter()
+    r = conmech.solve_ivp(system, (0.0, 1.0), y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
+    assert r.success
+    first_taylor = time.perf_counter() - t1
 print(json.dumps({"total": total, "compile": model.times.get("compile_or_load", 0.0),
                   "hit": bool(model.cache_hit), "import": t_import,
-                  "source_kb": len(model.source) / 1024}))
+                  "source_kb": len(model.source) / 1024, "first_taylor": first_taylor}))
 '''
 
 
@@ -78,12 +91,13 @@ def uptime():
         return "?"
 
 
-def run(python, which, cache):
+def run(python, which, cache, taylor=False):
     python, _, path = python.partition(":")
     env = dict(os.environ, CONMECH_CACHE=cache)
     if path:
         env["PYTHONPATH"] = path
-    out = subprocess.run([python, "-c", CHILD, which], capture_output=True, text=True,
+    out = subprocess.run([python, "-c", CHILD, which] + (["--taylor"] if taylor else []),
+                         capture_output=True, text=True,
                          env=env, timeout=3600)
     if out.returncode != 0:
         raise RuntimeError(f"{python} {which}: {out.stderr[-2000:]}")
@@ -94,6 +108,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--python", nargs="+", default=[f"this={sys.executable}"])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--taylor", action="store_true",
+                    help="also time the first TAYLOR solve after a cold construction "
+                         "(ode systems; a third process, its own fresh cache)")
     ap.add_argument("--systems", nargs="+", default=["arenstorf", "kepler", "arm7",
                                                        "chain30"])
     a = ap.parse_args()
@@ -108,27 +125,33 @@ def main():
                 with tempfile.TemporaryDirectory(prefix="bench_construction_") as cache:
                     cold = run(py, which, cache)
                     warm = run(py, which, cache)
+                with tempfile.TemporaryDirectory(prefix="bench_construction_") as cache:
+                    tay = run(py, which, cache, taylor=True)["first_taylor"] \
+                        if a.taylor else None
+                cold["first_taylor"] = tay
                 assert not cold["hit"] and warm["hit"], (cold, warm)
                 res[label].append(cold)
                 hits[label].append(warm)
                 print(f"  {which} {label}: {cold['total']:.2f} s (compile "
-                      f"{cold['compile']:.2f} s), hit {warm['total']*1e3:.0f} ms",
-                      flush=True)
+                      f"{cold['compile']:.2f} s), hit {warm['total']*1e3:.0f} ms, first "
+                      f"Taylor solve {tay if tay is None else round(tay, 2)} s", flush=True)
         for label, _ in pythons:
             tot = [r["total"] for r in res[label]]
             comp = [r["compile"] for r in res[label]]
             hit = [r["total"] for r in hits[label]]
+            tay = [r["first_taylor"] for r in res[label] if r["first_taylor"] is not None]
             rows.append((which, label, statistics.median(tot), min(tot),
                          statistics.median(comp), min(comp), statistics.median(hit) * 1e3,
-                         res[label][0]["source_kb"]))
+                         res[label][0]["source_kb"],
+                         f"{statistics.median(tay):.2f} / {min(tay):.2f}" if tay else "-"))
     print(f"load after: {uptime()}")
     print()
     print("| system | build | construction s (median / min) | compile s (median / min) | "
-          "cache hit ms (median) | source KiB |")
-    print("|---|---|---|---|---|---|")
-    for which, label, tm, tmin, cm, cmin, hm, kb in rows:
+          "cache hit ms (median) | model source KiB | first TAYLOR solve s (median / min) |")
+    print("|---|---|---|---|---|---|---|")
+    for which, label, tm, tmin, cm, cmin, hm, kb, tay in rows:
         print(f"| {which} | {label} | {tm:.2f} / {tmin:.2f} | {cm:.2f} / {cmin:.2f} | "
-              f"{hm:.0f} | {kb:.0f} |")
+              f"{hm:.0f} | {kb:.0f} | {tay} |")
 
 
 if __name__ == "__main__":
