@@ -9,8 +9,8 @@ bench_spatial_tree.py). Each construction runs in its own process with its own f
 CONMECH_CACHE, so that nothing is shared between runs; --python compares interpreters
 (``LABEL=PYTHON[:PYTHONPATH]``: e.g. this branch's interpreter with and without a copy
 of the package as it was before, on PYTHONPATH) in the same run, interleaved. Reported
-per system and interpreter: the wall-clock seconds of the whole construction (median and min of --repeat), its compile-only part (model.times
-compile_or_load) and the cache hit in a second process; with --taylor, for the ode
+per system and interpreter: the wall-clock seconds of the whole construction (median
+and min of --repeat), its compile-only part (model.times compile_or_load) and the cache hit in a second process; with --taylor, for the ode
 systems, the first TAYLOR solve after a cold construction (what it compiles then); the load
 average before and after.
 

@@ -4,8 +4,8 @@ against the run time of the result.
 
 For each level (--levels, default O1 O2 O3: -O1, -O2, -O3) and system (Arenstorf,
 Kepler), in a fresh cache: the compile seconds of the model library (rhs, jac, jac_prod),
-of its Taylor core library (conmech_taylor, conmech.symbolic.taylor_library) and of the recurrences written out for the order of
-rtol = 1e-12 (wall clock, provisional on a loaded machine); then the callgrind instruction
+of its Taylor core library (conmech_taylor, conmech.symbolic.taylor_library) and of the
+recurrences written out for the order of rtol = 1e-12 (wall clock, provisional on a loaded machine); then the callgrind instruction
 count of one solve_ivp call (DOP853 and TAYLOR, rtol = atol = 1e-12, Arenstorf: one
 period; Kepler e = 0.5: ten periods) with those libraries, counted inside the flat solver
 only (--toggle-collect on flat_solve_: the interpreter, the imports and the set-up not
