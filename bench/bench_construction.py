@@ -7,12 +7,12 @@ Systems: Arenstorf's restricted three-body problem and the Kepler problem
 arm7.urdf) and a spatial chain of 30 revolute links (symbolic.spatial_tree, the chain of
 bench_spatial_tree.py). Each construction runs in its own process with its own fresh
 CONMECH_CACHE, so that nothing is shared between runs; --python compares interpreters
-(``LABEL=PYTHON[:PYTHONPATH]``: e.g. this branch's interpreter with and without a copy
-of the package as it was before, on PYTHONPATH) in the same run, interleaved. Reported
-per system and interpreter: the wall-clock seconds of the whole construction (median
-and min of --repeat), its compile-only part (model.times compile_or_load) and the cache hit in a second process; with --taylor, for the ode
-systems, the first TAYLOR solve after a cold construction (what it compiles then); the load
-average before and after.
+(``LABEL=PYTHON[:PYTHONPATH]``: e.g. this branch's interpreter with and without a copy of
+the package as it was before, on PYTHONPATH) in the same run, interleaved. Reported per
+system and interpreter: the wall-clock seconds of the whole construction (median and min
+of --repeat), its compile-only part (model.times compile_or_load) and the cache hit in a
+second process; with --taylor, for the ode systems, the first TAYLOR solve after a cold
+construction (what it compiles then); the load average before and after.
 
 Usage:  python bench/bench_construction.py [--python LABEL=PYTHON[:PYTHONPATH] ...]
                                            [--repeat 3] [--taylor]

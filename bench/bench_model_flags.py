@@ -2,14 +2,15 @@
 """The gfortran optimisation level of conmech.symbolic's model libraries: compile time
 against the run time of the result.
 
-For each level (--levels, default O1 O2 O3: -O1, -O2, -O3) and system (Arenstorf,
-Kepler), in a fresh cache: the compile seconds of the model library (rhs, jac, jac_prod),
-of its Taylor core library (conmech_taylor, conmech.symbolic.taylor_library) and of the
-recurrences written out for the order of rtol = 1e-12 (wall clock, provisional on a loaded machine); then the callgrind instruction
-count of one solve_ivp call (DOP853 and TAYLOR, rtol = atol = 1e-12, Arenstorf: one
-period; Kepler e = 0.5: ten periods) with those libraries, counted inside the flat solver
-only (--toggle-collect on flat_solve_: the interpreter, the imports and the set-up not
-counted). Instruction counts are exactly repeatable on a shared machine.
+For each level (--levels, default O1 O2 O3: -O1, -O2, -O3) and system (Arenstorf, Kepler),
+in a fresh cache: the compile seconds of the model library (rhs, jac, jac_prod), of its
+Taylor core library (conmech_taylor, conmech.symbolic.taylor_library) and of the
+recurrences written out for the order of rtol = 1e-12 (wall clock, provisional on a loaded
+machine); then the callgrind instruction count of one solve_ivp call (DOP853 and TAYLOR,
+rtol = atol = 1e-12, Arenstorf: one period; Kepler e = 0.5: ten periods) with those
+libraries, counted inside the flat solver only (--toggle-collect on flat_solve_: the
+interpreter, the imports and the set-up not counted). Instruction counts are exactly
+repeatable on a shared machine.
 
 Usage:  python bench/bench_model_flags.py [--levels O1 O2 O3] [--systems arenstorf kepler]
 """
