@@ -1,7 +1,7 @@
 """The description cache: a second construction of the same multibody tree or URDF robot,
 in a new process, loads its compiled model without deriving anything.
 
-The derivation cache of :func:`conmech.symbolic._construct` is keyed by the sympy inputs
+The derivation cache of :func:`conmech.symbolic.pipeline._construct` is keyed by the sympy inputs
 of a construction (the tree's validated bodies, forces and loops as sympy objects): for a
 tree or a robot, building those inputs (parsing the URDF into sympy records, validating
 the bodies, printing them for the key) costs more than loading the cached model itself.
