@@ -132,10 +132,8 @@ def _circles(graph):
 
 
 # imports inside functions that may close a circle: a lower layer reaching into the optional
-# sympy front end (checked by the layer test), and the Taylor generator's printer helpers,
-# which symbolic/taylor.py takes through codegen while codegen asks it for the Taylor
-# procedures of an ODE (the edge goes once taylor.py imports them from symbolic/printer.py)
-_LAZY_EDGES = {("conmech.symbolic.codegen", "conmech.symbolic.taylor")}
+# sympy front end (checked by the layer test)
+_LAZY_EDGES = set()
 
 
 def test_no_import_circle_through_imports_inside_functions():

@@ -489,10 +489,12 @@ def test_hostile_names_cannot_inject_code(kind, tmp_path, built, monkeypatch):
     c_names = [f"conmech_{e}" for e in model.addresses]
     check_source(model.source, c_names + private_procedures(model.addresses, model.source),
                  c_names)
-    # the model library: parameter names kept as data, exactly
+    # the model library: parameter names kept as data, exactly; it holds the Taylor
+    # recurrences of an ode system too (compiled apart, on first need, for the model)
     lib = symbolic.save_model(s, tmp_path / "m.so")
-    entries = {f"conmech_{e}" for e in model.addresses} | {
+    entries = {f"conmech_{e}" for e in generate(model.derived, taylor=True)[1]} | {
         "conmech_model_info", "conmech_model_params", "conmech_model_param_names"}
+    assert {f"conmech_{e}" for e in model.addresses} <= entries
     assert _exports(lib) == entries
     loaded = compiled.load_model(lib)
     got = list(loaded.parameters)

@@ -195,10 +195,17 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress):
     computes several members' coefficients at once): method TAYLOR, a system with the
     batch routine, shared parameters, final states only (no t_eval, events, first_step
     or progress)."""
-    taylor = getattr(system, "taylor", None)
-    return (isinstance(method, str) and method.upper() == "TAYLOR" and bool(taylor)
-            and taylor.get("batch") is not None and nt == 0 and ne == 0 and mp <= 1
-            and first_step is None and progress is None)
+    if not (isinstance(method, str) and method.upper() == "TAYLOR"):
+        return False
+    # a system of conmech.symbolic compiles its Taylor recurrences here, on first need
+    # (their entries then in its spec, for the member-by-member path too), the batch
+    # routine only when the batch path runs
+    batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
+    if batch and hasattr(system, "taylor_parts"):
+        taylor = system.taylor_parts("batch")
+    else:
+        taylor = getattr(system, "taylor", None)
+    return batch and bool(taylor) and taylor.get("batch") is not None
 
 
 def _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps, nthreads):

@@ -73,6 +73,7 @@ from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import ctypes
 import math
 import os
+import threading
 
 import numpy as np
 
@@ -85,7 +86,7 @@ from .constrained import NativeConstrained
 
 __all__ = ["ode_system", "generalized_system", "constrained_system", "CompiledSystem",
            "CompiledConstrained", "evaluate", "function_address", "load_model",
-           "library_taylor"]
+           "library_taylor", "LazyTaylor"]
 
 _KIND_ODE, _KIND_GEN, _KIND_CON = (_table.KIND_ODE, _table.KIND_GENERALIZED,
                                    _table.KIND_CONSTRAINED)
@@ -181,15 +182,64 @@ def _taylor_spec(spec, taylor):
     return spec
 
 
+class LazyTaylor:
+    """The Taylor entries of a system (the ``taylor`` dict of :func:`ode_system`, or None),
+    made when first asked for, part by part: ``build(part)`` returns the entries of a part
+    ("core": ``jet`` and ``nw``; others, e.g. "var", "batch", "qp", their own entries), or
+    None when the system has no Taylor recurrences. :mod:`conmech.symbolic` compiles a
+    model's Taylor code only when a call runs Taylor's method, and only the part it needs.
+    Each part is built once (under a lock, so that threads asking together build once); a
+    failed build raises and is tried again at the next request."""
+
+    __slots__ = ("_build", "_value", "_parts", "_lock")
+
+    def __init__(self, build):
+        if not callable(build):
+            raise TypeError("LazyTaylor needs a callable that returns the taylor entries")
+        self._build = build
+        self._value = None
+        self._parts = set()
+        self._lock = threading.Lock()
+
+    @property
+    def built(self):
+        """Whether the core entries have been made."""
+        return "core" in self._parts
+
+    def has(self, part):
+        """Whether `part` has been made."""
+        return part in self._parts
+
+    def get(self, *parts):
+        """The taylor dict with the core and `parts` (and those made before), or None when
+        the system has no Taylor recurrences."""
+        for part in ("core",) + parts:
+            if part in self._parts:
+                continue
+            if part != "core" and self._value is None:
+                break
+            with self._lock:
+                if part in self._parts:
+                    continue
+                value = self._build(part)
+                if value is not None and not isinstance(value, dict):
+                    raise TypeError("the Taylor build must return a dict or None")
+                if value:
+                    self._value = dict(self._value or {}, **value)
+                self._parts.add(part)
+        return self._value
+
+
 class CompiledSystem(NativeSystem):
     """A first-order system (``kind`` 'ode') or a system in generalized coordinates
     (``kind`` 'generalized', state y = [q, q']) given by compiled functions. It works
     wherever a built-in system does: :func:`conmech.solve_ivp`, :mod:`conmech.stability`.
     Attributes: name, kind, dimension (state size), ndof (generalized only), params,
     param_names, spec (the function table handed to Fortran), taylor (the Taylor
-    coefficient routines, a dict, or None)."""
+    coefficient routines, a dict, or None; made on first access when the system was
+    given a :class:`LazyTaylor`, whose entries then go into ``spec``)."""
 
-    __slots__ = ("kind", "ndof", "taylor")
+    __slots__ = ("kind", "ndof", "_taylor")
 
     def __init__(self, name, kind, spec, params, param_names, keep, taylor=None):
         self.name = name
@@ -200,12 +250,39 @@ class CompiledSystem(NativeSystem):
         self.ndof = int(spec[1]) if kind == "generalized" else None
         self.dimension = 2*self.ndof if kind == "generalized" else int(spec[1])
         self._keep = keep
-        self.taylor = taylor
+        self._taylor = taylor
+
+    @property
+    def taylor(self):
+        """The Taylor entries (a dict) or None. A lazy set (:class:`LazyTaylor`) makes its
+        core here, at the first access, and its entries go into ``spec`` (shared with the
+        copies of :meth:`with_params`, which share the lazy set too): the Taylor paths
+        (``solve_ivp(method="TAYLOR")``, ``stm(method="TAYLOR")``, ensembles) read this
+        attribute, or call :meth:`taylor_parts`, before they hand ``spec`` to Fortran."""
+        return self.taylor_parts()
+
+    def taylor_parts(self, *parts):
+        """The Taylor entries with the lazy `parts` made ("var": the variational system,
+        for stm; "batch": ensembles; "qp": quadruple precision), their entries in
+        ``spec``; the entries as they are for a system given them at construction."""
+        t = self._taylor
+        if not isinstance(t, LazyTaylor):
+            return t
+        value = t.get(*parts)
+        if value and (parts or not self.spec[_TAYLOR_SLOTS["jet"] - 1]):
+            _taylor_spec(self.spec, value)
+        return value
+
+    @property
+    def taylor_pending(self):
+        """True while the Taylor entries are lazy and not built yet (no compilation has
+        been asked for)."""
+        return isinstance(self._taylor, LazyTaylor) and not self._taylor.built
 
     def with_params(self, **kw):
         """A copy with new values of some parameters (same compiled code: no rebuild)."""
         return CompiledSystem(self.name, self.kind, self.spec, _with_params(self, kw),
-                              self.param_names, self._keep, self.taylor)
+                              self.param_names, self._keep, self._taylor)
 
     def with_taylor(self, **entries):
         """A copy whose Taylor entries (see :func:`ode_system`) are updated (e.g. the
@@ -276,13 +353,18 @@ def ode_system(n: int, rhs, jac=None, params: Sequence[float] | dict = (),
     optionally ``var``/``nw_var`` (the same for the variational system [f; J Phi], state
     n + n**2), ``jet_fixed``/``order`` (a routine written out for one order),
     ``batch``/``width`` (members in the fastest dimension) and ``qp`` (quadruple
-    precision); :mod:`conmech.symbolic` generates them."""
+    precision); :mod:`conmech.symbolic` generates them. A :class:`LazyTaylor` instead of
+    the dict defers them to the first access of the system's ``taylor``."""
     n = _count(n, "n", 1)
     values, names = _params(params, param_names)
     spec = _make_spec(_KIND_ODE, n, 0, 0, False, {"rhs": rhs, "jac": jac,
                                                   "jac_prod": jac_prod})
     if spec[_SLOTS["rhs"] - 1] == 0:
         raise ValueError("rhs is required")
+    if isinstance(taylor, LazyTaylor):
+        # built at the first access of CompiledSystem.taylor (a Taylor call)
+        return CompiledSystem(str(name), "ode", spec, values, names,
+                              (keep, rhs, jac, jac_prod, taylor), taylor)
     spec = _taylor_spec(spec, taylor)
     return CompiledSystem(str(name), "ode", spec, values, names,
                           (keep, rhs, jac, jac_prod, taylor), dict(taylor) if taylor else None)

@@ -40,6 +40,11 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
         if not isinstance(system, NativeSystem):
             raise ValueError("method 'TAYLOR' needs a compiled system with Taylor code "
                              "(conmech.symbolic.ode_system), not a Python function")
+        # a system of conmech.symbolic compiles the recurrences of its variational
+        # system here, on first need (their entries then in its spec); without them
+        # Fortran refuses the method
+        if hasattr(system, "taylor_parts"):
+            system.taylor_parts("var")
         y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(
             *system._flat_args(), y0, t0, t1, rtol, atol)
     else:

@@ -40,6 +40,7 @@ from .printer import (_SQRT, FortranPrinter, _decl_temps, _names, _procedure,  #
 from .constrained_jac import constrained_derivatives
 from .library_info import _model_info
 from .tree_print import accel_procedure
+from .taylor import ode_taylor_lines
 from .source_text import (_c_names, check_source, comment_lines, comment_text,  # noqa: F401
                           private_procedures, string_constant)
 
@@ -60,6 +61,7 @@ CODEGEN_VERSION = "11"  # 2: conmech_* entry names, model-library description;
 #                         7: conmech_taylor* (Taylor coefficients, conmech.symbolic.taylor)
 #                         8: constrained: conmech_forces_jac, conmech_constraint_hessian
 #                         9: user strings escaped (comments, parameter names as data)
+#                        10: Taylor recurrences in a library of their own, on first need
 #                        11: Taylor: symmetric sums of squares, one weighted sum per power
 
 
@@ -119,12 +121,18 @@ def _constrained_derivative_procedures(printer, d, T, P, arr):
     return out
 
 
-def generate(d, module="conmech_symbolic_model", model_values=None):
+def generate(d, module="conmech_symbolic_model", model_values=None, taylor=False):
     """Fortran source of the bind(C) module for the derived system `d`; returns
     (source, list of the entry points present, e.g. ["mass", "forces", ...]).
     With `model_values` (the default parameter values), the module also describes itself
     as a model library (conmech_model_info, conmech_model_params,
-    conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`."""
+    conmech_model_param_names) for `sweep --model` and `conmech.compiled.load_model`.
+    With `taylor` an ode module also holds its Taylor recurrences (conmech_taylor* of
+    :mod:`conmech.symbolic.taylor`), as a model library written for other programs needs;
+    without, they are a library of their own compiled on first need
+    (:mod:`conmech.symbolic.taylor_library`): most calls never run Taylor's method, and
+    its recurrences (the system's and the variational system's, in double, batch and
+    quadruple precision) are most of the code to compile."""
     if not isinstance(module, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", module):
         raise ValueError(f"bad module name {module!r} (a Fortran name: a letter, then "
                          "letters, digits or underscores; at most 63 characters)")
@@ -153,13 +161,12 @@ def generate(d, module="conmech_symbolic_model", model_values=None):
                                 [("dfdy", d.jac, True)]))
         procs.append(_jac_prod_procedure(pr, d))
         entries = ["rhs", "jac", "jac_prod"]
-        # Taylor coefficients of the solution (conmech.symbolic.taylor), when f is smooth;
-        # imported here because taylor.py takes its printer helpers through this module
-        from .taylor import ode_taylor_lines
-        tl, te, _ = ode_taylor_lines(d, pr.names)
-        if tl:
-            procs.append(tl)
-            entries += te
+        if taylor:
+            # Taylor coefficients of the solution (conmech.symbolic.taylor), when f is smooth
+            tl, te, _ = ode_taylor_lines(d, pr.names)
+            if tl:
+                procs.append(tl)
+                entries += te
     else:
         Q1 = [T, arr("q", [n])]
         QV = Q1 + [arr("v", [n])]

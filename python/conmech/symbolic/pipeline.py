@@ -38,9 +38,13 @@ _V = ctypes.c_void_p
 class CompiledModel:
     """A derived system compiled and loaded: the library, the entry-point addresses, the
     generated source, and timings (``times``: derive, generate, compile_or_load, load;
-    ``cache_hit``). :meth:`call` evaluates an entry point through ctypes (for tests)."""
+    ``cache_hit``), the compiler ``flags`` (None: the defaults). An ode model's Taylor
+    recurrences are a library of their own, compiled on first need
+    (:mod:`conmech.symbolic.taylor_library`: ``taylor_path`` and ``taylor_cache_hit``
+    once built). :meth:`call` evaluates an entry point through ctypes (for tests)."""
 
-    def __init__(self, derived, source, path, lib, addresses, cache_hit, times):
+    def __init__(self, derived, source, path, lib, addresses, cache_hit, times, flags=None):
+        self.flags = list(flags) if flags is not None else None
         self.derived = derived
         self.source = source
         self.path = path
@@ -152,7 +156,7 @@ def compile_model(derived, flags=None):
     lib, addr = load(path, entries)
     t3 = time.perf_counter()
     times = {"generate": t1 - t0, "compile_or_load": t2 - t1, "load": t3 - t2}
-    return CompiledModel(derived, src, path, lib, addr, hit, times)
+    return CompiledModel(derived, src, path, lib, addr, hit, times, flags)
 
 
 def save_model(system, path, flags=None):
@@ -167,7 +171,8 @@ def save_model(system, path, flags=None):
     values = [float(v) for v in np.asarray(getattr(system, "params", None) if not
                                            isinstance(system, CompiledModel) else
                                            model.derived.param_values, dtype=float).ravel()]
-    src, entries = generate(model.derived, model_values=values)
+    # a model library for other programs is complete: its Taylor recurrences included
+    src, entries = generate(model.derived, model_values=values, taylor=True)
     lib_path, _ = compile_source(src, flags, entries + ["model_info", "model_params",
                                                        "model_param_names"])
     path = os.fspath(path)
@@ -221,8 +226,10 @@ def _system(model):
     common = dict(params=tuple(d.param_values), param_names=tuple(d.param_names), keep=model,
                   name="symbolic")
     if d.kind == "ode":
+        # the Taylor recurrences are compiled when a call first needs them
+        from .taylor_library import lazy_taylor
         return compiled.ode_system(d.n, a["rhs"], jac=a["jac"], jac_prod=a.get("jac_prod"),
-                                   taylor=compiled.library_taylor(model.lib), **common)
+                                   taylor=lazy_taylor(model), **common)
     if d.kind == "generalized":
         return as_lagrangian_system(compiled.generalized_system(
             d.n, a["mass"], a["forces"], forces_jac=a.get("forces_jac"),
@@ -294,7 +301,9 @@ def _from_cache(key, params, flags):
     t3 = time.perf_counter()
     times = {"derive": 0.0, "derived_cache": t1 - t0, "generate": 0.0,
              "compile_or_load": t2 - t1, "load": t3 - t2}
-    return CompiledModel(d, src, lib_path, lib, addr, hit, times)
+    model = CompiledModel(d, src, lib_path, lib, addr, hit, times, flags)
+    model.cache_key = key
+    return model
 
 
 def _store(key, model, flags):
@@ -350,6 +359,8 @@ def _construct(kind, inputs, params, options, derive, flags, model_only, descrip
             _check_compiled_mass(model)
         if key:
             _store(key, model, flags)
+    # the derivation cache's key, under which the Taylor library's source is kept too
+    model.cache_key = key
     if description and key:
         from .description import store_description
         store_description(description, key, params)

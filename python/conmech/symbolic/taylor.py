@@ -46,7 +46,8 @@ expanded (non-smooth functions: Abs, sign, Heaviside, Min, Max, ...).
 """
 import sympy as sp
 
-from .codegen import FortranPrinter
+from .printer import FortranPrinter, _names
+from .printer import _wrap as _wrap_line
 
 __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
            "variational_exprs", "TAYLOR_VERSION"]
@@ -467,7 +468,7 @@ class _Printer:
 
 
 def _wrap(line, ind):
-    from .codegen import _wrap as w
+    w = _wrap_line
     return w(line, ind)
 
 
@@ -897,7 +898,6 @@ def fixed_order_source(d, order, variational=True):
     `variational`): no loops, so the compiler schedules every multiply-add of the expansion
     at once. Same signature and work columns as ``conmech_taylor`` (called with order =
     `order` only)."""
-    from .codegen import _names
     dec, vdec, why = ode_decompositions(d, variational)
     if dec is None:
         raise TaylorUnsupported(why)
@@ -923,7 +923,6 @@ def event_source(d, exprs):
     n + m) the m events' series; order 0 evaluates g) and ``conmech_taylor_events_info``
     ([work columns, m, n]). The expressions are in the record's symbols (see
     :func:`event_exprs`)."""
-    from .codegen import _names
     dec = decompose(list(exprs), d.coords, d.t, d.params, given=True)
     lines = c_routine(dec, _names(d), "conmech_taylor_events", given=True)
     ind = "        "

@@ -72,7 +72,9 @@ def reference(system, t_span, y0, tol=1e-30, params=None, max_steps=1_000_000):
     t_span[1] by Taylor's method in quadruple precision (order ceil(-ln(tol)/2 + 1), 36 at
     the default 1e-30). y0, the times, tol and the parameters (``params``: {name: value},
     overriding the system's) may be given as decimal strings for full precision."""
-    taylor = getattr(system, "taylor", None)
+    # the quadruple-precision routine of a lazy system is compiled here, on first need
+    taylor = system.taylor_parts("qp") if hasattr(system, "taylor_parts") else \
+        getattr(system, "taylor", None)
     if not taylor or taylor.get("qp") is None:
         raise ValueError("the system has no quadruple-precision Taylor code (a system from "
                          "conmech.symbolic.ode_system with a smooth right-hand side)")
