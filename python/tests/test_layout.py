@@ -154,7 +154,7 @@ def test_no_import_circle_through_imports_inside_functions():
 def test_no_file_over_650_lines():
     """One concept per file: no module of the package, and no Fortran source of the library
     or the flat layer, over 650 lines; the two modules listed may only shrink."""
-    shrinking = {"conmech/symbolic/taylor.py": 936, "conmech/ivp/solve.py": 771}
+    shrinking = {"conmech/symbolic/taylor.py": 655, "conmech/ivp/solve.py": 753}
     long = []
     files = list(PACKAGE.rglob("*.py"))
     files += list((ROOT / "src").rglob("*.f90")) + list((ROOT / "python" / "conmech" / "flat")

@@ -115,13 +115,15 @@ def test_loop_written_out_and_batch_agree_bit_for_bit(systems, name, tol):
     w[:2, 0] = y0
     _call(tay["jet_fixed"], 0.0, order, w, _params(system))
     assert np.all(np.isfinite(loop)) and np.array_equal(w[:2], loop)
-    # the batch routine: members in the fastest dimension, w(width, 0:order, nw)
-    width = system.taylor["width"]
-    wb = np.zeros((system.taylor["nw"], order + 1, width))
+    # the batch routine (compiled on first need): members in the fastest dimension,
+    # w(width, 0:order, nw)
+    batch = system.taylor_parts("batch")
+    width = batch["width"]
+    wb = np.zeros((batch["nw"], order + 1, width))
     wb[:2, 0, :] = np.array(y0)[:, None]
     tb = np.zeros(width)
     fnb = ctypes.CFUNCTYPE(None, _P, ctypes.c_int, _P, _P)(
-        conmech.compiled.function_address(system.taylor["batch"]))
+        conmech.compiled.function_address(batch["batch"]))
     fnb(tb.ctypes.data_as(_P), order, wb.ctypes.data_as(_P),
         _params(system).ctypes.data_as(_P))
     for m in range(width):
