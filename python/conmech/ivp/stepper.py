@@ -112,6 +112,13 @@ class Stepper:
             if entry is None or entry.constrained_only:
                 raise ValueError(f"method must be a method of the table, one of "
                                  f"{', '.join(sorted(BY_NAME))}, got {name!r}")
+            if entry.name.upper() == "TAYLOR":
+                # the Taylor stepper's state (its jet, its order) is not packed for
+                # step-by-step use from Python: solve_ivp, ensemble.solve and stability.stm
+                # run it, and the Fortran ode_stepper steps it
+                raise ValueError("method TAYLOR is not available step by step from Python: "
+                                 "use conmech.solve_ivp(..., method='TAYLOR') (dense output "
+                                 "and events included), ensemble.solve or stability.stm")
             code = entry.code
         self._code = code
         info = method_info(code)
