@@ -90,6 +90,13 @@ program test_radau_sparse
                   "sparse stepper packed and unpacked at every step: the steps and "// &
                   "counters of ode_solve")
     call ts%finish()
+    ! main-program allocatables are not freed at exit (the leak check would report them)
+    if (allocated(st)) deallocate (st)
+    if (allocated(ptr)) deallocate (ptr)
+    if (allocated(idx)) deallocate (idx)
+    if (allocated(y0)) deallocate (y0)
+    if (allocated(msg)) deallocate (msg)
+    if (allocated(what)) deallocate (what)
 
 contains
 

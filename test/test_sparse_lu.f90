@@ -116,6 +116,23 @@ program test_sparse_lu
     call ts%check(info == 0 .and. 4*lu%factor_nnz() > 5*nnz_rcm, "shuffled tridiagonal without the "// &
                   "order fills in (L and U over 1.25 times the band)")
     call ts%finish()
+    ! main-program allocatables are not freed at exit (the leak check would report them)
+    if (allocated(ap)) deallocate (ap)
+    if (allocated(ai)) deallocate (ai)
+    if (allocated(q)) deallocate (q)
+    if (allocated(perm)) deallocate (perm)
+    if (allocated(zp)) deallocate (zp)
+    if (allocated(zi)) deallocate (zi)
+    if (allocated(ax)) deallocate (ax)
+    if (allocated(a)) deallocate (a)
+    if (allocated(b)) deallocate (b)
+    if (allocated(x)) deallocate (x)
+    if (allocated(u)) deallocate (u)
+    if (allocated(r1)) deallocate (r1)
+    if (allocated(zx)) deallocate (zx)
+    if (allocated(za)) deallocate (za)
+    if (allocated(zb)) deallocate (zb)
+    if (allocated(zs)) deallocate (zs)
 
 contains
 
