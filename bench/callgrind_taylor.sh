@@ -6,7 +6,9 @@
 # flags of the Python package's release build and of the libraries conmech.symbolic compiles
 # (override with FFLAGS; valgrind cannot decode AVX-512, so not -march=native on such a CPU).
 # "fixed": the recurrences written out for the order (generated here with the installed
-# conmech package: PYTHON, default python3, e.g. .venv/bin/python).
+# conmech package: PYTHON, default python3, e.g. .venv/bin/python), compiled with the flags
+# solve_ivp adds for it (-fopenmp-simd: its paired history sums); PAIRED=0: the history
+# sums unpaired (the same coefficients, one at a time), for comparison.
 # Usage (from the repository root, with fpm and valgrind on PATH): bash bench/callgrind_taylor.sh [TOL]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,12 +30,13 @@ from conmech.symbolic.taylor import fixed_order_source
 x, y, u, v = sp.symbols("x y u v")
 r3 = (x**2 + y**2)**sp.Rational(3, 2)
 kep = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+import os
 print(fixed_order_source(model_of(kep).derived, taylor_order(float(sys.argv[1])),
-                         variational=False))
+                         variational=False, paired=os.environ.get("PAIRED", "1") == "1"))
 PYEOF
 order=$("$PY" -c "from conmech.ivp.taylor import taylor_order; print(taylor_order($TOL))")
 sed "s/FIXED_ORDER_VALUE/$order/" bench/taylor_callgrind/kepler_fixed_jet.f90 >"$tmp/kepler_fixed_jet.f90"
-gfortran $FF -I"$tmp/cm/include" -J "$tmp" test/taylor_kepler_model.f90 "$tmp/fixed_source.f90" \
+gfortran $FF -fopenmp-simd -I"$tmp/cm/include" -J "$tmp" test/taylor_kepler_model.f90 "$tmp/fixed_source.f90" \
     "$tmp/kepler_fixed_jet.f90" bench/taylor_callgrind/bench_taylor.f90 -L"$libdir" -lconmech \
     -llapack -lblas -o "$tmp/bench_taylor"
 ir() { valgrind --tool=callgrind --callgrind-out-file="$tmp/o.$1.$2.$3" "$tmp/bench_taylor" \

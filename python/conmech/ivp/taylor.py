@@ -82,7 +82,8 @@ def _fixed_system(fun, model, order):
 def _fixed_library(d, order):
     import ctypes
     from ..symbolic import build    # sympy: see with_fixed_order
-    from ..symbolic.taylor import TaylorUnsupported, ode_decompositions, fixed_order_source
+    from ..symbolic.taylor import (FIXED_EXTRA_FLAGS, TaylorUnsupported, fixed_order_source,
+                                   ode_decompositions)
     dec, _, _ = ode_decompositions(d, variational=False)
     if dec is None:
         return None
@@ -90,7 +91,8 @@ def _fixed_library(d, order):
     if nhist*order*(order - 1)//2 > FIXED_MAX_TERMS:
         return None
     try:
-        path, _ = build.compile_source(fixed_order_source(d, order, variational=False))
+        path, _ = build.compile_source(fixed_order_source(d, order, variational=False),
+                                       flags=build.FFLAGS + FIXED_EXTRA_FLAGS)
     except (TaylorUnsupported, build.CompileError):
         return None         # the loop version runs (same coefficients, a little slower)
     return ctypes.CDLL(path)

@@ -56,6 +56,11 @@ __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures
 
 TAYLOR_VERSION = "2"
 
+#: flags added to the model libraries' for the written-out routine: its paired history sums
+#: are loops over two lanes marked ``!$omp simd`` (gfortran's SLP vectorizer leaves them
+#: scalar otherwise); -fopenmp-simd honours the directive alone (no OpenMP run time)
+FIXED_EXTRA_FLAGS = ["-fopenmp-simd"]
+
 
 # ---------------------------------------------------------------------- Fortran printing
 
@@ -92,9 +97,13 @@ class _Printer:
         self.const_names = {s: f"tc{k + 1}" for k, (s, _) in enumerate(dec.consts)}
         self.pr.names.update(self.const_names)
         self.scalars = None      # written-out code: the coefficients as scalars s<c>_<k>
+        self.lanes = {}          # ... or in a lane of a pair array: column -> (group, lane)
 
     def w(self, k, c):
         if self.scalars is not None and isinstance(k, int):
+            if c in self.lanes:
+                g, lane = self.lanes[c]
+                return f"g{g + 1}({lane + 1}, {k})"
             name = f"s{c}_{k}"
             self.scalars.add(name)
             return name
@@ -320,6 +329,97 @@ def _history_sum(pp, k, lft, rgt, wt):
     return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)], zero)
 
 
+def _pair_history(hist, dec):
+    """Pairs of history sums of the same form, computed together as the two lanes of one
+    2-wide vector (the written-out code): ([(i, j)] indices into `hist`, {column: (group,
+    lane)}). Two sums pair when their weights agree and each operand position holds either
+    one column in both (a broadcast scalar) or the two columns of a lane group in lane
+    order, groups being made on the way. As a compiler's SLP vectorizer does, pairs of
+    operations whose operands are made alike (the same kinds of operations down to a depth)
+    are taken first, deeper likeness first, then any that fit, each tier greedy in the
+    recipe's order: Kepler's x^2, y^2 make the group (x, y), and x P, y P pair with P
+    broadcast; Arenstorf's two distances pair with each other, not with y^2. Each lane
+    gets the scalar sum's operations in the same order, so the coefficients keep their
+    bits."""
+    made = {}
+    for op in dec.ops:
+        for c in op.out:
+            made[c] = op
+    jbase = {jc: c for c, jc in dec.jcol.items()}
+
+    def sig(c, d):
+        if c in jbase:
+            return ("j", sig(jbase[c], d))
+        op = made.get(c)
+        if op is None:
+            return ("x",)
+        if d == 0:
+            return (op.kind,)
+        return (op.kind, op.out.index(c)) + tuple(sig(a, d - 1) for a in op.args
+                                                  if a is not None)
+    lanes, pairs, used = {}, [], set()
+    ngroups = 0
+
+    def fits(ops):
+        trial, ng = dict(lanes), ngroups
+        for a, b in ops:
+            if a == b:
+                continue
+            la, lb = trial.get(a), trial.get(b)
+            if la is None and lb is None:
+                trial[a], trial[b] = (ng, 0), (ng, 1)
+                ng += 1
+            elif not (la is not None and lb is not None and la[0] == lb[0] and
+                      la[1] == 0 and lb[1] == 1):
+                return None
+        return trial, ng
+    for depth in (4, 2, 1, 0, None):
+        for i, (_, l1, r1, w1) in enumerate(hist):
+            if i in used:
+                continue
+            for j in range(i + 1, len(hist)):
+                _, l2, r2, w2 = hist[j]
+                if j in used or not (w1 is w2 or (w1 is not _SYM and w2 is not _SYM and
+                                                  w1 == w2)):
+                    continue
+                ops = [(l1, l2)] if w1 is _SYM else [(l1, l2), (r1, r2)]
+                if all(a == b for a, b in ops):
+                    continue         # the same sum twice (never made by the decomposition)
+                if depth is not None and any(a != b and sig(a, depth) != sig(b, depth)
+                                             for a, b in ops):
+                    continue
+                got = fits(ops)
+                if got is not None:
+                    lanes, ngroups = got
+                    pairs.append((i, j))
+                    used |= {i, j}
+                    break
+    return pairs, lanes
+
+
+def _history_sum_pair(pp, k, first, second):
+    """The history sums of order k of a pair (see _pair_history) as the expression of lane
+    ``ln``: lane by lane the operations of _history_sum, in its order."""
+    _, lft, rgt, wt = first
+    _, lft2, rgt2, _ = second
+
+    def V(kk, a, b):
+        if a == b:
+            return pp.w(kk, a)
+        return f"g{pp.lanes[a][0] + 1}(ln, {kk})"
+    zero = f"0.0_{pp.kind}"
+    if wt is _SYM:
+        terms = [f"{V(j, lft, lft2)}*{V(k - j, lft, lft2)}" for j in range(1, (k - 1)//2 + 1)]
+        out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
+        if k % 2 == 0:
+            mid = f"{V(k//2, lft, lft2)}*{V(k//2, lft, lft2)}"
+            out = f"{out} + {mid}" if out else mid
+        return out or zero
+    weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
+    return _sum_seq([f"{weight(j)}{V(j, lft, lft2)}*{V(k - j, rgt, rgt2)}"
+                     for j in range(1, k)], zero)
+
+
 def _decls(names, typ, ind):
     out = []
     for i in range(0, len(names), 10):
@@ -327,7 +427,8 @@ def _decls(names, typ, ind):
     return out
 
 
-def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixed=None):
+def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixed=None,
+               paired=True):
     """(declarations, statements) computing the coefficients in w (see the module
     docstring), for a procedure that declares t, order, w and the names the printer maps
     the parameters to. kind "dp" or "qp"; batch > 0: w(batch, 0:order, nw), t(batch);
@@ -335,11 +436,18 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     up to `order` (the outputs as columns ``dec.out_cols``), else the ODE recursion.
     fixed: an order p to write out (no loops, literal indices and constants, the values in
     scalars, the history sums in the loop's order); the procedure must then be called with
-    order = p."""
+    order = p. paired (with fixed, for an ODE): history sums of the same form computed
+    two at a time as 2-wide vectors (see _pair_history; the same bits)."""
     pp = _Printer(dec, names, batch > 0, kind)
     if fixed is not None:
         pp.scalars = set()
     rc = _Recipe(pp, given, "order" if fixed is None else fixed)
+    pairs = []
+    if fixed is not None and paired and not batch and not given:
+        pairs, pp.lanes = _pair_history(rc.hist, dec)
+        if pairs:             # the statements again, with the paired columns in lanes
+            pp.scalars = set()
+            rc = _Recipe(pp, given, fixed)
     W = pp.w
     vec = f"({batch})" if batch else ""
     one = pp.real(1)
@@ -412,8 +520,20 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     body = body[:1] + state_in + body[1:]
     for k in range(1, last + 1):
         E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
-        for h, lft, rgt, wt in rc.hist:
-            body += _wrap(f"{h} = {_history_sum(pp, k, lft, rgt, wt)}", ind)
+        if pairs:      # one loop over the two lanes (gfortran vectorizes it as told)
+            body += [f"{ind}!$omp simd", f"{ind}do ln = 1, 2"]
+            for m, (i, j) in enumerate(pairs):
+                body += _wrap(f"hv{m + 1}(ln) = "
+                              f"{_history_sum_pair(pp, k, rc.hist[i], rc.hist[j])}",
+                              ind + "    ")
+            body.append(f"{ind}end do")
+        for m, (i, j) in enumerate(pairs):
+            body += [f"{ind}{rc.hist[i][0]} = hv{m + 1}(1)",
+                     f"{ind}{rc.hist[j][0]} = hv{m + 1}(2)"]
+        in_pair = {i for pr in pairs for i in pr}
+        for i, (h, lft, rgt, wt) in enumerate(rc.hist):
+            if i not in in_pair:
+                body += _wrap(f"{h} = {_history_sum(pp, k, lft, rgt, wt)}", ind)
         for f in rc.cur:
             body += _wrap(f(E), ind)
         if not given:
@@ -427,12 +547,19 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
              for k in range(0 if given else 1, fixed + 1)]
     names_s = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
     decl += _decls(names_s, f"real({kind})", ind)
+    decl += _decls([f"g{g + 1}(2, 0:{fixed})" for g in
+                    range(max((v[0] for v in pp.lanes.values()), default=-1) + 1)],
+                   f"real({kind})", ind)
+    decl += _decls([f"hv{m + 1}(2)" for m in range(len(pairs))], f"real({kind})", ind)
+    if pairs:
+        decl.append(f"{ind}integer :: ln")
     return decl, body
 
 
-def c_routine(dec, names, cname, batch=0, given=False, fixed=None):
+def c_routine(dec, names, cname, batch=0, given=False, fixed=None, paired=True):
     """The bind(C) routine ``cname(t, order, w, p)`` (double precision; batch > 0: t and w
-    with a leading member dimension; fixed: written out for that order only)."""
+    with a leading member dimension; fixed: written out for that order only, paired: see
+    body_lines)."""
     ind = "        "
     nw = dec.ncol
     npar = max(len(dec.params), 1)
@@ -443,7 +570,7 @@ def c_routine(dec, names, cname, batch=0, given=False, fixed=None):
             f"{ind}real(dp), intent(inout) :: w({f'{batch}, ' if batch else ''}"
             f"0:order, {nw})",
             f"{ind}real(dp), intent(in) :: p({npar})"]
-    decl, body = body_lines(dec, names, "dp", batch, given, ind, fixed)
+    decl, body = body_lines(dec, names, "dp", batch, given, ind, fixed, paired)
     return head + decl + body + [f"    end subroutine {cname}", ""]
 
 
@@ -569,19 +696,20 @@ def emitted_taylor(tname, d, names):
     return binds, procs, None
 
 
-def fixed_order_source(d, order, variational=True):
+def fixed_order_source(d, order, variational=True, paired=True):
     """Fortran source of a module with the Taylor routines of the ode record `d` written out
     for one order (``conmech_taylor_fixed``, and ``conmech_taylor_var_fixed`` with
     `variational`): no loops, so the compiler schedules every multiply-add of the expansion
-    at once. Same signature and work columns as ``conmech_taylor`` (called with order =
-    `order` only)."""
+    at once; `paired`: history sums of the same form two at a time in 2-wide vectors. Same
+    signature and work columns as ``conmech_taylor`` (called with order = `order` only)."""
     dec, vdec, why = ode_decompositions(d, variational)
     if dec is None:
         raise TaylorUnsupported(why)
     names = _names(d)
-    lines = c_routine(dec, names, "conmech_taylor_fixed", fixed=order)
+    lines = c_routine(dec, names, "conmech_taylor_fixed", fixed=order, paired=paired)
     if vdec is not None:
-        lines += c_routine(vdec, names, "conmech_taylor_var_fixed", fixed=order)
+        lines += c_routine(vdec, names, "conmech_taylor_var_fixed", fixed=order,
+                           paired=paired)
     head = ["!> Generated by conmech.symbolic.taylor: Taylor coefficients written out for "
             f"order {order}. Do not edit.",
             "module conmech_symbolic_taylor_fixed",
