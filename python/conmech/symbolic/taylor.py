@@ -373,26 +373,32 @@ def _pair_history(hist, dec):
                       la[1] == 0 and lb[1] == 1):
                 return None
         return trial, ng
+    def attempt(i, j, depth):
+        """Sum i in lane 1 and sum j in lane 2, if they fit (then recorded)."""
+        nonlocal lanes, ngroups
+        _, l1, r1, w1 = hist[i]
+        _, l2, r2, w2 = hist[j]
+        if not (w1 is w2 or (w1 is not _SYM and w2 is not _SYM and w1 == w2)):
+            return False
+        ops = [(l1, l2)] if w1 is _SYM else [(l1, l2), (r1, r2)]
+        if all(a == b for a, b in ops):
+            return False             # the same sum twice (never made by the decomposition)
+        if depth is not None and any(a != b and sig(a, depth) != sig(b, depth)
+                                     for a, b in ops):
+            return False
+        got = fits(ops)
+        if got is None:
+            return False
+        lanes, ngroups = got
+        pairs.append((i, j))
+        used.update((i, j))
+        return True
     for depth in (4, 2, 1, 0, None):
-        for i, (_, l1, r1, w1) in enumerate(hist):
-            if i in used:
-                continue
+        for i in range(len(hist)):
             for j in range(i + 1, len(hist)):
-                _, l2, r2, w2 = hist[j]
-                if j in used or not (w1 is w2 or (w1 is not _SYM and w2 is not _SYM and
-                                                  w1 == w2)):
-                    continue
-                ops = [(l1, l2)] if w1 is _SYM else [(l1, l2), (r1, r2)]
-                if all(a == b for a, b in ops):
-                    continue         # the same sum twice (never made by the decomposition)
-                if depth is not None and any(a != b and sig(a, depth) != sig(b, depth)
-                                             for a, b in ops):
-                    continue
-                got = fits(ops)
-                if got is not None:
-                    lanes, ngroups = got
-                    pairs.append((i, j))
-                    used |= {i, j}
+                if i in used:
+                    break
+                if j not in used and (attempt(i, j, depth) or attempt(j, i, depth)):
                     break
     return pairs, lanes
 
@@ -420,10 +426,10 @@ def _history_sum_pair(pp, k, first, second):
                      for j in range(1, k)], zero)
 
 
-def _decls(names, typ, ind):
+def _decls(names, typ, ind, per_line=10):
     out = []
-    for i in range(0, len(names), 10):
-        out.append(f"{ind}{typ} :: " + ", ".join(names[i:i + 10]))
+    for i in range(0, len(names), per_line):
+        out.append(f"{ind}{typ} :: " + ", ".join(names[i:i + per_line]))
     return out
 
 
@@ -549,7 +555,7 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     decl += _decls(names_s, f"real({kind})", ind)
     decl += _decls([f"g{g + 1}(2, 0:{fixed})" for g in
                     range(max((v[0] for v in pp.lanes.values()), default=-1) + 1)],
-                   f"real({kind})", ind)
+                   f"real({kind})", ind, 5)
     decl += _decls([f"hv{m + 1}(2)" for m in range(len(pairs))], f"real({kind})", ind)
     if pairs:
         decl.append(f"{ind}integer :: ln")
