@@ -220,7 +220,12 @@ def breakdown(rounds, path):
           "flat call TAYLOR (loops)": flat("TAYLOR", kep),
           "flat call DOP853": flat("DOP853", kep),
           "solve_ivp DOP853, span 1e-9 (per-call cost)": ivp("DOP853", 1e-9),
-          "flat call DOP853, span 1e-9": flat("DOP853", kep, 1e-9)}
+          "solve_ivp TAYLOR, span 1e-9 (per-call cost)": ivp("TAYLOR", 1e-9),
+          "solve_ivp DOP853, span 0": ivp("DOP853", 0.0),
+          "solve_ivp TAYLOR, span 0": ivp("TAYLOR", 0.0),
+          "flat call DOP853, span 1e-9": flat("DOP853", kep, 1e-9),
+          "flat call TAYLOR (written out), span 1e-9": flat(
+              "TAYLOR", with_fixed_order(kep, 1e-12, 1e-12), 1e-9)}
     if hy is not None:
         run = heyoka_runner(pr, 1e-12)
         fs["heyoka propagate_until"] = run

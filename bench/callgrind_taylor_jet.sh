@@ -12,7 +12,7 @@ ORDER="${1:-15}"
 FF="${FFLAGS:--O3 -fPIC -fopenmp-simd}"
 PY="${PYTHON:-python3}"
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+[ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "$tmp" >&2
 "$PY" - "$ORDER" "$tmp" <<'PYEOF'
 import sys, sympy as sp
 from conmech import symbolic
