@@ -179,6 +179,8 @@ class _Recipe:
         one = pp.real(1)
         self.consts = [(pp.const_names[s], pp.pr._print(e)) for s, e in d.consts]
         s0, hist, cur, accs, invs = [], [], [], [], []
+        # products and squares: accumulator -> (kind, out, a, b); out -> its index in cur
+        self.acc_op, self.cur_at = {}, {}
 
         def JC(c):
             return d.jcol[c]
@@ -226,6 +228,8 @@ class _Recipe:
                 h = acc()
                 s0.append(f"{W(0, o)} = {W(0, a)}*{W(0, b)}")
                 hist.append((h, a, b, None))
+                self.acc_op[h] = ("mul", o, a, b)
+                self.cur_at[o] = len(cur)
                 cur.append(lambda E, o=o, a=a, b=b, h=h: f"{W(E['k'], o)} = {h} + "
                            f"{W(0, a)}*{W(E['k'], b)} + {W(E['k'], a)}*{W(0, b)}")
             elif kind == "sq":
@@ -233,6 +237,8 @@ class _Recipe:
                 s0.append(f"{W(0, o)} = {W(0, a)}**2")
                 hist.append((h, a, a, _SYM))
                 two = pp.real(2)
+                self.acc_op[h] = ("sq", o, a, a)
+                self.cur_at[o] = len(cur)
                 cur.append(lambda E, o=o, a=a, h=h, two=two: f"{W(E['k'], o)} = {h} + "
                            f"{two}*{W(0, a)}*{W(E['k'], a)}")
             elif kind in ("div", "recip"):
@@ -403,6 +409,58 @@ def _pair_history(hist, dec):
     return pairs, lanes
 
 
+def _pair_outputs(rc, pairs, lanes):
+    """The pairs (index m in `pairs`, i, j) of products or squares whose outputs can share a
+    lane group too (made here in `lanes` if neither has one), so that their current-order
+    statements run as one 2-lane statement (see _current_statements)."""
+    out = []
+    ng = max((v[0] for v in lanes.values()), default=-1) + 1
+    for m, (i, j) in enumerate(pairs):
+        op1, op2 = rc.acc_op.get(rc.hist[i][0]), rc.acc_op.get(rc.hist[j][0])
+        if op1 is None or op2 is None or op1[0] != op2[0]:
+            continue
+        o1, o2 = op1[1], op2[1]
+        l1, l2 = lanes.get(o1), lanes.get(o2)
+        if l1 is None and l2 is None:
+            lanes[o1], lanes[o2] = (ng, 0), (ng, 1)
+            ng += 1
+        elif not (l1 is not None and l2 is not None and l1[0] == l2[0] and l1[1] == 0 and
+                  l2[1] == 1):
+            continue
+        out.append((m, i, j))
+    return out
+
+
+def _current_statements(pp, rc, k, stmts, vcur):
+    """The current-order statements of order k, those of each pair in `vcur` as one 2-lane
+    statement (a tuple: the text of lane ``ln``), placed where the later of the two was,
+    unless a statement between them reads the earlier one's coefficient (then both stay
+    scalar). Lane by lane the scalar statement's operations in its order: the same bits."""
+    import re
+    stmts = list(stmts)
+    W = pp.w
+    for m, i, j in vcur:
+        kind, o1, a1, b1 = rc.acc_op[rc.hist[i][0]]
+        _, o2, a2, b2 = rc.acc_op[rc.hist[j][0]]
+        p1, p2 = rc.cur_at[o1], rc.cur_at[o2]
+        lo, hi = min(p1, p2), max(p1, p2)
+        tok = re.compile(r"(?<!\w)" + re.escape(W(k, o1 if p1 < p2 else o2)) + r"(?!\w)")
+        if any(isinstance(stmts[q], str) and tok.search(stmts[q].split("=", 1)[1])
+               for q in range(lo + 1, hi)):
+            continue
+
+        def V(kk, a, b):
+            return W(kk, a) if a == b else f"g{pp.lanes[a][0] + 1}(ln, {kk})"
+        lhs = f"g{pp.lanes[o1][0] + 1}(ln, {k}) = hv{m + 1}(ln) + "
+        if kind == "mul":
+            rhs = f"{V(0, a1, a2)}*{V(k, b1, b2)} + {V(k, a1, a2)}*{V(0, b1, b2)}"
+        else:
+            rhs = f"{pp.real(2)}*{V(0, a1, a2)}*{V(k, a1, a2)}"
+        stmts[lo] = None
+        stmts[hi] = (lhs + rhs,)
+    return [x for x in stmts if x is not None]
+
+
 def _history_sum_pair(pp, k, first, second):
     """The history sums of order k of a pair (see _pair_history) as the expression of lane
     ``ln``: lane by lane the operations of _history_sum, in its order."""
@@ -448,10 +506,11 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     if fixed is not None:
         pp.scalars = set()
     rc = _Recipe(pp, given, "order" if fixed is None else fixed)
-    pairs = []
+    pairs, vcur = [], []
     if fixed is not None and paired and not batch and not given:
         pairs, pp.lanes = _pair_history(rc.hist, dec)
         if pairs:             # the statements again, with the paired columns in lanes
+            vcur = _pair_outputs(rc, pairs, pp.lanes)
             pp.scalars = set()
             rc = _Recipe(pp, given, fixed)
     W = pp.w
@@ -540,8 +599,13 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
         for i, (h, lft, rgt, wt) in enumerate(rc.hist):
             if i not in in_pair:
                 body += _wrap(f"{h} = {_history_sum(pp, k, lft, rgt, wt)}", ind)
-        for f in rc.cur:
-            body += _wrap(f(E), ind)
+        for x in _current_statements(pp, rc, k, [f(E) for f in rc.cur], vcur):
+            if isinstance(x, tuple):
+                body += [f"{ind}!$omp simd", f"{ind}do ln = 1, 2"]
+                body += _wrap(x[0], ind + "    ")
+                body.append(f"{ind}end do")
+            else:
+                body += _wrap(x, ind)
         if not given:
             for i, o in enumerate(dec.outputs):
                 body += _wrap(f"{W(k + 1, i + 1)} = ({one}/{pp.real(k + 1)})*("
