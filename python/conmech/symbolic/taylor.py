@@ -431,6 +431,53 @@ def _pair_outputs(rc, pairs, lanes):
     return out
 
 
+def _pair_derivatives(dec, lanes):
+    """Pairs (i, j) of state components whose derivatives are one scaled column each with
+    the same factor, y_i' = c u, y_j' = c v, where (u, v) and (y_i, y_j) are lane groups in
+    lane order (made here when neither column has one): y^[k+1] of both in one 2-lane
+    statement. Repeated until nothing changes (Kepler: x' = u, y' = v make the group
+    (u, v); then u' = -m_x, v' = -m_y pair)."""
+    def single(o):
+        if o.c0 != 0 or len(o.terms) != 1:
+            return None
+        (c, v), = o.terms.items()
+        return c, sp.sympify(v)
+
+    def place(a, b, ng):
+        la, lb = lanes.get(a), lanes.get(b)
+        if la is None and lb is None:
+            lanes[a], lanes[b] = (ng, 0), (ng, 1)
+            return ng + 1
+        if la is not None and lb is not None and la[0] == lb[0] and la[1] == 0 and \
+                lb[1] == 1:
+            return ng
+        return None
+    out, used = [], set()
+    changed = True
+    while changed:
+        changed = False
+        for i in range(dec.n):
+            for j in range(dec.n):
+                if i == j or i in used or j in used:
+                    continue
+                si, sj = single(dec.outputs[i]), single(dec.outputs[j])
+                if si is None or sj is None or si[1] != sj[1]:
+                    continue
+                ng = max((v[0] for v in lanes.values()), default=-1) + 1
+                saved = dict(lanes)
+                for a, b in ((i + 1, j + 1), (si[0], sj[0])):
+                    if a != b and ng is not None:
+                        ng = place(a, b, ng)
+                if ng is None:
+                    lanes.clear()
+                    lanes.update(saved)
+                    continue
+                out.append((i, j))
+                used.update((i, j))
+                changed = True
+    return out
+
+
 def _current_statements(pp, rc, k, stmts, vcur):
     """The current-order statements of order k, those of each pair in `vcur` as one 2-lane
     statement (a tuple: the text of lane ``ln``), placed where the later of the two was,
@@ -506,11 +553,12 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
     if fixed is not None:
         pp.scalars = set()
     rc = _Recipe(pp, given, "order" if fixed is None else fixed)
-    pairs, vcur = [], []
+    pairs, vcur, opairs = [], [], []
     if fixed is not None and paired and not batch and not given:
         pairs, pp.lanes = _pair_history(rc.hist, dec)
         if pairs:             # the statements again, with the paired columns in lanes
             vcur = _pair_outputs(rc, pairs, pp.lanes)
+            opairs = _pair_derivatives(dec, pp.lanes)
             pp.scalars = set()
             rc = _Recipe(pp, given, fixed)
     W = pp.w
@@ -607,7 +655,23 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
             else:
                 body += _wrap(x, ind)
         if not given:
+            second = {i2 for _, i2 in opairs}
+            first = dict(opairs)
             for i, o in enumerate(dec.outputs):
+                if i in second:
+                    continue
+                if i in first:         # two outputs of one form: one 2-lane statement
+                    i2 = first[i]
+                    (a, v), = o.terms.items()
+                    (b, _), = dec.outputs[i2].terms.items()
+                    col = W(k, a) if a == b else f"g{pp.lanes[a][0] + 1}(ln, {k})"
+                    v = sp.sympify(v)
+                    term = col if v == 1 else f"-{col}" if v == -1 else f"{pp.num(v)}*{col}"
+                    body += [f"{ind}!$omp simd", f"{ind}do ln = 1, 2"]
+                    body += _wrap(f"g{pp.lanes[i + 1][0] + 1}(ln, {k + 1}) = "
+                                  f"({one}/{pp.real(k + 1)})*({term})", ind + "    ")
+                    body.append(f"{ind}end do")
+                    continue
                 body += _wrap(f"{W(k + 1, i + 1)} = ({one}/{pp.real(k + 1)})*("
                               f"{pp.lin_at(o, k, False)})", ind)
             body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
