@@ -21,6 +21,7 @@ from .implicit import jacobian_callback, is_sparse, sparsity_pattern
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
+from .._core.model import model_of
 from .._core.native import _NO_SPEC, NativeSystem
 from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
 from .result import _MESSAGES, OdeResult
@@ -351,9 +352,8 @@ def _refuse_taylor(fun):
     """ValueError naming why a compiled system has no Taylor recurrences, when the model
     says so (a generalized system M(q) q'' = Q); other systems are refused by the Fortran
     stepper with its own message."""
-    from ..symbolic import model_of
     try:
-        kind = getattr(model_of(fun).derived, "kind", None)
+        kind = model_of(fun).kind
     except TypeError:
         return
     if kind == "generalized":

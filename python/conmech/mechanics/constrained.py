@@ -28,6 +28,7 @@ from . import degrees_of_freedom as _dof
 from .._core.builtin_table import CONSTRAINED_NAMES
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings
+from .._core.model import model_of
 from ..ivp.methods import BY_NAME
 from .._core.native import _NO_SPEC, _unused_callback, check_params
 from .._core.result import DictResult
@@ -472,13 +473,13 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     if info == BAD_INPUT:
         raise ValueError(message)
     if info < 0 and message.startswith("inconsistent initial position"):
-        # a mechanism whose loops cannot close at q0: say which loop (a bad input, not a
-        # failed integration)
+        # a mechanism whose loops cannot close at q0: its model says which loop (a bad
+        # input, not a failed integration)
         try:
-            from ..symbolic.loops import closure_error
-        except ImportError:         # no sympy: no symbolic mechanism either
-            closure_error = None
-        err = closure_error(system, q0, t0) if closure_error is not None else None
+            model = model_of(system)
+        except TypeError:           # not a generated system: no loops to name
+            model = None
+        err = model.closure_error(system, q0, t0) if model is not None else None
         if err is not None:
             raise err
     m = system.n_hol + system.n_nh

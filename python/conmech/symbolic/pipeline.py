@@ -22,10 +22,12 @@ import sympy as sp
 
 from ..mechanics import compiled
 from .._core import slot_table as _table
+from .._core.model import SystemModel, model_of
 from .build import (CacheError, _conmech_version, cache_dir, check_private, compile_source,
                     load)
 from .codegen import CODEGEN_VERSION, generate
 from .derive import _as_value, singular_everywhere
+from .loop_report import closure_error as _closure_error
 from .momenta import as_lagrangian_system
 
 __all__ = ["CompiledModel", "compile_model", "save_model", "model_of"]
@@ -35,7 +37,7 @@ _P = ctypes.POINTER(ctypes.c_double)
 _V = ctypes.c_void_p
 
 
-class CompiledModel:
+class CompiledModel(SystemModel):
     """A derived system compiled and loaded: the library, the entry-point addresses, the
     generated source, and timings (``times``: derive, generate, compile_or_load, load;
     ``cache_hit``), the compiler ``flags`` (None: the defaults). An ode model's Taylor
@@ -56,6 +58,13 @@ class CompiledModel:
     @property
     def kind(self):
         return self.derived.kind
+
+    def closure_error(self, system, q0, t0=0.0):
+        """None when the closed loops of `system` (a tree made from this model) close at
+        q0, or it has none; otherwise the ValueError naming the loop with the largest
+        residual (:func:`conmech.constrained.solve` asks when its initial projection
+        fails)."""
+        return _closure_error(self, system, q0, t0)
 
     def _shapes(self, entry):
         d = self.derived
@@ -206,17 +215,6 @@ def _umask():
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
-
-
-def model_of(system):
-    """The :class:`CompiledModel` (derived expressions, source, library) behind a system
-    made by this module (also after ``with_params``)."""
-    keep = getattr(system, "_keep", None)
-    if isinstance(system, CompiledModel):
-        return system
-    if isinstance(keep, tuple) and keep and isinstance(keep[0], CompiledModel):
-        return keep[0]
-    raise TypeError("not a system made by conmech.symbolic")
 
 
 def _system(model):
