@@ -7,7 +7,8 @@ import warnings
 
 import numpy as np
 
-__all__ = ["real_scalar", "tolerance", "event_settings", "initial_state", "RTOL_FLOOR"]
+__all__ = ["real_scalar", "tolerance", "time_points", "event_settings", "initial_state",
+           "RTOL_FLOOR"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
 #: with SciPy's warning.
@@ -61,6 +62,31 @@ def tolerance(value, name, n, stacklevel=3):
     if name == "rtol" and (arr < RTOL_FLOOR).any():
         _warn_rtol(stacklevel + 1)
     return np.ascontiguousarray(arr)
+
+
+def time_points(t_eval, t0, tf):
+    """``t_eval`` as a float array, checked: real, one-dimensional, finite, inside
+    [t0, tf] and strictly monotonic in the direction of integration (SciPy's rules;
+    messages name ``t_eval``)."""
+    try:
+        t_ev = np.asarray(t_eval)
+        if t_ev.dtype.kind not in "biuf":
+            raise TypeError
+        t_ev = np.array(t_ev, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("t_eval must be an array of real numbers") from None
+    if t_ev.ndim != 1:
+        raise ValueError("t_eval must be 1-dimensional")
+    if not np.all(np.isfinite(t_ev)):
+        raise ValueError("t_eval contains NaN or Inf")
+    lo, hi = min(t0, tf), max(t0, tf)
+    if np.any(t_ev < lo) or np.any(t_ev > hi):
+        raise ValueError("values in t_eval are not within t_span")
+    d = np.diff(t_ev)
+    if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
+        raise ValueError("values in t_eval are not properly sorted (strictly monotonic in "
+                         "the direction of integration, no repeated values)")
+    return t_ev
 
 
 def _warn_rtol(stacklevel):

@@ -29,6 +29,7 @@ import numpy as np
 
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
+from .complex_form import real_form as _real_form
 from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput
 from .._core.checks import initial_state, real_scalar, tolerance
 from .implicit import jacobian_callback, sparsity_pattern, is_sparse
@@ -468,24 +469,6 @@ class Gauss6(Gauss):
     _code = BY_NAME["GAUSS6"].code
     order = 6
     n_stages = 3
-
-
-def _real_form(fun, n):
-    """fun of a complex y as a function of [Re y; Im y] returning [Re f; Im f]."""
-    def real_fun(t, u):
-        y = u[:n] + 1j * u[n:]
-        r = fun(t, y)
-        if r is None:
-            return None
-        f = np.asarray(r)
-        if f.dtype.kind not in "biufc":
-            return f          # the callback wrapper names the bad type
-        if f.size != n:
-            raise ValueError(f"fun must return an array of shape ({n},) (complex), got "
-                             f"shape {f.shape}")
-        f = f.reshape(n)
-        return np.concatenate([f.real, f.imag])
-    return real_fun
 
 
 def _butcher(cls):
