@@ -96,17 +96,7 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
     use conmech_flat_system, only: flat_system, SOURCE_SPEC
     use conmech_flat_ode_support, only: run_solve, copy_message
     implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2)
-    real(c_double), intent(in) :: y0(n)
-    integer(c_int), intent(in) :: method
-    real(c_double), intent(in) :: rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    include "flat_solve_args.inc"
     integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message

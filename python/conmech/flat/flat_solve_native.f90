@@ -26,10 +26,7 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
     use conmech_flat_spec, only: spec_system, spec_dimension
     use conmech_flat_ode_support, only: solve_into, store_result, copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t0, tf
     real(c_double), intent(in) :: y0(n)
@@ -42,21 +39,7 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
     real(c_double), intent(out) :: t_out(max(cap, 1)), y_out(n, max(cap, 1))
     integer(c_int), intent(out) :: nt, counts(5), info
     character(len=256), intent(out) :: message
-!f2py external store
-    interface
-        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: y(n, nt)
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_y(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-            real(c_double), intent(in) :: ts(nseg)
-            real(c_double), intent(in) :: hs(nseg)
-            real(c_double), intent(in) :: coef(n, nf1, nseg)
-        end subroutine store
-    end interface
+    include "flat_store_callback.inc"
     class(ode_system), allocatable :: sys
     type(ode_result) :: res
     character(len=:), allocatable :: msg
