@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["real_scalar", "tolerance", "time_points", "event_settings", "initial_state",
+__all__ = ["real_scalar", "real_number", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
            "RTOL_FLOOR"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
@@ -25,6 +25,17 @@ def real_scalar(value, name):
     if arr.ndim != 0:
         raise ValueError(f"{name} must be a scalar")
     return float(arr)
+
+
+def real_number(value, name):
+    """``value`` as a float: anything ``float()`` takes but a bool or a string (TypeError
+    naming ``name``); the range is the caller's to check."""
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
 
 
 def tolerance(value, name, n, stacklevel=3):
@@ -62,6 +73,17 @@ def tolerance(value, name, n, stacklevel=3):
     if name == "rtol" and (arr < RTOL_FLOOR).any():
         _warn_rtol(stacklevel + 1)
     return np.ascontiguousarray(arr)
+
+
+def time_span(t_span):
+    """(t0, tf) of ``t_span`` as floats (a sequence of two real numbers; messages name
+    ``t_span``)."""
+    try:
+        if len(t_span) != 2:
+            raise ValueError("t_span must have two elements (t0, tf)")
+    except TypeError:
+        raise TypeError("t_span must be a sequence (t0, tf)") from None
+    return real_scalar(t_span[0], "t_span[0]"), real_scalar(t_span[1], "t_span[1]")
 
 
 def time_points(t_eval, t0, tf):

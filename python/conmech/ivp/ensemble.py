@@ -41,7 +41,7 @@ import numpy as np
 
 from .. import _conmech
 from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
-from .._core.checks import time_points as _time_points
+from .._core.checks import time_points as _time_points, time_span as _time_span
 from .solve import solve_ivp as _solve_ivp
 from .._core.native import NativeSystem, function_address
 from .._core.status import BAD_INPUT
@@ -300,13 +300,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
 
     # ---------------------------------------------------------------- t_span, y0, params
-    try:
-        if len(t_span) != 2:
-            raise ValueError("t_span must have two elements (t0, tf)")
-    except TypeError:
-        raise TypeError("t_span must be a sequence (t0, tf)") from None
-    t0 = _real_scalar(t_span[0], "t_span[0]")
-    tf = _real_scalar(t_span[1], "t_span[1]")
+    t0, tf = _time_span(t_span)
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
     y0_in = np.asarray(y0)

@@ -15,7 +15,8 @@ import numpy as np
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
-    real_scalar as _real_scalar, time_points as _time_points, tolerance as _tolerance
+    real_scalar as _real_scalar, time_points as _time_points, time_span as _time_span, \
+    tolerance as _tolerance
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import jacobian_callback, is_sparse, sparsity_pattern
 from .methods import METHODS, RK45_SCIPY, method_info
@@ -234,13 +235,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     info = method_info(code)
 
     # ---------------------------------------------------------------- t_span, y0
-    try:
-        if len(t_span) != 2:
-            raise ValueError("t_span must have two elements (t0, tf)")
-    except TypeError:
-        raise TypeError("t_span must be a sequence (t0, tf)") from None
-    t0 = _real_scalar(t_span[0], "t_span[0]")
-    tf = _real_scalar(t_span[1], "t_span[1]")
+    t0, tf = _time_span(t_span)
     if not math.isfinite(t0):
         raise ValueError("t_span[0] must be finite")
     if math.isnan(tf):

@@ -27,7 +27,7 @@ from .. import _conmech
 from . import degrees_of_freedom as _dof
 from .._core.builtin_table import CONSTRAINED_NAMES
 from .._core.callback import Guard, as_result, message_text
-from .._core.checks import event_settings
+from .._core.checks import event_settings, real_number as _real_number
 from .._core.model import model_of
 from ..ivp.methods import BY_NAME
 from .._core.native import _NO_SPEC, _unused_callback, check_params
@@ -211,12 +211,7 @@ class ConstrainedSystem:
 
 
 def _finite(value, name, low=0.0, low_open=False, allow_inf=False):
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    v = _real_number(value, name)
     if np.isnan(v) or (np.isinf(v) and not (allow_inf and v > 0)):
         raise ValueError(f"{name} must be finite, got {v}")
     if v < low or (low_open and v == low):

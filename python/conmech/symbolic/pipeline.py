@@ -27,6 +27,7 @@ from .build import (CacheError, _conmech_version, cache_dir, check_private, comp
                     load)
 from .codegen import CODEGEN_VERSION, generate
 from .derive import _as_value, singular_everywhere
+from .description import _NotPlain, _param_names, store_description
 from .loop_report import closure_error as _closure_error
 from .momenta import as_lagrangian_system
 
@@ -247,16 +248,10 @@ def _input_key(kind, inputs, params, options):
     the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
     if not isinstance(params, dict):
         return None
-    names = []
-    for k, v in params.items():
-        if isinstance(k, sp.Symbol):
-            names.append(k.name)
-        elif isinstance(k, str):
-            names.append(k)
-        else:
-            return None
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-            return None
+    try:
+        names = list(_param_names(params)[::2])     # the names without their values
+    except _NotPlain:
+        return None
     try:
         text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
                             for x in inputs], names, options, CODEGEN_VERSION,
@@ -360,7 +355,6 @@ def _construct(kind, inputs, params, options, derive, flags, model_only, descrip
     # the derivation cache's key, under which the Taylor library's source is kept too
     model.cache_key = key
     if description and key:
-        from .description import store_description
         store_description(description, key, params)
     model.times["total"] = time.perf_counter() - t0
     return model if model_only else _system(model)
