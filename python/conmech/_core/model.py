@@ -25,8 +25,9 @@ class SystemModel:
 
 
 def model_of(system):
-    """The :class:`SystemModel` behind a system made by conmech.symbolic (also after
-    ``with_params``: the model is the first object such a system keeps); TypeError for any
+    """The model behind a system made by conmech.symbolic: its :class:`CompiledModel`
+    (derived expressions, source, library; a :class:`SystemModel`), also after
+    ``with_params`` (the model is the first object such a system keeps). TypeError for any
     other system."""
     if isinstance(system, SystemModel):
         return system
