@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["real_scalar", "real_number", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
+__all__ = ["real_scalar", "real_number", "step_limit", "NO_STEP_LIMIT", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
            "RTOL_FLOOR"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
@@ -36,6 +36,22 @@ def real_number(value, name):
         return float(value)
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+
+
+#: No step limit (SciPy has none): the largest count the Fortran counters hold.
+NO_STEP_LIMIT = 2**31 - 1
+
+
+def step_limit(max_steps):
+    """``max_steps`` as an int (None: :data:`NO_STEP_LIMIT`); a positive integer below
+    2**31, else TypeError/ValueError naming ``max_steps``."""
+    if max_steps is None:
+        return NO_STEP_LIMIT
+    if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
+        raise TypeError("max_steps must be None or an integer")
+    if not 1 <= max_steps <= NO_STEP_LIMIT:
+        raise ValueError("max_steps must be positive (and below 2**31)")
+    return int(max_steps)
 
 
 def tolerance(value, name, n, stacklevel=3):

@@ -20,10 +20,10 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
                              cap, t_out, y_out, nt, counts, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_result
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: solve_into, store_result, copy_message
     implicit none
     include "flat_spec_args.inc"
@@ -43,22 +43,14 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
     class(ode_system), allocatable :: sys
     type(ode_result) :: res
     character(len=:), allocatable :: msg
-    character(len=24) :: buf
     integer(c_int) :: none(1), dense_form
 
     ! t_out and y_out are written up to nt only (f2py hands them over zero-filled)
     nt = 0
     counts = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
+    call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, "", sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        write (buf, '(i0)') spec_dimension(name, nspec, spec)
-        call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
-                          //trim(name)//"'", message)
         return
     end if
     none = 0

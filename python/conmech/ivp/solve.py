@@ -6,7 +6,6 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import math
-import numbers
 
 import warnings
 
@@ -15,8 +14,8 @@ import numpy as np
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
-    real_scalar as _real_scalar, time_points as _time_points, time_span as _time_span, \
-    tolerance as _tolerance
+    real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
+    time_span as _time_span, tolerance as _tolerance
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import jacobian_callback, is_sparse, sparsity_pattern
 from .methods import METHODS, RK45_SCIPY, method_info
@@ -44,8 +43,6 @@ _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45
 _RK45_SCIPY = RK45_SCIPY
 _TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _HUGE = np.finfo(float).max
-# no step limit (SciPy has none): the largest count the Fortran counters hold
-_NO_LIMIT = 2**31 - 1
 # placeholders for f2py, which cannot pass empty arrays (read only, shared)
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
@@ -262,13 +259,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                          "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
     step_cap = max_steps is not None
-    if max_steps is None:
-        max_steps = _NO_LIMIT
-    elif isinstance(max_steps, (bool, np.bool_)) or \
-            not isinstance(max_steps, numbers.Integral):
-        raise TypeError("max_steps must be None or an integer")
-    elif not 1 <= max_steps <= _NO_LIMIT:
-        raise ValueError("max_steps must be positive (and below 2**31)")
+    max_steps = _step_limit(max_steps)
     sparsity = options.get("jac_sparsity")
     unused = sorted(k for k in options if not (k == "jac_sparsity" and info.uses_jacobian)) \
         if options else []

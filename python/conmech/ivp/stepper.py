@@ -22,7 +22,6 @@ infinite for the adaptive methods, and there is no limit on the number of steps 
 ``max_steps`` is given.
 """
 import math
-import numbers
 import warnings
 
 import numpy as np
@@ -31,7 +30,7 @@ from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .complex_form import real_form as _real_form
 from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput
-from .._core.checks import initial_state, real_scalar, tolerance
+from .._core.checks import initial_state, real_scalar, step_limit, tolerance
 from .implicit import jacobian_callback, sparsity_pattern, is_sparse
 from .methods import BY_NAME, RK45_SCIPY, method_info
 from .._core.native import NativeSystem
@@ -45,7 +44,6 @@ __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4
 _START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
 assert (_I_NJEV, _I_NLU) == (_I_NFEV + 1, _I_NFEV + 2)   # read as one slice
 _HUGE = np.finfo(float).max
-_NO_LIMIT = 2**31 - 1
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -177,13 +175,7 @@ class Stepper:
         hmax = real_scalar(max_step, "max_step")
         if not hmax > 0:
             raise ValueError("max_step must be positive")
-        if max_steps is None:
-            max_steps = _NO_LIMIT
-        elif isinstance(max_steps, (bool, np.bool_)) or \
-                not isinstance(max_steps, numbers.Integral):
-            raise TypeError("max_steps must be None or an integer")
-        elif not 1 <= max_steps <= _NO_LIMIT:
-            raise ValueError("max_steps must be positive (and below 2**31)")
+        max_steps = step_limit(max_steps)
 
         self.fun = fun
         self.t_old = None
