@@ -25,8 +25,14 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
     real(c_double), intent(out) :: residual, quarter(4), true_res, scale
     integer(c_int), intent(out) :: nsteps_used, iterations, nfev, finite, info
     character(len=256), intent(out) :: message
-    external :: flat_hill_orbit     ! flat_stab.f90: plain arguments, no interface needed
     interface
+        subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, &
+                                   closure_tol, max_nsteps, y0, period, jacobi, mono, mr, mi, &
+                                   s, c, residual, quarter, nsteps_used, iterations, nfev, &
+                                   info, message)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            include "flat_hill_orbit_args.inc"
+        end subroutine flat_hill_orbit
         subroutine flat_hill_residuals(nm, ms, kappa, y0s, res)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: nm
