@@ -248,9 +248,11 @@ def _input_key(kind, inputs, params, options):
     the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
     if not isinstance(params, dict):
         return None
+    # the names without their values; a value that is not a plain number, or an integer
+    # beyond a double's range, is left to the derivation to report
     try:
-        names = list(_param_names(params)[::2])     # the names without their values
-    except _NotPlain:
+        names = list(_param_names(params)[::2])
+    except (_NotPlain, OverflowError):
         return None
     try:
         text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
