@@ -35,6 +35,7 @@ from .stability.variational import stm as _stm
 from .mechanics.systems import hill_spatial as _hill_spatial
 from ._core.result import StatusRecord
 from ._core.status import raise_status
+from ._core.checks import real_number as _real_number
 
 __all__ = ["HillOrbit", "HillFamily", "variation_orbit", "family", "transverse",
            "locate_stability_change", "to_henon", "from_henon", "henon_gamma",
@@ -58,12 +59,7 @@ def _true_residuals(ms, kappa, y0s):
 
 
 def _check_float(value, name, positive=False, nonneg=False):
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    v = _real_number(value, name)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite")
     if positive and not v > 0:

@@ -14,7 +14,7 @@ module conmech_lapack
 
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
         dgelsy, dlange, dpstrf, dgesvd, dgeqp3, dgees
-    public :: la_solve, la_eig, la_sym_eig, la_det, la_finite
+    public :: la_solve, la_eig, la_sym_eig, la_det, la_finite, la_status
 
     !> True if every entry is finite (call it before handing data to LAPACK: NaN input
     !! makes some routines report an illegal argument).
@@ -280,13 +280,8 @@ contains
         lu = a
         anorm = dlange('1', n, n, lu, n, work)
         call dgetrf(n, n, lu, n, ipiv, lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-            return
-        else if (lainfo > 0) then
-            info = CM_SINGULAR
-            return
-        end if
+        info = la_status(lainfo, CM_SINGULAR)
+        if (info /= CM_SUCCESS) return
         call dgecon('1', n, lu, n, anorm, rcond, work, iwork, lainfo)
         if (rcond < rmin) then
             info = CM_SINGULAR
@@ -296,6 +291,20 @@ contains
         call dgetrs('N', n, nrhs, lu, n, ipiv, x, n, lainfo)
         info = CM_SUCCESS
     end subroutine la_solve
+
+    !> The status of a LAPACK return code: CM_SUCCESS for 0, CM_LAPACK_ERROR for an illegal
+    !! argument (< 0), and `positive` for the routine's own failure (> 0: a singular
+    !! factor, an iteration that did not converge, ...).
+    elemental integer function la_status(lainfo, positive) result(info)
+        integer, intent(in) :: lainfo, positive
+        if (lainfo < 0) then
+            info = CM_LAPACK_ERROR
+        else if (lainfo > 0) then
+            info = positive
+        else
+            info = CM_SUCCESS
+        end if
+    end function la_status
 
     !> Eigenvalues (and optionally right eigenvectors) of a general real matrix (dgeev).
     subroutine la_eig(a, wr, wi, info, vr)
@@ -324,14 +333,8 @@ contains
         lwork = max(1, int(wq(1)))
         allocate (work(lwork))
         call dgeev('N', jobvr, n, tmp, n, wr, wi, vl, 1, v, n, work, lwork, lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-        else if (lainfo > 0) then
-            info = CM_NO_CONVERGENCE
-        else
-            info = CM_SUCCESS
-            if (present(vr)) vr = v
-        end if
+        info = la_status(lainfo, CM_NO_CONVERGENCE)
+        if (info == CM_SUCCESS .and. present(vr)) vr = v
     end subroutine la_eig
 
     !> Eigenvalues (ascending) and optionally eigenvectors of a symmetric matrix (dsyev).
@@ -361,14 +364,8 @@ contains
         lwork = max(1, int(wq(1)))
         allocate (work(lwork))
         call dsyev(jobz, 'U', n, tmp, n, w, work, lwork, lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-        else if (lainfo > 0) then
-            info = CM_NO_CONVERGENCE
-        else
-            info = CM_SUCCESS
-            if (present(v)) v = tmp
-        end if
+        info = la_status(lainfo, CM_NO_CONVERGENCE)
+        if (info == CM_SUCCESS .and. present(v)) v = tmp
     end subroutine la_sym_eig
 
     !> Determinant of a general square matrix from its LU factorisation (dgetrf).

@@ -8,9 +8,9 @@
 !! decision is the whole point.
 module conmech_rank
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_LAPACK_ERROR, CM_NO_CONVERGENCE, &
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NO_CONVERGENCE, &
         CM_NONFINITE
-    use conmech_lapack, only: dgesvd, dgelsd, la_finite
+    use conmech_lapack, only: dgesvd, dgelsd, la_finite, la_status
     implicit none
     private
 
@@ -52,13 +52,7 @@ contains
         lwork = max(1, int(wq(1)))
         allocate (work(lwork))
         call dgesvd('A', 'A', m, n, tmp, m, s, u, m, vt, n, work, lwork, lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-        else if (lainfo > 0) then
-            info = CM_NO_CONVERGENCE
-        else
-            info = CM_SUCCESS
-        end if
+        info = la_status(lainfo, CM_NO_CONVERGENCE)
     end subroutine svd
 
     !> Singular values of an m x n matrix (descending; dgesvd without vectors).
@@ -87,11 +81,7 @@ contains
         lwork = max(1, int(wq(1)))
         allocate (work(lwork))
         call dgesvd('N', 'N', m, n, tmp, m, s, du, 1, dv, 1, work, lwork, lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-        else if (lainfo > 0) then
-            info = CM_NO_CONVERGENCE
-        end if
+        info = la_status(lainfo, CM_NO_CONVERGENCE)
     end subroutine singular_values
 
     !> Numerical rank: the number of singular values > thresh.
@@ -195,14 +185,8 @@ contains
         allocate (work(lwork), iwork(max(1, iq(1))))
         call dgelsd(m, n, 1, tmp, m, rhs, max(m, n), s, rcond, rank, work, lwork, iwork, &
                     lainfo)
-        if (lainfo < 0) then
-            info = CM_LAPACK_ERROR
-        else if (lainfo > 0) then
-            info = CM_NO_CONVERGENCE
-        else
-            info = CM_SUCCESS
-            x = rhs(1:n, 1)
-        end if
+        info = la_status(lainfo, CM_NO_CONVERGENCE)
+        if (info == CM_SUCCESS) x = rhs(1:n, 1)
     end subroutine min_norm_solve
 
     pure function identity(n) result(e)

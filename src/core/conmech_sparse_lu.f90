@@ -47,8 +47,7 @@ module conmech_sparse_lu
         !> Solve A x = b in place (after a successful `factor`).
         procedure :: solve => real_solve
         procedure :: prepare => real_prepare
-        procedure :: grow_l => real_grow_l
-        procedure :: grow_u => real_grow_u
+        procedure :: grow => real_grow
     end type sparse_lu_real
 
     !> Sparse LU of a complex matrix.
@@ -61,8 +60,7 @@ module conmech_sparse_lu
         !> Solve A x = b in place (after a successful `factor`).
         procedure :: solve => complex_solve
         procedure :: prepare => complex_prepare
-        procedure :: grow_l => complex_grow_l
-        procedure :: grow_u => complex_grow_u
+        procedure :: grow => complex_grow
     end type sparse_lu_complex
 
 contains
@@ -104,69 +102,25 @@ contains
 
     subroutine real_prepare(self, n, nnz)
         class(sparse_lu_real), intent(inout) :: self
-        integer, intent(in) :: n, nnz
-        integer :: cap
-        call self%prepare_base(n, nnz, cap)
-        if (allocated(self%x)) then
-            if (size(self%x) == n .and. size(self%lx) == size(self%li) .and. &
-                size(self%ux) == size(self%ui)) return
-            deallocate (self%x, self%lx, self%ux)
-        end if
-        allocate (self%x(n), self%lx(size(self%li)), self%ux(size(self%ui)))
+        include "conmech_sparse_lu_prepare.inc"
     end subroutine real_prepare
 
-    subroutine real_grow_l(self, m)
+    subroutine real_grow(self, ml, mu)
         class(sparse_lu_real), intent(inout) :: self
-        integer, intent(in) :: m
         real(dp), allocatable :: b(:)
-        call grow_int(self%li, m)
-        allocate (b(m))
-        b(1:size(self%lx)) = self%lx
-        call move_alloc(b, self%lx)
-    end subroutine real_grow_l
-
-    subroutine real_grow_u(self, m)
-        class(sparse_lu_real), intent(inout) :: self
-        integer, intent(in) :: m
-        real(dp), allocatable :: b(:)
-        call grow_int(self%ui, m)
-        allocate (b(m))
-        b(1:size(self%ux)) = self%ux
-        call move_alloc(b, self%ux)
-    end subroutine real_grow_u
+        include "conmech_sparse_lu_grow.inc"
+    end subroutine real_grow
 
     subroutine complex_prepare(self, n, nnz)
         class(sparse_lu_complex), intent(inout) :: self
-        integer, intent(in) :: n, nnz
-        integer :: cap
-        call self%prepare_base(n, nnz, cap)
-        if (allocated(self%x)) then
-            if (size(self%x) == n .and. size(self%lx) == size(self%li) .and. &
-                size(self%ux) == size(self%ui)) return
-            deallocate (self%x, self%lx, self%ux)
-        end if
-        allocate (self%x(n), self%lx(size(self%li)), self%ux(size(self%ui)))
+        include "conmech_sparse_lu_prepare.inc"
     end subroutine complex_prepare
 
-    subroutine complex_grow_l(self, m)
+    subroutine complex_grow(self, ml, mu)
         class(sparse_lu_complex), intent(inout) :: self
-        integer, intent(in) :: m
         complex(dp), allocatable :: b(:)
-        call grow_int(self%li, m)
-        allocate (b(m))
-        b(1:size(self%lx)) = self%lx
-        call move_alloc(b, self%lx)
-    end subroutine complex_grow_l
-
-    subroutine complex_grow_u(self, m)
-        class(sparse_lu_complex), intent(inout) :: self
-        integer, intent(in) :: m
-        complex(dp), allocatable :: b(:)
-        call grow_int(self%ui, m)
-        allocate (b(m))
-        b(1:size(self%ux)) = self%ux
-        call move_alloc(b, self%ux)
-    end subroutine complex_grow_u
+        include "conmech_sparse_lu_grow.inc"
+    end subroutine complex_grow
 
     subroutine real_factor(self, ap, ai, ax, q, tol, info)
         class(sparse_lu_real), intent(inout) :: self

@@ -15,7 +15,7 @@ submodule(conmech_constrained_system) conmech_constrained_derivatives
 
 contains
 
-    module procedure cs_fd_forces_jacobian
+    module procedure fd_forces_jacobian
         real(dp) :: qp(self%n), vp(self%n), fp(self%n), fm(self%n)
         real(dp) :: mp(self%n, self%n), mm(self%n, self%n), h
         integer :: j, n
@@ -42,9 +42,9 @@ contains
             vp(j) = v(j)
             r(:, n + j) = (fp - fm)/(2.0_dp*h)
         end do
-    end procedure cs_fd_forces_jacobian
+    end procedure fd_forces_jacobian
 
-    module procedure cs_fd_constraint_hessian
+    module procedure fd_constraint_hessian
         real(dp) :: qp(self%n), h
         real(dp) :: cp(self%n_hol + self%n_nh, self%n), cm(self%n_hol + self%n_nh, self%n)
         real(dp) :: c0p(self%n_hol + self%n_nh), c0m(self%n_hol + self%n_nh)
@@ -63,7 +63,7 @@ contains
             hl(:, j) = matmul(lam, cp - cm)/(2.0_dp*h)
             hv(:, j) = (matmul(cp - cm, v) + c0p - c0m)/(2.0_dp*h)
         end do
-    end procedure cs_fd_constraint_hessian
+    end procedure fd_constraint_hessian
 
     module procedure cs_has_no_forces_jacobian
         cs_has_no_forces_jacobian = .false.

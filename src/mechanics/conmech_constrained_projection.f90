@@ -7,11 +7,7 @@ submodule(conmech_constrained_system) conmech_constrained_projection
 contains
 
     !> Reaction force r = C(t, q)^T lam (n): O(n) for row windows.
-    module subroutine constraint_reaction(sys, t, q, lam, r)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), lam(:)
-        real(dp), intent(out) :: r(:)
+    module procedure constraint_reaction
         real(dp), allocatable :: c(:, :), c0(:)
         logical :: ok
         r = 0.0_dp
@@ -23,14 +19,10 @@ contains
         allocate (c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh))
         call constraint_matrix(sys, t, q, c, c0)
         r = matmul(lam, c)
-    end subroutine constraint_reaction
+    end procedure constraint_reaction
 
     !> Residuals at (t, q, v): rpos = max |phi|, rvel = max |C v + c0|.
-    module subroutine constraint_residuals(sys, t, q, v, rpos, rvel)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: rpos, rvel
+    module procedure constraint_residuals
         real(dp), allocatable :: c(:, :), c0(:)
         real(dp) :: ph(sys%n_hol)
         logical :: ok
@@ -49,7 +41,7 @@ contains
             call constraint_matrix(sys, t, q, c, c0)
             rvel = maxval(abs(matmul(c, v) + c0))
         end if
-    end subroutine constraint_residuals
+    end procedure constraint_residuals
 
     !> Mass-weighted projection of q onto phi(t, q) = 0 (Hairer-Lubich-Wanner):
     !! q = q~ + M(q~)^{-1} G(q~)^T mu by simplified Newton with M, G and the Schur
@@ -59,15 +51,7 @@ contains
     !! iterations (CM_NO_CONVERGENCE otherwise, q is then left unchanged). With
     !! `newton` = .true. G is refreshed at every iterate (Gauss-Newton, quadratic
     !! convergence from far away; used for the consistent initial values).
-    module subroutine project_position(sys, t, q, tol, max_iter, iters, info, msg, newton)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(inout) :: q(:)
-        real(dp), intent(in) :: tol
-        integer, intent(in) :: max_iter
-        integer, intent(out) :: iters, info
-        character(len=:), allocatable, intent(out) :: msg
-        logical, intent(in), optional :: newton   !! refresh G at every iterate (far start)
+    module procedure project_position
         real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
         real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
         real(dp) :: rnorm
@@ -140,18 +124,12 @@ contains
         write (buf, '(es10.3)') rnorm
         msg = "position projection did not converge: |phi| ="//trim(buf)// &
               " (inconsistent constraints, or too far from the manifold)"
-    end subroutine project_position
+    end procedure project_position
 
     !> Mass-weighted projection of v onto C(t, q) v + c0 = 0 (linear, one solve):
     !! v = v~ - M^{-1} C^T S^+ (C v~ + c0). CM_NO_CONVERGENCE if the projected residual is
     !! not small (inconsistent velocity constraints).
-    module subroutine project_velocity(sys, t, q, v, info, msg)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(inout) :: v(:)
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+    module procedure project_velocity
         real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol + sys%n_nh)
         real(dp) :: c(sys%n_hol + sys%n_nh, sys%n), c0(sys%n_hol + sys%n_nh)
         real(dp) :: s(sys%n_hol + sys%n_nh, sys%n_hol + sys%n_nh), r(sys%n_hol + sys%n_nh, 1)
@@ -192,6 +170,6 @@ contains
             info = CM_NO_CONVERGENCE
             msg = "velocity projection failed: the velocity constraints are inconsistent"
         end if
-    end subroutine project_velocity
+    end procedure project_velocity
 
 end submodule conmech_constrained_projection

@@ -72,25 +72,6 @@ module conmech_constrained_system
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
     public :: fd_forces_jacobian, fd_constraint_hessian
 
-    interface fd_phi_jac
-        module procedure cs_fd_phi_jac
-    end interface fd_phi_jac
-    interface fd_phi_t
-        module procedure cs_fd_phi_t
-    end interface fd_phi_t
-    interface fd_phi_gamma
-        module procedure cs_fd_phi_gamma
-    end interface fd_phi_gamma
-    interface fd_nh_gamma
-        module procedure cs_fd_nh_gamma
-    end interface fd_nh_gamma
-    interface fd_forces_jacobian
-        module procedure cs_fd_forces_jacobian
-    end interface fd_forces_jacobian
-    interface fd_constraint_hessian
-        module procedure cs_fd_constraint_hessian
-    end interface fd_constraint_hessian
-
     type, abstract :: constrained_system
         integer :: n = 0             !! number of (excessive) coordinates
         integer :: n_hol = 0         !! number of holonomic constraints phi(t, q) = 0
@@ -108,19 +89,19 @@ module conmech_constrained_system
         procedure(cs_mass), deferred :: mass
         procedure(cs_forces), deferred :: forces
         procedure :: phi => cs_no_phi
-        procedure :: phi_jac => cs_fd_phi_jac
-        procedure :: phi_t => cs_fd_phi_t
-        procedure :: phi_gamma => cs_fd_phi_gamma
+        procedure :: phi_jac => fd_phi_jac
+        procedure :: phi_t => fd_phi_t
+        procedure :: phi_gamma => fd_phi_gamma
         procedure :: nh_matrix => cs_no_nh
-        procedure :: nh_gamma => cs_fd_nh_gamma
+        procedure :: nh_gamma => fd_nh_gamma
         procedure :: mass_diagonal => cs_mass_diagonal
         procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: nh_matrix_band => cs_nh_matrix_band
         procedure :: energy => cs_no_energy
         procedure :: has_energy => cs_has_no_energy
-        procedure :: forces_jacobian => cs_fd_forces_jacobian
+        procedure :: forces_jacobian => fd_forces_jacobian
         procedure :: has_forces_jacobian => cs_has_no_forces_jacobian
-        procedure :: constraint_hessian => cs_fd_constraint_hessian
+        procedure :: constraint_hessian => fd_constraint_hessian
         procedure :: has_constraint_hessian => cs_has_no_constraint_hessian
     end type constrained_system
 
@@ -195,22 +176,22 @@ module conmech_constrained_system
         !> r = [dQ/dq - d(M a)/dq, dQ/dv] at (t, q, v) with a held fixed (n x 2n): the
         !! Jacobian of the force balance M(q) a - Q(t, q, v). Default: central differences
         !! of `forces` and `mass` (steps eps^(1/3) max(|x_j|, 1)).
-        module subroutine cs_fd_forces_jacobian(self, t, q, v, a, r)
+        module subroutine fd_forces_jacobian(self, t, q, v, a, r)
             class(constrained_system), intent(in) :: self
             real(dp), intent(in) :: t
             real(dp), intent(in) :: q(:), v(:), a(:)
             real(dp), intent(out) :: r(:, :)
-        end subroutine cs_fd_forces_jacobian
+        end subroutine fd_forces_jacobian
         !> The second derivatives of the constraints that a Newton iteration on the
         !! constrained equations needs, at (t, q, v) and multipliers lam (n_hol + n_nh):
         !! hl = d(C^T lam)/dq (n x n) and hv = d(C v + c0)/dq ((n_hol + n_nh) x n).
         !! Default: central differences of the constraint matrix and offset.
-        module subroutine cs_fd_constraint_hessian(self, t, q, v, lam, hl, hv)
+        module subroutine fd_constraint_hessian(self, t, q, v, lam, hl, hv)
             class(constrained_system), intent(in) :: self
             real(dp), intent(in) :: t
             real(dp), intent(in) :: q(:), v(:), lam(:)
             real(dp), intent(out) :: hl(:, :), hv(:, :)
-        end subroutine cs_fd_constraint_hessian
+        end subroutine fd_constraint_hessian
         !> The defaults are finite differences.
         module logical function cs_has_no_forces_jacobian(self)
             class(constrained_system), intent(in) :: self
@@ -353,7 +334,7 @@ contains
     end subroutine cs_no_phi
 
     !> Default G = d phi/d q by central differences.
-    subroutine cs_fd_phi_jac(self, t, q, g)
+    subroutine fd_phi_jac(self, t, q, g)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
@@ -370,10 +351,10 @@ contains
             qp(j) = q(j)
             g(:, j) = (cp - cm)/(2.0_dp*h)
         end do
-    end subroutine cs_fd_phi_jac
+    end subroutine fd_phi_jac
 
     !> Default phi_t: zero for scleronomic constraints, else a central difference in t.
-    subroutine cs_fd_phi_t(self, t, q, pt)
+    subroutine fd_phi_t(self, t, q, pt)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
@@ -387,11 +368,11 @@ contains
         call self%phi(t + h, q, cp)
         call self%phi(t - h, q, cm)
         pt = (cp - cm)/(2.0_dp*h)
-    end subroutine cs_fd_phi_t
+    end subroutine fd_phi_t
 
     !> Default gamma_h = -d^2/ds^2 phi(t + s, q + s v) at s = 0 (fourth-order five-point
     !! second difference; step eps^(1/6) times the scale of (t, q) over max(|v|, 1)).
-    subroutine cs_fd_phi_gamma(self, t, q, v, gam)
+    subroutine fd_phi_gamma(self, t, q, v, gam)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
@@ -416,7 +397,7 @@ contains
         call self%phi(t - s*tdir, q - s*v, cm)
         call self%phi(t - 2.0_dp*s*tdir, q - 2.0_dp*s*v, c2m)
         gam = -(-c2p + 16.0_dp*cp - 30.0_dp*c0 + 16.0_dp*cm - c2m)/(12.0_dp*s**2)
-    end subroutine cs_fd_phi_gamma
+    end subroutine fd_phi_gamma
 
     !> The default has no non-holonomic constraints.
     subroutine cs_no_nh(self, t, q, a, b)
@@ -431,7 +412,7 @@ contains
 
     !> Default gamma_n = -d/dt [A v + b] (v fixed) along (1, v), by the fourth-order
     !! five-point first difference with step eps^(1/5) times the scale of (t, q).
-    subroutine cs_fd_nh_gamma(self, t, q, v, gam)
+    subroutine fd_nh_gamma(self, t, q, v, gam)
         class(constrained_system), intent(in) :: self
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
@@ -449,7 +430,7 @@ contains
             w = w + wt(j)*(matmul(a, v) + b)
         end do
         gam = -w/(12.0_dp*s)
-    end subroutine cs_fd_nh_gamma
+    end subroutine fd_nh_gamma
 
     function cs_no_energy(self, t, q, v) result(e)
         class(constrained_system), intent(in) :: self

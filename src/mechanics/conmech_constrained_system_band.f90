@@ -36,22 +36,16 @@ contains
         has_mass_inverse = size(sys%mass_inv_band, 1) == sys%n
     end function has_mass_inverse
 
-    pure module logical function band_ready(sys)
-        class(constrained_system), intent(in) :: sys
+    module procedure band_ready
         band_ready = sys%n_hol >= 0 .and. sys%n_nh >= 0 .and. sys%n_hol + sys%n_nh > 0 &
                      .and. (sys%diagonal_mass .or. has_mass_inverse(sys))
         if (sys%n_hol > 0) band_ready = band_ready .and. sys%jac_width > 0 .and. &
                                         sys%jac_width <= sys%n
         if (sys%n_nh > 0) band_ready = band_ready .and. sys%nh_width > 0 .and. &
                                        sys%nh_width <= sys%n
-    end function band_ready
+    end procedure band_ready
 
-    module subroutine cs_nh_matrix_band(self, t, q, ab, b, first)
-        class(constrained_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: ab(:, :), b(:)
-        integer, intent(out) :: first(:)
+    module procedure cs_nh_matrix_band
         real(dp) :: a(self%n_nh, self%n)
         integer :: i, j0, j1, w
         w = size(ab, 2)
@@ -75,11 +69,9 @@ contains
             first(i) = min(j0, self%n - w + 1)
             ab(i, :) = a(i, first(i):first(i) + w - 1)
         end do
-    end subroutine cs_nh_matrix_band
+    end procedure cs_nh_matrix_band
 
-    module subroutine keep_mass_inverse(sys, mm)
-        class(constrained_system), intent(inout) :: sys
-        real(dp), intent(in) :: mm(:, :)
+    module procedure keep_mass_inverse
         real(dp), allocatable :: x(:, :)
         integer :: n, i, j, bm, lainfo
         n = sys%n
@@ -108,7 +100,7 @@ contains
                 sys%mass_inv_band(i, j - i) = x(i, j)
             end do
         end do
-    end subroutine keep_mass_inverse
+    end procedure keep_mass_inverse
 
     !> The mass operator at (t, q); ok = .false. if a diagonal mass is not positive.
     subroutine setup_mass(sys, t, q, br, ok)
@@ -249,13 +241,7 @@ contains
         call band_gtmul(br%cb, br%first, lam(br%perm), z)
     end subroutine ctmul
 
-    module subroutine band_accel(sys, t, q, v, a, lam, ok, alpha, beta)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: a(:), lam(:)
-        logical, intent(out) :: ok
-        real(dp), intent(in), optional :: alpha, beta
+    module procedure band_accel
         type(band_rows) :: br
         real(dp) :: r(sys%n_hol + sys%n_nh), w(sys%n_hol + sys%n_nh), ph(sys%n_hol)
         real(dp) :: z(sys%n), f(sys%n)
@@ -293,20 +279,9 @@ contains
             call minv_mul(sys, br, z, f)
             a = a + f
         end block
-    end subroutine band_accel
+    end procedure band_accel
 
-    module subroutine band_project_position(sys, t, q, ph, tol, max_iter, full, iters, &
-                                            info, msg, ok)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(inout) :: q(:)
-        real(dp), intent(in) :: ph(:)
-        real(dp), intent(in) :: tol
-        integer, intent(in) :: max_iter
-        logical, intent(in) :: full
-        integer, intent(out) :: iters, info
-        character(len=:), allocatable, intent(inout) :: msg
-        logical, intent(out) :: ok
+    module procedure band_project_position
         type(band_rows) :: br
         real(dp) :: r(sys%n_hol), qk(sys%n), dq(sys%n), z(sys%n), rnorm
         integer :: kd
@@ -359,16 +334,9 @@ contains
         write (buf, '(es10.3)') rnorm
         msg = "position projection did not converge: |phi| ="//trim(buf)// &
               " (inconsistent constraints, or too far from the manifold)"
-    end subroutine band_project_position
+    end procedure band_project_position
 
-    module subroutine band_project_velocity(sys, t, q, v, info, msg, ok)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(inout) :: v(:)
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(inout) :: msg
-        logical, intent(out) :: ok
+    module procedure band_project_velocity
         type(band_rows) :: br
         real(dp) :: r(sys%n_hol + sys%n_nh), z(sys%n), dv(sys%n), r0, vscale
         info = CM_SUCCESS
@@ -395,27 +363,17 @@ contains
             info = CM_NO_CONVERGENCE
             msg = "velocity projection failed: the velocity constraints are inconsistent"
         end if
-    end subroutine band_project_velocity
+    end procedure band_project_velocity
 
-    module subroutine band_reaction(sys, t, q, lam, r, ok)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), lam(:)
-        real(dp), intent(out) :: r(:)
-        logical, intent(out) :: ok
+    module procedure band_reaction
         type(band_rows) :: br
         br%bm = 0
         if (.not. sys%diagonal_mass) br%bm = -lbound(sys%mass_inv_band, 2)
         call setup_rows(sys, t, q, .false., .false., br, ok)
         if (ok) call ctmul(br, lam, r)
-    end subroutine band_reaction
+    end procedure band_reaction
 
-    module subroutine band_velocity_residual(sys, t, q, v, rvel, ok)
-        class(constrained_system), intent(in) :: sys
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: rvel
-        logical, intent(out) :: ok
+    module procedure band_velocity_residual
         type(band_rows) :: br
         real(dp) :: r(sys%n_hol + sys%n_nh)
         rvel = 0.0_dp
@@ -425,6 +383,6 @@ contains
         if (.not. ok) return
         call cmul(br, v, r)
         rvel = maxval(abs(r + br%c0))
-    end subroutine band_velocity_residual
+    end procedure band_velocity_residual
 
 end submodule conmech_constrained_system_band

@@ -151,25 +151,14 @@ contains
         real(dp), intent(out) :: jac(:, :)
         real(dp), intent(inout) :: yw(:), fw(:)
         integer, intent(inout) :: nfev
-        integer :: g, p, j, k
-        real(dp) :: delt
+        real(dp), allocatable :: jval(:)
+        integer :: j, k
+        allocate (jval(size(self%row_idx)))
+        call self%fd_values(sys, t, y, f0, uround, jval, yw, fw, nfev)
         jac = 0.0_dp
-        yw = y
-        do g = 1, self%ngroups
-            do p = self%gptr(g), self%gptr(g + 1) - 1
-                j = self%gcols(p)
-                yw(j) = y(j) + sqrt(uround*max(1.0e-5_dp, abs(y(j))))
-            end do
-            call sys%rhs(t, yw, fw)
-            nfev = nfev + 1
-            do p = self%gptr(g), self%gptr(g + 1) - 1
-                j = self%gcols(p)
-                delt = sqrt(uround*max(1.0e-5_dp, abs(y(j))))
-                do k = self%col_ptr(j), self%col_ptr(j + 1) - 1
-                    jac(self%row_idx(k), j) = (fw(self%row_idx(k)) - &
-                                               f0(self%row_idx(k)))/delt
-                end do
-                yw(j) = y(j)
+        do j = 1, self%n
+            do k = self%col_ptr(j), self%col_ptr(j + 1) - 1
+                jac(self%row_idx(k), j) = jval(k)
             end do
         end do
     end subroutine structure_fd_jacobian

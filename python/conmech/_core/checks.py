@@ -7,7 +7,8 @@ import warnings
 
 import numpy as np
 
-__all__ = ["real_scalar", "tolerance", "event_settings", "initial_state", "RTOL_FLOOR"]
+__all__ = ["real_scalar", "real_number", "step_limit", "NO_STEP_LIMIT", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
+           "RTOL_FLOOR"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
 #: with SciPy's warning.
@@ -24,6 +25,33 @@ def real_scalar(value, name):
     if arr.ndim != 0:
         raise ValueError(f"{name} must be a scalar")
     return float(arr)
+
+
+def real_number(value, name):
+    """``value`` as a float: anything ``float()`` takes but a bool or a string (TypeError
+    naming ``name``); the range is the caller's to check."""
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+
+
+#: No step limit (SciPy has none): the largest count the Fortran counters hold.
+NO_STEP_LIMIT = 2**31 - 1
+
+
+def step_limit(max_steps):
+    """``max_steps`` as an int (None: :data:`NO_STEP_LIMIT`); a positive integer below
+    2**31, else TypeError/ValueError naming ``max_steps``."""
+    if max_steps is None:
+        return NO_STEP_LIMIT
+    if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, numbers.Integral):
+        raise TypeError("max_steps must be None or an integer")
+    if not 1 <= max_steps <= NO_STEP_LIMIT:
+        raise ValueError("max_steps must be positive (and below 2**31)")
+    return int(max_steps)
 
 
 def tolerance(value, name, n, stacklevel=3):
@@ -61,6 +89,42 @@ def tolerance(value, name, n, stacklevel=3):
     if name == "rtol" and (arr < RTOL_FLOOR).any():
         _warn_rtol(stacklevel + 1)
     return np.ascontiguousarray(arr)
+
+
+def time_span(t_span):
+    """(t0, tf) of ``t_span`` as floats (a sequence of two real numbers; messages name
+    ``t_span``)."""
+    try:
+        if len(t_span) != 2:
+            raise ValueError("t_span must have two elements (t0, tf)")
+    except TypeError:
+        raise TypeError("t_span must be a sequence (t0, tf)") from None
+    return real_scalar(t_span[0], "t_span[0]"), real_scalar(t_span[1], "t_span[1]")
+
+
+def time_points(t_eval, t0, tf):
+    """``t_eval`` as a float array, checked: real, one-dimensional, finite, inside
+    [t0, tf] and strictly monotonic in the direction of integration (SciPy's rules;
+    messages name ``t_eval``)."""
+    try:
+        t_ev = np.asarray(t_eval)
+        if t_ev.dtype.kind not in "biuf":
+            raise TypeError
+        t_ev = np.array(t_ev, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("t_eval must be an array of real numbers") from None
+    if t_ev.ndim != 1:
+        raise ValueError("t_eval must be 1-dimensional")
+    if not np.all(np.isfinite(t_ev)):
+        raise ValueError("t_eval contains NaN or Inf")
+    lo, hi = min(t0, tf), max(t0, tf)
+    if np.any(t_ev < lo) or np.any(t_ev > hi):
+        raise ValueError("values in t_eval are not within t_span")
+    d = np.diff(t_ev)
+    if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
+        raise ValueError("values in t_eval are not properly sorted (strictly monotonic in "
+                         "the direction of integration, no repeated values)")
+    return t_ev
 
 
 def _warn_rtol(stacklevel):

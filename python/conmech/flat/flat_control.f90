@@ -18,10 +18,7 @@ subroutine flat_control_plant_eval(name, np, params, nspec, spec, nd, m, bmat, b
     use conmech_mech_plant, only: mech_plant
     use conmech_support_control, only: build_plant
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr
+    include "flat_plant_args.inc"
     real(c_double), intent(in) :: t, x(2*nd), u(m)
     real(c_double), intent(out) :: dxdt(2*nd), bx(2*nd, m)
     integer(c_int), intent(out) :: info
@@ -50,11 +47,10 @@ subroutine flat_control_vhc(name, np, params, nspec, spec, nd, m, bmat, baddr, n
     use conmech_vhc, only: vhc, vhc_eval, vhc_coefficients
     use conmech_support_control, only: build_plant, build_vhc
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, nth
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), thetas(nth)
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: nth
+    real(c_double), intent(in) :: thetas(nth)
     real(c_double), intent(out) :: alpha(nth), beta(nth), gamma(nth)
     real(c_double), intent(out) :: phis(nd, nth), dphis(nd, nth), ddphis(nd, nth)
     integer(c_int), intent(out) :: info
@@ -103,11 +99,10 @@ subroutine flat_control_reduced(name, np, params, nspec, spec, nd, m, bmat, badd
     use conmech_support_control, only: build_plant, build_vhc
     use conmech_support_reduced, only: velocity_zero
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, neval, with_events, maxev
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), y0(2), t0, t1, t_eval(max(neval, 1))
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: neval, with_events, maxev
+    real(c_double), intent(in) :: y0(2), t0, t1, t_eval(max(neval, 1))
     real(c_double), intent(in) :: rtol, atol
     real(c_double), intent(out) :: ys(2, max(neval, 1)), ev_t(max(maxev, 1))
     real(c_double), intent(out) :: ev_y(2, max(maxev, 1))
@@ -174,11 +169,10 @@ subroutine flat_control_energy(name, np, params, nspec, spec, nd, m, bmat, baddr
     use conmech_support_control, only: build_plant, build_vhc
     use conmech_support_reduced, only: energy_zero
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, nth, stop_at_zero
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), theta0, e0, thetas(nth), rtol, atol
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: nth, stop_at_zero
+    real(c_double), intent(in) :: theta0, e0, thetas(nth), rtol, atol
     real(c_double), intent(out) :: es(nth), theta_zero
     integer(c_int), intent(out) :: found, info
     character(len=256), intent(out) :: message
@@ -239,11 +233,10 @@ subroutine flat_control_law_eval(name, np, params, nspec, spec, nd, m, bmat, bad
     use conmech_control_system, only: feedback_law
     use conmech_support_control, only: build_plant_law
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, nx
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), ts(nx), xs(n, nx)
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: n, nx
+    real(c_double), intent(in) :: ts(nx), xs(n, nx)
     real(c_double), intent(out) :: us(m, nx)
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
@@ -277,11 +270,9 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     use conmech_flat_ode_support, only: run_solve
     use conmech_support_control, only: build_plant_law
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1))
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t_span(2), y0(n), rtol(n), atol(n), first_step, max_step
     integer(c_int), intent(in) :: method, max_steps, dense, neval, ne
     real(c_double), intent(in) :: t_eval(max(neval, 1))
@@ -330,11 +321,10 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
     use conmech_control_system, only: feedback_law
     use conmech_support_control, only: build_plant_law, project_states
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, k, nx
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), xs(n, nx)
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: n, k, nx
+    real(c_double), intent(in) :: xs(n, nx)
     real(c_double), intent(out) :: taus(nx), xis(k, nx), dists(nx)
     integer(c_int), intent(out) :: nfail, info
     character(len=256), intent(out) :: message
@@ -379,11 +369,10 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     use conmech_variational, only: integrate_stm
     use conmech_support_control, only: build_plant_law
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec, nd, m, nbp, nil, nrl, n, k, ng, nt, ntab
-    real(c_double), intent(in) :: params(max(np, 1)), bmat(nd, m), bpar(max(nbp, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1)), baddr, ilaw(nil)
-    real(c_double), intent(in) :: rlaw(max(nrl, 1)), y0(n), period, qw(k, k), rw(m, m)
+    include "flat_plant_args.inc"
+    include "flat_law_args.inc"
+    integer(c_int), intent(in) :: n, k, ng, nt, ntab
+    real(c_double), intent(in) :: y0(n), period, qw(k, k), rw(m, m)
     real(c_double), intent(in) :: rtol, atol, t(nt)
     real(c_double), intent(out) :: as(k, k, nt), bs(k, m, nt), ps(k, k, nt), ks(m, k, nt)
     real(c_double), intent(out) :: omr(k), omi(k), gev(k), hmr(2*k), hmi(2*k), cmr(k), cmi(k)

@@ -1,6 +1,6 @@
 !> Hill's variation orbit and its independent closure check in one call, so that
 !! conmech.hill.variation_orbit spends its time in Fortran: the orbit with its monodromy
-!! (conmech_hill_orbit, as flat_hill_orbit), then the true closure error of y0 from an
+!! (flat_hill_orbit, called here), then the true closure error of y0 from an
 !! independent adaptive integration of a quarter period (flat_hill_residuals: DOP853,
 !! rtol = atol = 1e-12, max(|x(pi/2)|, |y'(pi/2)|)), the scale max(1, |y0|) it is
 !! compared against, and whether the monodromy and S are finite.
@@ -16,7 +16,6 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_status, only: CM_SUCCESS
-    use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
     implicit none
     real(c_double), intent(in) :: m, kappa
     integer(c_int), intent(in) :: nsteps, full_period, use_guess
@@ -27,6 +26,13 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
     integer(c_int), intent(out) :: nsteps_used, iterations, nfev, finite, info
     character(len=256), intent(out) :: message
     interface
+        subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, &
+                                   closure_tol, max_nsteps, y0, period, jacobi, mono, mr, mi, &
+                                   s, c, residual, quarter, nsteps_used, iterations, nfev, &
+                                   info, message)
+            use, intrinsic :: iso_c_binding, only: c_double, c_int
+            include "flat_hill_orbit_args.inc"
+        end subroutine flat_hill_orbit
         subroutine flat_hill_residuals(nm, ms, kappa, y0s, res)
             use, intrinsic :: iso_c_binding, only: c_double, c_int
             integer(c_int), intent(in) :: nm
@@ -34,33 +40,12 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
             real(c_double), intent(out) :: res(nm)
         end subroutine flat_hill_residuals
     end interface
-    type(hill_orbit) :: orb
-    type(hill_orbit_options) :: opt
-    real(c_double) :: r(1)
-    if (nsteps > 0) opt%nsteps = nsteps
-    if (closure_tol > 0.0_c_double) opt%closure_tol = closure_tol
-    if (max_nsteps > 0) opt%max_nsteps = max_nsteps
-    opt%full_period = full_period /= 0
-    if (use_guess /= 0) then
-        call hill_variation_orbit(m, kappa, orb, opt, guess)
-    else
-        call hill_variation_orbit(m, kappa, orb, opt)
-    end if
-    y0 = orb%y0
-    period = orb%period
-    jacobi = orb%jacobi
-    mono = orb%monodromy
-    mult(1, :) = orb%mr
-    mult(2, :) = orb%mi
-    s = orb%stability_index
-    c = orb%c
-    residual = orb%residual
-    quarter = orb%quarter_state
-    nsteps_used = orb%nsteps
-    iterations = orb%iterations
-    nfev = orb%nfev
-    info = orb%info
-    message = orb%message
+    real(c_double) :: r(1), mr(4), mi(4)
+    call flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, closure_tol, &
+                         max_nsteps, y0, period, jacobi, mono, mr, mi, s, c, residual, &
+                         quarter, nsteps_used, iterations, nfev, info, message)
+    mult(1, :) = mr
+    mult(2, :) = mi
     true_res = huge(1.0_c_double)
     scale = 1.0_c_double
     finite = 0

@@ -93,19 +93,9 @@ subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces,
     include "flat_spec_args.inc"
     integer(c_int), intent(in) :: source
     integer(c_int), intent(in) :: has_jac, has_gamma, has_nh_gamma, rheonomic, mh, mn
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
-    integer(c_int), intent(in) :: method
-    real(c_double), intent(in) :: rtol, atol
-    integer(c_int), intent(in) :: iopt(5)
-    real(c_double), intent(in) :: ropt(5)
-    integer(c_int), intent(in) :: neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(c_int), intent(in) :: ne
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    integer(c_int), intent(out) :: stats(7)
-    real(c_double), intent(out) :: moved(2)
-    integer(c_int), intent(out) :: info
+    include "flat_constrained_args.inc"
     character(len=256), intent(out) :: message
 !f2py external mass, forces, phi, jac, gamma, nh, nhgamma, store, events, evstore
     interface

@@ -90,23 +90,13 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
                       sp_ptr, sp_idx, counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_system, only: flat_system, SOURCE_SPEC
     use conmech_flat_ode_support, only: run_solve, copy_message
     implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2)
-    real(c_double), intent(in) :: y0(n)
-    integer(c_int), intent(in) :: method
-    real(c_double), intent(in) :: rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    include "flat_solve_args.inc"
     integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
@@ -114,24 +104,19 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
     include "flat_solve_callbacks.inc"
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
-    character(len=24) :: buf
 
     counts = 0
     dense_form = 0
-    call flat_system(name, real(params(1:np), dp), nspec, spec, fun, jfun, source, n, sys, &
-                     info, msg)
+    if (source == SOURCE_SPEC) then     ! y0 must have the built-in or compiled system's size
+        call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, "", sys, &
+                                 info, msg)
+    else
+        call flat_system(name, real(params(1:np), dp), nspec, spec, fun, jfun, source, n, &
+                         sys, info, msg)
+    end if
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
         return
-    end if
-    if (source == SOURCE_SPEC) then
-        if (spec_dimension(name, nspec, spec) /= n) then
-            info = CM_BAD_INPUT
-            write (buf, '(i0)') spec_dimension(name, nspec, spec)
-            call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
-                              //trim(name)//"'", message)
-            return
-        end if
     end if
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &

@@ -20,16 +20,13 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
                              cap, t_out, y_out, nt, counts, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_result
-    use conmech_flat_spec, only: spec_system, spec_dimension
+    use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: solve_into, store_result, copy_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np, nspec
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: t0, tf
     real(c_double), intent(in) :: y0(n)
@@ -42,40 +39,18 @@ subroutine flat_solve_native(name, np, params, nspec, spec, store, n, t0, tf, y0
     real(c_double), intent(out) :: t_out(max(cap, 1)), y_out(n, max(cap, 1))
     integer(c_int), intent(out) :: nt, counts(5), info
     character(len=256), intent(out) :: message
-!f2py external store
-    interface
-        subroutine store(t, y, ev_t, ev_y, ev_id, ts, hs, coef, n, nt, nev, nseg, nf1)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nt, nev, nseg, nf1
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: y(n, nt)
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_y(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-            real(c_double), intent(in) :: ts(nseg)
-            real(c_double), intent(in) :: hs(nseg)
-            real(c_double), intent(in) :: coef(n, nf1, nseg)
-        end subroutine store
-    end interface
+    include "flat_store_callback.inc"
     class(ode_system), allocatable :: sys
     type(ode_result) :: res
     character(len=:), allocatable :: msg
-    character(len=24) :: buf
     integer(c_int) :: none(1), dense_form
 
     ! t_out and y_out are written up to nt only (f2py hands them over zero-filled)
     nt = 0
     counts = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
+    call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, "", sys, info, msg)
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        write (buf, '(i0)') spec_dimension(name, nspec, spec)
-        call copy_message("bad input: y0 must have size "//trim(buf)//" for the system '" &
-                          //trim(name)//"'", message)
         return
     end if
     none = 0

@@ -17,14 +17,7 @@ subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, clos
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
     implicit none
-    real(c_double), intent(in) :: m, kappa
-    integer(c_int), intent(in) :: nsteps, full_period, use_guess
-    real(c_double), intent(in) :: guess(2), closure_tol
-    integer(c_int), intent(in) :: max_nsteps
-    real(c_double), intent(out) :: y0(4), period, jacobi, mono(4, 4), mr(4), mi(4), s, c
-    real(c_double), intent(out) :: residual, quarter(4)
-    integer(c_int), intent(out) :: nsteps_used, iterations, nfev, info
-    character(len=256), intent(out) :: message
+    include "flat_hill_orbit_args.inc"
     type(hill_orbit) :: orb
     type(hill_orbit_options) :: opt
     real(c_double), allocatable :: g(:)

@@ -41,6 +41,7 @@ import numpy as np
 
 from .. import _conmech
 from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
+from .._core.checks import time_points as _time_points, time_span as _time_span
 from .solve import solve_ivp as _solve_ivp
 from .._core.native import NativeSystem, function_address
 from .._core.status import BAD_INPUT
@@ -299,13 +300,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
 
     # ---------------------------------------------------------------- t_span, y0, params
-    try:
-        if len(t_span) != 2:
-            raise ValueError("t_span must have two elements (t0, tf)")
-    except TypeError:
-        raise TypeError("t_span must be a sequence (t0, tf)") from None
-    t0 = _real_scalar(t_span[0], "t_span[0]")
-    tf = _real_scalar(t_span[1], "t_span[1]")
+    t0, tf = _time_span(t_span)
     if not (math.isfinite(t0) and math.isfinite(tf)):
         raise ValueError("t_span must be finite")
     y0_in = np.asarray(y0)
@@ -376,24 +371,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         raise TypeError("terminal must be a bool")
 
     # ---------------------------------------------------------------- t_eval, events
-    if t_eval is None:
-        t_ev = _PAD[:0]
-    else:
-        try:
-            t_ev = np.array(t_eval, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError("t_eval must be an array of real numbers") from None
-        if t_ev.ndim != 1:
-            raise ValueError("t_eval must be 1-dimensional")
-        if not np.all(np.isfinite(t_ev)):
-            raise ValueError("t_eval contains NaN or Inf")
-        lo, hi = min(t0, tf), max(t0, tf)
-        if np.any(t_ev < lo) or np.any(t_ev > hi):
-            raise ValueError("values in t_eval are not within t_span")
-        d = np.diff(t_ev)
-        if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
-            raise ValueError("values in t_eval are not properly sorted (strictly "
-                             "monotonic in the direction of integration)")
+    t_ev = _PAD[:0] if t_eval is None else _time_points(t_eval, t0, tf)
     if events is None:
         evs = []
     elif isinstance(events, Crossing) or callable(events):

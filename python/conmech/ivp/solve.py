@@ -6,7 +6,6 @@ from typing import Any, Callable, Sequence  # noqa: F401 (annotations)
 
 from numpy.typing import ArrayLike  # noqa: F401 (annotations)
 import math
-import numbers
 
 import warnings
 
@@ -15,14 +14,19 @@ import numpy as np
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
-    real_scalar as _real_scalar, tolerance as _tolerance
-from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSolution
+    real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
+    time_span as _time_span, tolerance as _tolerance
+from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import jacobian_callback, is_sparse, sparsity_pattern
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
+from .._core.model import model_of
 from .._core.native import _NO_SPEC, NativeSystem
 from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
+from .complex_form import complex_result as _complex_result, real_form as _real_form, \
+    real_form_event as _real_form_event
+from .empty import solve_empty as _solve_empty
 from .result import _MESSAGES, OdeResult
 from .._core.status import BAD_INPUT
 
@@ -39,8 +43,6 @@ _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45
 _RK45_SCIPY = RK45_SCIPY
 _TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _HUGE = np.finfo(float).max
-# no step limit (SciPy has none): the largest count the Fortran counters hold
-_NO_LIMIT = 2**31 - 1
 # placeholders for f2py, which cannot pass empty arrays (read only, shared)
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
@@ -230,13 +232,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     info = method_info(code)
 
     # ---------------------------------------------------------------- t_span, y0
-    try:
-        if len(t_span) != 2:
-            raise ValueError("t_span must have two elements (t0, tf)")
-    except TypeError:
-        raise TypeError("t_span must be a sequence (t0, tf)") from None
-    t0 = _real_scalar(t_span[0], "t_span[0]")
-    tf = _real_scalar(t_span[1], "t_span[1]")
+    t0, tf = _time_span(t_span)
     if not math.isfinite(t0):
         raise ValueError("t_span[0] must be finite")
     if math.isnan(tf):
@@ -263,13 +259,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                          "the step size")
     hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
     step_cap = max_steps is not None
-    if max_steps is None:
-        max_steps = _NO_LIMIT
-    elif isinstance(max_steps, (bool, np.bool_)) or \
-            not isinstance(max_steps, numbers.Integral):
-        raise TypeError("max_steps must be None or an integer")
-    elif not 1 <= max_steps <= _NO_LIMIT:
-        raise ValueError("max_steps must be positive (and below 2**31)")
+    max_steps = _step_limit(max_steps)
     sparsity = options.get("jac_sparsity")
     unused = sorted(k for k in options if not (k == "jac_sparsity" and info.uses_jacobian)) \
         if options else []
@@ -291,28 +281,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise TypeError("dense_output must be a bool")
 
     # ---------------------------------------------------------------- t_eval
-    if t_eval is None:
-        t_ev = _EMPTY
-    else:
-        try:
-            t_ev = np.asarray(t_eval)
-            if t_ev.dtype.kind not in "biuf":
-                raise TypeError
-            t_ev = np.array(t_ev, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError("t_eval must be an array of real numbers") from None
-        if t_ev.ndim != 1:
-            raise ValueError("t_eval must be 1-dimensional")
-        if not np.all(np.isfinite(t_ev)):
-            raise ValueError("t_eval contains NaN or Inf")
-        lo, hi = min(t0, tf), max(t0, tf)
-        if np.any(t_ev < lo) or np.any(t_ev > hi):
-            raise ValueError("values in t_eval are not within t_span")
-        d = np.diff(t_ev)
-        if (tf >= t0 and np.any(d <= 0)) or (tf < t0 and np.any(d >= 0)):
-            raise ValueError("values in t_eval are not properly sorted (strictly "
-                             "monotonic in the direction of integration, no repeated "
-                             "values)")
+    t_ev = _EMPTY if t_eval is None else _time_points(t_eval, t0, tf)
 
     # ---------------------------------------------------------------- events
     settings = _event_settings(events)
@@ -351,9 +320,8 @@ def _refuse_taylor(fun):
     """ValueError naming why a compiled system has no Taylor recurrences, when the model
     says so (a generalized system M(q) q'' = Q); other systems are refused by the Fortran
     stepper with its own message."""
-    from ..symbolic import model_of
     try:
-        kind = getattr(model_of(fun).derived, "kind", None)
+        kind = model_of(fun).kind
     except TypeError:
         return
     if kind == "generalized":
@@ -374,105 +342,6 @@ def _check_jac_value(jac, n):
     if tuple(shape) != (n, n):
         raise ValueError(f"`jac` is expected to have shape {(n, n)}, but actually has "
                          f"{tuple(shape)}.")
-
-
-def _real_form(fun, n):
-    """fun of a complex y as a function of [Re y; Im y] returning [Re f; Im f] (also for
-    a vectorized fun: columns)."""
-    def real_fun(t, u, *a):
-        y = u[:n] + 1j * u[n:]
-        r = fun(t, y, *a)
-        if r is None:
-            return None
-        f = np.asarray(r)
-        if f.dtype.kind not in "biufc":
-            return f          # the callback wrapper names the bad type
-        if f.size != y.size:
-            raise ValueError(f"fun must return an array of shape {y.shape} (complex), got "
-                             f"shape {f.shape}")
-        f = f.reshape(y.shape)
-        return np.concatenate([f.real, f.imag], axis=0)
-    return real_fun
-
-
-def _real_form_event(event, n):
-    def real_event(t, u, *a):
-        return event(t, u[:n] + 1j * u[n:], *a)
-    return real_event
-
-
-def _complex_result(res, n):
-    """The result of the real form back in complex numbers."""
-    if isinstance(res.y, np.ndarray):
-        res.y = res.y[:n] + 1j * res.y[n:]
-    if res.y_events is not None:
-        res.y_events = [ye[:, :n] + 1j * ye[:, n:] if ye.size else ye for ye in res.y_events]
-    if res.sol is not None:
-        res.sol = ComplexSolution(res.sol, n)
-    return res
-
-
-def _solve_empty(fun, builtin, args, t0, tf, y0, t_ev, with_t_eval, dense, settings,
-                 vectorized):
-    """A state of dimension zero (SciPy's solvers finish at once): fun is called once
-    (its return must be empty), the events are functions of t alone and located by
-    bisection on [t0, tf] (tf finite)."""
-    y = y0.copy()
-    yy = y[:, None] if vectorized else y
-    r = fun(t0, yy, *args)
-    as_result(r if r is not None else None, (0,), "fun")
-    t_end, status = tf, 0
-    t_events = y_events = None
-    if settings:
-        t_events = [[] for _ in settings]
-        remaining = [c for _, c, _, _ in settings]
-        found = []
-        if math.isfinite(tf) and tf != t0:
-            for k, (e, _, d, _) in enumerate(settings):
-                ga = float(as_result(e(t0, y.copy(), *args), (), f"events[{k}]"))
-                gb = float(as_result(e(tf, y.copy(), *args), (), f"events[{k}]"))
-                if (ga < 0 <= gb and d >= 0) or (ga > 0 >= gb and d <= 0):
-                    found.append((_bisect(lambda t: e(t, y.copy(), *args), t0, tf, ga, gb),
-                                  k))
-        for te, k in sorted(found, key=lambda x: (x[0] - t0) * math.copysign(1, tf - t0)):
-            if status == 1:
-                break
-            t_events[k].append(te)
-            if remaining[k] > 0:
-                remaining[k] -= 1
-                if remaining[k] == 0:
-                    t_end, status = te, 1
-        y_events = [np.zeros((len(te), 0)) if te else np.asarray([]) for te in t_events]
-        t_events = [np.asarray(te) for te in t_events]
-    if with_t_eval:
-        sgn = math.copysign(1.0, tf - t0)
-        t = t_ev[(t_ev - t_end) * sgn <= 0]
-    else:
-        t = np.array([t0, t_end])
-    sol = OdeSolution([t0, t_end], [ConstantDenseOutput(t0, t_end, y)]) if dense else None
-    return OdeResult(t=t, y=np.zeros((0, t.size), dtype=y.dtype), sol=sol,
-                     t_events=t_events, y_events=y_events, nfev=1, njev=0, nlu=0,
-                     status=status, message=_MESSAGES[status], success=True, naccept=0,
-                     nreject=0)
-
-
-def _bisect(g, a, b, ga, gb):
-    """A zero of g(t) between a and b (g(a) = ga, g(b) = gb of opposite signs or gb = 0)
-    by bisection to the spacing of doubles."""
-    if gb == 0:
-        return b
-    for _ in range(2100):
-        m = 0.5 * (a + b)
-        if m == a or m == b:
-            break
-        gm = float(g(m))
-        if gm == 0:
-            return m
-        if (gm < 0) == (ga < 0):
-            a, ga = m, gm
-        else:
-            b = m
-    return b
 
 
 def _solve(problem, common, h0, jac, pattern):

@@ -22,15 +22,15 @@ infinite for the adaptive methods, and there is no limit on the number of steps 
 ``max_steps`` is given.
 """
 import math
-import numbers
 import warnings
 
 import numpy as np
 
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
+from .complex_form import real_form as _real_form
 from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput
-from .._core.checks import initial_state, real_scalar, tolerance
+from .._core.checks import initial_state, real_scalar, step_limit, tolerance
 from .implicit import jacobian_callback, sparsity_pattern, is_sparse
 from .methods import BY_NAME, RK45_SCIPY, method_info
 from .._core.native import NativeSystem
@@ -44,7 +44,6 @@ __all__ = ["Stepper", "RungeKutta", "DOP853", "RK45", "DOPRI5", "VERNER98", "RK4
 _START, _STEP, _DENSE, _SIZES = 0, 1, 2, 3      # flat_stepper actions
 assert (_I_NJEV, _I_NLU) == (_I_NFEV + 1, _I_NFEV + 2)   # read as one slice
 _HUGE = np.finfo(float).max
-_NO_LIMIT = 2**31 - 1
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -176,13 +175,7 @@ class Stepper:
         hmax = real_scalar(max_step, "max_step")
         if not hmax > 0:
             raise ValueError("max_step must be positive")
-        if max_steps is None:
-            max_steps = _NO_LIMIT
-        elif isinstance(max_steps, (bool, np.bool_)) or \
-                not isinstance(max_steps, numbers.Integral):
-            raise TypeError("max_steps must be None or an integer")
-        elif not 1 <= max_steps <= _NO_LIMIT:
-            raise ValueError("max_steps must be positive (and below 2**31)")
+        max_steps = step_limit(max_steps)
 
         self.fun = fun
         self.t_old = None
@@ -468,24 +461,6 @@ class Gauss6(Gauss):
     _code = BY_NAME["GAUSS6"].code
     order = 6
     n_stages = 3
-
-
-def _real_form(fun, n):
-    """fun of a complex y as a function of [Re y; Im y] returning [Re f; Im f]."""
-    def real_fun(t, u):
-        y = u[:n] + 1j * u[n:]
-        r = fun(t, y)
-        if r is None:
-            return None
-        f = np.asarray(r)
-        if f.dtype.kind not in "biufc":
-            return f          # the callback wrapper names the bad type
-        if f.size != n:
-            raise ValueError(f"fun must return an array of shape ({n},) (complex), got "
-                             f"shape {f.shape}")
-        f = f.reshape(n)
-        return np.concatenate([f.real, f.imag])
-    return real_fun
 
 
 def _butcher(cls):

@@ -27,7 +27,8 @@ from .. import _conmech
 from . import degrees_of_freedom as _dof
 from .._core.builtin_table import CONSTRAINED_NAMES
 from .._core.callback import Guard, as_result, message_text
-from .._core.checks import event_settings
+from .._core.checks import event_settings, real_number as _real_number
+from .._core.model import model_of
 from ..ivp.methods import BY_NAME
 from .._core.native import _NO_SPEC, _unused_callback, check_params
 from .._core.result import DictResult
@@ -210,12 +211,7 @@ class ConstrainedSystem:
 
 
 def _finite(value, name, low=0.0, low_open=False, allow_inf=False):
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    v = _real_number(value, name)
     if np.isnan(v) or (np.isinf(v) and not (allow_inf and v > 0)):
         raise ValueError(f"{name} must be finite, got {v}")
     if v < low or (low_open and v == low):
@@ -472,13 +468,13 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
     if info == BAD_INPUT:
         raise ValueError(message)
     if info < 0 and message.startswith("inconsistent initial position"):
-        # a mechanism whose loops cannot close at q0: say which loop (a bad input, not a
-        # failed integration)
+        # a mechanism whose loops cannot close at q0: its model says which loop (a bad
+        # input, not a failed integration)
         try:
-            from ..symbolic.loops import closure_error
-        except ImportError:         # no sympy: no symbolic mechanism either
-            closure_error = None
-        err = closure_error(system, q0, t0) if closure_error is not None else None
+            model = model_of(system)
+        except TypeError:           # not a generated system: no loops to name
+            model = None
+        err = model.closure_error(system, q0, t0) if model is not None else None
         if err is not None:
             raise err
     m = system.n_hol + system.n_nh

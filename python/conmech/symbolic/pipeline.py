@@ -22,10 +22,13 @@ import sympy as sp
 
 from ..mechanics import compiled
 from .._core import slot_table as _table
+from .._core.model import SystemModel, model_of
 from .build import (CacheError, _conmech_version, cache_dir, check_private, compile_source,
                     load)
 from .codegen import CODEGEN_VERSION, generate
 from .derive import _as_value, singular_everywhere
+from .description import _NotPlain, _param_names, store_description
+from .loop_report import closure_error as _closure_error
 from .momenta import as_lagrangian_system
 
 __all__ = ["CompiledModel", "compile_model", "save_model", "model_of"]
@@ -35,7 +38,7 @@ _P = ctypes.POINTER(ctypes.c_double)
 _V = ctypes.c_void_p
 
 
-class CompiledModel:
+class CompiledModel(SystemModel):
     """A derived system compiled and loaded: the library, the entry-point addresses, the
     generated source, and timings (``times``: derive, generate, compile_or_load, load;
     ``cache_hit``), the compiler ``flags`` (None: the defaults). An ode model's Taylor
@@ -56,6 +59,13 @@ class CompiledModel:
     @property
     def kind(self):
         return self.derived.kind
+
+    def closure_error(self, system, q0, t0=0.0):
+        """None when the closed loops of `system` (a tree made from this model) close at
+        q0, or it has none; otherwise the ValueError naming the loop with the largest
+        residual (:func:`conmech.constrained.solve` asks when its initial projection
+        fails)."""
+        return _closure_error(self, system, q0, t0)
 
     def _shapes(self, entry):
         d = self.derived
@@ -208,17 +218,6 @@ def _umask():
     return mask
 
 
-def model_of(system):
-    """The :class:`CompiledModel` (derived expressions, source, library) behind a system
-    made by this module (also after ``with_params``)."""
-    keep = getattr(system, "_keep", None)
-    if isinstance(system, CompiledModel):
-        return system
-    if isinstance(keep, tuple) and keep and isinstance(keep[0], CompiledModel):
-        return keep[0]
-    raise TypeError("not a system made by conmech.symbolic")
-
-
 def _system(model):
     """The conmech.compiled system for a model."""
     d = model.derived
@@ -249,16 +248,12 @@ def _input_key(kind, inputs, params, options):
     the inputs are not plainly cacheable (then the derivation runs and reports errors)."""
     if not isinstance(params, dict):
         return None
-    names = []
-    for k, v in params.items():
-        if isinstance(k, sp.Symbol):
-            names.append(k.name)
-        elif isinstance(k, str):
-            names.append(k)
-        else:
-            return None
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-            return None
+    # the names without their values; a value that is not a plain number, or an integer
+    # beyond a double's range, is left to the derivation to report
+    try:
+        names = list(_param_names(params)[::2])
+    except (_NotPlain, OverflowError):
+        return None
     try:
         text = repr((kind, [sp.srepr(sp.sympify(x)) if x is not None else None
                             for x in inputs], names, options, CODEGEN_VERSION,
@@ -362,7 +357,6 @@ def _construct(kind, inputs, params, options, derive, flags, model_only, descrip
     # the derivation cache's key, under which the Taylor library's source is kept too
     model.cache_key = key
     if description and key:
-        from .description import store_description
         store_description(description, key, params)
     model.times["total"] = time.perf_counter() - t0
     return model if model_only else _system(model)

@@ -149,18 +149,8 @@ contains
                                neval, t_eval, store, stats, moved, info, message, ne, &
                                ev_dir, ev_term, events, evstore)
         class(constrained_system), intent(in) :: sys
-        integer(c_int), intent(in) :: n
-        real(c_double), intent(in) :: t_span(2), q0(n), v0(n)
-        integer(c_int), intent(in) :: method
-        real(c_double), intent(in) :: rtol, atol
-        integer(c_int), intent(in) :: iopt(5)
-        real(c_double), intent(in) :: ropt(5)
-        integer(c_int), intent(in) :: neval
-        real(c_double), intent(in) :: t_eval(max(neval, 1))
+        include "../flat_constrained_args.inc"
         external :: store
-        integer(c_int), intent(out) :: stats(7)
-        real(c_double), intent(out) :: moved(2)
-        integer(c_int), intent(out) :: info
         character(len=*), intent(out) :: message
         integer(c_int), intent(in), optional :: ne
         integer(c_int), intent(in), optional :: ev_dir(:), ev_term(:)

@@ -134,17 +134,7 @@ contains
                          jac_const, nnz, sp_ptr, sp_idx, events, store, counts, dense_form, &
                          info, message)
         class(ode_system), intent(in) :: sys
-        integer(c_int), intent(in) :: n
-        real(c_double), intent(in) :: t_span(2)
-        real(c_double), intent(in) :: y0(n)
-        integer(c_int), intent(in) :: method
-        real(c_double), intent(in) :: rtol(n), atol(n)
-        real(c_double), intent(in) :: first_step, max_step
-        integer(c_int), intent(in) :: max_steps, dense, neval
-        real(c_double), intent(in) :: t_eval(max(neval, 1))
-        integer(c_int), intent(in) :: ne
-        integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-        real(c_double), intent(in) :: ev_res(max(ne, 1))
+        include "../flat_solve_args.inc"
         integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
         external :: events, store
         integer(c_int), intent(out) :: counts(5), dense_form, info
@@ -167,17 +157,7 @@ contains
                           max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
                           jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events)
         class(ode_system), intent(in) :: sys
-        integer(c_int), intent(in) :: n
-        real(c_double), intent(in) :: t_span(2)
-        real(c_double), intent(in) :: y0(n)
-        integer(c_int), intent(in) :: method
-        real(c_double), intent(in) :: rtol(n), atol(n)
-        real(c_double), intent(in) :: first_step, max_step
-        integer(c_int), intent(in) :: max_steps, dense, neval
-        real(c_double), intent(in) :: t_eval(max(neval, 1))
-        integer(c_int), intent(in) :: ne
-        integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-        real(c_double), intent(in) :: ev_res(max(ne, 1))
+        include "../flat_solve_args.inc"
         integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
         type(ode_result), intent(out) :: res
         integer(c_int), intent(out) :: counts(5), info
