@@ -329,8 +329,9 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
             # order (other systems without Taylor code: the Fortran stepper's message)
             view = first_order_view(fun)
             if view is not fun:
+                # the tolerances as checked here (a warning about them is given once)
                 res = solve_ivp(view, t_span, y0, method, t_eval, dense_output, events,
-                                vectorized, args, rtol=rtol, atol=atol,
+                                vectorized, args, rtol=rtol_v, atol=atol_v,
                                 first_step=first_step, max_step=max_step,
                                 max_steps=max_steps, jac=jac, **options)
                 return name_the_mass_matrix(fun, res)
