@@ -1,6 +1,7 @@
 """Taylor's method for generalized systems M(t, q) q'' = Q(t, q, q') made by
 :mod:`conmech.symbolic` (``lagrangian_system`` with a Lagrangian or with ``mass=`` and
-``forces=``, ``dalembert_system``, trees through their M and Q): the run integrates the
+``forces=``, ``dalembert_system``; not the trees, whose accelerations come from their
+articulated-body code): the run integrates the
 system's first-order view y = [q; v], an ode system whose Taylor coefficients come from
 the recurrences of M and Q and the linear solve order by order
 (:mod:`conmech.symbolic.taylor_generalized`, compiled on first need and cached like an ode

@@ -80,12 +80,13 @@ class GeneralizedDecomposition:
 def generalized_decomposition(d):
     """(:class:`GeneralizedDecomposition`, None) of the generalized record `d`, or (None,
     reason) when its accelerations have no Taylor recurrences here (a non-smooth
-    expression, no mass matrix, an asymmetric one)."""
+    expression, no mass matrix as an expression (trees), an asymmetric one)."""
     if getattr(d, "kind", None) != "generalized":
         return None, "not a system in generalized coordinates"
-    if d.M is None or d.Q is None:
+    if getattr(d, "aba", None) is not None or d.M is None or d.Q is None:
         return None, ("the system has no mass matrix and forces as expressions (method "
-                      "TAYLOR expands M and Q)")
+                      "TAYLOR expands M and Q; a symbolic tree's accelerations come from "
+                      "its articulated-body code, which has no Taylor recurrences)")
     M = d.M
     for i in range(d.n):
         for j in range(i + 1, d.n):

@@ -32,7 +32,7 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "MODULE", "PARTS"]
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 1     # of the kept source (conmech_KEY.taylor.json)
+_FORMAT = 2     # of the kept source (conmech_KEY.taylor.json; 2: generalized models too)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
