@@ -5,8 +5,9 @@
 !! test would count as error) within 200 tol, or the rounding floor that e = 0.9 amplifies
 !! at tighter tolerances (1e-11: heyoka's errors at 1e-15 range over 1e-12 .. 4e-12 under
 !! 1-ulp changes of y0), energy and angular momentum are kept, the
-!! observed order at fixed steps is the order p, and a system without Taylor code is
-!! refused with a message.
+!! observed order at fixed steps is the order p, the stepper packed and unpacked at every
+!! step takes ode_solve's steps bit for bit, and a system without Taylor code is refused
+!! with a message.
 program test_taylor
     use conmech_kinds, only: dp, pi
     use conmech_status
@@ -14,7 +15,9 @@ program test_taylor
     use conmech_ode_options, only: ode_options, ode_stats
     use conmech_ode_solver, only: ode_solve, ode_result
     use conmech_ode_options, only: METHOD_TAYLOR
-    use conmech_taylor_stepper, only: taylor_propagate, taylor_order
+    use conmech_taylor_stepper, only: taylor_propagate, taylor_order, taylor_stepper
+    use conmech_ode_stepper, only: stepper_pack, stepper_unpack
+    use conmech_state_packer, only: state_packer
     use taylor_kepler_model, only: kepler_sym, new_kepler_sym
     use conmech_testing, only: test_suite
     implicit none
@@ -100,6 +103,46 @@ program test_taylor
         call res%sol%eval(1.234_dp, yd)
         call ts%check_less(maxval(abs(yd - kepler_exact(y0, 1.234_dp))), 1.0e-10_dp, &
                            "dense output (the Taylor polynomial) at t = 1.234")
+    end block
+
+    ! packed after every step and unpacked into a fresh stepper (the Python Stepper's
+    ! way): the steps of ode_solve, bit for bit; a state packed before the first expansion
+    ! (init only) packs and unpacks too
+    block
+        type(ode_result) :: res
+        type(taylor_stepper), allocatable :: s1, s2
+        type(state_packer) :: pk
+        logical :: same
+        integer :: k
+        opt = ode_options()
+        opt%method = METHOD_TAYLOR
+        opt%rtol = 1.0e-12_dp
+        opt%atol = 1.0e-12_dp
+        call ode_solve(kep, [0.0_dp, 2.0_dp*pi], y0, opt, res)
+        allocate (s1)
+        call s1%init(0.0_dp, 2.0_dp*pi, y0, opt, info, msg)
+        call stepper_pack(s1, pk)
+        allocate (s2)
+        call stepper_unpack(s2, METHOD_TAYLOR, pk%r(1:pk%nr), pk%iv(1:pk%ni), &
+                            pk%w(:, 1:pk%nw), info, msg)
+        call ts%check(info == CM_SUCCESS .and. s2%order == s1%order .and. &
+                      all(s2%y == y0), "a Taylor state packed after init only: "//msg)
+        deallocate (s2)
+        call s1%start(kep, info, msg)
+        same = info == CM_SUCCESS
+        do k = 2, res%nt
+            call stepper_pack(s1, pk)
+            allocate (s2)
+            call stepper_unpack(s2, METHOD_TAYLOR, pk%r(1:pk%nr), pk%iv(1:pk%ni), &
+                                pk%w(:, 1:pk%nw), info, msg)
+            call move_alloc(s2, s1)
+            if (info == CM_SUCCESS) call s1%step(kep, 2.0_dp*pi, info, msg)
+            same = same .and. info == CM_SUCCESS .and. s1%t == res%t(k) .and. &
+                   all(s1%y == res%y(:, k))
+        end do
+        call ts%check(same .and. s1%last .and. s1%st%nfev == res%stats%nfev .and. &
+                      s1%st%nreject == res%stats%nreject, &
+                      "Taylor packed at every step = ode_solve, bit for bit")
     end block
 
     ! no Taylor code: refused with a message

@@ -136,7 +136,8 @@ def _circles(graph):
 # system on first need (sympy only on that path; checked by the layer test). Any other
 # question a lower layer has for a generated system goes through its model
 # (conmech._core.model), not through an import of conmech.symbolic.
-_LAZY_EDGES = {("conmech.ivp.taylor", "conmech.symbolic")}
+_LAZY_EDGES = {("conmech.ivp.taylor", "conmech.symbolic"),
+               ("conmech.ivp.taylor_generalized", "conmech.symbolic")}
 
 
 def test_no_import_circle_through_imports_inside_functions():

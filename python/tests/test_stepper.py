@@ -322,7 +322,7 @@ def test_stepper_by_name_is_the_class():
         conmech.Stepper(kepler, 0.0, y0, 3.0, method="RATTLE")    # constrained systems only
     with pytest.raises(ValueError, match="first_step"):
         conmech.Stepper(kepler, 0.0, y0, 3.0, method="GAUSS4")    # a fixed-step method
-    # Taylor's method runs whole integrations (solve_ivp), not steps from Python: refused
-    # before anything reaches Fortran, naming where it runs
-    with pytest.raises(ValueError, match="solve_ivp"):
+    # Taylor's method needs generated coefficients (conmech.symbolic): a Python function
+    # has none, and the stepper says so (test_taylor_generalized.py steps symbolic systems)
+    with pytest.raises(ValueError, match="no Taylor coefficients"):
         conmech.Stepper(kepler, 0.0, y0, 3.0, method="TAYLOR")

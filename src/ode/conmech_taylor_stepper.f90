@@ -344,7 +344,10 @@ contains
     end function taylor_f_finite
 
     !> The whole state, for step-by-step use (the state parts of both expansions; the
-    !! operations' columns are scratch, recomputed by the next expansion).
+    !! operations' columns are scratch, recomputed by the next expansion). A state packed
+    !! before the first expansion (init only, or a start that failed) holds zero
+    !! coefficients. The scales E_i of the step's safety check are a function of y and the
+    !! tolerances: recomputed on reading, as `propose` computed them.
     subroutine taylor_transfer(self, p)
         class(taylor_stepper), intent(inout) :: self
         type(state_packer), intent(inout) :: p
@@ -365,8 +368,13 @@ contains
         call p%column(self%rtol)
         call p%column(self%atol)
         if (.not. p%reading()) then
-            a = transpose(self%jet(:, 1:self%n))
-            b = transpose(self%jold(:, 1:self%n))
+            ! the columns 0..order of the packed layout (explicit bounds: an assignment of
+            ! the transpose would give them the bounds 1..order + 1)
+            allocate (a(self%n, 0:self%order), b(self%n, 0:self%order))
+            a = 0.0_dp
+            b = 0.0_dp
+            if (allocated(self%jet)) a(:, :) = transpose(self%jet(:, 1:self%n))
+            if (allocated(self%jold)) b(:, :) = transpose(self%jold(:, 1:self%n))
         end if
         call p%columns(a, 0, self%order)
         call p%columns(b, 0, self%order)
@@ -380,6 +388,9 @@ contains
             if (allocated(b)) self%jold(:, 1:self%n) = transpose(b)
             if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
             allocate (self%dy(self%n), self%ynew(self%n), self%e(self%n))
+            self%dy = 0.0_dp
+            self%ynew = 0.0_dp
+            call taylor_scales(self%n, self%nblock, self%y, self%rtol, self%atol, self%e)
         end if
     end subroutine taylor_transfer
 

@@ -298,6 +298,11 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
     code = _METHOD_CODES.get(method.upper(), 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+    if method.upper() == "TAYLOR" and getattr(system, "kind", None) == "generalized":
+        # M(q) q'' = Q made by conmech.symbolic: its first-order view (no batch routine:
+        # member by member)
+        from .taylor_generalized import first_order_view
+        system = first_order_view(system)
 
     # ---------------------------------------------------------------- t_span, y0, params
     t0, tf = _time_span(t_span)

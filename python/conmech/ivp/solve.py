@@ -21,7 +21,7 @@ from .implicit import jacobian_callback, is_sparse, sparsity_pattern
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
-from .._core.model import model_of
+from .taylor_generalized import first_order_view, name_the_mass_matrix
 from .._core.native import _NO_SPEC, NativeSystem
 from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
 from .complex_form import complex_result as _complex_result, real_form as _real_form, \
@@ -292,8 +292,17 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     if builtin and code == _TAYLOR:
         if getattr(fun, "taylor", None):        # the recurrences written out for the order
             fun = with_fixed_order(fun, rtol, atol)
-        else:
-            _refuse_taylor(fun)
+        elif getattr(fun, "kind", None) == "generalized":
+            # M(q) q'' = Q: its first-order view, whose recurrences solve with M order by
+            # order (other systems without Taylor code: the Fortran stepper's message)
+            view = first_order_view(fun)
+            if view is not fun:
+                # the tolerances as checked here (a warning about them is given once)
+                res = solve_ivp(view, t_span, y0, method, t_eval, dense_output, events,
+                                vectorized, args, rtol=rtol_v, atol=atol_v,
+                                first_step=first_step, max_step=max_step,
+                                max_steps=max_steps, jac=jac, **options)
+                return name_the_mass_matrix(fun, res)
     if builtin and not settings and not dense_output and jac is None and pattern is None:
         # the common case (a compiled system, nothing called back): one Fortran call
         return _solve_native(fun, t0, tf, y0, t_ev, t_eval is not None, code, rtol_v,
@@ -314,24 +323,6 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                   atol=np.concatenate([atol_v, atol_v]))
     res = _solve(problem, common, h0, None, None)
     return _complex_result(res, n)
-
-
-def _refuse_taylor(fun):
-    """ValueError naming why a compiled system has no Taylor recurrences, when the model
-    says so (a generalized system M(q) q'' = Q); other systems are refused by the Fortran
-    stepper with its own message."""
-    try:
-        kind = model_of(fun).kind
-    except TypeError:
-        return
-    if kind == "generalized":
-        raise ValueError(
-            "method TAYLOR: a generalized system M(q) q'' = Q (symbolic.lagrangian_system) "
-            "has no Taylor recurrences: its accelerations come from a linear solve with "
-            "M(q) at every evaluation, and the recurrences of that solve are not generated. "
-            "Use method DOP853 or VERNER98, or write the first-order system with explicit "
-            "accelerations (q'' = M(q)^-1 Q, e.g. sympy's M.LUsolve(Q)) as "
-            "symbolic.ode_system")
 
 
 def _check_jac_value(jac, n):

@@ -111,13 +111,6 @@ class Stepper:
             if entry is None or entry.constrained_only:
                 raise ValueError(f"method must be a method of the table, one of "
                                  f"{', '.join(sorted(BY_NAME))}, got {name!r}")
-            if entry.name.upper() == "TAYLOR":
-                # the Taylor stepper's state (its jet, its order) is not packed for
-                # step-by-step use from Python: solve_ivp, ensemble.solve and stability.stm
-                # run it, and the Fortran ode_stepper steps it
-                raise ValueError("method TAYLOR is not available step by step from Python: "
-                                 "use conmech.solve_ivp(..., method='TAYLOR') (dense output "
-                                 "and events included), ensemble.solve or stability.stm")
             code = entry.code
         self._code = code
         info = method_info(code)
@@ -154,6 +147,8 @@ class Stepper:
             raise ValueError(_COMPLEX_REFUSED)
         self._rtol = tolerance(rtol, "rtol", n)
         self._atol = tolerance(atol, "atol", n)
+        if info.name.upper() == "TAYLOR" and self._builtin:
+            fun = _taylor_system(fun, self._rtol, self._atol)
         name = type(self).__name__ if type(self) is not Stepper else info.name
         if info.fixed_step:
             if first_step is None:
@@ -461,6 +456,20 @@ class Gauss6(Gauss):
     _code = BY_NAME["GAUSS6"].code
     order = 6
     n_stages = 3
+
+
+def _taylor_system(fun, rtol, atol):
+    """The system a Taylor stepper runs, as solve_ivp runs it: a generalized symbolic
+    system's first-order view (its recurrences solve with M(q) order by order); the
+    recurrences built if still pending, and written out for the order of the tolerances.
+    Other systems as they are (the Fortran stepper names what they lack)."""
+    from .taylor import with_fixed_order
+    from .taylor_generalized import first_order_view
+    if not getattr(fun, "taylor", None):        # reading it builds a pending Taylor part
+        fun = first_order_view(fun)
+    if getattr(fun, "taylor", None):
+        fun = with_fixed_order(fun, rtol, atol)
+    return fun
 
 
 def _butcher(cls):

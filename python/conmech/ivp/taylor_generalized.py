@@ -1,0 +1,84 @@
+"""Taylor's method for generalized systems M(t, q) q'' = Q(t, q, q') made by
+:mod:`conmech.symbolic` (``lagrangian_system`` with a Lagrangian or with ``mass=`` and
+``forces=``, ``dalembert_system``; not the trees, whose accelerations come from their
+articulated-body code): the run integrates the
+system's first-order view y = [q; v], an ode system whose Taylor coefficients come from
+the recurrences of M and Q and the linear solve order by order
+(:mod:`conmech.symbolic.taylor_generalized`, compiled on first need and cached like an ode
+model's Taylor library).
+
+:func:`first_order_view` gives the view (the same parameters; the model behind it, so that
+the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
+run's message what the mass matrix is at the last accepted point (a singular or indefinite
+M makes the coefficients non-finite, which the stepper reports as a non-finite right-hand
+side or a step size too small)."""
+import numpy as np
+
+from .._core.model import model_of
+
+__all__ = ["first_order_view", "name_the_mass_matrix"]
+
+
+def _model(fun):
+    """The symbolic model of a generalized system, or None for any other system."""
+    if getattr(fun, "kind", None) != "generalized":
+        return None
+    try:
+        model = model_of(fun)
+    except TypeError:
+        return None
+    return model if getattr(model.derived, "kind", None) == "generalized" else None
+
+
+def first_order_view(fun):
+    """The first-order view (an ode system of dimension 2 ndof with Taylor coefficients)
+    of a generalized system made by conmech.symbolic, with fun's parameters; any other
+    system is returned as it is. ValueError with the reason when the generalized system's
+    accelerations have no Taylor recurrences (a non-smooth expression, an asymmetric mass
+    matrix)."""
+    model = _model(fun)
+    if model is None:
+        return fun
+    from .. import compiled
+    from ..symbolic.taylor_library import lazy_taylor
+    tay = lazy_taylor(model).get()
+    if not tay:
+        raise ValueError("method TAYLOR: the generalized system M(q) q'' = Q has no Taylor "
+                         f"recurrences: {getattr(model, 'taylor_reason', None) or 'unknown'}"
+                         ". Use method DOP853 or VERNER98")
+    base = model.__dict__.get("_taylor_view")
+    if base is None:
+        base = compiled.ode_system(
+            2*model.derived.n, tay["rhs"], params=tuple(fun.params),
+            param_names=tuple(fun.param_names), keep=model, name=fun.name,
+            taylor={"jet": tay["jet"], "nw": tay["nw"]})
+        model._taylor_view = base
+    return compiled.CompiledSystem(base.name, "ode", base.spec, np.array(fun.params),
+                                   base.param_names, base._keep, base.taylor)
+
+
+def name_the_mass_matrix(fun, res):
+    """`res` (a failed run of fun's first-order view) with its message completed by the
+    state of the mass matrix at the last accepted point: not positive definite there, or
+    its condition number."""
+    model = _model(fun)
+    if model is None or res.success or res.status != -1 or not res.t.size:
+        return res
+    n = model.derived.n
+    t, q = float(res.t[-1]), np.array(res.y[:n, -1], dtype=float)
+    try:
+        m = model.call("mass", t, q, params=np.asarray(fun.params, dtype=float))
+    except (KeyError, ValueError, TypeError, AttributeError):
+        return res
+    m = np.array(m, dtype=float).reshape(n, n)
+    if not np.all(np.isfinite(m)):
+        note = "is not finite"
+    else:
+        ev = np.linalg.eigvalsh(0.5*(m + m.T))
+        if ev[0] > 0:
+            note = f"has smallest eigenvalue {ev[0]:.3g} and largest {ev[-1]:.3g}"
+        else:
+            note = "is not positive definite (singular or indefinite)"
+    res.message = (f"{res.message} (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at "
+                   f"the last accepted point, t = {t:.6g}, {note})")
+    return res

@@ -1,0 +1,321 @@
+"""Taylor coefficients of a generalized system M(t, q) q'' = Q(t, q, q') (a
+:func:`conmech.symbolic.lagrangian_system`), through the accelerations.
+
+The first-order state is y = [q; v]. Along the solution the entries of M and Q are
+expanded by the recurrences of :mod:`conmech.symbolic.taylor` (the same decomposition into
+elementary operations as an ode system's right-hand side, with q and v as the state), and
+the accelerations a = q'' follow order by order from the linear solve M(t) a(t) = Q(t):
+the k-th coefficient of the product M a is sum_{j=0..k} M_j a_{k-j}, so
+
+    M_0 a_k = Q_k - sum_{j=1..k} M_j a_{k-j},
+
+one factorisation of M_0 per expansion (M symmetric positive definite: Cholesky) and one
+pair of triangular solves per order. Then q^[k+1] = v^[k]/(k + 1) and v^[k+1] =
+a_k/(k + 1). The history sum over j of each product M_il a_l joins the operations' history
+sums in the one loop over j of an order; entries of M that are constant (no q, no t) have
+no coefficients beyond order 0 and no history terms.
+
+For up to :data:`WRITE_OUT_MAX` degrees of freedom the factorisation and the triangular
+solves are written out in scalars (n**3/6 + n**2 multiply-adds with no loop, no array and
+no library call: a LAPACK call per order would cost more than the solve itself for such
+n); beyond, they are short loops over a local array. A mass matrix that is not positive
+definite at the expansion point (a singular configuration) gives non-finite coefficients,
+which the stepper reports as a non-finite right-hand side (see
+:func:`conmech.ivp.taylor_generalized`, which names M in the message).
+
+The routine has the signature and the work-array convention of an ode system's
+``conmech_taylor(t, order, w, p)`` (w(0:order, nw), the state in the columns 1..2n), so the
+Taylor stepper, the dense output and the step control run on it unchanged; the library
+also exports ``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; M^-1 Q] from the order-1
+expansion), the first-order right-hand side of the stepper's view of the system.
+"""
+import sympy as sp
+
+from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap
+from .taylor_decompose import TaylorUnsupported, decompose
+
+__all__ = ["generalized_decomposition", "generalized_procedures", "WRITE_OUT_MAX"]
+
+#: the Cholesky factorisation and triangular solves are written out in scalars up to this
+#: many degrees of freedom (loops over a local array beyond)
+WRITE_OUT_MAX = 8
+
+
+class GeneralizedDecomposition:
+    """The decomposition of the entries of M (upper triangle, by columns) and Q in the
+    state [q; v] (attributes: ``dec``, the :class:`Decomposition` with the entries as
+    output columns; ``n`` degrees of freedom; ``mass`` {(i, j): output index} for i <= j
+    (0-based); ``forces`` [output index]; ``acols`` the work columns of the
+    accelerations' coefficients; ``ncol`` the work columns in all)."""
+
+    def __init__(self, d):
+        n = d.n
+        M, Q = d.M, d.Q
+        self.n = n
+        self.mass = {}
+        entries = []
+        for j in range(n):
+            for i in range(j + 1):
+                self.mass[(i, j)] = len(entries)
+                entries.append(M[i, j])
+        self.forces = list(range(len(entries), len(entries) + n))
+        entries += [Q[i] for i in range(n)]
+        state = list(d.coords) + list(d.speeds)
+        self.dec = decompose(entries, state, d.t, d.params, given=True)
+        base = self.dec.ncol
+        self.acols = list(range(base + 1, base + n + 1))
+        self.ncol = base + n
+
+    def entry(self, i, j):
+        """The affine form (_Lin) of M_ij (symmetric: the upper triangle's)."""
+        return self.dec.outputs[self.mass[(min(i, j), max(i, j))]]
+
+    def entry_col(self, i, j):
+        return self.dec.out_cols[self.mass[(min(i, j), max(i, j))]]
+
+    def constant(self, i, j):
+        return not self.entry(i, j).terms
+
+
+def generalized_decomposition(d):
+    """(:class:`GeneralizedDecomposition`, None) of the generalized record `d`, or (None,
+    reason) when its accelerations have no Taylor recurrences here (a non-smooth
+    expression, no mass matrix as an expression (trees), an asymmetric one)."""
+    if getattr(d, "kind", None) != "generalized":
+        return None, "not a system in generalized coordinates"
+    if getattr(d, "aba", None) is not None or d.M is None or d.Q is None:
+        return None, ("the system has no mass matrix and forces as expressions (method "
+                      "TAYLOR expands M and Q; a symbolic tree's accelerations come from "
+                      "its articulated-body code, which has no Taylor recurrences)")
+    M = d.M
+    for i in range(d.n):
+        for j in range(i + 1, d.n):
+            if M[i, j] != M[j, i] and sp.expand(M[i, j] - M[j, i]) != 0:
+                return None, ("the mass matrix is not symmetric: Taylor's linear solve "
+                              "factorises it by Cholesky")
+    try:
+        return GeneralizedDecomposition(d), None
+    except TaylorUnsupported as exc:
+        return None, str(exc)
+
+
+def _cholesky_out(g, pp, M0, ind, fail):
+    """Written-out Cholesky factorisation of M_0 (its entries as Fortran text M0(i, j)):
+    the strictly lower factor in scalars cl<i>_<j>, the reciprocal diagonal in cd<i>."""
+    n = g.n
+    lines, names = [], []
+    one = pp.real(1)
+    for j in range(n):
+        s = M0(j, j)
+        terms = [f"cl{j + 1}_{k + 1}**2" for k in range(j)]
+        expr = f"{s}" + "".join(f" - {t}" for t in terms)
+        lines += _wrap(f"cs = {expr}", ind)
+        lines.append(f"{ind}if (.not. cs > 0.0_dp) then")
+        lines += [f"{ind}    {x}" for x in fail]
+        lines.append(f"{ind}end if")
+        lines.append(f"{ind}cd{j + 1} = {one}/sqrt(cs)")
+        names.append(f"cd{j + 1}")
+        for i in range(j + 1, n):
+            terms = [f"cl{i + 1}_{k + 1}*cl{j + 1}_{k + 1}" for k in range(j)]
+            expr = f"{M0(i, j)}" + "".join(f" - {t}" for t in terms)
+            lines += _wrap(f"cl{i + 1}_{j + 1} = ({expr})*cd{j + 1}", ind)
+            names.append(f"cl{i + 1}_{j + 1}")
+    return lines, names
+
+
+def _solve_out(n, ind):
+    """Written-out triangular solves L L^T a = r in place in the scalars cr<i>."""
+    lines = []
+    for i in range(n):
+        terms = "".join(f" - cl{i + 1}_{k + 1}*cr{k + 1}" for k in range(i))
+        lines += _wrap(f"cr{i + 1} = (cr{i + 1}{terms})*cd{i + 1}", ind)
+    for i in reversed(range(n)):
+        terms = "".join(f" - cl{k + 1}_{i + 1}*cr{k + 1}" for k in range(i + 1, n))
+        lines += _wrap(f"cr{i + 1} = (cr{i + 1}{terms})*cd{i + 1}", ind)
+    return lines
+
+
+def _cholesky_loop(n, ind, fail):
+    """The same factorisation in loops over the local array lm (lower triangle, holding
+    M_0's on entry), reciprocal diagonal in ld."""
+    return [f"{ind}do jj = 1, {n}",
+            f"{ind}    cs = lm(jj, jj) - sum(lm(jj, 1:jj - 1)**2)",
+            f"{ind}    if (.not. cs > 0.0_dp) then"] + \
+        [f"{ind}        {x}" for x in fail] + \
+        [f"{ind}    end if",
+         f"{ind}    ld(jj) = 1.0_dp/sqrt(cs)",
+         f"{ind}    do ii = jj + 1, {n}",
+         f"{ind}        lm(ii, jj) = (lm(ii, jj) - sum(lm(ii, 1:jj - 1)*lm(jj, 1:jj - 1)))"
+         "*ld(jj)",
+         f"{ind}    end do",
+         f"{ind}end do"]
+
+
+def _solve_loop(n, ind):
+    return [f"{ind}do ii = 1, {n}",
+            f"{ind}    cr(ii) = (cr(ii) - sum(lm(ii, 1:ii - 1)*cr(1:ii - 1)))*ld(ii)",
+            f"{ind}end do",
+            f"{ind}do ii = {n}, 1, -1",
+            f"{ind}    cr(ii) = (cr(ii) - sum(lm(ii + 1:{n}, ii)*cr(ii + 1:{n})))*ld(ii)",
+            f"{ind}end do"]
+
+
+def generalized_body(g, names, ind="        ", write_out=None):
+    """(declarations, statements) of the coefficient routine (see the module docstring)
+    for a procedure that declares t, order, w(0:order, g.ncol) and p."""
+    n = g.n
+    dec = g.dec
+    out = n <= WRITE_OUT_MAX if write_out is None else write_out
+    pp = _Printer(dec, names, False, "dp")
+    rc = _Recipe(pp, True, "order")
+    W = pp.w
+    one = pp.real(1)
+    zero = "0.0_dp"
+    decl = _decls([c for c, _ in rc.consts], "real(dp)", ind)
+    decl += _decls(rc.accs + rc.invs, "real(dp)", ind)
+    decl += [f"{ind}real(dp) :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
+    body = [f"{ind}if (order < 1) return"]
+    for c, e in rc.consts:
+        body += _wrap(f"{c} = {e}", ind)
+    # order 0: the operations, the entries of M and Q, the factorisation, a_0
+    for x in rc.s0:
+        body += _wrap(x, ind)
+    varying = [(i, j) for (i, j) in g.mass if not g.constant(i, j)]
+    for (i, j) in varying:
+        body += _wrap(f"{W(0, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 0, True)}", ind)
+
+    def M0(i, j):
+        if g.constant(i, j):
+            return pp.lin_at(g.entry(i, j), 0, True)
+        return W(0, g.entry_col(i, j))
+    fail = ["w(1:order, :) = ieee_value(1.0_dp, ieee_quiet_nan)", "return"]
+    if out:
+        chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
+        solve = _solve_out(n, ind + "    ")
+        rvec = [f"cr{i + 1}" for i in range(n)]
+        gacc = [f"cg{i + 1}" for i in range(n)]
+        decl += _decls(names_c + rvec + gacc, "real(dp)", ind)
+    else:
+        decl += [f"{ind}real(dp) :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
+                 f"{ind}integer :: ii, jj"]
+        chol = [f"{ind}lm = 0.0_dp"]
+        for j in range(n):
+            for i in range(j, n):
+                chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
+        chol += _cholesky_loop(n, ind, fail)
+        solve = _solve_loop(n, ind + "    ")
+        rvec = [f"cr({i + 1})" for i in range(n)]
+        gacc = [f"cg({i + 1})" for i in range(n)]
+    body += chol
+    for i in range(n):
+        body += _wrap(f"{rvec[i]} = {pp.lin_at(dec.outputs[g.forces[i]], 0, True)}", ind)
+    body += [x[4:] if x.startswith(ind + "    ") else x for x in solve]
+    jstate = [c for c in range(1, 2*n + 1) if c in dec.jcol]
+    for i in range(n):
+        body.append(f"{ind}{W(0, g.acols[i])} = {rvec[i]}")
+        body.append(f"{ind}{W(1, i + 1)} = {W(0, n + i + 1)}")
+        body.append(f"{ind}{W(1, n + i + 1)} = {rvec[i]}")
+    body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+    # orders 1 .. order - 1
+    loop = [f"{ind}do k = 1, order - 1",
+            f"{ind}    fk = real(k, dp)",
+            f"{ind}    rk = {one}/fk",
+            f"{ind}    rk1 = {one}/(fk + {one})"]
+    loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
+    loop += [f"{ind}    {x} = {zero}" for x in gacc]
+    plain = [x for x in rc.hist if x[3] is not _SYM]
+    sym = [x for x in rc.hist if x[3] is _SYM]
+    # the products M_il a_l: sum_{j=1..k-1} M_j a_{k-j} (the term j = k below)
+    prods = [(i, l) for i in range(n) for l in range(n) if not g.constant(i, l)]
+    if plain or prods:
+        loop.append(f"{ind}    do j = 1, k - 1")
+        for h, lft, rgt, wt in plain:
+            wj = f"({wt}*real(j, dp) - fk)*" if wt else ""
+            loop += _wrap(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}", ind + "        ")
+        for i in range(n):
+            terms = [f"{W('j', g.entry_col(i, l))}*{W('k - j', g.acols[l])}"
+                     for (ii, l) in prods if ii == i]
+            if terms:
+                loop += _wrap(f"{gacc[i]} = {gacc[i]} + " + " + ".join(terms), ind + "        ")
+        loop.append(f"{ind}    end do")
+    if sym:
+        loop.append(f"{ind}    do j = 1, (k - 1)/2")
+        for h, lft, _, _ in sym:
+            loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}", ind + "        ")
+        loop.append(f"{ind}    end do")
+        loop += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
+        loop.append(f"{ind}    if (mod(k, 2) == 0) then")
+        for h, lft, _, _ in sym:
+            loop += _wrap(f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}", ind + "        ")
+        loop.append(f"{ind}    end if")
+    E = {"k": "k", "fk": "fk", "rk": "rk"}
+    for f in rc.cur:
+        loop += _wrap(f(E), ind + "    ")
+    for (i, j) in varying:
+        loop += _wrap(f"{W('k', g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 'k', False)}",
+                      ind + "    ")
+    # r = Q_k - sum_{j=1..k} M_j a_{k-j}, then a_k = M_0^-1 r
+    for i in range(n):
+        terms = [f" - {W('k', g.entry_col(i, l))}*{W(0, g.acols[l])}"
+                 for (ii, l) in prods if ii == i]
+        q = pp.lin_at(dec.outputs[g.forces[i]], "k", False)
+        loop += _wrap(f"{rvec[i]} = {q} - {gacc[i]}" + "".join(terms), ind + "    ")
+    loop += solve
+    for i in range(n):
+        loop.append(f"{ind}    {W('k', g.acols[i])} = {rvec[i]}")
+        loop.append(f"{ind}    {W('k + 1', i + 1)} = rk1*{W('k', n + i + 1)}")
+        loop.append(f"{ind}    {W('k + 1', n + i + 1)} = rk1*{rvec[i]}")
+    loop += [f"{ind}    {W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}"
+             for c in jstate]
+    loop.append(f"{ind}end do")
+    return decl, body + loop
+
+
+def generalized_procedures(g, names, prefix="conmech_taylor", write_out=None, npar=1):
+    """Fortran lines of ``prefix(t, order, w, p)`` (bind(C)), ``prefix_info(info)``
+    ([columns of w, 0, 2n, 0]) and ``prefix_rhs(t, y, dydt, p)`` (f = [v; M^-1 Q])."""
+    ind = "        "
+    nw = g.ncol
+    m = 2*g.n
+    lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
+             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{ind}real(dp), value, intent(in) :: t",
+             f"{ind}integer(c_int), value, intent(in) :: order",
+             f"{ind}real(dp), intent(inout) :: w(0:order, {nw})",
+             f"{ind}real(dp), intent(in) :: p({npar})"]
+    decl, body = generalized_body(g, names, ind, write_out)
+    lines += decl + body + [f"    end subroutine {prefix}", ""]
+    lines += [f'    subroutine {prefix}_info(info) bind(C, name="{prefix}_info")',
+              f"{ind}integer(c_int), intent(out) :: info(4)",
+              f"{ind}info = [{nw}, 0, {m}, 0]",
+              f"    end subroutine {prefix}_info", ""]
+    lines += [f'    subroutine {prefix}_rhs(t, y, dydt, p) bind(C, name="{prefix}_rhs")',
+              f"{ind}real(dp), value, intent(in) :: t",
+              f"{ind}real(dp), intent(in) :: y({m})",
+              f"{ind}real(dp), intent(out) :: dydt({m})",
+              f"{ind}real(dp), intent(in) :: p({npar})",
+              f"{ind}real(dp) :: w(0:1, {nw})",
+              f"{ind}w = 0.0_dp",
+              f"{ind}w(0, 1:{m}) = y",
+              f"{ind}call {prefix}(t, 1_c_int, w, p)",
+              f"{ind}dydt = w(1, 1:{m})",
+              f"    end subroutine {prefix}_rhs", ""]
+    return lines
+
+
+def generalized_lines(d, names, part, dec_cache):
+    """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
+    library (conmech.symbolic.taylor_library): the core only; the batch, quadruple
+    precision and variational parts are not generated for generalized systems."""
+    if "g" not in dec_cache:
+        dec_cache["g"] = generalized_decomposition(d)
+    g, why = dec_cache["g"]
+    if g is None:
+        return [], [], why
+    if part != "core":
+        return [], [], (f"the Taylor part {part!r} (ensembles, quadruple precision, the "
+                        "variational system) is generated for ode systems only, not for "
+                        "generalized systems M(q) q'' = Q")
+    npar = max(len(d.params), 1)
+    return generalized_procedures(g, names, npar=npar), \
+        ["taylor", "taylor_info", "taylor_rhs"], None
