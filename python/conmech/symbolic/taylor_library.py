@@ -7,7 +7,9 @@ right-hand side, its Jacobian and the Jacobian products. The Taylor recurrences 
 the variational system's) are several times that code, and only ``method="TAYLOR"`` runs
 them, so they are compiled apart, and each in its own library, as a call needs it
 (:data:`PARTS`): a Taylor solve (``solve_ivp(method="TAYLOR")``) needs the double routine
-only (``core``); a Taylor ensemble the batch routine; :mod:`conmech.symbolic.taylor_quad`
+only (``core``); a Taylor ensemble the batch routine and its propagator over SIMD lanes
+(:mod:`conmech.symbolic.taylor_batch`, compiled for the machine's vector instructions);
+:mod:`conmech.symbolic.taylor_quad`
 the quadruple-precision one; ``stm(method="TAYLOR")`` the variational system's (half of
 all the code). :func:`lazy_taylor` gives the system a :class:`conmech.compiled.LazyTaylor`
 whose first request of a part generates its module, compiles it into the same on-disk
@@ -24,10 +26,12 @@ import tempfile
 import threading
 import time
 
-from .build import cache_dir, check_private, compile_source, load
+from . import taylor_batch as _taylor_batch
+from .build import FFLAGS, cache_dir, check_private, compile_source, load
 from .codegen import _names, check_source, private_procedures
 
-__all__ = ["taylor_source", "taylor_library", "lazy_taylor", "MODULE", "PARTS"]
+__all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batch_entries",
+           "MODULE", "PARTS"]
 
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
@@ -44,8 +48,31 @@ _LOCK = threading.Lock()
 #: precision one of conmech.symbolic.taylor_quad, and the variational system's (the STM)
 PARTS = ("core", "batch", "qp", "var")
 
-#: members per call of the batch routine
-BATCH_WIDTH = 4
+#: members per call of the batch coefficient routine, and lanes of the batch propagator
+#: (conmech.symbolic.taylor_batch): the machine's vector width for doubles
+BATCH_WIDTH = _taylor_batch.machine_lanes()
+
+
+def batch_part(lanes=None):
+    """The part name of a batch library with `lanes` lanes (None: the machine's width,
+    the part "batch"); a ValueError for a lane count not in taylor_batch.LANES."""
+    if lanes is None or lanes == BATCH_WIDTH:
+        return "batch"
+    if isinstance(lanes, bool) or not isinstance(lanes, int) or \
+            lanes not in _taylor_batch.LANES:
+        raise ValueError("lanes must be one of "
+                         f"{', '.join(map(str, _taylor_batch.LANES))}, got {lanes!r}")
+    return f"batch{lanes}"
+
+
+def _lanes(part):
+    """The lanes of a batch part ("batch": the machine's width, "batchK": K), or None."""
+    if part == "batch":
+        return BATCH_WIDTH
+    if part.startswith("batch") and part[5:].isdigit() and \
+            int(part[5:]) in _taylor_batch.LANES:
+        return int(part[5:])
+    return None
 
 
 def _decompositions(model):
@@ -67,9 +94,14 @@ def _lines(d, part, dec_cache):
     if part == "core":
         return T.taylor_procedures(dec, names, "conmech_taylor", 0, False), \
             ["taylor", "taylor_info"], None
-    if part == "batch":
-        return T.c_routine(dec, names, "conmech_taylor_batch", batch=BATCH_WIDTH), \
-            ["taylor_batch"], None
+    lanes = _lanes(part)
+    if lanes is not None:
+        from .._core import status as S
+        run = _taylor_batch.run_routine(
+            d.n, dec.ncol, max(len(dec.params), 1), lanes,
+            (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE))
+        return T.c_routine(dec, names, "conmech_taylor_batch", batch=lanes) + run, \
+            ["taylor_batch", "taylor_batch_run"], None
     if part == "qp":
         return T.quad_routine(dec, names, "conmech_taylor_qp"), ["taylor_qp"], None
     if "var" not in dec_cache:
@@ -86,8 +118,9 @@ def taylor_source(d, part="core", _dec=None):
     ``conmech_taylor_var`` and ``_var_info``, the routines a model library with Taylor
     code holds. (None, [], reason) when f has no Taylor recurrences (a non-smooth
     expression)."""
-    if part not in PARTS:
-        raise ValueError(f"part must be one of {', '.join(PARTS)}, got {part!r}")
+    if part not in PARTS and _lanes(part) is None:
+        raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "
+                         f"got {part!r}")
     lines, entries, why = _lines(d, part, {} if _dec is None else _dec)
     if not lines:
         return None, [], why
@@ -114,8 +147,10 @@ def _entries(lib, part):
     if part == "core":
         lib.conmech_taylor_info(info)
         return {"jet": lib.conmech_taylor, "nw": int(info[0])}
-    if part == "batch":
-        return {"batch": lib.conmech_taylor_batch, "width": BATCH_WIDTH}
+    lanes = _lanes(part)
+    if lanes is not None:
+        return {"batch": lib.conmech_taylor_batch, "width": lanes,
+                "batch_run": lib.conmech_taylor_batch_run}
     if part == "qp":
         return {"qp": lib.conmech_taylor_qp}
     lib.conmech_taylor_var_info(info)
@@ -148,7 +183,12 @@ def taylor_library(model, part="core"):
         if src is None:
             state = (None, None, why)
         else:
-            path, hit = compile_source(src, getattr(model, "flags", None), entries)
+            flags = getattr(model, "flags", None)
+            lanes = _lanes(part)
+            if lanes is not None:   # the batch code for the machine's vector instructions
+                flags = list(FFLAGS if flags is None else flags) + \
+                    _taylor_batch.isa_flags(lanes)
+            path, hit = compile_source(src, flags, entries)
             lib, _ = load(path, entries)
             model.times[f"taylor_{part}_compile_or_load"] = time.perf_counter() - t1
             model.__dict__.setdefault("taylor_paths", {})[part] = path
@@ -163,6 +203,9 @@ def taylor_library(model, part="core"):
 
 
 def _source_path(key, part):
+    lanes = _lanes(part)
+    if lanes is not None:       # the batch source depends on the lanes (the machine's)
+        part = f"batch{lanes}"
     return os.path.join(cache_dir(), f"conmech_{key}.taylor-{part}.json")
 
 
@@ -219,6 +262,19 @@ def _store_source(key, part, src, entries, why):
                 os.unlink(tmp)
             except OSError:
                 pass
+
+
+_BATCH_LOCK = threading.Lock()
+
+
+def batch_entries(model, lanes):
+    """The entries (``batch``, ``width``, ``batch_run``) of the batch library of a compiled
+    ode model with `lanes` lanes other than the machine's (those are the lazy part
+    "batch" of its systems), built once per model under a lock; None when f has no Taylor
+    recurrences."""
+    part = batch_part(lanes)
+    with _BATCH_LOCK:
+        return taylor_library(model, part)
 
 
 def lazy_taylor(model):

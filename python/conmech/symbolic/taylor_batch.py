@@ -1,0 +1,297 @@
+"""Taylor's method for ensembles in SIMD lanes: the generated batch propagator.
+
+An ensemble of one symbolic ode system integrates many members with the same recurrences.
+heyoka's batch mode runs ``width`` members in lock-step, one SIMD lane each; this module
+generates the same for conmech, as Fortran that the compiler vectorises:
+
+- the coefficient routine ``conmech_taylor_batch(t, order, w, p)`` of
+  :func:`conmech.symbolic.taylor.c_routine` with a lane dimension first,
+  w(lanes, 0:order, nw): every statement of the recurrences is an operation on ``lanes``
+  contiguous values, one vector instruction (or two) per statement;
+- the propagator ``conmech_taylor_batch_run`` (this module), which steps the lanes
+  together with the state, the step, the time and the error scales of each lane in
+  arrays of ``lanes`` values: Horner's evaluation of the polynomials, the safety check of
+  the step, the error scales and the norms of the last two coefficients are vector
+  operations over the lanes with no branch per lane; the per-lane decisions (accept or
+  reject, reached the end, failed) are masks, and the logarithms of the step-size formula
+  are per lane.
+
+Lanes are refilled: when a member ends (it reached tf, or failed) its lane takes the next
+member of the call at once (its first expansion rides along with the other lanes' next
+step), so no lane waits for the slowest member of a group. Each member takes exactly the
+steps, and gets exactly the result, of its own :func:`conmech.solve_ivp` run with
+method="TAYLOR" (the arithmetic of :mod:`conmech_taylor_core`, operation for operation; the
+library is compiled without contraction of multiply-adds and calls glibc's scalar
+elementary functions, so vector and scalar code round alike), whatever its lane, its neighbours, the batch size or the number of threads.
+
+The lane count is the machine's vector width for doubles by default (:func:`machine_lanes`:
+8 with AVX-512, 4 with AVX2, else 2), and the library is compiled for that instruction set
+(:func:`isa_flags`); ``conmech.ensemble.solve(..., lanes=k)`` builds another width.
+"""
+import functools
+import platform
+
+from ..ivp.ensemble import LANES     # the lane counts a batch library can be built with
+
+__all__ = ["machine_lanes", "isa_flags", "run_routine", "LANES"]
+
+# the lanes round exactly as the scalar route does: the multiply-adds are not contracted
+# into fused ones (gfortran's default with an FMA instruction set), and sin, cos, exp, ...
+# are glibc's scalar functions, not its vector ones (libmvec, a few ulp apart), which
+# gfortran calls for the lanes when it pre-includes glibc's math-vector-fortran.h (by
+# default; -nostdinc leaves it out, and the generated code includes nothing)
+_NO_CONTRACT = ["-ffp-contract=off", "-nostdinc"]
+
+
+@functools.lru_cache(maxsize=1)
+def _cpu_features():
+    """The SIMD features of this processor (x86-64 only; an empty set elsewhere)."""
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return frozenset()
+    feats = set()
+    try:
+        import numpy as np
+        core = getattr(np, "_core", None) or np.core
+        table = core._multiarray_umath.__cpu_features__
+        feats = {k for k, v in table.items() if v}
+    except (ImportError, AttributeError):
+        try:
+            with open("/proc/cpuinfo") as fh:
+                for line in fh:
+                    if line.startswith("flags"):
+                        flags = set(line.split(":", 1)[1].split())
+                        feats = {k for k, f in (("AVX2", "avx2"), ("AVX512F", "avx512f"))
+                                 if f in flags}
+                        break
+        except OSError:
+            pass
+    return frozenset(f for f in feats if f in ("AVX2", "AVX512F"))
+
+
+def machine_lanes():
+    """Doubles per SIMD register of this machine: 8 (AVX-512), 4 (AVX2), else 2."""
+    feats = _cpu_features()
+    if "AVX512F" in feats:
+        return 8
+    if "AVX2" in feats:
+        return 4
+    return 2
+
+
+def isa_flags(lanes):
+    """Compiler flags of a batch library with `lanes` lanes: the machine's vector
+    instruction set (AVX-512 registers only for 8 or more lanes), no contraction."""
+    feats = _cpu_features()
+    if "AVX512F" in feats and lanes >= 8:
+        isa = ["-mavx512f", "-mavx2", "-mprefer-vector-width=512"]
+    elif "AVX2" in feats:
+        isa = ["-mavx2"]
+    else:
+        isa = []
+    return isa + _NO_CONTRACT
+
+
+def run_routine(n, nw, npar, lanes, codes):
+    """Fortran lines of ``conmech_taylor_batch_run`` for a system of n states, nw work
+    columns and npar parameter slots, with `lanes` lanes; it calls the coefficient routine
+    ``conmech_taylor_batch`` of the same module. codes: the status codes (success,
+    too_many_steps, step_too_small, nonfinite)."""
+    ok, many, small, nonfin = (int(c) for c in codes)
+    run = 1 if 1 not in (ok, many, small, nonfin) else 99     # "still running"
+    src = _RUN.format(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
+                      nonfin=nonfin, run=run)
+    return src.split("\n")
+
+
+_RUN = """\
+    !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
+    !! time (a lane takes the next member as soon as its own has ended), each member
+    !! exactly as the scalar Taylor stepper integrates it alone; tol(:, 1) = rtol, tol(:, 2)
+    !! = atol, steps of at most hmax, at most mxs attempted. st(j): the status of member j,
+    !! te(j) where it stopped, cnt(:, j) its expansions (nfev), accepted, rejected steps.
+    subroutine conmech_taylor_batch_run(m, y, span, tol, hmax, mxs, p, te, st, cnt) bind(C, name="conmech_taylor_batch_run")
+        integer(c_int), value, intent(in) :: m, mxs
+        real(dp), intent(inout) :: y({n}, m)
+        real(dp), intent(in) :: span(2), tol({n}, 2), p({npar})
+        real(dp), value, intent(in) :: hmax
+        real(dp), intent(out) :: te(m)
+        integer(c_int), intent(out) :: st(m), cnt(3, m)
+        integer, parameter :: nl = {lanes}, n = {n}, nw = {nw}
+        real(dp), parameter :: check_max = 10.0_dp
+        real(dp), allocatable :: w(:, :, :), c(:, :, :)
+        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
+        real(dp) :: yn(nl, n), dy(nl, n), yv(nl), dv(nl), err(nl), s1(nl), s2(nl), ym(nl)
+        real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
+        integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
+        logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
+        t0 = span(1)
+        tf = span(2)
+        atol = tol(:, 2)
+        st = {ok}
+        cnt = 0
+        te = t0
+        if (m < 1 .or. tf == t0) return
+        ! the scalar stepper's order, step bound and decay factor (conmech_taylor_core)
+        rt = max(tol(:, 1), epsilon(1.0_dp))
+        eps = max(minval(rt), minval(atol))
+        ord = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
+        decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
+        posneg = sign(1.0_dp, tf - t0)
+        hm = min(abs(hmax), abs(tf - t0))
+        allocate (w(nl, 0:ord, nw), c(nl, 0:ord, n))
+        w = 0.0_dp
+        c = 0.0_dp
+        t = t0
+        tlo = 0.0_dp
+        h = 0.0_dp
+        e = 1.0_dp
+        yc = 0.0_dp
+        mem = 0
+        done = {run}
+        nst = 0
+        na = 0
+        nr = 0
+        nx = 0
+        fresh = .false.
+        next = 1
+        do
+            ! lanes whose member has ended: its results out, the next member in (fresh:
+            ! its first expansion is made in this round, beside the others' steps)
+            do l = 1, nl
+                if (mem(l) /= 0) then
+                    if (done(l) == {run}) cycle
+                    j = mem(l)
+                    y(:, j) = yc(l, :)
+                    te(j) = t(l)
+                    st(j) = done(l)
+                    cnt(:, j) = [nx(l), na(l), nr(l)]
+                    mem(l) = 0
+                end if
+                if (next > m) cycle
+                mem(l) = next
+                yc(l, :) = y(:, next)
+                t(l) = t0
+                tlo(l) = 0.0_dp
+                h(l) = 0.0_dp
+                done(l) = {run}
+                fresh(l) = .true.
+                nst(l) = 0
+                na(l) = 0
+                nr(l) = 0
+                nx(l) = 0
+                next = next + 1
+            end do
+            if (all(mem == 0)) exit
+            ! each running lane's step: the scalar stepper's limits, then its candidate
+            do l = 1, nl
+                hc(l) = 0.0_dp
+                tc(l) = t(l)
+                hit(l) = .false.
+                stp(l) = .false.
+                if (mem(l) == 0 .or. fresh(l)) cycle
+                if (nst(l) >= mxs) then
+                    done(l) = {many}
+                else if (.not. (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))) then
+                    done(l) = {small}
+                else
+                    hc(l) = h(l)
+                    if ((t(l) + hc(l) - tf)*posneg >= 0.0_dp) then
+                        hc(l) = (tf - t(l)) - tlo(l)
+                        hit(l) = .true.
+                    end if
+                    nst(l) = nst(l) + 1
+                    tc(l) = t(l) + hc(l)
+                    stp(l) = .true.
+                end if
+            end do
+            ! the polynomials at the candidate steps (Horner, the value and its
+            ! derivative in one pass), all lanes at once; a lane without a step expands
+            ! at its current state (a new member: its initial state)
+            do i = 1, n
+                yv = c(:, ord, i)
+                dv = 0.0_dp
+                do k = ord - 1, 0, -1
+                    dv = yv + hc*dv
+                    yv = c(:, k, i) + hc*yv
+                end do
+                yn(:, i) = yv
+                dy(:, i) = dv
+                w(:, 0, i) = merge(yv, yc(:, i), stp)
+            end do
+            call conmech_taylor_batch(tc, int(ord, c_int), w, p)
+            nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
+            ! the safety check of every lane's step: h (P'(h) - f(t + h, P(h))) against
+            ! the scales, f there from the new expansion's first coefficients
+            fl = 16.0_dp*epsilon(1.0_dp)
+            err = 0.0_dp
+            do i = 1, n
+                err = max(err, abs(hc*(dy(:, i) - w(:, 1, i)))/(e(:, i) + fl*(abs(yn(:, i)) &
+                      + abs(hc*dy(:, i)))))
+            end do
+            err = err/real(ord + 1, dp)
+            acc = fresh .and. mem /= 0
+            do l = 1, nl
+                if (.not. stp(l)) cycle
+                if (.not. (err(l) <= check_max)) then
+                    nr(l) = nr(l) + 1
+                    if (err(l) == err(l) .and. err(l) <= huge(1.0_dp)) then
+                        h(l) = hc(l)*max(0.1_dp, min(0.5_dp, 0.8_dp*(check_max/err(l))** &
+                                                     (1.0_dp/real(ord + 1, dp))))
+                    else
+                        h(l) = 0.1_dp*hc(l)
+                    end if
+                    cycle
+                end if
+                na(l) = na(l) + 1
+                acc(l) = .true.
+                if (hit(l)) then
+                    t(l) = tf
+                    tlo(l) = 0.0_dp
+                    done(l) = {ok}
+                else
+                    ! t + h in double length (Knuth's TwoSum), as the scalar stepper
+                    s = t(l) + hc(l)
+                    bb = s - t(l)
+                    lo = (t(l) - (s - bb)) + (hc(l) - bb)
+                    lo = lo + tlo(l)
+                    t(l) = s + lo
+                    tlo(l) = lo - (t(l) - s)
+                end if
+            end do
+            ! accepted lanes: the new state, expansion and scales; the next step from
+            ! the last two coefficients (Jorba and Zou)
+            ym = 0.0_dp
+            do i = 1, n
+                yc(:, i) = merge(yn(:, i), yc(:, i), acc .and. .not. fresh)
+                ym = max(ym, abs(yc(:, i)))
+                do k = 0, ord
+                    c(:, k, i) = merge(w(:, k, i), c(:, k, i), acc)
+                end do
+            end do
+            fin = .true.
+            s1 = 0.0_dp
+            s2 = 0.0_dp
+            do i = 1, n
+                fin = fin .and. abs(c(:, 1, i)) <= huge(1.0_dp)
+                e(:, i) = merge(max(atol(i), rt(i)*ym, tiny(1.0_dp)), e(:, i), acc)
+                s1 = max(s1, abs(c(:, ord - 1, i))/e(:, i))
+                s2 = max(s2, abs(c(:, ord, i))/e(:, i))
+            end do
+            do l = 1, nl
+                if (.not. acc(l)) cycle
+                fresh(l) = .false.
+                if (.not. fin(l)) then
+                    done(l) = {nonfin}
+                    cycle
+                end if
+                if (done(l) /= {run}) cycle
+                lg = huge(1.0_dp)
+                if (s1(l) > 0.0_dp) lg = -log(s1(l)*eps)/real(ord - 1, dp)
+                if (s2(l) > 0.0_dp) lg = min(lg, -log(s2(l)*eps)/real(ord, dp))
+                rho = huge(1.0_dp)
+                if (lg < log(huge(1.0_dp))) rho = exp(lg)*decay
+                h(l) = min(rho, hm)*posneg
+            end do
+        end do
+    end subroutine conmech_taylor_batch_run
+"""
