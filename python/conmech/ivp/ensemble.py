@@ -203,6 +203,9 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes):
         return None
     batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
     if not batch:
+        # the member-by-member route: a system of conmech.symbolic compiles its Taylor
+        # recurrences here, on first need (their entries then in its spec)
+        getattr(system, "taylor", None)
         return None
     taylor = None
     if hasattr(system, "taylor_parts"):

@@ -30,17 +30,23 @@ The lane count is the machine's vector width for doubles by default (:func:`mach
 """
 import functools
 import platform
+import re
 
 from ..ivp.ensemble import LANES     # the lane counts a batch library can be built with
 
-__all__ = ["machine_lanes", "isa_flags", "run_routine", "LANES"]
+#: the version of the generated batch code (a change regenerates the kept sources)
+VERSION = 2
+
+__all__ = ["machine_lanes", "isa_flags", "coefficient_routine", "run_routine", "LANES"]
 
 # the lanes round exactly as the scalar route does: the multiply-adds are not contracted
 # into fused ones (gfortran's default with an FMA instruction set), and sin, cos, exp, ...
 # are glibc's scalar functions, not its vector ones (libmvec, a few ulp apart), which
 # gfortran calls for the lanes when it pre-includes glibc's math-vector-fortran.h (by
 # default; -nostdinc leaves it out, and the generated code includes nothing)
-_NO_CONTRACT = ["-ffp-contract=off", "-nostdinc"]
+# (-fopenmp-simd: the `!$omp simd` lane loops are vectorised as loops, not unrolled first
+# into scalar statements that the straight-line vectoriser then misses)
+_NO_CONTRACT = ["-ffp-contract=off", "-nostdinc", "-fopenmp-simd"]
 
 
 @functools.lru_cache(maxsize=1)
@@ -89,6 +95,88 @@ def isa_flags(lanes):
     else:
         isa = []
     return isa + _NO_CONTRACT
+
+
+_LANE_NAMES = re.compile(r"\b(h\d+|iv\d+|t)\b(?!\()")
+
+
+def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
+    """Fortran lines of the bind(C) routine ``cname(t, order, w, p)`` computing the Taylor
+    coefficients of `lanes` members at once, t(lanes), w(lanes, 0:order, nw) (w(:, 0, 1:n)
+    the states on entry): the statements of :mod:`conmech.symbolic.taylor`'s loop version
+    (the same operations in the same order, so each lane gets the scalar routine's
+    coefficients to the last bit) inside ``!$omp simd`` loops over the lanes, innermost:
+    one vector instruction per operation for all the lanes."""
+    from . import taylor as T
+    ind = "        "
+    kind = "dp"
+    pp = T._Printer(dec, names, False, kind)
+    pp.w = lambda k, c: f"w(l, {k}, {c})"
+    rc = T._Recipe(pp, False, "order")
+    W = pp.w
+
+    def lane(x):          # the accumulators, reciprocals and t are per lane
+        return _LANE_NAMES.sub(lambda mm: f"{mm.group(1)}(l)", x)
+
+    def loop(stmts, at):
+        out = [f"{at}!$omp simd", f"{at}do l = 1, nl"]
+        for x in stmts:
+            out += T._wrap(lane(x), at + "    ")
+        return out + [f"{at}end do"]
+    one = pp.real(1)
+    zero = f"0.0_{kind}"
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    head = [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}integer, parameter :: nl = {lanes}",
+            f"{ind}real(dp), intent(in) :: t(nl)",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})"]
+    decl = T._decls([c for c, _ in rc.consts], f"real({kind})", ind)
+    decl += T._decls([f"{x}(nl)" for x in rc.accs + rc.invs], f"real({kind})", ind)
+    decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
+    body = [f"{ind}if (order < 1) return"]
+    for c, e in rc.consts:
+        body += T._wrap(f"{c} = {e}", ind)
+    jstate = [i + 1 for i in range(dec.n) if i + 1 in dec.jcol]
+    first = list(rc.s0)
+    first += [f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}" for i, o in enumerate(dec.outputs)]
+    first += [f"{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+    body += loop(first, ind)
+    E = {"k": "k", "fk": "fk", "rk": "rk"}
+    body += [f"{ind}do k = 1, order - 1",
+             f"{ind}    fk = real(k, {kind})",
+             f"{ind}    rk = {one}/fk",
+             f"{ind}    rk1 = {one}/(fk + {one})"]
+    body += [f"{ind}    {h} = {zero}" for h in rc.accs]
+    plain = [x for x in rc.hist if x[3] is not T._SYM]
+    sym = [x for x in rc.hist if x[3] is T._SYM]
+    if plain:
+        body.append(f"{ind}    do j = 1, k - 1")
+        stm = []
+        for h, lft, rgt, wt in plain:
+            wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
+            stm.append(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}")
+        body += loop(stm, ind + "        ")
+        body.append(f"{ind}    end do")
+    if sym:       # squares: the pairs j < k - j once, doubled, and the middle term
+        body.append(f"{ind}    do j = 1, (k - 1)/2")
+        body += loop([f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}"
+                      for h, lft, _, _ in sym], ind + "        ")
+        body.append(f"{ind}    end do")
+        body += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
+        body.append(f"{ind}    if (mod(k, 2) == 0) then")
+        body += loop([f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}"
+                      for h, lft, _, _ in sym], ind + "        ")
+        body.append(f"{ind}    end if")
+    cur = [f(E) for f in rc.cur]
+    cur += [f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})"
+            for i, o in enumerate(dec.outputs)]
+    cur += [f"{W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}" for c in jstate]
+    body += loop(cur, ind + "    ")
+    body.append(f"{ind}end do")
+    return head + decl + body + [f"    end subroutine {cname}", ""]
 
 
 def run_routine(n, nw, npar, lanes, codes):
@@ -211,12 +299,18 @@ _RUN = """\
                 yv = c(:, ord, i)
                 dv = 0.0_dp
                 do k = ord - 1, 0, -1
-                    dv = yv + hc*dv
-                    yv = c(:, k, i) + hc*yv
+                    !$omp simd
+                    do l = 1, nl
+                        dv(l) = yv(l) + hc(l)*dv(l)
+                        yv(l) = c(l, k, i) + hc(l)*yv(l)
+                    end do
                 end do
-                yn(:, i) = yv
-                dy(:, i) = dv
-                w(:, 0, i) = merge(yv, yc(:, i), stp)
+                !$omp simd
+                do l = 1, nl
+                    yn(l, i) = yv(l)
+                    dy(l, i) = dv(l)
+                    w(l, 0, i) = merge(yv(l), yc(l, i), stp(l))
+                end do
             end do
             call conmech_taylor_batch(tc, int(ord, c_int), w, p)
             nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
@@ -225,8 +319,11 @@ _RUN = """\
             fl = 16.0_dp*epsilon(1.0_dp)
             err = 0.0_dp
             do i = 1, n
-                err = max(err, abs(hc*(dy(:, i) - w(:, 1, i)))/(e(:, i) + fl*(abs(yn(:, i)) &
-                      + abs(hc*dy(:, i)))))
+                !$omp simd
+                do l = 1, nl
+                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - w(l, 1, i)))/(e(l, i) &
+                                 + fl*(abs(yn(l, i)) + abs(hc(l)*dy(l, i)))))
+                end do
             end do
             err = err/real(ord + 1, dp)
             acc = fresh .and. mem /= 0
@@ -262,20 +359,29 @@ _RUN = """\
             ! the last two coefficients (Jorba and Zou)
             ym = 0.0_dp
             do i = 1, n
-                yc(:, i) = merge(yn(:, i), yc(:, i), acc .and. .not. fresh)
-                ym = max(ym, abs(yc(:, i)))
+                !$omp simd
+                do l = 1, nl
+                    yc(l, i) = merge(yn(l, i), yc(l, i), acc(l) .and. .not. fresh(l))
+                    ym(l) = max(ym(l), abs(yc(l, i)))
+                end do
                 do k = 0, ord
-                    c(:, k, i) = merge(w(:, k, i), c(:, k, i), acc)
+                    !$omp simd
+                    do l = 1, nl
+                        c(l, k, i) = merge(w(l, k, i), c(l, k, i), acc(l))
+                    end do
                 end do
             end do
             fin = .true.
             s1 = 0.0_dp
             s2 = 0.0_dp
             do i = 1, n
-                fin = fin .and. abs(c(:, 1, i)) <= huge(1.0_dp)
-                e(:, i) = merge(max(atol(i), rt(i)*ym, tiny(1.0_dp)), e(:, i), acc)
-                s1 = max(s1, abs(c(:, ord - 1, i))/e(:, i))
-                s2 = max(s2, abs(c(:, ord, i))/e(:, i))
+                !$omp simd
+                do l = 1, nl
+                    fin(l) = fin(l) .and. abs(c(l, 1, i)) <= huge(1.0_dp)
+                    e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
+                    s1(l) = max(s1(l), abs(c(l, ord - 1, i))/e(l, i))
+                    s2(l) = max(s2(l), abs(c(l, ord, i))/e(l, i))
+                end do
             end do
             do l = 1, nl
                 if (.not. acc(l)) cycle

@@ -100,7 +100,7 @@ def _lines(d, part, dec_cache):
         run = _taylor_batch.run_routine(
             d.n, dec.ncol, max(len(dec.params), 1), lanes,
             (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE))
-        return T.c_routine(dec, names, "conmech_taylor_batch", batch=lanes) + run, \
+        return _taylor_batch.coefficient_routine(dec, names, lanes) + run, \
             ["taylor_batch", "taylor_batch_run"], None
     if part == "qp":
         return T.quad_routine(dec, names, "conmech_taylor_qp"), ["taylor_qp"], None
@@ -205,7 +205,7 @@ def taylor_library(model, part="core"):
 def _source_path(key, part):
     lanes = _lanes(part)
     if lanes is not None:       # the batch source depends on the lanes (the machine's)
-        part = f"batch{lanes}"
+        part = f"batch{lanes}-v{_taylor_batch.VERSION}"
     return os.path.join(cache_dir(), f"conmech_{key}.taylor-{part}.json")
 
 
