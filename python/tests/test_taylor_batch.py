@@ -61,8 +61,8 @@ def test_members_are_their_own_solve_ivp_runs(kepler, pendulum):
     y0 = kepler_states(np.linspace(0.0, 0.8, m))
     res = ensemble.solve(kepler, (0, 7.5), y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
     assert res.success and res.done == m and (res.status == 0).all()
-    assert "batch_run" in kepler.taylor and kepler.taylor["width"] == \
-        taylor_batch.machine_lanes()
+    # the batch library of the machine's lanes, written out for order 15, ran
+    assert "batch" in symbolic.model_of(kepler).taylor_paths
     _same_as_solve_ivp(kepler, (0, 7.5), y0, res, 1e-12, 1e-12)
     # backwards in time, a parameter and a sine, a loose tolerance (another order)
     yp = np.column_stack([np.linspace(-2.5, 2.5, 6), np.linspace(1.0, -1.0, 6)])
@@ -81,8 +81,18 @@ def test_lanes_and_threads_do_not_change_the_results(kepler):
             r = ensemble.solve(kepler, (0, 12.0), y0, threads=threads, lanes=lanes, **kw)
             for key in ("y_final", "t_final", "naccept", "nreject", "nfev", "status"):
                 assert np.array_equal(r[key], ref[key]), (lanes, threads, key)
-    paths = symbolic.model_of(kepler).taylor_paths
-    assert {"batch", "batch1", "batch2", "batch8"} <= set(paths)
+    # the loop version of the recurrences (what runs when the written-out code would be
+    # too long): the same results
+    model = symbolic.model_of(kepler)
+    for lanes in (2, 4):
+        entries = taylor_library.batch_entries(model, lanes) if lanes != \
+            taylor_batch.machine_lanes() else kepler.taylor_parts("batch")
+        assert entries["width"] == lanes
+        tol = np.full(4, 1e-10)
+        r = ensemble._solve_taylor_batch(kepler, dict(kepler.taylor, **entries), 0.0, 12.0,
+                                         y0, len(y0), tol, tol, 1e300, 100000, 1)
+        for key in ("y_final", "t_final", "naccept", "nreject", "nfev", "status"):
+            assert np.array_equal(r[key], ref[key]), (lanes, key)
 
 
 def test_a_failing_member_fails_alone(kepler):
@@ -137,8 +147,9 @@ def test_generated_module_is_vectorised(kepler, tmp_path):
         pytest.skip("gfortran not installed")
     model = symbolic.model_of(kepler)
     lanes = taylor_batch.machine_lanes()
-    src, entries, why = taylor_library.taylor_source(model.derived, "batch")
-    assert why is None and entries == ["taylor_batch", "taylor_batch_run"]
+    src, entries, why = taylor_library.taylor_source(model.derived, f"batch{lanes}o15")
+    assert why is None
+    assert entries == ["taylor_batch", "taylor_batch_fixed", "taylor_batch_run"]
     assert f"integer, parameter :: nl = {lanes}," in src
     f = tmp_path / "batch.f90"
     f.write_text(src)
@@ -152,6 +163,9 @@ def test_generated_module_is_vectorised(kepler, tmp_path):
     if lanes >= 4:
         assert any("32 byte vectors" in ln or "64 byte vectors" in ln for ln in vec), \
             report[-2000:]
+    # the one-statement-per-lane-vector written-out routine (a single vectorised loop)
+    fixed = [ln for ln in vec if "batch.f90:" in ln]
+    assert fixed, report[-2000:]
     path = model.taylor_paths["batch"]
     manifest = os.path.splitext(path)[0] + ".json"
     import json

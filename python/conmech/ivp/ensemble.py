@@ -192,13 +192,14 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
-def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes):
+def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
     """The Taylor entries of the batch route of an ensemble, or None: method TAYLOR, a
     system with a batch routine, shared parameters, final states only (no t_eval, events,
     first_step or progress). A system of conmech.symbolic gets its batch library here, on
     first need: the coefficient routine and the propagator over SIMD lanes
     (conmech.symbolic.taylor_batch) with `lanes` lanes (None: the machine's vector
-    width)."""
+    width), the recurrences written out for the order of the tolerance eps when they are
+    small enough."""
     if not (isinstance(method, str) and method.upper() == "TAYLOR"):
         return None
     batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
@@ -211,19 +212,21 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes):
     if hasattr(system, "taylor_parts"):
         # a system of conmech.symbolic compiles its Taylor recurrences here, on first
         # need (their entries then in its spec, for the member-by-member path too)
-        from ..symbolic.taylor_library import batch_part
-        part = batch_part(lanes)
-        taylor = system.taylor_parts("batch") if part == "batch" else \
-            system.taylor_parts()
-        if taylor and part != "batch":
-            from ..symbolic.pipeline import model_of
-            from ..symbolic.taylor_library import batch_entries
-            try:
-                model = model_of(system)
-            except TypeError:
-                model = None
-            extra = batch_entries(model, lanes) if model is not None else None
-            taylor = dict(taylor, **extra) if extra else None
+        from ..symbolic.pipeline import model_of
+        from ..symbolic.taylor_library import batch_entries
+        from .taylor import taylor_order
+        taylor = system.taylor_parts()
+        try:
+            model = model_of(system)
+        except TypeError:
+            model = None
+        extra = None
+        if taylor and model is not None:
+            extra = batch_entries(model, lanes, taylor_order(eps))
+        if extra:
+            taylor = dict(taylor, **extra)
+        elif taylor:       # the machine's lanes, the loop version: the lazy part
+            taylor = system.taylor_parts("batch")
     else:
         taylor = getattr(system, "taylor", None)
     if not taylor or taylor.get("batch") is None:
@@ -488,7 +491,8 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         return 0
 
     nt = t_ev.size
-    taylor = _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes)
+    eps = max(float(np.min(rtol_v)), 2.220446049250313e-16, float(np.min(atol_v)))
+    taylor = _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps)
     if taylor is not None:
         return _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax,
                                    int(max_steps), nthreads)

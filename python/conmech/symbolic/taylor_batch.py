@@ -179,17 +179,67 @@ def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
     return head + decl + body + [f"    end subroutine {cname}", ""]
 
 
-def run_routine(n, nw, npar, lanes, codes):
+def fixed_routine(dec, names, lanes, order, cname="conmech_taylor_batch_fixed"):
+    """Fortran lines of the bind(C) routine ``cname(t, order, w, p)`` (arguments as
+    :func:`coefficient_routine`'s) with the recurrences written out for one `order` (it
+    does nothing for another order): the statements of the scalar routine written out
+    (:func:`conmech.symbolic.taylor.body_lines` with ``fixed``: no loops, literal indices,
+    the values in scalars; the same operations in the same order as the loop version) as
+    the body of ONE ``!$omp simd`` loop over the lanes, its scalars private to each lane
+    (a BLOCK): the compiler turns every scalar into a vector register of the lanes, the
+    whole expansion straight-line vector code, as heyoka's batch mode compiles it."""
+    import inspect
+    from . import taylor as T
+    ind = "        "
+    kw = {"paired": False} if "paired" in inspect.signature(T.body_lines).parameters else {}
+    decl, body = T.body_lines(dec, names, "dp", 0, False, ind + "        ", order, **kw)
+    guard = body[0].strip()
+    if not guard.startswith("if (order /="):
+        raise ValueError("unexpected written-out Taylor body")
+    lane_body = [_LANE_NAMES_FIXED.sub(lambda mm: f"{mm.group(1)}(l)",
+                                      x.replace("w(", "w(l, ")) for x in body[1:]]
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    return [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}integer, parameter :: nl = {lanes}",
+            f"{ind}real(dp), intent(in) :: t(nl)",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})",
+            f"{ind}integer :: l",
+            f"{ind}{guard}",
+            f"{ind}!$omp simd",
+            f"{ind}do l = 1, nl",
+            f"{ind}    block"] + decl + lane_body + \
+        [f"{ind}    end block", f"{ind}end do", f"    end subroutine {cname}", ""]
+
+
+# the time in a written-out body (the only per-lane name besides w)
+_LANE_NAMES_FIXED = re.compile(r"\b(t)\b(?!\()")
+
+
+def run_routine(n, nw, npar, lanes, codes, fixed=None):
     """Fortran lines of ``conmech_taylor_batch_run`` for a system of n states, nw work
     columns and npar parameter slots, with `lanes` lanes; it calls the coefficient routine
     ``conmech_taylor_batch`` of the same module. codes: the status codes (success,
-    too_many_steps, step_too_small, nonfinite)."""
+    too_many_steps, step_too_small, nonfinite). fixed: the order of the written-out routine
+    ``conmech_taylor_batch_fixed`` of the module, called for that order (else the loop
+    version)."""
     ok, many, small, nonfin = (int(c) for c in codes)
     run = 1 if 1 not in (ok, many, small, nonfin) else 99     # "still running"
     src = _RUN.format(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
-                      nonfin=nonfin, run=run)
+                      nonfin=nonfin, run=run, coef=_COEF if fixed is None else
+                      _COEF_FIXED.format(p=int(fixed)))
     return src.split("\n")
 
+
+_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), w, p)"
+_COEF_FIXED = """\
+            if (ord == {p}) then
+                call conmech_taylor_batch_fixed(tc, int(ord, c_int), w, p)
+            else
+                call conmech_taylor_batch(tc, int(ord, c_int), w, p)
+            end if"""
 
 _RUN = """\
     !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
@@ -312,7 +362,7 @@ _RUN = """\
                     w(l, 0, i) = merge(yv(l), yc(l, i), stp(l))
                 end do
             end do
-            call conmech_taylor_batch(tc, int(ord, c_int), w, p)
+{coef}
             nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
             ! the safety check of every lane's step: h (P'(h) - f(t + h, P(h))) against
             ! the scales, f there from the new expansion's first coefficients

@@ -22,6 +22,7 @@ finds it there (a cache hit, no compiler run). The copies of a system made by
 """
 import json
 import os
+import re
 import tempfile
 import threading
 import time
@@ -65,14 +66,24 @@ def batch_part(lanes=None):
     return f"batch{lanes}"
 
 
+_BATCH_PART = re.compile(r"batch(\d+)(?:o(\d+))?$")
+
+
 def _lanes(part):
-    """The lanes of a batch part ("batch": the machine's width, "batchK": K), or None."""
+    """The lanes of a batch part ("batch": the machine's width, "batchK": K, "batchKoP":
+    K, with the recurrences written out for order P), or None."""
     if part == "batch":
         return BATCH_WIDTH
-    if part.startswith("batch") and part[5:].isdigit() and \
-            int(part[5:]) in _taylor_batch.LANES:
-        return int(part[5:])
+    m = _BATCH_PART.match(part)
+    if m and int(m.group(1)) in _taylor_batch.LANES:
+        return int(m.group(1))
     return None
+
+
+def _fixed_order(part):
+    """The written-out order of a batch part "batchKoP", or None."""
+    m = _BATCH_PART.match(part)
+    return int(m.group(2)) if m and m.group(2) else None
 
 
 def _decompositions(model):
@@ -100,8 +111,16 @@ def _lines(d, part, dec_cache):
         run = _taylor_batch.run_routine(
             d.n, dec.ncol, max(len(dec.params), 1), lanes,
             (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE))
-        return _taylor_batch.coefficient_routine(dec, names, lanes) + run, \
-            ["taylor_batch", "taylor_batch_run"], None
+        fixed = _fixed_order(part)
+        if fixed is None:
+            return _taylor_batch.coefficient_routine(dec, names, lanes) + run, \
+                ["taylor_batch", "taylor_batch_run"], None
+        run = _taylor_batch.run_routine(
+            d.n, dec.ncol, max(len(dec.params), 1), lanes,
+            (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE), fixed)
+        return _taylor_batch.coefficient_routine(dec, names, lanes) + \
+            _taylor_batch.fixed_routine(dec, names, lanes, fixed) + run, \
+            ["taylor_batch", "taylor_batch_fixed", "taylor_batch_run"], None
     if part == "qp":
         return T.quad_routine(dec, names, "conmech_taylor_qp"), ["taylor_qp"], None
     if "var" not in dec_cache:
@@ -191,8 +210,10 @@ def taylor_library(model, part="core"):
             path, hit = compile_source(src, flags, entries)
             lib, _ = load(path, entries)
             model.times[f"taylor_{part}_compile_or_load"] = time.perf_counter() - t1
-            model.__dict__.setdefault("taylor_paths", {})[part] = path
-            model.__dict__.setdefault("taylor_hits", {})[part] = hit
+            # a batch library written out for an order is the model's batch library
+            name = "batch" if _fixed_order(part) is not None else part
+            model.__dict__.setdefault("taylor_paths", {})[name] = path
+            model.__dict__.setdefault("taylor_hits", {})[name] = hit
             if part == "core":
                 model.taylor_path, model.taylor_cache_hit = path, hit
             state = (lib, _entries(lib, part), None)
@@ -267,14 +288,43 @@ def _store_source(key, part, src, entries, why):
 _BATCH_LOCK = threading.Lock()
 
 
-def batch_entries(model, lanes):
-    """The entries (``batch``, ``width``, ``batch_run``) of the batch library of a compiled
-    ode model with `lanes` lanes other than the machine's (those are the lazy part
-    "batch" of its systems), built once per model under a lock; None when f has no Taylor
-    recurrences."""
+#: written-out batch recurrences up to this many history products per expansion (beyond,
+#: the loop version: the source and its compile time grow as order**2)
+FIXED_MAX_TERMS = 40000
+
+
+def batch_entries(model, lanes, order=None):
+    """The entries (``batch``, ``width``, ``batch_run``) of a batch library of a compiled
+    ode model: `lanes` lanes (None: the machine's), the recurrences written out for
+    `order` when given and small enough (FIXED_MAX_TERMS), else the loop version. Built
+    once per model, lanes and order, under a lock; None when f has no Taylor recurrences
+    (or, for the machine's lanes in the loop version, which is the lazy part "batch" of
+    the model's systems: ask the system)."""
     part = batch_part(lanes)
+    if order is not None:
+        dec = _decomposition(model)
+        if dec is not None:
+            # history sums: none for linear combinations and time, two for powers and
+            # sine/cosine pairs, one otherwise (conmech.symbolic.taylor's recipes)
+            nhist = sum(0 if op.kind in ("lin", "time") else
+                        2 if op.kind in ("pow", "sincos", "sinhcosh") else 1
+                        for op in dec.ops)
+            if nhist*order*(order - 1)//2 <= FIXED_MAX_TERMS:
+                part = f"batch{lanes or BATCH_WIDTH}o{int(order)}"
+    if part == "batch":
+        return None
     with _BATCH_LOCK:
         return taylor_library(model, part)
+
+
+def _decomposition(model):
+    """The decomposition of the model's f (computed once), or None."""
+    from . import taylor as T
+    cache = _decompositions(model)
+    if "f" not in cache:
+        dec, _, why = T.ode_decompositions(model.derived, variational=False)
+        cache["f"] = (dec, why)
+    return cache["f"][0]
 
 
 def lazy_taylor(model):
