@@ -226,7 +226,8 @@ def taylor_library(model, part="core"):
 def _source_path(key, part):
     lanes = _lanes(part)
     if lanes is not None:       # the batch source depends on the lanes (the machine's)
-        part = f"batch{lanes}-v{_taylor_batch.VERSION}"
+        fixed = _fixed_order(part)
+        part = f"batch{lanes}{'' if fixed is None else f'o{fixed}'}-v{_taylor_batch.VERSION}"
     return os.path.join(cache_dir(), f"conmech_{key}.taylor-{part}.json")
 
 
