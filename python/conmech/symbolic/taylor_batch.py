@@ -35,7 +35,7 @@ import re
 from ..ivp.ensemble import LANES     # the lane counts a batch library can be built with
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 2
+VERSION = 3
 
 __all__ = ["machine_lanes", "isa_flags", "coefficient_routine", "run_routine", "LANES"]
 
@@ -233,12 +233,12 @@ def run_routine(n, nw, npar, lanes, codes, fixed=None):
     return src.split("\n")
 
 
-_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), w, p)"
+_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)"
 _COEF_FIXED = """\
             if (ord == {p}) then
-                call conmech_taylor_batch_fixed(tc, int(ord, c_int), w, p)
+                call conmech_taylor_batch_fixed(tc, int(ord, c_int), wb(:, :, :, nu), p)
             else
-                call conmech_taylor_batch(tc, int(ord, c_int), w, p)
+                call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)
             end if"""
 
 _RUN = """\
@@ -256,11 +256,12 @@ _RUN = """\
         integer(c_int), intent(out) :: st(m), cnt(3, m)
         integer, parameter :: nl = {lanes}, n = {n}, nw = {nw}
         real(dp), parameter :: check_max = 10.0_dp
-        real(dp), allocatable :: w(:, :, :), c(:, :, :)
+        real(dp), allocatable :: wb(:, :, :, :)
         real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
-        real(dp) :: yn(nl, n), dy(nl, n), yv(nl), dv(nl), err(nl), s1(nl), s2(nl), ym(nl)
+        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
         real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
         integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
+        integer :: cu, nu
         logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
         t0 = span(1)
         tf = span(2)
@@ -276,9 +277,12 @@ _RUN = """\
         decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
         posneg = sign(1.0_dp, tf - t0)
         hm = min(abs(hmax), abs(tf - t0))
-        allocate (w(nl, 0:ord, nw), c(nl, 0:ord, n))
-        w = 0.0_dp
-        c = 0.0_dp
+        ! two expansions per lane: the current one (the polynomial of the step being
+        ! tried, cu) and the new one (at the step's end, nu); a step accepted makes the
+        ! new one current (the two swap), a lane whose step is rejected keeps its own
+        allocate (wb(nl, 0:ord, nw, 2))
+        wb = 0.0_dp
+        cu = 1
         t = t0
         tlo = 0.0_dp
         h = 0.0_dp
@@ -345,21 +349,25 @@ _RUN = """\
             ! the polynomials at the candidate steps (Horner, the value and its
             ! derivative in one pass), all lanes at once; a lane without a step expands
             ! at its current state (a new member: its initial state)
-            do i = 1, n
-                yv = c(:, ord, i)
-                dv = 0.0_dp
-                do k = ord - 1, 0, -1
+            nu = 3 - cu
+            !$omp simd
+            do l = 1, nl
+                yn(l, :) = wb(l, ord, 1:n, cu)
+                dy(l, :) = 0.0_dp
+            end do
+            do k = ord - 1, 0, -1
+                do i = 1, n
                     !$omp simd
                     do l = 1, nl
-                        dv(l) = yv(l) + hc(l)*dv(l)
-                        yv(l) = c(l, k, i) + hc(l)*yv(l)
+                        dy(l, i) = yn(l, i) + hc(l)*dy(l, i)
+                        yn(l, i) = wb(l, k, i, cu) + hc(l)*yn(l, i)
                     end do
                 end do
+            end do
+            do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    yn(l, i) = yv(l)
-                    dy(l, i) = dv(l)
-                    w(l, 0, i) = merge(yv(l), yc(l, i), stp(l))
+                    wb(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
                 end do
             end do
 {coef}
@@ -371,7 +379,7 @@ _RUN = """\
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - w(l, 1, i)))/(e(l, i) &
+                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - wb(l, 1, i, nu)))/(e(l, i) &
                                  + fl*(abs(yn(l, i)) + abs(hc(l)*dy(l, i)))))
                 end do
             end do
@@ -407,18 +415,17 @@ _RUN = """\
             end do
             ! accepted lanes: the new state, expansion and scales; the next step from
             ! the last two coefficients (Jorba and Zou)
+            ! lanes that did not accept: their current expansion into the new buffer
+            do l = 1, nl
+                if (mem(l) /= 0 .and. .not. acc(l)) wb(l, :, 1:n, nu) = wb(l, :, 1:n, cu)
+            end do
+            cu = nu
             ym = 0.0_dp
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
                     yc(l, i) = merge(yn(l, i), yc(l, i), acc(l) .and. .not. fresh(l))
                     ym(l) = max(ym(l), abs(yc(l, i)))
-                end do
-                do k = 0, ord
-                    !$omp simd
-                    do l = 1, nl
-                        c(l, k, i) = merge(w(l, k, i), c(l, k, i), acc(l))
-                    end do
                 end do
             end do
             fin = .true.
@@ -427,10 +434,10 @@ _RUN = """\
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    fin(l) = fin(l) .and. abs(c(l, 1, i)) <= huge(1.0_dp)
+                    fin(l) = fin(l) .and. abs(wb(l, 1, i, cu)) <= huge(1.0_dp)
                     e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
-                    s1(l) = max(s1(l), abs(c(l, ord - 1, i))/e(l, i))
-                    s2(l) = max(s2(l), abs(c(l, ord, i))/e(l, i))
+                    s1(l) = max(s1(l), abs(wb(l, ord - 1, i, cu))/e(l, i))
+                    s2(l) = max(s2(l), abs(wb(l, ord, i, cu))/e(l, i))
                 end do
             end do
             do l = 1, nl
