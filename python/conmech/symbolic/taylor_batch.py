@@ -187,7 +187,9 @@ def fixed_routine(dec, names, lanes, order, cname="conmech_taylor_batch_fixed"):
     the values in scalars; the same operations in the same order as the loop version) as
     the body of ONE ``!$omp simd`` loop over the lanes, its scalars private to each lane
     (a BLOCK): the compiler turns every scalar into a vector register of the lanes, the
-    whole expansion straight-line vector code, as heyoka's batch mode compiles it."""
+    whole expansion straight-line vector code, as heyoka's batch mode compiles it (for
+    expansions that call no elementary function but square roots: a scalar sin or exp
+    call keeps the loop scalar, see taylor_library.batch_entries)."""
     import inspect
     from . import taylor as T
     ind = "        "

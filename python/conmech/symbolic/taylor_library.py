@@ -310,12 +310,28 @@ def batch_entries(model, lanes, order=None):
             nhist = sum(0 if op.kind in ("lin", "time") else
                         2 if op.kind in ("pow", "sincos", "sinhcosh") else 1
                         for op in dec.ops)
-            if nhist*order*(order - 1)//2 <= FIXED_MAX_TERMS:
+            if nhist*order*(order - 1)//2 <= FIXED_MAX_TERMS and _algebraic(dec):
                 part = f"batch{lanes or BATCH_WIDTH}o{int(order)}"
     if part == "batch":
         return None
     with _BATCH_LOCK:
         return taylor_library(model, part)
+
+
+def _algebraic(dec):
+    """Whether the expansion calls no elementary function but square roots: glibc's scalar
+    sin, cos, exp, log, pow (kept for the scalar route's bits) stop the compiler from
+    vectorising the written-out routine's single loop over the lanes, while the loop
+    version keeps its history sums vectorised apart from them."""
+    import sympy as sp
+    for op in dec.ops:
+        if op.kind in ("lin", "time", "mul", "sq", "div", "recip", "sqrt"):
+            continue
+        r = sp.sympify(op.data.get("r")) if op.kind == "pow" else None
+        if r is not None and r.is_Rational and r.q == 2:
+            continue          # a half-integer power: square roots
+        return False
+    return True
 
 
 def _decomposition(model):
