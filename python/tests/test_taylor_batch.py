@@ -172,6 +172,8 @@ def test_generated_module_is_vectorised(kepler, tmp_path):
     inside = [ln for ln in vec if "loop vectorized" in ln and
               start < int(ln.split("batch.f90:")[1].split(":")[0]) <= end]
     assert inside, report[-2000:]
+    ensemble.solve(kepler, (0, 1.0), kepler_states([0.3]), method="TAYLOR", rtol=1e-12,
+                   atol=1e-12)
     path = model.taylor_paths["batch"]
     manifest = os.path.splitext(path)[0] + ".json"
     import json
