@@ -5,6 +5,11 @@
 !! conmech_taylor_stepper would step it alone (same arithmetic from conmech_taylor_core:
 !! bit for bit the same result). A member that has reached tf waits for the others.
 !!
+!! The lazily compiled batch library of a symbolic system also holds a propagator of its own
+!! (conmech.symbolic.taylor_batch: the step control in vector form too, lanes refilled as
+!! members end), run here by `taylor_batch_run_members` over OpenMP threads;
+!! `taylor_batch_propagate` runs a batch routine given without it.
+!!
 !! Each round: every member's candidate step is evaluated on its polynomial, the batch is
 !! expanded at all candidate points in one call, and each member accepts (its candidate
 !! becomes its current point, the new expansion its polynomial) or, if the safety check
@@ -18,7 +23,8 @@ module conmech_taylor_batch
         taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
     implicit none
     private
-    public :: taylor_batch_fn, taylor_batch_propagate
+    public :: taylor_batch_fn, taylor_batch_propagate, taylor_batch_run_fn, &
+        taylor_batch_run_members
 
     abstract interface
         !> The batch coefficients: t(width), w(width, 0:order, nw); on entry w(:, 0, 1:n) =
@@ -30,9 +36,64 @@ module conmech_taylor_batch
             real(c_double), intent(inout) :: w(*)
             real(c_double), intent(in) :: p(*)
         end subroutine taylor_batch_fn
+        !> The generated propagator over SIMD lanes (conmech.symbolic.taylor_batch): the
+        !! members y(n, m) from span(1) to span(2) in place, each as the scalar stepper
+        !! integrates it; tol(n, 2) = [rtol, atol]; per member st (status), te (where it
+        !! stopped), cnt(:, j) = [expansions, accepted, rejected].
+        subroutine taylor_batch_run_fn(m, y, span, tol, hmax, mxs, p, te, st, cnt) bind(c)
+            import :: c_double, c_int
+            integer(c_int), value :: m, mxs
+            real(c_double), intent(inout) :: y(*)
+            real(c_double), intent(in) :: span(2), tol(*), p(*)
+            real(c_double), value :: hmax
+            real(c_double), intent(out) :: te(*)
+            integer(c_int), intent(out) :: st(*), cnt(*)
+        end subroutine taylor_batch_run_fn
     end interface
 
 contains
+
+    !> The members y(:, 1:m) (n states each) from t0 to tf in place by the generated lane
+    !! propagator `run` (parameters p shared), in chunks of consecutive members spread
+    !! over `threads` OpenMP threads (0: the default number); each member's result does not
+    !! depend on the chunks or threads. info(j), tend(j), nexp(j), nacc(j), nrej(j): see
+    !! taylor_batch_run_fn.
+    subroutine taylor_batch_run_members(run, p, n, m, y, t0, tf, rtol, atol, hmax, max_steps, &
+                                        threads, tend, info, nexp, nacc, nrej)
+        !$ use omp_lib, only: omp_get_max_threads
+        procedure(taylor_batch_run_fn) :: run
+        integer, intent(in) :: n, m, max_steps, threads
+        real(dp), intent(in) :: p(:), t0, tf, rtol(n), atol(n), hmax
+        real(dp), intent(inout) :: y(n, m)
+        real(dp), intent(out) :: tend(m)
+        integer(c_int), intent(out) :: info(m), nexp(m), nacc(m), nrej(m)
+        integer(c_int), allocatable :: cnt(:, :)
+        real(dp) :: tol(n, 2)
+        integer :: nthr, chunk, nc, b, j0, nm
+        nthr = 1
+        !$ nthr = omp_get_max_threads()
+        if (threads > 0) nthr = threads
+        ! chunks small enough for the threads to share the work evenly, large enough that
+        ! a chunk's last members (when lanes fall idle) are a small part of it
+        chunk = max(16, min(512, (m + 8*nthr - 1)/(8*nthr)))
+        nc = (m + chunk - 1)/chunk
+        tol(:, 1) = rtol
+        tol(:, 2) = atol
+        allocate (cnt(3, m))
+        !$omp parallel do num_threads(nthr) schedule(dynamic, 1) default(shared) &
+        !$omp private(b, j0, nm)
+        do b = 1, nc
+            j0 = (b - 1)*chunk + 1
+            nm = min(chunk, m - j0 + 1)
+            call run(int(nm, c_int), y(:, j0:j0 + nm - 1), [t0, tf], tol, hmax, &
+                     int(max_steps, c_int), p, tend(j0:j0 + nm - 1), info(j0:j0 + nm - 1), &
+                     cnt(:, j0:j0 + nm - 1))
+        end do
+        !$omp end parallel do
+        nexp = cnt(1, :)
+        nacc = cnt(2, :)
+        nrej = cnt(3, :)
+    end subroutine taylor_batch_run_members
 
     !> Advance the members y(:, 1:nm) (nm <= width) from t0 to tf in place by Taylor's
     !! method with the batch routine `fn` (width members, nw work columns, parameters p),

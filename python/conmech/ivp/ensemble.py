@@ -49,6 +49,8 @@ from .._core.status import BAD_INPUT
 __all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
 
 _NOT_RUN = -99
+#: the lane counts of the SIMD Taylor route (conmech.symbolic.taylor_batch)
+LANES = (1, 2, 4, 8, 16)
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
 # the defaults of solve_ivp (method, rtol, atol), so that a member equals solve_ivp's run
@@ -191,43 +193,82 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
-def _taylor_batch(system, method, nt, ne, mp, first_step, progress):
-    """Whether an ensemble runs Taylor's method in batches (the generated batch routine
-    computes several members' coefficients at once): method TAYLOR, a system with the
-    batch routine, shared parameters, final states only (no t_eval, events, first_step
-    or progress)."""
+def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
+    """The Taylor entries of the batch route of an ensemble, or None: method TAYLOR, a
+    system with a batch routine, shared parameters, final states only (no t_eval, events,
+    first_step or progress). A system of conmech.symbolic gets its batch library here, on
+    first need: the coefficient routine and the propagator over SIMD lanes
+    (conmech.symbolic.taylor_batch) with `lanes` lanes (None: the machine's vector
+    width), the recurrences written out for the order of the tolerance eps when they are
+    small enough."""
     if not (isinstance(method, str) and method.upper() == "TAYLOR"):
-        return False
-    # a system of conmech.symbolic compiles its Taylor recurrences here, on first need
-    # (their entries then in its spec, for the member-by-member path too), the batch
-    # routine only when the batch path runs
+        return None
     batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
-    if batch and hasattr(system, "taylor_parts"):
-        taylor = system.taylor_parts("batch")
+    if not batch:
+        # the member-by-member route: a system of conmech.symbolic compiles its Taylor
+        # recurrences here, on first need (their entries then in its spec)
+        getattr(system, "taylor", None)
+        return None
+    taylor = None
+    if hasattr(system, "taylor_parts"):
+        # a system of conmech.symbolic compiles its Taylor recurrences here, on first
+        # need (their entries then in its spec, for the member-by-member path too)
+        from ..symbolic.pipeline import model_of
+        from ..symbolic.taylor_library import batch_entries
+        from .taylor import taylor_order
+        taylor = system.taylor_parts()
+        try:
+            model = model_of(system)
+        except TypeError:
+            model = None
+        extra = None
+        if taylor and model is not None:
+            extra = batch_entries(model, lanes, taylor_order(eps))
+        if extra:
+            taylor = dict(taylor, **extra)
+        elif taylor:       # the machine's lanes, the loop version: the lazy part
+            taylor = system.taylor_parts("batch")
     else:
         taylor = getattr(system, "taylor", None)
-    return batch and bool(taylor) and taylor.get("batch") is not None
+    if not taylor or taylor.get("batch") is None:
+        return None
+    return taylor
 
 
-def _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps, nthreads):
-    """The members in batches of the generated width, batches in OpenMP threads (each
-    member's steps are those of its solve_ivp run, bit for bit)."""
-    taylor = system.taylor
+def _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps,
+                        nthreads):
+    """The members in SIMD lanes (the generated propagator, lanes refilled as members end)
+    or in batches of the coefficient routine's width (a system given a batch routine
+    only), chunks of members in OpenMP threads; each member's steps are those of its
+    solve_ivp run, bit for bit."""
     n = system.dimension
     y0m = np.broadcast_to(y0a, (m, n)) if y0a.shape[0] == 1 else y0a
     p = system.params if system.params.size else _PAD
-    (y_final, t_final, codes, nfev, naccept, nreject, info,
-     message) = _conmech.flat_taylor_ensemble(
-        fnaddr=function_address(taylor["batch"], "taylor['batch']"),
-        width=int(taylor["width"]), nw=int(taylor["nw"]), np=system.params.size, params=p,
-        n=n, m=m, y0=np.asfortranarray(y0m.T), t_span=np.array([t0, tf]), rtol=rtol_v,
-        atol=atol_v, max_step=hmax, max_steps=max_steps, threads=nthreads)
+    if taylor.get("batch_run") is not None:
+        (y_final, t_final, codes, nfev, naccept, nreject, info,
+         message) = _conmech.flat_taylor_batch_run(
+            runaddr=function_address(taylor["batch_run"], "taylor['batch_run']"),
+            np=system.params.size, params=p, n=n, m=m, y0=np.asfortranarray(y0m.T),
+            t_span=np.array([t0, tf]), rtol=rtol_v, atol=atol_v, max_step=hmax,
+            max_steps=max_steps, threads=nthreads)
+    else:
+        (y_final, t_final, codes, nfev, naccept, nreject, info,
+         message) = _conmech.flat_taylor_ensemble(
+            fnaddr=function_address(taylor["batch"], "taylor['batch']"),
+            width=int(taylor["width"]), nw=int(taylor["nw"]), np=system.params.size,
+            params=p, n=n, m=m, y0=np.asfortranarray(y0m.T), t_span=np.array([t0, tf]),
+            rtol=rtol_v, atol=atol_v, max_step=hmax, max_steps=max_steps,
+            threads=nthreads)
     codes = np.asarray(codes, dtype=int)
     status = np.where(codes >= 0, codes, -1)
     info = int(info)
-    message = "Every member reached the end of the integration interval." if info >= 0 \
-        else ("a member failed: " + (bytes(message).decode("ascii", "replace").strip()
-                                     if not isinstance(message, str) else message.strip()))
+    if info >= 0:
+        message = "Every member reached the end of the integration interval."
+    else:
+        first = int(np.argmax(codes < 0))
+        from .._core.status import status_message
+        message = (f"{int((codes < 0).sum())} of {m} members failed; the first, member "
+                   f"{first}: {status_message(int(codes[first]))}")
     return EnsembleResult(
         t=None, y=None, t_final=t_final, y_final=np.ascontiguousarray(y_final.T),
         status=status, member_success=status >= 0, codes=codes, nfev=nfev.astype(int),
@@ -242,7 +283,8 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
           first_step: float | None = None, max_step: float = np.inf, max_steps: int = 100000,
           events=None, max_events: int = 1, terminal: bool = False, threads: int | None = None,
           chunk: int | None = None,
-          progress: Callable[[int, int], Any] | None = None) -> EnsembleResult:
+          progress: Callable[[int, int], Any] | None = None,
+          lanes: int | None = None) -> EnsembleResult:
     """Integrate an ensemble of members of one compiled system in parallel.
 
     Parameters
@@ -278,6 +320,12 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         ``progress(done, total)``, called between chunks from the calling thread. An
         exception raised in it cancels the members not yet started and is raised again
         after the call.
+    lanes : int, optional
+        method="TAYLOR" on a system of :mod:`conmech.symbolic` with final states only (no
+        t_eval, events, first_step, progress or per-member params): members integrated
+        together in this many SIMD lanes (1, 2, 4, 8 or 16; None: the machine's vector
+        width for doubles, 4 with AVX2, 8 with AVX-512), each a library compiled once per
+        model. The results do not depend on it. Only with method="TAYLOR".
 
     Returns
     -------
@@ -370,6 +418,15 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         if not 1 <= chunk <= 2**31 - 1:
             raise ValueError("chunk must be positive")
         nchunk = int(chunk)
+    if lanes is not None:
+        if isinstance(lanes, (bool, np.bool_)) or not isinstance(lanes, numbers.Integral):
+            raise TypeError("lanes must be an integer or None")
+        if int(lanes) not in LANES:
+            raise ValueError(f"lanes must be one of {', '.join(map(str, LANES))}, got "
+                             f"{lanes!r}")
+        if method.upper() != "TAYLOR":
+            raise ValueError("lanes applies to method='TAYLOR' only")
+        lanes = int(lanes)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable or None")
     if not isinstance(terminal, (bool, np.bool_)):
@@ -417,8 +474,10 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         return 0
 
     nt = t_ev.size
-    if _taylor_batch(system, method, nt, ne, mp, first_step, progress):
-        return _solve_taylor_batch(system, t0, tf, y0a, m, rtol_v, atol_v, hmax,
+    eps = max(float(np.min(rtol_v)), 2.220446049250313e-16, float(np.min(atol_v)))
+    taylor = _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps)
+    if taylor is not None:
+        return _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax,
                                    int(max_steps), nthreads)
     name, _, _, nspec, spec = system._flat_args()
     (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,

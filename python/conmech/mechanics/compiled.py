@@ -166,7 +166,7 @@ def _taylor_spec(spec, taylor):
         return spec
     if not isinstance(taylor, dict):
         raise TypeError("taylor must be a dict (jet, nw, and optionally var, nw_var)")
-    unknown = set(taylor) - set(_TAYLOR_SLOTS) - {"batch", "width", "qp", "model"}
+    unknown = set(taylor) - set(_TAYLOR_SLOTS) - {"batch", "width", "batch_run", "qp", "model"}
     if unknown:
         raise ValueError(f"unknown taylor entries {sorted(unknown)}")
     for key, slot in _TAYLOR_SLOTS.items():

@@ -7,7 +7,9 @@ right-hand side, its Jacobian and the Jacobian products. The Taylor recurrences 
 the variational system's) are several times that code, and only ``method="TAYLOR"`` runs
 them, so they are compiled apart, and each in its own library, as a call needs it
 (:data:`PARTS`): a Taylor solve (``solve_ivp(method="TAYLOR")``) needs the double routine
-only (``core``); a Taylor ensemble the batch routine; :mod:`conmech.symbolic.taylor_quad`
+only (``core``); a Taylor ensemble the batch routine and its propagator over SIMD lanes
+(:mod:`conmech.symbolic.taylor_batch`, compiled for the machine's vector instructions);
+:mod:`conmech.symbolic.taylor_quad`
 the quadruple-precision one; ``stm(method="TAYLOR")`` the variational system's (half of
 all the code). :func:`lazy_taylor` gives the system a :class:`conmech.compiled.LazyTaylor`
 whose first request of a part generates its module, compiles it into the same on-disk
@@ -20,14 +22,17 @@ finds it there (a cache hit, no compiler run). The copies of a system made by
 """
 import json
 import os
+import re
 import tempfile
 import threading
 import time
 
-from .build import cache_dir, check_private, compile_source, load
+from . import taylor_batch as _taylor_batch
+from .build import FFLAGS, cache_dir, check_private, compile_source, load
 from .codegen import _names, check_source, private_procedures
 
-__all__ = ["taylor_source", "taylor_library", "lazy_taylor", "MODULE", "PARTS"]
+__all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batch_entries",
+           "MODULE", "PARTS"]
 
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
@@ -44,8 +49,41 @@ _LOCK = threading.Lock()
 #: precision one of conmech.symbolic.taylor_quad, and the variational system's (the STM)
 PARTS = ("core", "batch", "qp", "var")
 
-#: members per call of the batch routine
-BATCH_WIDTH = 4
+#: members per call of the batch coefficient routine, and lanes of the batch propagator
+#: (conmech.symbolic.taylor_batch): the machine's vector width for doubles
+BATCH_WIDTH = _taylor_batch.machine_lanes()
+
+
+def batch_part(lanes=None):
+    """The part name of a batch library with `lanes` lanes (None: the machine's width,
+    the part "batch"); a ValueError for a lane count not in taylor_batch.LANES."""
+    if lanes is None or lanes == BATCH_WIDTH:
+        return "batch"
+    if isinstance(lanes, bool) or not isinstance(lanes, int) or \
+            lanes not in _taylor_batch.LANES:
+        raise ValueError("lanes must be one of "
+                         f"{', '.join(map(str, _taylor_batch.LANES))}, got {lanes!r}")
+    return f"batch{lanes}"
+
+
+_BATCH_PART = re.compile(r"batch(\d+)(?:o(\d+))?$")
+
+
+def _lanes(part):
+    """The lanes of a batch part ("batch": the machine's width, "batchK": K, "batchKoP":
+    K, with the recurrences written out for order P), or None."""
+    if part == "batch":
+        return BATCH_WIDTH
+    m = _BATCH_PART.match(part)
+    if m and int(m.group(1)) in _taylor_batch.LANES:
+        return int(m.group(1))
+    return None
+
+
+def _fixed_order(part):
+    """The written-out order of a batch part "batchKoP", or None."""
+    m = _BATCH_PART.match(part)
+    return int(m.group(2)) if m and m.group(2) else None
 
 
 def _decompositions(model):
@@ -70,9 +108,22 @@ def _lines(d, part, dec_cache):
     if part == "core":
         return T.taylor_procedures(dec, names, "conmech_taylor", 0, False), \
             ["taylor", "taylor_info"], None
-    if part == "batch":
-        return T.c_routine(dec, names, "conmech_taylor_batch", batch=BATCH_WIDTH), \
-            ["taylor_batch"], None
+    lanes = _lanes(part)
+    if lanes is not None:
+        from .._core import status as S
+        run = _taylor_batch.run_routine(
+            d.n, dec.ncol, max(len(dec.params), 1), lanes,
+            (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE))
+        fixed = _fixed_order(part)
+        if fixed is None:
+            return _taylor_batch.coefficient_routine(dec, names, lanes) + run, \
+                ["taylor_batch", "taylor_batch_run"], None
+        run = _taylor_batch.run_routine(
+            d.n, dec.ncol, max(len(dec.params), 1), lanes,
+            (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL, S.NONFINITE), fixed)
+        return _taylor_batch.coefficient_routine(dec, names, lanes) + \
+            _taylor_batch.fixed_routine(dec, names, lanes, fixed) + run, \
+            ["taylor_batch", "taylor_batch_fixed", "taylor_batch_run"], None
     if part == "qp":
         return T.quad_routine(dec, names, "conmech_taylor_qp"), ["taylor_qp"], None
     if "var" not in dec_cache:
@@ -90,8 +141,9 @@ def taylor_source(d, part="core", _dec=None):
     code holds. A generalized record M(q) q'' = Q has the core only, with
     ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`). (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
-    if part not in PARTS:
-        raise ValueError(f"part must be one of {', '.join(PARTS)}, got {part!r}")
+    if part not in PARTS and _lanes(part) is None:
+        raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "
+                         f"got {part!r}")
     lines, entries, why = _lines(d, part, {} if _dec is None else _dec)
     if not lines:
         return None, [], why
@@ -123,8 +175,10 @@ def _entries(lib, part):
         if rhs is not None:          # a generalized model: f = [v; M^-1 Q] for its view
             out["rhs"] = rhs
         return out
-    if part == "batch":
-        return {"batch": lib.conmech_taylor_batch, "width": BATCH_WIDTH}
+    lanes = _lanes(part)
+    if lanes is not None:
+        return {"batch": lib.conmech_taylor_batch, "width": lanes,
+                "batch_run": lib.conmech_taylor_batch_run}
     if part == "qp":
         return {"qp": lib.conmech_taylor_qp}
     lib.conmech_taylor_var_info(info)
@@ -157,11 +211,18 @@ def taylor_library(model, part="core"):
         if src is None:
             state = (None, None, why)
         else:
-            path, hit = compile_source(src, getattr(model, "flags", None), entries)
+            flags = getattr(model, "flags", None)
+            lanes = _lanes(part)
+            if lanes is not None:   # the batch code for the machine's vector instructions
+                flags = list(FFLAGS if flags is None else flags) + \
+                    _taylor_batch.isa_flags(lanes)
+            path, hit = compile_source(src, flags, entries)
             lib, _ = load(path, entries)
             model.times[f"taylor_{part}_compile_or_load"] = time.perf_counter() - t1
-            model.__dict__.setdefault("taylor_paths", {})[part] = path
-            model.__dict__.setdefault("taylor_hits", {})[part] = hit
+            # a batch library written out for an order is the model's batch library
+            name = "batch" if _fixed_order(part) is not None else part
+            model.__dict__.setdefault("taylor_paths", {})[name] = path
+            model.__dict__.setdefault("taylor_hits", {})[name] = hit
             if part == "core":
                 model.taylor_path, model.taylor_cache_hit = path, hit
             state = (lib, _entries(lib, part), None)
@@ -172,6 +233,10 @@ def taylor_library(model, part="core"):
 
 
 def _source_path(key, part):
+    lanes = _lanes(part)
+    if lanes is not None:       # the batch source depends on the lanes (the machine's)
+        fixed = _fixed_order(part)
+        part = f"batch{lanes}{'' if fixed is None else f'o{fixed}'}-v{_taylor_batch.VERSION}"
     return os.path.join(cache_dir(), f"conmech_{key}.taylor-{part}.json")
 
 
@@ -228,6 +293,64 @@ def _store_source(key, part, src, entries, why):
                 os.unlink(tmp)
             except OSError:
                 pass
+
+
+_BATCH_LOCK = threading.Lock()
+
+
+#: written-out batch recurrences up to this many history products per expansion (beyond,
+#: the loop version: the source and its compile time grow as order**2)
+FIXED_MAX_TERMS = 40000
+
+
+def batch_entries(model, lanes, order=None):
+    """The entries (``batch``, ``width``, ``batch_run``) of a batch library of a compiled
+    ode model: `lanes` lanes (None: the machine's), the recurrences written out for
+    `order` when given and small enough (FIXED_MAX_TERMS), else the loop version. Built
+    once per model, lanes and order, under a lock; None when f has no Taylor recurrences
+    (or, for the machine's lanes in the loop version, which is the lazy part "batch" of
+    the model's systems: ask the system)."""
+    part = batch_part(lanes)
+    if order is not None:
+        dec = _decomposition(model)
+        if dec is not None:
+            # history sums: none for linear combinations and time, two for powers and
+            # sine/cosine pairs, one otherwise (conmech.symbolic.taylor's recipes)
+            nhist = sum(0 if op.kind in ("lin", "time") else
+                        2 if op.kind in ("pow", "sincos", "sinhcosh") else 1
+                        for op in dec.ops)
+            if nhist*order*(order - 1)//2 <= FIXED_MAX_TERMS and _algebraic(dec):
+                part = f"batch{lanes or BATCH_WIDTH}o{int(order)}"
+    if part == "batch":
+        return None
+    with _BATCH_LOCK:
+        return taylor_library(model, part)
+
+
+def _algebraic(dec):
+    """Whether the expansion calls no elementary function but square roots: glibc's scalar
+    sin, cos, exp, log, pow (kept for the scalar route's bits) stop the compiler from
+    vectorising the written-out routine's single loop over the lanes, while the loop
+    version keeps its history sums vectorised apart from them."""
+    import sympy as sp
+    for op in dec.ops:
+        if op.kind in ("lin", "time", "mul", "sq", "div", "recip", "sqrt"):
+            continue
+        r = sp.sympify(op.data.get("r")) if op.kind == "pow" else None
+        if r is not None and r.is_Rational and r.q == 2:
+            continue          # a half-integer power: square roots
+        return False
+    return True
+
+
+def _decomposition(model):
+    """The decomposition of the model's f (computed once), or None."""
+    from . import taylor as T
+    cache = _decompositions(model)
+    if "f" not in cache:
+        dec, _, why = T.ode_decompositions(model.derived, variational=False)
+        cache["f"] = (dec, why)
+    return cache["f"][0]
 
 
 def lazy_taylor(model):

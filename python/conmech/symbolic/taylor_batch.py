@@ -1,0 +1,462 @@
+"""Taylor's method for ensembles in SIMD lanes: the generated batch propagator.
+
+An ensemble of one symbolic ode system integrates many members with the same recurrences.
+heyoka's batch mode runs ``width`` members in lock-step, one SIMD lane each; this module
+generates the same for conmech, as Fortran that the compiler vectorises:
+
+- the coefficient routine ``conmech_taylor_batch(t, order, w, p)`` of
+  :func:`conmech.symbolic.taylor.c_routine` with a lane dimension first,
+  w(lanes, 0:order, nw): every statement of the recurrences is an operation on ``lanes``
+  contiguous values, one vector instruction (or two) per statement;
+- the propagator ``conmech_taylor_batch_run`` (this module), which steps the lanes
+  together with the state, the step, the time and the error scales of each lane in
+  arrays of ``lanes`` values: Horner's evaluation of the polynomials, the safety check of
+  the step, the error scales and the norms of the last two coefficients are vector
+  operations over the lanes with no branch per lane; the per-lane decisions (accept or
+  reject, reached the end, failed) are masks, and the logarithms of the step-size formula
+  are per lane.
+
+Lanes are refilled: when a member ends (it reached tf, or failed) its lane takes the next
+member of the call at once (its first expansion rides along with the other lanes' next
+step), so no lane waits for the slowest member of a group. Each member takes exactly the
+steps, and gets exactly the result, of its own :func:`conmech.solve_ivp` run with
+method="TAYLOR" (the arithmetic of :mod:`conmech_taylor_core`, operation for operation; the
+library is compiled without contraction of multiply-adds and calls glibc's scalar
+elementary functions, so vector and scalar code round alike), whatever its lane, its neighbours, the batch size or the number of threads.
+
+The lane count is the machine's vector width for doubles by default (:func:`machine_lanes`:
+8 with AVX-512, 4 with AVX2, else 2), and the library is compiled for that instruction set
+(:func:`isa_flags`); ``conmech.ensemble.solve(..., lanes=k)`` builds another width.
+"""
+import functools
+import platform
+import re
+
+from ..ivp.ensemble import LANES     # the lane counts a batch library can be built with
+
+#: the version of the generated batch code (a change regenerates the kept sources)
+VERSION = 3
+
+__all__ = ["machine_lanes", "isa_flags", "coefficient_routine", "run_routine", "LANES"]
+
+# the lanes round exactly as the scalar route does: the multiply-adds are not contracted
+# into fused ones (gfortran's default with an FMA instruction set), and sin, cos, exp, ...
+# are glibc's scalar functions, not its vector ones (libmvec, a few ulp apart), which
+# gfortran calls for the lanes when it pre-includes glibc's math-vector-fortran.h (by
+# default; -nostdinc leaves it out, and the generated code includes nothing)
+# (-fopenmp-simd: the `!$omp simd` lane loops are vectorised as loops, not unrolled first
+# into scalar statements that the straight-line vectoriser then misses)
+_NO_CONTRACT = ["-ffp-contract=off", "-nostdinc", "-fopenmp-simd"]
+
+
+@functools.lru_cache(maxsize=1)
+def _cpu_features():
+    """The SIMD features of this processor (x86-64 only; an empty set elsewhere)."""
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return frozenset()
+    feats = set()
+    try:
+        import numpy as np
+        core = getattr(np, "_core", None) or np.core
+        table = core._multiarray_umath.__cpu_features__
+        feats = {k for k, v in table.items() if v}
+    except (ImportError, AttributeError):
+        try:
+            with open("/proc/cpuinfo") as fh:
+                for line in fh:
+                    if line.startswith("flags"):
+                        flags = set(line.split(":", 1)[1].split())
+                        feats = {k for k, f in (("AVX2", "avx2"), ("AVX512F", "avx512f"))
+                                 if f in flags}
+                        break
+        except OSError:
+            pass
+    return frozenset(f for f in feats if f in ("AVX2", "AVX512F"))
+
+
+def machine_lanes():
+    """Doubles per SIMD register of this machine: 8 (AVX-512), 4 (AVX2), else 2."""
+    feats = _cpu_features()
+    if "AVX512F" in feats:
+        return 8
+    if "AVX2" in feats:
+        return 4
+    return 2
+
+
+def isa_flags(lanes):
+    """Compiler flags of a batch library with `lanes` lanes: the machine's vector
+    instruction set (AVX-512 registers only for 8 or more lanes), no contraction."""
+    feats = _cpu_features()
+    if "AVX512F" in feats and lanes >= 8:
+        isa = ["-mavx512f", "-mavx2", "-mprefer-vector-width=512"]
+    elif "AVX2" in feats:
+        isa = ["-mavx2"]
+    else:
+        isa = []
+    return isa + _NO_CONTRACT
+
+
+_LANE_NAMES = re.compile(r"\b(h\d+|iv\d+|t)\b(?!\()")
+
+
+def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
+    """Fortran lines of the bind(C) routine ``cname(t, order, w, p)`` computing the Taylor
+    coefficients of `lanes` members at once, t(lanes), w(lanes, 0:order, nw) (w(:, 0, 1:n)
+    the states on entry): the statements of :mod:`conmech.symbolic.taylor`'s loop version
+    (the same operations in the same order, so each lane gets the scalar routine's
+    coefficients to the last bit) inside ``!$omp simd`` loops over the lanes, innermost:
+    one vector instruction per operation for all the lanes."""
+    from . import taylor as T
+    ind = "        "
+    kind = "dp"
+    pp = T._Printer(dec, names, False, kind)
+    pp.w = lambda k, c: f"w(l, {k}, {c})"
+    rc = T._Recipe(pp, False, "order")
+    W = pp.w
+
+    def lane(x):          # the accumulators, reciprocals and t are per lane
+        return _LANE_NAMES.sub(lambda mm: f"{mm.group(1)}(l)", x)
+
+    def loop(stmts, at):
+        out = [f"{at}!$omp simd", f"{at}do l = 1, nl"]
+        for x in stmts:
+            out += T._wrap(lane(x), at + "    ")
+        return out + [f"{at}end do"]
+    one = pp.real(1)
+    zero = f"0.0_{kind}"
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    head = [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}integer, parameter :: nl = {lanes}",
+            f"{ind}real(dp), intent(in) :: t(nl)",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})"]
+    decl = T._decls([c for c, _ in rc.consts], f"real({kind})", ind)
+    decl += T._decls([f"{x}(nl)" for x in rc.accs + rc.invs], f"real({kind})", ind)
+    decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
+    body = [f"{ind}if (order < 1) return"]
+    for c, e in rc.consts:
+        body += T._wrap(f"{c} = {e}", ind)
+    jstate = [i + 1 for i in range(dec.n) if i + 1 in dec.jcol]
+    first = list(rc.s0)
+    first += [f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}" for i, o in enumerate(dec.outputs)]
+    first += [f"{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+    body += loop(first, ind)
+    E = {"k": "k", "fk": "fk", "rk": "rk"}
+    body += [f"{ind}do k = 1, order - 1",
+             f"{ind}    fk = real(k, {kind})",
+             f"{ind}    rk = {one}/fk",
+             f"{ind}    rk1 = {one}/(fk + {one})"]
+    body += [f"{ind}    {h} = {zero}" for h in rc.accs]
+    plain = [x for x in rc.hist if x[3] is not T._SYM]
+    sym = [x for x in rc.hist if x[3] is T._SYM]
+    if plain:
+        body.append(f"{ind}    do j = 1, k - 1")
+        stm = []
+        for h, lft, rgt, wt in plain:
+            wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
+            stm.append(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}")
+        body += loop(stm, ind + "        ")
+        body.append(f"{ind}    end do")
+    if sym:       # squares: the pairs j < k - j once, doubled, and the middle term
+        body.append(f"{ind}    do j = 1, (k - 1)/2")
+        body += loop([f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}"
+                      for h, lft, _, _ in sym], ind + "        ")
+        body.append(f"{ind}    end do")
+        body += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
+        body.append(f"{ind}    if (mod(k, 2) == 0) then")
+        body += loop([f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}"
+                      for h, lft, _, _ in sym], ind + "        ")
+        body.append(f"{ind}    end if")
+    cur = [f(E) for f in rc.cur]
+    cur += [f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})"
+            for i, o in enumerate(dec.outputs)]
+    cur += [f"{W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}" for c in jstate]
+    body += loop(cur, ind + "    ")
+    body.append(f"{ind}end do")
+    return head + decl + body + [f"    end subroutine {cname}", ""]
+
+
+def fixed_routine(dec, names, lanes, order, cname="conmech_taylor_batch_fixed"):
+    """Fortran lines of the bind(C) routine ``cname(t, order, w, p)`` (arguments as
+    :func:`coefficient_routine`'s) with the recurrences written out for one `order` (it
+    does nothing for another order): the statements of the scalar routine written out
+    (:func:`conmech.symbolic.taylor.body_lines` with ``fixed``: no loops, literal indices,
+    the values in scalars; the same operations in the same order as the loop version) as
+    the body of ONE ``!$omp simd`` loop over the lanes, its scalars private to each lane
+    (a BLOCK): the compiler turns every scalar into a vector register of the lanes, the
+    whole expansion straight-line vector code, as heyoka's batch mode compiles it (for
+    expansions that call no elementary function but square roots: a scalar sin or exp
+    call keeps the loop scalar, see taylor_library.batch_entries)."""
+    import inspect
+    from . import taylor as T
+    ind = "        "
+    kw = {"paired": False} if "paired" in inspect.signature(T.body_lines).parameters else {}
+    decl, body = T.body_lines(dec, names, "dp", 0, False, ind + "        ", order, **kw)
+    guard = body[0].strip()
+    if not guard.startswith("if (order /="):
+        raise ValueError("unexpected written-out Taylor body")
+    lane_body = [_LANE_NAMES_FIXED.sub(lambda mm: f"{mm.group(1)}(l)",
+                                      x.replace("w(", "w(l, ")) for x in body[1:]]
+    nw = dec.ncol
+    npar = max(len(dec.params), 1)
+    return [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}integer, parameter :: nl = {lanes}",
+            f"{ind}real(dp), intent(in) :: t(nl)",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})",
+            f"{ind}integer :: l",
+            f"{ind}{guard}",
+            f"{ind}!$omp simd",
+            f"{ind}do l = 1, nl",
+            f"{ind}    block"] + decl + lane_body + \
+        [f"{ind}    end block", f"{ind}end do", f"    end subroutine {cname}", ""]
+
+
+# the time in a written-out body (the only per-lane name besides w)
+_LANE_NAMES_FIXED = re.compile(r"\b(t)\b(?!\()")
+
+
+def run_routine(n, nw, npar, lanes, codes, fixed=None):
+    """Fortran lines of ``conmech_taylor_batch_run`` for a system of n states, nw work
+    columns and npar parameter slots, with `lanes` lanes; it calls the coefficient routine
+    ``conmech_taylor_batch`` of the same module. codes: the status codes (success,
+    too_many_steps, step_too_small, nonfinite). fixed: the order of the written-out routine
+    ``conmech_taylor_batch_fixed`` of the module, called for that order (else the loop
+    version)."""
+    ok, many, small, nonfin = (int(c) for c in codes)
+    run = 1 if 1 not in (ok, many, small, nonfin) else 99     # "still running"
+    src = _RUN.format(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
+                      nonfin=nonfin, run=run, coef=_COEF if fixed is None else
+                      _COEF_FIXED.format(p=int(fixed)))
+    return src.split("\n")
+
+
+_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)"
+_COEF_FIXED = """\
+            if (ord == {p}) then
+                call conmech_taylor_batch_fixed(tc, int(ord, c_int), wb(:, :, :, nu), p)
+            else
+                call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)
+            end if"""
+
+_RUN = """\
+    !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
+    !! time (a lane takes the next member as soon as its own has ended), each member
+    !! exactly as the scalar Taylor stepper integrates it alone; tol(:, 1) = rtol, tol(:, 2)
+    !! = atol, steps of at most hmax, at most mxs attempted. st(j): the status of member j,
+    !! te(j) where it stopped, cnt(:, j) its expansions (nfev), accepted, rejected steps.
+    subroutine conmech_taylor_batch_run(m, y, span, tol, hmax, mxs, p, te, st, cnt) bind(C, name="conmech_taylor_batch_run")
+        integer(c_int), value, intent(in) :: m, mxs
+        real(dp), intent(inout) :: y({n}, m)
+        real(dp), intent(in) :: span(2), tol({n}, 2), p({npar})
+        real(dp), value, intent(in) :: hmax
+        real(dp), intent(out) :: te(m)
+        integer(c_int), intent(out) :: st(m), cnt(3, m)
+        integer, parameter :: nl = {lanes}, n = {n}, nw = {nw}
+        real(dp), parameter :: check_max = 10.0_dp
+        real(dp), allocatable :: wb(:, :, :, :)
+        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
+        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
+        real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
+        integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
+        integer :: cu, nu
+        logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
+        t0 = span(1)
+        tf = span(2)
+        atol = tol(:, 2)
+        st = {ok}
+        cnt = 0
+        te = t0
+        if (m < 1 .or. tf == t0) return
+        ! the scalar stepper's order, step bound and decay factor (conmech_taylor_core)
+        rt = max(tol(:, 1), epsilon(1.0_dp))
+        eps = max(minval(rt), minval(atol))
+        ord = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
+        decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
+        posneg = sign(1.0_dp, tf - t0)
+        hm = min(abs(hmax), abs(tf - t0))
+        ! two expansions per lane: the current one (the polynomial of the step being
+        ! tried, cu) and the new one (at the step's end, nu); a step accepted makes the
+        ! new one current (the two swap), a lane whose step is rejected keeps its own
+        allocate (wb(nl, 0:ord, nw, 2))
+        wb = 0.0_dp
+        cu = 1
+        t = t0
+        tlo = 0.0_dp
+        h = 0.0_dp
+        e = 1.0_dp
+        yc = 0.0_dp
+        mem = 0
+        done = {run}
+        nst = 0
+        na = 0
+        nr = 0
+        nx = 0
+        fresh = .false.
+        next = 1
+        do
+            ! lanes whose member has ended: its results out, the next member in (fresh:
+            ! its first expansion is made in this round, beside the others' steps)
+            do l = 1, nl
+                if (mem(l) /= 0) then
+                    if (done(l) == {run}) cycle
+                    j = mem(l)
+                    y(:, j) = yc(l, :)
+                    te(j) = t(l)
+                    st(j) = done(l)
+                    cnt(:, j) = [nx(l), na(l), nr(l)]
+                    mem(l) = 0
+                end if
+                if (next > m) cycle
+                mem(l) = next
+                yc(l, :) = y(:, next)
+                t(l) = t0
+                tlo(l) = 0.0_dp
+                h(l) = 0.0_dp
+                done(l) = {run}
+                fresh(l) = .true.
+                nst(l) = 0
+                na(l) = 0
+                nr(l) = 0
+                nx(l) = 0
+                next = next + 1
+            end do
+            if (all(mem == 0)) exit
+            ! each running lane's step: the scalar stepper's limits, then its candidate
+            do l = 1, nl
+                hc(l) = 0.0_dp
+                tc(l) = t(l)
+                hit(l) = .false.
+                stp(l) = .false.
+                if (mem(l) == 0 .or. fresh(l)) cycle
+                if (nst(l) >= mxs) then
+                    done(l) = {many}
+                else if (.not. (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))) then
+                    done(l) = {small}
+                else
+                    hc(l) = h(l)
+                    if ((t(l) + hc(l) - tf)*posneg >= 0.0_dp) then
+                        hc(l) = (tf - t(l)) - tlo(l)
+                        hit(l) = .true.
+                    end if
+                    nst(l) = nst(l) + 1
+                    tc(l) = t(l) + hc(l)
+                    stp(l) = .true.
+                end if
+            end do
+            ! the polynomials at the candidate steps (Horner, the value and its
+            ! derivative in one pass), all lanes at once; a lane without a step expands
+            ! at its current state (a new member: its initial state)
+            nu = 3 - cu
+            !$omp simd
+            do l = 1, nl
+                yn(l, :) = wb(l, ord, 1:n, cu)
+                dy(l, :) = 0.0_dp
+            end do
+            do k = ord - 1, 0, -1
+                do i = 1, n
+                    !$omp simd
+                    do l = 1, nl
+                        dy(l, i) = yn(l, i) + hc(l)*dy(l, i)
+                        yn(l, i) = wb(l, k, i, cu) + hc(l)*yn(l, i)
+                    end do
+                end do
+            end do
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    wb(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
+                end do
+            end do
+{coef}
+            nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
+            ! the safety check of every lane's step: h (P'(h) - f(t + h, P(h))) against
+            ! the scales, f there from the new expansion's first coefficients
+            fl = 16.0_dp*epsilon(1.0_dp)
+            err = 0.0_dp
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - wb(l, 1, i, nu)))/(e(l, i) &
+                                 + fl*(abs(yn(l, i)) + abs(hc(l)*dy(l, i)))))
+                end do
+            end do
+            err = err/real(ord + 1, dp)
+            acc = fresh .and. mem /= 0
+            do l = 1, nl
+                if (.not. stp(l)) cycle
+                if (.not. (err(l) <= check_max)) then
+                    nr(l) = nr(l) + 1
+                    if (err(l) == err(l) .and. err(l) <= huge(1.0_dp)) then
+                        h(l) = hc(l)*max(0.1_dp, min(0.5_dp, 0.8_dp*(check_max/err(l))** &
+                                                     (1.0_dp/real(ord + 1, dp))))
+                    else
+                        h(l) = 0.1_dp*hc(l)
+                    end if
+                    cycle
+                end if
+                na(l) = na(l) + 1
+                acc(l) = .true.
+                if (hit(l)) then
+                    t(l) = tf
+                    tlo(l) = 0.0_dp
+                    done(l) = {ok}
+                else
+                    ! t + h in double length (Knuth's TwoSum), as the scalar stepper
+                    s = t(l) + hc(l)
+                    bb = s - t(l)
+                    lo = (t(l) - (s - bb)) + (hc(l) - bb)
+                    lo = lo + tlo(l)
+                    t(l) = s + lo
+                    tlo(l) = lo - (t(l) - s)
+                end if
+            end do
+            ! accepted lanes: the new state, expansion and scales; the next step from
+            ! the last two coefficients (Jorba and Zou)
+            ! lanes that did not accept: their current expansion into the new buffer
+            do l = 1, nl
+                if (mem(l) /= 0 .and. .not. acc(l)) wb(l, :, 1:n, nu) = wb(l, :, 1:n, cu)
+            end do
+            cu = nu
+            ym = 0.0_dp
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    yc(l, i) = merge(yn(l, i), yc(l, i), acc(l) .and. .not. fresh(l))
+                    ym(l) = max(ym(l), abs(yc(l, i)))
+                end do
+            end do
+            fin = .true.
+            s1 = 0.0_dp
+            s2 = 0.0_dp
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    fin(l) = fin(l) .and. abs(wb(l, 1, i, cu)) <= huge(1.0_dp)
+                    e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
+                    s1(l) = max(s1(l), abs(wb(l, ord - 1, i, cu))/e(l, i))
+                    s2(l) = max(s2(l), abs(wb(l, ord, i, cu))/e(l, i))
+                end do
+            end do
+            do l = 1, nl
+                if (.not. acc(l)) cycle
+                fresh(l) = .false.
+                if (.not. fin(l)) then
+                    done(l) = {nonfin}
+                    cycle
+                end if
+                if (done(l) /= {run}) cycle
+                lg = huge(1.0_dp)
+                if (s1(l) > 0.0_dp) lg = -log(s1(l)*eps)/real(ord - 1, dp)
+                if (s2(l) > 0.0_dp) lg = min(lg, -log(s2(l)*eps)/real(ord, dp))
+                rho = huge(1.0_dp)
+                if (lg < log(huge(1.0_dp))) rho = exp(lg)*decay
+                h(l) = min(rho, hm)*posneg
+            end do
+        end do
+    end subroutine conmech_taylor_batch_run
+"""
