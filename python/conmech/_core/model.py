@@ -4,7 +4,8 @@ conmech.symbolic compiles a system from its Lagrangian or its equations and keep
 compiled model (derivation, library, entry points) with the system it returns. The
 integrators sometimes need to ask that model a question only it can answer (which kind of
 system it is, for the Taylor method's refusal; which closed loop of a mechanism cannot
-close at the initial positions, for the constrained solver's message). They ask through
+close at the initial positions, for the constrained solver's message; the Taylor
+recurrences in SIMD lanes, for ensembles). They ask through
 this interface, which the symbolic layer's :class:`conmech.symbolic.CompiledModel`
 implements, so that no lower layer imports the optional sympy front end."""
 
@@ -21,6 +22,12 @@ class SystemModel:
     def closure_error(self, system, q0, t0=0.0):
         """None when the closed loops of `system` (made from this model) close at q0, or
         it has none; otherwise the ValueError naming the loop that does not close."""
+        return None
+
+    def taylor_batch_entries(self, lanes, order=None):
+        """The entries of a batch library of this model's Taylor recurrences in `lanes`
+        SIMD lanes (None: the machine's), written out for `order` when given, or None when
+        the model has none (the ensembles' lane route asks)."""
         return None
 
 

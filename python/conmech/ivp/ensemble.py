@@ -45,12 +45,12 @@ from .._core.checks import time_points as _time_points, time_span as _time_span
 from .solve import solve_ivp as _solve_ivp
 from .._core.native import NativeSystem, function_address
 from .._core.status import BAD_INPUT
+from .._core.model import model_of
+from .._core.lanes import LANES
 
 __all__ = ["solve", "crossing", "Crossing", "EnsembleResult"]
 
 _NOT_RUN = -99
-#: the lane counts of the SIMD Taylor route (conmech.symbolic.taylor_batch)
-LANES = (1, 2, 4, 8, 16)
 _PAD = np.zeros(1)
 _PADI = np.zeros(1, dtype=np.intc)
 # the defaults of solve_ivp (method, rtol, atol), so that a member equals solve_ivp's run
@@ -213,8 +213,6 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
     if hasattr(system, "taylor_parts"):
         # a system of conmech.symbolic compiles its Taylor recurrences here, on first
         # need (their entries then in its spec, for the member-by-member path too)
-        from ..symbolic.pipeline import model_of
-        from ..symbolic.taylor_library import batch_entries
         from .taylor import taylor_order
         taylor = system.taylor_parts()
         try:
@@ -223,7 +221,7 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
             model = None
         extra = None
         if taylor and model is not None:
-            extra = batch_entries(model, lanes, taylor_order(eps))
+            extra = model.taylor_batch_entries(lanes, taylor_order(eps))
         if extra:
             taylor = dict(taylor, **extra)
         elif taylor:       # the machine's lanes, the loop version: the lazy part

@@ -67,6 +67,14 @@ class CompiledModel(SystemModel):
         fails)."""
         return _closure_error(self, system, q0, t0)
 
+    def taylor_batch_entries(self, lanes, order=None):
+        """The batch library's entries of this ode model's Taylor recurrences in `lanes`
+        lanes (conmech.symbolic.taylor_library.batch_entries); None for other kinds."""
+        if self.kind != "ode":
+            return None
+        from .taylor_library import batch_entries
+        return batch_entries(self, lanes, order)
+
     def _shapes(self, entry):
         d = self.derived
         return _table.shapes(entry, d.n, d.n_hol, d.n_nh)

@@ -32,7 +32,7 @@ import functools
 import platform
 import re
 
-from ..ivp.ensemble import LANES     # the lane counts a batch library can be built with
+from .._core.lanes import LANES     # the lane counts a batch library can be built with
 
 #: the version of the generated batch code (a change regenerates the kept sources)
 VERSION = 3
