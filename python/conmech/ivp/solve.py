@@ -17,7 +17,7 @@ from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
     real_scalar as _real_scalar, tolerance as _tolerance
 from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput, OdeSolution
-from .implicit import jacobian_callback, is_sparse, sparsity_pattern
+from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
@@ -157,8 +157,11 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         or a constant sparse ``jac``), n >= 100 and at most 10% of the n^2 entries in it,
         the two LU factorisations per step are sparse (Gilbert-Peierls with a reverse
         Cuthill-McKee column order, J kept on its pattern: work and memory grow with the
-        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable returning a
-        sparse matrix is converted to a dense one (dense LUs).
+        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable is evaluated
+        once at (t0, y0) before the run, as SciPy's (that value serves the first
+        Jacobian); if it returns a sparse matrix, that structure is the pattern (sparse
+        LUs by the same rule) and its values are passed on it, never densified; a later
+        nonzero entry outside the first structure is a ValueError naming the entry.
         The other methods validate it and warn that it has no effect, as SciPy's
         explicit ones.
     **options
@@ -484,7 +487,7 @@ def _solve(problem, common, h0, jac, pattern):
     with_t_eval, settings = problem["with_t_eval"], problem["settings"]
     n = y0.size
     ne = len(settings)
-    run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern)
+    run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern, y0)
     remaining = [s[1] for s in settings]       # occurrences left before termination
     if ne:
         ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
@@ -562,7 +565,7 @@ class _Run:
     Fortran call of one segment."""
 
     def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None,
-                 pattern=None):
+                 pattern=None, y0=None):
         self.guard = Guard()
         self.jac = jac
         self.njev = self.nlu = 0
@@ -576,8 +579,12 @@ class _Run:
         self.failure = []
         if builtin and jac is not None:
             raise TypeError("jac cannot be used with a built-in system (it has its own)")
-        self.jac_cb, self.has_jac, self.jac_const = jacobian_callback(jac, n, args,
-                                                                      self.failure)
+        # a callable jac is evaluated at (t0, y0) here (SciPy's Radau does the same); a
+        # sparse value fixes the pattern and the values travel on it (flat_sparse_jac)
+        self.jac_cb, self.has_jac, self.jac_const, self.sparse_jac = start_jacobian(
+            jac, n, args, self.failure, t0, y0)
+        if self.sparse_jac is not None:
+            pattern = self.sparse_jac.pattern
         nnz, ptr, idx = pattern if pattern is not None else (-1, None, _PADI)
         self.pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
                             np.zeros(n + 1, dtype=np.intc), sp_idx=idx)
@@ -674,6 +681,9 @@ class _Run:
         elif self.builtin:
             counts, form, info, message = _conmech.flat_solve(
                 *self.fun._system_args(), events_cb, store, jac_const=0, **kw)
+        elif self.sparse_jac is not None:
+            counts, form, info, message = _conmech.flat_solve_sparse_jac(
+                self.rhs, self.sparse_jac.callback, events_cb, store, **kw)
         else:
             counts, form, info, message = _conmech.flat_solve(
                 "", 0, _PAD, 0, _NO_SPEC, self.rhs, self.jac_cb, 2 if self.has_jac else 1,
