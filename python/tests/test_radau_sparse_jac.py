@@ -163,6 +163,15 @@ def test_bad_shapes_and_exceptions_reach_the_caller():
     with pytest.raises(ValueError, match="expected to have shape"):
         conmech.solve_ivp(f, [0, 1], y0, method="Radau",
                           jac=lambda t, y: sp.identity(2 * nb + 1, format="csc"))
+    # a later sparse value of the wrong shape
+    jac0 = brusselator_jac(nb)
+    seen = []
+
+    def shrinking(t, y):
+        seen.append(t)
+        return jac0(t, y) if len(seen) == 1 else sp.identity(2 * nb - 1, format="csc")
+    with pytest.raises(ValueError, match=r"expected to have shape \(200, 200\)"):
+        conmech.solve_ivp(f, [0, 10], y0, method="Radau", jac=shrinking)
 
     class Boom(Exception):
         pass

@@ -138,23 +138,26 @@ def _held_value(held, t, y):
 
 def start_jacobian(jac, n, args, failure, t0, y0):
     """A method's Jacobian at the start of a run: (callback, has_jac, constant, sparse).
-    A callable ``jac`` is evaluated at (t0, y0) first (SciPy's Radau does the same; an
-    exception or a bad shape reaches the caller here); if that value is a sparse matrix,
-    ``sparse`` is the :class:`SparseJacobian` that serves the run (its ``pattern`` for the
-    flat routines, itself the values callback), else None and the dense callback of
-    :func:`jacobian_callback` (which returns that first value for the first request)."""
+    A callable ``jac`` is evaluated at (t0, y0) first (SciPy's Radau does the same); if
+    that value is an (n, n) sparse matrix, ``sparse`` is the :class:`SparseJacobian` that
+    serves the run (its ``pattern`` for the flat routines, its ``callback`` the values),
+    else None and the dense callback of :func:`jacobian_callback` (which returns a good
+    first value for the first request). A first value that raises or has a bad shape is
+    not kept: the solver's own request evaluates it again and reports it, as without the
+    first evaluation (the same exception, or the shape error, from the run)."""
     if not callable(jac):
         return (*jacobian_callback(jac, n, args, failure), None)
     y = np.array(y0, dtype=float)
-    m = jac(t0, y.copy(), *args)
+    try:
+        m = jac(t0, y.copy(), *args)
+        shape = tuple(m.shape) if is_sparse(m) else np.shape(m)
+    except Exception:       # noqa: BLE001 (raised again by the run's own evaluation)
+        return (*jacobian_callback(jac, n, args, failure), None)
+    if shape != (n, n):
+        return (*jacobian_callback(jac, n, args, failure), None)
     if is_sparse(m):
-        if tuple(m.shape) != (n, n):
-            raise _shape_error(n, tuple(m.shape))
         sparse = SparseJacobian(jac, n, args, failure, m, (t0, y))
         return _no_jacobian, 0, 0, sparse
-    shape = np.shape(m)
-    if shape != (n, n):
-        raise _shape_error(n, shape)
     return (*jacobian_callback(jac, n, args, failure, first=(t0, y, m)), None)
 
 
