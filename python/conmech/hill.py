@@ -58,12 +58,16 @@ def _true_residuals(ms, kappa, y0s):
 
 
 def _check_float(value, name, positive=False, nonneg=False):
-    if isinstance(value, (bool, np.bool_, str, bytes)):
+    if type(value) is float:            # the common case, checked without conversions
+        v = value
+    elif isinstance(value, (bool, np.bool_, str, bytes)):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    else:
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise TypeError(f"{name} must be a real number, got {type(value).__name__}") \
+                from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite")
     if positive and not v > 0:
@@ -206,7 +210,8 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
     return HillOrbit(m=m, kappa=kappa, y0=y0, period=period, jacobi=jacobi, monodromy=mono,
-                     multipliers=mult.T.view(np.complex128)[:, 0], stability_index=s, c=c,
+                     multipliers=mult.ravel(order="F").view(np.complex128),
+                     stability_index=s, c=c,
                      residual=residual,
                      quarter_state=quarter, nsteps=nsu, iterations=iterations, nfev=nfev)
 
