@@ -28,26 +28,20 @@ from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
 
-# the names solve_ivp accepts: every method of the Fortran table (conmech_ode_methods) but
-# the constrained-only ones, with its aliases (the Python spelling first where SciPy has
-# one: "RK45", "Radau")
+# the names solve_ivp accepts: the Fortran table's methods (conmech_ode_methods) but the
+# constrained-only ones, with aliases (the Python spelling first: "RK45", "Radau")
 _METHOD_CODES = {n.upper(): m.code for m in METHODS.values() if not m.constrained_only
                  for n in (m.name, *m.aliases)}
 _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45", "RADAU"))
-# solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
-# (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
+# RK45 is code 12 here (DOPRI5 with SciPy's control, METHOD_RK45_SCIPY), DOPRI5 elsewhere
 _RK45_SCIPY = RK45_SCIPY
 _TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _HUGE = np.finfo(float).max
 # no step limit (SciPy has none): the largest count the Fortran counters hold
 _NO_LIMIT = 2**31 - 1
 # placeholders for f2py, which cannot pass empty arrays (read only, shared)
-_PAD = np.zeros(1)
-_PADI = np.zeros(1, dtype=np.intc)
-_PAD.flags.writeable = False
-_PADI.flags.writeable = False
-_EMPTY = np.zeros(0)
-_EMPTY.flags.writeable = False
+_PAD, _PADI, _EMPTY = np.zeros(1), np.zeros(1, dtype=np.intc), np.zeros(0)
+_PAD.flags.writeable = _PADI.flags.writeable = _EMPTY.flags.writeable = False
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -157,11 +151,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         or a constant sparse ``jac``), n >= 100 and at most 10% of the n^2 entries in it,
         the two LU factorisations per step are sparse (Gilbert-Peierls with a reverse
         Cuthill-McKee column order, J kept on its pattern: work and memory grow with the
-        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable is evaluated
-        once at (t0, y0) before the run, as SciPy's (that value serves the first
-        Jacobian); if it returns a sparse matrix, that structure is the pattern (sparse
-        LUs by the same rule) and its values are passed on it, never densified; a later
-        nonzero entry outside the first structure is a ValueError naming the entry.
+        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable's sparse value
+        at (t0, y0) fixes the pattern: its values are passed on it, never densified.
         The other methods validate it and warn that it has no effect, as SciPy's
         explicit ones.
     **options
@@ -579,12 +570,9 @@ class _Run:
         self.failure = []
         if builtin and jac is not None:
             raise TypeError("jac cannot be used with a built-in system (it has its own)")
-        # a callable jac is evaluated at (t0, y0) here (SciPy's Radau does the same); a
-        # sparse value fixes the pattern and the values travel on it (flat_sparse_jac)
         self.jac_cb, self.has_jac, self.jac_const, self.sparse_jac = start_jacobian(
             jac, n, args, self.failure, t0, y0)
-        if self.sparse_jac is not None:
-            pattern = self.sparse_jac.pattern
+        pattern = self.sparse_jac.pattern if self.sparse_jac is not None else pattern
         nnz, ptr, idx = pattern if pattern is not None else (-1, None, _PADI)
         self.pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
                             np.zeros(n + 1, dtype=np.intc), sp_idx=idx)

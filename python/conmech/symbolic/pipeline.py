@@ -11,6 +11,7 @@ stability routines run with no Python in the loop.
 import ctypes
 import errno
 import hashlib
+import math
 import os
 import pickle
 import shutil
@@ -163,12 +164,12 @@ def _address(a):
 
 def _out_buffer(shape):
     """A zeroed ctypes buffer for an output of `shape` (at least one element)."""
-    return (_D * max(int(np.prod(shape)), 1))()
+    return (_D * max(math.prod(shape), 1))()
 
 
 def _as_array(buf, shape):
     """The output buffer as an array of `shape` (Fortran order), sharing its memory."""
-    size = int(np.prod(shape))
+    size = math.prod(shape)
     if size == 0:
         return np.zeros(shape, order="F")
     a = np.frombuffer(buf, dtype=float, count=size)
