@@ -33,6 +33,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "python", "tests"))
 
 import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
+from conmech.symbolic.pipeline import _system  # noqa: E402  (the compiled system of a model_only model)
 import sympy as sp  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
 
@@ -154,7 +155,7 @@ def main(argv=None):
         hit_proc = float(out.stdout.split()[-1])
         crows.append((name, mod.times["derive"], mod.times["generate"],
                       mod.times["compile_or_load"], first, hit, hit_proc))
-        sym = symbolic._system(mod)
+        sym = _system(mod)
         if name == "arenstorf":
             built, cb = conmech.systems.arenstorf(MU), cb_arenstorf
         else:
@@ -216,7 +217,7 @@ def main(argv=None):
     ref = conmech.solve_ivp(var, (0, AR_T), np.r_[AR_Y0, np.eye(4).ravel()], method="DOP853",
                             rtol=1e-13, atol=1e-13).y[4:, -1].reshape(4, 4)
     make, _ = construct("arenstorf")
-    sym = symbolic._system(make())
+    sym = _system(make())
     lines += ["", "Arenstorf monodromy (stability.monodromy, rtol = atol = 1e-13) against "
               "DOP853 on the 20 variational equations with a hand-written Jacobian:", "",
               "| Jacobian | rel. error | time ms |", "|---|---|---|"]

@@ -57,6 +57,7 @@ def build_conmech(N, form):
     import sympy
     from sympy.physics.mechanics import dynamicsymbols
     from conmech import symbolic
+    from conmech.symbolic.pipeline import _system
     t = dynamicsymbols._t
     q = dynamicsymbols(f"th1:{N + 1}")
     syms = {"m": sympy.symbols(f"m1:{N + 1}"), "l": sympy.symbols(f"l1:{N + 1}")}
@@ -91,7 +92,7 @@ def build_conmech(N, form):
     t0 = time.perf_counter()
     model = construct(model_only=True)
     total = time.perf_counter() - t0
-    system = symbolic._system(model)
+    system = _system(model)
     times = dict(model.times)
     times["total"] = total
     return system, times, construct
