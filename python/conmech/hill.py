@@ -59,7 +59,10 @@ def _true_residuals(ms, kappa, y0s):
 
 
 def _check_float(value, name, positive=False, nonneg=False):
-    v = _real_number(value, name)
+    if type(value) is float:            # the common case, checked without conversions
+        v = value
+    else:
+        v = _real_number(value, name)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite")
     if positive and not v > 0:
@@ -202,7 +205,8 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
     return HillOrbit(m=m, kappa=kappa, y0=y0, period=period, jacobi=jacobi, monodromy=mono,
-                     multipliers=mult.T.view(np.complex128)[:, 0], stability_index=s, c=c,
+                     multipliers=mult.ravel(order="F").view(np.complex128),
+                     stability_index=s, c=c,
                      residual=residual,
                      quarter_state=quarter, nsteps=nsu, iterations=iterations, nfev=nfev)
 

@@ -13,6 +13,7 @@ module conmech_radau_newton
     use conmech_radau_coefficients
     use conmech_radau_collocation, only: radau_extrapolate
     use conmech_radau_stepper, only: radau_stepper
+    use conmech_sparse_jacobian_system, only: sparse_jacobian_system
     implicit none
     private
 
@@ -31,9 +32,10 @@ contains
     end subroutine radau_rhs
 
     !> s%jac = df/dy at (s%t, s%y): the system's `jacobian` if it has one (a constant one,
-    !! s%jstruct%constant, is read and not counted in njev: SciPy's count), else forward
-    !! differences with steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, or one per group
-    !! of columns with a sparsity pattern; s%f0 = f(t, y)).
+    !! s%jstruct%constant, is read and not counted in njev: SciPy's count; on the sparse
+    !! path a sparse_jacobian_system with the same pattern gives its values on it), else
+    !! forward differences with steps sqrt(eps max(1e-5, |y_j|)) (n evaluations, or one
+    !! per group of columns with a sparsity pattern; s%f0 = f(t, y)).
     subroutine radau_jacobian(s, sys)
         type(radau_stepper), intent(inout) :: s
         class(ode_system), intent(in) :: sys
@@ -43,6 +45,14 @@ contains
         if (sys%has_jacobian()) then
             if (.not. s%jstruct%constant) s%st%njev = s%st%njev + 1
             if (s%sparse) then
+                ! a system that gives J on the same pattern: its values, never densified
+                select type (sys)
+                class is (sparse_jacobian_system)
+                    if (sys%same_pattern(s%jstruct%col_ptr, s%jstruct%row_idx)) then
+                        call sys%jacobian_values(s%t, s%y, s%jval)
+                        return
+                    end if
+                end select
                 ! the system gives J dense: its entries on the pattern
                 allocate (jfull(s%n, s%n))
                 call sys%jacobian(s%t, s%y, jfull)

@@ -41,23 +41,7 @@ subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y
     integer(c_int), intent(inout) :: iv(max(ni, 1))
     integer(c_int), intent(out) :: sizes(3), info
     character(len=256), intent(out) :: message
-!f2py external fun, jac
-    interface
-        subroutine fun(t, y, dydt, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dydt(n)
-        end subroutine fun
-        subroutine jac(t, y, dfdy, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n)
-            real(c_double), intent(out) :: dfdy(n, n)
-        end subroutine jac
-    end interface
+    include "flat_stepper_callbacks.inc"
     type(callback_jac_system) :: sys
     sys%f => fun
     sys%n = n
@@ -81,11 +65,7 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: np
-    real(c_double), intent(in) :: params(max(np, 1))
-    integer(c_int), intent(in) :: nspec
-    integer(8), intent(in) :: spec(max(nspec, 1))  ! c_int64_t (f2py: long_long)
+    include "flat_spec_args.inc"
     integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
     real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
     real(c_double), intent(in) :: first_step, max_step

@@ -17,7 +17,7 @@ from .._core.checks import event_settings as _event_settings, initial_state as _
     real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
     time_span as _time_span, tolerance as _tolerance
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
-from .implicit import jacobian_callback, is_sparse, sparsity_pattern
+from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
@@ -32,24 +32,18 @@ from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
 
-# the names solve_ivp accepts: every method of the Fortran table (conmech_ode_methods) but
-# the constrained-only ones, with its aliases (the Python spelling first where SciPy has
-# one: "RK45", "Radau")
+# the names solve_ivp accepts: the Fortran table's methods (conmech_ode_methods) but the
+# constrained-only ones, with aliases (the Python spelling first: "RK45", "Radau")
 _METHOD_CODES = {n.upper(): m.code for m in METHODS.values() if not m.constrained_only
                  for n in (m.name, *m.aliases)}
 _METHODS = ("RK45", "Radau") + tuple(n for n in _METHOD_CODES if n not in ("RK45", "RADAU"))
-# solve_ivp runs RK45 as code 12: DOPRI5 with SciPy's step control and initial step
-# (conmech_flat_ode_support METHOD_RK45_SCIPY); elsewhere (ensembles) RK45 is DOPRI5
+# RK45 is code 12 here (DOPRI5 with SciPy's control, METHOD_RK45_SCIPY), DOPRI5 elsewhere
 _RK45_SCIPY = RK45_SCIPY
 _TAYLOR = _METHOD_CODES.get("TAYLOR", -1)
 _HUGE = np.finfo(float).max
 # placeholders for f2py, which cannot pass empty arrays (read only, shared)
-_PAD = np.zeros(1)
-_PADI = np.zeros(1, dtype=np.intc)
-_PAD.flags.writeable = False
-_PADI.flags.writeable = False
-_EMPTY = np.zeros(0)
-_EMPTY.flags.writeable = False
+_PAD, _PADI, _EMPTY = np.zeros(1), np.zeros(1, dtype=np.intc), np.zeros(0)
+_PAD.flags.writeable = _PADI.flags.writeable = _EMPTY.flags.writeable = False
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
 
@@ -159,8 +153,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         or a constant sparse ``jac``), n >= 100 and at most 10% of the n^2 entries in it,
         the two LU factorisations per step are sparse (Gilbert-Peierls with a reverse
         Cuthill-McKee column order, J kept on its pattern: work and memory grow with the
-        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable returning a
-        sparse matrix is converted to a dense one (dense LUs).
+        entries, not with n^3 / n^2); otherwise dense (LAPACK). A callable's sparse value
+        at (t0, y0) fixes the pattern: its values are passed on it, never densified.
         The other methods validate it and warn that it has no effect, as SciPy's
         explicit ones.
     **options
@@ -344,7 +338,7 @@ def _solve(problem, common, h0, jac, pattern):
     with_t_eval, settings = problem["with_t_eval"], problem["settings"]
     n = y0.size
     ne = len(settings)
-    run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern)
+    run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern, y0)
     remaining = [s[1] for s in settings]       # occurrences left before termination
     if ne:
         ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
@@ -422,7 +416,7 @@ class _Run:
     Fortran call of one segment."""
 
     def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None,
-                 pattern=None):
+                 pattern=None, y0=None):
         self.guard = Guard()
         self.jac = jac
         self.njev = self.nlu = 0
@@ -436,8 +430,9 @@ class _Run:
         self.failure = []
         if builtin and jac is not None:
             raise TypeError("jac cannot be used with a built-in system (it has its own)")
-        self.jac_cb, self.has_jac, self.jac_const = jacobian_callback(jac, n, args,
-                                                                      self.failure)
+        self.jac_cb, self.has_jac, self.jac_const, self.sparse_jac = start_jacobian(
+            jac, n, args, self.failure, t0, y0)
+        pattern = self.sparse_jac.pattern if self.sparse_jac is not None else pattern
         nnz, ptr, idx = pattern if pattern is not None else (-1, None, _PADI)
         self.pattern = dict(nnz=nnz, sp_ptr=ptr if ptr is not None else
                             np.zeros(n + 1, dtype=np.intc), sp_idx=idx)
@@ -534,6 +529,9 @@ class _Run:
         elif self.builtin:
             counts, form, info, message = _conmech.flat_solve(
                 *self.fun._system_args(), events_cb, store, jac_const=0, **kw)
+        elif self.sparse_jac is not None:
+            counts, form, info, message = _conmech.flat_solve_sparse_jac(
+                self.rhs, self.sparse_jac.callback, events_cb, store, **kw)
         else:
             counts, form, info, message = _conmech.flat_solve(
                 "", 0, _PAD, 0, _NO_SPEC, self.rhs, self.jac_cb, 2 if self.has_jac else 1,

@@ -21,6 +21,7 @@ Radau, as SciPy's Radau), an empty y0 finishes at the first step, ``t_bound`` ma
 infinite for the adaptive methods, and there is no limit on the number of steps unless
 ``max_steps`` is given.
 """
+import functools
 import math
 import warnings
 
@@ -31,7 +32,7 @@ from .._core.callback import Guard, as_result, message_text
 from .complex_form import real_form as _real_form
 from .dense import ComplexSolution, ConstantDenseOutput, DenseOutput
 from .._core.checks import initial_state, real_scalar, step_limit, tolerance
-from .implicit import jacobian_callback, sparsity_pattern, is_sparse
+from .implicit import start_jacobian, sparsity_pattern, is_sparse
 from .methods import BY_NAME, RK45_SCIPY, method_info
 from .._core.native import NativeSystem
 from .._core.status import BAD_INPUT
@@ -180,9 +181,7 @@ class Stepper:
         self.direction = float(np.sign(t_bound - t0)) if t_bound != t0 else 1.0
         self.n = n
         self.status = "running"
-        self.nfev = 0
-        self.njev = 0
-        self.nlu = 0
+        self._nfev_start = 0      # nfev before the state exists (n = 0: fun's one call)
         self._y0 = y.copy()
         self._first_step = h0
         self._max_step = min(hmax, _HUGE)
@@ -194,12 +193,13 @@ class Stepper:
         self._iv = np.zeros(1, dtype=np.intc)
         self._cached = {}
         self._step_call = None
+        self._sparse_jac = None
         if n == 0:
             # nothing to integrate: SciPy's solver evaluates fun once and finishes at the
             # first step (t = t_bound)
             r = fun(self.t, y.copy())
             as_result(r, (0,), "fun")
-            self.nfev = 1
+            self._nfev_start = 1
             return
         if self._complex:
             # [Re y; Im y] for the real stepper, tolerances per part
@@ -224,8 +224,13 @@ class Stepper:
             # every return of fun is checked (shape, None, complex) by the one wrapper of
             # conmech._callback; an exception stops the step and is re-raised unchanged
             self._rhs = self._guard.wrap(fun, 2, (m,), "fun")
-            self._jac_cb, self._has_jac, self._jac_const = jacobian_callback(
-                jac, m, (), self._failure)
+            # a callable jac is evaluated at (t0, y0) now, as SciPy's Radau does; a sparse
+            # value makes its pattern the Jacobian's and the values travel on it
+            self._jac_cb, self._has_jac, self._jac_const, self._sparse_jac = start_jacobian(
+                jac, m, (), self._failure, t0, y)
+            if self._sparse_jac is not None:
+                nnz, ptr, idx = self._sparse_jac.pattern
+                self._pattern = dict(nnz=nnz, sp_ptr=ptr, sp_idx=idx)
         info_, message, sizes = self._call(_SIZES)
         if info_ == BAD_INPUT:
             raise ValueError(message)
@@ -253,6 +258,26 @@ class Stepper:
         """Size of the last successful step (None before the first one)."""
         return None if self.t_old is None else abs(self.t - self.t_old)
 
+    # the counters are read from the packed state when asked (SciPy's attributes): a step
+    # then only reads t back
+    @property
+    def nfev(self):
+        """Evaluations of fun (finite-difference Jacobians included)."""
+        iv = self._iv
+        return int(iv[_I_NFEV]) if iv.size > _I_NREJECT else self._nfev_start
+
+    @property
+    def njev(self):
+        """Evaluations of the Jacobian (methods that use one)."""
+        iv = self._iv
+        return int(iv[_I_NJEV]) if iv.size > _I_NREJECT else 0
+
+    @property
+    def nlu(self):
+        """LU decompositions (methods that use one)."""
+        iv = self._iv
+        return int(iv[_I_NLU]) if iv.size > _I_NREJECT else 0
+
     @property
     def naccept(self):
         return int(self._iv[_I_NACCEPT]) if self._iv.size > _I_NACCEPT else 0
@@ -262,13 +287,18 @@ class Stepper:
         return int(self._iv[_I_NREJECT]) if self._iv.size > _I_NREJECT else 0
 
     def _positional(self, action):
-        """The flat routine and its positional arguments for a step or a dense output:
-        built once (the state arrays r, iv, w are updated in place, so the same objects
-        serve every call). The step routines take only the method, the system and the
-        state (the tolerances, t_bound and the Jacobian's structure are in the state):
-        f2py's conversion of each argument is most of the Python cost of a step."""
-        nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
-        state = (nr, ni, nw, self._r, self._iv, self._w)
+        """The flat routine and its positional arguments for a step or a dense output,
+        returning (info, message): built once (the state arrays r, iv, w are updated in
+        place, so the same objects serve every call). The step routines take only the
+        method, the system and the state (the tolerances, t_bound and the Jacobian's
+        structure are in the state; the state's sizes are the arrays'), and return no
+        array: f2py's conversion of each argument and each returned array is most of the
+        Python cost of a step."""
+        state = (self._r, self._iv, self._w)
+        if self._sparse_jac is not None:
+            # the system's pattern is not in the packed state: the full argument list
+            return (_without_sizes(functools.partial(_conmech.flat_stepper_sparse_jac,
+                                                     **self._arguments(action))), ())
         if self._builtin:
             return (_conmech.flat_stepper_step_builtin,
                     self.fun._flat_args() + (action, self._code) + state)
@@ -281,8 +311,22 @@ class Stepper:
             if cached is None:
                 cached = self._cached[action] = self._positional(action)
             routine, args = cached
-            sizes, info, message = routine(*args)
-            return self._after(action, sizes, info, message)
+            info, message = routine(*args)
+            return self._after(action, None, info, message)
+        common = self._arguments(action)
+        if self._sparse_jac is not None:
+            sizes, info, message = _conmech.flat_stepper_sparse_jac(**common)
+        elif self._builtin:
+            sizes, info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(),
+                                                                 **common)
+        else:
+            sizes, info, message = _conmech.flat_stepper_callback(
+                self._rhs, self._jac_cb, has_jac=self._has_jac, jac_const=self._jac_const,
+                **common)
+        return self._after(action, sizes, info, message)
+
+    def _arguments(self, action):
+        """The keyword arguments of the full flat stepper routines for an action."""
         nr, ni, nw = self._r.size, self._iv.size, self._w.shape[1]
         if action == _SIZES:
             nr = ni = nw = 0
@@ -292,14 +336,9 @@ class Stepper:
                       rtol=self._rtol, atol=self._atol, first_step=self._first_step,
                       max_step=self._max_step, max_steps=self._max_steps,
                       r=self._r, iv=self._iv, w=self._w, **self._pattern)
-        if self._builtin:
-            sizes, info, message = _conmech.flat_stepper_builtin(*self.fun._flat_args(),
-                                                                 **common)
-        else:
-            sizes, info, message = _conmech.flat_stepper_callback(
-                self._rhs, self._jac_cb, has_jac=self._has_jac, jac_const=self._jac_const,
-                **common)
-        return self._after(action, sizes, info, message)
+        if self._sparse_jac is not None:
+            common.update(fun=self._rhs, jvals=self._sparse_jac.callback)
+        return common
 
     def _after(self, action, sizes, info, message):
         """Failures of the callbacks re-raised, the counts and t read from the state."""
@@ -312,10 +351,8 @@ class Stepper:
         # the 256-character message is cleaned only when there is one to report (cleaning
         # it costs more than the rest of a step's glue)
         message = message_text(message) if info != 0 else ""
-        if action != _SIZES and self._iv.size > _I_NREJECT:
-            self.nfev, self.njev, self.nlu = self._iv[_I_NFEV:_I_NLU + 1].tolist()
-            if action == _STEP:
-                self.t = self._r.item(_R_T)
+        if action == _STEP and self._iv.size > _I_NREJECT:
+            self.t = self._r.item(_R_T)
         return info, message, sizes
 
     # ------------------------------------------------------------------ SciPy's API
@@ -328,25 +365,24 @@ class Stepper:
             self.status = "failed"
             message, self._pending = self._pending, None
             return message
-        if self.n == 0 or self.t == self.t_bound:
-            self.t_old = self.t
+        t = self.t
+        if self.n == 0 or t == self.t_bound:
+            self.t_old = t
             self.t = self.t_bound
             self.status = "finished"
             return None
-        t = self.t
         # the step's call inlined (its routine and arguments built once): a step of a
         # compiled system is a few microseconds, of which Python's calls are a good part
         call = self._step_call
         if call is None:
             call = self._step_call = self._positional(_STEP)
-        sizes, info, message = call[0](*call[1])
+        info, message = call[0](*call[1])
         if info or self._failure or self._guard.error is not None:
-            info, message, _ = self._after(_STEP, sizes, info, message)
+            info, message, _ = self._after(_STEP, None, info, message)
             if info != 0:
                 self.status = "failed"
                 return message
         else:
-            self.nfev, self.njev, self.nlu = self._iv[_I_NFEV:_I_NLU + 1].tolist()
             self.t = self._r.item(_R_T)
         self.t_old = t
         if self.direction*(self.t - self.t_bound) >= 0:
@@ -470,6 +506,15 @@ def _taylor_system(fun, rtol, atol):
     if getattr(fun, "taylor", None):
         fun = with_fixed_order(fun, rtol, atol)
     return fun
+
+
+def _without_sizes(routine):
+    """A full flat stepper routine (sizes, info, message) as a step routine (info,
+    message)."""
+    def call():
+        _, info, message = routine()
+        return info, message
+    return call
 
 
 def _butcher(cls):

@@ -11,6 +11,7 @@ stability routines run with no Python in the loop.
 import ctypes
 import errno
 import hashlib
+import math
 import os
 import pickle
 import shutil
@@ -129,7 +130,12 @@ class CompiledModel(SystemModel):
         fn, n_in, shapes, ret = self._entry(entry)
         if entry == "jac_prod":
             return self._call_jac_prod(fn, t, *arrays, params=params)
-        p = self._params(params)
+        if params is None:
+            pp = self.__dict__.get("_p0_ref")
+            if pp is None:
+                pp = self._p0_ref = _address(self._params(None))
+        else:
+            pp = _address(self._params(params))
         if len(arrays) != n_in:
             raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
         n = self.derived.n
@@ -141,13 +147,14 @@ class CompiledModel(SystemModel):
                 shape = (self.derived.n_hol + self.derived.n_nh,)
             if a.shape != shape:
                 raise ValueError(f"input arrays must have shape {shape}, got {a.shape}")
-            ins.append(a)
-        outs = [np.zeros(s, order="F") for s in shapes]
-        r = fn(float(t), *[a.ctypes.data for a in ins], *[o.ctypes.data for o in outs],
-               p.ctypes.data)
+            ins.append(_address(a))
+        # the outputs in ctypes buffers (no address to look up), seen by numpy afterwards
+        outs = [_out_buffer(s) for s in shapes]
+        r = fn(float(t), *ins, *outs, pp)
         if ret:
             return float(r)
-        return outs[0] if len(outs) == 1 else tuple(outs)
+        res = [_as_array(o, s) for o, s in zip(outs, shapes)]
+        return res[0] if len(res) == 1 else tuple(res)
 
     def _call_jac_prod(self, fn, t, y, x, params=None):
         """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
@@ -162,6 +169,29 @@ class CompiledModel(SystemModel):
         jx = np.zeros(x.shape, order="F")
         fn(float(t), y.ctypes.data, x.shape[1], x.ctypes.data, jx.ctypes.data, p.ctypes.data)
         return jx.ravel() if vec else jx
+
+
+def _address(a):
+    """A float64 C-contiguous array as a ctypes pointer argument. NumPy's ``a.ctypes``
+    costs microseconds per call (a Python object built each time); a ctypes view of the
+    buffer costs a fraction of that. A read-only or empty array is copied first."""
+    if not a.flags.writeable or a.size == 0:
+        a = np.array(a) if a.size else np.zeros(1)
+    return ctypes.byref(_D.from_buffer(a))
+
+
+def _out_buffer(shape):
+    """A zeroed ctypes buffer for an output of `shape` (at least one element)."""
+    return (_D * max(math.prod(shape), 1))()
+
+
+def _as_array(buf, shape):
+    """The output buffer as an array of `shape` (Fortran order), sharing its memory."""
+    size = math.prod(shape)
+    if size == 0:
+        return np.zeros(shape, order="F")
+    a = np.frombuffer(buf, dtype=float, count=size)
+    return a.reshape(shape, order="F") if len(shape) > 1 else a
 
 
 def compile_model(derived, flags=None):

@@ -16,7 +16,7 @@ module conmech_flat_stepper_support
         set_jacobian_structure
     implicit none
     private
-    public :: stepper_action
+    public :: stepper_action, step_action
 
     integer, parameter, public :: ACTION_START = 0, ACTION_STEP = 1, ACTION_DENSE = 2, &
         ACTION_SIZES = 3
@@ -144,5 +144,31 @@ contains
         end subroutine write_back
 
     end subroutine stepper_action
+
+    !> ACTION_STEP or ACTION_DENSE on the packed state (r(nr), iv(ni), w(n, nw)) with only
+    !! what they read (stepper_action with placeholders for the rest); other actions are
+    !! refused with CM_BAD_INPUT.
+    subroutine step_action(sys, action, method, n, nr, ni, nw, r, iv, w, info, message)
+        class(ode_system), intent(in) :: sys
+        integer(c_int), intent(in) :: action, method, n, nr, ni, nw
+        real(c_double), intent(inout) :: r(nr), w(n, nw)
+        integer(c_int), intent(inout) :: iv(ni)
+        integer(c_int), intent(out) :: info
+        character(len=*), intent(out) :: message
+        integer(c_int) :: none(1), sizes(3)
+        real(c_double) :: unused(n)
+        if (action /= ACTION_STEP .and. action /= ACTION_DENSE) then
+            info = CM_BAD_INPUT
+            call copy_message("bad input: action must be 1 (step) or 2 (dense output)", &
+                              message)
+            return
+        end if
+        none = 0
+        unused = 0.0_c_double
+        ! t0, t_bound, y0, tolerances and the pattern are not read by a step: placeholders
+        call stepper_action(sys, action, n, nr, ni, nw, 0.0_c_double, 0.0_c_double, unused, &
+                            method, unused, unused, 0.0_c_double, 0.0_c_double, 1, 0, -1, &
+                            none, none, r, iv, w, sizes, info, message)
+    end subroutine step_action
 
 end module conmech_flat_stepper_support

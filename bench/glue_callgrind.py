@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Instructions per call of conmech's Python entry points that do one Fortran call, split
+into the Fortran call (the flat routine, inclusive) and the Python + f2py glue around it,
+by callgrind (exact counts, independent of the machine's load).
+
+    python bench/glue_callgrind.py [CASE ...] [--k1 10] [--k2 1010]
+
+Each case runs K1 and K2 times in two processes under ``valgrind --tool=callgrind``
+(OPENBLAS_NUM_THREADS=1); (I(K2) - I(K1))/(K2 - K1) is one call, with the interpreter's
+start-up, the imports and the set-up cancelled. The Fortran share is the inclusive count
+of the flat routine the call ends in (callgrind_annotate), the glue the rest.
+
+Cases:
+  step    conmech.DOP853(kepler).step(), one accepted step (flat_stepper_step_builtin)
+  solve   conmech.solve_ivp(kepler, (0, 0.01), DOP853): the fixed cost of a short solve
+          of a built-in system (flat_solve_native)
+  hill    conmech.hill.variation_orbit(M_HILL) (flat_hill_orbit_checked)
+  call    CompiledModel.call("rhs", t, y) of a symbolic ode model (the model's rhs, in
+          its own library)
+
+    python bench/glue_callgrind.py one CASE REPS        (what valgrind runs)
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+# (the flat routine or model symbol whose inclusive count is the Fortran share)
+SYMBOLS = {"step": "flat_stepper_step_builtin_", "solve": "flat_solve_native_",
+           "hill": "flat_hill_orbit_checked_", "call": "conmech_rhs"}
+
+
+def make(case):
+    """The call to count, after its set-up."""
+    import numpy as np
+    import conmech
+    if case == "step":
+        s = conmech.DOP853(conmech.systems.kepler(), 0.0, [0.4, 0.0, 0.0, 2.0], 1e9,
+                           rtol=1e-10, atol=1e-10)
+        return s.step
+    if case == "solve":
+        kep = conmech.systems.kepler()
+        y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
+        return lambda: conmech.solve_ivp(kep, (0.0, 0.01), y0, method="DOP853")
+    if case == "hill":
+        from conmech import hill
+        return lambda: hill.variation_orbit(hill.M_HILL)
+    if case == "call":
+        import sympy as sp
+        from conmech import symbolic
+        from conmech.symbolic import model_of
+        x, v, k = sp.symbols("x v k")
+        sys_ = symbolic.ode_system([v, -k * sp.sin(x)], [x, v], params={k: 2.0})
+        model = model_of(sys_)
+        y = np.array([0.3, 0.1])
+        model.call("rhs", 0.0, y)
+        return lambda: model.call("rhs", 0.0, y)
+    raise SystemExit(f"unknown case {case}")
+
+
+def one(case, reps):
+    f = make(case)
+    f()
+    for _ in range(reps):
+        f()
+
+
+def count(case, reps, tmp):
+    out = os.path.join(tmp, f"cg.{case}.{reps}")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                    sys.executable, os.path.abspath(__file__), "one", case, str(reps)],
+                   check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    total = None
+    with open(out) as fh:
+        for line in fh:
+            if line.startswith(("summary:", "totals:")):
+                total = int(line.split()[1])
+                break
+    ann = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", out],
+                         capture_output=True, text=True).stdout
+    sym = SYMBOLS[case]
+    fort = 0
+    for line in ann.splitlines():
+        m = re.match(r"\s*([\d,]+)\s.*[\s:]" + re.escape(sym) + r"(\s|$|\[)", line)
+        if m:
+            fort = int(m.group(1).replace(",", ""))
+            break
+    return total, fort
+
+
+def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "one":
+        one(sys.argv[2], int(sys.argv[3]))
+        return
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("cases", nargs="*", default=list(SYMBOLS))
+    ap.add_argument("--k1", type=int, default=10)
+    ap.add_argument("--k2", type=int, default=1010)
+    a = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in a.cases:
+            t1, f1 = count(case, a.k1, tmp)
+            t2, f2 = count(case, a.k2, tmp)
+            k = a.k2 - a.k1
+            tot, fort = (t2 - t1) / k, (f2 - f1) / k
+            print(f"{case:6s} instructions per call: total {tot:,.0f}, Fortran ({SYMBOLS[case]}) "
+                  f"{fort:,.0f}, Python + f2py glue {tot - fort:,.0f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,86 @@
+!> Flat f2py routines for a Python right-hand side fun(t, y) whose Jacobian is sparse:
+!! jvals(t, y) returns the values of df/dy on a fixed pattern (nnz entries compressed by
+!! columns: rows sp_idx(sp_ptr(j) : sp_ptr(j + 1) - 1) of column j, 1-based), the k-th
+!! value for the k-th entry. Radau takes its sparse LUs with that pattern (n >= 100, at
+!! most 10 % dense; else dense LUs from the scattered values) and reads the values
+!! directly: no n x n array is formed (conmech_sparse_jacobian_system). Conventions as in
+!! flat_ode.f90 (solve) and flat_stepper.f90 (the stepper's actions).
+
+!> solve_ivp with a sparse Jacobian: flat_solve's arguments for a Python system, with
+!! jvals and the pattern in place of the dense Jacobian.
+subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, method, rtol, &
+                                 atol, first_step, max_step, max_steps, dense, neval, &
+                                 t_eval, ne, ev_dir, ev_term, ev_res, nnz, sp_ptr, sp_idx, &
+                                 counts, dense_form, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_flat_ode_support, only: run_solve, copy_message
+    use conmech_flat_sparse_jac_support, only: callback_sparse_jac_system, &
+        make_sparse_jac_system
+    implicit none
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: t_span(2)
+    real(c_double), intent(in) :: y0(n)
+    integer(c_int), intent(in) :: method
+    real(c_double), intent(in) :: rtol(n), atol(n)
+    real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: max_steps, dense, neval
+    real(c_double), intent(in) :: t_eval(max(neval, 1))
+    integer(c_int), intent(in) :: ne
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
+    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
+    integer(c_int), intent(out) :: counts(5), dense_form, info
+    character(len=256), intent(out) :: message
+    include "flat_sparse_jac_callbacks.inc"
+    include "flat_solve_callbacks.inc"
+    type(callback_sparse_jac_system) :: sys
+    character(len=:), allocatable :: msg
+
+    counts = 0
+    dense_form = 0
+    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, msg)
+    if (info /= CM_SUCCESS) then
+        call copy_message(msg, message)
+        return
+    end if
+    call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
+                   dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, nnz, sp_ptr, &
+                   sp_idx, events, store, counts, dense_form, info, message)
+end subroutine flat_solve_sparse_jac
+
+!> One stepper action (flat_stepper_callback's) with a sparse Jacobian: jvals and the
+!! pattern in place of the dense Jacobian; every action takes the full argument list (the
+!! system's pattern is not in the packed state).
+subroutine flat_stepper_sparse_jac(fun, jvals, action, n, nr, ni, nw, t0, t_bound, y0, &
+                                   method, rtol, atol, first_step, max_step, max_steps, &
+                                   nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, message)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use conmech_status, only: CM_SUCCESS
+    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_stepper_support, only: stepper_action
+    use conmech_flat_sparse_jac_support, only: callback_sparse_jac_system, &
+        make_sparse_jac_system
+    implicit none
+    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
+    real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
+    real(c_double), intent(in) :: first_step, max_step
+    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
+    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
+    integer(c_int), intent(inout) :: iv(max(ni, 1))
+    integer(c_int), intent(out) :: sizes(3), info
+    character(len=256), intent(out) :: message
+    include "flat_sparse_jac_callbacks.inc"
+    type(callback_sparse_jac_system) :: sys
+    character(len=:), allocatable :: msg
+
+    sizes = 0
+    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, msg)
+    if (info /= CM_SUCCESS) then
+        call copy_message(msg, message)
+        return
+    end if
+    call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
+                        first_step, max_step, max_steps, 0, nnz, sp_ptr, sp_idx, r, iv, w, &
+                        sizes, info, message)
+end subroutine flat_stepper_sparse_jac
