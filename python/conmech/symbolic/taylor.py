@@ -317,6 +317,24 @@ def _decls(names, typ, ind, per_line=10):
     return out
 
 
+
+def square_sums(sym, W, pp, ind):
+    """The loop lines of the history sums of squares (recipes marked _SYM): the pairs
+    j < k - j once, doubled, and the middle term when k is even; W(j, column) spells a
+    coefficient of the jet."""
+    if not sym:
+        return []
+    lines = [f"{ind}    do j = 1, (k - 1)/2"]
+    for h, lft, _, _ in sym:
+        lines += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}", ind + "        ")
+    lines.append(f"{ind}    end do")
+    lines += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
+    lines.append(f"{ind}    if (mod(k, 2) == 0) then")
+    for h, lft, _, _ in sym:
+        lines += _wrap(f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}", ind + "        ")
+    lines.append(f"{ind}    end if")
+    return lines
+
 def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixed=None,
                paired=True):
     """(declarations, statements) computing the coefficients in w (see the module
@@ -381,16 +399,7 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
                 loop += _wrap(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}",
                               ind + "        ")
             loop.append(f"{ind}    end do")
-        if sym:       # squares: the pairs j < k - j once, doubled, and the middle term
-            loop.append(f"{ind}    do j = 1, (k - 1)/2")
-            for h, lft, _, _ in sym:
-                loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}", ind + "        ")
-            loop.append(f"{ind}    end do")
-            loop += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
-            loop.append(f"{ind}    if (mod(k, 2) == 0) then")
-            for h, lft, _, _ in sym:
-                loop += _wrap(f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}", ind + "        ")
-            loop.append(f"{ind}    end if")
+        loop += square_sums(sym, W, pp, ind)
         for f in rc.cur:
             loop += _wrap(f(E), ind + "    ")
         if not given:

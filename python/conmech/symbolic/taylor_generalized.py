@@ -31,7 +31,7 @@ expansion), the first-order right-hand side of the stepper's view of the system.
 """
 import sympy as sp
 
-from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap
+from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 
 __all__ = ["generalized_decomposition", "generalized_procedures", "WRITE_OUT_MAX"]
@@ -238,16 +238,7 @@ def generalized_body(g, names, ind="        ", write_out=None):
             if terms:
                 loop += _wrap(f"{gacc[i]} = {gacc[i]} + " + " + ".join(terms), ind + "        ")
         loop.append(f"{ind}    end do")
-    if sym:
-        loop.append(f"{ind}    do j = 1, (k - 1)/2")
-        for h, lft, _, _ in sym:
-            loop += _wrap(f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}", ind + "        ")
-        loop.append(f"{ind}    end do")
-        loop += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
-        loop.append(f"{ind}    if (mod(k, 2) == 0) then")
-        for h, lft, _, _ in sym:
-            loop += _wrap(f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}", ind + "        ")
-        loop.append(f"{ind}    end if")
+    loop += square_sums(sym, W, pp, ind)
     E = {"k": "k", "fk": "fk", "rk": "rk"}
     for f in rc.cur:
         loop += _wrap(f(E), ind + "    ")
