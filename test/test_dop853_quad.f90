@@ -83,5 +83,6 @@ program test_dop853_quad
                              1.0e-20_qp, 10**6, info, msg, cnt)
     call ts%check(info == CM_BAD_INPUT .and. index(msg, "nw") > 0, "nw < n: "//msg)
     call ts%check(all(y == y0), "the state is untouched on refusal")
+    if (allocated(msg)) deallocate (msg)
     call ts%finish()
 end program test_dop853_quad
