@@ -132,6 +132,11 @@ def test_bad_input_refused(kepler):
         ref(kepler, (0, 1), y0, rtol=1e-33)
     with pytest.raises(ValueError, match="rtol"):
         ref(kepler, (0, 1), y0, rtol="nan")
+    with pytest.raises(ValueError, match="rtol"):
+        ref(kepler, (0, 1), y0, rtol=1)
+    # the bound itself is accepted, as a float or a decimal string
+    for tol in (1e-32, "1e-32"):
+        assert ref(kepler, (0, "0.01"), y0, rtol=tol).success
     with pytest.raises(ValueError, match="atol"):
         ref(kepler, (0, 1), y0, rtol=1e-20, atol=0)
     with pytest.raises(ValueError, match="atol"):

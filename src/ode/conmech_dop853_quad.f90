@@ -9,7 +9,7 @@
 !! coefficients' accuracy is stated in conmech_dop853_quad_coefficients.
 module conmech_dop853_quad
     use, intrinsic :: iso_c_binding, only: c_int, c_loc
-    use, intrinsic :: iso_fortran_env, only: qp => real128
+    use, intrinsic :: iso_fortran_env, only: qp => real128, real64
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_TOO_MANY_STEPS, &
                               CM_STEP_TOO_SMALL, CM_NONFINITE, status_message
     use conmech_taylor_quad, only: taylor_qp_fn
@@ -29,7 +29,9 @@ module conmech_dop853_quad
     real(qp), parameter :: safe = 0.9_qp          !! safety factor of the step prediction
     real(qp), parameter :: facc1 = 1.0_qp/0.333_qp !! largest step decrease, 1/fac1
     real(qp), parameter :: facc2 = 1.0_qp/6.0_qp  !! largest step increase, 1/fac2
-    real(qp), parameter :: min_rtol = 1.0e-32_qp  !! tolerances below it are refused
+    !> tolerances below it are refused (compared in double precision, so that the decimal
+    !! 1e-32 read to any precision is accepted)
+    real(real64), parameter :: min_rtol = 1.0e-32_real64
 
 contains
 
@@ -62,7 +64,7 @@ contains
             call refuse("bad input: n must be positive and nw at least n")
             return
         end if
-        if (.not. (rtol >= min_rtol .and. rtol < 1.0_qp)) then
+        if (.not. (real(rtol, real64) >= min_rtol .and. rtol < 1.0_qp)) then
             call refuse("bad input: rtol must lie in [1e-32, 1) (the coefficients carry "// &
                         "about 30 digits, real128 34)")
             return

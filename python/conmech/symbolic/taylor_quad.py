@@ -149,18 +149,21 @@ def _method_name(method):
 
 
 def _tolerance(value, what):
-    """A tolerance as a pair, refused below 1e-32 (DOP853's coefficients carry about 30
-    digits and real128 34: a smaller one could never be met) or at 1 and above."""
+    """A tolerance as a pair: rtol in [1e-32, 1) (below 1e-32 it asks for more than
+    DOP853's coefficients, printed to about 30 digits, and real128's 34 can give), atol
+    positive and finite (a zero atol would make the error scale of a zero component zero)."""
     if isinstance(value, bool) or value is None:
         raise TypeError(f"{what} must be a number, a decimal string, a Decimal or an "
                         f"mpmath number, got {type(value).__name__}")
     pair = to_pair(value, what)
-    with localcontext() as ctx:
-        ctx.prec = 60
-        d = Decimal(pair[0]) + Decimal(pair[1])
-        if not Decimal("1e-32") <= d < 1:
-            raise ValueError(f"{what} must lie in [1e-32, 1), got {value!r} (DOP853's "
-                             "coefficients carry about 30 digits, real128 34)")
+    if what == "atol":
+        if not pair[0] > 0:
+            raise ValueError(f"atol must be positive, got {value!r}")
+    # compared as the nearest double, as the Fortran side does: "1e-32" to any precision
+    # is accepted
+    elif not 1e-32 <= pair[0] < 1:
+        raise ValueError(f"{what} must lie in [1e-32, 1), got {value!r} (DOP853's "
+                         "coefficients carry about 30 digits, real128 34)")
     return np.array(pair)
 
 
@@ -169,10 +172,10 @@ def reference_dop853(system, t_span, y0, rtol=1e-25, atol=None, params=None,
     """Integrate a system made by :func:`conmech.symbolic.ode_system` from t_span[0] to
     t_span[1] by Hairer's DOP853 in quadruple precision: the 8(5,3) pair, its error estimator
     and step-size control, the error per component scaled by atol + rtol |y| (atol defaults
-    to rtol; both in [1e-32, 1)). The right-hand side is the first Taylor coefficient of the
-    system's generated quadruple-precision routine. ``fixed_steps=N`` takes N equal steps
-    without error control (for measuring the order). Inputs as in :func:`reference`; the
-    result is a :class:`QuadResult` with ``nfev``, ``nsteps`` (accepted steps), ``nreject``
+    to rtol; rtol in [1e-32, 1), atol positive). The right-hand side is the first Taylor
+    coefficient of the system's generated quadruple-precision routine. ``fixed_steps=N``
+    takes N equal steps without error control (for measuring the order). Inputs as in
+    :func:`reference`; the result is a :class:`QuadResult` with ``nfev``, ``nsteps`` (accepted steps), ``nreject``
     and ``order`` 8."""
     taylor, n, ypairs, tpairs, ppairs = _quad_inputs(system, t_span, y0, params)
     rtolp = _tolerance(rtol, "rtol")
