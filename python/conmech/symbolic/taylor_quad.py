@@ -175,8 +175,8 @@ def reference_dop853(system, t_span, y0, rtol=1e-25, atol=None, params=None,
     to rtol; rtol in [1e-32, 1), atol positive). The right-hand side is the first Taylor
     coefficient of the system's generated quadruple-precision routine. ``fixed_steps=N``
     takes N equal steps without error control (for measuring the order). Inputs as in
-    :func:`reference`; the result is a :class:`QuadResult` with ``nfev``, ``nsteps`` (accepted steps), ``nreject``
-    and ``order`` 8."""
+    :func:`reference`; the result is a :class:`QuadResult` with ``nfev``, ``nsteps``
+    (accepted steps), ``nreject`` and ``order`` 8."""
     taylor, n, ypairs, tpairs, ppairs = _quad_inputs(system, t_span, y0, params)
     rtolp = _tolerance(rtol, "rtol")
     atolp = rtolp if atol is None else _tolerance(atol, "atol")
