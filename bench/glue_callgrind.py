@@ -16,7 +16,12 @@ Cases:
           of a built-in system (flat_solve_native)
   hill    conmech.hill.variation_orbit(M_HILL) (flat_hill_orbit_checked)
   call    CompiledModel.call("rhs", t, y) of a symbolic ode model (the model's rhs, in
-          its own library)
+          its own library; the flat routine flat_entry_call_1 calls it)
+  sym     solve_ivp(kepler from conmech.symbolic, (0, 0), DOP853): the fixed cost on a
+          compiled symbolic system (flat_solve_native)
+  symp    the same with a parameter (params={mu: 1.0})
+  taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_solve_native)
+  py      solve_ivp(Python callable, (0, 0), DOP853) (flat_solve)
 
     python bench/glue_callgrind.py one CASE REPS        (what valgrind runs)
 """
@@ -29,7 +34,9 @@ import tempfile
 
 # (the flat routine or model symbol whose inclusive count is the Fortran share)
 SYMBOLS = {"step": "flat_stepper_step_builtin_", "solve": "flat_solve_native_",
-           "hill": "flat_hill_orbit_checked_", "call": "conmech_rhs"}
+           "hill": "flat_hill_orbit_checked_", "call": "conmech_rhs",
+           "sym": "flat_solve_native_", "symp": "flat_solve_native_",
+           "taylor": "flat_solve_native_", "py": "flat_solve_"}
 
 
 def make(case):
@@ -57,6 +64,26 @@ def make(case):
         y = np.array([0.3, 0.1])
         model.call("rhs", 0.0, y)
         return lambda: model.call("rhs", 0.0, y)
+    if case in ("sym", "symp", "taylor"):
+        import sympy as sp
+        from conmech import symbolic
+        x, y, u, v, mu = sp.symbols("x y u v mu")
+        r3 = (x**2 + y**2)**sp.Rational(3, 2)
+        if case == "symp":
+            s = symbolic.ode_system([u, v, -mu*x/r3, -mu*y/r3], [x, y, u, v],
+                                    params={mu: 1.0})
+        else:
+            s = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+        y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
+        m = "TAYLOR" if case == "taylor" else "DOP853"
+        return lambda: conmech.solve_ivp(s, (0.0, 0.0), y0, method=m, rtol=1e-12,
+                                         atol=1e-12)
+    if case == "py":
+        y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
+
+        def f(t, y):
+            return -y
+        return lambda: conmech.solve_ivp(f, (0.0, 0.0), y0, method="DOP853")
     raise SystemExit(f"unknown case {case}")
 
 
@@ -69,7 +96,8 @@ def one(case, reps):
 
 def count(case, reps, tmp):
     out = os.path.join(tmp, f"cg.{case}.{reps}")
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               PYTHONHASHSEED="0")     # the imports' counts repeatable between the runs
     subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
                     sys.executable, os.path.abspath(__file__), "one", case, str(reps)],
                    check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

@@ -27,6 +27,7 @@ from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F4
 from .complex_form import complex_result as _complex_result, real_form as _real_form, \
     real_form_event as _real_form_event
 from .empty import solve_empty as _solve_empty
+from .solve_fast import fast_solve as _fast_solve
 from .result import _MESSAGES, OdeResult
 from .._core.status import BAD_INPUT
 
@@ -185,6 +186,16 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         On bad input; the message names the argument. An exception raised inside ``fun``
         or an event function reaches the caller unchanged.
     """
+    if (type(rtol) is float and type(atol) is float and type(method) is str and args is None
+            and t_eval is None and events is None and dense_output is False
+            and vectorized is False and jac is None and not options and first_step is None
+            and max_steps is None and type(max_step) is float and max_step == math.inf
+            and isinstance(fun, NativeSystem)):
+        # the most frequent call, with plain inputs: checked with the cheapest tests of the
+        # same rules (None: an input of another kind or a bad one, checked below)
+        res = _fast_solve(fun, t_span, y0, method, rtol, atol, _TAYLOR, with_fixed_order)
+        if res is not None:
+            return res
     # ---------------------------------------------------------------- fun and args
     builtin = isinstance(fun, NativeSystem)
     if not builtin and not callable(fun):

@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 
 from ..mechanics import compiled
+from .. import _conmech as _flat
 from .._core import slot_table as _table
 from .._core.model import SystemModel, model_of
 from .build import (CacheError, _conmech_version, cache_dir, check_private, compile_source,
@@ -127,34 +128,65 @@ class CompiledModel(SystemModel):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
         (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
         parameters or `params`."""
-        fn, n_in, shapes, ret = self._entry(entry)
-        if entry == "jac_prod":
+        e = self.__dict__.get("_calls", _NO_CALLS).get(entry)
+        if e is None:
+            e = self._call_layout(entry)
+        address, in_shapes, shapes, sizes, ret = e
+        if address is None:
+            fn = self._entry(entry)[0]
             return self._call_jac_prod(fn, t, *arrays, params=params)
-        if params is None:
-            pp = self.__dict__.get("_p0_ref")
-            if pp is None:
-                pp = self._p0_ref = _address(self._params(None))
-        else:
-            pp = _address(self._params(params))
-        if len(arrays) != n_in:
-            raise ValueError(f"'{entry}' takes t and {n_in} array(s), got {len(arrays)}")
-        n = self.derived.n
+        p = self._params(params)
+        if len(arrays) != len(in_shapes):
+            raise ValueError(f"'{entry}' takes t and {len(in_shapes)} array(s), got "
+                             f"{len(arrays)}")
         ins = []
-        for i, a in enumerate(arrays):
-            a = np.ascontiguousarray(a, dtype=float)
-            shape = (n,)
-            if entry == "constraint_hessian" and i == 2:      # the multipliers
-                shape = (self.derived.n_hol + self.derived.n_nh,)
+        for a, shape in zip(arrays, in_shapes):
+            if type(a) is not np.ndarray or a.dtype != np.float64:
+                a = np.asarray(a, dtype=float)
             if a.shape != shape:
                 raise ValueError(f"input arrays must have shape {shape}, got {a.shape}")
-            ins.append(_address(a))
-        # the outputs in ctypes buffers (no address to look up), seen by numpy afterwards
-        outs = [_out_buffer(s) for s in shapes]
-        r = fn(float(t), *ins, *outs, pp)
+            ins.append(a if a.size else _PLACEHOLDER)
+        t = float(t)
+        # one f2py call (its argument handling is cheaper than ctypes' pointer objects);
+        # the outputs are the fresh arrays f2py allocates, flattened in Fortran order
+        if len(ins) == 1 and len(shapes) == 1 and not ret:
+            out, info = _flat.flat_entry_call_1(address, t, ins[0], sizes[0], p)
+            outs = (out,)
+        else:
+            ins += [_PLACEHOLDER] * (3 - len(ins))
+            m = list(sizes) + [1] * (2 - len(sizes))
+            out1, out2, value, info = _flat.flat_entry_call(
+                address, int(ret), t, len(in_shapes), *ins, len(shapes), *m, p)
+            outs = (out1, out2)
+        if info != 0:
+            raise RuntimeError(f"the model entry '{entry}' could not be called (its "
+                               f"signature is not one of conmech's)")
         if ret:
-            return float(r)
+            return float(value)
         res = [_as_array(o, s) for o, s in zip(outs, shapes)]
         return res[0] if len(res) == 1 else tuple(res)
+
+    def _call_layout(self, entry):
+        """(address, input shapes, output shapes, output sizes (at least 1), returns a
+        value) of an entry point, made once per model and entry; address None for
+        jac_prod (its own call)."""
+        if entry not in self.addresses:
+            raise ValueError(f"this model has no entry point '{entry}' "
+                             f"(has: {', '.join(self.addresses)})")
+        calls = self.__dict__.setdefault("_calls", {})
+        if entry == "jac_prod":
+            calls[entry] = e = (None, (), (), (), False)
+            return e
+        d = self.derived
+        ret = _table.returns_value(entry)
+        shapes = list(self._shapes(entry))
+        in_shapes = [(d.n,)] * _table.BY_NAME[entry].inputs
+        if entry == "constraint_hessian":                      # the multipliers
+            in_shapes[2] = (d.n_hol + d.n_nh,)
+        sizes = tuple(max(math.prod(s), 1) for s in shapes)
+        calls[entry] = e = (int(self.addresses[entry]), tuple(in_shapes), tuple(shapes),
+                            sizes, ret)
+        return e
 
     def _call_jac_prod(self, fn, t, y, x, params=None):
         """jx = J(t, y) x through the compiled conmech_jac_prod (x: n or n x k)."""
@@ -171,27 +203,20 @@ class CompiledModel(SystemModel):
         return jx.ravel() if vec else jx
 
 
-def _address(a):
-    """A float64 C-contiguous array as a ctypes pointer argument. NumPy's ``a.ctypes``
-    costs microseconds per call (a Python object built each time); a ctypes view of the
-    buffer costs a fraction of that. A read-only or empty array is copied first."""
-    if not a.flags.writeable or a.size == 0:
-        a = np.array(a) if a.size else np.zeros(1)
-    return ctypes.byref(_D.from_buffer(a))
+_NO_CALLS = {}
+# the one-element stand-in for an empty or unused array argument (f2py cannot pass empty
+# arrays; the entry never reads it)
+_PLACEHOLDER = np.zeros(1)
+_PLACEHOLDER.flags.writeable = False
 
 
-def _out_buffer(shape):
-    """A zeroed ctypes buffer for an output of `shape` (at least one element)."""
-    return (_D * max(math.prod(shape), 1))()
-
-
-def _as_array(buf, shape):
-    """The output buffer as an array of `shape` (Fortran order), sharing its memory."""
-    size = math.prod(shape)
-    if size == 0:
+def _as_array(out, shape):
+    """A flat output (Fortran order) as an array of `shape`, sharing its memory."""
+    if len(shape) == 1:
+        return out if shape[0] else np.zeros(shape)
+    if math.prod(shape) == 0:
         return np.zeros(shape, order="F")
-    a = np.frombuffer(buf, dtype=float, count=size)
-    return a.reshape(shape, order="F") if len(shape) > 1 else a
+    return out.reshape(shape, order="F")
 
 
 def compile_model(derived, flags=None):

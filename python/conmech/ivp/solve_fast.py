@@ -1,0 +1,123 @@
+"""The fast entry of :func:`conmech.solve_ivp` for its most frequent call: a built-in or
+compiled system, a method named by a string, float tolerances, a span and a state of
+plain floats, and none of the options that call back into Python (events, t_eval, dense
+output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
+same rules (type tests on Python scalars and lists, no NumPy conversion to find a type)
+and goes to the one-call native path; any input outside these kinds, or one that breaks
+a rule, returns None and the full checks of solve_ivp run, with their messages. The
+result is the one the full path gives (the same Fortran call with the same arrays)."""
+import math
+
+import numpy as np
+
+from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR
+from .methods import BY_NAME, RK45_SCIPY
+from .native_path import solve_native
+
+__all__ = ["fast_solve", "fast_method_code"]
+
+_HUGE = float(np.finfo(float).max)
+# method string (as given) -> code, for the methods the fast path takes: an adaptive step
+# (the fixed-step ones need first_step) on a first-order system. Bounded: only names the
+# table knows get in, in the spellings users typed.
+_CODES = {}
+# (id(system), rtol, atol) -> (system, the system method TAYLOR runs for them): the
+# Taylor entries, once made, are fixed, so the look-up of taylor_system is made once
+_TAYLOR = {}
+# (value, n) -> read-only tolerance array of that value (the flat call reads it only)
+_TOLERANCES = {}
+
+
+def fast_method_code(method):
+    """The method code of the string ``method`` when the fast path takes it, else 0."""
+    code = _CODES.get(method)
+    if code is not None:
+        return code
+    upper = method.upper()
+    m = BY_NAME.get(upper)
+    if m is None or m.fixed_step or m.constrained_only:
+        return 0
+    code = RK45_SCIPY if upper == "RK45" else m.code
+    if len(_CODES) < 256:
+        _CODES[method] = code
+    return code
+
+
+def _tolerance(v, n):
+    arr = _TOLERANCES.get((v, n))
+    if arr is None:
+        arr = np.empty(n)
+        arr.fill(v)
+        arr.flags.writeable = False
+        if len(_TOLERANCES) >= 64:
+            _TOLERANCES.clear()
+        _TOLERANCES[(v, n)] = arr
+    return arr
+
+
+def _state(y0, n):
+    """y0 as a float64 array of size n when it is a list or tuple of n finite floats (or
+    ints), or a 1-D float64 array of n finite entries; else None."""
+    if type(y0) is list or type(y0) is tuple:
+        if len(y0) != n:
+            return None
+        for v in y0:
+            if not ((isinstance(v, float) or type(v) is int) and math.isfinite(v)):
+                return None
+        return np.array(y0, dtype=float)
+    if type(y0) is np.ndarray and y0.dtype == np.float64 and y0.shape == (n,):
+        if n <= 32:
+            if not all(map(math.isfinite, y0.tolist())):
+                return None
+        elif not np.isfinite(y0).all():
+            return None
+        return y0
+    return None
+
+
+def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
+    """The result of solve_ivp(fun, t_span, y0, method, rtol=rtol, atol=atol) for a
+    NativeSystem ``fun``, float ``rtol``/``atol`` and a string ``method``, when every
+    input is of a plain kind and valid; None otherwise (the caller runs the full checks).
+    ``taylor_system(fun, rtol, atol)`` gives the system method TAYLOR runs (its
+    recurrences written out for the tolerances' order), ``taylor_code`` that method's
+    code."""
+    code = fast_method_code(method)
+    if not code:
+        return None
+    if type(t_span) is tuple or type(t_span) is list:
+        if len(t_span) != 2:
+            return None
+        t0, tf = t_span
+        if not ((type(t0) is float or type(t0) is int) and (type(tf) is float or
+                                                              type(tf) is int)):
+            return None
+        t0, tf = float(t0), float(tf)
+        if not (math.isfinite(t0) and math.isfinite(tf)):
+            return None
+    else:
+        return None
+    if not (0.0 <= atol < math.inf and RTOL_FLOOR <= rtol < math.inf):
+        return None
+    n = fun.dimension
+    y = _state(y0, n)
+    if y is None:
+        return None
+    if code == taylor_code:
+        hit = _TAYLOR.get((id(fun), rtol, atol))
+        if hit is not None and hit[0] is fun:
+            fun = hit[1]
+        elif getattr(fun, "taylor", None):      # as solve_ivp: the written-out recurrences
+            run = taylor_system(fun, rtol, atol)
+            if len(_TAYLOR) >= 64:
+                _TAYLOR.clear()
+            _TAYLOR[(id(fun), rtol, atol)] = (fun, run)    # fun kept: its id stays its own
+            fun = run
+        elif getattr(fun, "kind", None) == "generalized":
+            return None                         # its first-order view: the full path
+    return solve_native(fun, t0, tf, y, _EMPTY, False, code, _tolerance(rtol, n),
+                        _tolerance(atol, n), 0.0, _HUGE, NO_STEP_LIMIT)
+
+
+_EMPTY = np.zeros(0)
+_EMPTY.flags.writeable = False

@@ -1,0 +1,120 @@
+"""solve_ivp's fast entry (conmech.ivp.solve_fast): a call with plain inputs on a native
+system takes it, gives the result of the full path bit for bit, and every bad input still
+gets the full path's message."""
+import math
+
+import numpy as np
+import pytest
+
+import conmech
+from conmech.ivp import solve_fast
+
+Y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
+
+
+@pytest.fixture
+def counted(monkeypatch):
+    calls = []
+    real = solve_fast.solve_native
+
+    def wrapped(*a, **k):
+        calls.append(a)
+        return real(*a, **k)
+    monkeypatch.setattr(solve_fast, "solve_native", wrapped)
+    return calls
+
+
+def _same(a, b):
+    assert set(a) == set(b)
+    for k in a:
+        va, vb = a[k], b[k]
+        if isinstance(va, np.ndarray):
+            assert va.dtype == vb.dtype and va.shape == vb.shape
+            assert np.array_equal(va, vb), k
+        else:
+            assert va == vb, k
+
+
+@pytest.mark.parametrize("method", ["RK45", "dop853", "DOPRI5", "Radau", "VERNER98"])
+@pytest.mark.parametrize("y0", [Y0, tuple(Y0), np.array(Y0), [0.5, 0, 0, np.sqrt(3.0)]])
+def test_fast_equals_full_path(counted, method, y0):
+    kep = conmech.systems.kepler()
+    fast = conmech.solve_ivp(kep, (0.0, 3.0), y0, method=method, rtol=1e-9, atol=1e-10)
+    assert len(counted) == 1
+    # np.float64 tolerances are not a fast-path kind: the full checks run
+    full = conmech.solve_ivp(kep, (0.0, 3.0), y0, method=method, rtol=np.float64(1e-9),
+                             atol=np.float64(1e-10))
+    assert len(counted) == 1
+    assert fast.success and fast.t.size > 3
+    _same(fast, full)
+
+
+def test_fast_zero_span_and_backwards(counted):
+    kep = conmech.systems.kepler()
+    for span in [(1.0, 1.0), (2, 0)]:
+        fast = conmech.solve_ivp(kep, span, Y0, method="DOP853")
+        full = conmech.solve_ivp(kep, list(map(np.float64, span)), Y0, method="DOP853")
+        _same(fast, full)
+    assert len(counted) == 2
+    r = conmech.solve_ivp(kep, (1.0, 1.0), Y0)
+    assert r.t.tolist() == [1.0, 1.0] and r.y.shape == (4, 2)
+
+
+def test_fast_input_not_modified():
+    kep = conmech.systems.kepler()
+    y0 = np.array(Y0)
+    r = conmech.solve_ivp(kep, (0.0, 1.0), y0, method="DOP853")
+    assert np.array_equal(y0, Y0)
+    r.y[:, 0] = 7.0            # the result owns its arrays
+    assert np.array_equal(y0, Y0)
+
+
+@pytest.mark.parametrize("kw, exc, text", [
+    (dict(y0=[0.5, 0.0, math.nan, 1.0]), ValueError, "must be finite"),
+    (dict(y0=[0.5, 0.0, 1.0]), ValueError, "y0 must have shape (4,)"),
+    (dict(y0=np.zeros((4, 1))), ValueError, "1-dimensional"),
+    (dict(y0=[0.5, 0.0, 0.0, 1j]), TypeError, "y0 must be real"),
+    (dict(y0=[0.5, 0.0, 0.0, True]), None, None),
+    (dict(t_span=(0.0, math.inf)), ValueError, "infinite end"),
+    (dict(t_span=(math.nan, 1.0)), ValueError, "t_span[0] must be finite"),
+    (dict(t_span=(0.0, 1.0, 2.0)), ValueError, "two elements"),
+    (dict(t_span=(0.0, "1")), TypeError, "t_span[1]"),
+    (dict(rtol=-1.0), ValueError, "rtol must be non-negative"),
+    (dict(atol=math.inf), ValueError, "atol must be finite"),
+    (dict(method="NOPE"), ValueError, "method must be one of"),
+    (dict(method="RK4"), ValueError, "first_step is required"),
+])
+def test_bad_inputs_keep_their_messages(kw, exc, text):
+    args = dict(t_span=(0.0, 1.0), y0=Y0, method="DOP853", rtol=1e-6, atol=1e-8)
+    args.update(kw)
+    kep = conmech.systems.kepler()
+    call = (lambda: conmech.solve_ivp(kep, args["t_span"], args["y0"], method=args["method"],
+                                      rtol=args["rtol"], atol=args["atol"]))
+    if exc is None:           # a bool entry: NumPy's float of it, as the full path
+        assert call().success
+        return
+    with pytest.raises(exc) as info:
+        call()
+    assert text in str(info.value)
+
+
+def test_small_rtol_warns_as_scipy(counted):
+    kep = conmech.systems.kepler()
+    with pytest.warns(UserWarning, match="rtol"):
+        r = conmech.solve_ivp(kep, (0.0, 0.5), Y0, method="DOP853", rtol=1e-20)
+    assert r.success and not counted     # the warning is the full path's
+
+
+@pytest.mark.parametrize("method", ["TAYLOR", "DOP853"])
+def test_fast_symbolic_with_params(counted, method):
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    x, y, u, v, mu = sp.symbols("x y u v mu")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    kep = symbolic.ode_system([u, v, -mu*x/r3, -mu*y/r3], [x, y, u, v], params={mu: 1.0})
+    fast = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method=method, rtol=1e-12, atol=1e-12)
+    full = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method=method,
+                             rtol=np.float64(1e-12), atol=np.float64(1e-12))
+    assert len(counted) == 1
+    _same(fast, full)
+    assert np.max(np.abs(fast.y[:, -1] - Y0)) < 1e-9      # one period closes the orbit
