@@ -97,7 +97,7 @@ def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
     # the pivot checks: after the order-0 statements, before the loop over the orders
     # (order 0 evaluates the chain in full: the accelerations, as the tree's right-hand
     # side does, and then nothing of order >= 1 is kept from a non-positive pivot)
-    from .taylor import _Printer
+    from .taylor import _Printer, _wrap
     pp = _Printer(dec, names, False, "dp")
     start = f"{ind}do k = 1, order - 1"
     at = body.index(start) if start in body else len(body)
@@ -105,11 +105,14 @@ def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
     for lin in pivots:
         if not lin.terms:
             continue          # a constant pivot: checked positive when the tree was built
-        checks += [f"{ind}if (.not. ({pp.lin_at(lin, 0, True)} > 0.0_dp)) then",
+        checks += _wrap(f"pivot = {pp.lin_at(lin, 0, True)}", ind)
+        checks += [f"{ind}if (.not. (pivot > 0.0_dp)) then",
                    f"{ind}    w(1:order, :) = ieee_value(1.0_dp, ieee_quiet_nan)",
                    f"{ind}    return",
                    f"{ind}end if"]
     body = body[:at] + checks + body[at:]
+    if checks:
+        decl = decl + [f"{ind}real(dp) :: pivot"]
     lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
              f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{ind}real(dp), value, intent(in) :: t",
