@@ -296,7 +296,7 @@ def test_energy_is_conserved_over_a_long_run():
     E = np.array([float(np.ravel(model.call("energy", 0.0, y[:3], y[3:]))[0])
                   for y in r.y.T])
     assert np.max(np.abs(E - E[0])) <= 1e-10*max(1.0, abs(E[0]))
-    # and not trivially: DOP853 at a loose tolerance drifts visibly more
+    # and not trivially: Taylor at a loose tolerance drifts visibly more
     rl = conmech.solve_ivp(system, (0, 120.0), y0, method="TAYLOR", rtol=1e-6, atol=1e-6,
                            t_eval=np.linspace(0, 120.0, 241))
     El = np.array([float(np.ravel(model.call("energy", 0.0, y[:3], y[3:]))[0])
@@ -306,17 +306,17 @@ def test_energy_is_conserved_over_a_long_run():
 
 def test_error_falls_with_the_tolerance():
     """The global error at t = 6 of the 3-link chain against a reference (Taylor and
-    DOP853 at 1e-14, which agree to 1e-11): at tolerances 1e-7, 1e-9, 1e-11 the error
+    DOP853 at 3e-14, which agree to 1e-11): at tolerances 1e-7, 1e-9, 1e-11 the error
     falls about in proportion (log-log slope 0.6..1.6) and stays below 100 times the
     tolerance: the order and the step from the tolerance work for the tree's
     recurrences."""
     bodies, params, g = chain(3)
     system = planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute")
     y0 = [1.2, 0.4, -0.5, 0.0, 0.3, -0.2]
-    ref = conmech.solve_ivp(system, (0, 6.0), y0, method="TAYLOR", rtol=1e-14,
-                            atol=1e-14).y[:, -1]
-    ref2 = conmech.solve_ivp(system, (0, 6.0), y0, method="DOP853", rtol=1e-14,
-                             atol=1e-14).y[:, -1]
+    ref = conmech.solve_ivp(system, (0, 6.0), y0, method="TAYLOR", rtol=3e-14,
+                            atol=3e-14).y[:, -1]
+    ref2 = conmech.solve_ivp(system, (0, 6.0), y0, method="DOP853", rtol=3e-14,
+                             atol=3e-14).y[:, -1]
     assert np.max(np.abs(ref - ref2)) <= 1e-11
     tols = [1e-7, 1e-9, 1e-11]
     errs = []

@@ -87,9 +87,9 @@ def name_the_mass_matrix(fun, res):
 
 
 def _pivots(model, res, fun):
-    """For a tree: "; the articulated inertia of the joint of body 'b' is x" for each
-    pivot of its articulated-body algorithm that is not positive at the last accepted
-    point (empty otherwise)."""
+    """For a tree: "; the articulated inertia of the joint of body 'b' is x, not
+    positive ..." for the first pivot of its articulated-body algorithm that is not
+    positive at the last accepted point (empty if none is)."""
     from ..symbolic.taylor_tree import is_tree, pivot_values
     d = model.derived
     if not is_tree(d):
@@ -101,8 +101,11 @@ def _pivots(model, res, fun):
                             np.asarray(fun.params, dtype=float))
     except (ValueError, TypeError, AttributeError):
         return ""
-    bad = [f"; the articulated inertia of the joint of {m.split(': ', 1)[-1]} is {x:.6g}"
-           if ": " in m else f"; an articulated inertia is {x:.6g}"
-           for m, x in vals if not x > 0]
-    return "".join(bad) + (" (not positive: the pivot of the articulated-body algorithm)"
-                           if bad else "")
+    # the first in the chain's order (leaves first): the pivots of its ancestors are then
+    # not finite
+    for marker, x in vals:
+        if not x > 0:
+            body = marker.split(": ", 1)[1] if ": " in marker else "a body"
+            return (f"; the articulated inertia of the joint of {body} is {x:.6g}, not "
+                    "positive (the pivot of the articulated-body algorithm)")
+    return ""
