@@ -7,6 +7,8 @@ definition by definition into elementary operations with Taylor recurrences).
   Lagrangian (sympy's Euler-Lagrange equations of its energies, not the articulated-body
   code), expanded along the solution by truncated power series in 40-digit arithmetic
   (mpmath), orders 0..8, to a few dozen round-offs;
+- coefficients of an ode system whose decomposition sums symbolic coefficients of one
+  column (as the chains of trees do): the exact series of a linear system;
 - Taylor against DOP853, both at rtol 1e-13: a 3-link planar chain (absolute angles) and a
   branched tree with a prismatic joint, springs, dampers and a time-dependent torque agree
   to 1e-10; the same for the spatial route (three joints of the shipped arm, URDF);
@@ -218,6 +220,23 @@ def test_coefficients_are_the_series_of_the_lagrangian_solution(coordinates):
         assert scale > 0
         err = np.max(np.abs(got[:, k] - ref[:, k]))
         assert err <= 64*np.finfo(float).eps*scale, (k, err/scale)
+
+
+def test_coefficients_that_become_sums_print_as_factors():
+    """A column reached by two terms with symbolic factors (p x + q (x + y): x's
+    coefficient is p + q, as in the chains of definitions of trees) is one named constant
+    in the generated code, not the text "p + q*x": the coefficients of the linear system
+    y' = A y are A**k y0 / k!, exactly up to round-off."""
+    import math
+    x, y, p, q = sp.symbols("x_sum y_sum p_sum q_sum")
+    system = symbolic.ode_system([p*x + q*(x + y), -x], [x, y], params={p: 0.3, q: -1.7})
+    tay = system.taylor
+    y0 = np.array([0.4, -1.1])
+    got = coefficients(conmech.compiled.function_address(tay["jet"]), tay["nw"],
+                       system.params, y0, 6)
+    A = np.array([[0.3 - 1.7, -1.7], [-1.0, 0.0]])
+    ref = np.array([np.linalg.matrix_power(A, k) @ y0/math.factorial(k) for k in range(7)]).T
+    assert np.max(np.abs(got - ref)) <= 1e-15
 
 
 # ------------------------------------------------------------------ trajectories
