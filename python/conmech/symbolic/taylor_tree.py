@@ -30,10 +30,17 @@ view runs on them): ``conmech_taylor(t, order, w, p)`` and ``_info`` with the wo
 convention of an ode system's (the state [q; v] in the columns 1..2n), and
 ``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; a] from the order-1 expansion).
 """
-from .taylor import body_lines
-from .taylor_decompose import TaylorUnsupported, decompose
+import math
 
-__all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_procedures", "tree_lines", "pivot_values"]
+import sympy as sp
+
+from .spatial_aba import _spatial_aba
+from .taylor import _Printer, _wrap, body_lines
+from .taylor_decompose import TaylorUnsupported, decompose
+from .tree_aba import _aba
+
+__all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_procedures", "tree_lines",
+           "pivot_values"]
 
 
 def is_tree(d):
@@ -55,9 +62,6 @@ def tree_chain(d):
     if getattr(d, "point_forces", None) or getattr(d, "loops", None):
         return None, ("a tree with forces at points of bodies or closed loops has no "
                       "Taylor recurrences here")
-    from .spatial_aba import _spatial_aba
-    from .tree_aba import _aba
-    import sympy as sp
     index = {name: J.col for name, J in zip(d.order_names, d.joints)}
     tau = list(d.user_forces)
     if d.planar:
@@ -97,7 +101,6 @@ def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
     # the pivot checks: after the order-0 statements, before the loop over the orders
     # (order 0 evaluates the chain in full: the accelerations, as the tree's right-hand
     # side does, and then nothing of order >= 1 is kept from a non-positive pivot)
-    from .taylor import _Printer, _wrap
     pp = _Printer(dec, names, False, "dp")
     start = f"{ind}do k = 1, order - 1"
     at = body.index(start) if start in body else len(body)
@@ -159,8 +162,6 @@ def pivot_values(d, t, q, v, params):
     """The pivots D_i of the tree record `d` (the articulated inertias of its joints, in
     the chain's order) at (t, q, v) with the parameter values `params`, evaluated along
     the chain in floating point: [(the pivot's symbol, value)]. For messages."""
-    import math
-    import sympy as sp
     chain, _ = tree_chain(d)
     defs = chain[0] if chain is not None else []
     env = {d.t: sp.Float(float(t))}
