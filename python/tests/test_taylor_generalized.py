@@ -14,8 +14,7 @@ method step by step from Python (conmech.Stepper(method="TAYLOR")).
   conserved to the tolerance's level over about 60 periods;
 - a mass matrix singular at the initial point or along the solution: a failed run whose
   message names M (never non-finite or silent output);
-- a non-smooth Lagrangian and a symbolic tree (articulated-body code) are refused with
-  the reason;
+- a non-smooth Lagrangian is refused with the reason (trees: test_taylor_tree.py);
 - conmech.Stepper(method="TAYLOR"), ode and generalized systems, a fresh model whose Taylor
   library is still to be built: the steps, states and counts of solve_ivp's run, bit for
   bit, and the dense output of each step from its Taylor polynomial;
@@ -236,22 +235,13 @@ def test_singular_mass_matrix_is_reported():
     assert np.max(np.abs(r.y[0, away] - np.sqrt(1 - 2*r.t[away]))) < 1e-8
 
 
-def test_non_smooth_lagrangian_and_trees_are_refused_with_the_reason():
+def test_non_smooth_lagrangian_is_refused_with_the_reason():
     t = dynamicsymbols._t
     q = dynamicsymbols("q")
     system = symbolic.lagrangian_system(q.diff(t)**2/2 - sp.Abs(q), [q])
     with pytest.raises(ValueError, match="M\\(q\\) q'' = Q has no Taylor recurrences"):
         conmech.solve_ivp(system, (0, 1), [0.5, 0.0], method="TAYLOR")
     assert conmech.solve_ivp(system, (0, 1), [0.5, 0.0], method="DOP853").success
-    # a symbolic tree integrates through its articulated-body code: refused, naming it
-    p1, p2 = dynamicsymbols("p1 p2")
-    m, l, g = sp.symbols("m l g")
-    rod = dict(mass=m, com=(l/2, 0), inertia=m*l**2/12)
-    bodies = [symbolic.Body("a", None, "revolute", p1, **rod),
-              symbolic.Body("b", "a", "revolute", p2, at=(l, 0), **rod)]
-    tree = symbolic.planar_tree(bodies, {m: 1.0, l: 1.0, g: 9.81}, gravity=(0, -g))
-    with pytest.raises(ValueError, match="articulated-body code"):
-        conmech.solve_ivp(tree, (0, 1), [0.3, 0.5, 0.0, 0.2], method="TAYLOR")
 
 
 # ------------------------------------------------------------------ step by step

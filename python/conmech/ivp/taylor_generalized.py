@@ -1,17 +1,19 @@
 """Taylor's method for generalized systems M(t, q) q'' = Q(t, q, q') made by
 :mod:`conmech.symbolic` (``lagrangian_system`` with a Lagrangian or with ``mass=`` and
-``forces=``, ``dalembert_system``; not the trees, whose accelerations come from their
-articulated-body code): the run integrates the
-system's first-order view y = [q; v], an ode system whose Taylor coefficients come from
-the recurrences of M and Q and the linear solve order by order
-(:mod:`conmech.symbolic.taylor_generalized`, compiled on first need and cached like an ode
-model's Taylor library).
+``forces=``, ``dalembert_system``, and the trees ``planar_tree``, ``spatial_tree``,
+``from_urdf``): the run integrates the system's first-order view y = [q; v], an ode
+system whose Taylor coefficients come from the recurrences of M and Q and the linear
+solve order by order (:mod:`conmech.symbolic.taylor_generalized`), or for a tree from the
+recurrences of its articulated-body code, definition by definition
+(:mod:`conmech.symbolic.taylor_tree`); compiled on first need and cached like an ode
+model's Taylor library.
 
 :func:`first_order_view` gives the view (the same parameters; the model behind it, so that
 the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
 run's message what the mass matrix is at the last accepted point (a singular or indefinite
 M makes the coefficients non-finite, which the stepper reports as a non-finite right-hand
-side or a step size too small)."""
+side or a step size too small), and for a tree which joint's articulated inertia (the
+pivot of its articulated-body algorithm) is not positive there."""
 import numpy as np
 
 from .._core.model import model_of
@@ -80,5 +82,30 @@ def name_the_mass_matrix(fun, res):
         else:
             note = "is not positive definite (singular or indefinite)"
     res.message = (f"{res.message} (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at "
-                   f"the last accepted point, t = {t:.6g}, {note})")
+                   f"the last accepted point, t = {t:.6g}, {note}{_pivots(model, res, fun)})")
     return res
+
+
+def _pivots(model, res, fun):
+    """For a tree: "; the articulated inertia of the joint of body 'b' is x, not
+    positive ..." for the first pivot of its articulated-body algorithm that is not
+    positive at the last accepted point (empty if none is)."""
+    from ..symbolic.taylor_tree import is_tree, pivot_values
+    d = model.derived
+    if not is_tree(d):
+        return ""
+    n = d.n
+    y = np.array(res.y[:, -1], dtype=float)
+    try:
+        vals = pivot_values(d, float(res.t[-1]), y[:n], y[n:2*n],
+                            np.asarray(fun.params, dtype=float))
+    except (ValueError, TypeError, AttributeError):
+        return ""
+    # the first in the chain's order (leaves first): the pivots of its ancestors are then
+    # not finite
+    for marker, x in vals:
+        if not x > 0:
+            body = marker.split(": ", 1)[1] if ": " in marker else "a body"
+            return (f"; the articulated inertia of the joint of {body} is {x:.6g}, not "
+                    "positive (the pivot of the articulated-body algorithm)")
+    return ""

@@ -73,12 +73,17 @@ class Decomposition:
     Symbols (run-time values p(1..)), outputs : expressions in t, state, params.
     ``given=False`` (an ODE): output i is y_i'; ``given=True``: the state series is given
     (e.g. events along a polynomial) and the outputs are materialized as columns.
+    ``defs``: a chain of definitions [(Symbol, expression in t, state, params and earlier
+    Symbols of the chain)] the outputs may use (straight-line code such as a tree's
+    articulated-body algorithm): each is decomposed once, as an intermediate, instead of
+    being substituted into the outputs; entries whose expression is a string (markers of
+    the chain, such as pivot checks) are skipped.
 
     Attributes: n, ncol (columns of w), ops (in evaluation order), consts [(name, expr)],
     outputs (list of _Lin), out_cols (given=True: the output columns), t_col (or None).
     """
 
-    def __init__(self, outputs, state, t, params, given=False):
+    def __init__(self, outputs, state, t, params, given=False, defs=()):
         self.state = list(state)
         self.n = len(self.state)
         self.t = t
@@ -95,7 +100,8 @@ class Decomposition:
         self._var = set(self.state) | {t}
         self._cse = {}
         exprs = [sp.sympify(e) for e in outputs]
-        for e in exprs:
+        chain = [(s, sp.sympify(e)) for s, e in defs if not isinstance(e, str)]
+        for e in exprs + [e for _, e in chain]:
             for f in e.atoms(sp.Function):
                 if not (type(f) in _SMOOTH_FUNCS or isinstance(f, sp.Function) and
                         f.func in _SMOOTH_FUNCS):
@@ -105,6 +111,12 @@ class Decomposition:
                         "cosh, tanh, their inverses, powers and roots)")
             for a in e.atoms(sp.Abs, sp.Min, sp.Max, sp.Piecewise):
                 raise TaylorUnsupported(f"{a} is not smooth: no Taylor recurrence")
+        for s, e in chain:            # the given chain first: the outputs refer to it
+            if self._is_const(e):
+                self._cse[s] = ("c", self._const(e))
+            else:
+                self._var.add(s)
+                self._cse[s] = ("v", self._build(e))
         repl, red = sp.cse(exprs, symbols=sp.numbered_symbols("tcse", cls=sp.Dummy),
                            order="none")
         for s, e in repl:
@@ -182,6 +194,12 @@ class Decomposition:
         if e in self._memo:
             return self._memo[e]
         r = self._build_new(e)
+        if any(v.is_Add for v in r.terms.values()):
+            # coefficients that became sums (a column reached by two terms with symbolic
+            # factors, e.g. through definitions that share it): one named constant each,
+            # so that every coefficient prints as a factor
+            r = _Lin(r.c0, {c: self._const(v) if v.is_Add else v
+                            for c, v in r.terms.items()})
         self._memo[e] = r
         return r
 
@@ -319,9 +337,9 @@ class Decomposition:
         return out
 
 
-def decompose(exprs, state, t, params, given=False):
+def decompose(exprs, state, t, params, given=False, defs=()):
     """The :class:`Decomposition` of the expressions (see the class)."""
-    return Decomposition(exprs, state, t, params, given)
+    return Decomposition(exprs, state, t, params, given, defs)
 
 
 def variational_exprs(f, jac, n):

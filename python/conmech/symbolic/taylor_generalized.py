@@ -85,8 +85,8 @@ def generalized_decomposition(d):
         return None, "not a system in generalized coordinates"
     if getattr(d, "aba", None) is not None or d.M is None or d.Q is None:
         return None, ("the system has no mass matrix and forces as expressions (method "
-                      "TAYLOR expands M and Q; a symbolic tree's accelerations come from "
-                      "its articulated-body code, which has no Taylor recurrences)")
+                      "TAYLOR expands M and Q here; a symbolic tree's recurrences come "
+                      "from its articulated-body code: conmech.symbolic.taylor_tree)")
     M = d.M
     for i in range(d.n):
         for j in range(i + 1, d.n):
@@ -298,6 +298,9 @@ def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
     library (conmech.symbolic.taylor_library): the core only; the batch, quadruple
     precision and variational parts are not generated for generalized systems."""
+    from .taylor_tree import is_tree, tree_lines
+    if is_tree(d):              # a tree: through its articulated-body code
+        return tree_lines(d, names, part, dec_cache)
     if "g" not in dec_cache:
         dec_cache["g"] = generalized_decomposition(d)
     g, why = dec_cache["g"]

@@ -37,7 +37,7 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 2     # of the kept source (conmech_KEY.taylor.json; 2: generalized models too)
+_FORMAT = 3     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock

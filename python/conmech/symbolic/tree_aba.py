@@ -15,7 +15,7 @@ def _check_pivot(code, D, body):
             raise ValueError(f"body '{body}': the articulated inertia of its joint is "
                              f"{D}: the mass matrix is not positive definite")
     else:
-        code.positive(D)
+        code.positive(D, body)
 
 
 def _aba(order, index, data, qs, vs, tau_user, gravity, absolute, trig=None):
@@ -168,6 +168,7 @@ class _Code:
         self.memo[e] = s
         return s
 
-    def positive(self, s):
-        """Mark s (a defined symbol) as a pivot that must be positive."""
-        self.defs.append((s, "positive"))
+    def positive(self, s, body=None):
+        """Mark s (a defined symbol) as a pivot that must be positive: the marker is the
+        text "positive", followed by the body whose joint it belongs to (for messages)."""
+        self.defs.append((s, "positive" if body is None else f"positive: body '{body}'"))
