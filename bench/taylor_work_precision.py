@@ -4,7 +4,12 @@ conmech's own DOP853 on the same compiled system: Kepler e = 0.9 and Arenstorf's
 period each, rtol = atol = tol over 1e-8 .. 1e-16.
 
 Errors are measured at the end of the period against a quadruple-precision Taylor reference
-(conmech.symbolic.taylor_quad, tol 1e-30; it closes Arenstorf's orbit to 1e-25). Times are
+(conmech.symbolic.taylor_quad, tol 1e-30; it closes Arenstorf's orbit to 1e-25) started
+from the exact values of the doubles the runs start from (bench_taylor.reference: the
+published decimal initial values are another orbit, 6.8e-13 away on Kepler after one
+period). Below tol ~1e-13 on Kepler e = 0.9 every code is at the round-off floor of a
+double-precision state (a few 1e-12, scattered by an order of magnitude with the
+roundings: python/tests/test_taylor_precision.py), so single errors there compare luck. Times are
 the minimum over interleaved rounds in one process (each round times every method at every
 tolerance once, so a burst of load hits all of them alike). Orders and steps are printed
 beside the times.
@@ -135,7 +140,8 @@ def main():
     lines = ["# Work-precision: conmech TAYLOR vs heyoka vs conmech DOP853", "",
              f"`python bench/taylor_work_precision.py --rounds {args.rounds}`; heyoka "
              f"{getattr(hy, '__version__', 'not installed')}; one period, rtol = atol = tol; "
-             "error = max-norm at the end against a quadruple-precision Taylor reference; "
+             "error = max-norm at the end against a quadruple-precision Taylor reference from the "
+             "exact values of the doubles the runs start from; "
              f"time = min over {args.rounds} interleaved rounds (us, through Python: "
              "solve_ivp / propagate_until). "
              f"Load average (1 min) {load0[0]:.1f} at the start, {load1[0]:.1f} at the end "

@@ -19,8 +19,8 @@ module conmech_taylor_batch
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_rho, &
-        taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
+    use conmech_taylor_core, only: taylor_order, taylor_next_rho, taylor_eval_step, &
+        taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
     implicit none
     private
     public :: taylor_batch_fn, taylor_batch_propagate, taylor_batch_run_fn, &
@@ -111,7 +111,7 @@ contains
         real(dp), intent(out) :: tend(nm)
         real(dp), allocatable :: w(:, :, :), cur(:, :, :)
         real(dp) :: t(width), tlo(width), h(width), tc(width), e(n, width), hcand(width)
-        real(dp) :: ynew(n), dy(n), f1(n), eps, decay, posneg, hm, err, rt(n)
+        real(dp) :: ynew(n), dy(n), f1(n), eps, decay, posneg, hm, err, rt(n), rho
         integer :: ord, j, k, nsteps(width)
         logical :: active(width), hit(width)
         info = CM_SUCCESS
@@ -146,8 +146,8 @@ contains
                 active(j) = .false.
                 cycle
             end if
-            call taylor_scales(n, n, y(:, j), rt, atol, e(:, j))
-            h(j) = min(taylor_rho(n, ord, cur(:, :, j), e(:, j), eps, decay), hm)*posneg
+            call taylor_next_rho(n, n, ord, cur(:, :, j), rt, atol, eps, decay, e(:, j), rho)
+            h(j) = min(rho, hm)*posneg
         end do
         do while (any(active))
             ! candidate points of the active members
@@ -213,8 +213,9 @@ contains
                     active(j) = .false.
                     cycle
                 end if
-                call taylor_scales(n, n, y(:, j), rt, atol, e(:, j))
-                h(j) = min(taylor_rho(n, ord, cur(:, :, j), e(:, j), eps, decay), hm)*posneg
+                call taylor_next_rho(n, n, ord, cur(:, :, j), rt, atol, eps, decay, e(:, j), &
+                                     rho)
+                h(j) = min(rho, hm)*posneg
             end do
         end do
         do k = 1, nm

@@ -9,15 +9,23 @@
 !! - `taylor_eval_step`: y(t + h) and the polynomial's derivative there (Horner);
 !! - `taylor_check`: the safety-check ratio |h (P'(h) - f(t + h, P(h)))| / ((p + 1) E_i),
 !!   about the local error over the tolerance (the next expansion gives f there for free);
-!! - `taylor_add_time`: t + h in double length (Knuth's TwoSum).
+!! - `taylor_add_time`: t + h in double length (Knuth's TwoSum);
+!! - `taylor_eval_jet`, `taylor_check_jet`, `taylor_next_rho`: the same arithmetic, operation
+!!   for operation, on the expansions themselves (the scalar stepper's path: the new state
+!!   is written by Horner straight into the next expansion's zeroth coefficients, the check
+!!   reads f there, and the scales and the norms of the last two coefficients are one pass).
 module conmech_taylor_core
+    use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
     implicit none
     private
     public :: taylor_order, taylor_scales, taylor_rho, taylor_eval_step, taylor_check, &
-        taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
+        taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX, taylor_eval_jet, taylor_check_jet, &
+        taylor_next_rho
 
     real(dp), parameter :: TAYLOR_CHECK_MAX = 10.0_dp   !! rejected above 10 x the tolerance
+    real(dp), parameter :: LOG_HUGE = log(huge(1.0_dp))
+    integer, parameter :: NOT_NORMAL = -huge(1)
 
 contains
 
@@ -71,7 +79,7 @@ contains
         if (s1 > 0.0_dp) l = -log(s1*eps)/real(p - 1, dp)
         if (s2 > 0.0_dp) l = min(l, -log(s2*eps)/real(p, dp))
         rho = huge(1.0_dp)
-        if (l < log(huge(1.0_dp))) rho = exp(l)*decay
+        if (l < LOG_HUGE) rho = exp(l)*decay
     end function taylor_rho
 
     !> y(t + h) = sum_k c(k, i) h^k and its derivative dy (Horner; the derivative from the
@@ -137,6 +145,113 @@ contains
             dy(i) = d1
         end if
     end subroutine taylor_eval_step
+
+    !> taylor_eval_step with the new state also written into w(0, 1:n) (the zeroth
+    !! coefficients of the expansion about the step's end, which the system then
+    !! completes): the same Horner chains. The chains' results go to the contiguous ynew
+    !! and dy first (stored contiguously, the compiler pairs the chains into packed
+    !! operations; a strided store into w keeps them scalar), then into w.
+    pure subroutine taylor_eval_jet(n, p, c, h, w, ynew, dy)
+        integer, intent(in) :: n, p
+        real(dp), intent(in) :: c(0:p, n), h
+        real(dp), intent(inout) :: w(0:p, n)
+        real(dp), intent(out) :: ynew(n), dy(n)
+        integer :: i
+        call taylor_eval_step(n, p, c, h, ynew, dy)
+        do i = 1, n
+            w(0, i) = ynew(i)
+        end do
+    end subroutine taylor_eval_jet
+
+    !> taylor_check (err) on the expansion about the step's end, w(0, :) = P(h) and
+    !! w(1, :) = f(t + h, P(h)); finite: f there is finite (the next step's precondition), found in
+    !! the same pass.
+    pure subroutine taylor_check_jet(n, p, h, w, dy, e, err, finite)
+        integer, intent(in) :: n, p
+        real(dp), intent(in) :: h, w(0:p, n), dy(n), e(n)
+        real(dp), intent(out) :: err
+        logical, intent(out) :: finite
+        real(dp) :: c, d
+        integer :: i
+        real(dp) :: z
+        c = 16.0_dp*epsilon(1.0_dp)
+        err = 0.0_dp
+        z = 0.0_dp
+        do i = 1, n
+            d = abs(h*(dy(i) - w(1, i)))
+            err = max(err, d/(e(i) + c*(abs(w(0, i)) + abs(h*dy(i)))))
+            z = z + 0.0_dp*w(1, i)          ! NaN once an f_i is Inf or NaN (IEEE: 0 Inf)
+        end do
+        finite = z == z
+        err = err/real(p + 1, dp)
+    end subroutine taylor_check_jet
+
+    !> taylor_scales of the state w(0, 1:n) (e) and taylor_rho of the expansion w (rho) in one pass
+    !! over it (the same values, bit for bit). The two radii (1/N_k)^(1/k) of the last two
+    !! coefficients need two logarithms only when their order is not already told by the
+    !! binary exponents of N_k: ln N = (e + ln(f)/ln 2) ln 2 with N = f 2^e, f in [1/2, 1),
+    !! so -ln(N_k)/k lies in an interval of width ln 2/k known from e alone; the radius whose
+    !! interval lies entirely below the other's is the minimum, and its logarithm alone is
+    !! taken. Then one exponential.
+    pure subroutine taylor_next_rho(n, nb, p, w, rtol, atol, eps, decay, e, rho)
+        integer, intent(in) :: n, nb, p
+        real(dp), intent(in) :: w(0:p, n), rtol(n), atol(n), eps, decay
+        real(dp), intent(out) :: e(n), rho
+        real(dp) :: y1, y2, s1, s2, l, a1, a2
+        integer :: i, e1, e2
+        y1 = 0.0_dp
+        do i = 1, nb
+            y1 = max(y1, abs(w(0, i)))
+        end do
+        s1 = 0.0_dp
+        s2 = 0.0_dp
+        do i = 1, nb
+            e(i) = max(atol(i), rtol(i)*y1, tiny(1.0_dp))
+            s1 = max(s1, abs(w(p - 1, i))/e(i))
+            s2 = max(s2, abs(w(p, i))/e(i))
+        end do
+        if (n > nb) then
+            y2 = 0.0_dp
+            do i = nb + 1, n
+                y2 = max(y2, abs(w(0, i)))
+            end do
+            do i = nb + 1, n
+                e(i) = max(atol(i), rtol(i)*y2, tiny(1.0_dp))
+                s1 = max(s1, abs(w(p - 1, i))/e(i))
+                s2 = max(s2, abs(w(p, i))/e(i))
+            end do
+        end if
+        l = huge(1.0_dp)
+        a1 = s1*eps
+        a2 = s2*eps
+        e1 = binary_exponent(a1)
+        e2 = binary_exponent(a2)
+        if (s1 > 0.0_dp .and. s2 > 0.0_dp .and. e1 /= NOT_NORMAL .and. e2 /= NOT_NORMAL) then
+            ! l1 = -ln(a1)/(p - 1) in (-e1, -(e1 - 1)] ln 2/(p - 1), l2 likewise over p
+            if ((e1 - 1)*p > e2*(p - 1)) then
+                l = -log(a1)/real(p - 1, dp)             ! l1 < l2 for sure
+            else if ((e2 - 1)*(p - 1) > e1*p) then
+                l = -log(a2)/real(p, dp)                 ! l2 < l1 for sure
+            else
+                l = min(-log(a1)/real(p - 1, dp), -log(a2)/real(p, dp))
+            end if
+        else
+            if (s1 > 0.0_dp) l = -log(a1)/real(p - 1, dp)
+            if (s2 > 0.0_dp) l = min(l, -log(a2)/real(p, dp))
+        end if
+        rho = huge(1.0_dp)
+        if (l < LOG_HUGE) rho = exp(l)*decay
+    end subroutine taylor_next_rho
+
+    !> e with a = f 2^e, f in [1/2, 1), for a positive normal finite a (from the bits, as
+    !! the intrinsic exponent() gives it); NOT_NORMAL for zero, subnormal, Inf or NaN.
+    pure integer function binary_exponent(a) result(ex)
+        real(dp), intent(in) :: a
+        integer(int64) :: bits
+        bits = ishft(transfer(a, 0_int64), -52)       ! sign and biased exponent
+        ex = NOT_NORMAL
+        if (bits >= 1 .and. bits <= 2046) ex = int(bits) - 1022
+    end function binary_exponent
 
     !> The safety-check ratio of a step: f1 = f(t + h, ynew) from the next expansion, e the
     !! scales at the step's start (a rounding floor of 16 eps |y| is added).

@@ -32,8 +32,8 @@ module conmech_taylor_stepper
     use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_taylor_events, only: taylor_events, limit_step
-    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_rho, &
-        taylor_eval_step, taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
+    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_add_time, &
+        taylor_shrink, TAYLOR_CHECK_MAX, taylor_eval_jet, taylor_check_jet, taylor_next_rho
     implicit none
     private
 
@@ -54,9 +54,13 @@ module conmech_taylor_stepper
         real(dp) :: decay = 0.0_dp        !! exp(-2 - 0.7/(p - 1)), Jorba and Zou's factor
         real(dp) :: err = 0.0_dp          !! safety-check ratio of the last accepted step
         integer :: nsteps = 0, max_steps = 100000
+        logical :: finite = .false.       !! f at the current point finite
         real(dp), allocatable :: rtol(:), atol(:), dy(:), ynew(:), e(:)
-        real(dp), allocatable :: jet(:, :)    !! (0:p, nw) expansion at (t, y)
-        real(dp), allocatable :: jold(:, :)   !! (0:p, nw) expansion at (t_old, y_old)
+        !> (0:p, nw, 2): the expansion at (t, y) is jets(:, :, ic), the one at (t_old,
+        !! y_old) (the last step's polynomial, and the next step's work array) the other;
+        !! an accepted step swaps them by flipping ic (no copy)
+        real(dp), allocatable :: jets(:, :, :)
+        integer :: ic = 1
         !> compiled events: steps are shortened so that none holds two roots of one event
         class(taylor_events), pointer :: ev => null()
     contains
@@ -108,8 +112,8 @@ contains
         self%nsteps = 0
         self%err = 0.0_dp
         self%nw = 0
-        if (allocated(self%jet)) deallocate (self%jet)
-        if (allocated(self%jold)) deallocate (self%jold)
+        self%finite = .false.
+        if (allocated(self%jets)) deallocate (self%jets)
         if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
         allocate (self%dy(n), self%ynew(n), self%e(n))
     end subroutine taylor_init
@@ -173,11 +177,11 @@ contains
             end if
             return
         end if
-        if (allocated(self%jet)) deallocate (self%jet, self%jold)
-        allocate (self%jet(0:self%order, self%nw), self%jold(0:self%order, self%nw))
-        self%jet = 0.0_dp
-        self%jold = 0.0_dp
-        call expand(self, sys, self%jet, self%t, self%y)
+        if (allocated(self%jets)) deallocate (self%jets)
+        allocate (self%jets(0:self%order, self%nw, 2))
+        self%jets = 0.0_dp
+        self%ic = 1
+        call expand(self, sys, self%jets(:, :, 1), self%t, self%y)
         if (.not. self%f_finite()) then
             info = CM_NONFINITE
             msg = "the right-hand side is not finite at the initial point"
@@ -187,26 +191,37 @@ contains
         if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
     end subroutine taylor_start
 
+    !> The expansion w at (t, y) (y copied into its zeroth coefficients), and whether f there
+    !! is finite.
     subroutine expand(self, sys, w, t, y)
         class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
         real(dp), intent(inout) :: w(0:self%order, self%nw)
         real(dp), intent(in) :: t, y(self%n)
+        integer :: i
         w(0, 1:self%n) = y
         call sys%taylor_jet(self%kind, t, self%order, self%nw, w)
         self%st%nfev = self%st%nfev + 1
+        self%finite = .true.
+        do i = 1, self%n
+            if (.not. abs(w(1, i)) <= huge(1.0_dp)) self%finite = .false.
+        end do
     end subroutine expand
 
     !> Jorba and Zou's step from the current expansion (signed, at most hmax); the scales
     !! E_i at the current point are kept for the step's safety check.
     subroutine propose(self)
         class(taylor_stepper), intent(inout) :: self
-        call taylor_scales(self%n, self%nblock, self%y, self%rtol, self%atol, self%e)
-        self%h = min(taylor_rho(self%n, self%order, self%jet, self%e, self%eps, self%decay), &
-                     self%hmax)*self%posneg
+        real(dp) :: rho
+        call taylor_next_rho(self%n, self%nblock, self%order, self%jets(:, :, self%ic), &
+                             self%rtol, self%atol, self%eps, self%decay, self%e, rho)
+        self%h = min(rho, self%hmax)*self%posneg
     end subroutine propose
 
-    !> One accepted step towards `target` (landing on it if the step would pass it).
+    !> One accepted step towards `target` (landing on it if the step would pass it). The
+    !! candidate state is written by Horner straight into the other expansion's zeroth
+    !! coefficients, the system expands there in place, and an accepted step makes that
+    !! expansion the current one by flipping ic.
     subroutine taylor_step(self, sys, target, info, msg)
         class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
@@ -214,12 +229,15 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         real(dp) :: h, err, d
-        integer :: p
+        integer :: p, n, ic, io
+        logical :: fin
         character(len=32) :: buf
-        real(dp), allocatable :: tmp(:, :)
         ! msg is set on failure only (as the Runge-Kutta steppers): no allocation per step
         info = CM_SUCCESS
         p = self%order
+        n = self%n
+        ic = self%ic
+        io = 3 - ic
         h = self%h
         self%last = .false.
         do
@@ -242,14 +260,15 @@ contains
             end if
             if (associated(self%ev)) then
                 d = h
-                call limit_step(self%ev, self%t, p, self%jet, h)
+                call limit_step(self%ev, self%t, p, self%jets(:, :, ic), h)
                 if (h /= d) self%hit = .false.
             end if
             self%nsteps = self%nsteps + 1
-            call taylor_eval_step(self%n, p, self%jet, h, self%ynew, self%dy)
-            call expand(self, sys, self%jold, self%t + h, self%ynew)
-            err = taylor_check(self%n, p, h, self%ynew, self%dy, self%jold(1, 1:self%n), &
-                               self%e)
+            call taylor_eval_jet(n, p, self%jets(:, :, ic), h, self%jets(:, :, io), self%ynew, &
+                                 self%dy)
+            call sys%taylor_jet(self%kind, self%t + h, p, self%nw, self%jets(:, :, io))
+            self%st%nfev = self%st%nfev + 1
+            call taylor_check_jet(n, p, h, self%jets(:, :, io), self%dy, self%e, err, fin)
             if (err <= TAYLOR_CHECK_MAX) exit
             ! rejected (or not finite): a shorter step from the same expansion
             self%st%nreject = self%st%nreject + 1
@@ -257,20 +276,19 @@ contains
         end do
         ! accept: the new expansion becomes the current one, the old the step's polynomial
         self%err = err
-        call move_alloc(self%jet, tmp)
-        call move_alloc(self%jold, self%jet)
-        call move_alloc(tmp, self%jold)
+        self%finite = fin
+        self%ic = io
         self%st%naccept = self%st%naccept + 1
         self%t_old = self%t
         ! sections, not whole allocatables: no reallocation check per step
-        self%y_old(1:self%n) = self%y(1:self%n)
+        self%y_old(1:n) = self%y(1:n)
         if (self%hit) then
             self%t = target
             self%t_lo = 0.0_dp
         else
             call taylor_add_time(self%t, self%t_lo, h)
         end if
-        self%y(1:self%n) = self%ynew(1:self%n)
+        self%y(1:n) = self%jets(0, 1:n, io)
         self%h_done = h
         self%dense_ready = .false.
         self%last = self%hit .and. target == self%tf
@@ -287,7 +305,7 @@ contains
         integer :: k
         hk = 1.0_dp
         do k = 0, self%order
-            self%fc(:, k) = self%jold(k, 1:self%n)*hk
+            self%fc(:, k) = self%jets(k, 1:self%n, 3 - self%ic)*hk
             hk = hk*self%h_done
         end do
         self%dense_ready = .true.
@@ -302,11 +320,13 @@ contains
         character(len=:), allocatable, intent(inout), optional :: msg
         real(dp) :: s
         integer :: i, k
+        integer :: io
         s = tt - self%t_old
+        io = 3 - self%ic
         do i = 1, self%n
-            yout(i) = self%jold(self%order, i)
+            yout(i) = self%jets(self%order, i, io)
             do k = self%order - 1, 0, -1
-                yout(i) = self%jold(k, i) + s*yout(i)
+                yout(i) = self%jets(k, i, io) + s*yout(i)
             end do
         end do
         if (present(info)) info = CM_SUCCESS
@@ -326,21 +346,17 @@ contains
     subroutine taylor_refresh(self, sys)
         class(taylor_stepper), intent(inout) :: self
         class(ode_system), intent(in) :: sys
-        call expand(self, sys, self%jet, self%t, self%y)
+        call expand(self, sys, self%jets(:, :, self%ic), self%t, self%y)
         call propose(self)
         self%f_stale = .false.
     end subroutine taylor_refresh
 
-    !> f at the current point finite (comparisons: the module does not use ieee_arithmetic,
-    !! whose procedures save and restore the floating-point state on every call).
+    !> f at the current point finite (found by the expansion's own pass over it:
+    !! comparisons, no ieee_arithmetic, whose procedures save and restore the
+    !! floating-point state on every call).
     logical function taylor_f_finite(self)
         class(taylor_stepper), intent(in) :: self
-        integer :: i
-        taylor_f_finite = allocated(self%jet)
-        if (.not. taylor_f_finite) return
-        do i = 1, self%n
-            if (.not. abs(self%jet(1, i)) <= huge(1.0_dp)) taylor_f_finite = .false.
-        end do
+        taylor_f_finite = allocated(self%jets) .and. self%finite
     end function taylor_f_finite
 
     !> The whole state, for step-by-step use (the state parts of both expansions; the
@@ -373,19 +389,21 @@ contains
             allocate (a(self%n, 0:self%order), b(self%n, 0:self%order))
             a = 0.0_dp
             b = 0.0_dp
-            if (allocated(self%jet)) a(:, :) = transpose(self%jet(:, 1:self%n))
-            if (allocated(self%jold)) b(:, :) = transpose(self%jold(:, 1:self%n))
+            if (allocated(self%jets)) then
+                a(:, :) = transpose(self%jets(:, 1:self%n, self%ic))
+                b(:, :) = transpose(self%jets(:, 1:self%n, 3 - self%ic))
+            end if
         end if
         call p%columns(a, 0, self%order)
         call p%columns(b, 0, self%order)
         if (p%reading()) then
-            if (allocated(self%jet)) deallocate (self%jet, self%jold)
-            allocate (self%jet(0:self%order, max(self%nw, self%n)), &
-                      self%jold(0:self%order, max(self%nw, self%n)))
-            self%jet = 0.0_dp
-            self%jold = 0.0_dp
-            if (allocated(a)) self%jet(:, 1:self%n) = transpose(a)
-            if (allocated(b)) self%jold(:, 1:self%n) = transpose(b)
+            if (allocated(self%jets)) deallocate (self%jets)
+            allocate (self%jets(0:self%order, max(self%nw, self%n), 2))
+            self%jets = 0.0_dp
+            self%ic = 1
+            if (allocated(a)) self%jets(:, 1:self%n, 1) = transpose(a)
+            if (allocated(b)) self%jets(:, 1:self%n, 2) = transpose(b)
+            self%finite = all(abs(self%jets(1, 1:self%n, 1)) <= huge(1.0_dp))
             if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
             allocate (self%dy(self%n), self%ynew(self%n), self%e(self%n))
             self%dy = 0.0_dp

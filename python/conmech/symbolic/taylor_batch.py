@@ -35,7 +35,7 @@ import re
 from .._core.lanes import LANES     # the lane counts a batch library can be built with
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 3
+VERSION = 4
 
 __all__ = ["machine_lanes", "isa_flags", "coefficient_routine", "run_routine", "LANES"]
 
@@ -262,7 +262,11 @@ _RUN = """\
         real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
         real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
         real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
+        real(dp) :: a1, a2
+        integer, parameter :: i8 = selected_int_kind(18)
+        integer(i8) :: b1, b2
         integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
+        integer :: e1, e2
         integer :: cu, nu
         logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
         t0 = span(1)
@@ -450,9 +454,28 @@ _RUN = """\
                     cycle
                 end if
                 if (done(l) /= {run}) cycle
+                ! one logarithm where the binary exponents of the two norms already tell
+                ! the smaller radius (conmech_taylor_core's taylor_next_rho: the same value)
                 lg = huge(1.0_dp)
-                if (s1(l) > 0.0_dp) lg = -log(s1(l)*eps)/real(ord - 1, dp)
-                if (s2(l) > 0.0_dp) lg = min(lg, -log(s2(l)*eps)/real(ord, dp))
+                a1 = s1(l)*eps
+                a2 = s2(l)*eps
+                b1 = ishft(transfer(a1, 0_i8), -52)
+                b2 = ishft(transfer(a2, 0_i8), -52)
+                if (s1(l) > 0.0_dp .and. s2(l) > 0.0_dp .and. b1 >= 1 .and. b1 <= 2046 &
+                    .and. b2 >= 1 .and. b2 <= 2046) then
+                    e1 = int(b1) - 1022
+                    e2 = int(b2) - 1022
+                    if ((e1 - 1)*ord > e2*(ord - 1)) then
+                        lg = -log(a1)/real(ord - 1, dp)
+                    else if ((e2 - 1)*(ord - 1) > e1*ord) then
+                        lg = -log(a2)/real(ord, dp)
+                    else
+                        lg = min(-log(a1)/real(ord - 1, dp), -log(a2)/real(ord, dp))
+                    end if
+                else
+                    if (s1(l) > 0.0_dp) lg = -log(a1)/real(ord - 1, dp)
+                    if (s2(l) > 0.0_dp) lg = min(lg, -log(a2)/real(ord, dp))
+                end if
                 rho = huge(1.0_dp)
                 if (lg < log(huge(1.0_dp))) rho = exp(lg)*decay
                 h(l) = min(rho, hm)*posneg
