@@ -1,11 +1,10 @@
 !> Support of the flat f2py layer for the integrators (compiled into the extension, not
 !! wrapped by f2py: it holds derived types).
 !!
-!! `callback_system` and `callback_events` adapt external procedures with an implicit
-!! interface (in practice f2py callbacks into Python) to conmech's `ode_system` and
-!! `ode_events`; `run_solve` runs `ode_solve` from plain arguments and hands the whole
-!! result to a `store` procedure, so that output sizes need not be known in advance and
-!! nothing is saved between calls (thread-safe).
+!! `callback_system` and `callback_events` (from conmech_flat_callbacks, re-exported) adapt
+!! f2py callbacks into Python to conmech's `ode_system` and `ode_events`; `run_solve` runs
+!! `ode_solve` from plain arguments and hands the whole result to a `store` procedure,
+!! so that output sizes need not be known in advance and nothing is saved between calls (thread-safe).
 !!
 !! Calling conventions of the external procedures (all arguments by reference):
 !!
@@ -23,6 +22,8 @@ module conmech_flat_ode_support
         ode_stepper
     use conmech_ode_methods, only: new_stepper
     use conmech_radau_stepper, only: radau_stepper
+    use conmech_flat_callbacks, only: callback_system, callback_jac_system, &
+                                      callback_events
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
@@ -33,61 +34,7 @@ module conmech_flat_ode_support
     !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
     integer(c_int), parameter, public :: METHOD_RK45_SCIPY = 12
 
-    !> A system whose right-hand side is an external procedure fun(t, y, dydt, n).
-    type, extends(ode_system) :: callback_system
-        procedure(), pointer, nopass :: f => null()
-        integer(c_int) :: n = 0
-    contains
-        procedure :: rhs => callback_rhs
-    end type callback_system
-
-    !> A system with its exact Jacobian from an external procedure jac(t, y, dfdy, n).
-    type, extends(callback_system) :: callback_jac_system
-        procedure(), pointer, nopass :: jac => null()
-    contains
-        procedure :: jacobian => callback_jacobian
-        procedure :: has_jacobian => callback_has_jacobian
-    end type callback_jac_system
-
-    !> Event functions given by one external procedure events(t, y, g, n, ne).
-    type, extends(ode_events) :: callback_events
-        procedure(), pointer, nopass :: g => null()
-        integer(c_int) :: n = 0
-        integer(c_int) :: ne = 0
-    contains
-        procedure :: eval => callback_eval
-    end type callback_events
-
 contains
-
-    subroutine callback_rhs(self, t, y, dydt)
-        class(callback_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        call self%f(t, y, dydt, self%n)
-    end subroutine callback_rhs
-
-    subroutine callback_jacobian(self, t, y, dfdy)
-        class(callback_jac_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        call self%jac(t, y, dfdy, self%n)
-    end subroutine callback_jacobian
-
-    logical function callback_has_jacobian(self)
-        class(callback_jac_system), intent(in) :: self
-        callback_has_jacobian = associated(self%jac)
-    end function callback_has_jacobian
-
-    subroutine callback_eval(self, t, y, g)
-        class(callback_events), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: g(:)
-        call self%g(t, y, g, self%n, self%ne)
-    end subroutine callback_eval
 
     !> Copy a message into a fixed-length output (truncated, blank padded).
     subroutine copy_message(src, dst)

@@ -28,11 +28,10 @@ module conmech_flat_system
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system
-    use conmech_flat_ode_support, only: callback_system, callback_jac_system
+    use conmech_flat_callbacks, only: callback_system, callback_jac_system
     use conmech_flat_spec, only: spec_kind, KIND_BUILTIN
     use conmech_param_system, only: builtin_param_system, make_param_system, &
                                     make_compiled_param_system
-    use conmech_support_cont, only: callback_param_system, callback_param_jac_system
     implicit none
     private
     public :: flat_system, flat_param_system, SOURCE_SPEC, SOURCE_FUN, SOURCE_FUN_JAC
@@ -119,18 +118,20 @@ contains
             end block
         case (SOURCE_FUN)
             block
-                type(callback_param_system) :: s
+                type(callback_system) :: s
                 s%f => fun
                 s%n = n
+                s%parametric = .true.
                 s%p = p0
                 allocate (sys, source=s)
             end block
         case (SOURCE_FUN_JAC)
             block
-                type(callback_param_jac_system) :: s
+                type(callback_jac_system) :: s
                 s%f => fun
-                s%jf => jfun
+                s%jac => jfun
                 s%n = n
+                s%parametric = .true.
                 s%p = p0
                 allocate (sys, source=s)
             end block

@@ -23,6 +23,7 @@ module conmech_support_control
     use conmech_status
     use conmech_generalized, only: generalized_system
     use conmech_flat_spec, only: spec_generalized
+    use conmech_flat_callbacks, only: callback_law
     use conmech_control_system, only: feedback_law
     use conmech_mech_plant, only: mech_plant
     use conmech_vhc, only: vhc, vhc_law
@@ -31,14 +32,6 @@ module conmech_support_control
     private
     public :: callback_law, c_law, zero_law, build_plant, build_vhc, build_law, law_rsize
     public :: project_states, build_plant_law
-
-    !> u from an external procedure law(t, x, u, n, m).
-    type, extends(feedback_law) :: callback_law
-        procedure(), pointer, nopass :: f => null()
-        integer(c_int) :: n = 0
-    contains
-        procedure :: eval => cb_eval
-    end type callback_law
 
     abstract interface
         subroutine c_law_fun(t, x, u, p) bind(c)
@@ -64,18 +57,6 @@ module conmech_support_control
     end type zero_law
 
 contains
-
-    subroutine cb_eval(self, t, x, u)
-        class(callback_law), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: x(:)
-        real(dp), intent(out) :: u(:)
-        real(c_double) :: tt, xx(size(x)), uu(size(u))
-        tt = t
-        xx = x
-        call self%f(tt, xx, uu, self%n, int(self%n_inputs, c_int))
-        u = uu
-    end subroutine cb_eval
 
     subroutine c_eval(self, t, x, u)
         class(c_law), intent(in) :: self
