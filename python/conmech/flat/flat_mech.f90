@@ -88,7 +88,7 @@ subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces,
     use conmech_constrained_system, only: constrained_system
     use conmech_flat_spec, only: spec_constrained
     use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_callbacks, only: callback_constrained
+    use conmech_flat_adapters, only: callback_constrained
     use conmech_flat_mech_support, only: run_constrained
     implicit none
     include "flat_spec_args.inc"

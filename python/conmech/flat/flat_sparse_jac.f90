@@ -15,7 +15,7 @@ subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, metho
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
     use conmech_flat_ode_support, only: run_solve, copy_message
-    use conmech_flat_callbacks, only: callback_sparse_jac_system, &
+    use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
     implicit none
     integer(c_int), intent(in) :: n
@@ -59,7 +59,7 @@ subroutine flat_stepper_sparse_jac(fun, jvals, action, n, nr, ni, nw, t0, t_boun
     use conmech_status, only: CM_SUCCESS
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_stepper_support, only: stepper_action
-    use conmech_flat_callbacks, only: callback_sparse_jac_system, &
+    use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
     implicit none
     integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps

@@ -30,7 +30,7 @@ subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y
                                  jac_const, nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, &
                                  message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_callbacks, only: callback_jac_system
+    use conmech_flat_adapters, only: callback_jac_system
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
     integer(c_int), intent(in) :: action, n, nr, ni, nw, method, has_jac, max_steps

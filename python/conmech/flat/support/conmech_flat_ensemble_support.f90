@@ -2,7 +2,7 @@
 !!
 !! `builtin_members` gives member i the built-in system `name` (or the compiled system of
 !! `spec`, conmech_flat_spec) with the parameters of column i of a table;
-!! `callback_progress` (conmech_flat_callbacks, re-exported) relays the ensemble's progress
+!! `callback_progress` (conmech_flat_adapters, re-exported) relays the ensemble's progress
 !! reports to a Python progress(done, total, cancel).
 module conmech_flat_ensemble_support
     use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
@@ -10,7 +10,7 @@ module conmech_flat_ensemble_support
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system
     use conmech_ensemble, only: ensemble_members
-    use conmech_flat_callbacks, only: callback_progress
+    use conmech_flat_adapters, only: callback_progress
     implicit none
     private
     public :: builtin_members, callback_progress

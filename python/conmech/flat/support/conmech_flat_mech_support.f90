@@ -1,7 +1,7 @@
 !> Support of the flat f2py layer for constrained mechanical systems (compiled into the
 !! extension, not wrapped: it holds derived types).
 !!
-!! `callback_constrained` (conmech_flat_callbacks, re-exported) adapts f2py callbacks into
+!! `callback_constrained` (conmech_flat_adapters, re-exported) adapts f2py callbacks into
 !! Python to `constrained_system`; `run_constrained` runs `constrained_solve` from plain arguments
 !! and hands the whole result to a `store` procedure. Calling conventions (by reference):
 !!
@@ -25,7 +25,7 @@ module conmech_flat_mech_support
     use conmech_constrained_solver
     use conmech_ode_system, only: ode_events
     use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_callbacks, only: callback_constrained, callback_events
+    use conmech_flat_adapters, only: callback_constrained, callback_events
     implicit none
     private
     public :: callback_constrained, run_constrained

@@ -1,7 +1,7 @@
 !> Support of the flat f2py layer for the integrators (compiled into the extension, not
 !! wrapped by f2py: it holds derived types).
 !!
-!! `callback_system` and `callback_events` (from conmech_flat_callbacks, re-exported) adapt
+!! `callback_system` and `callback_events` (from conmech_flat_adapters, re-exported) adapt
 !! f2py callbacks into Python to conmech's `ode_system` and `ode_events`; `run_solve` runs
 !! `ode_solve` from plain arguments and hands the whole result to a `store` procedure,
 !! so that output sizes need not be known in advance and nothing is saved between calls (thread-safe).
@@ -22,7 +22,7 @@ module conmech_flat_ode_support
         ode_stepper
     use conmech_ode_methods, only: new_stepper
     use conmech_radau_stepper, only: radau_stepper
-    use conmech_flat_callbacks, only: callback_system, callback_jac_system, &
+    use conmech_flat_adapters, only: callback_system, callback_jac_system, &
                                       callback_events
     implicit none
     private

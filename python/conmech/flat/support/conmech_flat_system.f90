@@ -28,7 +28,7 @@ module conmech_flat_system
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system
-    use conmech_flat_callbacks, only: callback_system, callback_jac_system
+    use conmech_flat_adapters, only: callback_system, callback_jac_system
     use conmech_flat_spec, only: spec_kind, KIND_BUILTIN
     use conmech_param_system, only: builtin_param_system, make_param_system, &
                                     make_compiled_param_system

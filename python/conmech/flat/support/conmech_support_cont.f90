@@ -8,7 +8,7 @@ module conmech_support_cont
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_flat_callbacks, only: callback_system, callback_energy
+    use conmech_flat_adapters, only: callback_system, callback_energy
     use conmech_param_system, only: builtin_param_system, set_builtin_param
     use conmech_shooting, only: set_parameter_proc
     use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &

@@ -5,7 +5,7 @@ module conmech_support_stab
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
-    use conmech_flat_callbacks, only: callback_hill
+    use conmech_flat_adapters, only: callback_hill
     use conmech_ode_solver, only: ode_options
     use conmech_variational, only: integrate_stm
     implicit none

@@ -1,6 +1,6 @@
 !> Support of the flat layer for the general transverse linearisation (compiled, not
 !! wrapped): the system and its transverse model from a built-in name or a compiled spec,
-!! the model with a Python energy gradient (conmech_flat_callbacks, re-exported), and the packing of a `transverse_frame` into the
+!! the model with a Python energy gradient (conmech_flat_adapters, re-exported), and the packing of a `transverse_frame` into the
 !! flat routine's output arrays.
 !!
 !! Callback convention: egrad(t, y, g, n), real(c_double) t, y(n), g(n); integer(c_int) n.
@@ -19,7 +19,7 @@ module conmech_support_transverse_general
     use conmech_systems_basic, only: kepler_2d
     use conmech_transverse_mech, only: generalized_model, constrained_model, constrained_index1
     use conmech_transverse_general, only: transverse_frame, transverse_eval, transverse_hill
-    use conmech_flat_callbacks, only: callback_energy_model
+    use conmech_flat_adapters, only: callback_energy_model
     implicit none
     private
     public :: callback_energy_model, system_and_model, pack_frame

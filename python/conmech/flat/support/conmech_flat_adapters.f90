@@ -1,14 +1,15 @@
-!> The callback adapters of the flat f2py layer, in one place (compiled into the extension,
-!! not wrapped: it holds derived types).
+!> The adapters of the flat f2py layer to conmech's abstract contracts, in one place
+!! (compiled into the extension, not wrapped: it holds derived types).
 !!
-!! Each type extends one of conmech's abstract contracts (`ode_system`, `ode_events`,
+!! Each type extends one of the contracts (`ode_system`, `ode_events`,
 !! `sparse_jacobian_system`, `constrained_system`, `feedback_law`, `periodic_lq`,
-!! `branch_energy`, `planar_natural_system`, `transverse_model`, `ensemble_progress`) and
-!! forwards its deferred bindings to external procedures with an
-!! implicit interface: in practice f2py call-backs into Python, set as procedure-pointer
-!! components by the flat routines. One adapter per contract, so that a flat routine of any
-!! topic reuses the same forwarding code. Calling conventions (all arguments by reference;
-!! real(c_double) values, integer(c_int) sizes):
+!! `branch_energy`, `planar_natural_system`, `transverse_model`, `ensemble_progress`). Most
+!! forward the deferred bindings to external procedures with an implicit interface (f2py
+!! call-backs into Python, set as procedure-pointer components by the flat routines); the
+!! rest are the few fixed implementations the flat routines need (a compiled or zero
+!! feedback law, the reduced dynamics' event functions). One adapter per need, so that a
+!! flat routine of any topic reuses the same forwarding code. Calling conventions (all
+!! arguments by reference; real(c_double) values, integer(c_int) sizes):
 !!
 !!     fun(t, y, dydt, n)  or  fun(t, y, p, dydt, n)       callback_system (parametric: p)
 !!     jac(t, y, dfdy, n)  or  jac(t, y, p, dfdy, n)       callback_jac_system
@@ -24,8 +25,10 @@
 !!     pot(q, v, g, h)                                     callback_natural
 !!     egrad(t, y, g, n)                                   callback_energy_model
 !!     progress(done, total, cancel)                       callback_progress
-module conmech_flat_callbacks
-    use, intrinsic :: iso_c_binding, only: c_double, c_int
+!!     void law(double t, const double *x, double *u, const double *p)  c_law (compiled)
+module conmech_flat_adapters
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_funptr, c_null_funptr, &
+                                           c_f_procpointer
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NONFINITE
     use conmech_lapack, only: la_finite
@@ -45,6 +48,7 @@ module conmech_flat_callbacks
     public :: callback_sparse_jac_system, make_sparse_jac_system
     public :: callback_constrained, callback_law, callback_lq, callback_energy, callback_hill
     public :: callback_natural, callback_energy_model, callback_progress
+    public :: c_law, zero_law, velocity_zero, energy_zero
 
     !> A system whose right-hand side is an external fun(t, y, dydt, n), or, when
     !! `parametric`, fun(t, y, p, dydt, n) at the parameter value p (continuation sets p).
@@ -167,6 +171,41 @@ module conmech_flat_callbacks
     contains
         procedure :: report => progress_report
     end type callback_progress
+
+    abstract interface
+        subroutine c_law_fun(t, x, u, p) bind(c)
+            import :: c_double
+            real(c_double), value :: t
+            real(c_double), intent(in) :: x(*), p(*)
+            real(c_double), intent(out) :: u(*)
+        end subroutine c_law_fun
+    end interface
+
+    !> u from a compiled function with parameters.
+    type, extends(feedback_law) :: c_law
+        type(c_funptr) :: fp = c_null_funptr
+        real(dp), allocatable :: p(:)
+    contains
+        procedure :: eval => c_eval
+    end type c_law
+
+    !> u = 0.
+    type, extends(feedback_law) :: zero_law
+    contains
+        procedure :: eval => z_eval
+    end type zero_law
+
+    !> g = theta' (the second component).
+    type, extends(ode_events) :: velocity_zero
+    contains
+        procedure :: eval => vz_eval
+    end type velocity_zero
+
+    !> g = E (the first component).
+    type, extends(ode_events) :: energy_zero
+    contains
+        procedure :: eval => ez_eval
+    end type energy_zero
 
 contains
 
@@ -414,4 +453,44 @@ contains
         cancel = c /= 0
     end subroutine progress_report
 
-end module conmech_flat_callbacks
+    subroutine c_eval(self, t, x, u)
+        class(c_law), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: x(:)
+        real(dp), intent(out) :: u(:)
+        procedure(c_law_fun), pointer :: f
+        real(c_double) :: pdum(1)
+        call c_f_procpointer(self%fp, f)
+        if (size(self%p) > 0) then
+            call f(t, x, u, self%p)
+        else
+            pdum = 0.0_c_double
+            call f(t, x, u, pdum)
+        end if
+    end subroutine c_eval
+
+    subroutine z_eval(self, t, x, u)
+        class(zero_law), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: x(:)
+        real(dp), intent(out) :: u(:)
+        u = 0.0_dp
+    end subroutine z_eval
+
+    subroutine vz_eval(self, t, y, g)
+        class(velocity_zero), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: g(:)
+        g(1) = y(2)
+    end subroutine vz_eval
+
+    subroutine ez_eval(self, t, y, g)
+        class(energy_zero), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        real(dp), intent(out) :: g(:)
+        g(1) = y(1)
+    end subroutine ez_eval
+
+end module conmech_flat_adapters
