@@ -316,7 +316,7 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
                                 dists, nfail, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_mech_plant, only: mech_plant
     use conmech_control_system, only: feedback_law
     use conmech_support_control, only: build_plant_law, project_states
