@@ -27,7 +27,7 @@ module conmech_flat_ode_support
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
-    public :: solve_into, store_result
+    public :: solve_into, store_result, flat_ode_options
     public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
@@ -42,6 +42,23 @@ contains
         character(len=*), intent(out) :: dst
         dst = src
     end subroutine copy_message
+
+    !> The integration options every flat integrator routine takes from its plain arguments:
+    !! the method code, the tolerances per component, the first and largest step (0: none),
+    !! the step limit and dense output (dense /= 0). SciPy's RK45 code is left to the caller.
+    function flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense) &
+        result(opt)
+        integer(c_int), intent(in) :: method, max_steps, dense
+        real(c_double), intent(in) :: rtol(:), atol(:), first_step, max_step
+        type(ode_options) :: opt
+        opt%method = method
+        opt%rtol_vec = rtol
+        opt%atol_vec = atol
+        opt%first_step = first_step
+        opt%max_step = max_step
+        opt%max_steps = max_steps
+        opt%dense_output = dense /= 0
+    end function flat_ode_options
 
     !> What the caller knows of df/dy, on a fresh stepper of a method that uses it (Radau):
     !! constant (jac_const /= 0: read once, never re-evaluated, not counted in njev), and
@@ -127,17 +144,11 @@ contains
             call copy_message("bad input: array sizes must be positive", message)
             return
         end if
-        opt%method = method
+        opt = flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense)
         if (method == METHOD_RK45_SCIPY) then
             opt%method = METHOD_DOPRI5
             opt%beta = 0.0_dp
         end if
-        opt%rtol_vec = rtol
-        opt%atol_vec = atol
-        opt%first_step = first_step
-        opt%max_step = max_step
-        opt%max_steps = max_steps
-        opt%dense_output = dense /= 0
         call new_stepper(opt%method, stp, sinfo, msg)
         if (sinfo == CM_SUCCESS) call set_jacobian_structure(stp, n, jac_const, nnz, sp_ptr, &
                                                              sp_idx, sinfo, msg)
