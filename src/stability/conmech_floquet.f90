@@ -89,7 +89,6 @@ contains
         real(dp), intent(in), optional :: tol
         integer :: n, i
         real(dp) :: tl
-        complex(dp) :: mu
         tl = 1.0e-6_dp
         if (present(tol)) tl = tol
         n = size(m, 1)
@@ -106,18 +105,7 @@ contains
         end do
         res%abs_mult = sqrt(res%mr**2 + res%mi**2)
         res%det = 1.0_dp
-        mu = (1.0_dp, 0.0_dp)
-        do i = 1, n
-            mu = mu*cmplx(res%mr(i), res%mi(i), dp)
-            if (res%abs_mult(i) > 0.0_dp) then
-                res%exponents(i) = log(cmplx(res%mr(i), res%mi(i), dp))/t_period
-            else
-                res%exponents(i) = cmplx(-huge(1.0_dp), 0.0_dp, dp)
-            end if
-        end do
-        res%det = real(mu, dp)
-        res%max_abs = maxval(res%abs_mult)
-        res%stable = res%max_abs <= 1.0_dp + tl
+        call exponents_and_det(res, t_period, tl)
     end subroutine floquet_analysis
 
     !> The floquet_result of multipliers computed from the factors of the monodromy
@@ -130,7 +118,6 @@ contains
         real(dp), intent(in) :: t_period
         type(floquet_result), intent(out) :: res
         integer :: n, i
-        complex(dp) :: mu
         res%info = ms%info
         if (ms%info /= CM_SUCCESS .or. .not. allocated(ms%mr)) return
         n = size(ms%mr)
@@ -142,8 +129,19 @@ contains
         do i = 1, min(n, size(m, 1), size(m, 2))
             res%trace = res%trace + m(i, i)
         end do
+        call exponents_and_det(res, t_period, unit_circle_tolerance(ms, 1.0e-6_dp))
+    end subroutine floquet_from_multipliers
+
+    !> From the multipliers mr + i mi (and |mu|, already in res) of a period t_period: the
+    !! Floquet exponents log(mu)/T (-huge for mu = 0 or T <= 0), det M as their product,
+    !! max |mu| and stability (max |mu| <= 1 + tol).
+    subroutine exponents_and_det(res, t_period, tol)
+        type(floquet_result), intent(inout) :: res
+        real(dp), intent(in) :: t_period, tol
+        complex(dp) :: mu
+        integer :: i
         mu = (1.0_dp, 0.0_dp)
-        do i = 1, n
+        do i = 1, size(res%mr)
             mu = mu*cmplx(res%mr(i), res%mi(i), dp)
             if (res%abs_mult(i) > 0.0_dp .and. t_period > 0.0_dp) then
                 res%exponents(i) = log(cmplx(res%mr(i), res%mi(i), dp))/t_period
@@ -153,8 +151,8 @@ contains
         end do
         res%det = real(mu, dp)
         res%max_abs = maxval(res%abs_mult)
-        res%stable = res%max_abs <= 1.0_dp + unit_circle_tolerance(ms, 1.0e-6_dp)
-    end subroutine floquet_from_multipliers
+        res%stable = res%max_abs <= 1.0_dp + tol
+    end subroutine exponents_and_det
 
     !> Trace-based stability index of a planar conservative periodic orbit (4 x 4 monodromy):
     !! S = (trace M - 2)/2; linearly stable iff |S| < 1.
