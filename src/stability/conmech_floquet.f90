@@ -25,7 +25,7 @@ module conmech_floquet
     private
 
     public :: floquet_result, floquet_analysis, planar_stability_index
-    public :: floquet_from_multipliers
+    public :: floquet_from_multipliers, multipliers_2x2
     public :: hill_coefficient_fun, hill_equation, hill_result, hill_solve, hill_solve_samples
     public :: fourier_coefficients, fourier_eval
 
@@ -284,7 +284,7 @@ contains
         real(dp), intent(in), optional :: rtol
         type(ode_options) :: opt
         type(ode_stats) :: st
-        real(dp) :: y(2), phi(2, 2), disc
+        real(dp) :: y(2), phi(2, 2)
         character(len=:), allocatable :: msg
         if (.not. (eq%period > 0.0_dp)) then
             res%info = CM_BAD_INPUT
@@ -305,17 +305,26 @@ contains
         res%half_trace = 0.5_dp*(phi(1, 1) + phi(2, 2))
         res%det = phi(1, 1)*phi(2, 2) - phi(1, 2)*phi(2, 1)
         res%stable = abs(res%half_trace) < 1.0_dp
-        disc = res%half_trace**2 - res%det
-        if (disc >= 0.0_dp) then
-            res%mr = [res%half_trace + sqrt(disc), res%half_trace - sqrt(disc)]
-            res%mi = 0.0_dp
-        else
-            res%mr = res%half_trace
-            res%mi = [sqrt(-disc), -sqrt(-disc)]
-        end if
+        call multipliers_2x2(res%half_trace, res%det, res%mr, res%mi)
         res%rho = acos(max(-1.0_dp, min(1.0_dp, res%half_trace)))/(2.0_dp*pi)
         res%info = CM_SUCCESS
         res%message = "success"
     end subroutine hill_monodromy
+
+    !> The two multipliers of a 2 x 2 monodromy from its half trace a and determinant d:
+    !! the roots a +- sqrt(a^2 - d) of mu^2 - 2 a mu + d, real or a complex pair.
+    pure subroutine multipliers_2x2(half_trace, det, mr, mi)
+        real(dp), intent(in) :: half_trace, det
+        real(dp), intent(out) :: mr(2), mi(2)
+        real(dp) :: disc
+        disc = half_trace**2 - det
+        if (disc >= 0.0_dp) then
+            mr = [half_trace + sqrt(disc), half_trace - sqrt(disc)]
+            mi = 0.0_dp
+        else
+            mr = half_trace
+            mi = [sqrt(-disc), -sqrt(-disc)]
+        end if
+    end subroutine multipliers_2x2
 
 end module conmech_floquet
