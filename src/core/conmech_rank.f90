@@ -26,9 +26,7 @@ contains
         real(dp), intent(out) :: s(:)
         real(dp), intent(out) :: vt(:, :)
         integer, intent(out) :: info
-        real(dp), allocatable :: tmp(:, :), work(:)
-        real(dp) :: wq(1)
-        integer :: m, n, lwork, lainfo
+        integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
         if (size(u, 1) /= m .or. size(u, 2) /= m .or. size(vt, 1) /= n .or. &
@@ -46,13 +44,7 @@ contains
             if (n > 0) vt = identity(n)
             return
         end if
-        allocate (tmp(m, n))
-        tmp = a
-        call dgesvd('A', 'A', m, n, tmp, m, s, u, m, vt, n, wq, -1, lainfo)
-        lwork = max(1, int(wq(1)))
-        allocate (work(lwork))
-        call dgesvd('A', 'A', m, n, tmp, m, s, u, m, vt, n, work, lwork, lainfo)
-        info = la_status(lainfo, CM_NO_CONVERGENCE)
+        call run_dgesvd('A', a, s, u, vt, info)
     end subroutine svd
 
     !> Singular values of an m x n matrix (descending; dgesvd without vectors).
@@ -60,9 +52,8 @@ contains
         real(dp), intent(in) :: a(:, :)
         real(dp), intent(out) :: s(:)
         integer, intent(out) :: info
-        real(dp), allocatable :: tmp(:, :), work(:)
-        real(dp) :: wq(1), du(1, 1), dv(1, 1)
-        integer :: m, n, lwork, lainfo
+        real(dp) :: du(1, 1), dv(1, 1)
+        integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
         if (size(s) /= min(m, n)) then
@@ -75,14 +66,31 @@ contains
         end if
         info = CM_SUCCESS
         if (m == 0 .or. n == 0) return
+        call run_dgesvd('N', a, s, du, dv, info)
+    end subroutine singular_values
+
+    !> dgesvd on a copy of the m x n matrix a, after its workspace query: job 'A' (all of
+    !! u (m x m) and vt (n x n)) or 'N' (the values only; u and vt 1 x 1 placeholders).
+    subroutine run_dgesvd(job, a, s, u, vt, info)
+        character(len=1), intent(in) :: job
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(out) :: s(:)
+        real(dp), intent(out) :: u(:, :), vt(:, :)
+        integer, intent(out) :: info
+        real(dp), allocatable :: tmp(:, :), work(:)
+        real(dp) :: wq(1)
+        integer :: m, n, lwork, lainfo
+        m = size(a, 1)
+        n = size(a, 2)
         allocate (tmp(m, n))
         tmp = a
-        call dgesvd('N', 'N', m, n, tmp, m, s, du, 1, dv, 1, wq, -1, lainfo)
+        call dgesvd(job, job, m, n, tmp, m, s, u, size(u, 1), vt, size(vt, 1), wq, -1, lainfo)
         lwork = max(1, int(wq(1)))
         allocate (work(lwork))
-        call dgesvd('N', 'N', m, n, tmp, m, s, du, 1, dv, 1, work, lwork, lainfo)
+        call dgesvd(job, job, m, n, tmp, m, s, u, size(u, 1), vt, size(vt, 1), work, lwork, &
+                    lainfo)
         info = la_status(lainfo, CM_NO_CONVERGENCE)
-    end subroutine singular_values
+    end subroutine run_dgesvd
 
     !> Numerical rank: the number of singular values > thresh.
     subroutine numerical_rank(a, thresh, rank, info)

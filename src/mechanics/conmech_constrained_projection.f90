@@ -74,13 +74,8 @@ contains
                                        msg, ok)
             if (ok) return
         end if
-        if (has_mass_factor(sys)) then
-            mm = sys%mass_factor        ! factorised once by prepare_mass
-        else
-            call sys%mass(t, q, mm)
-            call mass_cholesky(mm, info, msg)
-            if (info /= CM_SUCCESS) return
-        end if
+        call factored_mass(sys, t, q, mm, info, msg)
+        if (info /= CM_SUCCESS) return
         call sys%phi_jac(t, q, g)
         x = transpose(g)
         call dpotrs('U', n, mh, mm, n, x, n, lainfo)
@@ -145,13 +140,8 @@ contains
             call band_project_velocity(sys, t, q, v, info, msg, ok)
             if (ok) return
         end if
-        if (has_mass_factor(sys)) then
-            mm = sys%mass_factor        ! factorised once by prepare_mass
-        else
-            call sys%mass(t, q, mm)
-            call mass_cholesky(mm, info, msg)
-            if (info /= CM_SUCCESS) return
-        end if
+        call factored_mass(sys, t, q, mm, info, msg)
+        if (info /= CM_SUCCESS) return
         call constraint_matrix(sys, t, q, c, c0)
         r(:, 1) = matmul(c, v) + c0
         r0 = maxval(abs(r(:, 1)))
@@ -171,5 +161,22 @@ contains
             msg = "velocity projection failed: the velocity constraints are inconsistent"
         end if
     end procedure project_velocity
+
+    !> The Cholesky factor of M(t, q) (upper): the one prepare_mass stored for a constant
+    !! mass, else M factorised here; info /= CM_SUCCESS when M is not positive definite.
+    subroutine factored_mass(sys, t, q, mm, info, msg)
+        class(constrained_system), intent(in) :: sys
+        real(dp), intent(in) :: t, q(:)
+        real(dp), intent(out) :: mm(:, :)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(inout) :: msg
+        info = CM_SUCCESS
+        if (has_mass_factor(sys)) then
+            mm = sys%mass_factor
+        else
+            call sys%mass(t, q, mm)
+            call mass_cholesky(mm, info, msg)
+        end if
+    end subroutine factored_mass
 
 end submodule conmech_constrained_projection

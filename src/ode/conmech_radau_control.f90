@@ -58,25 +58,26 @@ contains
         s%a2 = hee1*s%z1 + hee2*s%z2 + hee3*s%z3
         if (allocated(s%mass)) s%a2 = matmul(s%mass, s%a2)
         s%cont = s%a2 + s%f0
-        if (s%sparse) then
-            call s%slu%solve_real(s%cont)
-        else
-            call dgetrs('N', n, 1, s%e1, n, s%ip1, s%cont, n, linfo)
-        end if
-        s%err = max(sqrt(sum((s%cont/s%scal)**2)/real(n, dp)), 1.0e-10_dp)
+        call solve_and_measure()
         if (s%err < 1.0_dp) return
         if (s%first .or. s%reject) then
             s%a1 = s%y + s%cont
             call radau_rhs(sys, s%st, s%t, s%a1, s%a3)
             s%cont = s%a3 + s%a2
+            call solve_and_measure()
+        end if
+        if (.not. ieee_is_finite(s%err)) s%err = 1.0e10_dp
+    contains
+        !> cont <- (I - h gamma0 J)^{-1} cont by the real LU (sparse or dense) and its
+        !! scaled RMS norm (at least 1e-10) into err.
+        subroutine solve_and_measure()
             if (s%sparse) then
                 call s%slu%solve_real(s%cont)
             else
                 call dgetrs('N', n, 1, s%e1, n, s%ip1, s%cont, n, linfo)
             end if
             s%err = max(sqrt(sum((s%cont/s%scal)**2)/real(n, dp)), 1.0e-10_dp)
-        end if
-        if (.not. ieee_is_finite(s%err)) s%err = 1.0e10_dp
+        end subroutine solve_and_measure
     end subroutine radau_estimate_error
 
     !> The proposed step s%hnew = h/quot, quot = max(facr, min(facl, err^(1/4)/fac)),

@@ -22,7 +22,7 @@ module conmech_collocation
     use conmech_ode_solver, only: ode_options, ode_integrate
     use conmech_lapack, only: dgetrf, dgetrs
     use conmech_orbit_types, only: set_parameter_proc
-    use conmech_orbit_bvp, only: orbit_bvp, bvp_z, bvp_span, bvp_param
+    use conmech_orbit_bvp, only: orbit_bvp, bvp_z, bvp_begin
     use conmech_block_chain, only: chain_factor
     use conmech_multiple_shooting, only: bvp_ode_options
     implicit none
@@ -61,14 +61,8 @@ contains
         k = bvp%k
         nm = n*m
         nw = bvp%nw
-        span = bvp_span(bvp, x)
-        p = bvp_param(bvp, x)
-        if (.not. (span > 0.0_dp)) then
-            info = CM_NO_CONVERGENCE
-            msg = "the period became non-positive"
-            return
-        end if
-        call alloc(bvp)
+        call bvp_begin(bvp, x, .true., span, p, info, msg)
+        if (info /= CM_SUCCESS) return
         allocate (f(n, m), jac(n, n, m), w(nm, nm), rhs(nm, 1 + n + nw), v(n, nm), &
                   dsw(n, max(nw, 1)), drw(nm, max(nw, 1)), y(n, m), ipiv(nm))
         if (bvp%pfree) then
@@ -182,25 +176,6 @@ contains
             end do
         end subroutine stage_f
     end subroutine co_evaluate
-
-    subroutine alloc(bvp)
-        type(orbit_bvp), intent(inout) :: bvp
-        integer :: n, k, nm, nw
-        n = bvp%n
-        k = bvp%k
-        nm = n*bvp%m
-        nw = bvp%nw
-        if (allocated(bvp%a)) then
-            if (size(bvp%a, 3) == k .and. size(bvp%c, 2) == nw .and. &
-                size(bvp%ws, 1) == nm) return
-            deallocate (bvp%a, bvp%b, bvp%c, bvp%d, bvp%gres, bvp%fstart, bvp%fend)
-        end if
-        if (allocated(bvp%ws)) deallocate (bvp%ws, bvp%wz, bvp%ww, bvp%sres)
-        allocate (bvp%a(n, n, k), bvp%b(n, n, k), bvp%c(n, nw, k), bvp%d(n, k), &
-                  bvp%gres(n, k), bvp%fstart(n, k), bvp%fend(n, k))
-        allocate (bvp%ws(nm, k), bvp%wz(nm, n, k), bvp%ww(nm, nw, k), bvp%sres(nm, k))
-        bvp%c = 0.0_dp
-    end subroutine alloc
 
     !> Nodes and stages of the orbit integrated from y0 over [0, span] (the initial
     !! guess), into x (border unknowns untouched).

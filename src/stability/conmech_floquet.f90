@@ -25,7 +25,7 @@ module conmech_floquet
     private
 
     public :: floquet_result, floquet_analysis, planar_stability_index
-    public :: floquet_from_multipliers
+    public :: floquet_from_multipliers, multipliers_2x2
     public :: hill_coefficient_fun, hill_equation, hill_result, hill_solve, hill_solve_samples
     public :: fourier_coefficients, fourier_eval
 
@@ -89,7 +89,6 @@ contains
         real(dp), intent(in), optional :: tol
         integer :: n, i
         real(dp) :: tl
-        complex(dp) :: mu
         tl = 1.0e-6_dp
         if (present(tol)) tl = tol
         n = size(m, 1)
@@ -106,18 +105,7 @@ contains
         end do
         res%abs_mult = sqrt(res%mr**2 + res%mi**2)
         res%det = 1.0_dp
-        mu = (1.0_dp, 0.0_dp)
-        do i = 1, n
-            mu = mu*cmplx(res%mr(i), res%mi(i), dp)
-            if (res%abs_mult(i) > 0.0_dp) then
-                res%exponents(i) = log(cmplx(res%mr(i), res%mi(i), dp))/t_period
-            else
-                res%exponents(i) = cmplx(-huge(1.0_dp), 0.0_dp, dp)
-            end if
-        end do
-        res%det = real(mu, dp)
-        res%max_abs = maxval(res%abs_mult)
-        res%stable = res%max_abs <= 1.0_dp + tl
+        call exponents_and_det(res, t_period, tl)
     end subroutine floquet_analysis
 
     !> The floquet_result of multipliers computed from the factors of the monodromy
@@ -130,7 +118,6 @@ contains
         real(dp), intent(in) :: t_period
         type(floquet_result), intent(out) :: res
         integer :: n, i
-        complex(dp) :: mu
         res%info = ms%info
         if (ms%info /= CM_SUCCESS .or. .not. allocated(ms%mr)) return
         n = size(ms%mr)
@@ -142,8 +129,19 @@ contains
         do i = 1, min(n, size(m, 1), size(m, 2))
             res%trace = res%trace + m(i, i)
         end do
+        call exponents_and_det(res, t_period, unit_circle_tolerance(ms, 1.0e-6_dp))
+    end subroutine floquet_from_multipliers
+
+    !> From the multipliers mr + i mi (and |mu|, already in res) of a period t_period: the
+    !! Floquet exponents log(mu)/T (-huge for mu = 0 or T <= 0), det M as their product,
+    !! max |mu| and stability (max |mu| <= 1 + tol).
+    subroutine exponents_and_det(res, t_period, tol)
+        type(floquet_result), intent(inout) :: res
+        real(dp), intent(in) :: t_period, tol
+        complex(dp) :: mu
+        integer :: i
         mu = (1.0_dp, 0.0_dp)
-        do i = 1, n
+        do i = 1, size(res%mr)
             mu = mu*cmplx(res%mr(i), res%mi(i), dp)
             if (res%abs_mult(i) > 0.0_dp .and. t_period > 0.0_dp) then
                 res%exponents(i) = log(cmplx(res%mr(i), res%mi(i), dp))/t_period
@@ -153,8 +151,8 @@ contains
         end do
         res%det = real(mu, dp)
         res%max_abs = maxval(res%abs_mult)
-        res%stable = res%max_abs <= 1.0_dp + unit_circle_tolerance(ms, 1.0e-6_dp)
-    end subroutine floquet_from_multipliers
+        res%stable = res%max_abs <= 1.0_dp + tol
+    end subroutine exponents_and_det
 
     !> Trace-based stability index of a planar conservative periodic orbit (4 x 4 monodromy):
     !! S = (trace M - 2)/2; linearly stable iff |S| < 1.
@@ -286,7 +284,7 @@ contains
         real(dp), intent(in), optional :: rtol
         type(ode_options) :: opt
         type(ode_stats) :: st
-        real(dp) :: y(2), phi(2, 2), disc
+        real(dp) :: y(2), phi(2, 2)
         character(len=:), allocatable :: msg
         if (.not. (eq%period > 0.0_dp)) then
             res%info = CM_BAD_INPUT
@@ -307,17 +305,26 @@ contains
         res%half_trace = 0.5_dp*(phi(1, 1) + phi(2, 2))
         res%det = phi(1, 1)*phi(2, 2) - phi(1, 2)*phi(2, 1)
         res%stable = abs(res%half_trace) < 1.0_dp
-        disc = res%half_trace**2 - res%det
-        if (disc >= 0.0_dp) then
-            res%mr = [res%half_trace + sqrt(disc), res%half_trace - sqrt(disc)]
-            res%mi = 0.0_dp
-        else
-            res%mr = res%half_trace
-            res%mi = [sqrt(-disc), -sqrt(-disc)]
-        end if
+        call multipliers_2x2(res%half_trace, res%det, res%mr, res%mi)
         res%rho = acos(max(-1.0_dp, min(1.0_dp, res%half_trace)))/(2.0_dp*pi)
         res%info = CM_SUCCESS
         res%message = "success"
     end subroutine hill_monodromy
+
+    !> The two multipliers of a 2 x 2 monodromy from its half trace a and determinant d:
+    !! the roots a +- sqrt(a^2 - d) of mu^2 - 2 a mu + d, real or a complex pair.
+    pure subroutine multipliers_2x2(half_trace, det, mr, mi)
+        real(dp), intent(in) :: half_trace, det
+        real(dp), intent(out) :: mr(2), mi(2)
+        real(dp) :: disc
+        disc = half_trace**2 - det
+        if (disc >= 0.0_dp) then
+            mr = [half_trace + sqrt(disc), half_trace - sqrt(disc)]
+            mi = 0.0_dp
+        else
+            mr = half_trace
+            mi = [sqrt(-disc), -sqrt(-disc)]
+        end if
+    end subroutine multipliers_2x2
 
 end module conmech_floquet

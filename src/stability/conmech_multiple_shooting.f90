@@ -17,7 +17,7 @@ module conmech_multiple_shooting
     use conmech_ode_solver, only: ode_options, ode_integrate
     use conmech_variational, only: integrate_stm
     use conmech_orbit_types, only: set_parameter_proc
-    use conmech_orbit_bvp, only: orbit_bvp, bvp_z, bvp_span, bvp_param
+    use conmech_orbit_bvp, only: orbit_bvp, bvp_z, bvp_span, bvp_begin
     use conmech_block_chain, only: chain_factor
     implicit none
     private
@@ -52,14 +52,8 @@ contains
         n = bvp%n
         k = bvp%k
         oo = bvp_ode_options(bvp)
-        span = bvp_span(bvp, x)
-        p = bvp_param(bvp, x)
-        if (.not. (span > 0.0_dp)) then
-            info = CM_NO_CONVERGENCE
-            msg = "the period became non-positive"
-            return
-        end if
-        call alloc(bvp)
+        call bvp_begin(bvp, x, .false., span, p, info, msg)
+        if (info /= CM_SUCCESS) return
         if (bvp%pfree) then
             ! the parameter derivative of every segment end: all at p + h, then p - h
             allocate (yp(n, k), ym(n, k))
@@ -124,20 +118,6 @@ contains
             end do
         end subroutine ends
     end subroutine ms_evaluate
-
-    subroutine alloc(bvp)
-        type(orbit_bvp), intent(inout) :: bvp
-        integer :: n, k
-        n = bvp%n
-        k = bvp%k
-        if (allocated(bvp%a)) then
-            if (size(bvp%a, 3) == k .and. size(bvp%c, 2) == bvp%nw) return
-            deallocate (bvp%a, bvp%b, bvp%c, bvp%d, bvp%gres, bvp%fstart, bvp%fend)
-        end if
-        allocate (bvp%a(n, n, k), bvp%b(n, n, k), bvp%c(n, bvp%nw, k), bvp%d(n, k), &
-                  bvp%gres(n, k), bvp%fstart(n, k), bvp%fend(n, k))
-        bvp%c = 0.0_dp
-    end subroutine alloc
 
     !> The nodes z_j = y(mesh_j S) of the orbit integrated from y0 (the initial guess of
     !! the segments), into x (stages and border unknowns untouched).

@@ -32,7 +32,7 @@ module conmech_orbit_bvp
     private
 
     public :: orbit_bvp, bvp_setup, bvp_pack, bvp_z, bvp_span, bvp_param, bvp_index_w
-    public :: bvp_boundary, bvp_solve, bvp_residual, bvp_state_scale
+    public :: bvp_boundary, bvp_solve, bvp_residual, bvp_state_scale, bvp_begin
 
     !> The discretised problem and its last linearisation.
     type :: orbit_bvp
@@ -172,6 +172,50 @@ contains
         p = bvp%p
         if (bvp%pfree) p = x(bvp%nx)
     end function bvp_param
+
+    !> The start of an evaluation at X, the same for multiple shooting and collocation:
+    !! the time span S and the parameter p of X (CM_NO_CONVERGENCE when S <= 0, the Newton
+    !! iterate having left the problem), and the chain blocks A, B, C, d with the chain
+    !! residuals and segment-end values allocated for K segments (kept when their sizes
+    !! still hold; C zeroed); `stages` (collocation) also the stage blocks of m stages.
+    subroutine bvp_begin(bvp, x, stages, span, p, info, msg)
+        type(orbit_bvp), intent(inout) :: bvp
+        real(dp), intent(in) :: x(:)
+        logical, intent(in) :: stages
+        real(dp), intent(out) :: span, p
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        integer :: n, k, nm, nw
+        logical :: keep
+        span = bvp_span(bvp, x)
+        p = bvp_param(bvp, x)
+        if (.not. (span > 0.0_dp)) then
+            info = CM_NO_CONVERGENCE
+            msg = "the period became non-positive"
+            return
+        end if
+        info = CM_SUCCESS
+        n = bvp%n
+        k = bvp%k
+        nm = n*bvp%m
+        nw = bvp%nw
+        if (allocated(bvp%a)) then
+            keep = size(bvp%a, 3) == k .and. size(bvp%c, 2) == nw
+            if (keep .and. stages) then
+                keep = allocated(bvp%ws)
+                if (keep) keep = size(bvp%ws, 1) == nm
+            end if
+            if (keep) return
+            deallocate (bvp%a, bvp%b, bvp%c, bvp%d, bvp%gres, bvp%fstart, bvp%fend)
+        end if
+        allocate (bvp%a(n, n, k), bvp%b(n, n, k), bvp%c(n, nw, k), bvp%d(n, k), &
+                  bvp%gres(n, k), bvp%fstart(n, k), bvp%fend(n, k))
+        if (stages) then
+            if (allocated(bvp%ws)) deallocate (bvp%ws, bvp%wz, bvp%ww, bvp%sres)
+            allocate (bvp%ws(nm, k), bvp%wz(nm, n, k), bvp%ww(nm, nw, k), bvp%sres(nm, k))
+        end if
+        bvp%c = 0.0_dp
+    end subroutine bvp_begin
 
     !> max(1, |z|) over the nodes: the scale of the closure tolerances.
     pure real(dp) function bvp_state_scale(bvp, x) result(s)

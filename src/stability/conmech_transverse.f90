@@ -25,6 +25,7 @@ module conmech_transverse
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_integrate, METHOD_DOP853
+    use conmech_floquet, only: multipliers_2x2
     implicit none
     private
 
@@ -149,7 +150,7 @@ contains
         real(dp), intent(in), optional :: rtol
         type(transverse_ode) :: ts
         type(ode_options) :: opt
-        real(dp) :: z(8), disc
+        real(dp) :: z(8)
         character(len=:), allocatable :: msg
         if (.not. (period > 0.0_dp) .or. .not. all(ieee_is_finite(y0)) .or. &
             .not. (y0(3)**2 + y0(4)**2 > 0.0_dp)) then
@@ -180,14 +181,7 @@ contains
         res%half_trace = 0.5_dp*(z(5) + z(8))
         res%det = z(5)*z(8) - z(6)*z(7)
         res%closure = maxval(abs(z(1:4) - y0))
-        disc = res%half_trace**2 - res%det
-        if (disc >= 0.0_dp) then
-            res%mr = [res%half_trace + sqrt(disc), res%half_trace - sqrt(disc)]
-            res%mi = 0.0_dp
-        else
-            res%mr = res%half_trace
-            res%mi = [sqrt(-disc), -sqrt(-disc)]
-        end if
+        call multipliers_2x2(res%half_trace, res%det, res%mr, res%mi)
         res%info = CM_SUCCESS
         res%message = "success"
     end subroutine transverse_monodromy

@@ -97,7 +97,7 @@ subroutine flat_control_reduced(name, np, params, nspec, spec, nd, m, bmat, badd
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOP853
     use conmech_vhc, only: vhc_reduced
     use conmech_support_control, only: build_plant, build_vhc
-    use conmech_support_reduced, only: velocity_zero
+    use conmech_flat_adapters, only: velocity_zero
     implicit none
     include "flat_plant_args.inc"
     include "flat_law_args.inc"
@@ -167,7 +167,7 @@ subroutine flat_control_energy(name, np, params, nspec, spec, nd, m, bmat, baddr
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOP853
     use conmech_vhc, only: vhc_energy
     use conmech_support_control, only: build_plant, build_vhc
-    use conmech_support_reduced, only: energy_zero
+    use conmech_flat_adapters, only: energy_zero
     implicit none
     include "flat_plant_args.inc"
     include "flat_law_args.inc"
@@ -316,7 +316,7 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
                                 dists, nfail, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_mech_plant, only: mech_plant
     use conmech_control_system, only: feedback_law
     use conmech_support_control, only: build_plant_law, project_states
@@ -494,7 +494,7 @@ subroutine flat_control_riccati(afun, bfun, k, m, period, qw, rw, rtol, atol, nt
     use conmech_status, only: CM_SUCCESS
     use conmech_periodic_riccati, only: riccati_options, riccati_result, periodic_riccati, &
                                         riccati_gain
-    use conmech_support_reduced, only: callback_lq
+    use conmech_flat_adapters, only: callback_lq
     implicit none
     integer(c_int), intent(in) :: k, m, nt
     real(c_double), intent(in) :: period, qw(k, k), rw(m, m), rtol, atol, t(nt)

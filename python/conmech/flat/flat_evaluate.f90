@@ -6,7 +6,7 @@ subroutine flat_evaluate_ode(name, np, params, nspec, spec, n, t, y, f, jac, ana
                              message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: copy_message

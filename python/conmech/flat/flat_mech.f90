@@ -74,7 +74,7 @@ end subroutine flat_mech_initial_state
 
 !> Solve a constrained system: built-in or compiled (source 0: `name` / `spec`, see
 !! conmech_flat_spec; the Python callables are never called) or given by Python callables
-!! (source 1; see conmech_flat_mech_support for their conventions). has_jac, has_gamma,
+!! (source 1; flat_constrained_callbacks.inc gives their conventions). has_jac, has_gamma,
 !! has_nh_gamma, rheonomic: 0 or 1 (source 1); without an analytic Jacobian or
 !! acceleration term the documented finite differences are used.
 subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces, phi, jac, &
@@ -88,7 +88,8 @@ subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces,
     use conmech_constrained_system, only: constrained_system
     use conmech_flat_spec, only: spec_constrained
     use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_mech_support, only: callback_constrained, run_constrained
+    use conmech_flat_adapters, only: callback_constrained
+    use conmech_flat_mech_support, only: run_constrained
     implicit none
     include "flat_spec_args.inc"
     integer(c_int), intent(in) :: source
@@ -97,82 +98,7 @@ subroutine flat_constrained(name, np, params, nspec, spec, source, mass, forces,
     integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     include "flat_constrained_args.inc"
     character(len=256), intent(out) :: message
-!f2py external mass, forces, phi, jac, gamma, nh, nhgamma, store, events, evstore
-    interface
-        subroutine mass(t, q, mm, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n)
-            real(c_double), intent(out) :: mm(n, n)
-        end subroutine mass
-        subroutine forces(t, q, v, f, n)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n), v(n)
-            real(c_double), intent(out) :: f(n)
-        end subroutine forces
-        subroutine phi(t, q, c, n, mh)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mh
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n)
-            real(c_double), intent(out) :: c(mh)
-        end subroutine phi
-        subroutine jac(t, q, g, n, mh)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mh
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n)
-            real(c_double), intent(out) :: g(mh, n)
-        end subroutine jac
-        subroutine gamma(t, q, v, gam, n, mh)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mh
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n), v(n)
-            real(c_double), intent(out) :: gam(mh)
-        end subroutine gamma
-        subroutine nh(t, q, a, b, n, mn)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mn
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n)
-            real(c_double), intent(out) :: a(mn, n), b(mn)
-        end subroutine nh
-        subroutine nhgamma(t, q, v, gam, n, mn)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mn
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: q(n), v(n)
-            real(c_double), intent(out) :: gam(mn)
-        end subroutine nhgamma
-        subroutine events(t, y, g, n2, ne)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n2, ne
-            real(c_double), intent(in) :: t
-            real(c_double), intent(in) :: y(n2)
-            real(c_double), intent(out) :: g(ne)
-        end subroutine events
-        subroutine evstore(ev_t, ev_q, ev_v, ev_id, n, nev)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, nev
-            real(c_double), intent(in) :: ev_t(nev)
-            real(c_double), intent(in) :: ev_q(n, nev), ev_v(n, nev)
-            integer(c_int), intent(in) :: ev_id(nev)
-        end subroutine evstore
-        subroutine store(t, q, v, acc, lam, reac, cm, rp, rv, en, pw, n, mm, nt)
-            use, intrinsic :: iso_c_binding, only: c_double, c_int
-            integer(c_int), intent(in) :: n, mm, nt
-            real(c_double), intent(in) :: t(nt)
-            real(c_double), intent(in) :: q(n, nt), v(n, nt), acc(n, nt)
-            real(c_double), intent(in) :: lam(mm, nt)
-            real(c_double), intent(in) :: reac(n, nt)
-            real(c_double), intent(in) :: cm(mm, n, nt)
-            real(c_double), intent(in) :: rp(nt), rv(nt), en(nt), pw(nt)
-        end subroutine store
-    end interface
+    include "flat_constrained_callbacks.inc"
     class(constrained_system), allocatable :: cs
     type(callback_constrained) :: cb
     character(len=:), allocatable :: msg

@@ -15,20 +15,10 @@ subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, metho
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
     use conmech_flat_ode_support, only: run_solve, copy_message
-    use conmech_flat_sparse_jac_support, only: callback_sparse_jac_system, &
+    use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
     implicit none
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(in) :: t_span(2)
-    real(c_double), intent(in) :: y0(n)
-    integer(c_int), intent(in) :: method
-    real(c_double), intent(in) :: rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: max_steps, dense, neval
-    real(c_double), intent(in) :: t_eval(max(neval, 1))
-    integer(c_int), intent(in) :: ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
-    real(c_double), intent(in) :: ev_res(max(ne, 1))
+    include "flat_solve_args.inc"
     integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
     integer(c_int), intent(out) :: counts(5), dense_form, info
     character(len=256), intent(out) :: message
@@ -59,17 +49,10 @@ subroutine flat_stepper_sparse_jac(fun, jvals, action, n, nr, ni, nw, t0, t_boun
     use conmech_status, only: CM_SUCCESS
     use conmech_flat_ode_support, only: copy_message
     use conmech_flat_stepper_support, only: stepper_action
-    use conmech_flat_sparse_jac_support, only: callback_sparse_jac_system, &
+    use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
     implicit none
-    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
-    real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
-    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
-    integer(c_int), intent(inout) :: iv(max(ni, 1))
-    integer(c_int), intent(out) :: sizes(3), info
-    character(len=256), intent(out) :: message
+    include "flat_stepper_args.inc"
     include "flat_sparse_jac_callbacks.inc"
     type(callback_sparse_jac_system) :: sys
     character(len=:), allocatable :: msg

@@ -261,7 +261,7 @@ subroutine flat_transverse_callback(pot, omega, y0, period, rtol, nt, t, phi_t, 
     use conmech_ode_solver, only: ode_options, ode_integrate
     use conmech_variational, only: integrate_stm
     use conmech_transverse, only: transverse_result, transverse_monodromy, transverse_phi
-    use conmech_support_transverse, only: callback_natural
+    use conmech_flat_adapters, only: callback_natural
     implicit none
     real(c_double), intent(in) :: omega, y0(4), period, rtol
     integer(c_int), intent(in) :: nt

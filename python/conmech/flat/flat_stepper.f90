@@ -30,17 +30,11 @@ subroutine flat_stepper_callback(fun, jac, action, n, nr, ni, nw, t0, t_bound, y
                                  jac_const, nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, &
                                  message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_jac_system
+    use conmech_flat_adapters, only: callback_jac_system
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
-    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, has_jac, max_steps
-    real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
-    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
-    integer(c_int), intent(inout) :: iv(max(ni, 1))
-    integer(c_int), intent(out) :: sizes(3), info
-    character(len=256), intent(out) :: message
+    include "flat_stepper_args.inc"
+    integer(c_int), intent(in) :: has_jac, jac_const
     include "flat_stepper_callbacks.inc"
     type(callback_jac_system) :: sys
     sys%f => fun
@@ -66,14 +60,7 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni
     use conmech_flat_stepper_support, only: stepper_action
     implicit none
     include "flat_spec_args.inc"
-    integer(c_int), intent(in) :: action, n, nr, ni, nw, method, max_steps
-    real(c_double), intent(in) :: t0, t_bound, y0(n), rtol(n), atol(n)
-    real(c_double), intent(in) :: first_step, max_step
-    integer(c_int), intent(in) :: nnz, sp_ptr(n + 1), sp_idx(max(nnz, 1))
-    real(c_double), intent(inout) :: r(max(nr, 1)), w(n, max(nw, 1))
-    integer(c_int), intent(inout) :: iv(max(ni, 1))
-    integer(c_int), intent(out) :: sizes(3), info
-    character(len=256), intent(out) :: message
+    include "flat_stepper_args.inc"
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
     sizes = 0

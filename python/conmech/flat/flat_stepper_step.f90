@@ -12,7 +12,7 @@
 subroutine flat_stepper_step_callback(fun, jac, action, method, has_jac, n, nr, ni, nw, r, &
                                       iv, w, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_flat_ode_support, only: callback_jac_system
+    use conmech_flat_adapters, only: callback_jac_system
     use conmech_flat_stepper_support, only: step_action
     implicit none
     integer(c_int), intent(in) :: action, method, has_jac, n, nr, ni, nw

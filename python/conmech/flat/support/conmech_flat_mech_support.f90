@@ -1,8 +1,8 @@
 !> Support of the flat f2py layer for constrained mechanical systems (compiled into the
 !! extension, not wrapped: it holds derived types).
 !!
-!! `callback_constrained` adapts external procedures (f2py callbacks into Python) to
-!! `constrained_system`; `run_constrained` runs `constrained_solve` from plain arguments
+!! `callback_constrained` (conmech_flat_adapters, re-exported) adapts f2py callbacks into
+!! Python to `constrained_system`; `run_constrained` runs `constrained_solve` from plain arguments
 !! and hands the whole result to a `store` procedure. Calling conventions (by reference):
 !!
 !!     mass(t, q, mm, n)            real(c_double) t, q(n), mm(n, n)
@@ -24,118 +24,13 @@ module conmech_flat_mech_support
     use conmech_constrained_system
     use conmech_constrained_solver
     use conmech_ode_system, only: ode_events
-    use conmech_flat_ode_support, only: copy_message, callback_events
+    use conmech_flat_ode_support, only: copy_message
+    use conmech_flat_adapters, only: callback_constrained, callback_events
     implicit none
     private
     public :: callback_constrained, run_constrained
 
-    type, extends(constrained_system) :: callback_constrained
-        procedure(), pointer, nopass :: fmass => null()
-        procedure(), pointer, nopass :: fforces => null()
-        procedure(), pointer, nopass :: fphi => null()
-        procedure(), pointer, nopass :: fjac => null()
-        procedure(), pointer, nopass :: fgamma => null()
-        procedure(), pointer, nopass :: fnh => null()
-        procedure(), pointer, nopass :: fnhgamma => null()
-        logical :: has_jac = .false., has_gamma = .false., has_nh_gamma = .false.
-    contains
-        procedure :: mass => cb_mass
-        procedure :: forces => cb_forces
-        procedure :: phi => cb_phi
-        procedure :: phi_jac => cb_jac
-        procedure :: phi_gamma => cb_gamma
-        procedure :: nh_matrix => cb_nh
-        procedure :: nh_gamma => cb_nh_gamma
-    end type callback_constrained
-
 contains
-
-    subroutine cb_mass(self, t, q, mm)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: mm(:, :)
-        integer(c_int) :: n
-        n = self%n
-        call self%fmass(t, q, mm, n)
-    end subroutine cb_mass
-
-    subroutine cb_forces(self, t, q, v, f)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: f(:)
-        integer(c_int) :: n
-        n = self%n
-        call self%fforces(t, q, v, f, n)
-    end subroutine cb_forces
-
-    subroutine cb_phi(self, t, q, c)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: c(:)
-        integer(c_int) :: n, mh
-        n = self%n
-        mh = self%n_hol
-        call self%fphi(t, q, c, n, mh)
-    end subroutine cb_phi
-
-    subroutine cb_jac(self, t, q, g)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: g(:, :)
-        integer(c_int) :: n, mh
-        if (.not. self%has_jac) then
-            call fd_phi_jac(self, t, q, g)
-            return
-        end if
-        n = self%n
-        mh = self%n_hol
-        call self%fjac(t, q, g, n, mh)
-    end subroutine cb_jac
-
-    subroutine cb_gamma(self, t, q, v, gam)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: gam(:)
-        integer(c_int) :: n, mh
-        if (.not. self%has_gamma) then
-            call fd_phi_gamma(self, t, q, v, gam)
-            return
-        end if
-        n = self%n
-        mh = self%n_hol
-        call self%fgamma(t, q, v, gam, n, mh)
-    end subroutine cb_gamma
-
-    subroutine cb_nh(self, t, q, a, b)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: a(:, :), b(:)
-        integer(c_int) :: n, mn
-        n = self%n
-        mn = self%n_nh
-        call self%fnh(t, q, a, b, n, mn)
-    end subroutine cb_nh
-
-    subroutine cb_nh_gamma(self, t, q, v, gam)
-        class(callback_constrained), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp), intent(out) :: gam(:)
-        integer(c_int) :: n, mn
-        if (.not. self%has_nh_gamma) then
-            call fd_nh_gamma(self, t, q, v, gam)
-            return
-        end if
-        n = self%n
-        mn = self%n_nh
-        call self%fnhgamma(t, q, v, gam, n, mn)
-    end subroutine cb_nh_gamma
 
     !> Run `constrained_solve` from plain arguments; the result goes to `store`.
     !! first_step 0: automatic; neval 0: output at every accepted step. iopt(1:5) =

@@ -1,11 +1,10 @@
 !> Support of the flat f2py layer for the integrators (compiled into the extension, not
 !! wrapped by f2py: it holds derived types).
 !!
-!! `callback_system` and `callback_events` adapt external procedures with an implicit
-!! interface (in practice f2py callbacks into Python) to conmech's `ode_system` and
-!! `ode_events`; `run_solve` runs `ode_solve` from plain arguments and hands the whole
-!! result to a `store` procedure, so that output sizes need not be known in advance and
-!! nothing is saved between calls (thread-safe).
+!! `callback_system` and `callback_events` (from conmech_flat_adapters, re-exported) adapt
+!! f2py callbacks into Python to conmech's `ode_system` and `ode_events`; `run_solve` runs
+!! `ode_solve` from plain arguments and hands the whole result to a `store` procedure,
+!! so that output sizes need not be known in advance and nothing is saved between calls (thread-safe).
 !!
 !! Calling conventions of the external procedures (all arguments by reference):
 !!
@@ -23,71 +22,19 @@ module conmech_flat_ode_support
         ode_stepper
     use conmech_ode_methods, only: new_stepper
     use conmech_radau_stepper, only: radau_stepper
+    use conmech_flat_adapters, only: callback_system, callback_jac_system, &
+                                      callback_events
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
-    public :: solve_into, store_result
+    public :: solve_into, store_result, flat_ode_options
     public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
     !! (no Lund stabilisation) and SciPy's initial step (select_initial_step).
     integer(c_int), parameter, public :: METHOD_RK45_SCIPY = 12
 
-    !> A system whose right-hand side is an external procedure fun(t, y, dydt, n).
-    type, extends(ode_system) :: callback_system
-        procedure(), pointer, nopass :: f => null()
-        integer(c_int) :: n = 0
-    contains
-        procedure :: rhs => callback_rhs
-    end type callback_system
-
-    !> A system with its exact Jacobian from an external procedure jac(t, y, dfdy, n).
-    type, extends(callback_system) :: callback_jac_system
-        procedure(), pointer, nopass :: jac => null()
-    contains
-        procedure :: jacobian => callback_jacobian
-        procedure :: has_jacobian => callback_has_jacobian
-    end type callback_jac_system
-
-    !> Event functions given by one external procedure events(t, y, g, n, ne).
-    type, extends(ode_events) :: callback_events
-        procedure(), pointer, nopass :: g => null()
-        integer(c_int) :: n = 0
-        integer(c_int) :: ne = 0
-    contains
-        procedure :: eval => callback_eval
-    end type callback_events
-
 contains
-
-    subroutine callback_rhs(self, t, y, dydt)
-        class(callback_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        call self%f(t, y, dydt, self%n)
-    end subroutine callback_rhs
-
-    subroutine callback_jacobian(self, t, y, dfdy)
-        class(callback_jac_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        call self%jac(t, y, dfdy, self%n)
-    end subroutine callback_jacobian
-
-    logical function callback_has_jacobian(self)
-        class(callback_jac_system), intent(in) :: self
-        callback_has_jacobian = associated(self%jac)
-    end function callback_has_jacobian
-
-    subroutine callback_eval(self, t, y, g)
-        class(callback_events), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: g(:)
-        call self%g(t, y, g, self%n, self%ne)
-    end subroutine callback_eval
 
     !> Copy a message into a fixed-length output (truncated, blank padded).
     subroutine copy_message(src, dst)
@@ -95,6 +42,23 @@ contains
         character(len=*), intent(out) :: dst
         dst = src
     end subroutine copy_message
+
+    !> The integration options every flat integrator routine takes from its plain arguments:
+    !! the method code, the tolerances per component, the first and largest step (0: none),
+    !! the step limit and dense output (dense /= 0). SciPy's RK45 code is left to the caller.
+    function flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense) &
+        result(opt)
+        integer(c_int), intent(in) :: method, max_steps, dense
+        real(c_double), intent(in) :: rtol(:), atol(:), first_step, max_step
+        type(ode_options) :: opt
+        opt%method = method
+        opt%rtol_vec = rtol
+        opt%atol_vec = atol
+        opt%first_step = first_step
+        opt%max_step = max_step
+        opt%max_steps = max_steps
+        opt%dense_output = dense /= 0
+    end function flat_ode_options
 
     !> What the caller knows of df/dy, on a fresh stepper of a method that uses it (Radau):
     !! constant (jac_const /= 0: read once, never re-evaluated, not counted in njev), and
@@ -180,17 +144,11 @@ contains
             call copy_message("bad input: array sizes must be positive", message)
             return
         end if
-        opt%method = method
+        opt = flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense)
         if (method == METHOD_RK45_SCIPY) then
             opt%method = METHOD_DOPRI5
             opt%beta = 0.0_dp
         end if
-        opt%rtol_vec = rtol
-        opt%atol_vec = atol
-        opt%first_step = first_step
-        opt%max_step = max_step
-        opt%max_steps = max_steps
-        opt%dense_output = dense /= 0
         call new_stepper(opt%method, stp, sinfo, msg)
         if (sinfo == CM_SUCCESS) call set_jacobian_structure(stp, n, jac_const, nnz, sp_ptr, &
                                                              sp_idx, sinfo, msg)

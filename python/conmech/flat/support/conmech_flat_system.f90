@@ -28,11 +28,10 @@ module conmech_flat_system
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system
-    use conmech_flat_ode_support, only: callback_system, callback_jac_system
+    use conmech_flat_adapters, only: callback_system, callback_jac_system
     use conmech_flat_spec, only: spec_kind, KIND_BUILTIN
     use conmech_param_system, only: builtin_param_system, make_param_system, &
                                     make_compiled_param_system
-    use conmech_support_cont, only: callback_param_system, callback_param_jac_system
     implicit none
     private
     public :: flat_system, flat_param_system, SOURCE_SPEC, SOURCE_FUN, SOURCE_FUN_JAC
@@ -57,21 +56,8 @@ contains
         select case (source)
         case (SOURCE_SPEC)
             call spec_system(name, params, nspec, spec, sys, info, msg)
-        case (SOURCE_FUN)
-            block
-                type(callback_system) :: s
-                s%f => fun
-                s%n = n
-                allocate (sys, source=s)
-            end block
-        case (SOURCE_FUN_JAC)
-            block
-                type(callback_jac_system) :: s
-                s%f => fun
-                s%jac => jfun
-                s%n = n
-                allocate (sys, source=s)
-            end block
+        case (SOURCE_FUN, SOURCE_FUN_JAC)
+            call python_system(fun, jfun, source, n, .false., 0.0_dp, sys)
         case default
             info = CM_BAD_INPUT
             msg = "bad input: unknown system source"
@@ -117,27 +103,38 @@ contains
                 if (size(params) > 0) p_start = params(max(ip, 1))
                 allocate (sys, source=b)
             end block
-        case (SOURCE_FUN)
-            block
-                type(callback_param_system) :: s
-                s%f => fun
-                s%n = n
-                s%p = p0
-                allocate (sys, source=s)
-            end block
-        case (SOURCE_FUN_JAC)
-            block
-                type(callback_param_jac_system) :: s
-                s%f => fun
-                s%jf => jfun
-                s%n = n
-                s%p = p0
-                allocate (sys, source=s)
-            end block
+        case (SOURCE_FUN, SOURCE_FUN_JAC)
+            call python_system(fun, jfun, source, n, .true., p0, sys)
         case default
             info = CM_BAD_INPUT
             msg = "bad input: unknown system source"
         end select
     end subroutine flat_param_system
+
+    !> The adapter of a Python right-hand side fun (and, for SOURCE_FUN_JAC, its Jacobian
+    !! jfun), with the parameter value p when `parametric`.
+    subroutine python_system(fun, jfun, source, n, parametric, p, sys)
+        procedure() :: fun, jfun
+        integer(c_int), intent(in) :: source, n
+        logical, intent(in) :: parametric
+        real(dp), intent(in) :: p
+        class(ode_system), allocatable, intent(out) :: sys
+        if (source == SOURCE_FUN_JAC) then
+            allocate (callback_jac_system :: sys)
+        else
+            allocate (callback_system :: sys)
+        end if
+        select type (sys)
+        class is (callback_system)
+            sys%f => fun
+            sys%n = n
+            sys%parametric = parametric
+            sys%p = p
+        end select
+        select type (sys)
+        type is (callback_jac_system)
+            sys%jac => jfun
+        end select
+    end subroutine python_system
 
 end module conmech_flat_system

@@ -1,6 +1,6 @@
 !> Support of the flat f2py layer for the continuation of periodic orbits (compiled, not
-!! wrapped): a built-in system with one parameter made settable, a Python right-hand side
-!! fun(t, y, p, dydt, n) with the parameter p, a Python energy(y, p, e, n), and
+!! wrapped): the parameter of a built-in system or of a Python right-hand side
+!! fun(t, y, p, dydt, n) made settable (`set_param_any`), and
 !! `run_continuation`, which runs `continue_orbits` from plain arguments and packs the
 !! branch into explicit-shape arrays.
 module conmech_support_cont
@@ -8,6 +8,7 @@ module conmech_support_cont
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
+    use conmech_flat_adapters, only: callback_system, callback_energy
     use conmech_param_system, only: builtin_param_system, set_builtin_param
     use conmech_shooting, only: set_parameter_proc
     use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &
@@ -15,70 +16,13 @@ module conmech_support_cont
     use conmech_branch_switch, only: switch_period_doubling, switch_branch_point
     implicit none
     private
-    public :: callback_param_system, set_param_any, run_continuation, callback_energy
-    public :: callback_param_jac_system
+    public :: set_param_any, run_continuation, callback_energy
     public :: MAX_SPECIAL, NROPT, NIOPT
 
     integer, parameter :: MAX_SPECIAL = 64
     integer, parameter :: NROPT = 15, NIOPT = 16
 
-    !> A Python energy(y, p, e, n) along the branch.
-    type, extends(branch_energy) :: callback_energy
-        procedure(), pointer, nopass :: f => null()
-        integer(c_int) :: n = 0
-    contains
-        procedure :: value => ce_value
-    end type callback_energy
-
-    !> A Python right-hand side fun(t, y, p, dydt, n) with the parameter p.
-    type, extends(ode_system) :: callback_param_system
-        procedure(), pointer, nopass :: f => null()
-        real(c_double) :: p = 0.0_dp
-        integer(c_int) :: n = 0
-    contains
-        procedure :: rhs => cp_rhs
-    end type callback_param_system
-
-    !> The same with its exact Jacobian df/dy from a Python jac(t, y, p, dfdy, n).
-    type, extends(callback_param_system) :: callback_param_jac_system
-        procedure(), pointer, nopass :: jf => null()
-    contains
-        procedure :: jacobian => cpj_jacobian
-        procedure :: has_jacobian => cpj_has_jacobian
-    end type callback_param_jac_system
-
 contains
-
-    function ce_value(self, y, p) result(e)
-        class(callback_energy), intent(in) :: self
-        real(dp), intent(in) :: y(:), p
-        real(dp) :: e
-        real(c_double) :: yy(self%n)
-        yy = y
-        e = 0.0_dp
-        call self%f(yy, p, e, self%n)
-    end function ce_value
-
-    subroutine cp_rhs(self, t, y, dydt)
-        class(callback_param_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        call self%f(t, y, self%p, dydt, self%n)
-    end subroutine cp_rhs
-
-    subroutine cpj_jacobian(self, t, y, dfdy)
-        class(callback_param_jac_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        call self%jf(t, y, self%p, dfdy, self%n)
-    end subroutine cpj_jacobian
-
-    logical function cpj_has_jacobian(self)
-        class(callback_param_jac_system), intent(in) :: self
-        cpj_has_jacobian = associated(self%jf)
-    end function cpj_has_jacobian
 
     !> set_param for both wrappers (a built-in system is rebuilt with the new parameter).
     subroutine set_param_any(sys, p)
@@ -87,7 +31,7 @@ contains
         select type (sys)
         type is (builtin_param_system)
             call set_builtin_param(sys, p)
-        class is (callback_param_system)
+        class is (callback_system)
             sys%p = p
         end select
     end subroutine set_param_any

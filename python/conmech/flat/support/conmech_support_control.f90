@@ -17,12 +17,12 @@
 !!           xs(n, ng+1), fs, as, qs(n, k, ng+1), qd, ks(m, k, ng+1), km, then the
 !!           nominal's rlaw]
 module conmech_support_control
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_funptr, &
-                                           c_null_funptr, c_intptr_t, c_f_procpointer
+    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_null_funptr, c_intptr_t
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_generalized, only: generalized_system
     use conmech_flat_spec, only: spec_generalized
+    use conmech_flat_adapters, only: callback_law, c_law, zero_law
     use conmech_control_system, only: feedback_law
     use conmech_mech_plant, only: mech_plant
     use conmech_vhc, only: vhc, vhc_law
@@ -32,74 +32,8 @@ module conmech_support_control
     public :: callback_law, c_law, zero_law, build_plant, build_vhc, build_law, law_rsize
     public :: project_states, build_plant_law
 
-    !> u from an external procedure law(t, x, u, n, m).
-    type, extends(feedback_law) :: callback_law
-        procedure(), pointer, nopass :: f => null()
-        integer(c_int) :: n = 0
-    contains
-        procedure :: eval => cb_eval
-    end type callback_law
-
-    abstract interface
-        subroutine c_law_fun(t, x, u, p) bind(c)
-            import :: c_double
-            real(c_double), value :: t
-            real(c_double), intent(in) :: x(*), p(*)
-            real(c_double), intent(out) :: u(*)
-        end subroutine c_law_fun
-    end interface
-
-    !> u from a compiled function with parameters.
-    type, extends(feedback_law) :: c_law
-        type(c_funptr) :: fp = c_null_funptr
-        real(dp), allocatable :: p(:)
-    contains
-        procedure :: eval => c_eval
-    end type c_law
-
-    !> u = 0.
-    type, extends(feedback_law) :: zero_law
-    contains
-        procedure :: eval => z_eval
-    end type zero_law
 
 contains
-
-    subroutine cb_eval(self, t, x, u)
-        class(callback_law), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: x(:)
-        real(dp), intent(out) :: u(:)
-        real(c_double) :: tt, xx(size(x)), uu(size(u))
-        tt = t
-        xx = x
-        call self%f(tt, xx, uu, self%n, int(self%n_inputs, c_int))
-        u = uu
-    end subroutine cb_eval
-
-    subroutine c_eval(self, t, x, u)
-        class(c_law), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: x(:)
-        real(dp), intent(out) :: u(:)
-        procedure(c_law_fun), pointer :: f
-        real(c_double) :: pdum(1)
-        call c_f_procpointer(self%fp, f)
-        if (size(self%p) > 0) then
-            call f(t, x, u, self%p)
-        else
-            pdum = 0.0_c_double
-            call f(t, x, u, pdum)
-        end if
-    end subroutine c_eval
-
-    subroutine z_eval(self, t, x, u)
-        class(zero_law), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: x(:)
-        real(dp), intent(out) :: u(:)
-        u = 0.0_dp
-    end subroutine z_eval
 
     !> The plant (see the module notes). info /= 0 with a message if the system is not a
     !! generalized one or the sizes do not match.

@@ -5,49 +5,14 @@ module conmech_support_stab
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
-    use conmech_ode_system, only: ode_system
+    use conmech_flat_adapters, only: callback_hill
     use conmech_ode_solver, only: ode_options
     use conmech_variational, only: integrate_stm
     implicit none
     private
     public :: callback_hill_solve
 
-    !> Hill's equation y = [N, N'] with Phi from an external phi(t, p).
-    type, extends(ode_system) :: callback_hill
-        procedure(), pointer, nopass :: g => null()
-    contains
-        procedure :: rhs => callback_hill_rhs
-        procedure :: jacobian => callback_hill_jac
-        procedure :: has_jacobian => callback_hill_has_jac
-    end type callback_hill
-
 contains
-
-    subroutine callback_hill_rhs(self, t, y, dydt)
-        class(callback_hill), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dydt(:)
-        real(c_double) :: p
-        call self%g(t, p)
-        dydt(1) = y(2)
-        dydt(2) = -p*y(1)
-    end subroutine callback_hill_rhs
-
-    subroutine callback_hill_jac(self, t, y, dfdy)
-        class(callback_hill), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: y(:)
-        real(dp), intent(out) :: dfdy(:, :)
-        real(c_double) :: p
-        call self%g(t, p)
-        dfdy = reshape([0.0_dp, -p, 1.0_dp, 0.0_dp], [2, 2])
-    end subroutine callback_hill_jac
-
-    logical function callback_hill_has_jac(self)
-        class(callback_hill), intent(in) :: self
-        callback_hill_has_jac = .true.
-    end function callback_hill_has_jac
 
     !> Monodromy of N'' + Phi(t) N = 0 over one period, Phi from the external phi(t, p).
     subroutine callback_hill_solve(phi, period, rtol, mono, half_trace, det, info, message)

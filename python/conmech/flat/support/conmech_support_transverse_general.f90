@@ -1,6 +1,6 @@
 !> Support of the flat layer for the general transverse linearisation (compiled, not
 !! wrapped): the system and its transverse model from a built-in name or a compiled spec,
-!! a model with a Python energy gradient, and the packing of a `transverse_frame` into the
+!! the model with a Python energy gradient (conmech_flat_adapters, re-exported), and the packing of a `transverse_frame` into the
 !! flat routine's output arrays.
 !!
 !! Callback convention: egrad(t, y, g, n), real(c_double) t, y(n), g(n); integer(c_int) n.
@@ -19,6 +19,7 @@ module conmech_support_transverse_general
     use conmech_systems_basic, only: kepler_2d
     use conmech_transverse_mech, only: generalized_model, constrained_model, constrained_index1
     use conmech_transverse_general, only: transverse_frame, transverse_eval, transverse_hill
+    use conmech_flat_adapters, only: callback_energy_model
     implicit none
     private
     public :: callback_energy_model, system_and_model, pack_frame
@@ -32,16 +33,6 @@ module conmech_support_transverse_general
         procedure :: energy => bem_energy
         procedure :: energy_gradient => bem_energy_gradient
     end type builtin_energy_model
-
-    !> A model whose energy gradient is an external procedure egrad(t, y, g, n).
-    type, extends(transverse_model) :: callback_energy_model
-        procedure(), pointer, nopass :: egrad => null()
-        logical :: present = .false.
-        integer(c_int) :: n = 0
-    contains
-        procedure :: has_energy => cem_has_energy
-        procedure :: energy_gradient => cem_energy_gradient
-    end type callback_energy_model
 
 contains
 
@@ -84,22 +75,6 @@ contains
             g = [s%mu*x(1)/r3, s%mu*x(2)/r3, x(3), x(4)]
         end select
     end subroutine bem_energy_gradient
-
-    logical function cem_has_energy(self)
-        class(callback_energy_model), intent(in) :: self
-        cem_has_energy = self%present
-    end function cem_has_energy
-
-    subroutine cem_energy_gradient(self, t, x, g)
-        class(callback_energy_model), intent(in) :: self
-        real(dp), intent(in) :: t, x(:)
-        real(dp), intent(out) :: g(:)
-        real(c_double) :: tt, xx(size(x)), gg(size(x))
-        tt = t
-        xx = x
-        call self%egrad(tt, xx, gg, self%n)
-        g = gg
-    end subroutine cem_energy_gradient
 
     !> The first-order system and its transverse model: a generalized system (built-in or
     !! compiled: its energy), a constrained one (index-1 form; its manifold normals and
