@@ -33,6 +33,8 @@ import sympy as sp
 
 from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
+from .taylor_first_order import first_order_procedures
+from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["generalized_decomposition", "generalized_procedures", "WRITE_OUT_MAX"]
 
@@ -268,37 +270,14 @@ def generalized_procedures(g, names, prefix="conmech_taylor", write_out=None, np
     ind = "        "
     nw = g.ncol
     m = 2*g.n
-    lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
-             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
-             f"{ind}real(dp), value, intent(in) :: t",
-             f"{ind}integer(c_int), value, intent(in) :: order",
-             f"{ind}real(dp), intent(inout) :: w(0:order, {nw})",
-             f"{ind}real(dp), intent(in) :: p({npar})"]
     decl, body = generalized_body(g, names, ind, write_out)
-    lines += decl + body + [f"    end subroutine {prefix}", ""]
-    lines += [f'    subroutine {prefix}_info(info) bind(C, name="{prefix}_info")',
-              f"{ind}integer(c_int), intent(out) :: info(4)",
-              f"{ind}info = [{nw}, 0, {m}, 0]",
-              f"    end subroutine {prefix}_info", ""]
-    lines += [f'    subroutine {prefix}_rhs(t, y, dydt, p) bind(C, name="{prefix}_rhs")',
-              f"{ind}real(dp), value, intent(in) :: t",
-              f"{ind}real(dp), intent(in) :: y({m})",
-              f"{ind}real(dp), intent(out) :: dydt({m})",
-              f"{ind}real(dp), intent(in) :: p({npar})",
-              f"{ind}real(dp) :: w(0:1, {nw})",
-              f"{ind}w = 0.0_dp",
-              f"{ind}w(0, 1:{m}) = y",
-              f"{ind}call {prefix}(t, 1_c_int, w, p)",
-              f"{ind}dydt = w(1, 1:{m})",
-              f"    end subroutine {prefix}_rhs", ""]
-    return lines
+    return first_order_procedures(prefix, nw, m, npar, decl, body, ind)
 
 
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
     library (conmech.symbolic.taylor_library): the core only; the batch, quadruple
     precision and variational parts are not generated for generalized systems."""
-    from .taylor_tree import is_tree, tree_lines
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)
     if "g" not in dec_cache:

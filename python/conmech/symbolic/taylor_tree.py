@@ -37,6 +37,7 @@ import sympy as sp
 from .spatial_aba import _spatial_aba
 from .taylor import _Printer, _wrap, body_lines
 from .taylor_decompose import TaylorUnsupported, decompose
+from .taylor_first_order import first_order_procedures
 from .tree_aba import _aba
 
 __all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_procedures", "tree_lines",
@@ -116,29 +117,7 @@ def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
     body = body[:at] + checks + body[at:]
     if checks:
         decl = decl + [f"{ind}real(dp) :: pivot"]
-    lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
-             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
-             f"{ind}real(dp), value, intent(in) :: t",
-             f"{ind}integer(c_int), value, intent(in) :: order",
-             f"{ind}real(dp), intent(inout) :: w(0:order, {nw})",
-             f"{ind}real(dp), intent(in) :: p({npar})"]
-    lines += decl + body + [f"    end subroutine {prefix}", ""]
-    lines += [f'    subroutine {prefix}_info(info) bind(C, name="{prefix}_info")',
-              f"{ind}integer(c_int), intent(out) :: info(4)",
-              f"{ind}info = [{nw}, 0, {m}, 0]",
-              f"    end subroutine {prefix}_info", ""]
-    lines += [f'    subroutine {prefix}_rhs(t, y, dydt, p) bind(C, name="{prefix}_rhs")',
-              f"{ind}real(dp), value, intent(in) :: t",
-              f"{ind}real(dp), intent(in) :: y({m})",
-              f"{ind}real(dp), intent(out) :: dydt({m})",
-              f"{ind}real(dp), intent(in) :: p({npar})",
-              f"{ind}real(dp) :: w(0:1, {nw})",
-              f"{ind}w = 0.0_dp",
-              f"{ind}w(0, 1:{m}) = y",
-              f"{ind}call {prefix}(t, 1_c_int, w, p)",
-              f"{ind}dydt = w(1, 1:{m})",
-              f"    end subroutine {prefix}_rhs", ""]
-    return lines
+    return first_order_procedures(prefix, nw, m, npar, decl, body, ind)
 
 
 def tree_lines(d, names, part, dec_cache):

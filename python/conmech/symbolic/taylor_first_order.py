@@ -1,0 +1,35 @@
+"""The Fortran procedures every Taylor library of a second-order system exports around its
+recurrences (generalized systems M(q) q'' = Q and trees): the recurrences of the
+first-order view y = [q; v] as ``prefix(t, order, w, p)``, ``prefix_info(info)`` (the
+columns of w and the size 2n of the view) and ``prefix_rhs(t, y, dydt, p)``, the view's
+right-hand side as the order-1 coefficient of the same recurrences."""
+
+__all__ = ["first_order_procedures"]
+
+
+def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
+    """Fortran lines of the three procedures around the recurrences' declarations `decl`
+    and statements `body` (w has `nw` columns, the state `m` entries, p `npar`)."""
+    lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
+             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{ind}real(dp), value, intent(in) :: t",
+             f"{ind}integer(c_int), value, intent(in) :: order",
+             f"{ind}real(dp), intent(inout) :: w(0:order, {nw})",
+             f"{ind}real(dp), intent(in) :: p({npar})"]
+    lines += decl + body + [f"    end subroutine {prefix}", ""]
+    lines += [f'    subroutine {prefix}_info(info) bind(C, name="{prefix}_info")',
+              f"{ind}integer(c_int), intent(out) :: info(4)",
+              f"{ind}info = [{nw}, 0, {m}, 0]",
+              f"    end subroutine {prefix}_info", ""]
+    lines += [f'    subroutine {prefix}_rhs(t, y, dydt, p) bind(C, name="{prefix}_rhs")',
+              f"{ind}real(dp), value, intent(in) :: t",
+              f"{ind}real(dp), intent(in) :: y({m})",
+              f"{ind}real(dp), intent(out) :: dydt({m})",
+              f"{ind}real(dp), intent(in) :: p({npar})",
+              f"{ind}real(dp) :: w(0:1, {nw})",
+              f"{ind}w = 0.0_dp",
+              f"{ind}w(0, 1:{m}) = y",
+              f"{ind}call {prefix}(t, 1_c_int, w, p)",
+              f"{ind}dydt = w(1, 1:{m})",
+              f"    end subroutine {prefix}_rhs", ""]
+    return lines
