@@ -5,10 +5,10 @@
 !! counts = [nfev, nsteps, naccept, nreject].
 subroutine flat_dop853_quad(fnaddr, nw, np, params, n, y0, t_span, rtol, atol, max_steps, &
                             fixed_steps, y1, counts, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_intptr_t, c_funptr, &
-                                           c_null_funptr, c_f_procpointer
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_BAD_INPUT
     use conmech_taylor_quad, only: qp, taylor_qp_fn
+    use conmech_flat_quad_pairs, only: from_pairs, from_pair, to_pairs, quad_routine
     use conmech_dop853_quad, only: dop853_propagate_qp, dop853_qp_counts
     use conmech_flat_ode_support, only: copy_message
     implicit none
@@ -20,11 +20,10 @@ subroutine flat_dop853_quad(fnaddr, nw, np, params, n, y0, t_span, rtol, atol, m
     integer(c_int), intent(out) :: counts(4), info
     character(len=256), intent(out) :: message
     procedure(taylor_qp_fn), pointer :: fn
-    type(c_funptr) :: fp
     type(dop853_qp_counts) :: cnt
-    real(qp) :: y(n), p(max(np, 1)), yq
+    real(qp) :: y(n), p(max(np, 1))
     character(len=:), allocatable :: msg
-    integer :: i, inf
+    integer :: inf
     y1 = y0
     counts = 0
     if (fnaddr == 0 .or. nw < n .or. n < 1 .or. np < 0) then
@@ -32,24 +31,13 @@ subroutine flat_dop853_quad(fnaddr, nw, np, params, n, y0, t_span, rtol, atol, m
         call copy_message("bad input: invalid quadruple-precision Taylor routine", message)
         return
     end if
-    fp = transfer(int(fnaddr, c_intptr_t), c_null_funptr)
-    call c_f_procpointer(fp, fn)
-    do i = 1, n
-        y(i) = real(y0(1, i), qp) + real(y0(2, i), qp)
-    end do
-    do i = 1, max(np, 1)
-        p(i) = real(params(1, i), qp) + real(params(2, i), qp)
-    end do
-    call dop853_propagate_qp(fn, n, nw, p, real(t_span(1, 1), qp) + real(t_span(2, 1), qp), &
-                             real(t_span(1, 2), qp) + real(t_span(2, 2), qp), y, &
-                             real(rtol(1), qp) + real(rtol(2), qp), &
-                             real(atol(1), qp) + real(atol(2), qp), max_steps, inf, msg, cnt, &
+    call quad_routine(fnaddr, fn)
+    y = from_pairs(y0)
+    p = from_pairs(params)
+    call dop853_propagate_qp(fn, n, nw, p, from_pair(t_span(:, 1)), from_pair(t_span(:, 2)), &
+                             y, from_pair(rtol), from_pair(atol), max_steps, inf, msg, cnt, &
                              fixed_steps=fixed_steps)
-    do i = 1, n
-        yq = y(i)
-        y1(1, i) = real(yq, c_double)
-        y1(2, i) = real(yq - real(y1(1, i), qp), c_double)
-    end do
+    call to_pairs(y, y1)
     counts = [cnt%nfev, cnt%nsteps, cnt%naccept, cnt%nreject]
     info = inf
     call copy_message(msg, message)

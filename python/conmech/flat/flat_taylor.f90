@@ -188,10 +188,10 @@ end subroutine flat_taylor_ensemble
 !! steps at order `order`.
 subroutine flat_taylor_quad(fnaddr, nw, np, params, n, y0, t_span, tol, max_steps, y1, &
                             nsteps, order, info, message)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_intptr_t, c_funptr, &
-                                           c_null_funptr, c_f_procpointer
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, status_message
     use conmech_taylor_quad, only: qp, taylor_qp_fn, taylor_propagate_qp
+    use conmech_flat_quad_pairs, only: from_pairs, from_pair, to_pairs, quad_routine
     use conmech_flat_ode_support, only: copy_message
     implicit none
     integer(8), intent(in) :: fnaddr
@@ -201,9 +201,8 @@ subroutine flat_taylor_quad(fnaddr, nw, np, params, n, y0, t_span, tol, max_step
     integer(c_int), intent(out) :: nsteps, order, info
     character(len=256), intent(out) :: message
     procedure(taylor_qp_fn), pointer :: fn
-    type(c_funptr) :: fp
-    real(qp) :: y(n), p(max(np, 1)), yq
-    integer :: i, ns, ord, inf
+    real(qp) :: y(n), p(max(np, 1))
+    integer :: ns, ord, inf
     y1 = y0
     nsteps = 0
     order = 0
@@ -212,22 +211,12 @@ subroutine flat_taylor_quad(fnaddr, nw, np, params, n, y0, t_span, tol, max_step
         call copy_message("bad input: invalid quadruple-precision Taylor routine", message)
         return
     end if
-    fp = transfer(int(fnaddr, c_intptr_t), c_null_funptr)
-    call c_f_procpointer(fp, fn)
-    do i = 1, n
-        y(i) = real(y0(1, i), qp) + real(y0(2, i), qp)
-    end do
-    do i = 1, max(np, 1)
-        p(i) = real(params(1, i), qp) + real(params(2, i), qp)
-    end do
-    call taylor_propagate_qp(fn, n, nw, p, real(t_span(1, 1), qp) + real(t_span(2, 1), qp), &
-                             real(t_span(1, 2), qp) + real(t_span(2, 2), qp), y, &
-                             real(tol(1), qp) + real(tol(2), qp), max_steps, inf, ns, ord)
-    do i = 1, n
-        yq = y(i)
-        y1(1, i) = real(yq, c_double)
-        y1(2, i) = real(yq - real(y1(1, i), qp), c_double)
-    end do
+    call quad_routine(fnaddr, fn)
+    y = from_pairs(y0)
+    p = from_pairs(params)
+    call taylor_propagate_qp(fn, n, nw, p, from_pair(t_span(:, 1)), from_pair(t_span(:, 2)), &
+                             y, from_pair(tol), max_steps, inf, ns, ord)
+    call to_pairs(y, y1)
     nsteps = ns
     order = ord
     info = inf
