@@ -15,17 +15,17 @@ MU = cr3bp.MU_EARTH_MOON
 
 def _libration_mp(mu, k):
     """L_k (k = 1, 2, 3) as a root of Omega_x(x, 0, 0) at 30 digits (mpmath)."""
-    mpmath.mp.dps = 30
-    mu = mpmath.mpf(mu)
+    with mpmath.workdps(30):      # the caller's precision is left as it was
+        mu = mpmath.mpf(mu)
 
-    def ox(x):
-        d1, d2 = x + mu, x - 1 + mu
-        return x - (1 - mu)*d1/abs(d1)**3 - mu*d2/abs(d2)**3
-    guess = {1: 1 - mu - (mu/3)**(mpmath.mpf(1)/3), 2: 1 - mu + (mu/3)**(mpmath.mpf(1)/3),
-             3: -1 - 5*mu/12}[k]
-    x = mpmath.findroot(ox, guess)
-    r1, r2 = abs(x + mu), abs(x - 1 + mu)
-    return x, x*x + 2*((1 - mu)/r1 + mu/r2)
+        def ox(x):
+            d1, d2 = x + mu, x - 1 + mu
+            return x - (1 - mu)*d1/abs(d1)**3 - mu*d2/abs(d2)**3
+        guess = {1: 1 - mu - (mu/3)**(mpmath.mpf(1)/3), 2: 1 - mu + (mu/3)**(mpmath.mpf(1)/3),
+                 3: -1 - 5*mu/12}[k]
+        x = mpmath.findroot(ox, guess)
+        r1, r2 = abs(x + mu), abs(x - 1 + mu)
+        return x, x*x + 2*((1 - mu)/r1 + mu/r2)
 
 
 @pytest.mark.parametrize("mu", [MU, 0.5, 1e-6, 0.2])

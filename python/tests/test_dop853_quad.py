@@ -23,7 +23,14 @@ sp = pytest.importorskip("sympy")
 from conmech import symbolic  # noqa: E402
 from conmech.symbolic import taylor_quad  # noqa: E402
 
-mpmath.mp.dps = 50
+
+
+@pytest.fixture(autouse=True)
+def _fifty_digits():
+    """mpmath at 50 digits inside each test of this module (the global precision of the
+    other modules' tests left as it was)."""
+    with mpmath.workdps(50):
+        yield
 
 ARENSTORF_Y0 = ["0.994", "0", "0", "-2.00158510637908252240537862224"]
 ARENSTORF_T = "17.0652165601579625588917206249"   # Hairer, Norsett, Wanner I, II.0
