@@ -21,9 +21,6 @@ _HUGE = float(np.finfo(float).max)
 # (the fixed-step ones need first_step) on a first-order system. Bounded: only names the
 # table knows get in, in the spellings users typed.
 _CODES = {}
-# (id(system), rtol, atol) -> (system, the system method TAYLOR runs for them): the
-# Taylor entries, once made, are fixed, so the look-up of taylor_system is made once
-_TAYLOR = {}
 # (value, n) -> read-only tolerance array of that value (the flat call reads it only)
 _TOLERANCES = {}
 
@@ -104,15 +101,8 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
     if y is None:
         return None
     if code == taylor_code:
-        hit = _TAYLOR.get((id(fun), rtol, atol))
-        if hit is not None and hit[0] is fun:
-            fun = hit[1]
-        elif getattr(fun, "taylor", None):      # as solve_ivp: the written-out recurrences
-            run = taylor_system(fun, rtol, atol)
-            if len(_TAYLOR) >= 64:
-                _TAYLOR.clear()
-            _TAYLOR[(id(fun), rtol, atol)] = (fun, run)    # fun kept: its id stays its own
-            fun = run
+        if getattr(fun, "taylor", None):        # as solve_ivp: the written-out recurrences
+            fun = taylor_system(fun, rtol, atol)    # (cached per system and order there)
         elif getattr(fun, "kind", None) == "generalized":
             return None                         # its first-order view: the full path
     return solve_native(fun, t0, tf, y, _EMPTY, False, code, _tolerance(rtol, n),
