@@ -24,6 +24,7 @@ def _both(fun, t_span, y0, **kw):
     fast = conmech.solve_ivp(fun, t_span, y0, **kw)
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(solve_mod, "_solve_native", _general)
+        mp.setattr(solve_mod, "_fast_solve", lambda *a: None)     # the fast entry too
         full = conmech.solve_ivp(fun, t_span, y0, **kw)
     return fast, full
 
@@ -90,6 +91,7 @@ def test_bad_input_raises_the_same():
             conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
         with pytest.MonkeyPatch.context() as mp:
             mp.setattr(solve_mod, "_solve_native", _general)
+            mp.setattr(solve_mod, "_fast_solve", lambda *a: None)
             with pytest.raises(ValueError) as full:
                 conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
         assert str(fast.value) == str(full.value)

@@ -15,12 +15,12 @@ Y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
 @pytest.fixture
 def counted(monkeypatch):
     calls = []
-    real = solve_fast.solve_native
+    real = solve_fast.run_native
 
     def wrapped(*a, **k):
         calls.append(a)
         return real(*a, **k)
-    monkeypatch.setattr(solve_fast, "solve_native", wrapped)
+    monkeypatch.setattr(solve_fast, "run_native", wrapped)
     return calls
 
 
