@@ -16,14 +16,16 @@
 !! [t0, tf]. ipar = [np, nspec, method, max_steps, neval, with_t_eval] (method as
 !! flat_solve, METHOD_RK45_SCIPY included; with_t_eval /= 0: the points are t_eval's); rpar = [first_step, max_step, rtol(1:n), atol(1:n),
 !! t_eval(1:max(neval, 1))] (neval = 0: a point at every step, one unused number last).
-!! On return iout = [nt, nfev, njev, nlu, naccept, nreject, info, handle]: nt > 0 points
+!! On return iout(1:8) = [nt, nfev, njev, nlu, naccept, nreject, info, handle] and
+!! iout(9:40) the message, its 256 characters as bytes (f2py's character output costs a
+!! loop over every character on every call; this is read only when needed): nt > 0 points
 !! in out (layout above); nt < 0: -nt points, more than out holds, kept at `handle` for
 !! flat_solve_take (which must be called once, to take or to free them). Points as
 !! solve_ivp returns them: a zero-length span without t_eval gives (t0, y0) twice (SciPy's
 !! solver makes one empty step), a run that stored no point gives (t0, y0). info is the
 !! run's status (0 end reached, < 0 failure, CM_BAD_INPUT refused) with its message.
 subroutine flat_solve_packed(name, lp, params, ls, spec, ipar, lr, rpar, t0, tf, n, y0, &
-                             nout, out, iout, message)
+                             nout, out, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_loc, c_intptr_t
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
@@ -41,8 +43,8 @@ subroutine flat_solve_packed(name, lp, params, ls, spec, ipar, lr, rpar, t0, tf,
     real(c_double), intent(in) :: t0, tf
     real(c_double), intent(in) :: y0(n)
     real(c_double), intent(inout) :: out(nout)
-    integer(c_int64_t), intent(inout) :: iout(8)
-    character(len=256), intent(out) :: message
+    integer(c_int64_t), intent(inout) :: iout(40)
+    character(len=256) :: message
     class(ode_system), allocatable :: sys
     type(ode_result) :: res
     type(ode_result), pointer :: kept
@@ -57,6 +59,7 @@ subroutine flat_solve_packed(name, lp, params, ls, spec, ipar, lr, rpar, t0, tf,
         lr < 2 + 2*n + max(neval, 1) .or. nout < 2*(n + 1)) then
         iout(7) = CM_BAD_INPUT
         call copy_message("bad input: packed arguments of inconsistent sizes", message)
+        iout(9:40) = transfer(message, iout(9:40))
         return
     end if
     message = ""
@@ -72,6 +75,7 @@ subroutine flat_solve_packed(name, lp, params, ls, spec, ipar, lr, rpar, t0, tf,
     end if
     iout(2:6) = counts
     iout(7) = info
+    iout(9:40) = transfer(message, iout(9:40))
     if (info == CM_BAD_INPUT) return
     if (tf == t0 .and. ipar(6) == 0) then
         ! SciPy's solver makes one (empty) step: t = [t0, t0]

@@ -27,10 +27,10 @@ _TEMPLATE = dict(t=None, y=None, sol=None, t_events=None, y_events=None, nfev=0,
 
 def prepare(fun, code, rtol, atol, h0, hmax, max_steps, t_ev=None):
     """The packed fixed arguments of flat_solve_packed for the system ``fun`` (checked
-    arguments): (fun, params, spec, ipar, rpar, n), where params and spec are the arrays
-    they were packed for (a system given new ones is packed again), ipar = [np, nspec,
-    method, max_steps, neval, with t_eval], rpar = [first_step, max_step, rtol, atol, t_eval or one
-    unused number]."""
+    arguments): (fun, params, spec, ipar, rpar, n, name as bytes), where params and spec
+    are the arrays they were packed for (a system given new ones is packed again),
+    ipar = [np, nspec, method, max_steps, neval, with t_eval], rpar = [first_step,
+    max_step, rtol, atol, t_eval or one unused number]."""
     params, spec = fun.params, fun.spec
     n = fun.dimension
     neval = 0 if t_ev is None else t_ev.size
@@ -39,7 +39,7 @@ def prepare(fun, code, rtol, atol, h0, hmax, max_steps, t_ev=None):
     rpar = np.concatenate([[h0, hmax], np.broadcast_to(rtol, (n,)),
                            np.broadcast_to(atol, (n,)), t_ev if neval else _PAD])
     ipar.flags.writeable = rpar.flags.writeable = False
-    return fun, params, spec, ipar, rpar, n
+    return fun, params, spec, ipar, rpar, n, fun.name.encode("ascii", "replace")
 
 
 def run(prep, t0, tf, y0, cap=0):
@@ -47,16 +47,16 @@ def run(prep, t0, tf, y0, cap=0):
     (:func:`prepare`) from ``y0`` (n finite numbers: an array, list or tuple) over
     [t0, tf]; room for ``cap`` points in one call (0: _OUT_DOUBLES numbers; 2 for a
     zero-length span)."""
-    fun, params, spec, ipar, rpar, n = prep
+    fun, params, spec, ipar, rpar, n, name = prep
     if not cap:
         cap = 2 if tf == t0 else max(_OUT_DOUBLES // (n + 1), 2)
     out = np.empty(cap*(n + 1))
-    iout = np.empty(8, dtype=_INT64)
-    message = _conmech.flat_solve_packed(fun.name, params if params.size else _PAD, spec,
-                                         ipar, rpar, t0, tf, y0, out, iout)
-    nt, nfev, njev, nlu, naccept, nreject, info, handle = iout.tolist()
+    iout = np.empty(40, dtype=_INT64)       # 8 numbers, then the message's 256 bytes
+    _conmech.flat_solve_packed(name, params if params.size else _PAD, spec, ipar, rpar, t0,
+                               tf, y0, out, iout)
+    nt, nfev, njev, nlu, naccept, nreject, info, handle = iout[:8].tolist()
     if info == BAD_INPUT:
-        raise ValueError(message_text(message))
+        raise ValueError(message_text(iout[8:]))
     if nt < 0:
         nt = -nt
         try:
@@ -78,9 +78,10 @@ def run(prep, t0, tf, y0, cap=0):
         res["naccept"], res["nreject"] = naccept, nreject
     if info:
         if info > 0:
-            res["status"], res["message"] = info, _MESSAGES.get(info) or message_text(message)
+            res["status"], res["message"] = info, _MESSAGES.get(info) or message_text(
+                iout[8:])
         else:
-            res["status"], res["message"] = -1, message_text(message)
+            res["status"], res["message"] = -1, message_text(iout[8:])
             res["success"] = False
     return res
 

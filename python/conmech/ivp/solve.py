@@ -15,7 +15,7 @@ from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
     real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
-    time_span as _time_span, tolerance as _tolerance
+    time_span as _time_span, step_controls as _step_controls
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
@@ -251,14 +251,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise ValueError(_COMPLEX_REFUSED)
 
     # ---------------------------------------------------------------- tolerances, steps
-    rtol_v = _tolerance(rtol, "rtol", n)
-    atol_v = _tolerance(atol, "atol", n)
-    if first_step is None:
-        h0 = 0.0
-    else:
-        h0 = _positive_finite(first_step, "first_step")
-        if h0 > abs(tf - t0) and tf != t0:
-            raise ValueError("first_step exceeds the length of t_span")
+    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf,
+                                        lambda h: _positive_finite(h, "first_step"))
     if info.fixed_step and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
