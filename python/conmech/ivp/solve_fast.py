@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR
+from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR, _warn_rtol
 from .methods import BY_NAME, RK45_SCIPY
 from .native_path import prepare, run as run_native
 
@@ -109,6 +109,8 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
         _PREPARED[key] = prep
     elif _state(y0, prep[6]) is None:
         return None
+    if rtol < RTOL_FLOOR:
+        _warn_rtol(4)           # SciPy's warning, at the user's call (Fortran raises rtol)
     return run_native(prep[1:], t0, tf, y0)
 
 
@@ -118,7 +120,7 @@ def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
     code = fast_method_code(method)
     if not code:
         return None
-    if not (0.0 <= atol < math.inf and RTOL_FLOOR <= rtol < math.inf):
+    if not (0.0 <= atol < math.inf and 0.0 <= rtol < math.inf):
         return None
     n = fun.dimension
     run_fun = fun
