@@ -99,3 +99,30 @@ def test_bad_input_raises_the_same():
         conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.nan, 0.0, 1.0])
     with pytest.raises(ValueError, match="finite"):
         conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.inf] + [0.0] * 2)
+
+
+def test_packed_arguments_of_inconsistent_sizes_refused():
+    # flat_solve_packed checks the packed arrays against the state's size: a refusal with
+    # a message, never a read past an array
+    from conmech import _conmech
+    from conmech.ivp import native_path
+    from conmech.ivp.methods import BY_NAME
+    from conmech._core.status import BAD_INPUT
+    k = conmech.systems.kepler(1.0)
+    tol = np.full(4, 1e-8)
+    fun, params, spec, ipar, rpar, n, name = native_path.prepare(
+        k, BY_NAME["DOP853"].code, tol, tol, 0.0, 1e300, 1000)
+    y0 = np.array(KEPLER_Y0)
+    for r, out in ((rpar[:-2], np.empty(50)), (rpar, np.empty(2*n + 1))):
+        iout = np.zeros(40, dtype=np.int64)
+        _conmech.flat_solve_packed(name, params, spec, ipar, r, 0.0, 1.0, y0, out, iout)
+        assert iout[6] == BAD_INPUT and iout[0] == 0
+        assert "inconsistent sizes" in native_path.message_text(iout[8:])
+    iout = np.zeros(40, dtype=np.int64)
+    out = np.empty(2*(n + 1))          # room for two points: the run's are kept for take
+    _conmech.flat_solve_packed(name, params, spec, ipar, rpar, 0.0, 1.0, y0, out, iout)
+    nt = -int(iout[0])
+    assert iout[6] == 0 and nt > 2 and iout[7] != 0
+    # a take that does not match the kept points copies nothing (and frees them)
+    assert _conmech.flat_solve_take(int(iout[7]), n, nt + 1, np.empty((nt + 1)*(n + 1))) \
+        == BAD_INPUT

@@ -126,3 +126,21 @@ def test_fast_symbolic_with_params(counted, method):
     assert len(counted) == 1
     _same(fast, full)
     assert np.max(np.abs(fast.y[:, -1] - Y0)) < 1e-9      # one period closes the orbit
+
+
+def test_prepared_call_reads_the_systems_parameters(counted):
+    # the packed arguments are kept per system, method and tolerances; the parameters
+    # are the system's at each call (changed in place or given a new array)
+    k = conmech.systems.kepler(1.0)
+    ref = {mu: conmech.solve_ivp(conmech.systems.kepler(mu), (0.0, 2.0), Y0,
+                                 method="DOP853", rtol=1e-9, atol=1e-9) for mu in (1.0, 2.0)}
+    r1 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    k.params[0] = 2.0
+    r2 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    k.params = np.array([1.0])
+    r3 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    assert len(counted) == 5
+    _same(r1, ref[1.0])
+    _same(r2, ref[2.0])
+    _same(r3, ref[1.0])
+    assert not np.array_equal(r1.y, r2.y)
