@@ -54,9 +54,14 @@ def run(prep, t0, tf, y0, cap=0):
     iout = np.empty(40, dtype=_INT64)       # 8 numbers, then the message's 256 bytes
     _conmech.flat_solve_packed(name, params if params.size else _PAD, spec, ipar, rpar, t0,
                                tf, y0, out, iout)
+    return _result(out, iout, n)
+
+
+def _take(out, iout, n, guard=None):
+    """(the points' array, nt, counts..., info) of a packed call's outputs: the kept points
+    taken when they did not fit; ``guard``'s error (an exception of a Python function)
+    raised once they are freed; a refusal raised as ValueError."""
     nt, nfev, njev, nlu, naccept, nreject, info, handle = iout[:8].tolist()
-    if info == BAD_INPUT:
-        raise ValueError(message_text(iout[8:]))
     if nt < 0:
         nt = -nt
         try:
@@ -65,7 +70,17 @@ def run(prep, t0, tf, y0, cap=0):
             _conmech.flat_solve_take(handle, n, 0, _PAD)     # free the kept points
             raise
         _conmech.flat_solve_take(handle, n, nt, out)
-    elif nt*(n + 1) != out.size:
+    if guard is not None:
+        guard.check()
+    if info == BAD_INPUT:
+        raise ValueError(message_text(iout[8:]))
+    return out, nt, nfev, njev, nlu, naccept, nreject, info
+
+
+def _result(out, iout, n, guard=None):
+    """The OdeResult of a packed call's outputs (:func:`_take`)."""
+    out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
+    if nt*(n + 1) != out.size:
         out = out[:nt*(n + 1)].copy()       # the result does not hold on to the room
     res = OdeResult(_TEMPLATE)
     res["t"] = out[:nt]
@@ -83,6 +98,25 @@ def run(prep, t0, tf, y0, cap=0):
         else:
             res["status"], res["message"] = -1, message_text(iout[8:])
             res["success"] = False
+    return res
+
+
+def solve_callable(rhs, guard, n, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0,
+                   hmax, max_steps):
+    """solve_ivp of a Python right-hand side without events, dense output or a Jacobian
+    (checked arguments; ``rhs`` the guarded call-back fun(t, y, dydt, n), ``guard`` its
+    Guard): one call of flat_solve_rhs_packed, whose only call-back is ``rhs``."""
+    neval = t_ev.size if with_t_eval else 0
+    ipar = np.array([0, 0, code, max_steps, neval, with_t_eval], dtype=np.intc)
+    rpar = np.concatenate([[h0, hmax], rtol, atol, t_ev if neval else _PAD])
+    cap = max(t_ev.size, 2) if with_t_eval else 2 if tf == t0 else max(
+        _OUT_DOUBLES // (n + 1), 2)
+    out = np.empty(cap*(n + 1))
+    iout = np.zeros(40, dtype=_INT64)
+    _conmech.flat_solve_rhs_packed(rhs, ipar, rpar, t0, tf, y0, out, iout)
+    res = _result(out, iout, n, guard)
+    if with_t_eval and res.t.size == 0:
+        res.t, res.y = [], []   # SciPy's lists when no point of t_eval was reached
     return res
 
 

@@ -23,7 +23,8 @@ from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
 from .taylor_generalized import first_order_view, name_the_mass_matrix
 from .._core.native import _NO_SPEC, NativeSystem
-from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
+from .native_path import _OUT_DOUBLES, solve_native as _solve_native, \
+    solve_callable as _solve_callable  # noqa: F401 (tests)
 from .complex_form import complex_result as _complex_result, real_form as _real_form, \
     real_form_event as _real_form_event
 from .empty import solve_empty as _solve_empty
@@ -311,6 +312,13 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                    settings=settings, vectorized=bool(vectorized))
     if n == 0:
         return _solve_empty(**problem)
+    if not builtin and not settings and not dense_output and jac is None and pattern is None \
+            and not is_complex:
+        # a Python right-hand side and nothing else called back: one Fortran call whose
+        # only call-back is fun (its exceptions raised by the guard)
+        run = _Run(fun, False, args, n, [], problem["vectorized"], t0, None, None, y0)
+        return _solve_callable(run.rhs, run.guard, n, t0, tf, y0, t_ev, t_eval is not None,
+                               code, rtol_v, atol_v, h0, hmax, int(max_steps))
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
                   max_steps=int(max_steps), dense=int(bool(dense_output)))
     if not is_complex:
