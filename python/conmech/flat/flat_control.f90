@@ -462,7 +462,6 @@ subroutine flat_control_riccati(afun, bfun, k, m, period, qw, rw, rtol, atol, nt
                                 hmr, hmi, cmr, cmi, cl_mono, periodicity, min_eig, passes, &
                                 info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
     use conmech_periodic_riccati, only: riccati_options, riccati_result, periodic_riccati
     use conmech_flat_adapters, only: callback_lq
