@@ -82,7 +82,7 @@ subroutine flat_solve_rhs_packed(fun, ipar, lr, rpar, t0, tf, n, y0, nout, out, 
         end subroutine fun
     end interface
     class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
+    character(len=256) :: msg
     integer :: info
     integer(c_int64_t) :: nospec(1)
 
