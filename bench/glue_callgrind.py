@@ -13,14 +13,14 @@ of the flat routine the call ends in (callgrind_annotate), the glue the rest.
 Cases:
   step    conmech.DOP853(kepler).step(), one accepted step (flat_stepper_step_builtin)
   solve   conmech.solve_ivp(kepler, (0, 0.01), DOP853): the fixed cost of a short solve
-          of a built-in system (flat_solve_native)
+          of a built-in system (flat_solve_packed)
   hill    conmech.hill.variation_orbit(M_HILL) (flat_hill_orbit_checked)
   call    CompiledModel.call("rhs", t, y) of a symbolic ode model (the model's rhs, in
           its own library; the flat routine flat_entry_call_1 calls it)
   sym     solve_ivp(kepler from conmech.symbolic, (0, 0), DOP853): the fixed cost on a
-          compiled symbolic system (flat_solve_native)
+          compiled symbolic system (flat_solve_packed)
   symp    the same with a parameter (params={mu: 1.0})
-  taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_solve_native)
+  taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_solve_packed)
   py      solve_ivp(Python callable, (0, 0), DOP853) (flat_solve)
 
     python bench/glue_callgrind.py one CASE REPS        (what valgrind runs)
@@ -32,11 +32,13 @@ import subprocess
 import sys
 import tempfile
 
-# (the flat routine or model symbol whose inclusive count is the Fortran share)
-SYMBOLS = {"step": "flat_stepper_step_builtin_", "solve": "flat_solve_native_",
+# (the flat routine or model symbol whose inclusive count is the Fortran share; the
+# solve cases name the routine of an older build second, so that a build from before
+# flat_solve_packed is split the same way)
+_SOLVE = "flat_solve_packed_|flat_solve_native_"
+SYMBOLS = {"step": "flat_stepper_step_builtin_", "solve": _SOLVE,
            "hill": "flat_hill_orbit_checked_", "call": "conmech_rhs",
-           "sym": "flat_solve_native_", "symp": "flat_solve_native_",
-           "taylor": "flat_solve_native_", "py": "flat_solve_"}
+           "sym": _SOLVE, "symp": _SOLVE, "taylor": _SOLVE, "py": "flat_solve_"}
 
 
 def make(case):
@@ -109,12 +111,14 @@ def count(case, reps, tmp):
                 break
     ann = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", out],
                          capture_output=True, text=True).stdout
-    sym = SYMBOLS[case]
     fort = 0
-    for line in ann.splitlines():
-        m = re.match(r"\s*([\d,]+)\s.*[\s:]" + re.escape(sym) + r"(\s|$|\[)", line)
-        if m:
-            fort = int(m.group(1).replace(",", ""))
+    for sym in SYMBOLS[case].split("|"):
+        for line in ann.splitlines():
+            m = re.match(r"\s*([\d,]+)\s.*[\s:]" + re.escape(sym) + r"(\s|$|\[)", line)
+            if m:
+                fort = int(m.group(1).replace(",", ""))
+                break
+        if fort:
             break
     return total, fort
 

@@ -24,6 +24,7 @@ def _both(fun, t_span, y0, **kw):
     fast = conmech.solve_ivp(fun, t_span, y0, **kw)
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(solve_mod, "_solve_native", _general)
+        mp.setattr(solve_mod, "_fast_solve", lambda *a: None)     # the fast entry too
         full = conmech.solve_ivp(fun, t_span, y0, **kw)
     return fast, full
 
@@ -90,6 +91,7 @@ def test_bad_input_raises_the_same():
             conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
         with pytest.MonkeyPatch.context() as mp:
             mp.setattr(solve_mod, "_solve_native", _general)
+            mp.setattr(solve_mod, "_fast_solve", lambda *a: None)
             with pytest.raises(ValueError) as full:
                 conmech.solve_ivp(k, (0.0, 1.0), KEPLER_Y0, **kw)
         assert str(fast.value) == str(full.value)
@@ -97,3 +99,79 @@ def test_bad_input_raises_the_same():
         conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.nan, 0.0, 1.0])
     with pytest.raises(ValueError, match="finite"):
         conmech.solve_ivp(k, (0.0, 1.0), [0.5, np.inf] + [0.0] * 2)
+
+
+def test_packed_arguments_of_inconsistent_sizes_refused():
+    # flat_solve_packed checks the packed arrays against the state's size: a refusal with
+    # a message, never a read past an array
+    from conmech import _conmech
+    from conmech.ivp import native_path
+    from conmech.ivp.methods import BY_NAME
+    from conmech._core.status import BAD_INPUT
+    k = conmech.systems.kepler(1.0)
+    tol = np.full(4, 1e-8)
+    fun, params, spec, ipar, rpar, n, name = native_path.prepare(
+        k, BY_NAME["DOP853"].code, tol, tol, 0.0, 1e300, 1000)
+    y0 = np.array(KEPLER_Y0)
+    for r, out in ((rpar[:-2], np.empty(50)), (rpar, np.empty(2*n + 1))):
+        iout = np.zeros(40, dtype=np.int64)
+        _conmech.flat_solve_packed(name, params, spec, ipar, r, 0.0, 1.0, y0, out, iout)
+        assert iout[6] == BAD_INPUT and iout[0] == 0
+        assert "inconsistent sizes" in native_path.message_text(iout[8:])
+    iout = np.zeros(40, dtype=np.int64)
+    out = np.empty(2*(n + 1))          # room for two points: the run's are kept for take
+    _conmech.flat_solve_packed(name, params, spec, ipar, rpar, 0.0, 1.0, y0, out, iout)
+    nt = -int(iout[0])
+    assert iout[6] == 0 and nt > 2 and iout[7] != 0
+    # a take that does not match the kept points copies nothing (and frees them)
+    assert _conmech.flat_solve_take(int(iout[7]), n, nt + 1, np.empty((nt + 1)*(n + 1))) \
+        == BAD_INPUT
+
+
+def _general_callable(fun, t_span, y0, method, t_eval=None, rtol=1e-3, atol=1e-6,
+                      max_steps=2**31 - 1):
+    from conmech.ivp.methods import BY_NAME, RK45_SCIPY
+    y0 = np.array(y0, dtype=float)
+    n = y0.size
+    t_ev = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
+    problem = dict(fun=fun, builtin=False, args=(), t0=float(t_span[0]),
+                   tf=float(t_span[1]), y0=y0, t_ev=t_ev, with_t_eval=t_eval is not None,
+                   dense=False, settings=[], vectorized=False)
+    code = RK45_SCIPY if method == "RK45" else BY_NAME[method.upper()].code
+    common = dict(method=code, rtol=np.full(n, rtol), atol=np.full(n, atol),
+                  max_step=np.finfo(float).max, max_steps=max_steps, dense=0)
+    return solve_mod._solve(problem, common, 0.0, None, None)
+
+
+def _kepler_rhs(t, y):
+    r3 = (y[0]**2 + y[1]**2)**1.5
+    return [y[2], y[3], -y[0]/r3, -y[1]/r3]
+
+
+@pytest.mark.parametrize("method", ["RK45", "DOPRI5", "DOP853", "VERNER98", "Radau"])
+def test_python_rhs_one_call_identical(method):
+    # a Python right-hand side without events, dense output or Jacobian: one flat call
+    # whose only call-back is fun gives the general path's result bit for bit
+    for span, kw in (((0.0, 0.0), {}), ((0.0, 3.0), dict(rtol=1e-8, atol=1e-10)),
+                     ((2.0, -1.0), dict(rtol=1e-6)),
+                     ((0.0, 5.0), dict(t_eval=np.linspace(0.0, 5.0, 7), rtol=1e-9)),
+                     ((0.0, 60.0), dict(rtol=1e-11, atol=1e-11)),      # points kept, taken
+                     ((0.0, 10.0), dict(max_steps=5))):
+        fast = conmech.solve_ivp(_kepler_rhs, span, KEPLER_Y0, method=method, **kw)
+        full = _general_callable(_kepler_rhs, span, KEPLER_Y0, method, **kw)
+        _same(fast, full)
+    assert fast.status == -1 and fast.message
+
+
+def test_python_rhs_exception_reaches_the_caller():
+    class Boom(Exception):
+        pass
+    calls = []
+
+    def f(t, y):
+        calls.append(t)
+        if len(calls) > 30:
+            raise Boom("from fun")
+        return -y
+    with pytest.raises(Boom, match="from fun"):
+        conmech.solve_ivp(f, (0.0, 60.0), KEPLER_Y0, method="DOP853", rtol=1e-12)

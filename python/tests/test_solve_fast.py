@@ -15,12 +15,12 @@ Y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
 @pytest.fixture
 def counted(monkeypatch):
     calls = []
-    real = solve_fast.solve_native
+    real = solve_fast.run_native
 
     def wrapped(*a, **k):
         calls.append(a)
         return real(*a, **k)
-    monkeypatch.setattr(solve_fast, "solve_native", wrapped)
+    monkeypatch.setattr(solve_fast, "run_native", wrapped)
     return calls
 
 
@@ -99,10 +99,18 @@ def test_bad_inputs_keep_their_messages(kw, exc, text):
 
 
 def test_small_rtol_warns_as_scipy(counted):
+    # the fast entry gives the full path's warning, at the user's line, and its result
     kep = conmech.systems.kepler()
-    with pytest.warns(UserWarning, match="rtol"):
+    with pytest.warns(UserWarning, match="rtol") as fast_w:
         r = conmech.solve_ivp(kep, (0.0, 0.5), Y0, method="DOP853", rtol=1e-20)
-    assert r.success and not counted     # the warning is the full path's
+    assert r.success and len(counted) == 1
+    with pytest.warns(UserWarning, match="rtol") as full_w:
+        full = conmech.solve_ivp(kep, (0.0, 0.5), Y0, method="DOP853",
+                                 rtol=np.float64(1e-20))
+    assert len(counted) == 1
+    assert [w.filename for w in fast_w] == [w.filename for w in full_w] == [__file__]
+    assert [str(w.message) for w in fast_w] == [str(w.message) for w in full_w]
+    _same(r, full)
 
 
 @pytest.mark.parametrize("method", ["TAYLOR", "DOP853"])
@@ -118,3 +126,21 @@ def test_fast_symbolic_with_params(counted, method):
     assert len(counted) == 1
     _same(fast, full)
     assert np.max(np.abs(fast.y[:, -1] - Y0)) < 1e-9      # one period closes the orbit
+
+
+def test_prepared_call_reads_the_systems_parameters(counted):
+    # the packed arguments are kept per system, method and tolerances; the parameters
+    # are the system's at each call (changed in place or given a new array)
+    k = conmech.systems.kepler(1.0)
+    ref = {mu: conmech.solve_ivp(conmech.systems.kepler(mu), (0.0, 2.0), Y0,
+                                 method="DOP853", rtol=1e-9, atol=1e-9) for mu in (1.0, 2.0)}
+    r1 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    k.params[0] = 2.0
+    r2 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    k.params = np.array([1.0])
+    r3 = conmech.solve_ivp(k, (0.0, 2.0), Y0, method="DOP853", rtol=1e-9, atol=1e-9)
+    assert len(counted) == 5
+    _same(r1, ref[1.0])
+    _same(r2, ref[2.0])
+    _same(r3, ref[1.0])
+    assert not np.array_equal(r1.y, r2.y)

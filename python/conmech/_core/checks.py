@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 
 __all__ = ["real_scalar", "real_number", "step_limit", "NO_STEP_LIMIT", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
-           "RTOL_FLOOR"]
+           "RTOL_FLOOR", "step_controls"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
 #: with SciPy's warning.
@@ -125,6 +125,21 @@ def time_points(t_eval, t0, tf):
         raise ValueError("values in t_eval are not properly sorted (strictly monotonic in "
                          "the direction of integration, no repeated values)")
     return t_ev
+
+
+def step_controls(rtol, atol, n, first_step, t0, tf, check_first_step):
+    """The tolerances as arrays of shape (n,) (:func:`tolerance`, warnings pointing at the
+    caller's caller) and the first step (0.0 for None, else ``check_first_step(first_step)``,
+    which raises with the caller's message, and at most the length of [t0, tf] when that
+    is not zero)."""
+    rtol_v = tolerance(rtol, "rtol", n, stacklevel=4)
+    atol_v = tolerance(atol, "atol", n, stacklevel=4)
+    if first_step is None:
+        return rtol_v, atol_v, 0.0
+    h0 = check_first_step(first_step)
+    if h0 > abs(tf - t0) and tf != t0:
+        raise ValueError("first_step exceeds the length of t_span")
+    return rtol_v, atol_v, h0
 
 
 def _warn_rtol(stacklevel):

@@ -1,59 +1,134 @@
 """The short path of :func:`conmech.solve_ivp`: a built-in or compiled system without events,
 dense output or a Python Jacobian is integrated by one call of the flat routine
-flat_solve_native, which returns the points in arrays sized here; only a run with more
-points than that room calls back into Python to hand them over."""
+flat_solve_packed, with no call-back into Python. Its fixed arguments (the method, the
+tolerances, the step limits: everything but the span and the state) are packed once per
+system, method and tolerances (:func:`prepare`, kept on the system by the fast entry), the
+points come back in an array sized here, and a run with more points than that leaves them
+in Fortran memory for one more call (flat_solve_take) rather than calling back."""
 import numpy as np
 
 from .. import _conmech
 from .._core.callback import message_text
+from .._core.native import _NO_SPEC
 from .._core.status import BAD_INPUT
 from .result import _MESSAGES, OdeResult
 
 _PAD = np.zeros(1)
 _PAD.flags.writeable = False
-# the room for the points of a run returned without a call-back (_solve_native): numbers
-# of t and y (8 kB; a run with more points hands them over through a call-back)
+# the room for the points of a run returned by the one call (numbers of t and y: 8 kB);
+# a run with more points hands them over by flat_solve_take
 _OUT_DOUBLES = 1024
+_INT64 = np.int64
+# the result's keys in SciPy's order with conmech's extras last, and the fields of a run
+# without events or dense output that are always the same
+_TEMPLATE = dict(t=None, y=None, sol=None, t_events=None, y_events=None, nfev=0, njev=0,
+                 nlu=0, status=0, message=_MESSAGES[0], success=True, naccept=0, nreject=0)
+
+
+def prepare(fun, code, rtol, atol, h0, hmax, max_steps, t_ev=None):
+    """The packed fixed arguments of flat_solve_packed for the system ``fun`` (checked
+    arguments): (fun, params, spec, ipar, rpar, n, name as bytes), where params and spec
+    are the arrays they were packed for (a system given new ones is packed again),
+    ipar = [np, nspec, method, max_steps, neval, with t_eval], rpar = [first_step,
+    max_step, rtol, atol, t_eval or one unused number]."""
+    params, spec = fun.params, fun.spec
+    n = fun.dimension
+    neval = 0 if t_ev is None else t_ev.size
+    ipar = np.array([params.size, spec.size if spec is not _NO_SPEC else 0, code,
+                     max_steps, neval, t_ev is not None], dtype=np.intc)
+    rpar = np.concatenate([[h0, hmax], np.broadcast_to(rtol, (n,)),
+                           np.broadcast_to(atol, (n,)), t_ev if neval else _PAD])
+    ipar.flags.writeable = rpar.flags.writeable = False
+    return fun, params, spec, ipar, rpar, n, fun.name.encode("ascii", "replace")
+
+
+def run(prep, t0, tf, y0, cap=0):
+    """The OdeResult of one run of flat_solve_packed with the packed arguments ``prep``
+    (:func:`prepare`) from ``y0`` (n finite numbers: an array, list or tuple) over
+    [t0, tf]; room for ``cap`` points in one call (0: _OUT_DOUBLES numbers; 2 for a
+    zero-length span)."""
+    fun, params, spec, ipar, rpar, n, name = prep
+    if not cap:
+        cap = 2 if tf == t0 else max(_OUT_DOUBLES // (n + 1), 2)
+    out = np.empty(cap*(n + 1))
+    iout = np.empty(40, dtype=_INT64)       # 8 numbers, then the message's 256 bytes
+    _conmech.flat_solve_packed(name, params if params.size else _PAD, spec, ipar, rpar, t0,
+                               tf, y0, out, iout)
+    return _result(out, iout, n)
+
+
+def _take(out, iout, n, guard=None):
+    """(the points' array, nt, counts..., info) of a packed call's outputs: the kept points
+    taken when they did not fit; ``guard``'s error (an exception of a Python function)
+    raised once they are freed; a refusal raised as ValueError."""
+    nt, nfev, njev, nlu, naccept, nreject, info, handle = iout[:8].tolist()
+    if nt < 0:
+        nt = -nt
+        try:
+            out = np.empty(nt*(n + 1))
+        except BaseException:
+            _conmech.flat_solve_take(handle, n, 0, _PAD)     # free the kept points
+            raise
+        _conmech.flat_solve_take(handle, n, nt, out)
+    if guard is not None:
+        guard.check()
+    if info == BAD_INPUT:
+        raise ValueError(message_text(iout[8:]))
+    return out, nt, nfev, njev, nlu, naccept, nreject, info
+
+
+def _result(out, iout, n, guard=None):
+    """The OdeResult of a packed call's outputs (:func:`_take`)."""
+    out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
+    if nt*(n + 1) != out.size:
+        out = out[:nt*(n + 1)].copy()       # the result does not hold on to the room
+    res = OdeResult(_TEMPLATE)
+    res["t"] = out[:nt]
+    res["y"] = out[nt:].reshape(n, nt)
+    if nfev:
+        res["nfev"] = nfev
+    if njev or nlu:
+        res["njev"], res["nlu"] = njev, nlu
+    if naccept or nreject:
+        res["naccept"], res["nreject"] = naccept, nreject
+    if info:
+        if info > 0:
+            res["status"], res["message"] = info, _MESSAGES.get(info) or message_text(
+                iout[8:])
+        else:
+            res["status"], res["message"] = -1, message_text(iout[8:])
+            res["success"] = False
+    return res
+
+
+def solve_callable(rhs, guard, n, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0,
+                   hmax, max_steps):
+    """solve_ivp of a Python right-hand side without events, dense output or a Jacobian
+    (checked arguments; ``rhs`` the guarded call-back fun(t, y, dydt, n), ``guard`` its
+    Guard): one call of flat_solve_rhs_packed, whose only call-back is ``rhs``."""
+    neval = t_ev.size if with_t_eval else 0
+    ipar = np.array([0, 0, code, max_steps, neval, with_t_eval], dtype=np.intc)
+    rpar = np.concatenate([[h0, hmax], rtol, atol, t_ev if neval else _PAD])
+    cap = max(t_ev.size, 2) if with_t_eval else 2 if tf == t0 else max(
+        _OUT_DOUBLES // (n + 1), 2)
+    out = np.empty(cap*(n + 1))
+    iout = np.zeros(40, dtype=_INT64)
+    _conmech.flat_solve_rhs_packed(rhs, ipar, rpar, t0, tf, y0, out, iout)
+    res = _result(out, iout, n, guard)
+    if with_t_eval and res.t.size == 0:
+        res.t, res.y = [], []   # SciPy's lists when no point of t_eval was reached
+    return res
 
 
 def solve_native(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax,
-                  max_steps):
+                 max_steps):
     """solve_ivp of a built-in or compiled system without events or dense output (checked
     arguments): the result of :func:`_solve` for such a run, from one call of
-    flat_solve_native, which returns the points in arrays sized here (t_eval's length,
-    else room for _OUT_DOUBLES numbers) and calls ``store`` back only when a run has more."""
-    n = y0.size
-    neval = t_ev.size
-    cap = neval if with_t_eval else max(_OUT_DOUBLES // (n + 1), 2)
-    out = []
-
-    def store(t, y, ev_t, ev_y, ev_id, ts, hs, coef):
-        # more points than cap: the arrays wrap Fortran memory that is freed on return
-        out.append(t.copy())
-        out.append(y.reshape(n, t.size).copy())
-
-    t_out, y_out, nt, counts, info, message = _conmech.flat_solve_native(
-        *fun._flat_args(), store, t0, tf, y0, code, rtol, atol, h0, hmax,
-        max_steps, neval, t_ev if neval else _PAD, cap)
-    info = int(info)
-    if info == BAD_INPUT:
-        raise ValueError(message_text(message))
-    if nt < 0:
-        t, y = out
-    elif nt > 0:
-        t, y = t_out[:nt].copy(), y_out[:, :nt].copy()
-    else:               # no point stored: a run refused before its first step
-        t, y = np.array([t0]), y0[:, None].copy()
-    if tf == t0 and not with_t_eval:
-        # SciPy's solver makes one (empty) step: t = [t0, t0]
-        t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)
-    elif with_t_eval and t.size == 0:
-        t, y = [], []          # SciPy's lists when no point of t_eval was reached
-    nfev, njev, nlu, naccept, nreject = counts.tolist()
-    if info >= 0:
-        status, message = info, _MESSAGES.get(info) or message_text(message)
-    else:
-        status, message = -1, message_text(message)
-    return OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None, nfev=nfev,
-                     njev=njev, nlu=nlu, status=status, message=message,
-                     success=status >= 0, naccept=naccept, nreject=nreject)
+    flat_solve_packed (points returned in an array of t_eval's length, else room for
+    _OUT_DOUBLES numbers, and handed over by flat_solve_take when a run has more)."""
+    prep = prepare(fun, code, rtol, atol, h0, hmax, max_steps,
+                   t_ev if with_t_eval else None)
+    res = run(prep, t0, tf, y0, max(t_ev.size, 2) if with_t_eval else 0)
+    if with_t_eval and res.t.size == 0:
+        res.t, res.y = [], []   # SciPy's lists when no point of t_eval was reached
+    return res

@@ -15,7 +15,7 @@ from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
     real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
-    time_span as _time_span, tolerance as _tolerance
+    time_span as _time_span, step_controls as _step_controls
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
@@ -23,7 +23,8 @@ from .stepper import method_code
 from .taylor import run_compiled_events, with_fixed_order
 from .taylor_generalized import first_order_view, name_the_mass_matrix
 from .._core.native import _NO_SPEC, NativeSystem
-from .native_path import _OUT_DOUBLES, solve_native as _solve_native  # noqa: F401 (tests)
+from .native_path import _OUT_DOUBLES, solve_native as _solve_native, \
+    solve_callable as _solve_callable  # noqa: F401 (tests)
 from .complex_form import complex_result as _complex_result, real_form as _real_form, \
     real_form_event as _real_form_event
 from .empty import solve_empty as _solve_empty
@@ -251,14 +252,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise ValueError(_COMPLEX_REFUSED)
 
     # ---------------------------------------------------------------- tolerances, steps
-    rtol_v = _tolerance(rtol, "rtol", n)
-    atol_v = _tolerance(atol, "atol", n)
-    if first_step is None:
-        h0 = 0.0
-    else:
-        h0 = _positive_finite(first_step, "first_step")
-        if h0 > abs(tf - t0) and tf != t0:
-            raise ValueError("first_step exceeds the length of t_span")
+    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf,
+                                        lambda h: _positive_finite(h, "first_step"))
     if info.fixed_step and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
@@ -317,6 +312,13 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
                    settings=settings, vectorized=bool(vectorized))
     if n == 0:
         return _solve_empty(**problem)
+    if not builtin and not settings and not dense_output and jac is None and pattern is None \
+            and not is_complex:
+        # a Python right-hand side and nothing else called back: one Fortran call whose
+        # only call-back is fun (its exceptions raised by the guard)
+        run = _Run(fun, False, args, n, [], problem["vectorized"], t0, None, None, y0)
+        return _solve_callable(run.rhs, run.guard, n, t0, tf, y0, t_ev, t_eval is not None,
+                               code, rtol_v, atol_v, h0, hmax, int(max_steps))
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
                   max_steps=int(max_steps), dense=int(bool(dense_output)))
     if not is_complex:

@@ -3,16 +3,17 @@ compiled system, a method named by a string, float tolerances, a span and a stat
 plain floats, and none of the options that call back into Python (events, t_eval, dense
 output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
 same rules (type tests on Python scalars and lists, no NumPy conversion to find a type)
-and goes to the one-call native path; any input outside these kinds, or one that breaks
-a rule, returns None and the full checks of solve_ivp run, with their messages. The
-result is the one the full path gives (the same Fortran call with the same arrays)."""
+and goes to the one-call native path with arguments packed once per system, method and
+tolerances; any input outside these kinds, or one that breaks a rule, returns None and
+the full checks of solve_ivp run, with their messages. The result is the one the full
+path gives (the same Fortran call with the same arrays)."""
 import math
 
 import numpy as np
 
-from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR
+from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR, _warn_rtol
 from .methods import BY_NAME, RK45_SCIPY
-from .native_path import solve_native
+from .native_path import prepare, run as run_native
 
 __all__ = ["fast_solve", "fast_method_code"]
 
@@ -53,15 +54,16 @@ def _tolerance(v, n):
 
 
 def _state(y0, n):
-    """y0 as a float64 array of size n when it is a list or tuple of n finite floats (or
-    ints), or a 1-D float64 array of n finite entries; else None."""
+    """y0 itself when it is a list or tuple of n finite floats (or ints), or a 1-D
+    float64 array of n finite entries (the flat call reads it as a float64 array); else
+    None."""
     if type(y0) is list or type(y0) is tuple:
         if len(y0) != n:
             return None
         for v in y0:
             if not ((isinstance(v, float) or type(v) is int) and math.isfinite(v)):
                 return None
-        return np.array(y0, dtype=float)
+        return y0
     if type(y0) is np.ndarray and y0.dtype == np.float64 and y0.shape == (n,):
         if n <= 32:
             if not all(map(math.isfinite, y0.tolist())):
@@ -78,10 +80,9 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
     input is of a plain kind and valid; None otherwise (the caller runs the full checks).
     ``taylor_system(fun, rtol, atol)`` gives the system method TAYLOR runs (its
     recurrences written out for the tolerances' order), ``taylor_code`` that method's
-    code."""
-    code = fast_method_code(method)
-    if not code:
-        return None
+    code. The packed arguments of the flat call are kept per system, method and
+    tolerances (the last _KEEP), so that a repeated call checks only the span and the
+    state."""
     if type(t_span) is tuple or type(t_span) is list:
         if len(t_span) != 2:
             return None
@@ -94,20 +95,45 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
             return None
     else:
         return None
-    if not (0.0 <= atol < math.inf and RTOL_FLOOR <= rtol < math.inf):
+    key = (id(fun), method, rtol, atol)
+    prep = _PREPARED.get(key)
+    if prep is None or prep[0] is not fun or prep[2] is not prep[1].params or \
+            prep[3] is not prep[1].spec:
+        if _state(y0, fun.dimension) is None:
+            return None
+        prep = _prepare(fun, method, rtol, atol, taylor_code, taylor_system)
+        if prep is None:
+            return None
+        if len(_PREPARED) >= _KEEP:       # systems made and dropped in a loop
+            _PREPARED.clear()
+        _PREPARED[key] = prep
+    elif _state(y0, prep[6]) is None:
+        return None
+    if rtol < RTOL_FLOOR:
+        _warn_rtol(4)           # SciPy's warning, at the user's call (Fortran raises rtol)
+    return run_native(prep[1:], t0, tf, y0)
+
+
+def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
+    """(fun, the packed arguments of native_path.prepare) for the fast path's call, or
+    None when the method or the tolerances are not of its kinds (the full checks run)."""
+    code = fast_method_code(method)
+    if not code:
+        return None
+    if not (0.0 <= atol < math.inf and 0.0 <= rtol < math.inf):
         return None
     n = fun.dimension
-    y = _state(y0, n)
-    if y is None:
-        return None
+    run_fun = fun
     if code == taylor_code:
         if getattr(fun, "taylor", None):        # as solve_ivp: the written-out recurrences
-            fun = taylor_system(fun, rtol, atol)    # (cached per system and order there)
+            run_fun = taylor_system(fun, rtol, atol)    # (cached per system and order)
         elif getattr(fun, "kind", None) == "generalized":
             return None                         # its first-order view: the full path
-    return solve_native(fun, t0, tf, y, _EMPTY, False, code, _tolerance(rtol, n),
-                        _tolerance(atol, n), 0.0, _HUGE, NO_STEP_LIMIT)
+    return (fun,) + prepare(run_fun, code, _tolerance(rtol, n), _tolerance(atol, n), 0.0,
+                            _HUGE, NO_STEP_LIMIT)
 
 
-_EMPTY = np.zeros(0)
-_EMPTY.flags.writeable = False
+# (id(system), method, rtol, atol) -> (system, the packed arguments); the system is kept
+# with them, so its id stays its own while the entry lives
+_PREPARED = {}
+_KEEP = 256
