@@ -385,6 +385,8 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
         for i, o in enumerate(dec.outputs):
             body += _wrap(f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}", ind)
         body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+        if fixed is not None:
+            body += [f"{ind}w(1, {c}) = {W(1, c)}" for c in range(1, dec.n + 1)]
     if fixed is None:
         decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j"]
         E = {"k": "k", "fk": "fk", "rk": "rk"}
@@ -467,9 +469,12 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
                               f"{pp.lin_at(o, k, False)})", ind)
             body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
                      for c in jstate]
-    outs = dec.out_cols if given else range(1, dec.n + 1)
-    body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in outs
-             for k in range(0 if given else 1, fixed + 1)]
+            # the state's coefficients of order k + 1 out at once, from the registers
+            # they were computed in (a copy at the end reloads each one first)
+            body += [f"{ind}w({k + 1}, {c}) = {W(k + 1, c)}" for c in range(1, dec.n + 1)]
+    if given:
+        body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in dec.out_cols
+                 for k in range(0, fixed + 1)]
     names_s = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
     decl += _decls(names_s, f"real({kind})", ind)
     decl += _decls([f"g{g + 1}(2, 0:{fixed})" for g in
