@@ -35,7 +35,7 @@ import re
 from .._core.lanes import LANES     # the lane counts a batch library can be built with
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 5
+VERSION = 6
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_routine",
            "run_routine", "LANES"]
@@ -270,7 +270,7 @@ _RUN = """\
         real(dp), parameter :: check_max = 10.0_dp
         real(dp), allocatable :: wb(:, :, :, :)
         real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
-        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl), ya(nl), da(nl)
+        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
         real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
         real(dp) :: a1, a2
         integer, parameter :: i8 = selected_int_kind(18)
@@ -365,25 +365,19 @@ _RUN = """\
             ! the polynomials at the candidate steps (Horner, the value and its
             ! derivative in one pass), all lanes at once; a lane without a step expands
             ! at its current state (a new member: its initial state)
-            ! (component by component: its two chains stay in registers over the orders)
             nu = 3 - cu
-            do i = 1, n
-                !$omp simd
-                do l = 1, nl
-                    ya(l) = wb(l, ord, i, cu)
-                    da(l) = 0.0_dp
-                end do
-                do k = ord - 1, 0, -1
+            !$omp simd
+            do l = 1, nl
+                yn(l, :) = wb(l, ord, 1:n, cu)
+                dy(l, :) = 0.0_dp
+            end do
+            do k = ord - 1, 0, -1
+                do i = 1, n
                     !$omp simd
                     do l = 1, nl
-                        da(l) = ya(l) + hc(l)*da(l)
-                        ya(l) = wb(l, k, i, cu) + hc(l)*ya(l)
+                        dy(l, i) = yn(l, i) + hc(l)*dy(l, i)
+                        yn(l, i) = wb(l, k, i, cu) + hc(l)*yn(l, i)
                     end do
-                end do
-                !$omp simd
-                do l = 1, nl
-                    yn(l, i) = ya(l)
-                    dy(l, i) = da(l)
                 end do
             end do
             do i = 1, n
