@@ -15,6 +15,7 @@ module conmech_rank
     private
 
     public :: svd, singular_values, numerical_rank, null_space, range_basis, min_norm_solve
+    public :: identity
 
 contains
 
@@ -197,6 +198,7 @@ contains
         if (info == CM_SUCCESS) x = rhs(1:n, 1)
     end subroutine min_norm_solve
 
+    !> The n x n identity matrix.
     pure function identity(n) result(e)
         integer, intent(in) :: n
         real(dp) :: e(n, n)

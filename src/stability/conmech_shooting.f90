@@ -33,6 +33,7 @@ module conmech_shooting
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, METHOD_DOP853
     use conmech_variational, only: integrate_stm
+    use conmech_rank, only: identity
     use conmech_floquet, only: floquet_result, floquet_from_multipliers
     use conmech_block_chain, only: lstsq_solve
     use conmech_orbit_types
@@ -122,7 +123,7 @@ contains
         do it = 1, opt%max_iter
             orbit%iterations = it
             yt = y
-            call identity(phi)
+            phi = identity(size(phi, 1))
             call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
             if (info < 0) then
                 orbit%info = info
@@ -248,7 +249,7 @@ contains
         do it = 1, opt%max_iter
             orbit%iterations = it
             yt = y
-            call identity(phi)
+            phi = identity(size(phi, 1))
             call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
             if (info < 0) then
                 orbit%info = info
@@ -475,14 +476,5 @@ contains
             g = g + w*hist(:, j)
         end do
     end subroutine extrapolate
-
-    pure subroutine identity(a)
-        real(dp), intent(out) :: a(:, :)
-        integer :: i
-        a = 0.0_dp
-        do i = 1, size(a, 1)
-            a(i, i) = 1.0_dp
-        end do
-    end subroutine identity
 
 end module conmech_shooting

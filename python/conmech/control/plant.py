@@ -11,7 +11,8 @@ import numpy as np
 
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
-from ..ivp.solve import DenseOutput, OdeResult, _event_settings, _METHOD_CODES
+from .._core.driver_events import first_crossing_events
+from ..ivp.solve import DenseOutput, OdeResult, _METHOD_CODES
 from .._core.native import NativeSystem, function_address
 from .._core.status import BAD_INPUT, raise_status
 
@@ -262,16 +263,7 @@ def simulate(plant: ControlledSystem, law: Any, t_span: Sequence[float], x0: Arr
     for nm, v in (("rtol", rtol), ("atol", atol)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{nm} must be positive and finite")
-    settings = _event_settings(events)
-    for i, (_, _, _, res) in enumerate(settings):
-        if res > 0:     # sampling inside the steps is solve_ivp's (not this driver's)
-            raise ValueError(f"events[{i}].resolution is not supported by the closed-loop solve (only "
-                             "by conmech.solve_ivp)")
-    settings = [s[:3] for s in settings]
-    for i, (e, count, d) in enumerate(settings):
-        if count > 1:
-            raise ValueError(f"events[{i}].terminal must be a bool here (stop at the "
-                             "first crossing)")
+    settings = first_crossing_events(events, "the closed-loop solve")
     ne = len(settings)
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(
         np.asarray(t_eval, dtype=float).ravel())

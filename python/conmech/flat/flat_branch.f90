@@ -44,16 +44,12 @@ subroutine flat_branch(name, np, params, nspec, spec, ip, fun, jfun, source, p0,
     class(ode_system), allocatable :: sys
     type(callback_energy) :: en
     real(c_double) :: pstart
-    character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
     direction = 1
     call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
-                           sys, pstart, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
+                           sys, pstart, info, message)
+    if (info /= 0) return
     en%f => energy
     en%n = n
     call run_continuation(sys, n, y0, period, pstart, ropt, iopt, nfree, free_idx, ntg, &

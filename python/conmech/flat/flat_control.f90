@@ -24,12 +24,10 @@ subroutine flat_control_plant_eval(name, np, params, nspec, spec, nd, m, bmat, b
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
     type(mech_plant) :: plant
-    character(len=:), allocatable :: msg
     dxdt = 0.0_c_double
     bx = 0.0_c_double
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
+                     bpar(1:nbp), plant, info, message)
     if (info /= CM_SUCCESS) return
     call plant%rhs_u(t, x, u, dxdt)
     call plant%input_matrix(t, x, u, bx)
@@ -57,7 +55,6 @@ subroutine flat_control_vhc(name, np, params, nspec, spec, nd, m, bmat, baddr, n
     character(len=256), intent(out) :: message
     type(mech_plant) :: plant
     type(vhc) :: con
-    character(len=:), allocatable :: msg
     integer :: i, used, i2
     alpha = 0.0_c_double
     beta = 0.0_c_double
@@ -66,8 +63,7 @@ subroutine flat_control_vhc(name, np, params, nspec, spec, nd, m, bmat, baddr, n
     dphis = 0.0_c_double
     ddphis = 0.0_c_double
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), plant, info, msg)
-    message = msg
+                     bpar(1:nbp), plant, info, message)
     if (info /= CM_SUCCESS) return
     call build_vhc(ilaw, rlaw(1:nrl), nd, con, used)
     do i = 1, nth
@@ -112,15 +108,13 @@ subroutine flat_control_reduced(name, np, params, nspec, spec, nd, m, bmat, badd
     type(ode_options) :: oo
     type(ode_result) :: res
     type(velocity_zero) :: ev
-    character(len=:), allocatable :: msg
     integer :: used
     ys = 0.0_c_double
     ev_t = 0.0_c_double
     ev_y = 0.0_c_double
     nev = 0
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), red%plant, info, msg)
-    message = msg
+                     bpar(1:nbp), red%plant, info, message)
     if (info /= CM_SUCCESS) return
     call build_vhc(ilaw, rlaw(1:nrl), nd, red%con, used)
     oo%method = METHOD_DOP853
@@ -180,15 +174,13 @@ subroutine flat_control_energy(name, np, params, nspec, spec, nd, m, bmat, baddr
     type(ode_options) :: oo
     type(ode_result) :: res
     type(energy_zero) :: ev
-    character(len=:), allocatable :: msg
     real(c_double) :: tend
     integer :: used, i
     es = ieee_value(1.0_c_double, ieee_quiet_nan)
     theta_zero = 0.0_c_double
     found = 0
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                     bpar(1:nbp), en%plant, info, msg)
-    message = msg
+                     bpar(1:nbp), en%plant, info, message)
     if (info /= CM_SUCCESS) return
     call build_vhc(ilaw, rlaw(1:nrl), nd, en%con, used)
     tend = thetas(nth)
@@ -243,12 +235,10 @@ subroutine flat_control_law_eval(name, np, params, nspec, spec, nd, m, bmat, bad
     include "flat_control_law.inc"
     type(mech_plant) :: plant
     class(feedback_law), allocatable :: law
-    character(len=:), allocatable :: msg
     integer :: i
     us = 0.0_c_double
     call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, msg)
-    message = msg
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, message)
     if (info /= CM_SUCCESS) return
     do i = 1, nx
         call law%eval(ts(i), xs(:, i), us(:, i))
@@ -283,7 +273,6 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     include "flat_solve_callbacks.inc"
     type(closed_loop) :: cl
     type(mech_plant) :: plant
-    character(len=:), allocatable :: msg
     integer(c_int) :: counts(5)
     ! no event resolution (SciPy's rule), no Jacobian structure (nnz = -1)
     real(c_double) :: ev_res(max(ne, 1))
@@ -296,8 +285,7 @@ subroutine flat_control_solve(name, np, params, nspec, spec, nd, m, bmat, baddr,
     sp_ptr = 1
     sp_idx = 0
     call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, cl%law, info, msg)
-    message = msg
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, cl%law, info, message)
     if (info /= CM_SUCCESS) return
     allocate (cl%plant, source=plant)
     cl%n_inputs = m
@@ -331,17 +319,14 @@ subroutine flat_control_project(name, np, params, nspec, spec, nd, m, bmat, badd
     include "flat_control_law.inc"
     type(mech_plant) :: plant
     class(feedback_law), allocatable :: law
-    character(len=:), allocatable :: msg
     taus = 0.0_c_double
     xis = 0.0_c_double
     dists = 0.0_c_double
     nfail = 0
     call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, msg)
-    message = msg
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, law, info, message)
     if (info /= CM_SUCCESS) return
-    call project_states(law, xs, taus, xis, dists, nfail, info, msg)
-    message = msg
+    call project_states(law, xs, taus, xis, dists, nfail, info, message)
 end subroutine flat_control_project
 
 !> Transverse LQR design around the periodic orbit (y0, period) of the closed loop under a
@@ -363,11 +348,12 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     use conmech_mech_plant, only: mech_plant
     use conmech_control_system, only: feedback_law, closed_loop
     use conmech_transverse_general, only: transverse_options, transverse_eval
-    use conmech_periodic_riccati, only: riccati_options, riccati_gain
+    use conmech_periodic_riccati, only: riccati_options
     use conmech_orbital_stabilisation, only: orbital_design_result, orbital_design
     use conmech_ode_solver, only: ode_options
     use conmech_variational, only: integrate_stm
-    use conmech_support_control, only: build_plant_law
+    use conmech_rank, only: identity
+    use conmech_support_control, only: build_plant_law, pack_riccati
     implicit none
     include "flat_plant_args.inc"
     include "flat_law_args.inc"
@@ -388,8 +374,8 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     type(closed_loop) :: cl
     type(ode_options) :: oo
     character(len=:), allocatable :: msg
-    real(dp) :: x(n), qp(n, k), kg(m, k), p(k, k), y(n), mono(n, n)
-    integer :: i, o, j, i2
+    real(dp) :: x(n), qp(n, k), y(n), mono(n, n)
+    integer :: i, o, i2
     as = 0.0_c_double
     bs = 0.0_c_double
     ps = 0.0_c_double
@@ -409,8 +395,7 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     closure = 0.0_c_double
     passes = 0
     call build_plant_law(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &
-                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, nominal, info, msg)
-    message = msg
+                         bpar(1:nbp), ilaw, rlaw(1:nrl), nrl, pylaw, n, plant, nominal, info, message)
     if (info /= CM_SUCCESS) return
     if (n /= 2*nd .or. k /= n - 1 .or. ntab /= 1 + 3*n*(ng + 1) + 2*n*k*(ng + 1) + &
         2*m*k*(ng + 1)) then
@@ -431,21 +416,11 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
         omi = des%lq%fr%mi
         closure = des%lq%fr%closure
     end if
-    if (allocated(des%ric%hmr)) then
-        hmr = des%ric%hmr
-        hmi = des%ric%hmi
-    end if
+    call pack_riccati(des%ric, des%lq, t, ps, ks, hmr, hmi, cmr, cmi, periodicity, min_eig, &
+                      passes)
     if (info /= CM_SUCCESS) return
-    cmr = des%ric%cmr
-    cmi = des%ric%cmi
-    periodicity = des%ric%periodicity
-    min_eig = des%ric%min_eig
-    passes = des%ric%passes
     do i = 1, nt
         call transverse_eval(des%lq%fr, t(i), x, qp, as(:, :, i), bs(:, :, i), i2)
-        call riccati_gain(des%ric, des%lq, t(i), kg, p, i2)
-        ps(:, :, i) = p
-        ks(:, :, i) = -kg
     end do
     o = 1
     rtab(1) = period
@@ -470,10 +445,7 @@ subroutine flat_control_design(name, np, params, nspec, spec, nd, m, bmat, baddr
     oo%atol = atol
     oo%max_steps = 1000000
     y = y0
-    mono = 0.0_dp
-    do j = 1, n
-        mono(j, j) = 1.0_dp
-    end do
+    mono = identity(n)
     call integrate_stm(cl, 0.0_dp, period, y, mono, oo, i2, msg)
     if (i2 < 0) then
         info = i2
@@ -490,11 +462,10 @@ subroutine flat_control_riccati(afun, bfun, k, m, period, qw, rw, rtol, atol, nt
                                 hmr, hmi, cmr, cmi, cl_mono, periodicity, min_eig, passes, &
                                 info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
-    use conmech_periodic_riccati, only: riccati_options, riccati_result, periodic_riccati, &
-                                        riccati_gain
+    use conmech_periodic_riccati, only: riccati_options, riccati_result, periodic_riccati
     use conmech_flat_adapters, only: callback_lq
+    use conmech_support_control, only: pack_riccati
     implicit none
     integer(c_int), intent(in) :: k, m, nt
     real(c_double), intent(in) :: period, qw(k, k), rw(m, m), rtol, atol, t(nt)
@@ -520,8 +491,6 @@ subroutine flat_control_riccati(afun, bfun, k, m, period, qw, rw, rtol, atol, nt
     type(callback_lq) :: lq
     type(riccati_options) :: ropt
     type(riccati_result) :: res
-    real(dp) :: kg(m, k), p(k, k)
-    integer :: i, i2
     ps = 0.0_c_double
     ks = 0.0_c_double
     hmr = 0.0_c_double
@@ -542,20 +511,6 @@ subroutine flat_control_riccati(afun, bfun, k, m, period, qw, rw, rtol, atol, nt
     call periodic_riccati(lq, qw, rw, ropt, res)
     info = res%info
     message = res%message
-    if (allocated(res%hmr)) then
-        hmr = res%hmr
-        hmi = res%hmi
-    end if
-    if (info /= CM_SUCCESS) return
-    cmr = res%cmr
-    cmi = res%cmi
-    cl_mono = res%cl_monodromy
-    periodicity = res%periodicity
-    min_eig = res%min_eig
-    passes = res%passes
-    do i = 1, nt
-        call riccati_gain(res, lq, t(i), kg, p, i2)
-        ps(:, :, i) = p
-        ks(:, :, i) = -kg
-    end do
+    call pack_riccati(res, lq, t, ps, ks, hmr, hmi, cmr, cmi, periodicity, min_eig, passes)
+    if (info == CM_SUCCESS) cl_mono = res%cl_monodromy
 end subroutine flat_control_riccati

@@ -29,12 +29,8 @@ subroutine flat_equilibrium_structure(name, np, params, nspec, spec, fun, jfun, 
     include "flat_system_args.inc"
     class(ode_system), allocatable :: sys
     type(equilibrium_result) :: e
-    character(len=:), allocatable :: msg
-    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, message)
+    if (info /= 0) return
     call analyze_equilibrium(sys, y, e, t, tol)
     call unpack_structure(e, n, jac, wr, wi, kind, saddle, residual, analytic, zero_mult, &
                           largest_block, secular_freq, family_dim, family, ndrift, drift, &
@@ -109,13 +105,12 @@ subroutine flat_degrees_of_freedom(name, np, params, nspec, spec, n, t, q, proje
     dof = 0
     velocity_dof = 0
     call spec_constrained(name, real(params(1:np), dp), nspec, spec, cs, info, msg)
+    if (info == CM_SUCCESS .and. cs%n /= n) then
+        info = CM_BAD_INPUT
+        msg = "degrees_of_freedom: q has the wrong number of components"
+    end if
     if (info /= CM_SUCCESS) then
         call copy_message(msg, message)
-        return
-    end if
-    if (cs%n /= n) then
-        info = CM_BAD_INPUT
-        message = "degrees_of_freedom: q has the wrong number of components"
         return
     end if
     call degrees_of_freedom(cs, t, q, r, project /= 0, rank_tol)

@@ -24,14 +24,13 @@ subroutine flat_evaluate_ode(name, np, params, nspec, spec, n, t, y, f, jac, ana
     analytic = 0
     call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, &
                              "bad input: y has the wrong size for the system", sys, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
+    if (info == CM_SUCCESS) then
+        call sys%rhs(t, y, f)
+        call sys%jacobian(t, y, jac)
+        if (sys%has_jacobian()) analytic = 1
+        msg = "success"
     end if
-    call sys%rhs(t, y, f)
-    call sys%jacobian(t, y, jac)
-    if (sys%has_jacobian()) analytic = 1
-    call copy_message("success", message)
+    call copy_message(msg, message)
 end subroutine flat_evaluate_ode
 
 !> Quantities of a mechanical system at (t, q, v): mass matrix, forces, energy (has_e = 1

@@ -26,15 +26,11 @@ subroutine flat_eq_continuation(name, np, params, nspec, spec, ip, fun, jfun, so
     include "flat_param_args.inc"
     class(ode_system), allocatable :: sys
     real(c_double) :: pstart
-    character(len=:), allocatable :: msg
     npts = 0
     nsp = 0
     call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
-                           sys, pstart, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
+                           sys, pstart, info, message)
+    if (info /= 0) return
     call run_eq_continuation(sys, n, y0, pstart, ropt, iopt, mp, npts, pp, ys, wr, wi, psi, &
                              nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q, sp_a, &
                              info, message)
@@ -61,16 +57,12 @@ subroutine flat_hopf(name, np, params, nspec, spec, ip, fun, jfun, source, p0, n
     include "flat_param_args.inc"
     class(ode_system), allocatable :: sys
     real(c_double) :: pstart
-    character(len=:), allocatable :: msg
     out = 0.0_c_double
     q = 0.0_c_double
     adj = 0.0_c_double
     call flat_param_system(name, params(1:np), nspec, spec, ip, fun, jfun, source, n, p0, &
-                           sys, pstart, info, msg)
-    if (info /= CM_SUCCESS) then
-        message = msg
-        return
-    end if
+                           sys, pstart, info, message)
+    if (info /= CM_SUCCESS) return
     call run_hopf(sys, n, t, y, l1_tol, out, q, adj, info, message)
 end subroutine flat_hopf
 

@@ -110,14 +110,12 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
     if (source == SOURCE_SPEC) then     ! y0 must have the built-in or compiled system's size
         call spec_system_of_size(name, real(params(1:np), dp), nspec, spec, n, "", sys, &
                                  info, msg)
+        call copy_message(msg, message)
     else
         call flat_system(name, real(params(1:np), dp), nspec, spec, fun, jfun, source, n, &
-                         sys, info, msg)
+                         sys, info, message)
     end if
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
+    if (info /= CM_SUCCESS) return
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
                    sp_idx, events, store, counts, dense_form, info, message)

@@ -25,10 +25,8 @@ subroutine flat_po(name, np, params, nspec, spec, fun, jfun, source, n, y0, peri
     character(len=256), intent(out) :: message
     include "flat_system_args.inc"
     class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
-    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, message)
     if (info /= 0) then
-        message = msg
         nnodes = 0
         return
     end if

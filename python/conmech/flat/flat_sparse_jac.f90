@@ -14,7 +14,7 @@ subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, metho
                                  counts, dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
-    use conmech_flat_ode_support, only: run_solve, copy_message
+    use conmech_flat_ode_support, only: run_solve
     use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
     implicit none
@@ -25,15 +25,11 @@ subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, metho
     include "flat_sparse_jac_callbacks.inc"
     include "flat_solve_callbacks.inc"
     type(callback_sparse_jac_system) :: sys
-    character(len=:), allocatable :: msg
 
     counts = 0
     dense_form = 0
-    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
+    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, message)
+    if (info /= CM_SUCCESS) return
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, nnz, sp_ptr, &
                    sp_idx, events, store, counts, dense_form, info, message)
@@ -47,7 +43,6 @@ subroutine flat_stepper_sparse_jac(fun, jvals, action, n, nr, ni, nw, t0, t_boun
                                    nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use conmech_status, only: CM_SUCCESS
-    use conmech_flat_ode_support, only: copy_message
     use conmech_flat_stepper_support, only: stepper_action
     use conmech_flat_adapters, only: callback_sparse_jac_system, &
         make_sparse_jac_system
@@ -55,14 +50,10 @@ subroutine flat_stepper_sparse_jac(fun, jvals, action, n, nr, ni, nw, t0, t_boun
     include "flat_stepper_args.inc"
     include "flat_sparse_jac_callbacks.inc"
     type(callback_sparse_jac_system) :: sys
-    character(len=:), allocatable :: msg
 
     sizes = 0
-    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
+    call make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, message)
+    if (info /= CM_SUCCESS) return
     call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
                         first_step, max_step, max_steps, 0, nnz, sp_ptr, sp_idx, r, iv, w, &
                         sizes, info, message)

@@ -181,6 +181,7 @@ subroutine flat_stm(name, np, params, nspec, spec, fun, jfun, source, n, y0, t0,
     use conmech_ode_solver, only: ode_options, ode_stats
     use conmech_flat_system, only: flat_system
     use conmech_variational, only: integrate_stm
+    use conmech_rank, only: identity
     implicit none
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: y0(n), t0, t1, rtol, atol
@@ -192,18 +193,11 @@ subroutine flat_stm(name, np, params, nspec, spec, fun, jfun, source, n, y0, t0,
     character(len=:), allocatable :: msg
     type(ode_options) :: opt
     type(ode_stats) :: st
-    integer :: i
     nfev = 0
     y1 = y0
-    phi = 0.0_c_double
-    do i = 1, n
-        phi(i, i) = 1.0_c_double
-    end do
-    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
+    phi = identity(n)
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, message)
+    if (info /= 0) return
     opt%rtol = rtol
     opt%atol = atol
     call integrate_stm(sys, t0, t1, y1, phi, opt, info, msg, st)
@@ -339,11 +333,8 @@ subroutine flat_find_equilibrium(name, np, params, nspec, spec, fun, jfun, sourc
     class(ode_system), allocatable :: sys
     character(len=:), allocatable :: msg
     yout = y
-    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, msg)
-    if (info /= 0) then
-        message = msg
-        return
-    end if
+    call flat_system(name, params(1:np), nspec, spec, fun, jfun, source, n, sys, info, message)
+    if (info /= 0) return
     call find_equilibrium(sys, yout, info, msg, t, tol, max_iter)
     message = msg
 end subroutine flat_find_equilibrium

@@ -64,9 +64,10 @@ subroutine flat_transverse_general(name, np, params, nspec, spec, fun, jfun, sou
     if (source == SOURCE_SPEC) then
         call system_and_model(name, real(params(1:np), dp), nspec, spec, sys, model, kd, &
                               info, msg)
+        message = msg
     else
         call flat_system(name, real(params(1:np), dp), nspec, spec, fun, jfun, source, n, &
-                         sys, info, msg)
+                         sys, info, message)
         cmodel%egrad => egrad
         cmodel%present = has_energy /= 0
         cmodel%n = n
@@ -74,7 +75,6 @@ subroutine flat_transverse_general(name, np, params, nspec, spec, fun, jfun, sou
     end if
     kind = kd
     if (info /= CM_SUCCESS) then
-        message = msg
         fr%info = info
         call pack_frame(fr, nt, t, kmax, n, k, reduced, closure, drift, defect, mono, mr, mi, &
                         fmono, fr_re, fr_im, holo, xs, qs, as, phis, psis, nfev)

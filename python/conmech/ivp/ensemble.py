@@ -40,7 +40,8 @@ import numbers
 import numpy as np
 
 from .. import _conmech
-from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _real_scalar, _tolerance
+from .solve import (OdeResult, _METHOD_CODES, _METHODS, _HUGE, _positive_finite, _real_scalar,
+                    _tolerance)
 from .._core.checks import time_points as _time_points, time_span as _time_span
 from .solve import solve_ivp as _solve_ivp
 from .._core.native import NativeSystem, function_address
@@ -139,6 +140,20 @@ def _check_system(system):
                     f"{type(system).__name__}")
 
 
+def _member_rows(value, what, or_else, width, shapes):
+    """The members' rows of an array argument (a 1-d one: a single member): real numbers,
+    `width` columns (`shapes` says which shapes are accepted)."""
+    try:
+        table = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{what} must be an array of real numbers{or_else}") from None
+    if table.ndim == 1:
+        table = table.reshape(1, -1)
+    if table.ndim != 2 or table.shape[1] != width:
+        raise ValueError(f"{what} must have shape {shapes}, got shape {np.shape(value)}")
+    return table
+
+
 def _member_params(system, params):
     """Parameter table (np, mp) in Fortran order, and mp."""
     base = system.params
@@ -174,16 +189,9 @@ def _member_params(system, params):
         for j, arr in cols.items():
             table[:, j] = arr
     else:
-        try:
-            table = np.array(params, dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError("params must be an array of real numbers or a dict") from None
-        if table.ndim == 1:
-            table = table.reshape(1, -1)
-        if table.ndim != 2 or table.shape[1] != npar:
-            raise ValueError(f"params must have shape (m, {npar}) for the system "
-                             f"'{system.name}' ({', '.join(system.param_names)}), got "
-                             f"shape {np.shape(params)}")
+        table = _member_rows(params, "params", " or a dict", npar,
+                             f"(m, {npar}) for the system '{system.name}' "
+                             f"({', '.join(system.param_names)})")
     if table.shape[0] == 0:
         raise ValueError("params has no rows (no members)")
     if not np.isfinite(table).all():
@@ -357,15 +365,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
     y0_in = np.asarray(y0)
     if y0_in.dtype.kind == "c":
         raise TypeError("y0 must be real: complex states are not supported")
-    try:
-        y0a = np.array(y0_in, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError("y0 must be an array of real numbers") from None
-    if y0a.ndim == 1:
-        y0a = y0a.reshape(1, -1)
-    if y0a.ndim != 2 or y0a.shape[1] != n:
-        raise ValueError(f"y0 must have shape (m, {n}) or ({n},) for the system "
-                         f"'{system.name}', got shape {np.shape(y0)}")
+    y0a = _member_rows(y0_in, "y0", "", n, f"(m, {n}) or ({n},) for the system '{system.name}'")
     if y0a.shape[0] == 0:
         raise ValueError("y0 has no rows (no members)")
     if not np.isfinite(y0a).all():
@@ -380,21 +380,13 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
     # ---------------------------------------------------------------- options
     rtol_v = _tolerance(rtol, "rtol", n)
     atol_v = _tolerance(atol, "atol", n)
-    if first_step is None:
-        h0 = 0.0
-    else:
-        h0 = _real_scalar(first_step, "first_step")
-        if not (h0 > 0 and math.isfinite(h0)):
-            raise ValueError("first_step must be positive")
-        if h0 > abs(tf - t0) and tf != t0:
-            raise ValueError("first_step exceeds the length of t_span")
+    h0 = 0.0 if first_step is None else _positive_finite(first_step, "first_step")
+    if h0 > abs(tf - t0) and tf != t0:
+        raise ValueError("first_step exceeds the length of t_span")
     if code == 1 and first_step is None:
         raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
                          "step size")
-    hmax = _real_scalar(max_step, "max_step")
-    if not hmax > 0:
-        raise ValueError("max_step must be positive")
-    hmax = min(hmax, _HUGE)
+    hmax = min(_positive_finite(max_step, "max_step", allow_inf=True), _HUGE)
     for value, name in ((max_steps, "max_steps"), (max_events, "max_events")):
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
             raise TypeError(f"{name} must be an integer")

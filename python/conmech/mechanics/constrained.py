@@ -27,7 +27,8 @@ from .. import _conmech
 from . import degrees_of_freedom as _dof
 from .._core.builtin_table import CONSTRAINED_NAMES
 from .._core.callback import Guard, as_result, message_text
-from .._core.checks import event_settings, real_number as _real_number
+from .._core.checks import real_number as _real_number
+from .._core.driver_events import first_crossing_events
 from .._core.model import model_of
 from ..ivp.methods import BY_NAME
 from .._core.native import _NO_SPEC, _unused_callback, check_params
@@ -393,17 +394,8 @@ def solve(system: str | NativeConstrained | ConstrainedSystem, t_span: Sequence[
         if np.any(d <= 0):
             raise ValueError("t_eval must be strictly monotonic in the direction of "
                              "integration (sorted, no repeated values)")
-    settings = event_settings(events)
-    for i, (_, _, _, res) in enumerate(settings):
-        if res > 0:     # sampling inside the steps is solve_ivp's (not this driver's)
-            raise ValueError(f"events[{i}].resolution is not supported by constrained.solve (only "
-                             "by conmech.solve_ivp)")
-    settings = [s[:3] for s in settings]
+    settings = first_crossing_events(events, "constrained.solve")
     ne = len(settings)
-    for i, (_, count, _) in enumerate(settings):
-        if count > 1:
-            raise ValueError(f"events[{i}].terminal: constrained.solve stops at the first "
-                             "occurrence (terminal must be a boolean)")
     ev_dir = np.array([d for _, _, d in settings] or [0], dtype=np.intc)
     ev_term = np.array([int(c > 0) for _, c, _ in settings] or [0], dtype=np.intc)
     ev_guard = Guard()

@@ -25,15 +25,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..mechanics.compiled import CompiledConstrained, evaluate
+from ..mechanics.compiled import evaluate
 from ..mechanics.constrained import ConstrainedSystem, NativeConstrained, builtin
 from .equilibria import equilibrium, lagrange_dirichlet, multistart, potential_hessian
 from .._core.validate import _real, _state
 from .._core.result import Record
+from .manifold_checks import checked_values, constraint_jacobian, holonomic_sizes
 
 __all__ = ["ConstrainedEquilibrium", "constrained_equilibrium", "constrained_equilibria"]
-
-_RHEONOMIC_BUILTINS = ("pendulum_moving_xy", "yoyo")
 
 
 class ConstrainedEquilibrium(Record):
@@ -66,15 +65,7 @@ def _evaluator(system, t):
     if isinstance(system, str):
         system = builtin(system)
     if isinstance(system, NativeConstrained):
-        if system.n_nh > 0:
-            raise ValueError(f"'{system.name}' has non-holonomic constraints: equilibria on "
-                             "a constraint manifold need holonomic constraints only")
-        compiled_rheonomic = isinstance(system, CompiledConstrained) and \
-            int(system.spec[4]) != 0       # spec[4]: the rheonomic flag (_make_spec)
-        if system.name in _RHEONOMIC_BUILTINS or compiled_rheonomic:
-            raise ValueError(f"'{system.name}' has time-dependent (rheonomic) constraints: "
-                             "it has no equilibria")
-        n, m = system.n, system.n_hol
+        n, m = holonomic_sizes(system, "equilibria")
 
         def fun(q, v):
             d = evaluate(system, t, q, v)
@@ -85,38 +76,15 @@ def _evaluator(system, t):
         has_energy = evaluate(system, t, np.ones(n), np.zeros(n))["energy"] is not None
         return n, m, fun, (energy if has_energy else None)
     if isinstance(system, ConstrainedSystem):
-        if system.n_nh > 0:
-            raise ValueError("the system has non-holonomic constraints: equilibria on a "
-                             "constraint manifold need holonomic constraints only")
-        if system.rheonomic:
-            raise ValueError("the system has time-dependent (rheonomic) constraints: it has "
-                             "no equilibria")
-        n, m = system.n, system.n_hol
-
-        def arr(x, shape, what):
-            a = np.asarray(x, dtype=float)
-            if a.size != int(np.prod(shape)) or not np.all(np.isfinite(a)):
-                raise ValueError(f"{what} must return {shape} finite values, got "
-                                 f"{a.shape}")
-            return a.reshape(shape)
+        n, m = holonomic_sizes(system, "equilibria")
 
         def fun(q, v):
-            mm = arr(system.mass(t, q), (n, n), "mass(t, q)")
-            qf = arr(system.forces(t, q, v), (n,), "forces(t, q, v)")
+            mm = checked_values(system.mass(t, q), (n, n), "mass(t, q)")
+            qf = checked_values(system.forces(t, q, v), (n,), "forces(t, q, v)")
             if m == 0:
                 return mm, qf, np.zeros(0), np.zeros((0, n))
-            ph = arr(system.phi(t, q), (m,), "phi(t, q)")
-            if system.jac is not None:
-                g = arr(system.jac(t, q), (m, n), "jac(t, q)")
-            else:
-                g = np.empty((m, n))
-                for j in range(n):
-                    h = np.finfo(float).eps**(1/3)*max(1.0, abs(q[j]))
-                    e = np.zeros(n)
-                    e[j] = h
-                    g[:, j] = (arr(system.phi(t, q + e), (m,), "phi")
-                               - arr(system.phi(t, q - e), (m,), "phi"))/(2*h)
-            return mm, qf, ph, g
+            ph = checked_values(system.phi(t, q), (m,), "phi(t, q)")
+            return mm, qf, ph, constraint_jacobian(system, t, q, m, n)
         energy = None
         if system.energy is not None:
             def energy(q):

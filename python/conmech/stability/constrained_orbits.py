@@ -33,26 +33,18 @@ import numpy as np
 import scipy.linalg
 
 from .. import _conmech
-from ..mechanics.compiled import CompiledConstrained, evaluate
+from ..mechanics.compiled import evaluate
 from ..mechanics.constrained import ConstrainedSystem, NativeConstrained, builtin
 from ..mechanics.constrained import solve as _constrained_solve
 from .continuation import continuation
 from .orbits import periodic_orbit, symmetric_orbit
 from .._core.validate import _real, _state
 from .._core.result import Record
+from .manifold_checks import checked_values as _arr, constraint_jacobian, holonomic_sizes
 
 __all__ = ["ManifoldChart", "ConstrainedOrbit", "ConstrainedBranch",
            "constrained_periodic_orbit", "constrained_symmetric_orbit",
            "constrained_continuation"]
-
-_RHEONOMIC_BUILTINS = ("pendulum_moving_xy", "yoyo")
-
-
-def _arr(x, shape, what):
-    a = np.asarray(x, dtype=float)
-    if a.size != int(np.prod(shape)) or not np.all(np.isfinite(a)):
-        raise ValueError(f"{what} must return {shape} finite values, got {a.shape}")
-    return a.reshape(shape)
 
 
 def _evaluator(system):
@@ -61,15 +53,7 @@ def _evaluator(system):
     if isinstance(system, str):
         system = builtin(system)
     if isinstance(system, NativeConstrained):
-        if system.n_nh > 0:
-            raise ValueError(f"system: '{system.name}' has non-holonomic constraints; "
-                             "periodic orbits on a constraint manifold need holonomic ones")
-        rheo = isinstance(system, CompiledConstrained) and int(system.spec[4]) != 0
-        if system.name in _RHEONOMIC_BUILTINS or rheo:
-            raise ValueError(f"system: '{system.name}' has time-dependent (rheonomic) "
-                             "constraints: its manifold moves, use the generalized "
-                             "coordinates")
-        n, m = system.n, system.n_hol
+        n, m = holonomic_sizes(system, "periodic orbits")
         evaluate(system, 0.0, np.zeros(n), np.zeros(n))      # checks the system once
         name, np_, p, nspec, spec = system._flat_args()
         mn = system.n_nh
@@ -85,25 +69,11 @@ def _evaluator(system):
                     np.asarray(g)[:m].reshape(m, n), np.asarray(gh)[:m])
         return system, n, m, fun
     if isinstance(system, ConstrainedSystem):
-        if system.n_nh > 0:
-            raise ValueError("system: non-holonomic constraints; periodic orbits on a "
-                             "constraint manifold need holonomic ones")
-        if system.rheonomic:
-            raise ValueError("system: time-dependent (rheonomic) constraints: its manifold "
-                             "moves, use the generalized coordinates")
-        n, m = system.n, system.n_hol
+        n, m = holonomic_sizes(system, "periodic orbits")
         h1 = np.finfo(float).eps**(1/3)
 
         def jac(q):
-            if system.jac is not None:
-                return _arr(system.jac(0.0, q), (m, n), "jac(t, q)")
-            g = np.empty((m, n))
-            for j in range(n):
-                e = np.zeros(n)
-                e[j] = h1*max(1.0, abs(q[j]))
-                g[:, j] = (_arr(system.phi(0.0, q + e), (m,), "phi(t, q)")
-                           - _arr(system.phi(0.0, q - e), (m,), "phi(t, q)"))/(2*e[j])
-            return g
+            return constraint_jacobian(system, 0.0, q, m, n)
 
         def fun(q, v):
             mm = _arr(system.mass(0.0, q), (n, n), "mass(t, q)")

@@ -68,7 +68,30 @@ class SpecialPoint(Record):
         return f"SpecialPoint({self.kind!r}, p={self.p!r}, index={self.index}{loc})"
 
 
-class Branch(StatusRecord):
+class BranchRecord(StatusRecord):
+    """What a branch of any kind holds first: the points' parameter values ``p``, the
+    ``special`` points and the ``message``; its length is its number of points."""
+
+    __slots__ = ()
+
+    def __len__(self):
+        return len(self.p)
+
+    def __repr__(self):
+        return (f"{type(self).__name__}(points={len(self.p)}, p=[{self.p[0]:.6g} .. "
+                f"{self.p[-1]:.6g}], special={[(s.kind, round(s.p, 12)) for s in self.special]}"
+                f", message={self.message!r})")
+
+
+def branch_points(npts, info, message):
+    """The points a flat continuation returned (npts of its arrays' mp) as a slice; none
+    (the start itself failed): its status raised."""
+    if int(npts) == 0:
+        raise_status(info, message)
+    return slice(0, int(npts))
+
+
+class Branch(BranchRecord):
     """A branch of periodic orbits from :func:`continuation`.
 
     Arrays over the points: p (parameter), period, y0 (N, n), multipliers (N, n) complex
@@ -89,14 +112,6 @@ class Branch(StatusRecord):
                  "residual", "iterations", "energy", "special", "status", "message",
                  "param", "conservative", "kernel_ratio", "multiplier_error", "accuracy",
                  "stable_tol", "direction", "method")
-
-    def __len__(self):
-        return len(self.p)
-
-    def __repr__(self):
-        return (f"Branch(points={len(self.p)}, p=[{self.p[0]:.6g} .. {self.p[-1]:.6g}], "
-                f"special={[(s.kind, round(s.p, 12)) for s in self.special]}, "
-                f"message={self.message!r})")
 
 
 def _param_index(system, param):
@@ -310,10 +325,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     g.check()
     (npts, pp, per, ys, mr, mi, merr, acc, s, psi, res, iters, nsp, sk, si, sp_p, sp_per,
      sp_y, sp_mr, sp_mi, sp_s, sp_loc, sp_test, sp_clo, sp_br, dirout, info, message) = out
-    npts = int(npts)
-    if npts == 0:
-        raise_status(info, message)
-    k = slice(0, npts)
+    k = branch_points(npts, info, message)
     mult = (np.asarray(mr)[:, k] + 1j*np.asarray(mi)[:, k]).T.copy()
     merr = np.array(merr[:, k]).T.copy()
     s = np.array(s[k])

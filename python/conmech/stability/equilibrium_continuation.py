@@ -12,8 +12,8 @@ from .. import _conmech
 from .._core.callback import Guard, as_result
 from .._core.native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
 from .._core.validate import _check_dim, _count, _msg, _real, _state
-from .continuation import Branch, _param_index, continuation
-from .._core.result import Record, StatusRecord
+from .continuation import Branch, BranchRecord, _param_index, branch_points, continuation
+from .._core.result import Record
 from .._core.status import raise_status
 
 __all__ = ["EquilibriumBranch", "EquilibriumSpecialPoint", "HopfNormalForm",
@@ -72,7 +72,7 @@ class EquilibriumSpecialPoint(Record):
                 f"located={self.located}{extra})")
 
 
-class EquilibriumBranch(StatusRecord):
+class EquilibriumBranch(BranchRecord):
     """A branch of equilibria from :func:`equilibrium_continuation`.
 
     Arrays over the points: p, y (N, n), eigenvalues (N, n) complex, n_unstable
@@ -85,14 +85,6 @@ class EquilibriumBranch(StatusRecord):
 
     __slots__ = ("p", "y", "eigenvalues", "n_unstable", "stable", "tests", "residual",
                  "iterations", "special", "status", "message", "param")
-
-    def __len__(self):
-        return len(self.p)
-
-    def __repr__(self):
-        return (f"EquilibriumBranch(points={len(self.p)}, p=[{self.p[0]:.6g} .. "
-                f"{self.p[-1]:.6g}], special={[(s.kind, round(s.p, 12)) for s in self.special]}"
-                f", message={self.message!r})")
 
 
 def _param_rhs(system, n, y0, p0):
@@ -200,10 +192,7 @@ def equilibrium_continuation(system: Any, y0: ArrayLike, param: str | int | None
         pname = param if isinstance(param, str) else "p"
     (npts, pp, ys, wr, wi, psi, nunst, res, iters, nsp, spi, spr, sp_y, sp_wr, sp_wi, sp_q,
      sp_a, info, message) = out
-    npts = int(npts)
-    if npts == 0:
-        raise_status(info, message)
-    k = slice(0, npts)
+    k = branch_points(npts, info, message)
     eig = (np.asarray(wr)[:, k] + 1j*np.asarray(wi)[:, k]).T.copy()
     tests = np.array(psi[:, k]).T.copy()
     has_pair = np.any(np.asarray(wi)[:, k] > 0, axis=0)

@@ -21,13 +21,14 @@ pendulum: d2S[sin(pi t/T)] = (T/2)((pi/T)^2 - g/l) m l^2 changes sign at T = pi 
 import numpy as np
 import sympy as sp
 
+from .._core.result import Record
 from .momenta import analysis
 from .quadrature import dense_segments, integrate_dense
 
 __all__ = ["action", "first_variation", "second_variation", "Variation", "check_stationary"]
 
 
-class Variation:
+class Variation(Record):
     """Result of :func:`first_variation` / :func:`check_stationary`: ``delta_S`` (the first
     variation of the action), ``virtual_work`` (integral of Q . eta, 0 without
     non-conservative forces), ``residual`` (delta_S + virtual_work: zero on a motion),
@@ -35,8 +36,7 @@ class Variation:
     that cancel), ``relative`` (|residual| / scale), ``second`` (the second variation when
     computed, else None)."""
 
-    def __init__(self, **kw):
-        self.__dict__.update(kw)
+    __slots__ = ("delta_S", "virtual_work", "residual", "scale", "relative", "second")
 
     def __repr__(self):
         return (f"Variation(delta_S={self.delta_S:.3e}, residual={self.residual:.3e}, "

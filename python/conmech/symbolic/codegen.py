@@ -35,8 +35,8 @@ import sympy as sp
 
 from .._core import slot_table as _table
 from .printer import (_SQRT, FortranPrinter, _decl_temps, _names, _procedure,  # noqa: F401
-                      _trig_defs, _wrap, assignments, prepare, product_lines, product_terms,
-                      trig_split)
+                      _trig_defs, _wrap, assignments, entry_heads, prepare, product_lines,
+                      product_terms, trig_split)
 from .constrained_jac import constrained_derivatives
 from .library_info import _model_info
 from .tree_print import accel_procedure
@@ -141,12 +141,8 @@ def generate(d, module="conmech_symbolic_model", model_values=None, taylor=False
         c_names = _c_names(entries, model_values)
         check_source(src, c_names + private_procedures(entries, src), c_names)
         return src, entries
-    pr = FortranPrinter(_names(d))
+    pr, npar, ind, T, P = entry_heads(d)
     n = d.n
-    npar = max(len(d.params), 1)
-    ind = "        "
-    T = f"{ind}real(dp), value, intent(in) :: t"
-    P = f"{ind}real(dp), intent(in) :: p({npar})"
 
     def arr(name, shape, intent="in"):
         return f"{ind}real(dp), intent({intent}) :: {name}({', '.join(map(str, shape))})"

@@ -41,6 +41,7 @@ import sympy as sp
 
 from .kinematics import _add, _cross, _dot, _path_to_root, relative
 from .printer import _decl_temps, assignments
+from .tree import _components
 from .tree_print import SC_DECL, pos_call
 from .loop_report import worst_loop as _worst_loop
 from .pipeline import model_of
@@ -104,19 +105,7 @@ class PointForce:
 
 
 def _vec(x, dim, what):
-    try:
-        seq = list(x)
-    except TypeError:
-        raise TypeError(f"{what} must be {dim} expressions") from None
-    if len(seq) != dim:
-        raise ValueError(f"{what} must have {dim} components, got {len(seq)}")
-    out = []
-    for e in seq:
-        try:
-            out.append(sp.sympify(e, strict=True) if not isinstance(e, sp.Basic) else e)
-        except (sp.SympifyError, TypeError):
-            raise TypeError(f"{what}: {e!r} is not a sympy expression or a number") from None
-    return out
+    return _components(x, dim, what, f"{dim} expressions")
 
 
 def _perp_pair(u, what):

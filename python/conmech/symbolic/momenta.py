@@ -33,7 +33,7 @@ from sympy.physics.mechanics import dynamicsymbols
 
 from ..mechanics import compiled
 from .build import compile_source, load
-from .printer import FortranPrinter, _names, _procedure
+from .printer import _procedure, entry_heads
 from .source_text import check_source, comment_lines, comment_text
 
 __all__ = ["Momenta", "FirstIntegrals", "LagrangianSystem", "momenta", "first_integrals",
@@ -159,24 +159,24 @@ class _Analysis:
                                module="conmech_symbolic_momenta")
         return self._lib
 
+    def _state_hessian(self, slot, expr, entry, module):
+        """The library of one entry `entry`: the Hessian of expr in y = [q, v] (2n x 2n),
+        built once and kept in the attribute `slot`."""
+        if getattr(self, slot) is None:
+            d = self.d
+            H = sp.hessian(expr, list(d.coords) + list(d.speeds))
+            setattr(self, slot, _build(d, [(entry, H, (2*d.n, 2*d.n))], module=module))
+        return getattr(self, slot)
+
     def lagrangian_hessian_library(self):
         """The Hessian of L in y = [q, v] (2n x 2n), for the second variation."""
-        if self._lhess is None:
-            d = self.d
-            y = list(d.coords) + list(d.speeds)
-            H = sp.hessian(self.L, y)
-            self._lhess = _build(d, [("lagrangian_hess", H, (2*d.n, 2*d.n))],
-                                 module="conmech_symbolic_lagrangian_hessian")
-        return self._lhess
+        return self._state_hessian("_lhess", self.L, "lagrangian_hess",
+                                   "conmech_symbolic_lagrangian_hessian")
 
     def hessian_library(self):
-        if self._hess is None:
-            d = self.d
-            y = list(d.coords) + list(d.speeds)
-            H = sp.hessian(d.energy, y)
-            self._hess = _build(d, [("energy_hess", H, (2*d.n, 2*d.n))],
-                                module="conmech_symbolic_energy_hessian")
-        return self._hess
+        """The Hessian of the energy in y = [q, v] (2n x 2n)."""
+        return self._state_hessian("_hess", self.d.energy, "energy_hess",
+                                   "conmech_symbolic_energy_hessian")
 
 
 class _Lib:
@@ -235,12 +235,8 @@ def _build(d, vectors, scalars=(), module="conmech_symbolic_extra"):
     vectors [(name, Matrix, shape)] as subroutines name(t, q, v, out, p), scalars
     [(name, expr)] as real functions name(t, q, v, p), each with a batch form
     name_batch(m, ts, qs, vs, out, p)."""
-    pr = FortranPrinter(_names(d))
+    pr, npar, ind, T, P = entry_heads(d)
     n = d.n
-    npar = max(len(d.params), 1)
-    ind = "        "
-    T = f"{ind}real(dp), value, intent(in) :: t"
-    P = f"{ind}real(dp), intent(in) :: p({npar})"
     QV = [T, f"{ind}real(dp), intent(in) :: q({n})", f"{ind}real(dp), intent(in) :: v({n})"]
     procs, shapes = [], {}
     for name, mat, shape in vectors:

@@ -8,6 +8,7 @@ built before; otherwise the expressions are derived (``derive.py``), the Fortran
 :func:`_system` wraps it as a ``conmech.compiled`` system that the integrators and the
 stability routines run with no Python in the loop.
 """
+import contextlib
 import ctypes
 import errno
 import hashlib
@@ -25,8 +26,8 @@ from ..mechanics import compiled
 from .. import _conmech as _flat
 from .._core import slot_table as _table
 from .._core.model import SystemModel, model_of
-from .build import (CacheError, _conmech_version, cache_dir, check_private, compile_source,
-                    load)
+from .build import (CacheError, _conmech_version, _write_atomic, cache_dir, check_private,
+                    compile_source, load)
 from .codegen import CODEGEN_VERSION, generate
 from .derive import _as_value, singular_everywhere
 from .description import _NotPlain, _param_names, store_description
@@ -268,10 +269,8 @@ def save_model(system, path, flags=None):
                                  f"{exc.strerror or exc}") from None
     finally:
         if tmp is not None:
-            try:
+            with contextlib.suppress(OSError):
                 os.unlink(tmp)
-            except OSError:
-                pass
     return path
 
 
@@ -365,22 +364,12 @@ def _from_cache(key, params, flags):
 
 
 def _store(key, model, flags):
-    path = _entry_path(key)
-    d = model.derived
-    tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=os.path.dirname(path))
-        with os.fdopen(fd, "wb") as fh:
-            pickle.dump((d, model.source, list(model.addresses),
-                         list(flags) if flags is not None else None), fh)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
+        data = pickle.dumps((model.derived, model.source, list(model.addresses),
+                             list(flags) if flags is not None else None))
+        _write_atomic(_entry_path(key), data, 0o644)
     except Exception:        # the derivation cache is an optimisation only
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
+        pass
 
 
 def _check_compiled_mass(model):

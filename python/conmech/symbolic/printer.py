@@ -390,3 +390,12 @@ def _names(d):
     for i, s in enumerate(d.params):
         names[s] = f"p({i + 1})"
     return names
+
+
+def entry_heads(d, ind="        "):
+    """What every generated entry point of the derived record d starts from: the printer of
+    its expressions, the parameter vector's length (at least 1: Fortran has no empty
+    explicit-shape dummy), the indent and the declarations of t (by value) and p(npar)."""
+    npar = max(len(d.params), 1)
+    return (FortranPrinter(_names(d)), npar, ind, f"{ind}real(dp), value, intent(in) :: t",
+            f"{ind}real(dp), intent(in) :: p({npar})")

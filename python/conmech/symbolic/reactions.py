@@ -23,13 +23,14 @@ parent's turned by the joint's fixed rotation, then by the joint angle about its
 import numpy as np
 import sympy as sp
 
+from .._core.result import Record
 from .kinematics import relative
 from .pipeline import model_of
 
 __all__ = ["JointReaction", "joint_reactions"]
 
 
-class JointReaction:
+class JointReaction(Record):
     """The reaction of one loop-closure joint along a result: ``label``, ``kind`` (the
     joint), ``body_a``, ``body_b`` (names; None: the ground), ``force`` (2 or 3 components
     x nt, on body a, in body a's frame), ``moment`` (on body a, body a's frame: 3 x nt for
@@ -37,10 +38,6 @@ class JointReaction:
     that transmit none), ``rows`` (the slice of the result's ``lam`` it groups)."""
 
     __slots__ = ("label", "kind", "body_a", "body_b", "force", "moment", "rows")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         return (f"JointReaction({self.label!r}, {self.kind}, force {self.force.shape}"

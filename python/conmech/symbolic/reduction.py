@@ -26,6 +26,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
+from .._core.result import Record
 from .constructors import lagrangian_system
 from .simplify import _quadratic_parts
 from .momenta import LagrangianSystem, _build, analysis, is_zero, to_user
@@ -34,7 +35,7 @@ from .quadrature import cumulative_dense
 __all__ = ["reduce", "ReducedSystem", "Reduction"]
 
 
-class Reduction:
+class Reduction(Record):
     """What :func:`reduce` derived. Attributes (sympy expressions in the user's
     dynamicsymbols and parameter names): ``cyclic`` (names), ``momentum_names``
     (the run-time parameters p_<name>), ``remaining`` (names of the reduced coordinates),
@@ -45,8 +46,9 @@ class Reduction:
     ``singular`` (det M_cc, whose zeros make the amended potential singular when a
     momentum is not zero)."""
 
-    def __init__(self, **kw):
-        self.__dict__.update(kw)
+    __slots__ = ("cyclic", "momentum_names", "remaining", "routhian", "reduced_mass",
+                 "gyroscopic", "amended_potential", "energy", "cyclic_velocity", "closed_form",
+                 "singular")
 
     def __repr__(self):
         return (f"Reduction(cyclic={self.cyclic}, remaining={self.remaining}, "

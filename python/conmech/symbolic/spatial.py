@@ -34,7 +34,7 @@ from sympy.core.function import AppliedUndef
 from sympy.physics.mechanics import dynamicsymbols
 
 from .spatial_aba import _rodrigues, _spatial_aba
-from .tree import _check_tree, _derive, _expr, _force_list, _forces_at
+from .tree import _check_tree, _components, _derive, _expr, _force_list, _forces_at
 
 __all__ = ["SpatialBody", "build_spatial_tree", "derive_spatial_tree"]
 
@@ -44,12 +44,8 @@ class SpatialBody:
 
     Parameters
     ----------
-    name : str
-        The body's name (unique in the tree).
-    parent : str or None
-        The parent body's name; None: the body is jointed to the ground.
-    joint : {"revolute", "prismatic"}
-        The joint to the parent.
+    name, parent, joint, mass
+        As for the planar tree's body (``conmech.symbolic.Body``).
     q : sympy dynamicsymbol
         The joint's coordinate (a function of t), relative to the parent.
     axis : 3 expressions
@@ -60,8 +56,6 @@ class SpatialBody:
     rot : 3x3 rotation matrix, optional
         The fixed rotation of the joint frame in the parent's frame (columns: the joint
         frame's axes in parent coordinates); None: the identity.
-    mass : expression
-        The body's mass (>= 0).
     com : 3 expressions
         The centre of mass in the body's own frame.
     inertia : 3x3 expressions, optional
@@ -84,13 +78,7 @@ class SpatialBody:
 
 
 def _vec3(x, what):
-    try:
-        seq = list(x)
-    except TypeError:
-        raise TypeError(f"{what} must be 3 expressions (x, y, z)") from None
-    if len(seq) != 3:
-        raise ValueError(f"{what} must have 3 components, got {len(seq)}")
-    return sp.Matrix([_expr(e, what) for e in seq])
+    return sp.Matrix(_components(x, 3, what, "3 expressions (x, y, z)"))
 
 
 def _mat3(x, what, default, zero_ok=False):

@@ -4,7 +4,7 @@ first-order view y = [q; v] as ``prefix(t, order, w, p)``, ``prefix_info(info)``
 columns of w and the size 2n of the view) and ``prefix_rhs(t, y, dydt, p)``, the view's
 right-hand side as the order-1 coefficient of the same recurrences."""
 
-__all__ = ["first_order_procedures"]
+__all__ = ["core_part_lines", "first_order_procedures"]
 
 
 def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
@@ -33,3 +33,21 @@ def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
               f"{ind}dydt = w(1, 1:{m})",
               f"    end subroutine {prefix}_rhs", ""]
     return lines
+
+
+def core_part_lines(d, part, dec_cache, key, decompose, what, procedures):
+    """(Fortran lines, entry names, reason) of one part of the Taylor library of a model whose
+    recurrences run through its first-order view: the core only (the batch, quadruple
+    precision and variational parts are generated for ode systems only). decompose(d) ->
+    (*pieces, reason), pieces[0] None when the model is not supported, is kept in
+    dec_cache[key] for the other parts; procedures(*pieces) writes the core; `what` names
+    the kind of model in the refusal of another part."""
+    if key not in dec_cache:
+        dec_cache[key] = decompose(d)
+    *pieces, why = dec_cache[key]
+    if pieces[0] is None:
+        return [], [], why
+    if part != "core":
+        return [], [], (f"the Taylor part {part!r} (ensembles, quadruple precision, the "
+                        f"variational system) is generated for ode systems only, not for {what}")
+    return procedures(*pieces), ["taylor", "taylor_info", "taylor_rhs"], None

@@ -33,7 +33,7 @@ import sympy as sp
 
 from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
-from .taylor_first_order import first_order_procedures
+from .taylor_first_order import core_part_lines, first_order_procedures
 from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["generalized_decomposition", "generalized_procedures", "WRITE_OUT_MAX"]
@@ -280,15 +280,7 @@ def generalized_lines(d, names, part, dec_cache):
     precision and variational parts are not generated for generalized systems."""
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)
-    if "g" not in dec_cache:
-        dec_cache["g"] = generalized_decomposition(d)
-    g, why = dec_cache["g"]
-    if g is None:
-        return [], [], why
-    if part != "core":
-        return [], [], (f"the Taylor part {part!r} (ensembles, quadruple precision, the "
-                        "variational system) is generated for ode systems only, not for "
-                        "generalized systems M(q) q'' = Q")
     npar = max(len(d.params), 1)
-    return generalized_procedures(g, names, npar=npar), \
-        ["taylor", "taylor_info", "taylor_rhs"], None
+    return core_part_lines(d, part, dec_cache, "g", generalized_decomposition,
+                           "generalized systems M(q) q'' = Q",
+                           lambda g: generalized_procedures(g, names, npar=npar))

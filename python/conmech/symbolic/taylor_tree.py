@@ -37,7 +37,7 @@ import sympy as sp
 from .spatial_aba import _spatial_aba
 from .taylor import _Printer, _wrap, body_lines
 from .taylor_decompose import TaylorUnsupported, decompose
-from .taylor_first_order import first_order_procedures
+from .taylor_first_order import core_part_lines, first_order_procedures
 from .tree_aba import _aba
 
 __all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_procedures", "tree_lines",
@@ -124,17 +124,9 @@ def tree_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a tree model's Taylor library
     (:mod:`conmech.symbolic.taylor_library`): the core only (the batch, quadruple
     precision and variational parts are generated for ode systems only)."""
-    if "tree" not in dec_cache:
-        dec_cache["tree"] = tree_decomposition(d)
-    dec, pivots, why = dec_cache["tree"]
-    if dec is None:
-        return [], [], why
-    if part != "core":
-        return [], [], (f"the Taylor part {part!r} (ensembles, quadruple precision, the "
-                        "variational system) is generated for ode systems only, not for "
-                        "trees (their first-order view runs the core)")
-    return tree_procedures(dec, pivots, names), ["taylor", "taylor_info", "taylor_rhs"], \
-        None
+    return core_part_lines(d, part, dec_cache, "tree", tree_decomposition,
+                           "trees (their first-order view runs the core)",
+                           lambda dec, pivots: tree_procedures(dec, pivots, names))
 
 
 def pivot_values(d, t, q, v, params):

@@ -81,14 +81,19 @@ class Body:
                 f"q={self.q}, mass={self.mass})")
 
 
-def _pair(x, what):
+def _components(x, k, what, kind):
+    """The k components of the vector x as expressions; `kind` says what x must be."""
     try:
         seq = list(x)
     except TypeError:
-        raise TypeError(f"{what} must be a pair of expressions (x, y)") from None
-    if len(seq) != 2:
-        raise ValueError(f"{what} must have 2 components, got {len(seq)}")
+        raise TypeError(f"{what} must be {kind}") from None
+    if len(seq) != k:
+        raise ValueError(f"{what} must have {k} components, got {len(seq)}")
     return [_expr(e, what) for e in seq]
+
+
+def _pair(x, what):
+    return _components(x, 2, what, "a pair of expressions (x, y)")
 
 
 def _expr(e, what):

@@ -16,7 +16,7 @@ import sympy as sp
 from .library_info import _model_info
 from .loops import loop_code
 from .printer import FortranPrinter, _decl_temps, _names, _wrap
-from .kinematics import Code, point_force_code, pos_pass, relative, vel_pass
+from .kinematics import Code, _sym3, point_force_code, pos_pass, relative, vel_pass
 from .tree_pairs import FIXED, straight_pairs
 from .spatial_aba import _spatial_aba
 from .tree_aba import _aba
@@ -77,15 +77,15 @@ def _loaded_pos(st, pos, keep_pose):
         if d["I"] is not None:
             m, h, Io = d["I"]
             e["I"] = (st.scalar(m), [st.scalar(x) for x in h],
-                      _sym(lambda i, j: st.scalar(Io[i][j])))
-            e["Jw"] = _sym(lambda i, j: st.scalar(d["Jw"][i][j]))
+                      _sym3(lambda i, j: st.scalar(Io[i][j])))
+            e["Jw"] = _sym3(lambda i, j: st.scalar(d["Jw"][i][j]))
             e["cw"] = [st.scalar(x) for x in d["cw"]]
         else:
             e["I"] = e["Jw"] = e["cw"] = None
         if d["Ic"] is not None:
             m, h, Io = d["Ic"]
             e["Ic"] = (st.scalar(m), [st.scalar(x) for x in h],
-                       _sym(lambda i, j: st.scalar(Io[i][j])))
+                       _sym3(lambda i, j: st.scalar(Io[i][j])))
         else:
             e["Ic"] = None
         if k in keep_pose:
@@ -93,14 +93,6 @@ def _loaded_pos(st, pos, keep_pose):
             e["p"] = [st.scalar(x) for x in d["p"]]
         out.append(e)
     return out
-
-
-def _sym(f):
-    M = [[None]*3 for _ in range(3)]
-    for i in range(3):
-        for j in range(i, 3):
-            M[i][j] = M[j][i] = f(i, j)
-    return M
 
 
 class Emit:

@@ -34,6 +34,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
+from .._core.result import Record
 from .description import urdf_description_key
 from .description_lookup import description_hit
 from .spatial import SpatialBody
@@ -45,7 +46,7 @@ _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "pris
 _URDF_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
-class UrdfJoint:
+class UrdfJoint(Record):
     """A joint of a URDF robot as data: name, type, parent and child link, origin (xyz,
     rpy), axis, limits (lower, upper, effort, velocity; None where absent), dynamics
     (damping, friction; 0 where absent) and, for a movable joint, its coordinate (a
@@ -53,10 +54,6 @@ class UrdfJoint:
 
     __slots__ = ("name", "type", "parent", "child", "xyz", "rpy", "axis", "lower", "upper",
                  "effort", "velocity", "damping", "friction", "coordinate", "index")
-
-    def __init__(self, **kw):
-        for k in self.__slots__:
-            setattr(self, k, kw.get(k))
 
     def __repr__(self):
         return (f"UrdfJoint({self.name!r}, {self.type!r}, parent={self.parent!r}, "

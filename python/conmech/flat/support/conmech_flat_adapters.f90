@@ -248,16 +248,16 @@ contains
 
     !> The system of fun and jvals with the pattern (sp_ptr(n + 1), sp_idx(nnz), 1-based,
     !! by columns); CM_BAD_INPUT when the pattern is not one (the structure's own checks
-    !! follow in set_jacobian_structure).
-    subroutine make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, msg)
+    !! follow in set_jacobian_structure), with the flat routine's `message`.
+    subroutine make_sparse_jac_system(fun, jvals, n, nnz, sp_ptr, sp_idx, sys, info, message)
         procedure() :: fun, jvals
         integer(c_int), intent(in) :: n, nnz, sp_ptr(:), sp_idx(:)
         type(callback_sparse_jac_system), intent(out) :: sys
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(out) :: message
         info = CM_BAD_INPUT
         if (n < 1 .or. nnz < 0 .or. size(sp_ptr) < n + 1 .or. size(sp_idx) < nnz) then
-            msg = "bad input: the sparse Jacobian's pattern arrays are too short"
+            message = "bad input: the sparse Jacobian's pattern arrays are too short"
             return
         end if
         sys%f => fun
@@ -267,7 +267,7 @@ contains
         sys%col_ptr = sp_ptr(1:n + 1)
         sys%row_idx = sp_idx(1:nnz)
         info = CM_SUCCESS
-        msg = "success"
+        message = "success"
     end subroutine make_sparse_jac_system
 
     subroutine sparse_callback_rhs(self, t, y, dydt)

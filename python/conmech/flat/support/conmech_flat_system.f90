@@ -40,8 +40,9 @@ module conmech_flat_system
 
 contains
 
-    !> The first-order system of dimension n described by one flat argument set (above).
-    subroutine flat_system(name, params, nspec, spec, fun, jfun, source, n, sys, info, msg)
+    !> The first-order system of dimension n described by one flat argument set (above);
+    !! info /= 0 and `message` (the flat routine's own output) when it cannot be built.
+    subroutine flat_system(name, params, nspec, spec, fun, jfun, source, n, sys, info, message)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
         integer, intent(in) :: nspec
@@ -50,7 +51,8 @@ contains
         integer(c_int), intent(in) :: source, n
         class(ode_system), allocatable, intent(out) :: sys
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(out) :: message
+        character(len=:), allocatable :: msg
         info = 0
         msg = "success"
         select case (source)
@@ -62,13 +64,15 @@ contains
             info = CM_BAD_INPUT
             msg = "bad input: unknown system source"
         end select
+        message = msg
     end subroutine flat_system
 
     !> The system of the parametric flat argument set (above) and the parameter value it
     !! starts from (params(ip), or p0 for Python functions). ip < 0 with a built-in or
-    !! compiled system: the system itself, with no parameter (p_start = p0).
+    !! compiled system: the system itself, with no parameter (p_start = p0). info /= 0 and
+    !! `message` (the flat routine's own output) when it cannot be built.
     subroutine flat_param_system(name, params, nspec, spec, ip, fun, jfun, source, n, p0, &
-                                 sys, p_start, info, msg)
+                                 sys, p_start, info, message)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:)
         integer, intent(in) :: nspec
@@ -79,7 +83,10 @@ contains
         class(ode_system), allocatable, intent(out) :: sys
         real(dp), intent(out) :: p_start
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(out) :: message
+        character(len=:), allocatable :: msg
+        type(builtin_param_system) :: b
+        class(ode_system), allocatable :: inner
         info = 0
         msg = "success"
         p_start = p0
@@ -87,28 +94,23 @@ contains
         case (SOURCE_SPEC)
             if (ip < 0) then
                 call spec_system(name, params, nspec, spec, sys, info, msg)
-                return
+            else if (spec_kind(nspec, spec) == KIND_BUILTIN) then
+                call make_param_system(name, params, ip, b, info, msg)
+            else
+                call spec_system(name, params, nspec, spec, inner, info, msg)
+                if (info == 0) call make_compiled_param_system(inner, params, ip, b, info, msg)
             end if
-            block
-                type(builtin_param_system) :: b
-                class(ode_system), allocatable :: inner
-                if (spec_kind(nspec, spec) == KIND_BUILTIN) then
-                    call make_param_system(name, params, ip, b, info, msg)
-                else
-                    call spec_system(name, params, nspec, spec, inner, info, msg)
-                    if (info == 0) call make_compiled_param_system(inner, params, ip, b, &
-                                                                   info, msg)
-                end if
-                if (info /= 0) return
+            if (ip >= 0 .and. info == 0) then
                 if (size(params) > 0) p_start = params(max(ip, 1))
                 allocate (sys, source=b)
-            end block
+            end if
         case (SOURCE_FUN, SOURCE_FUN_JAC)
             call python_system(fun, jfun, source, n, .true., p0, sys)
         case default
             info = CM_BAD_INPUT
             msg = "bad input: unknown system source"
         end select
+        message = msg
     end subroutine flat_param_system
 
     !> The adapter of a Python right-hand side fun (and, for SOURCE_FUN_JAC, its Jacobian

@@ -27,33 +27,37 @@ module conmech_support_control
     use conmech_mech_plant, only: mech_plant
     use conmech_vhc, only: vhc, vhc_law
     use conmech_transverse_lqr, only: transverse_lqr_law
+    use conmech_periodic_riccati, only: periodic_lq, riccati_result, riccati_gain
     implicit none
     private
     public :: callback_law, c_law, zero_law, build_plant, build_vhc, build_law, law_rsize
-    public :: project_states, build_plant_law
+    public :: project_states, build_plant_law, pack_riccati
 
 
 contains
 
-    !> The plant (see the module notes). info /= 0 with a message if the system is not a
-    !! generalized one or the sizes do not match.
-    subroutine build_plant(name, params, nspec, spec, nd, m, bmat, baddr, bpar, plant, info, msg)
+    !> The plant (see the module notes). info /= 0 with the flat routine's `message` if the
+    !! system is not a generalized one or the sizes do not match.
+    subroutine build_plant(name, params, nspec, spec, nd, m, bmat, baddr, bpar, plant, info, &
+                           message)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:), bmat(:, :), bpar(:)
         integer, intent(in) :: nspec, nd, m
         integer(c_int64_t), intent(in) :: spec(:), baddr
         type(mech_plant), intent(out) :: plant
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(out) :: message
         class(generalized_system), allocatable :: gs
+        character(len=:), allocatable :: msg
         call spec_generalized(name, params, nspec, spec, gs, info, msg)
         if (info /= CM_SUCCESS) then
-            msg = "control: the plant must be a system in generalized coordinates ("//msg//")"
+            message = "control: the plant must be a system in generalized coordinates ("// &
+                      msg//")"
             return
         end if
         if (gs%ndof /= nd .or. m < 1) then
             info = CM_BAD_INPUT
-            msg = "control: the input matrix does not match the plant's coordinates"
+            message = "control: the input matrix does not match the plant's coordinates"
             return
         end if
         call move_alloc(gs, plant%mech)
@@ -62,13 +66,13 @@ contains
         if (baddr /= 0) plant%bfun = transfer(int(baddr, c_intptr_t), c_null_funptr)
         plant%p = bpar
         info = CM_SUCCESS
-        msg = "success"
+        message = "success"
     end subroutine build_plant
 
     !> The plant and the feedback law of one flat control argument set (the plant by
-    !! build_plant, the law by build_law): info and msg of the first that fails.
+    !! build_plant, the law by build_law): info and the message of the first that fails.
     subroutine build_plant_law(name, params, nspec, spec, nd, m, bmat, baddr, bpar, ilaw, &
-                               rlaw, nrl, pylaw, n, plant, law, info, msg)
+                               rlaw, nrl, pylaw, n, plant, law, info, message)
         character(len=*), intent(in) :: name
         real(dp), intent(in) :: params(:), bmat(:, :), bpar(:)
         integer, intent(in) :: nspec, nd, m
@@ -80,10 +84,13 @@ contains
         type(mech_plant), intent(out) :: plant
         class(feedback_law), allocatable, intent(out) :: law
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        call build_plant(name, params, nspec, spec, nd, m, bmat, baddr, bpar, plant, info, msg)
+        character(len=*), intent(out) :: message
+        character(len=:), allocatable :: msg
+        call build_plant(name, params, nspec, spec, nd, m, bmat, baddr, bpar, plant, info, &
+                         message)
         if (info /= CM_SUCCESS) return
         call build_law(ilaw, rlaw, nrl, pylaw, plant, n, law, info, msg)
+        message = msg
     end subroutine build_plant_law
 
     !> The virtual constraint of a kind-3 law (ilaw(3:5), rlaw from its start).
@@ -211,21 +218,21 @@ contains
 
     !> tau, xi (k, nx), the distance of the states xs (n, nx) under a transverse LQR law;
     !! nfail counts the states whose section equation had no root near the orbit.
-    subroutine project_states(law, xs, taus, xis, dists, nfail, info, msg)
+    subroutine project_states(law, xs, taus, xis, dists, nfail, info, message)
         class(feedback_law), intent(in) :: law
         real(dp), intent(in) :: xs(:, :)
         real(dp), intent(out) :: taus(:), xis(:, :), dists(:)
         integer(c_int), intent(out) :: nfail, info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=*), intent(out) :: message
         integer :: i, i2
         nfail = 0
         info = CM_SUCCESS
-        msg = "success"
+        message = "success"
         select type (law)
         type is (transverse_lqr_law)
             if (law%k /= size(xis, 1) .or. law%n /= size(xs, 1)) then
                 info = CM_BAD_INPUT
-                msg = "project: sizes do not match the law"
+                message = "project: sizes do not match the law"
                 return
             end if
             do i = 1, size(xs, 2)
@@ -234,8 +241,39 @@ contains
             end do
         class default
             info = CM_BAD_INPUT
-            msg = "project: not a transverse LQR law"
+            message = "project: not a transverse LQR law"
         end select
     end subroutine project_states
+
+    !> The outputs of a periodic Riccati solution res of lq, as both Riccati routines return
+    !! them: the Hamiltonian's multipliers (when computed) and, when res succeeded, the
+    !! closed loop's multipliers, P's periodicity and smallest eigenvalue, the refinement
+    !! passes, and P and the gain K (u = K x) at the times t; what res does not give is
+    !! left as the caller set it (zero).
+    subroutine pack_riccati(res, lq, t, ps, ks, hmr, hmi, cmr, cmi, periodicity, min_eig, &
+                            passes)
+        type(riccati_result), intent(in) :: res
+        class(periodic_lq), intent(in) :: lq
+        real(dp), intent(in) :: t(:)
+        real(dp), intent(inout) :: ps(:, :, :), ks(:, :, :), hmr(:), hmi(:), cmr(:), cmi(:)
+        real(dp), intent(inout) :: periodicity, min_eig
+        integer(c_int), intent(inout) :: passes
+        real(dp) :: kg(size(ks, 1), size(ks, 2))
+        integer :: i, i2
+        if (allocated(res%hmr)) then
+            hmr = res%hmr
+            hmi = res%hmi
+        end if
+        if (res%info /= CM_SUCCESS) return
+        cmr = res%cmr
+        cmi = res%cmi
+        periodicity = res%periodicity
+        min_eig = res%min_eig
+        passes = res%passes
+        do i = 1, size(t)
+            call riccati_gain(res, lq, t(i), kg, ps(:, :, i), i2)
+            ks(:, :, i) = -kg
+        end do
+    end subroutine pack_riccati
 
 end module conmech_support_control
