@@ -2,15 +2,16 @@
 # Callgrind instructions of ONE Taylor expansion written out for one order (the routine
 # solve_ivp's method TAYLOR runs every step), history sums paired into 2-wide vectors
 # (conmech.symbolic.taylor's default) against unpaired, Kepler and Arenstorf, compiled
-# with the flags of the written-out library (-O3 -fPIC -fopenmp-simd; override with FFLAGS). The checksums of the
-# two forms must agree to the last digit (the same coefficients, bit for bit).
+# with the flags of the written-out library (-O3 -fPIC and conmech.symbolic.taylor's
+# FIXED_EXTRA_FLAGS, the machine's; override with FFLAGS). The checksums of the two forms
+# must agree to the last digit (the same coefficients, bit for bit).
 # Usage (repository root, installed conmech package, valgrind on PATH):
 #   bash bench/callgrind_taylor_jet.sh [ORDER]      (default 15: tol 1e-12)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ORDER="${1:-15}"
-FF="${FFLAGS:--O3 -fPIC -fopenmp-simd}"
 PY="${PYTHON:-python3}"
+FF="${FFLAGS:--O3 -fPIC $("$PY" -c "from conmech.symbolic.taylor import FIXED_EXTRA_FLAGS as F; print(' '.join(F))")}"
 tmp=$(mktemp -d)
 [ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "$tmp" >&2
 "$PY" - "$ORDER" "$tmp" <<'PYEOF'

@@ -128,3 +128,34 @@ def test_paired_routine_is_the_unpaired_one_bit_for_bit(name):
     a = _fixed_jet(paired, nw, order, y0, list(params.values()))
     b = _fixed_jet(plain, nw, order, y0, list(params.values()))
     assert np.all(np.isfinite(a)) and np.array_equal(a, b)
+
+
+def test_written_out_flags_keep_the_bits():
+    """The written-out routine is compiled for the machine's vector encoding (AVX2 where
+    the processor has it) but never with contracted multiply-adds: a fused a*b + c rounds
+    once, the loop version (compiled with the package's flags) twice, and the coefficients
+    would drift apart from it and from the batch lanes."""
+    flags = T.FIXED_EXTRA_FLAGS
+    assert "-fopenmp-simd" in flags
+    assert "-ffp-contract=off" in flags
+    assert not any(f.startswith("-march") or f == "-mfma" for f in flags)
+
+
+@pytest.mark.parametrize("order", [2, 15])
+def test_each_state_coefficient_is_stored_once(order):
+    """The state's coefficients go into w as they are computed: each w(k, i), k = 1..p,
+    i = 1..n, is assigned exactly once (no second copy), and w(0, i) never (the input)."""
+    import re
+    system = symbolic.ode_system(kepler_f(), [x, y, u, v])
+    d = model_of(system).derived
+    src = T.fixed_order_source(d, order, variational=False)
+    stores = re.findall(r"^\s*w\((\d+), (\d+)\) =", src, flags=re.M)
+    assert sorted(stores) == sorted((str(k), str(i)) for k in range(1, order + 1)
+                                    for i in range(1, 5))
+    # and the routine still gives the unpaired routine's (and so the loop version's) bits
+    nw = system.taylor["nw"]
+    y0 = [0.994, 0.01, 0.02, -2.0]
+    a = _fixed_jet(src, nw, order, y0, [])
+    b = _fixed_jet(T.fixed_order_source(d, order, variational=False, paired=False), nw,
+                   order, y0, [])
+    assert np.all(np.isfinite(a)) and np.array_equal(a, b)

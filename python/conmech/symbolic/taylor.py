@@ -50,6 +50,7 @@ from .printer import FortranPrinter, _names
 from .printer import _wrap as _wrap_line
 from .taylor_decompose import (_JWEIGHT, Decomposition,  # noqa: F401 (public names)
                                TaylorUnsupported, decompose, variational_exprs)
+from .taylor_batch import scalar_isa_flags as _scalar_isa_flags
 from .taylor_lanes import (_SYM, _current_statements, _history_sum,  # noqa: F401
                            _history_sum_pair, _pair_derivatives, _pair_history,
                            _pair_outputs, _sum_seq)
@@ -61,8 +62,10 @@ TAYLOR_VERSION = "2"
 
 #: flags added to the model libraries' for the written-out routine: its paired history sums
 #: are loops over two lanes marked ``!$omp simd`` (gfortran's SLP vectorizer leaves them
-#: scalar otherwise); -fopenmp-simd honours the directive alone (no OpenMP run time)
-FIXED_EXTRA_FLAGS = ["-fopenmp-simd"]
+#: scalar otherwise); -fopenmp-simd honours the directive alone (no OpenMP run time); the
+#: machine's AVX2 encoding without contraction (taylor_batch.scalar_isa_flags: the same
+#: bits, fewer instructions)
+FIXED_EXTRA_FLAGS = _scalar_isa_flags()
 
 
 # ---------------------------------------------------------------------- Fortran printing
@@ -382,6 +385,8 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
         for i, o in enumerate(dec.outputs):
             body += _wrap(f"{W(1, i + 1)} = {pp.lin_at(o, 0, True)}", ind)
         body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+        if fixed is not None:
+            body += [f"{ind}w(1, {c}) = {W(1, c)}" for c in range(1, dec.n + 1)]
     if fixed is None:
         decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j"]
         E = {"k": "k", "fk": "fk", "rk": "rk"}
@@ -464,9 +469,12 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
                               f"{pp.lin_at(o, k, False)})", ind)
             body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
                      for c in jstate]
-    outs = dec.out_cols if given else range(1, dec.n + 1)
-    body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in outs
-             for k in range(0 if given else 1, fixed + 1)]
+            # the state's coefficients of order k + 1 out at once, from the registers
+            # they were computed in (a copy at the end reloads each one first)
+            body += [f"{ind}w({k + 1}, {c}) = {W(k + 1, c)}" for c in range(1, dec.n + 1)]
+    if given:
+        body += [f"{ind}w({k}, {c}) = {W(k, c)}" for c in dec.out_cols
+                 for k in range(0, fixed + 1)]
     names_s = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
     decl += _decls(names_s, f"real({kind})", ind)
     decl += _decls([f"g{g + 1}(2, 0:{fixed})" for g in

@@ -27,10 +27,11 @@ def _sum_seq(terms, zero):
     return " + ".join(terms) if terms else zero
 
 
-def _history_sum(pp, k, lft, rgt, wt):
+def _history_sum(pp, k, lft, rgt, wt, W=None):
     """The history sum of order k written out (literal indices), the same operations in
-    the same order as the loop version's (see body_lines), so the same bits."""
-    W = pp.w
+    the same order as the loop version's (see body_lines), so the same bits. W(j, column)
+    spells a coefficient (default: the printer's)."""
+    W = pp.w if W is None else W
     zero = f"0.0_{pp.kind}"
     if wt is _SYM:
         terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in range(1, (k - 1)//2 + 1)]
@@ -220,19 +221,11 @@ def _history_sum_pair(pp, k, first, second):
     ``ln``: lane by lane the operations of _history_sum, in its order."""
     _, lft, rgt, wt = first
     _, lft2, rgt2, _ = second
+    partner = {lft: lft2, rgt: rgt2}
 
-    def V(kk, a, b):
+    def V(kk, a):
+        b = partner[a]
         if a == b:
             return pp.w(kk, a)
         return f"g{pp.lanes[a][0] + 1}(ln, {kk})"
-    zero = f"0.0_{pp.kind}"
-    if wt is _SYM:
-        terms = [f"{V(j, lft, lft2)}*{V(k - j, lft, lft2)}" for j in range(1, (k - 1)//2 + 1)]
-        out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
-        if k % 2 == 0:
-            mid = f"{V(k//2, lft, lft2)}*{V(k//2, lft, lft2)}"
-            out = f"{out} + {mid}" if out else mid
-        return out or zero
-    weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
-    return _sum_seq([f"{weight(j)}{V(j, lft, lft2)}*{V(k - j, rgt, rgt2)}"
-                     for j in range(1, k)], zero)
+    return _history_sum(pp, k, lft, rgt, wt, V)
