@@ -212,12 +212,15 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
                            "orbit (a better guess or more nsteps is needed)")
     if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
-    return HillOrbit(m, kappa, out[0:4], period, jacobi, out[4:20].reshape(4, 4, order="F"),
-                     out[20:28].view(np.complex128), s, c, residual, out[28:32], int(nsu),
-                     int(iterations), int(nfev))
+    # views made by the ndarray constructor (offsets in bytes): cheaper than reshape(order=)
+    # and view(complex) on a slice
+    return HillOrbit(m, kappa, out[0:4], period, jacobi,
+                     _ndarray((4, 4), _F8, out, 32, None, "F"), _ndarray(4, _C16, out, 160),
+                     s, c, residual, out[28:32], int(nsu), int(iterations), int(nfev))
 
 
 _NO_GUESS = np.zeros(2)
+_ndarray, _F8, _C16 = np.ndarray, np.dtype(np.float64), np.dtype(np.complex128)
 
 
 class HillFamily(StatusRecord):
