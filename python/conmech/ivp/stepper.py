@@ -103,6 +103,17 @@ class Stepper:
     error_estimator_order = 0
     n_stages = 0
 
+    def __init_subclass__(cls, code=None, order=None, error_estimator_order=None,
+                          n_stages=None, **kwargs):
+        """A method's class names its table code and SciPy's class attributes in its
+        bases' keywords: ``class DOP853(RungeKutta, code=..., order=8, ...)``."""
+        super().__init_subclass__(**kwargs)
+        for name, value in (("_code", code), ("order", order),
+                            ("error_estimator_order", error_estimator_order),
+                            ("n_stages", n_stages)):
+            if value is not None:
+                setattr(cls, name, value)
+
     def __init__(self, fun, t0, y0, t_bound, max_step=np.inf, rtol=1e-3, atol=1e-6,
                  vectorized=False, first_step=None, max_steps=None, **extraneous):
         code = self._code
@@ -412,51 +423,36 @@ class RungeKutta(Stepper):
     """Base class of conmech's explicit Runge-Kutta steppers (parameters: :class:`Stepper`)."""
 
 
-class DOP853(RungeKutta):
+class DOP853(RungeKutta, code=BY_NAME["DOP853"].code, order=8, error_estimator_order=7,
+             n_stages=12):
     """Dormand-Prince 8(5,3) with dense output of order 7 (SciPy's OdeSolver interface)."""
-    _code = BY_NAME["DOP853"].code
-    order = 8
-    error_estimator_order = 7
-    n_stages = 12
 
 
-class RK45(RungeKutta):
+class RK45(RungeKutta, code=RK45_SCIPY, order=5, error_estimator_order=4, n_stages=6):
     """Dormand-Prince 5(4) with SciPy's step control and initial step (as
     ``scipy.integrate.RK45`` and ``conmech.solve_ivp(method="RK45")``: no Lund
     stabilisation, SciPy's ``select_initial_step``), dense output of order 4; SciPy's
     OdeSolver interface. ``conmech.DOPRI5`` is the same pair with Hairer's control."""
-    _code = RK45_SCIPY
-    order = 5
-    error_estimator_order = 4
-    n_stages = 6
 
 
-class DOPRI5(RungeKutta):
+class DOPRI5(RungeKutta, code=BY_NAME["DOPRI5"].code, order=5, error_estimator_order=4,
+             n_stages=6):
     """Dormand-Prince 5(4) as Hairer's DOPRI5 (Lund-stabilised step control, Hairer's
     initial step, dense output of order 4), SciPy's OdeSolver interface."""
-    _code = BY_NAME["DOPRI5"].code
-    order = 5
-    error_estimator_order = 4
-    n_stages = 6
 
 
-class VERNER98(RungeKutta):
+class VERNER98(RungeKutta, code=BY_NAME["VERNER98"].code, order=9,
+               error_estimator_order=8, n_stages=16):
     """Verner's 9(8) pair with dense output of order 8 (SciPy's OdeSolver interface)."""
-    _code = BY_NAME["VERNER98"].code
-    order = 9
-    error_estimator_order = 8
-    n_stages = 16
 
 
-class RK4(RungeKutta):
+class RK4(RungeKutta, code=BY_NAME["RK4"].code, order=4, error_estimator_order=0,
+          n_stages=4):
     """Classical fixed-step RK4 (step ``first_step``), SciPy's OdeSolver interface."""
-    _code = BY_NAME["RK4"].code
-    order = 4
-    error_estimator_order = 0
-    n_stages = 4
 
 
-class Radau(Stepper):
+class Radau(Stepper, code=BY_NAME["RADAU5"].code, order=5, error_estimator_order=3,
+            n_stages=3):
     """Radau IIA of order 5 (Hairer's RADAU5 Newton and step control) with SciPy's
     OdeSolver interface, for stiff problems; ``dense_output()`` is the collocation
     polynomial of the last step.
@@ -466,10 +462,6 @@ class Radau(Stepper):
     system, which has its own) and ``jac_sparsity`` (grouped differences, and sparse LUs
     for n >= 100 at most 10% dense).
     """
-    _code = BY_NAME["RADAU5"].code
-    order = 5
-    error_estimator_order = 3
-    n_stages = 3
 
 
 class Gauss(Stepper):
@@ -480,18 +472,12 @@ class Gauss(Stepper):
     iteration does not converge fails with the time."""
 
 
-class Gauss4(Gauss):
+class Gauss4(Gauss, code=BY_NAME["GAUSS4"].code, order=4, n_stages=2):
     """Gauss-Legendre collocation with 2 stages (order 4, symplectic), fixed step."""
-    _code = BY_NAME["GAUSS4"].code
-    order = 4
-    n_stages = 2
 
 
-class Gauss6(Gauss):
+class Gauss6(Gauss, code=BY_NAME["GAUSS6"].code, order=6, n_stages=3):
     """Gauss-Legendre collocation with 3 stages (order 6, symplectic), fixed step."""
-    _code = BY_NAME["GAUSS6"].code
-    order = 6
-    n_stages = 3
 
 
 def _taylor_system(fun, rtol, atol):
