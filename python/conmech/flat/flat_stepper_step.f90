@@ -33,12 +33,9 @@ end subroutine flat_stepper_step_callback
 subroutine flat_stepper_step_builtin(name, np, params, nspec, spec, action, method, n, nr, &
                                      ni, nw, r, iv, w, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system
-    use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_stepper_support, only: step_action
+    use conmech_flat_stepper_support, only: step_action, stepper_system
     implicit none
     include "flat_spec_args.inc"
     integer(c_int), intent(in) :: action, method, n, nr, ni, nw
@@ -47,12 +44,8 @@ subroutine flat_stepper_step_builtin(name, np, params, nspec, spec, action, meth
     integer(c_int), intent(out) :: info
     character(len=256), intent(out) :: message
     class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
     ! the dimension was checked against the system when the state was made (action 0)
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
+    call stepper_system(name, params(1:np), nspec, spec, 0_c_int, sys, info, message)
+    if (info /= CM_SUCCESS) return
     call step_action(sys, action, method, n, nr, ni, nw, r, iv, w, info, message)
 end subroutine flat_stepper_step_builtin
