@@ -199,12 +199,12 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
         raise ValueError("max_nsteps must be >= nsteps (and >= 20)")
     # the orbit and its independent closure check in one Fortran call, every number in one
     # array (its layout: flat_hill_checked.f90), the orbit's arrays views of it
-    out, message = _conmech.flat_hill_orbit_checked(
-        m, kappa, nsteps, 1 if full_period else 0, use, g, closure_tol, max_nsteps)
+    out = _conmech.flat_hill_orbit_checked(m, kappa, nsteps, 1 if full_period else 0, use,
+                                           g, closure_tol, max_nsteps)
     (period, jacobi, s, c, residual, res, scale, nsu, iterations, nfev, finite,
-     info) = out[32:].tolist()
+     info) = out[32:44].tolist()
     if info != 0:
-        raise_status(int(info), message)
+        raise_status(int(info), out[44:76].tobytes())
     if not res <= RESIDUAL_TOL*scale:
         raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
                            f"periodic to the tolerance (true residual {res:.3g} > "
