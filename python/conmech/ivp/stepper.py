@@ -202,6 +202,8 @@ class Stepper:
         self._failure = []
         self._r = np.zeros(1)
         self._iv = np.zeros(1, dtype=np.intc)
+        # the step routines' message buffer: written (blank-padded bytes) only on failure
+        self._msg = np.zeros(256, dtype=np.int8)
         self._cached = {}
         self._step_call = None
         self._sparse_jac = None
@@ -299,17 +301,18 @@ class Stepper:
 
     def _positional(self, action):
         """The flat routine and its positional arguments for a step or a dense output,
-        returning (info, message): built once (the state arrays r, iv, w are updated in
+        returning info (a failure's message in self._msg): built once (the state arrays r, iv, w are updated in
         place, so the same objects serve every call). The step routines take only the
         method, the system and the state (the tolerances, t_bound and the Jacobian's
         structure are in the state; the state's sizes are the arrays'), and return no
         array: f2py's conversion of each argument and each returned array is most of the
         Python cost of a step."""
-        state = (self._r, self._iv, self._w)
+        state = (self._r, self._iv, self._w, self._msg)
         if self._sparse_jac is not None:
             # the system's pattern is not in the packed state: the full argument list
             return (_without_sizes(functools.partial(_conmech.flat_stepper_sparse_jac,
-                                                     **self._arguments(action))), ())
+                                                     **self._arguments(action)), self._msg),
+                    ())
         if self._builtin:
             return (_conmech.flat_stepper_step_builtin,
                     self.fun._flat_args() + (action, self._code) + state)
@@ -322,8 +325,7 @@ class Stepper:
             if cached is None:
                 cached = self._cached[action] = self._positional(action)
             routine, args = cached
-            info, message = routine(*args)
-            return self._after(action, None, info, message)
+            return self._after(action, None, routine(*args), self._msg)
         common = self._arguments(action)
         if self._sparse_jac is not None:
             sizes, info, message = _conmech.flat_stepper_sparse_jac(**common)
@@ -387,9 +389,9 @@ class Stepper:
         call = self._step_call
         if call is None:
             call = self._step_call = self._positional(_STEP)
-        info, message = call[0](*call[1])
+        info = call[0](*call[1])
         if info or self._failure or self._guard.error is not None:
-            info, message, _ = self._after(_STEP, None, info, message)
+            info, message, _ = self._after(_STEP, None, info, self._msg)
             if info != 0:
                 self.status = "failed"
                 return message
@@ -494,12 +496,14 @@ def _taylor_system(fun, rtol, atol):
     return fun
 
 
-def _without_sizes(routine):
-    """A full flat stepper routine (sizes, info, message) as a step routine (info,
-    message)."""
+def _without_sizes(routine, msg):
+    """A full flat stepper routine (sizes, info, message) as a step routine (info; the
+    message of a failure written into the buffer msg as the step routines write it)."""
     def call():
         _, info, message = routine()
-        return info, message
+        if info:
+            msg[:] = np.frombuffer(bytes(message)[:msg.size].ljust(msg.size), dtype=np.int8)
+        return info
     return call
 
 
