@@ -178,8 +178,12 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     ValueError
         Bad arguments; RuntimeError when Newton fails (the message says why).
     """
-    m = _check_float(m, "m", nonneg=True)
-    kappa = _check_float(kappa, "kappa", positive=True)
+    # plain floats and ints in range (the common call) pass by type tests and comparisons
+    # alone (nan fails them); anything else takes the checks and their messages
+    if type(m) is not float or not 0.0 <= m < _INF:
+        m = _check_float(m, "m", nonneg=True)
+    if type(kappa) is not float or not 0.0 < kappa < _INF:
+        kappa = _check_float(kappa, "kappa", positive=True)
     if guess is None:
         use, g = 0, _NO_GUESS
     else:
@@ -187,11 +191,11 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
         if g.size != 2 or not np.all(np.isfinite(g)):
             raise ValueError("guess must be two finite numbers (x0, v0)")
         use = 1
-    if not _is_integer(nsteps):
+    if type(nsteps) is not int and not _is_integer(nsteps):
         raise TypeError("nsteps must be an integer")
     if not 0 <= nsteps <= 100000:
         raise ValueError("nsteps must be in [0, 100000]")
-    if not _is_integer(max_nsteps):
+    if type(max_nsteps) is not int and not _is_integer(max_nsteps):
         raise TypeError("max_nsteps must be an integer")
     if closure_tol != 1e-12:
         closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
@@ -221,6 +225,7 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
 
 _NO_GUESS = np.zeros(2)
 _ndarray, _F8, _C16 = np.ndarray, np.dtype(np.float64), np.dtype(np.complex128)
+_INF = math.inf
 
 
 class HillFamily(StatusRecord):
