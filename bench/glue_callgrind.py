@@ -22,6 +22,12 @@ Cases:
   symp    the same with a parameter (params={mu: 1.0})
   taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_solve_packed)
   py      solve_ivp(Python callable, (0, 0), DOP853) (flat_solve)
+  radau   conmech.Radau(kepler).step(), rtol = atol = 1e-10 (flat_stepper_step_builtin)
+  gauss6  conmech.Gauss6(kepler, first_step=1e-3).step() (flat_stepper_step_builtin)
+  tstep   conmech.Stepper(symbolic kepler, method="TAYLOR").step(), rtol = atol = 1e-12
+          (flat_stepper_step_builtin)
+  family  conmech.hill.family(64 values of m in [0.05, 0.1], locate=False): per call of
+          64 orbits (flat_hill_family)
 
     python bench/glue_callgrind.py one CASE REPS        (what valgrind runs)
 """
@@ -45,6 +51,8 @@ def make(case):
     """The call to count, after its set-up."""
     import numpy as np
     import conmech
+    if case in MORE_CASES:
+        return MORE_CASES[case]()
     if case == "step":
         s = conmech.DOP853(conmech.systems.kepler(), 0.0, [0.4, 0.0, 0.0, 2.0], 1e9,
                            rtol=1e-10, atol=1e-10)
@@ -87,6 +95,44 @@ def make(case):
             return -y
         return lambda: conmech.solve_ivp(f, (0.0, 0.0), y0, method="DOP853")
     raise SystemExit(f"unknown case {case}")
+
+
+def _stepper_case(method, fun, **kw):
+    """A step of `method` on `fun` from the Kepler state of the `step` case."""
+    import conmech
+    s = conmech.Stepper(fun, 0.0, [0.4, 0.0, 0.0, 2.0], 1e3, method=method, **kw)
+    return s.step
+
+
+def _symbolic_kepler():
+    import sympy as sp
+    from conmech import symbolic
+    x, y, u, v = sp.symbols("x y u v")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    return symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+
+
+def _family_case():
+    import numpy as np
+    from conmech import hill
+    ms = np.linspace(0.05, 0.1, 64)
+    return lambda: hill.family(ms, locate=False)
+
+
+def _kepler():
+    import conmech
+    return conmech.systems.kepler()
+
+
+# the cases of the steppers other than DOP853 and of hill.family (their flat routines)
+MORE_CASES = {
+    "radau": lambda: _stepper_case("Radau", _kepler(), rtol=1e-10, atol=1e-10),
+    "gauss6": lambda: _stepper_case("Gauss6", _kepler(), first_step=1e-3),
+    "tstep": lambda: _stepper_case("TAYLOR", _symbolic_kepler(), rtol=1e-12, atol=1e-12),
+    "family": _family_case,
+}
+SYMBOLS.update(radau="flat_stepper_step_builtin_", gauss6="flat_stepper_step_builtin_",
+               tstep="flat_stepper_step_builtin_", family="flat_hill_family_")
 
 
 def one(case, reps):

@@ -72,6 +72,13 @@ def _check_float(value, name, positive=False, nonneg=False):
     return v
 
 
+def _is_integer(value):
+    """True for an int or a NumPy integer, not a bool (a plain int, the common case, by one
+    type test)."""
+    return type(value) is int or (isinstance(value, (int, np.integer))
+                                  and not isinstance(value, (bool, np.bool_)))
+
+
 class HillOrbit:
     """A variation orbit of Hill's problem.
 
@@ -171,8 +178,12 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
     ValueError
         Bad arguments; RuntimeError when Newton fails (the message says why).
     """
-    m = _check_float(m, "m", nonneg=True)
-    kappa = _check_float(kappa, "kappa", positive=True)
+    # plain floats and ints in range (the common call) pass by type tests and comparisons
+    # alone (nan fails them); anything else takes the checks and their messages
+    if type(m) is not float or not 0.0 <= m < _INF:
+        m = _check_float(m, "m", nonneg=True)
+    if type(kappa) is not float or not 0.0 < kappa < _INF:
+        kappa = _check_float(kappa, "kappa", positive=True)
     if guess is None:
         use, g = 0, _NO_GUESS
     else:
@@ -180,23 +191,24 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
         if g.size != 2 or not np.all(np.isfinite(g)):
             raise ValueError("guess must be two finite numbers (x0, v0)")
         use = 1
-    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+    if type(nsteps) is not int and not _is_integer(nsteps):
         raise TypeError("nsteps must be an integer")
     if not 0 <= nsteps <= 100000:
         raise ValueError("nsteps must be in [0, 100000]")
-    if isinstance(max_nsteps, (bool, np.bool_)) or not isinstance(max_nsteps,
-                                                                 (int, np.integer)):
+    if type(max_nsteps) is not int and not _is_integer(max_nsteps):
         raise TypeError("max_nsteps must be an integer")
     if closure_tol != 1e-12:
         closure_tol = _check_float(closure_tol, "closure_tol", positive=True)
     if max_nsteps < max(nsteps, 20):
         raise ValueError("max_nsteps must be >= nsteps (and >= 20)")
-    # the orbit and its independent closure check in one Fortran call
-    (y0, period, jacobi, mono, mult, s, c, residual, quarter, nsu, iterations, nfev,
-     res, scale, finite, info, message) = _conmech.flat_hill_orbit_checked(
-        m, kappa, nsteps, 1 if full_period else 0, use, g, closure_tol, max_nsteps)
+    # the orbit and its independent closure check in one Fortran call, every number in one
+    # array (its layout: flat_hill_checked.f90), the orbit's arrays views of it
+    out = _conmech.flat_hill_orbit_checked(m, kappa, nsteps, 1 if full_period else 0, use,
+                                           g, closure_tol, max_nsteps)
+    (period, jacobi, s, c, residual, res, scale, nsu, iterations, nfev, finite,
+     info) = out[32:44].tolist()
     if info != 0:
-        raise_status(info, message)
+        raise_status(int(info), out[44:76].tobytes())
     if not res <= RESIDUAL_TOL*scale:
         raise RuntimeError(f"hill_variation_orbit: the orbit found for m = {m} is not "
                            f"periodic to the tolerance (true residual {res:.3g} > "
@@ -204,14 +216,16 @@ def variation_orbit(m: float, kappa: float = 1.0, guess: ArrayLike | None = None
                            "orbit (a better guess or more nsteps is needed)")
     if not finite:
         raise RuntimeError("hill_variation_orbit: the monodromy is not finite")
-    return HillOrbit(m=m, kappa=kappa, y0=y0, period=period, jacobi=jacobi, monodromy=mono,
-                     multipliers=mult.ravel(order="F").view(np.complex128),
-                     stability_index=s, c=c,
-                     residual=residual,
-                     quarter_state=quarter, nsteps=nsu, iterations=iterations, nfev=nfev)
+    # views made by the ndarray constructor (offsets in bytes): cheaper than reshape(order=)
+    # and view(complex) on a slice
+    return HillOrbit(m, kappa, out[0:4], period, jacobi,
+                     _ndarray((4, 4), _F8, out, 32, None, "F"), _ndarray(4, _C16, out, 160),
+                     s, c, residual, out[28:32], int(nsu), int(iterations), int(nfev))
 
 
 _NO_GUESS = np.zeros(2)
+_ndarray, _F8, _C16 = np.ndarray, np.dtype(np.float64), np.dtype(np.complex128)
+_INF = math.inf
 
 
 class HillFamily(StatusRecord):
@@ -274,7 +288,7 @@ def family(ms: ArrayLike, kappa: float = 1.0, nsteps: int = 0, chunk_size: int =
     if not np.all(np.isfinite(ms)) or np.any(ms < 0):
         raise ValueError("ms must be finite and non-negative")
     kappa = _check_float(kappa, "kappa", positive=True)
-    if isinstance(nsteps, (bool, np.bool_)) or not isinstance(nsteps, (int, np.integer)):
+    if not _is_integer(nsteps):
         raise TypeError("nsteps must be an integer")
     if not 0 <= int(nsteps) <= 100000:
         raise ValueError("nsteps must be in [0, 100000]")
@@ -392,24 +406,25 @@ def to_henon(m, state, kappa=1.0):
     000) in Henon's units (x'' - 2 y' = 3 x - x/r^3, y'' + 2 x' = -y/r^3): time t_H = m t,
     lengths x_H = m^(2/3) kappa^(-1/3) x, velocities v_H = m^(-1/3) kappa^(-1/3) v. The
     synodic period becomes 2 pi m."""
-    m = _check_float(m, "m", positive=True)
-    kappa = _check_float(kappa, "kappa", positive=True)
-    st = np.asarray(state, dtype=float)
-    if st.shape[-1] != 4:
-        raise ValueError("state must end with 4 components [x, y, x', y']")
-    f = kappa**(-1/3)
-    return np.concatenate([st[..., :2]*m**(2/3)*f, st[..., 2:]*m**(-1/3)*f], axis=-1)
+    return _rescale(m, state, kappa, 1.0)
 
 
 def from_henon(m, state, kappa=1.0):
     """Inverse of :func:`to_henon`."""
+    return _rescale(m, state, kappa, -1.0)
+
+
+def _rescale(m, state, kappa, sign):
+    """Hill's units to Henon's (sign = 1) or back (sign = -1): lengths times
+    (m^(2/3) kappa^(-1/3))^sign, velocities times (m^(-1/3) kappa^(-1/3))^sign."""
     m = _check_float(m, "m", positive=True)
     kappa = _check_float(kappa, "kappa", positive=True)
     st = np.asarray(state, dtype=float)
     if st.shape[-1] != 4:
         raise ValueError("state must end with 4 components [x, y, x', y']")
-    f = kappa**(1/3)
-    return np.concatenate([st[..., :2]*m**(-2/3)*f, st[..., 2:]*m**(1/3)*f], axis=-1)
+    f = kappa**(-sign/3)
+    return np.concatenate([st[..., :2]*m**(sign*2/3)*f, st[..., 2:]*m**(-sign/3)*f],
+                          axis=-1)
 
 
 def henon_gamma(m, jacobi, kappa=1.0):
@@ -432,12 +447,8 @@ def plot_orbit(orbit, ax=None, npoints=401):
     states, _ = orbit.sample(t)
     ax.plot(states[0], states[1], label=f"m = {orbit.m:.6g}, c = {orbit.c:.12f}")
     ax.plot([0.0], [0.0], "o", color="k", label="Earth")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
     ax.set_title("Hill's variation orbit (rotating frame)")
-    ax.legend(loc="best")
-    return ax
+    return _equal_axes(ax, "x", "y")
 
 
 def plot_multipliers(orbit, ax=None):
@@ -453,9 +464,14 @@ def plot_multipliers(orbit, ax=None):
     ang = 2.0*np.pi*orbit.c
     ax.plot([np.cos(ang)]*2, [np.sin(ang), -np.sin(ang)], "o", mfc="none", ms=12,
             label="exp(+-2 pi i c)")
+    return _equal_axes(ax, "Re", "Im")
+
+
+def _equal_axes(ax, xlabel, ylabel):
+    """Equal scales, the axes' labels and the legend: the plane plots' finish."""
     ax.set_aspect("equal")
-    ax.set_xlabel("Re")
-    ax.set_ylabel("Im")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.legend(loc="best")
     return ax
 

@@ -80,6 +80,45 @@ def test_family_c_equals_single_orbits():
     assert np.max(np.abs(fam.stability_index - (tr - 2)/2)) < 1e-10
 
 
+def test_orbit_unpacked_from_one_array():
+    """variation_orbit's result is unpacked from the flat routine's one output array: its
+    arrays must be the orbit's (the multipliers the eigenvalues of the monodromy, the
+    monodromy symplectic-like with det 1 and trace 2 + 2 S, y0 on the x axis crossing it
+    at right angles, the quarter-period state on the y axis), the counts plain ints and
+    the scalars plain floats, as when they were returned one by one."""
+    orb = hill.variation_orbit(hill.M_HILL)
+    M = orb.monodromy
+    assert M.shape == (4, 4) and M.flags.f_contiguous and M.dtype == np.float64
+    assert orb.multipliers.shape == (4,) and orb.multipliers.dtype == np.complex128
+    ev = np.linalg.eigvals(M)
+    for mu in orb.multipliers:
+        assert np.min(np.abs(ev - mu)) < 1e-6           # the Jordan pair at 1: ~sqrt(eps)
+    assert abs(np.linalg.det(M) - 1.0) < 1e-10
+    assert abs((np.trace(M) - 2.0)/2.0 - orb.stability_index) < 1e-10
+    assert orb.y0.shape == (4,) and orb.y0[1] == 0.0 and orb.y0[2] == 0.0
+    assert orb.quarter_state.shape == (4,) and abs(orb.quarter_state[0]) < 1e-12
+    assert abs(orb.quarter_state[3]) < 1e-12
+    for name in ("nsteps", "iterations", "nfev"):
+        assert type(getattr(orb, name)) is int and getattr(orb, name) > 0
+    for name in ("period", "jacobi", "stability_index", "c", "residual"):
+        assert type(getattr(orb, name)) is float
+    assert orb.period == 2.0*np.pi and orb.residual <= 1e-12
+    # writing into one array of the orbit leaves the others alone
+    y0, mono = orb.y0.copy(), M.copy()
+    orb.quarter_state[:] = 7.0
+    assert np.array_equal(orb.y0, y0) and np.array_equal(orb.monodromy, mono)
+    # integers of NumPy types are accepted, floats and bools are not
+    assert hill.variation_orbit(hill.M_HILL, nsteps=np.int32(20)).c == orb.c
+    for bad in (20.0, True):
+        with pytest.raises(TypeError, match="nsteps must be an integer"):
+            hill.variation_orbit(hill.M_HILL, nsteps=bad)
+        with pytest.raises(TypeError, match="max_nsteps must be an integer"):
+            hill.variation_orbit(hill.M_HILL, max_nsteps=bad)
+    # a failure's Fortran message travels in the same array
+    with pytest.raises(RuntimeError, match="^hill_variation_orbit: Newton diverged$"):
+        hill.variation_orbit(5.0)
+
+
 def test_hill_bad_input():
     with pytest.raises(ValueError, match="m"):
         hill.variation_orbit(-0.1)

@@ -90,3 +90,36 @@ def test_outputs_fresh_and_inputs_untouched():
         model.call("nope", 0.0, y)
     with pytest.raises(ValueError, match="params must have 1"):
         model.call("rhs", 0.0, y, params=[1.0, 2.0])
+
+
+def test_fast_path_agrees_with_the_checked_call():
+    """After its first call, an entry with one input and one output is called by identity
+    and type tests only: every input the checks would convert (a list, float32, an int t,
+    a strided view, explicit parameters) must give bit for bit what the plain call gives,
+    and every bad input must still be refused with its message."""
+    x, v, k = sp.symbols("x v k")
+    model = symbolic.ode_system([v, -k*sp.sin(x)], [x, v], params={k: 2.0}, model_only=True)
+    y = np.array([0.3, 0.1])
+    first = model.call("rhs", 0.5, y)                 # the checked call
+    fast = model.call("rhs", 0.5, y)                  # the fast path
+    assert first is not fast and np.array_equal(first, fast)
+    assert np.array_equal(fast, [0.1, -2.0*np.sin(0.3)])
+    strided = np.array([0.3, -1.0, 0.1])[::2]
+    for t, arr, kw in ((0.5, [0.3, 0.1], {}), (np.float64(0.5), y, {}), (0.5, strided, {}),
+                       (0.5, y, {"params": [2.0]}), (0.5, y, {"params": np.array([2.0])})):
+        assert np.array_equal(model.call("rhs", t, arr, **kw), fast)
+    # an int t and a float32 input are converted, as by the checked call
+    assert np.array_equal(model.call("rhs", 0, y), model.call("rhs", 0.0, y))
+    y32 = np.array([0.25, 0.5], dtype=np.float32)
+    assert np.array_equal(model.call("rhs", 0.5, y32),
+                          model.call("rhs", 0.5, y32.astype(np.float64)))
+    # 2-D outputs keep their shape and Fortran order on the fast path
+    J1, J2 = model.call("jac", 0.0, y), model.call("jac", 0.0, y)
+    assert J2.shape == (2, 2) and J2.flags.f_contiguous and np.array_equal(J1, J2)
+    # the checks still run for what the fast path does not take
+    with pytest.raises(ValueError, match="shape"):
+        model.call("rhs", 0.0, np.zeros(3))
+    with pytest.raises(ValueError, match="takes t and 1"):
+        model.call("rhs", 0.0, y, y)
+    with pytest.raises(TypeError, match="params must be 1 real numbers"):
+        model.call("rhs", 0.0, y, params=[True])

@@ -326,3 +326,38 @@ def test_stepper_by_name_is_the_class():
     # has none, and the stepper says so (test_taylor_generalized.py steps symbolic systems)
     with pytest.raises(ValueError, match="no Taylor coefficients"):
         conmech.Stepper(kepler, 0.0, y0, 3.0, method="TAYLOR")
+
+
+def test_step_failure_messages_through_the_buffer():
+    """A failed step's message comes from the stepper's message buffer (the step routines
+    write it only on failure): the text must be the Fortran message, the same for a
+    built-in system, a Python callable and Radau with a sparse pattern (the full routine
+    behind the step), and a later failure must not show an earlier message's tail."""
+    import scipy.sparse as sps
+
+    def blow_up(t, y):
+        return y**2
+
+    runs = [conmech.DOP853(blow_up, 0.0, [1.0], 2.0, max_steps=50),
+            conmech.Radau(blow_up, 0.0, [1.0], 2.0, max_steps=50),
+            conmech.Radau(lambda t, y: y**2, 0.0, np.ones(120), 2.0, max_steps=50,
+                          jac_sparsity=sps.identity(120, format="csc")),
+            conmech.DOP853(conmech.systems.kepler(), 0.0, [1e-3, 0.0, 0.0, 0.0], 10.0,
+                           max_steps=20)]
+    for s in runs:
+        message = None
+        while s.status == "running":
+            message = s.step()
+        assert s.status == "failed"
+        assert message.startswith("too many steps: max_steps reached at t = "), message
+        assert message == message.strip() and message.isprintable()
+    # the routine writes the whole buffer on failure (blank-padded): nothing of what was
+    # there before is left, and the text is the Fortran message
+    from conmech._core.callback import message_text
+    s = conmech.DOP853(conmech.systems.kepler(), 0.0, [0.4, 0.0, 0.0, 2.0], 10.0)
+    s.step()
+    routine, args = s._step_call
+    buf = np.full(256, ord("x"), dtype=np.int8)
+    info = routine("no_such_system", *args[1:-1], buf)
+    assert info != 0 and not np.any(buf == ord("x"))
+    assert message_text(buf) == "bad input: unknown built-in system 'no_such_system'"

@@ -4,15 +4,25 @@
 !! independent adaptive integration of a quarter period (flat_hill_residuals: DOP853,
 !! rtol = atol = 1e-12, max(|x(pi/2)|, |y'(pi/2)|)), the scale max(1, |y0|) it is
 !! compared against, and whether the monodromy and S are finite.
+!!
+!! Every number comes back in one array `out`, which Python unpacks by views (y0, the
+!! monodromy, the multipliers as a complex view, the quarter-period state are slices of
+!! it): f2py then allocates one array and converts one message instead of building six
+!! arrays and eleven Python numbers, which was most of the call's cost outside Fortran.
+!! The message travels in `out` too (its 256 bytes as 32 doubles, a bit copy): a
+!! character output is allocated, padded and trimmed by f2py at every call, which cost
+!! more than the rest of the wrapper.
 
-!> As flat_hill_orbit (the multipliers as (real, imaginary) pairs: the memory of a complex
-!! array), plus true_res (the independent closure error; huge(1) if that
-!! integration fails), scale = max(1, max |y0|) and finite = 1 when the monodromy and S
-!! are finite.
+!> As flat_hill_orbit, packed into out(76):
+!!   out(1:4) y0, out(5:20) the monodromy (column-major 4 x 4), out(21:28) the multipliers
+!!   as (real, imaginary) pairs (the memory of a complex array), out(29:32) the state at
+!!   T/4, then period, jacobi, s, c, residual (33:37), true_res (the independent closure
+!!   error; huge(1) if that integration fails) and scale = max(1, max |y0|) (38:39), and
+!!   nsteps_used, iterations, nfev, finite (1 when the monodromy and S are finite) and
+!!   info (40:44) as exact doubles, and out(45:76) the 256 bytes of the message (blank
+!!   when info = 0; Python reads them as bytes, never as numbers).
 subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, guess, &
-                                   closure_tol, max_nsteps, y0, period, jacobi, mono, &
-                                   mult, s, c, residual, quarter, nsteps_used, iterations, &
-                                   nfev, true_res, scale, finite, info, message)
+                                   closure_tol, max_nsteps, out)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_status, only: CM_SUCCESS
@@ -21,10 +31,7 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
     integer(c_int), intent(in) :: nsteps, full_period, use_guess
     real(c_double), intent(in) :: guess(2), closure_tol
     integer(c_int), intent(in) :: max_nsteps
-    real(c_double), intent(out) :: y0(4), period, jacobi, mono(4, 4), mult(2, 4), s, c
-    real(c_double), intent(out) :: residual, quarter(4), true_res, scale
-    integer(c_int), intent(out) :: nsteps_used, iterations, nfev, finite, info
-    character(len=256), intent(out) :: message
+    real(c_double), intent(out) :: out(76)
     interface
         subroutine flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, &
                                    closure_tol, max_nsteps, y0, period, jacobi, mono, mr, mi, &
@@ -40,18 +47,28 @@ subroutine flat_hill_orbit_checked(m, kappa, nsteps, full_period, use_guess, gue
             real(c_double), intent(out) :: res(nm)
         end subroutine flat_hill_residuals
     end interface
-    real(c_double) :: r(1), mr(4), mi(4)
+    real(c_double) :: r(1), y0(4), mono(4, 4), mr(4), mi(4), quarter(4)
+    real(c_double) :: period, jacobi, s, c, residual, true_res, scale
+    integer(c_int) :: nsteps_used, iterations, nfev, finite, info
+    character(len=256) :: message
     call flat_hill_orbit(m, kappa, nsteps, full_period, use_guess, guess, closure_tol, &
                          max_nsteps, y0, period, jacobi, mono, mr, mi, s, c, residual, &
                          quarter, nsteps_used, iterations, nfev, info, message)
-    mult(1, :) = mr
-    mult(2, :) = mi
     true_res = huge(1.0_c_double)
     scale = 1.0_c_double
     finite = 0
-    if (info /= CM_SUCCESS) return
-    call flat_hill_residuals(1_c_int, [m], kappa, reshape(y0, [4, 1]), r)
-    true_res = r(1)
-    scale = max(1.0_c_double, maxval(abs(y0)))
-    if (all(ieee_is_finite(mono)) .and. ieee_is_finite(s)) finite = 1
+    if (info == CM_SUCCESS) then
+        call flat_hill_residuals(1_c_int, [m], kappa, reshape(y0, [4, 1]), r)
+        true_res = r(1)
+        scale = max(1.0_c_double, maxval(abs(y0)))
+        if (all(ieee_is_finite(mono)) .and. ieee_is_finite(s)) finite = 1
+    end if
+    out(1:4) = y0
+    out(5:20) = reshape(mono, [16])
+    out(21:27:2) = mr
+    out(22:28:2) = mi
+    out(29:32) = quarter
+    out(33:39) = [period, jacobi, s, c, residual, true_res, scale]
+    out(40:44) = real([nsteps_used, iterations, nfev, finite, info], c_double)
+    out(45:76) = transfer(message, out(45:76))
 end subroutine flat_hill_orbit_checked

@@ -52,29 +52,16 @@ subroutine flat_stepper_builtin(name, np, params, nspec, spec, action, n, nr, ni
                                 max_steps, nnz, sp_ptr, sp_idx, r, iv, w, sizes, info, &
                                 message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system, spec_dimension
-    use conmech_flat_ode_support, only: copy_message
-    use conmech_flat_stepper_support, only: stepper_action
+    use conmech_flat_stepper_support, only: stepper_action, stepper_system
     implicit none
     include "flat_spec_args.inc"
     include "flat_stepper_args.inc"
     class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
     sizes = 0
-    call spec_system(name, real(params(1:np), dp), nspec, spec, sys, info, msg)
-    if (info /= CM_SUCCESS) then
-        call copy_message(msg, message)
-        return
-    end if
-    if (spec_dimension(name, nspec, spec) /= n) then
-        info = CM_BAD_INPUT
-        call copy_message("bad input: y0 has the wrong size for the system '"//trim(name) &
-                          //"'", message)
-        return
-    end if
+    call stepper_system(name, params(1:np), nspec, spec, n, sys, info, message)
+    if (info /= CM_SUCCESS) return
     call stepper_action(sys, action, n, nr, ni, nw, t0, t_bound, y0, method, rtol, atol, &
                         first_step, max_step, max_steps, 0, nnz, sp_ptr, sp_idx, r, iv, w, &
                         sizes, info, message)

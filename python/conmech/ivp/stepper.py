@@ -103,6 +103,17 @@ class Stepper:
     error_estimator_order = 0
     n_stages = 0
 
+    def __init_subclass__(cls, code=None, order=None, error_estimator_order=None,
+                          n_stages=None, **kwargs):
+        """A method's class names its table code and SciPy's class attributes in its
+        bases' keywords: ``class DOP853(RungeKutta, code=..., order=8, ...)``."""
+        super().__init_subclass__(**kwargs)
+        for name, value in (("_code", code), ("order", order),
+                            ("error_estimator_order", error_estimator_order),
+                            ("n_stages", n_stages)):
+            if value is not None:
+                setattr(cls, name, value)
+
     def __init__(self, fun, t0, y0, t_bound, max_step=np.inf, rtol=1e-3, atol=1e-6,
                  vectorized=False, first_step=None, max_steps=None, **extraneous):
         code = self._code
@@ -191,6 +202,8 @@ class Stepper:
         self._failure = []
         self._r = np.zeros(1)
         self._iv = np.zeros(1, dtype=np.intc)
+        # the step routines' message buffer: written (blank-padded bytes) only on failure
+        self._msg = np.zeros(256, dtype=np.int8)
         self._cached = {}
         self._step_call = None
         self._sparse_jac = None
@@ -288,17 +301,18 @@ class Stepper:
 
     def _positional(self, action):
         """The flat routine and its positional arguments for a step or a dense output,
-        returning (info, message): built once (the state arrays r, iv, w are updated in
+        returning info (a failure's message in self._msg): built once (the state arrays r, iv, w are updated in
         place, so the same objects serve every call). The step routines take only the
         method, the system and the state (the tolerances, t_bound and the Jacobian's
         structure are in the state; the state's sizes are the arrays'), and return no
         array: f2py's conversion of each argument and each returned array is most of the
         Python cost of a step."""
-        state = (self._r, self._iv, self._w)
+        state = (self._r, self._iv, self._w, self._msg)
         if self._sparse_jac is not None:
             # the system's pattern is not in the packed state: the full argument list
             return (_without_sizes(functools.partial(_conmech.flat_stepper_sparse_jac,
-                                                     **self._arguments(action))), ())
+                                                     **self._arguments(action)), self._msg),
+                    ())
         if self._builtin:
             return (_conmech.flat_stepper_step_builtin,
                     self.fun._flat_args() + (action, self._code) + state)
@@ -311,8 +325,7 @@ class Stepper:
             if cached is None:
                 cached = self._cached[action] = self._positional(action)
             routine, args = cached
-            info, message = routine(*args)
-            return self._after(action, None, info, message)
+            return self._after(action, None, routine(*args), self._msg)
         common = self._arguments(action)
         if self._sparse_jac is not None:
             sizes, info, message = _conmech.flat_stepper_sparse_jac(**common)
@@ -376,9 +389,9 @@ class Stepper:
         call = self._step_call
         if call is None:
             call = self._step_call = self._positional(_STEP)
-        info, message = call[0](*call[1])
+        info = call[0](*call[1])
         if info or self._failure or self._guard.error is not None:
-            info, message, _ = self._after(_STEP, None, info, message)
+            info, message, _ = self._after(_STEP, None, info, self._msg)
             if info != 0:
                 self.status = "failed"
                 return message
@@ -412,51 +425,36 @@ class RungeKutta(Stepper):
     """Base class of conmech's explicit Runge-Kutta steppers (parameters: :class:`Stepper`)."""
 
 
-class DOP853(RungeKutta):
+class DOP853(RungeKutta, code=BY_NAME["DOP853"].code, order=8, error_estimator_order=7,
+             n_stages=12):
     """Dormand-Prince 8(5,3) with dense output of order 7 (SciPy's OdeSolver interface)."""
-    _code = BY_NAME["DOP853"].code
-    order = 8
-    error_estimator_order = 7
-    n_stages = 12
 
 
-class RK45(RungeKutta):
+class RK45(RungeKutta, code=RK45_SCIPY, order=5, error_estimator_order=4, n_stages=6):
     """Dormand-Prince 5(4) with SciPy's step control and initial step (as
     ``scipy.integrate.RK45`` and ``conmech.solve_ivp(method="RK45")``: no Lund
     stabilisation, SciPy's ``select_initial_step``), dense output of order 4; SciPy's
     OdeSolver interface. ``conmech.DOPRI5`` is the same pair with Hairer's control."""
-    _code = RK45_SCIPY
-    order = 5
-    error_estimator_order = 4
-    n_stages = 6
 
 
-class DOPRI5(RungeKutta):
+class DOPRI5(RungeKutta, code=BY_NAME["DOPRI5"].code, order=5, error_estimator_order=4,
+             n_stages=6):
     """Dormand-Prince 5(4) as Hairer's DOPRI5 (Lund-stabilised step control, Hairer's
     initial step, dense output of order 4), SciPy's OdeSolver interface."""
-    _code = BY_NAME["DOPRI5"].code
-    order = 5
-    error_estimator_order = 4
-    n_stages = 6
 
 
-class VERNER98(RungeKutta):
+class VERNER98(RungeKutta, code=BY_NAME["VERNER98"].code, order=9,
+               error_estimator_order=8, n_stages=16):
     """Verner's 9(8) pair with dense output of order 8 (SciPy's OdeSolver interface)."""
-    _code = BY_NAME["VERNER98"].code
-    order = 9
-    error_estimator_order = 8
-    n_stages = 16
 
 
-class RK4(RungeKutta):
+class RK4(RungeKutta, code=BY_NAME["RK4"].code, order=4, error_estimator_order=0,
+          n_stages=4):
     """Classical fixed-step RK4 (step ``first_step``), SciPy's OdeSolver interface."""
-    _code = BY_NAME["RK4"].code
-    order = 4
-    error_estimator_order = 0
-    n_stages = 4
 
 
-class Radau(Stepper):
+class Radau(Stepper, code=BY_NAME["RADAU5"].code, order=5, error_estimator_order=3,
+            n_stages=3):
     """Radau IIA of order 5 (Hairer's RADAU5 Newton and step control) with SciPy's
     OdeSolver interface, for stiff problems; ``dense_output()`` is the collocation
     polynomial of the last step.
@@ -466,10 +464,6 @@ class Radau(Stepper):
     system, which has its own) and ``jac_sparsity`` (grouped differences, and sparse LUs
     for n >= 100 at most 10% dense).
     """
-    _code = BY_NAME["RADAU5"].code
-    order = 5
-    error_estimator_order = 3
-    n_stages = 3
 
 
 class Gauss(Stepper):
@@ -480,18 +474,12 @@ class Gauss(Stepper):
     iteration does not converge fails with the time."""
 
 
-class Gauss4(Gauss):
+class Gauss4(Gauss, code=BY_NAME["GAUSS4"].code, order=4, n_stages=2):
     """Gauss-Legendre collocation with 2 stages (order 4, symplectic), fixed step."""
-    _code = BY_NAME["GAUSS4"].code
-    order = 4
-    n_stages = 2
 
 
-class Gauss6(Gauss):
+class Gauss6(Gauss, code=BY_NAME["GAUSS6"].code, order=6, n_stages=3):
     """Gauss-Legendre collocation with 3 stages (order 6, symplectic), fixed step."""
-    _code = BY_NAME["GAUSS6"].code
-    order = 6
-    n_stages = 3
 
 
 def _taylor_system(fun, rtol, atol):
@@ -508,12 +496,14 @@ def _taylor_system(fun, rtol, atol):
     return fun
 
 
-def _without_sizes(routine):
-    """A full flat stepper routine (sizes, info, message) as a step routine (info,
-    message)."""
+def _without_sizes(routine, msg):
+    """A full flat stepper routine (sizes, info, message) as a step routine (info; the
+    message of a failure written into the buffer msg as the step routines write it)."""
     def call():
         _, info, message = routine()
-        return info, message
+        if info:
+            msg[:] = np.frombuffer(bytes(message)[:msg.size].ljust(msg.size), dtype=np.int8)
+        return info
     return call
 
 

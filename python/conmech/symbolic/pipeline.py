@@ -129,6 +129,18 @@ class CompiledModel(SystemModel):
         """Evaluate entry point `entry` ('rhs', 'mass', ...) at t and the input arrays
         (y; q; q, v; q, v, a; for 'jac_prod' y and an n x k block x), with the model's
         parameters or `params`."""
+        fast = self.__dict__.get("_fast", _NO_CALLS).get(entry)
+        if (fast is not None and params is None and len(arrays) == 1 and type(t) is float
+                and type(arrays[0]) is np.ndarray):
+            # the common call (one float64 array of the input's shape, the model's
+            # parameters, an entry with one input and one output) by identity and type
+            # tests only; anything else takes the checks below, with their messages
+            address, shape, size, out_shape, p = fast
+            y = arrays[0]
+            if y.dtype is _F64 and y.shape == shape:
+                out, info = _flat.flat_entry_call_1(address, t, y, size, p)
+                if info == 0:
+                    return out if out_shape is None else out.reshape(out_shape, order="F")
         e = self.__dict__.get("_calls", _NO_CALLS).get(entry)
         if e is None:
             e = self._call_layout(entry)
@@ -165,6 +177,12 @@ class CompiledModel(SystemModel):
         if ret:
             return float(value)
         res = [_as_array(o, s) for o, s in zip(outs, shapes)]
+        if len(res) == 1 and len(ins) == 1 and params is None and res[0] is not None \
+                and math.prod(in_shapes[0]) > 0 and math.prod(shapes[0]) > 0:
+            # this entry's calls from now on take the fast path above
+            self.__dict__.setdefault("_fast", {})[entry] = (
+                address, in_shapes[0], sizes[0],
+                None if len(shapes[0]) == 1 else shapes[0], p)
         return res[0] if len(res) == 1 else tuple(res)
 
     def _call_layout(self, entry):
@@ -205,6 +223,7 @@ class CompiledModel(SystemModel):
 
 
 _NO_CALLS = {}
+_F64 = np.dtype(np.float64)
 # the one-element stand-in for an empty or unused array argument (f2py cannot pass empty
 # arrays; the entry never reads it)
 _PLACEHOLDER = np.zeros(1)

@@ -14,14 +14,40 @@ module conmech_flat_stepper_support
     use conmech_ode_methods, only: new_stepper
     use conmech_flat_ode_support, only: METHOD_RK45_SCIPY, scipy_first_step, copy_message, &
         set_jacobian_structure, flat_ode_options
+    use conmech_flat_spec, only: spec_system, spec_system_of_size
     implicit none
     private
-    public :: stepper_action, step_action
+    public :: stepper_action, step_action, stepper_system
 
     integer, parameter, public :: ACTION_START = 0, ACTION_STEP = 1, ACTION_DENSE = 2, &
         ACTION_SIZES = 3
 
 contains
+
+    !> The built-in (or compiled) system `name` with parameters params of a flat stepper
+    !! routine; n > 0: it must have n state variables (checked when the state is made; a
+    !! step of an existing state passes n = 0 and skips the check). info /= CM_SUCCESS:
+    !! the failure's text in the flat layer's 256-character message.
+    subroutine stepper_system(name, params, nspec, spec, n, sys, info, message)
+        use, intrinsic :: iso_c_binding, only: c_int64_t
+        character(len=*), intent(in) :: name
+        real(c_double), intent(in) :: params(:)
+        integer(c_int), intent(in) :: nspec, n
+        integer(c_int64_t), intent(in) :: spec(:)
+        class(ode_system), allocatable, intent(out) :: sys
+        integer(c_int), intent(out) :: info
+        character(len=256), intent(out) :: message
+        character(len=:), allocatable :: msg
+        if (n > 0) then
+            call spec_system_of_size(name, real(params, dp), nspec, spec, n, &
+                                     "bad input: y0 has the wrong size for the system '" &
+                                     //trim(name)//"'", sys, info, msg)
+        else
+            call spec_system(name, real(params, dp), nspec, spec, sys, info, msg)
+        end if
+        message = ""
+        if (info /= CM_SUCCESS) call copy_message(msg, message)
+    end subroutine stepper_system
 
     !> One action on a packed stepper of `method`: ACTION_START (init at (t0, y0) towards
     !! t_bound, then start: f at t0 and the first step), ACTION_STEP (one accepted step),
