@@ -237,9 +237,9 @@ def library_path(source, flags=None):
 
 # ------------------------------------------------------------------ manifests
 
-def _read_json(path):
-    """A small JSON file of the cache (its ownership checked), or None if absent or
-    unreadable."""
+def _read_json(path, limit=1 << 16):
+    """A JSON file of the cache (its ownership checked; at most `limit` bytes read, None:
+    the whole file), or None if absent or unreadable."""
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     except OSError:
@@ -247,7 +247,7 @@ def _read_json(path):
     try:
         check_private(path, os.fstat(fd))
         with os.fdopen(fd, "rb", closefd=False) as fh:
-            text = fh.read(1 << 16)
+            text = fh.read() if limit is None else fh.read(limit)
         return json.loads(text.decode())
     except (ValueError, UnicodeDecodeError, OSError):
         return None

@@ -23,12 +23,12 @@ finds it there (a cache hit, no compiler run). The copies of a system made by
 import json
 import os
 import re
-import tempfile
 import threading
 import time
 
 from . import taylor_batch as _taylor_batch
-from .build import FFLAGS, cache_dir, check_private, compile_source, load
+from .build import (FFLAGS, _read_json, _write_atomic, cache_dir, compile_source,
+                    load)
 from .codegen import _names, check_source, private_procedures
 
 __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batch_entries",
@@ -245,15 +245,8 @@ def _load_source(key, part):
     the model in the cache finds its Taylor source too, with no sympy work), or None. The
     file is trusted as the cache's other files are (check_private), and the source is
     checked as a generated one is."""
-    path = _source_path(key, part)
+    info = _read_json(_source_path(key, part), limit=None)
     try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
-    except OSError:
-        return None
-    try:
-        check_private(path, os.fstat(fd))
-        with os.fdopen(fd, "rb", closefd=False) as fh:
-            info = json.loads(fh.read().decode())
         if info.get("format") != _FORMAT:
             return None
         src, entries, why = info["source"], info["entries"], info["reason"]
@@ -266,10 +259,8 @@ def _load_source(key, part):
         c_names = [f"conmech_{e}" for e in entries]
         check_source(src, c_names + internal, c_names)
         return src, entries, None
-    except (ValueError, KeyError, TypeError, AttributeError, UnicodeDecodeError, OSError):
-        return None         # stale or damaged: generated again
-    finally:
-        os.close(fd)
+    except (ValueError, KeyError, TypeError, AttributeError):
+        return None         # absent, stale or damaged: generated again
 
 
 def _store_source(key, part, src, entries, why):
@@ -277,22 +268,10 @@ def _store_source(key, part, src, entries, why):
     failure to write it is ignored)."""
     data = json.dumps({"format": _FORMAT, "source": src, "entries": list(entries),
                        "reason": why}).encode()
-    tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=cache_dir())
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, _source_path(key, part))
-        tmp = None
+        _write_atomic(_source_path(key, part), data, 0o644)
     except OSError:
         pass
-    finally:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
 
 
 _BATCH_LOCK = threading.Lock()
