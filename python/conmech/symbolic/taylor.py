@@ -50,7 +50,7 @@ from .printer import FortranPrinter, _names
 from .printer import _wrap as _wrap_line
 from .taylor_decompose import (_JWEIGHT, Decomposition,  # noqa: F401 (public names)
                                TaylorUnsupported, decompose, variational_exprs)
-from .taylor_batch import scalar_isa_flags as _scalar_isa_flags
+from .isa import scalar_isa_flags as _scalar_isa_flags
 from .taylor_lanes import (_SYM, _current_statements, _history_sum,  # noqa: F401
                            _history_sum_pair, _pair_derivatives, _pair_history,
                            _pair_outputs, _sum_seq)
@@ -60,11 +60,10 @@ __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures
 
 TAYLOR_VERSION = "2"
 
-#: flags added to the model libraries' for the written-out routine: its paired history sums
-#: are loops over two lanes marked ``!$omp simd`` (gfortran's SLP vectorizer leaves them
-#: scalar otherwise); -fopenmp-simd honours the directive alone (no OpenMP run time); the
-#: machine's AVX2 encoding without contraction (taylor_batch.scalar_isa_flags: the same
-#: bits, fewer instructions)
+#: flags added to the model libraries' for the written-out routine (isa.scalar_isa_flags):
+#: -fopenmp-simd for its paired history sums (two-lane loops marked ``!$omp simd``, which
+#: gfortran's SLP vectorizer leaves scalar otherwise; no OpenMP run time), the machine's
+#: AVX2 encoding without contraction (the same bits, fewer instructions)
 FIXED_EXTRA_FLAGS = _scalar_isa_flags()
 
 
