@@ -301,8 +301,8 @@ class Stepper:
 
     def _positional(self, action):
         """The flat routine and its positional arguments for a step or a dense output,
-        returning info (a failure's message in self._msg): built once (the state arrays r, iv, w are updated in
-        place, so the same objects serve every call). The step routines take only the
+        returning info (a failure's message in self._msg): built once (the state arrays r,
+        iv, w are updated in place, so the same objects serve every call). The step routines take only the
         method, the system and the state (the tolerances, t_bound and the Jacobian's
         structure are in the state; the state's sizes are the arrays'), and return no
         array: f2py's conversion of each argument and each returned array is most of the
