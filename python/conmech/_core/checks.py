@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 
 __all__ = ["real_scalar", "real_number", "step_limit", "NO_STEP_LIMIT", "tolerance", "time_span", "time_points", "event_settings", "initial_state",
-           "RTOL_FLOOR", "step_controls"]
+           "RTOL_FLOOR", "step_controls", "positive_finite"]
 
 #: The smallest relative tolerance (SciPy's 100 eps): smaller values are raised to it,
 #: with SciPy's warning.
@@ -127,16 +127,25 @@ def time_points(t_eval, t0, tf):
     return t_ev
 
 
-def step_controls(rtol, atol, n, first_step, t0, tf, check_first_step):
+def positive_finite(value, name, allow_inf=False):
+    """A real scalar that is positive and finite (or +inf with ``allow_inf``); ValueError
+    naming `name` otherwise."""
+    v = real_scalar(value, name)
+    if math.isnan(v) or not v > 0 or (v == math.inf and not allow_inf):
+        raise ValueError(f"{name} must be a positive{'' if allow_inf else ' finite'} "
+                         f"number, got {v}")
+    return v
+
+
+def step_controls(rtol, atol, n, first_step, t0, tf):
     """The tolerances as arrays of shape (n,) (:func:`tolerance`, warnings pointing at the
-    caller's caller) and the first step (0.0 for None, else ``check_first_step(first_step)``,
-    which raises with the caller's message, and at most the length of [t0, tf] when that
-    is not zero)."""
+    caller's caller) and the first step (0.0 for None, else a positive finite number at
+    most the length of [t0, tf] when that is not zero)."""
     rtol_v = tolerance(rtol, "rtol", n, stacklevel=4)
     atol_v = tolerance(atol, "atol", n, stacklevel=4)
     if first_step is None:
         return rtol_v, atol_v, 0.0
-    h0 = check_first_step(first_step)
+    h0 = positive_finite(first_step, "first_step")
     if h0 > abs(tf - t0) and tf != t0:
         raise ValueError("first_step exceeds the length of t_span")
     return rtol_v, atol_v, h0

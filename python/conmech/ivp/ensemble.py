@@ -40,9 +40,9 @@ import numbers
 import numpy as np
 
 from .. import _conmech
-from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE, _positive_finite, _real_scalar
-from .._core.checks import step_controls as _step_controls, time_points as _time_points, \
-    time_span as _time_span
+from .solve import OdeResult, _METHOD_CODES, _METHODS, _HUGE
+from .._core.checks import positive_finite as _positive_finite, real_scalar as _real_scalar, \
+    step_controls as _step_controls, time_points as _time_points, time_span as _time_span
 from .solve import solve_ivp as _solve_ivp
 from .._core.native import NativeSystem, function_address
 from .._core.status import BAD_INPUT
@@ -378,8 +378,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
     m = max(mp, my0)
 
     # ---------------------------------------------------------------- options
-    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf,
-                                        lambda h: _positive_finite(h, "first_step"))
+    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf)
     if code == 1 and first_step is None:
         raise ValueError("first_step is required by RK4 (a fixed-step method): pass the "
                          "step size")

@@ -14,8 +14,9 @@ import numpy as np
 from .. import _conmech
 from .._core.callback import Guard, as_result, message_text
 from .._core.checks import event_settings as _event_settings, initial_state as _initial_state, \
-    real_scalar as _real_scalar, step_limit as _step_limit, time_points as _time_points, \
-    time_span as _time_span, step_controls as _step_controls
+    step_limit as _step_limit, time_points as _time_points, \
+    time_span as _time_span, step_controls as _step_controls, \
+    positive_finite as _positive_finite
 from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
 from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
@@ -52,14 +53,6 @@ _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support int
 
 class _StopAtStart(Exception):
     """Internal: a terminal event zero at t0 stops the run there (SciPy's rule)."""
-
-
-def _positive_finite(value, name, allow_inf=False):
-    v = _real_scalar(value, name)
-    if math.isnan(v) or not v > 0 or (v == math.inf and not allow_inf):
-        raise ValueError(f"{name} must be a positive{'' if allow_inf else ' finite'} "
-                         f"number, got {v}")
-    return v
 
 
 _OPTION_NAMES = ("jac", "jac_sparsity", "lband", "uband", "min_step")
@@ -252,8 +245,7 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         raise ValueError(_COMPLEX_REFUSED)
 
     # ---------------------------------------------------------------- tolerances, steps
-    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf,
-                                        lambda h: _positive_finite(h, "first_step"))
+    rtol_v, atol_v, h0 = _step_controls(rtol, atol, n, first_step, t0, tf)
     if info.fixed_step and first_step is None:
         raise ValueError(f"first_step is required by {method} (a fixed-step method): pass "
                          "the step size")
