@@ -17,7 +17,7 @@ from .._core.checks import event_settings as _event_settings, initial_state as _
     step_limit as _step_limit, time_points as _time_points, \
     time_span as _time_span, step_controls as _step_controls, \
     positive_finite as _positive_finite
-from .dense import ConstantDenseOutput, DenseOutput, OdeSolution
+from .dense import DenseOutput, OdeSolution
 from .implicit import is_sparse, sparsity_pattern, start_jacobian
 from .methods import METHODS, RK45_SCIPY, method_info
 from .stepper import method_code
@@ -30,7 +30,8 @@ from .complex_form import complex_result as _complex_result, real_form as _real_
     real_form_event as _real_form_event
 from .empty import solve_empty as _solve_empty
 from .solve_fast import fast_solve as _fast_solve
-from .result import _MESSAGES, OdeResult
+from .result import OdeResult
+from .assemble import assemble as _assemble, drop_first_point as _drop_first_point
 from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
@@ -408,14 +409,6 @@ def _solve(problem, common, h0, jac, pattern):
                      status, message, nfev, naccept, nreject)
 
 
-def _drop_first_point(out, with_t_eval):
-    """A continuation segment repeats its start point (the event): drop it."""
-    if not with_t_eval and out["t"].size:
-        out["t"] = out["t"][1:]
-        out["y"] = out["y"][:, 1:]
-    return out
-
-
 class _Run:
     """The callbacks of one solve_ivp call (one Guard for fun and the events) and the
     Fortran call of one segment."""
@@ -567,50 +560,3 @@ def _compiled_events(fun, code, settings):
     # conmech.symbolic needs sympy, an optional dependency: imported on this path only
     from ..symbolic.taylor_events import compiled_events
     return compiled_events(fun, [st[0] for st in settings]) is not None
-
-
-def _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, dense_output, form, status,
-              message, nfev, naccept, nreject):
-    if status >= 0:
-        message = _MESSAGES.get(status, message)
-    ts = [s["t"] for s in segs]
-    ys = [s["y"] if s["y"] is not None else np.repeat(y0[:, None], s["t"].size, axis=1)
-          for s in segs]
-    if len(segs) == 1:      # one segment (no terminal event restarted it): its own arrays
-        t, y = ts[0], ys[0]
-    else:
-        t = np.concatenate(ts) if ts else np.array([t0])
-        y = np.concatenate(ys, axis=1) if ys else y0[:, None].copy()
-    if tf == t0 and not with_t_eval:
-        # SciPy's solver makes one (empty) step: t = [t0, t0]
-        t, y = np.array([t0, t0]), np.repeat(y0[:, None], 2, axis=1)
-    if with_t_eval and t.size == 0:
-        t, y = [], []          # SciPy's lists when no point of t_eval was reached
-    res = OdeResult(t=t, y=y, sol=None, t_events=None, y_events=None,
-                    nfev=nfev, njev=run.njev, nlu=run.nlu, status=status,
-                    message=message, success=status >= 0, naccept=naccept,
-                    nreject=nreject)
-    if ne > 0:
-        evs = [e for s in segs for e in s["ev"]]
-        res.t_events = [np.array([te for i, te, _ in evs if i == k]) for k in range(ne)]
-        res.y_events = [np.array([ye for i, _, ye in evs if i == k]) for k in range(ne)]
-        res.y_events = [ye if ye.size else np.asarray([]) for ye in res.y_events]
-    if not dense_output:
-        return res
-    dens = [s["dense"] for s in segs if s.get("dense") is not None]
-    if dens:
-        t_last = float(t[-1]) if not with_t_eval and len(t) else None
-        last = dens[-1]
-        if t_last is None:
-            t_last = float(last[0][-1] + last[1][-1])
-            if status == 1 and ne > 0 and any(s["ev"] for s in segs):
-                t_last = [e for s in segs for e in s["ev"]][-1][1]
-        res.sol = DenseOutput(np.concatenate([d[0] for d in dens]),
-                              np.concatenate([d[1] for d in dens]),
-                              np.concatenate([d[2] for d in dens], axis=2), t0, t_last,
-                              form=int(form))
-    else:
-        # no step (a zero-length span, a terminal event at t0, a failure at the first
-        # step): the constant y0 on [t0, t0], as SciPy's OdeSolution of one empty step
-        res.sol = OdeSolution([t0, t0], [ConstantDenseOutput(t0, t0, y0)])
-    return res
