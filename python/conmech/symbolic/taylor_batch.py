@@ -34,7 +34,7 @@ from .._core.lanes import LANES     # the lane counts a batch library can be bui
 from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (public names)
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 6
+VERSION = 7
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_routine",
            "run_routine", "LANES"]
@@ -164,26 +164,47 @@ _LANE_NAMES_FIXED = re.compile(r"\b(t)\b(?!\()")
 
 def run_routine(n, nw, npar, lanes, codes, fixed=None):
     """Fortran lines of ``conmech_taylor_batch_run`` for a system of n states, nw work
-    columns and npar parameter slots, with `lanes` lanes; it calls the coefficient routine
+    columns and npar parameter slots, with `lanes` lanes, and of the module's private
+    stepping routines it calls (:func:`step_routines`); they call the coefficient routine
     ``conmech_taylor_batch`` of the same module. codes: the status codes (success,
     too_many_steps, step_too_small, nonfinite). fixed: the order of the written-out routine
     ``conmech_taylor_batch_fixed`` of the module, called for that order (else the loop
-    version)."""
+    version) by a stepping routine compiled for that order."""
     ok, many, small, nonfin = (int(c) for c in codes)
     run = 1 if 1 not in (ok, many, small, nonfin) else 99     # "still running"
-    src = _RUN.format(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
-                      nonfin=nonfin, run=run, coef=_COEF if fixed is None else
-                      _COEF_FIXED.format(p=int(fixed)))
+    fmt = dict(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
+               nonfin=nonfin, run=run)
+    call = _CALL.format(name="conmech_taylor_batch_steps", ordarg="ord, ")
+    if fixed is not None:
+        call = _CALL_FIXED.format(p=int(fixed), call=call)
+    src = _RUN.format(call=call, **fmt)
+    src += _STEPS.format(name="conmech_taylor_batch_steps", ordarg="ord, ",
+                         orddecl="integer, intent(in) :: ord", coef=_COEF, **fmt)
+    if fixed is not None:
+        src += _STEPS.format(name=f"conmech_taylor_batch_steps{int(fixed)}", ordarg="",
+                             orddecl=f"integer, parameter :: ord = {int(fixed)}",
+                             coef=_COEF_FIXED, **fmt)
     return src.split("\n")
 
 
-_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)"
-_COEF_FIXED = """\
-            if (ord == {p}) then
-                call conmech_taylor_batch_fixed(tc, int(ord, c_int), wb(:, :, :, nu), p)
-            else
-                call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)
-            end if"""
+def step_routines(fixed=None):
+    """The names of the private stepping routines of :func:`run_routine`'s code."""
+    return ["conmech_taylor_batch_steps"] + \
+        ([] if fixed is None else [f"conmech_taylor_batch_steps{int(fixed)}"])
+
+
+_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), w(:, :, :, nu), p)"
+_COEF_FIXED = \
+    "            call conmech_taylor_batch_fixed(tc, int(ord, c_int), w(:, :, :, nu), p)"
+_CALL = """\
+        call {name}({ordarg}m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, wb, te, st, cnt)"""
+_CALL_FIXED = """\
+        if (ord == {p}) then
+            call conmech_taylor_batch_steps{p}(m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, &
+                                              wb, te, st, cnt)
+        else
+    {call}
+        end if"""
 
 _RUN = """\
     !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
@@ -198,19 +219,10 @@ _RUN = """\
         real(dp), value, intent(in) :: hmax
         real(dp), intent(out) :: te(m)
         integer(c_int), intent(out) :: st(m), cnt(3, m)
-        integer, parameter :: nl = {lanes}, n = {n}, nw = {nw}
-        real(dp), parameter :: check_max = 10.0_dp
-        real(dp), allocatable :: wb(:, :, :, :)
-        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
-        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
-        real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
-        real(dp) :: a1, a2
-        integer, parameter :: i8 = selected_int_kind(18)
-        integer(i8) :: b1, b2
-        integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
-        integer :: e1, e2
-        integer :: cu, nu
-        logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
+        integer, parameter :: nl = {lanes}, nw = {nw}
+        real(dp), allocatable :: wb(:)
+        real(dp) :: rt({n}), atol({n}), t0, tf, eps, decay, hm
+        integer :: ord
         t0 = span(1)
         tf = span(2)
         atol = tol(:, 2)
@@ -223,13 +235,48 @@ _RUN = """\
         eps = max(minval(rt), minval(atol))
         ord = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
         decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
-        posneg = sign(1.0_dp, tf - t0)
         hm = min(abs(hmax), abs(tf - t0))
-        ! two expansions per lane: the current one (the polynomial of the step being
-        ! tried, cu) and the new one (at the step's end, nu); a step accepted makes the
-        ! new one current (the two swap), a lane whose step is rejected keeps its own
-        allocate (wb(nl, 0:ord, nw, 2))
-        wb = 0.0_dp
+        ! two expansions per lane (see the stepping routine), nl*(ord + 1)*nw values each
+        allocate (wb(nl*(ord + 1)*nw*2))
+{call}
+    end subroutine conmech_taylor_batch_run
+
+"""
+
+_STEPS = """\
+    !> The lanes' steps of conmech_taylor_batch_run for the order ord; w: two expansions per
+    !! lane, the current one (the polynomial of the step being tried, cu) and the new one
+    !! (at the step's end, nu): a step accepted makes the new one current (the two swap), a
+    !! lane whose step is rejected keeps its own. Every per-lane quantity is an array over
+    !! the lanes and every per-step operation a vector one over them, the decisions masks;
+    !! only the logarithm and exponential of the next step (glibc's scalar functions, as
+    !! the scalar stepper calls them) and the rare paths (a rejected step, a lane that
+    !! ends) run lane by lane.
+    subroutine {name}({ordarg}m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, w, te, st, cnt)
+        {orddecl}
+        integer(c_int), intent(in) :: m, mxs
+        real(dp), intent(inout) :: y({n}, m)
+        real(dp), intent(in) :: t0, tf, rt({n}), atol({n}), eps, decay, hm, p({npar})
+        real(dp), intent(out) :: w({lanes}, 0:ord, {nw}, 2)
+        real(dp), intent(inout) :: te(m)
+        integer(c_int), intent(inout) :: st(m), cnt(3, m)
+        integer, parameter :: nl = {lanes}, n = {n}
+        real(dp), parameter :: check_max = 10.0_dp, fl = 16.0_dp*epsilon(1.0_dp)
+        ! the margin of the choice of the smaller radius without its logarithms (below)
+        real(dp), parameter :: margin = 1.0e-9_dp
+        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n), yn(nl, n)
+        real(dp) :: dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl), a1(nl), a2(nl), q(nl)
+        real(dp) :: posneg, lg, rho, s, bb, lo, tn, tl, r, pw
+        ! the lanes' masks and counters in 8 bytes, the width of their doubles: the
+        ! compiler makes vector selects of them (4-byte logicals beside doubles stay scalar)
+        integer, parameter :: i8 = selected_int_kind(18)
+        integer(i8) :: b1, b2
+        integer :: l, i, k, j, next, cu, nu, e1, e2
+        integer(i8) :: mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl), pick(nl)
+        logical(i8) :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl), go, rej(nl), ok(nl)
+        real(dp) :: z(nl)
+        posneg = sign(1.0_dp, tf - t0)
+        w = 0.0_dp
         cu = 1
         t = t0
         tlo = 0.0_dp
@@ -237,7 +284,7 @@ _RUN = """\
         e = 1.0_dp
         yc = 0.0_dp
         mem = 0
-        done = {run}
+        done = {ok}             ! an empty lane: filled at once
         nst = 0
         na = 0
         nr = 0
@@ -246,182 +293,205 @@ _RUN = """\
         next = 1
         do
             ! lanes whose member has ended: its results out, the next member in (fresh:
-            ! its first expansion is made in this round, beside the others' steps)
-            do l = 1, nl
-                if (mem(l) /= 0) then
+            ! its first expansion is made in this round, beside the others' steps); a
+            ! lane left empty is "running" with no member (mem = 0)
+            if (any(done /= {run})) then
+                do l = 1, nl
                     if (done(l) == {run}) cycle
-                    j = mem(l)
-                    y(:, j) = yc(l, :)
-                    te(j) = t(l)
-                    st(j) = done(l)
-                    cnt(:, j) = [nx(l), na(l), nr(l)]
-                    mem(l) = 0
-                end if
-                if (next > m) cycle
-                mem(l) = next
-                yc(l, :) = y(:, next)
-                t(l) = t0
-                tlo(l) = 0.0_dp
-                h(l) = 0.0_dp
-                done(l) = {run}
-                fresh(l) = .true.
-                nst(l) = 0
-                na(l) = 0
-                nr(l) = 0
-                nx(l) = 0
-                next = next + 1
-            end do
-            if (all(mem == 0)) exit
-            ! each running lane's step: the scalar stepper's limits, then its candidate
-            do l = 1, nl
-                hc(l) = 0.0_dp
-                tc(l) = t(l)
-                hit(l) = .false.
-                stp(l) = .false.
-                if (mem(l) == 0 .or. fresh(l)) cycle
-                if (nst(l) >= mxs) then
-                    done(l) = {many}
-                else if (.not. (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))) then
-                    done(l) = {small}
-                else
-                    hc(l) = h(l)
-                    if ((t(l) + hc(l) - tf)*posneg >= 0.0_dp) then
-                        hc(l) = (tf - t(l)) - tlo(l)
-                        hit(l) = .true.
+                    j = int(mem(l))
+                    if (j /= 0) then
+                        y(:, j) = yc(l, :)
+                        te(j) = t(l)
+                        st(j) = int(done(l), c_int)
+                        cnt(:, j) = int([nx(l), na(l), nr(l)], c_int)
+                        mem(l) = 0
                     end if
-                    nst(l) = nst(l) + 1
-                    tc(l) = t(l) + hc(l)
-                    stp(l) = .true.
-                end if
+                    done(l) = {run}
+                    if (next > m) cycle
+                    mem(l) = next
+                    yc(l, :) = y(:, next)
+                    t(l) = t0
+                    tlo(l) = 0.0_dp
+                    h(l) = 0.0_dp
+                    fresh(l) = .true.
+                    nst(l) = 0
+                    na(l) = 0
+                    nr(l) = 0
+                    nx(l) = 0
+                    next = next + 1
+                end do
+                if (all(mem == 0)) exit
+            end if
+            ! each running lane's step: the scalar stepper's limits, then its candidate
+            !$omp simd private(go)
+            do l = 1, nl
+                go = mem(l) /= 0 .and. .not. fresh(l)
+                done(l) = merge(int({many}, i8), merge(int({small}, i8), done(l), go .and. .not. &
+                                (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))), go .and. nst(l) >= mxs)
+                stp(l) = go .and. done(l) == {run}
+                hit(l) = stp(l) .and. (t(l) + h(l) - tf)*posneg >= 0.0_dp
+                hc(l) = merge(merge((tf - t(l)) - tlo(l), h(l), hit(l)), 0.0_dp, stp(l))
+                tc(l) = merge(t(l) + hc(l), t(l), stp(l))
+                nst(l) = nst(l) + merge(1_i8, 0_i8, stp(l))
+                nx(l) = nx(l) + merge(1_i8, 0_i8, stp(l) .or. (fresh(l) .and. mem(l) /= 0))
             end do
             ! the polynomials at the candidate steps (Horner, the value and its
             ! derivative in one pass), all lanes at once; a lane without a step expands
             ! at its current state (a new member: its initial state)
             nu = 3 - cu
-            !$omp simd
-            do l = 1, nl
-                yn(l, :) = wb(l, ord, 1:n, cu)
-                dy(l, :) = 0.0_dp
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    yn(l, i) = w(l, ord, i, cu)
+                    dy(l, i) = 0.0_dp
+                end do
             end do
             do k = ord - 1, 0, -1
                 do i = 1, n
                     !$omp simd
                     do l = 1, nl
                         dy(l, i) = yn(l, i) + hc(l)*dy(l, i)
-                        yn(l, i) = wb(l, k, i, cu) + hc(l)*yn(l, i)
+                        yn(l, i) = w(l, k, i, cu) + hc(l)*yn(l, i)
                     end do
                 end do
             end do
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    wb(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
+                    w(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
                 end do
             end do
 {coef}
-            nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
             ! the safety check of every lane's step: h (P'(h) - f(t + h, P(h))) against
             ! the scales, f there from the new expansion's first coefficients
-            fl = 16.0_dp*epsilon(1.0_dp)
             err = 0.0_dp
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - wb(l, 1, i, nu)))/(e(l, i) &
+                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - w(l, 1, i, nu)))/(e(l, i) &
                                  + fl*(abs(yn(l, i)) + abs(hc(l)*dy(l, i)))))
                 end do
             end do
-            err = err/real(ord + 1, dp)
-            acc = fresh .and. mem /= 0
+            ! accepted or rejected; the time of an accepted step, t + h in double length
+            ! (Knuth's TwoSum, as the scalar stepper), tf where the step hits the end
+            !$omp simd private(s, bb, lo, tn, tl)
             do l = 1, nl
-                if (.not. stp(l)) cycle
-                if (.not. (err(l) <= check_max)) then
-                    nr(l) = nr(l) + 1
+                err(l) = err(l)/real(ord + 1, dp)
+                ok(l) = stp(l) .and. err(l) <= check_max
+                rej(l) = stp(l) .and. .not. (err(l) <= check_max)
+                nr(l) = nr(l) + merge(1_i8, 0_i8, rej(l))
+                na(l) = na(l) + merge(1_i8, 0_i8, ok(l))
+                s = t(l) + hc(l)
+                bb = s - t(l)
+                lo = (t(l) - (s - bb)) + (hc(l) - bb)
+                lo = lo + tlo(l)
+                tn = s + lo
+                tl = lo - (tn - s)
+                t(l) = merge(merge(tf, tn, hit(l)), t(l), ok(l))
+                tlo(l) = merge(merge(0.0_dp, tl, hit(l)), tlo(l), ok(l))
+                done(l) = merge(int({ok}, i8), done(l), ok(l) .and. hit(l))
+                acc(l) = ok(l) .or. (fresh(l) .and. mem(l) /= 0)
+            end do
+            ! rejected steps: the step shrunk by the check's ratio; the lanes that did not
+            ! accept keep their current expansion (copied into the new buffer)
+            if (any(rej)) then
+                do l = 1, nl
+                    if (.not. rej(l)) cycle
                     if (err(l) == err(l) .and. err(l) <= huge(1.0_dp)) then
                         h(l) = hc(l)*max(0.1_dp, min(0.5_dp, 0.8_dp*(check_max/err(l))** &
                                                      (1.0_dp/real(ord + 1, dp))))
                     else
                         h(l) = 0.1_dp*hc(l)
                     end if
-                    cycle
-                end if
-                na(l) = na(l) + 1
-                acc(l) = .true.
-                if (hit(l)) then
-                    t(l) = tf
-                    tlo(l) = 0.0_dp
-                    done(l) = {ok}
-                else
-                    ! t + h in double length (Knuth's TwoSum), as the scalar stepper
-                    s = t(l) + hc(l)
-                    bb = s - t(l)
-                    lo = (t(l) - (s - bb)) + (hc(l) - bb)
-                    lo = lo + tlo(l)
-                    t(l) = s + lo
-                    tlo(l) = lo - (t(l) - s)
-                end if
-            end do
-            ! accepted lanes: the new state, expansion and scales; the next step from
-            ! the last two coefficients (Jorba and Zou)
-            ! lanes that did not accept: their current expansion into the new buffer
-            do l = 1, nl
-                if (mem(l) /= 0 .and. .not. acc(l)) wb(l, :, 1:n, nu) = wb(l, :, 1:n, cu)
-            end do
+                end do
+            end if
+            if (.not. all(acc .or. mem == 0)) then
+                do l = 1, nl
+                    if (mem(l) /= 0 .and. .not. acc(l)) w(l, :, 1:n, nu) = w(l, :, 1:n, cu)
+                end do
+            end if
             cu = nu
+            ! accepted lanes: the new state, expansion and scales; the norms of the last
+            ! two coefficients (Jorba and Zou)
             ym = 0.0_dp
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    yc(l, i) = merge(yn(l, i), yc(l, i), acc(l) .and. .not. fresh(l))
+                    yc(l, i) = merge(yn(l, i), yc(l, i), ok(l))
                     ym(l) = max(ym(l), abs(yc(l, i)))
                 end do
             end do
-            fin = .true.
+            ! z: 0 where the new first coefficients are finite, else a NaN
+            z = 0.0_dp
             s1 = 0.0_dp
             s2 = 0.0_dp
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    fin(l) = fin(l) .and. abs(wb(l, 1, i, cu)) <= huge(1.0_dp)
+                    z(l) = z(l) + 0.0_dp*w(l, 1, i, cu)
                     e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
-                    s1(l) = max(s1(l), abs(wb(l, ord - 1, i, cu))/e(l, i))
-                    s2(l) = max(s2(l), abs(wb(l, ord, i, cu))/e(l, i))
+                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/e(l, i))
+                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/e(l, i))
                 end do
             end do
+            ! the next step h = min(rho, hm) from the radius rho = exp(lg) decay, lg the
+            ! smaller of -log(a1)/(ord - 1) and -log(a2)/ord (conmech_taylor_core's
+            ! taylor_next_rho, the same value): which one is smaller is known without the
+            ! logarithms when q = a1 (a1/a2)**(ord - 1) (> 1: the first) is off 1 by more
+            ! than the margin (far more than the rounding of q or of the logarithms), so
+            ! one logarithm per lane (pick); else both, or the exponent test, lane by lane
+            !$omp simd private(r, pw)
             do l = 1, nl
-                if (.not. acc(l)) cycle
-                fresh(l) = .false.
-                if (.not. fin(l)) then
-                    done(l) = {nonfin}
-                    cycle
+                fresh(l) = fresh(l) .and. .not. acc(l)
+                fin(l) = z(l) == 0.0_dp .or. .not. acc(l)
+                done(l) = merge(int({nonfin}, i8), done(l), .not. fin(l))
+                a1(l) = s1(l)*eps
+                a2(l) = s2(l)*eps
+                r = a1(l)/a2(l)
+                pw = r
+                do j = 2, ord - 1
+                    pw = pw*r
+                end do
+                q(l) = a1(l)*pw
+                pick(l) = 0
+                if (a1(l) >= tiny(1.0_dp) .and. a1(l) <= huge(1.0_dp) .and. &
+                    a2(l) >= tiny(1.0_dp) .and. a2(l) <= huge(1.0_dp) .and. &
+                    pw >= tiny(1.0_dp) .and. pw <= huge(1.0_dp)) then
+                    if (q(l) > 1.0_dp + margin) pick(l) = 1
+                    if (q(l) < 1.0_dp - margin) pick(l) = 2
                 end if
-                if (done(l) /= {run}) cycle
-                ! one logarithm where the binary exponents of the two norms already tell
-                ! the smaller radius (conmech_taylor_core's taylor_next_rho: the same value)
-                lg = huge(1.0_dp)
-                a1 = s1(l)*eps
-                a2 = s2(l)*eps
-                b1 = ishft(transfer(a1, 0_i8), -52)
-                b2 = ishft(transfer(a2, 0_i8), -52)
-                if (s1(l) > 0.0_dp .and. s2(l) > 0.0_dp .and. b1 >= 1 .and. b1 <= 2046 &
-                    .and. b2 >= 1 .and. b2 <= 2046) then
-                    e1 = int(b1) - 1022
-                    e2 = int(b2) - 1022
-                    if ((e1 - 1)*ord > e2*(ord - 1)) then
-                        lg = -log(a1)/real(ord - 1, dp)
-                    else if ((e2 - 1)*(ord - 1) > e1*ord) then
-                        lg = -log(a2)/real(ord, dp)
-                    else
-                        lg = min(-log(a1)/real(ord - 1, dp), -log(a2)/real(ord, dp))
-                    end if
+            end do
+            do l = 1, nl
+                if (.not. acc(l) .or. done(l) /= {run}) cycle
+                if (pick(l) == 1) then
+                    lg = -log(a1(l))/real(ord - 1, dp)
+                else if (pick(l) == 2) then
+                    lg = -log(a2(l))/real(ord, dp)
                 else
-                    if (s1(l) > 0.0_dp) lg = -log(a1)/real(ord - 1, dp)
-                    if (s2(l) > 0.0_dp) lg = min(lg, -log(a2)/real(ord, dp))
+                    lg = huge(1.0_dp)
+                    b1 = ishft(transfer(a1(l), 0_i8), -52)
+                    b2 = ishft(transfer(a2(l), 0_i8), -52)
+                    if (s1(l) > 0.0_dp .and. s2(l) > 0.0_dp .and. b1 >= 1 .and. &
+                        b1 <= 2046 .and. b2 >= 1 .and. b2 <= 2046) then
+                        e1 = int(b1) - 1022
+                        e2 = int(b2) - 1022
+                        if ((e1 - 1)*ord > e2*(ord - 1)) then
+                            lg = -log(a1(l))/real(ord - 1, dp)
+                        else if ((e2 - 1)*(ord - 1) > e1*ord) then
+                            lg = -log(a2(l))/real(ord, dp)
+                        else
+                            lg = min(-log(a1(l))/real(ord - 1, dp), -log(a2(l))/real(ord, dp))
+                        end if
+                    else
+                        if (s1(l) > 0.0_dp) lg = -log(a1(l))/real(ord - 1, dp)
+                        if (s2(l) > 0.0_dp) lg = min(lg, -log(a2(l))/real(ord, dp))
+                    end if
                 end if
                 rho = huge(1.0_dp)
                 if (lg < log(huge(1.0_dp))) rho = exp(lg)*decay
                 h(l) = min(rho, hm)*posneg
             end do
         end do
-    end subroutine conmech_taylor_batch_run
+    end subroutine {name}
+
 """
