@@ -267,14 +267,16 @@ _STEPS = """\
         real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n), yn(nl, n)
         real(dp) :: dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl), a1(nl), a2(nl), q(nl)
         real(dp) :: posneg, lg, rho, s, bb, lo, tn, tl, r, pw
-        ! the lanes' masks and counters in 8 bytes, the width of their doubles: the
-        ! compiler makes vector selects of them (4-byte logicals beside doubles stay scalar)
+        ! the lanes' flags (1 or 0), counters, members and statuses are doubles (small
+        ! integers, exact), tested by comparisons in the lane loops: the compiler makes
+        ! vector compares and blends of them (logicals or integers read from memory
+        ! beside doubles become a branch per lane)
         integer, parameter :: i8 = selected_int_kind(18)
         integer(i8) :: b1, b2
         integer :: l, i, k, j, next, cu, nu, e1, e2
-        integer(i8) :: mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl), pick(nl)
-        logical(i8) :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl), go, rej(nl), ok(nl)
-        real(dp) :: z(nl)
+        real(dp) :: mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl), pick(nl)
+        real(dp) :: fresh(nl), hit(nl), stp(nl), acc(nl), rej(nl), ok(nl), z(nl)
+        real(dp) :: en, yv, go, a, b
         posneg = sign(1.0_dp, tf - t0)
         w = 0.0_dp
         cu = 1
@@ -289,7 +291,7 @@ _STEPS = """\
         na = 0
         nr = 0
         nx = 0
-        fresh = .false.
+        fresh = 0.0_dp
         next = 1
         do
             ! lanes whose member has ended: its results out, the next member in (fresh:
@@ -298,22 +300,22 @@ _STEPS = """\
             if (any(done /= {run})) then
                 do l = 1, nl
                     if (done(l) == {run}) cycle
-                    j = int(mem(l))
+                    j = nint(mem(l))
                     if (j /= 0) then
                         y(:, j) = yc(l, :)
                         te(j) = t(l)
-                        st(j) = int(done(l), c_int)
-                        cnt(:, j) = int([nx(l), na(l), nr(l)], c_int)
+                        st(j) = nint(done(l), c_int)
+                        cnt(:, j) = nint([nx(l), na(l), nr(l)], c_int)
                         mem(l) = 0
                     end if
                     done(l) = {run}
                     if (next > m) cycle
-                    mem(l) = next
+                    mem(l) = real(next, dp)
                     yc(l, :) = y(:, next)
                     t(l) = t0
                     tlo(l) = 0.0_dp
                     h(l) = 0.0_dp
-                    fresh(l) = .true.
+                    fresh(l) = 1.0_dp
                     nst(l) = 0
                     na(l) = 0
                     nr(l) = 0
@@ -323,17 +325,23 @@ _STEPS = """\
                 if (all(mem == 0)) exit
             end if
             ! each running lane's step: the scalar stepper's limits, then its candidate
-            !$omp simd private(go)
+            !$omp simd private(go, a, b)
             do l = 1, nl
-                go = mem(l) /= 0 .and. .not. fresh(l)
-                done(l) = merge(int({many}, i8), merge(int({small}, i8), done(l), go .and. .not. &
-                                (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))), go .and. nst(l) >= mxs)
-                stp(l) = go .and. done(l) == {run}
-                hit(l) = stp(l) .and. (t(l) + h(l) - tf)*posneg >= 0.0_dp
-                hc(l) = merge(merge((tf - t(l)) - tlo(l), h(l), hit(l)), 0.0_dp, stp(l))
-                tc(l) = merge(t(l) + hc(l), t(l), stp(l))
-                nst(l) = nst(l) + merge(1_i8, 0_i8, stp(l))
-                nx(l) = nx(l) + merge(1_i8, 0_i8, stp(l) .or. (fresh(l) .and. mem(l) /= 0))
+                go = merge(1.0_dp, 0.0_dp, mem(l) /= 0.0_dp .and. fresh(l) == 0.0_dp)
+                a = real({small}, dp)
+                b = real({many}, dp)
+                done(l) = merge(b, merge(a, done(l), go /= 0.0_dp .and. .not. &
+                                (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))), &
+                                go /= 0.0_dp .and. nst(l) >= real(mxs, dp))
+                stp(l) = merge(1.0_dp, 0.0_dp, go /= 0.0_dp .and. done(l) == {run})
+                hit(l) = merge(1.0_dp, 0.0_dp, stp(l) /= 0.0_dp .and. &
+                               (t(l) + h(l) - tf)*posneg >= 0.0_dp)
+                a = (tf - t(l)) - tlo(l)
+                b = t(l) + merge(a, h(l), hit(l) /= 0.0_dp)
+                hc(l) = merge(merge(a, h(l), hit(l) /= 0.0_dp), 0.0_dp, stp(l) /= 0.0_dp)
+                tc(l) = merge(b, t(l), stp(l) /= 0.0_dp)
+                nst(l) = nst(l) + stp(l)
+                nx(l) = nx(l) + merge(1.0_dp, stp(l), fresh(l) /= 0.0_dp .and. mem(l) /= 0.0_dp)
             end do
             ! the polynomials at the candidate steps (Horner, the value and its
             ! derivative in one pass), all lanes at once; a lane without a step expands
@@ -356,9 +364,11 @@ _STEPS = """\
                 end do
             end do
             do i = 1, n
-                !$omp simd
+                !$omp simd private(a, b)
                 do l = 1, nl
-                    w(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
+                    a = yn(l, i)
+                    b = yc(l, i)
+                    w(l, 0, i, nu) = merge(a, b, stp(l) /= 0.0_dp)
                 end do
             end do
 {coef}
@@ -374,29 +384,32 @@ _STEPS = """\
             end do
             ! accepted or rejected; the time of an accepted step, t + h in double length
             ! (Knuth's TwoSum, as the scalar stepper), tf where the step hits the end
-            !$omp simd private(s, bb, lo, tn, tl)
+            !$omp simd private(s, bb, lo, tn, tl, a, b)
             do l = 1, nl
                 err(l) = err(l)/real(ord + 1, dp)
-                ok(l) = stp(l) .and. err(l) <= check_max
-                rej(l) = stp(l) .and. .not. (err(l) <= check_max)
-                nr(l) = nr(l) + merge(1_i8, 0_i8, rej(l))
-                na(l) = na(l) + merge(1_i8, 0_i8, ok(l))
+                ok(l) = merge(1.0_dp, 0.0_dp, stp(l) /= 0.0_dp .and. err(l) <= check_max)
+                rej(l) = stp(l) - ok(l)
+                nr(l) = nr(l) + rej(l)
+                na(l) = na(l) + ok(l)
                 s = t(l) + hc(l)
                 bb = s - t(l)
                 lo = (t(l) - (s - bb)) + (hc(l) - bb)
                 lo = lo + tlo(l)
                 tn = s + lo
                 tl = lo - (tn - s)
-                t(l) = merge(merge(tf, tn, hit(l)), t(l), ok(l))
-                tlo(l) = merge(merge(0.0_dp, tl, hit(l)), tlo(l), ok(l))
-                done(l) = merge(int({ok}, i8), done(l), ok(l) .and. hit(l))
-                acc(l) = ok(l) .or. (fresh(l) .and. mem(l) /= 0)
+                a = merge(tf, tn, hit(l) /= 0.0_dp)
+                b = merge(0.0_dp, tl, hit(l) /= 0.0_dp)
+                t(l) = merge(a, t(l), ok(l) /= 0.0_dp)
+                tlo(l) = merge(b, tlo(l), ok(l) /= 0.0_dp)
+                a = real({ok}, dp)
+                done(l) = merge(a, done(l), ok(l) /= 0.0_dp .and. hit(l) /= 0.0_dp)
+                acc(l) = merge(1.0_dp, ok(l), fresh(l) /= 0.0_dp .and. mem(l) /= 0.0_dp)
             end do
             ! rejected steps: the step shrunk by the check's ratio; the lanes that did not
             ! accept keep their current expansion (copied into the new buffer)
-            if (any(rej)) then
+            if (any(rej /= 0.0_dp)) then
                 do l = 1, nl
-                    if (.not. rej(l)) cycle
+                    if (rej(l) == 0.0_dp) cycle
                     if (err(l) == err(l) .and. err(l) <= huge(1.0_dp)) then
                         h(l) = hc(l)*max(0.1_dp, min(0.5_dp, 0.8_dp*(check_max/err(l))** &
                                                      (1.0_dp/real(ord + 1, dp))))
@@ -405,9 +418,9 @@ _STEPS = """\
                     end if
                 end do
             end if
-            if (.not. all(acc .or. mem == 0)) then
+            if (any(acc == 0.0_dp .and. mem /= 0.0_dp)) then
                 do l = 1, nl
-                    if (mem(l) /= 0 .and. .not. acc(l)) w(l, :, 1:n, nu) = w(l, :, 1:n, cu)
+                    if (mem(l) /= 0.0_dp .and. acc(l) == 0.0_dp) w(l, :, 1:n, nu) = w(l, :, 1:n, cu)
                 end do
             end if
             cu = nu
@@ -415,10 +428,13 @@ _STEPS = """\
             ! two coefficients (Jorba and Zou)
             ym = 0.0_dp
             do i = 1, n
-                !$omp simd
+                !$omp simd private(a, b, yv)
                 do l = 1, nl
-                    yc(l, i) = merge(yn(l, i), yc(l, i), ok(l))
-                    ym(l) = max(ym(l), abs(yc(l, i)))
+                    a = yn(l, i)
+                    b = yc(l, i)
+                    yv = merge(a, b, ok(l) /= 0.0_dp)
+                    yc(l, i) = yv
+                    ym(l) = max(ym(l), abs(yv))
                 end do
             end do
             ! z: 0 where the new first coefficients are finite, else a NaN
@@ -426,12 +442,15 @@ _STEPS = """\
             s1 = 0.0_dp
             s2 = 0.0_dp
             do i = 1, n
-                !$omp simd
+                !$omp simd private(en, a)
                 do l = 1, nl
                     z(l) = z(l) + 0.0_dp*w(l, 1, i, cu)
-                    e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
-                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/e(l, i))
-                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/e(l, i))
+                    en = max(atol(i), rt(i)*ym(l), tiny(1.0_dp))
+                    a = e(l, i)
+                    en = merge(en, a, acc(l) /= 0.0_dp)
+                    e(l, i) = en
+                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/en)
+                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/en)
                 end do
             end do
             ! the next step h = min(rho, hm) from the radius rho = exp(lg) decay, lg the
@@ -440,11 +459,11 @@ _STEPS = """\
             ! logarithms when q = a1 (a1/a2)**(ord - 1) (> 1: the first) is off 1 by more
             ! than the margin (far more than the rounding of q or of the logarithms), so
             ! one logarithm per lane (pick); else both, or the exponent test, lane by lane
-            !$omp simd private(r, pw)
+            !$omp simd private(r, pw, a)
             do l = 1, nl
-                fresh(l) = fresh(l) .and. .not. acc(l)
-                fin(l) = z(l) == 0.0_dp .or. .not. acc(l)
-                done(l) = merge(int({nonfin}, i8), done(l), .not. fin(l))
+                fresh(l) = merge(0.0_dp, fresh(l), acc(l) /= 0.0_dp)
+                a = real({nonfin}, dp)
+                done(l) = merge(a, done(l), .not. (z(l) == 0.0_dp) .and. acc(l) /= 0.0_dp)
                 a1(l) = s1(l)*eps
                 a2(l) = s2(l)*eps
                 r = a1(l)/a2(l)
@@ -453,19 +472,17 @@ _STEPS = """\
                     pw = pw*r
                 end do
                 q(l) = a1(l)*pw
-                pick(l) = 0
-                if (a1(l) >= tiny(1.0_dp) .and. a1(l) <= huge(1.0_dp) .and. &
-                    a2(l) >= tiny(1.0_dp) .and. a2(l) <= huge(1.0_dp) .and. &
-                    pw >= tiny(1.0_dp) .and. pw <= huge(1.0_dp)) then
-                    if (q(l) > 1.0_dp + margin) pick(l) = 1
-                    if (q(l) < 1.0_dp - margin) pick(l) = 2
-                end if
+                a = merge(1.0_dp, merge(2.0_dp, 0.0_dp, q(l) < 1.0_dp - margin), &
+                          q(l) > 1.0_dp + margin)
+                pick(l) = merge(a, 0.0_dp, a1(l) >= tiny(1.0_dp) .and. a1(l) <= huge(1.0_dp) &
+                                .and. a2(l) >= tiny(1.0_dp) .and. a2(l) <= huge(1.0_dp) .and. &
+                                pw >= tiny(1.0_dp) .and. pw <= huge(1.0_dp))
             end do
             do l = 1, nl
-                if (.not. acc(l) .or. done(l) /= {run}) cycle
-                if (pick(l) == 1) then
+                if (acc(l) == 0.0_dp .or. done(l) /= {run}) cycle
+                if (pick(l) == 1.0_dp) then
                     lg = -log(a1(l))/real(ord - 1, dp)
-                else if (pick(l) == 2) then
+                else if (pick(l) == 2.0_dp) then
                     lg = -log(a2(l))/real(ord, dp)
                 else
                     lg = huge(1.0_dp)
