@@ -265,6 +265,7 @@ _STEPS = """\
         ! the margin of the choice of the smaller radius without its logarithms (below)
         real(dp), parameter :: margin = 1.0e-9_dp
         real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n), yn(nl, n)
+        real(dp) :: ea(nl, n)
         real(dp) :: dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl), a1(nl), a2(nl), q(nl)
         real(dp) :: posneg, lg, rho, s, bb, lo, tn, tl, r, pw
         ! the lanes' flags (1 or 0), counters, members and statuses are doubles (small
@@ -276,7 +277,7 @@ _STEPS = """\
         integer :: l, i, k, j, next, cu, nu, e1, e2
         real(dp) :: mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl), pick(nl)
         real(dp) :: fresh(nl), hit(nl), stp(nl), acc(nl), rej(nl), ok(nl), z(nl)
-        real(dp) :: en, yv, go, a, b
+        real(dp) :: yv, go, a, b
         posneg = sign(1.0_dp, tf - t0)
         w = 0.0_dp
         cu = 1
@@ -441,16 +442,21 @@ _STEPS = """\
             z = 0.0_dp
             s1 = 0.0_dp
             s2 = 0.0_dp
+            ! (the new scales in a loop of their own: beside the select, their maxima
+            ! make the loop scalar)
             do i = 1, n
-                !$omp simd private(en, a)
+                !$omp simd
+                do l = 1, nl
+                    ea(l, i) = max(atol(i), rt(i)*ym(l), tiny(1.0_dp))
+                end do
+            end do
+            do i = 1, n
+                !$omp simd
                 do l = 1, nl
                     z(l) = z(l) + 0.0_dp*w(l, 1, i, cu)
-                    en = max(atol(i), rt(i)*ym(l), tiny(1.0_dp))
-                    a = e(l, i)
-                    en = merge(en, a, acc(l) /= 0.0_dp)
-                    e(l, i) = en
-                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/en)
-                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/en)
+                    e(l, i) = merge(ea(l, i), e(l, i), acc(l) /= 0.0_dp)
+                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/e(l, i))
+                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/e(l, i))
                 end do
             end do
             ! the next step h = min(rho, hm) from the radius rho = exp(lg) decay, lg the
