@@ -13,8 +13,11 @@ generates the same for conmech, as Fortran that the compiler vectorises:
   arrays of ``lanes`` values: Horner's evaluation of the polynomials, the safety check of
   the step, the error scales and the norms of the last two coefficients are vector
   operations over the lanes with no branch per lane; the per-lane decisions (accept or
-  reject, reached the end, failed) are masks, and the logarithms of the step-size formula
-  are per lane.
+  reject, reached the end, failed) are masks held as doubles (so that the compiler's
+  selects stay vector ones), and the one logarithm and exponential of the step-size
+  formula are per lane. Its steps run in a private routine compiled for the order of the
+  written-out recurrences (constant bounds, Horner unrolled) and in another for any
+  order.
 
 Lanes are refilled: when a member ends (it reached tf, or failed) its lane takes the next
 member of the call at once (its first expansion rides along with the other lanes' next
