@@ -172,6 +172,19 @@ def test_generated_module_is_vectorised(kepler, tmp_path):
     inside = [ln for ln in vec if "loop vectorized" in ln and
               start < int(ln.split("batch.f90:")[1].split(":")[0]) <= end]
     assert inside, report[-2000:]
+    # the stepping routine compiled for that order: Horner's polynomial, the new error
+    # scales and the norms of the last two coefficients are vector loops over the lanes
+    # (a select on a logical or a maximum beside a select made them scalar, lane by lane)
+    start = next(i for i, ln in enumerate(lines) if "subroutine conmech_taylor_batch_steps15"
+                 in ln)
+    end = next(i for i in range(start, len(lines)) if "end subroutine" in lines[i])
+    if lanes >= 4:
+        for stmt in ("dy(l, i) = yn(l, i) + hc(l)*dy(l, i)", "ea(l, i) = max(",
+                     "z(l) = z(l) + 0.0_dp*w(l, 1, i, cu)"):
+            at = next(i for i in range(start, end) if stmt in lines[i]) + 1
+            assert any(f"batch.f90:{at}:" in ln and "loop vectorized" in ln and
+                       ("32 byte vectors" in ln or "64 byte vectors" in ln)
+                       for ln in vec), (stmt, report[-2000:])
     ensemble.solve(kepler, (0, 1.0), kepler_states([0.3]), method="TAYLOR", rtol=1e-12,
                    atol=1e-12)
     path = model.taylor_paths["batch"]

@@ -13,8 +13,11 @@ generates the same for conmech, as Fortran that the compiler vectorises:
   arrays of ``lanes`` values: Horner's evaluation of the polynomials, the safety check of
   the step, the error scales and the norms of the last two coefficients are vector
   operations over the lanes with no branch per lane; the per-lane decisions (accept or
-  reject, reached the end, failed) are masks, and the logarithms of the step-size formula
-  are per lane.
+  reject, reached the end, failed) are masks held as doubles (so that the compiler's
+  selects stay vector ones), and the one logarithm and exponential of the step-size
+  formula are per lane. Its steps run in a private routine compiled for the order of the
+  written-out recurrences (constant bounds, Horner unrolled) and in another for any
+  order.
 
 Lanes are refilled: when a member ends (it reached tf, or failed) its lane takes the next
 member of the call at once (its first expansion rides along with the other lanes' next
@@ -34,7 +37,7 @@ from .._core.lanes import LANES     # the lane counts a batch library can be bui
 from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (public names)
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 6
+VERSION = 7
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_routine",
            "run_routine", "LANES"]
@@ -164,26 +167,47 @@ _LANE_NAMES_FIXED = re.compile(r"\b(t)\b(?!\()")
 
 def run_routine(n, nw, npar, lanes, codes, fixed=None):
     """Fortran lines of ``conmech_taylor_batch_run`` for a system of n states, nw work
-    columns and npar parameter slots, with `lanes` lanes; it calls the coefficient routine
+    columns and npar parameter slots, with `lanes` lanes, and of the module's private
+    stepping routines it calls (:func:`step_routines`); they call the coefficient routine
     ``conmech_taylor_batch`` of the same module. codes: the status codes (success,
     too_many_steps, step_too_small, nonfinite). fixed: the order of the written-out routine
     ``conmech_taylor_batch_fixed`` of the module, called for that order (else the loop
-    version)."""
+    version) by a stepping routine compiled for that order."""
     ok, many, small, nonfin = (int(c) for c in codes)
     run = 1 if 1 not in (ok, many, small, nonfin) else 99     # "still running"
-    src = _RUN.format(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
-                      nonfin=nonfin, run=run, coef=_COEF if fixed is None else
-                      _COEF_FIXED.format(p=int(fixed)))
+    fmt = dict(n=n, nw=nw, npar=npar, lanes=lanes, ok=ok, many=many, small=small,
+               nonfin=nonfin, run=run)
+    call = _CALL.format(name="conmech_taylor_batch_steps", ordarg="ord, ")
+    if fixed is not None:
+        call = _CALL_FIXED.format(p=int(fixed), call=call)
+    src = _RUN.format(call=call, **fmt)
+    src += _STEPS.format(name="conmech_taylor_batch_steps", ordarg="ord, ",
+                         orddecl="integer, intent(in) :: ord", coef=_COEF, **fmt)
+    if fixed is not None:
+        src += _STEPS.format(name=f"conmech_taylor_batch_steps{int(fixed)}", ordarg="",
+                             orddecl=f"integer, parameter :: ord = {int(fixed)}",
+                             coef=_COEF_FIXED, **fmt)
     return src.split("\n")
 
 
-_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)"
-_COEF_FIXED = """\
-            if (ord == {p}) then
-                call conmech_taylor_batch_fixed(tc, int(ord, c_int), wb(:, :, :, nu), p)
-            else
-                call conmech_taylor_batch(tc, int(ord, c_int), wb(:, :, :, nu), p)
-            end if"""
+def step_routines(fixed=None):
+    """The names of the private stepping routines of :func:`run_routine`'s code."""
+    return ["conmech_taylor_batch_steps"] + \
+        ([] if fixed is None else [f"conmech_taylor_batch_steps{int(fixed)}"])
+
+
+_COEF = "            call conmech_taylor_batch(tc, int(ord, c_int), w(:, :, :, nu), p)"
+_COEF_FIXED = \
+    "            call conmech_taylor_batch_fixed(tc, int(ord, c_int), w(:, :, :, nu), p)"
+_CALL = """\
+        call {name}({ordarg}m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, wb, te, st, cnt)"""
+_CALL_FIXED = """\
+        if (ord == {p}) then
+            call conmech_taylor_batch_steps{p}(m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, &
+                                              wb, te, st, cnt)
+        else
+    {call}
+        end if"""
 
 _RUN = """\
     !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
@@ -198,19 +222,10 @@ _RUN = """\
         real(dp), value, intent(in) :: hmax
         real(dp), intent(out) :: te(m)
         integer(c_int), intent(out) :: st(m), cnt(3, m)
-        integer, parameter :: nl = {lanes}, n = {n}, nw = {nw}
-        real(dp), parameter :: check_max = 10.0_dp
-        real(dp), allocatable :: wb(:, :, :, :)
-        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n)
-        real(dp) :: yn(nl, n), dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl)
-        real(dp) :: rt(n), atol(n), t0, tf, eps, decay, posneg, hm, lg, rho, fl, s, bb, lo
-        real(dp) :: a1, a2
-        integer, parameter :: i8 = selected_int_kind(18)
-        integer(i8) :: b1, b2
-        integer :: ord, l, i, k, j, next, mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl)
-        integer :: e1, e2
-        integer :: cu, nu
-        logical :: fresh(nl), hit(nl), stp(nl), acc(nl), fin(nl)
+        integer, parameter :: nl = {lanes}, nw = {nw}
+        real(dp), allocatable :: wb(:)
+        real(dp) :: rt({n}), atol({n}), t0, tf, eps, decay, hm
+        integer :: ord
         t0 = span(1)
         tf = span(2)
         atol = tol(:, 2)
@@ -223,13 +238,51 @@ _RUN = """\
         eps = max(minval(rt), minval(atol))
         ord = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
         decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
-        posneg = sign(1.0_dp, tf - t0)
         hm = min(abs(hmax), abs(tf - t0))
-        ! two expansions per lane: the current one (the polynomial of the step being
-        ! tried, cu) and the new one (at the step's end, nu); a step accepted makes the
-        ! new one current (the two swap), a lane whose step is rejected keeps its own
-        allocate (wb(nl, 0:ord, nw, 2))
-        wb = 0.0_dp
+        ! two expansions per lane (see the stepping routine), nl*(ord + 1)*nw values each
+        allocate (wb(nl*(ord + 1)*nw*2))
+{call}
+    end subroutine conmech_taylor_batch_run
+
+"""
+
+_STEPS = """\
+    !> The lanes' steps of conmech_taylor_batch_run for the order ord; w: two expansions per
+    !! lane, the current one (the polynomial of the step being tried, cu) and the new one
+    !! (at the step's end, nu): a step accepted makes the new one current (the two swap), a
+    !! lane whose step is rejected keeps its own. Every per-lane quantity is an array over
+    !! the lanes and every per-step operation a vector one over them, the decisions masks;
+    !! only the logarithm and exponential of the next step (glibc's scalar functions, as
+    !! the scalar stepper calls them) and the rare paths (a rejected step, a lane that
+    !! ends) run lane by lane.
+    subroutine {name}({ordarg}m, y, t0, tf, rt, atol, eps, decay, hm, mxs, p, w, te, st, cnt)
+        {orddecl}
+        integer(c_int), intent(in) :: m, mxs
+        real(dp), intent(inout) :: y({n}, m)
+        real(dp), intent(in) :: t0, tf, rt({n}), atol({n}), eps, decay, hm, p({npar})
+        real(dp), intent(out) :: w({lanes}, 0:ord, {nw}, 2)
+        real(dp), intent(inout) :: te(m)
+        integer(c_int), intent(inout) :: st(m), cnt(3, m)
+        integer, parameter :: nl = {lanes}, n = {n}
+        real(dp), parameter :: check_max = 10.0_dp, fl = 16.0_dp*epsilon(1.0_dp)
+        ! the margin of the choice of the smaller radius without its logarithms (below)
+        real(dp), parameter :: margin = 1.0e-9_dp
+        real(dp) :: t(nl), tlo(nl), h(nl), hc(nl), tc(nl), e(nl, n), yc(nl, n), yn(nl, n)
+        real(dp) :: ea(nl, n)
+        real(dp) :: dy(nl, n), err(nl), s1(nl), s2(nl), ym(nl), a1(nl), a2(nl), q(nl)
+        real(dp) :: posneg, lg, rho, s, bb, lo, tn, tl, r, pw
+        ! the lanes' flags (1 or 0), counters, members and statuses are doubles (small
+        ! integers, exact), tested by comparisons in the lane loops: the compiler makes
+        ! vector compares and blends of them (logicals or integers read from memory
+        ! beside doubles become a branch per lane)
+        integer, parameter :: i8 = selected_int_kind(18)
+        integer(i8) :: b1, b2
+        integer :: l, i, k, j, next, cu, nu, e1, e2
+        real(dp) :: mem(nl), done(nl), nst(nl), na(nl), nr(nl), nx(nl), pick(nl)
+        real(dp) :: fresh(nl), hit(nl), stp(nl), acc(nl), rej(nl), ok(nl), z(nl)
+        real(dp) :: yv, go, a, b
+        posneg = sign(1.0_dp, tf - t0)
+        w = 0.0_dp
         cu = 1
         t = t0
         tlo = 0.0_dp
@@ -237,191 +290,234 @@ _RUN = """\
         e = 1.0_dp
         yc = 0.0_dp
         mem = 0
-        done = {run}
+        done = {ok}             ! an empty lane: filled at once
         nst = 0
         na = 0
         nr = 0
         nx = 0
-        fresh = .false.
+        fresh = 0.0_dp
         next = 1
         do
             ! lanes whose member has ended: its results out, the next member in (fresh:
-            ! its first expansion is made in this round, beside the others' steps)
-            do l = 1, nl
-                if (mem(l) /= 0) then
+            ! its first expansion is made in this round, beside the others' steps); a
+            ! lane left empty is "running" with no member (mem = 0)
+            if (any(done /= {run})) then
+                do l = 1, nl
                     if (done(l) == {run}) cycle
-                    j = mem(l)
-                    y(:, j) = yc(l, :)
-                    te(j) = t(l)
-                    st(j) = done(l)
-                    cnt(:, j) = [nx(l), na(l), nr(l)]
-                    mem(l) = 0
-                end if
-                if (next > m) cycle
-                mem(l) = next
-                yc(l, :) = y(:, next)
-                t(l) = t0
-                tlo(l) = 0.0_dp
-                h(l) = 0.0_dp
-                done(l) = {run}
-                fresh(l) = .true.
-                nst(l) = 0
-                na(l) = 0
-                nr(l) = 0
-                nx(l) = 0
-                next = next + 1
-            end do
-            if (all(mem == 0)) exit
-            ! each running lane's step: the scalar stepper's limits, then its candidate
-            do l = 1, nl
-                hc(l) = 0.0_dp
-                tc(l) = t(l)
-                hit(l) = .false.
-                stp(l) = .false.
-                if (mem(l) == 0 .or. fresh(l)) cycle
-                if (nst(l) >= mxs) then
-                    done(l) = {many}
-                else if (.not. (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))) then
-                    done(l) = {small}
-                else
-                    hc(l) = h(l)
-                    if ((t(l) + hc(l) - tf)*posneg >= 0.0_dp) then
-                        hc(l) = (tf - t(l)) - tlo(l)
-                        hit(l) = .true.
+                    j = nint(mem(l))
+                    if (j /= 0) then
+                        y(:, j) = yc(l, :)
+                        te(j) = t(l)
+                        st(j) = nint(done(l), c_int)
+                        cnt(:, j) = nint([nx(l), na(l), nr(l)], c_int)
+                        mem(l) = 0
                     end if
-                    nst(l) = nst(l) + 1
-                    tc(l) = t(l) + hc(l)
-                    stp(l) = .true.
-                end if
+                    done(l) = {run}
+                    if (next > m) cycle
+                    mem(l) = real(next, dp)
+                    yc(l, :) = y(:, next)
+                    t(l) = t0
+                    tlo(l) = 0.0_dp
+                    h(l) = 0.0_dp
+                    fresh(l) = 1.0_dp
+                    nst(l) = 0
+                    na(l) = 0
+                    nr(l) = 0
+                    nx(l) = 0
+                    next = next + 1
+                end do
+                if (all(mem == 0)) exit
+            end if
+            ! each running lane's step: the scalar stepper's limits, then its candidate
+            !$omp simd private(go, a, b)
+            do l = 1, nl
+                go = merge(1.0_dp, 0.0_dp, mem(l) /= 0.0_dp .and. fresh(l) == 0.0_dp)
+                a = real({small}, dp)
+                b = real({many}, dp)
+                done(l) = merge(b, merge(a, done(l), go /= 0.0_dp .and. .not. &
+                                (0.1_dp*abs(h(l)) > abs(t(l))*epsilon(1.0_dp))), &
+                                go /= 0.0_dp .and. nst(l) >= real(mxs, dp))
+                stp(l) = merge(1.0_dp, 0.0_dp, go /= 0.0_dp .and. done(l) == {run})
+                hit(l) = merge(1.0_dp, 0.0_dp, stp(l) /= 0.0_dp .and. &
+                               (t(l) + h(l) - tf)*posneg >= 0.0_dp)
+                a = (tf - t(l)) - tlo(l)
+                b = t(l) + merge(a, h(l), hit(l) /= 0.0_dp)
+                hc(l) = merge(merge(a, h(l), hit(l) /= 0.0_dp), 0.0_dp, stp(l) /= 0.0_dp)
+                tc(l) = merge(b, t(l), stp(l) /= 0.0_dp)
+                nst(l) = nst(l) + stp(l)
+                nx(l) = nx(l) + merge(1.0_dp, stp(l), fresh(l) /= 0.0_dp .and. mem(l) /= 0.0_dp)
             end do
             ! the polynomials at the candidate steps (Horner, the value and its
             ! derivative in one pass), all lanes at once; a lane without a step expands
             ! at its current state (a new member: its initial state)
             nu = 3 - cu
-            !$omp simd
-            do l = 1, nl
-                yn(l, :) = wb(l, ord, 1:n, cu)
-                dy(l, :) = 0.0_dp
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    yn(l, i) = w(l, ord, i, cu)
+                    dy(l, i) = 0.0_dp
+                end do
             end do
             do k = ord - 1, 0, -1
                 do i = 1, n
                     !$omp simd
                     do l = 1, nl
                         dy(l, i) = yn(l, i) + hc(l)*dy(l, i)
-                        yn(l, i) = wb(l, k, i, cu) + hc(l)*yn(l, i)
+                        yn(l, i) = w(l, k, i, cu) + hc(l)*yn(l, i)
                     end do
                 end do
             end do
             do i = 1, n
-                !$omp simd
+                !$omp simd private(a, b)
                 do l = 1, nl
-                    wb(l, 0, i, nu) = merge(yn(l, i), yc(l, i), stp(l))
+                    a = yn(l, i)
+                    b = yc(l, i)
+                    w(l, 0, i, nu) = merge(a, b, stp(l) /= 0.0_dp)
                 end do
             end do
 {coef}
-            nx = nx + merge(1, 0, stp .or. (fresh .and. mem /= 0))
             ! the safety check of every lane's step: h (P'(h) - f(t + h, P(h))) against
             ! the scales, f there from the new expansion's first coefficients
-            fl = 16.0_dp*epsilon(1.0_dp)
             err = 0.0_dp
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - wb(l, 1, i, nu)))/(e(l, i) &
+                    err(l) = max(err(l), abs(hc(l)*(dy(l, i) - w(l, 1, i, nu)))/(e(l, i) &
                                  + fl*(abs(yn(l, i)) + abs(hc(l)*dy(l, i)))))
                 end do
             end do
-            err = err/real(ord + 1, dp)
-            acc = fresh .and. mem /= 0
+            ! accepted or rejected; the time of an accepted step, t + h in double length
+            ! (Knuth's TwoSum, as the scalar stepper), tf where the step hits the end
+            !$omp simd private(s, bb, lo, tn, tl, a, b)
             do l = 1, nl
-                if (.not. stp(l)) cycle
-                if (.not. (err(l) <= check_max)) then
-                    nr(l) = nr(l) + 1
+                err(l) = err(l)/real(ord + 1, dp)
+                ok(l) = merge(1.0_dp, 0.0_dp, stp(l) /= 0.0_dp .and. err(l) <= check_max)
+                rej(l) = stp(l) - ok(l)
+                nr(l) = nr(l) + rej(l)
+                na(l) = na(l) + ok(l)
+                s = t(l) + hc(l)
+                bb = s - t(l)
+                lo = (t(l) - (s - bb)) + (hc(l) - bb)
+                lo = lo + tlo(l)
+                tn = s + lo
+                tl = lo - (tn - s)
+                a = merge(tf, tn, hit(l) /= 0.0_dp)
+                b = merge(0.0_dp, tl, hit(l) /= 0.0_dp)
+                t(l) = merge(a, t(l), ok(l) /= 0.0_dp)
+                tlo(l) = merge(b, tlo(l), ok(l) /= 0.0_dp)
+                a = real({ok}, dp)
+                done(l) = merge(a, done(l), ok(l) /= 0.0_dp .and. hit(l) /= 0.0_dp)
+                acc(l) = merge(1.0_dp, ok(l), fresh(l) /= 0.0_dp .and. mem(l) /= 0.0_dp)
+            end do
+            ! rejected steps: the step shrunk by the check's ratio; the lanes that did not
+            ! accept keep their current expansion (copied into the new buffer)
+            if (any(rej /= 0.0_dp)) then
+                do l = 1, nl
+                    if (rej(l) == 0.0_dp) cycle
                     if (err(l) == err(l) .and. err(l) <= huge(1.0_dp)) then
                         h(l) = hc(l)*max(0.1_dp, min(0.5_dp, 0.8_dp*(check_max/err(l))** &
                                                      (1.0_dp/real(ord + 1, dp))))
                     else
                         h(l) = 0.1_dp*hc(l)
                     end if
-                    cycle
-                end if
-                na(l) = na(l) + 1
-                acc(l) = .true.
-                if (hit(l)) then
-                    t(l) = tf
-                    tlo(l) = 0.0_dp
-                    done(l) = {ok}
-                else
-                    ! t + h in double length (Knuth's TwoSum), as the scalar stepper
-                    s = t(l) + hc(l)
-                    bb = s - t(l)
-                    lo = (t(l) - (s - bb)) + (hc(l) - bb)
-                    lo = lo + tlo(l)
-                    t(l) = s + lo
-                    tlo(l) = lo - (t(l) - s)
-                end if
-            end do
-            ! accepted lanes: the new state, expansion and scales; the next step from
-            ! the last two coefficients (Jorba and Zou)
-            ! lanes that did not accept: their current expansion into the new buffer
-            do l = 1, nl
-                if (mem(l) /= 0 .and. .not. acc(l)) wb(l, :, 1:n, nu) = wb(l, :, 1:n, cu)
-            end do
+                end do
+            end if
+            if (any(acc == 0.0_dp .and. mem /= 0.0_dp)) then
+                do l = 1, nl
+                    if (mem(l) /= 0.0_dp .and. acc(l) == 0.0_dp) w(l, :, 1:n, nu) = w(l, :, 1:n, cu)
+                end do
+            end if
             cu = nu
+            ! accepted lanes: the new state, expansion and scales; the norms of the last
+            ! two coefficients (Jorba and Zou)
             ym = 0.0_dp
             do i = 1, n
-                !$omp simd
+                !$omp simd private(a, b, yv)
                 do l = 1, nl
-                    yc(l, i) = merge(yn(l, i), yc(l, i), acc(l) .and. .not. fresh(l))
-                    ym(l) = max(ym(l), abs(yc(l, i)))
+                    a = yn(l, i)
+                    b = yc(l, i)
+                    yv = merge(a, b, ok(l) /= 0.0_dp)
+                    yc(l, i) = yv
+                    ym(l) = max(ym(l), abs(yv))
                 end do
             end do
-            fin = .true.
+            ! z: 0 where the new first coefficients are finite, else a NaN
+            z = 0.0_dp
             s1 = 0.0_dp
             s2 = 0.0_dp
+            ! (the new scales in a loop of their own: beside the select, their maxima
+            ! make the loop scalar)
             do i = 1, n
                 !$omp simd
                 do l = 1, nl
-                    fin(l) = fin(l) .and. abs(wb(l, 1, i, cu)) <= huge(1.0_dp)
-                    e(l, i) = merge(max(atol(i), rt(i)*ym(l), tiny(1.0_dp)), e(l, i), acc(l))
-                    s1(l) = max(s1(l), abs(wb(l, ord - 1, i, cu))/e(l, i))
-                    s2(l) = max(s2(l), abs(wb(l, ord, i, cu))/e(l, i))
+                    ea(l, i) = max(atol(i), rt(i)*ym(l), tiny(1.0_dp))
                 end do
             end do
+            do i = 1, n
+                !$omp simd
+                do l = 1, nl
+                    z(l) = z(l) + 0.0_dp*w(l, 1, i, cu)
+                    e(l, i) = merge(ea(l, i), e(l, i), acc(l) /= 0.0_dp)
+                    s1(l) = max(s1(l), abs(w(l, ord - 1, i, cu))/e(l, i))
+                    s2(l) = max(s2(l), abs(w(l, ord, i, cu))/e(l, i))
+                end do
+            end do
+            ! the next step h = min(rho, hm) from the radius rho = exp(lg) decay, lg the
+            ! smaller of -log(a1)/(ord - 1) and -log(a2)/ord (conmech_taylor_core's
+            ! taylor_next_rho, the same value): which one is smaller is known without the
+            ! logarithms when q = a1 (a1/a2)**(ord - 1) (> 1: the first) is off 1 by more
+            ! than the margin (far more than the rounding of q or of the logarithms), so
+            ! one logarithm per lane (pick); else both, or the exponent test, lane by lane
+            !$omp simd private(r, pw, a)
             do l = 1, nl
-                if (.not. acc(l)) cycle
-                fresh(l) = .false.
-                if (.not. fin(l)) then
-                    done(l) = {nonfin}
-                    cycle
-                end if
-                if (done(l) /= {run}) cycle
-                ! one logarithm where the binary exponents of the two norms already tell
-                ! the smaller radius (conmech_taylor_core's taylor_next_rho: the same value)
-                lg = huge(1.0_dp)
-                a1 = s1(l)*eps
-                a2 = s2(l)*eps
-                b1 = ishft(transfer(a1, 0_i8), -52)
-                b2 = ishft(transfer(a2, 0_i8), -52)
-                if (s1(l) > 0.0_dp .and. s2(l) > 0.0_dp .and. b1 >= 1 .and. b1 <= 2046 &
-                    .and. b2 >= 1 .and. b2 <= 2046) then
-                    e1 = int(b1) - 1022
-                    e2 = int(b2) - 1022
-                    if ((e1 - 1)*ord > e2*(ord - 1)) then
-                        lg = -log(a1)/real(ord - 1, dp)
-                    else if ((e2 - 1)*(ord - 1) > e1*ord) then
-                        lg = -log(a2)/real(ord, dp)
-                    else
-                        lg = min(-log(a1)/real(ord - 1, dp), -log(a2)/real(ord, dp))
-                    end if
+                fresh(l) = merge(0.0_dp, fresh(l), acc(l) /= 0.0_dp)
+                a = real({nonfin}, dp)
+                done(l) = merge(a, done(l), .not. (z(l) == 0.0_dp) .and. acc(l) /= 0.0_dp)
+                a1(l) = s1(l)*eps
+                a2(l) = s2(l)*eps
+                r = a1(l)/a2(l)
+                pw = r
+                do j = 2, ord - 1
+                    pw = pw*r
+                end do
+                q(l) = a1(l)*pw
+                a = merge(1.0_dp, merge(2.0_dp, 0.0_dp, q(l) < 1.0_dp - margin), &
+                          q(l) > 1.0_dp + margin)
+                pick(l) = merge(a, 0.0_dp, a1(l) >= tiny(1.0_dp) .and. a1(l) <= huge(1.0_dp) &
+                                .and. a2(l) >= tiny(1.0_dp) .and. a2(l) <= huge(1.0_dp) .and. &
+                                pw >= tiny(1.0_dp) .and. pw <= huge(1.0_dp))
+            end do
+            do l = 1, nl
+                if (acc(l) == 0.0_dp .or. done(l) /= {run}) cycle
+                if (pick(l) == 1.0_dp) then
+                    lg = -log(a1(l))/real(ord - 1, dp)
+                else if (pick(l) == 2.0_dp) then
+                    lg = -log(a2(l))/real(ord, dp)
                 else
-                    if (s1(l) > 0.0_dp) lg = -log(a1)/real(ord - 1, dp)
-                    if (s2(l) > 0.0_dp) lg = min(lg, -log(a2)/real(ord, dp))
+                    lg = huge(1.0_dp)
+                    b1 = ishft(transfer(a1(l), 0_i8), -52)
+                    b2 = ishft(transfer(a2(l), 0_i8), -52)
+                    if (s1(l) > 0.0_dp .and. s2(l) > 0.0_dp .and. b1 >= 1 .and. &
+                        b1 <= 2046 .and. b2 >= 1 .and. b2 <= 2046) then
+                        e1 = int(b1) - 1022
+                        e2 = int(b2) - 1022
+                        if ((e1 - 1)*ord > e2*(ord - 1)) then
+                            lg = -log(a1(l))/real(ord - 1, dp)
+                        else if ((e2 - 1)*(ord - 1) > e1*ord) then
+                            lg = -log(a2(l))/real(ord, dp)
+                        else
+                            lg = min(-log(a1(l))/real(ord - 1, dp), -log(a2(l))/real(ord, dp))
+                        end if
+                    else
+                        if (s1(l) > 0.0_dp) lg = -log(a1(l))/real(ord - 1, dp)
+                        if (s2(l) > 0.0_dp) lg = min(lg, -log(a2(l))/real(ord, dp))
+                    end if
                 end if
                 rho = huge(1.0_dp)
                 if (lg < log(huge(1.0_dp))) rho = exp(lg)*decay
                 h(l) = min(rho, hm)*posneg
             end do
         end do
-    end subroutine conmech_taylor_batch_run
+    end subroutine {name}
+
 """
