@@ -2,6 +2,7 @@
 !! points and the branch itself (see conmech_continuation).
 module conmech_branch_types
     use conmech_kinds, only: dp
+    use conmech_code_names, only: code_name
     use conmech_status
     implicit none
     private
@@ -105,18 +106,9 @@ contains
     pure function special_name(kind) result(s)
         integer, intent(in) :: kind
         character(len=:), allocatable :: s
-        select case (kind)
-        case (SP_FOLD)
-            s = "fold"
-        case (SP_BP)
-            s = "branch point"
-        case (SP_PD)
-            s = "period doubling"
-        case (SP_NS)
-            s = "Neimark-Sacker"
-        case default
-            s = "unknown"
-        end select
+        s = code_name(kind, [SP_FOLD, SP_BP, SP_PD, SP_NS], &
+                      [character(len=15) :: "fold", "branch point", "period doubling", &
+                       "Neimark-Sacker"], "unknown")
     end function special_name
 
 end module conmech_branch_types

@@ -3,6 +3,7 @@
 !! branch itself.
 module conmech_eq_branch_types
     use conmech_kinds, only: dp
+    use conmech_code_names, only: code_name
     use conmech_status
     implicit none
     private
@@ -87,14 +88,7 @@ contains
     pure function eq_special_name(kind) result(s)
         integer, intent(in) :: kind
         character(len=:), allocatable :: s
-        select case (kind)
-        case (EQ_FOLD)
-            s = "fold"
-        case (EQ_HOPF)
-            s = "Hopf"
-        case default
-            s = "unknown"
-        end select
+        s = code_name(kind, [EQ_FOLD, EQ_HOPF], [character(len=4) :: "fold", "Hopf"], "unknown")
     end function eq_special_name
 
 end module conmech_eq_branch_types
