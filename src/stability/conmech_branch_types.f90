@@ -2,6 +2,7 @@
 !! points and the branch itself (see conmech_continuation).
 module conmech_branch_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
     use conmech_code_names, only: code_name
     use conmech_status
     implicit none
@@ -90,9 +91,7 @@ module conmech_branch_types
     end type special_point
 
     !> A branch: its points and special points, the status and a message.
-    type :: branch
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: branch
         integer :: direction = 1              !! the side the branch was continued to
         integer :: npoints = 0
         type(cont_point), allocatable :: points(:)

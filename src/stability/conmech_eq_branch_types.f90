@@ -3,6 +3,7 @@
 !! branch itself.
 module conmech_eq_branch_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
     use conmech_code_names, only: code_name
     use conmech_status
     implicit none
@@ -73,9 +74,7 @@ module conmech_eq_branch_types
     end type eq_special
 
     !> A branch of equilibria: its points and special points, the status and a message.
-    type :: eq_branch
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: eq_branch
         integer :: npoints = 0
         type(eq_point), allocatable :: points(:)
         integer :: nspecial = 0

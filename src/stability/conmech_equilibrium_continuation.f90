@@ -91,18 +91,16 @@ contains
         x(n + 1) = p0
         call correct(sys, set_param, o, x, t, .true., x, it, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = "equilibrium continuation: the start is not an equilibrium "// &
-                         "(Newton at fixed p from y0: "//msg//")"
+            call br%fail(info, "equilibrium continuation: the start is not an equilibrium "// &
+                               "(Newton at fixed p from y0: "//msg//")")
             return
         end if
         t = 0.0_dp
         t(n + 1) = real(sign(1, o%direction), dp)
         call make_point(sys, set_param, o, x, t, it, 0.0_dp, br%points(1), info)
         if (info /= CM_SUCCESS) then
-            br%info = CM_SINGULAR
-            br%message = "equilibrium continuation: degenerate start (no unique tangent: "// &
-                         "a fold or a branch point at p0)"
+            call br%fail(CM_SINGULAR, "equilibrium continuation: degenerate start (no unique "// &
+                                      "tangent: a fold or a branch point at p0)")
             return
         end if
         br%npoints = 1
@@ -119,10 +117,9 @@ contains
                 ds = 0.5_dp*ds
                 if (ds < o%ds_min) then
                     write (buf, '(es23.15)') x(n + 1)
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "equilibrium continuation stopped at p = "// &
-                                 trim(adjustl(buf))//": the corrector did not converge "// &
-                                 "with ds >= ds_min ("//msg//")"
+                    call br%fail(CM_NO_CONVERGENCE, "equilibrium continuation stopped at p = "// &
+                                                    trim(adjustl(buf))//": the corrector did "// &
+                                                    "not converge with ds >= ds_min ("//msg//")")
                     exit
                 end if
                 cycle
@@ -143,9 +140,9 @@ contains
                 br%message = "success: the branch reached the end of the p range, p = "// &
                              trim(adjustl(buf))
                 if (.not. last%located) then
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "equilibrium continuation: the end of the p range, p = "// &
-                                 trim(adjustl(buf))//", was not located"
+                    call br%fail(CM_NO_CONVERGENCE, "equilibrium continuation: the end of the "// &
+                                                    "p range, p = "//trim(adjustl(buf))// &
+                                                    ", was not located")
                 end if
                 exit
             end if

@@ -169,9 +169,8 @@ contains
         br%fb = ob%stability_index - target
         if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS .or. &
             .not. (br%fa*br%fb <= 0.0_dp) .or. oa%kappa /= ob%kappa .or. br%a == br%b) then
-            orb%info = CM_BAD_INPUT
-            orb%message = "hill_locate_index: need two converged orbits (same kappa) with "// &
-                          "S - target of opposite signs"
+            call orb%fail(CM_BAD_INPUT, "hill_locate_index: need two converged orbits (same "// &
+                                        "kappa) with S - target of opposite signs")
             return
         end if
         ua = [oa%y0(1), oa%y0(4)]
@@ -187,8 +186,7 @@ contains
             if (moved) ua = ub
             ub = [orb%y0(1), orb%y0(4)]
         end do
-        orb%info = CM_NO_CONVERGENCE
-        orb%message = "hill_locate_index: no convergence in 100 iterations"
+        call orb%fail(CM_NO_CONVERGENCE, "hill_locate_index: no convergence in 100 iterations")
     end subroutine hill_locate_index
 
     pure real(dp) function lagrange_weight(x, xs, np, j) result(w)

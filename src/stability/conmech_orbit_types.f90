@@ -4,6 +4,7 @@
 !! conmech_shooting re-exports all of them.
 module conmech_orbit_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
     use conmech_code_names, only: code_name
     use conmech_status
     use conmech_ode_system, only: ode_system
@@ -44,9 +45,7 @@ module conmech_orbit_types
     end type shooting_options
 
     !> A periodic orbit.
-    type :: periodic_orbit
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: periodic_orbit
         real(dp), allocatable :: y0(:)          !! initial state
         real(dp) :: period = 0.0_dp
         real(dp), allocatable :: monodromy(:, :)  !! the formed product of the segment STMs
