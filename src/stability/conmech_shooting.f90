@@ -346,12 +346,7 @@ contains
         nh = 0
         do i = 1, size(ps)
             call set_param(sys, ps(i))
-            if (nh == 0) then
-                g(1:n) = y0
-                g(n + 1) = tau
-            else
-                call extrapolate(ps(i), pp, hist, nh, g)
-            end if
+            call next_guess(ps(i), y0, tau, pp, hist, nh, g)
             call find_symmetric_orbit(sys, g(1:n), free, g(n + 1), targets, orbits(i), &
                                       options, free_time, pf)
             if (orbits(i)%info == CM_SUCCESS) then
@@ -376,18 +371,27 @@ contains
         nh = 0
         do i = 1, size(ps)
             call set_param(sys, ps(i))
-            if (nh == 0) then
-                g(1:n) = y0
-                g(n + 1) = period
-            else
-                call extrapolate(ps(i), pp, hist, nh, g)
-            end if
+            call next_guess(ps(i), y0, period, pp, hist, nh, g)
             call find_periodic_orbit(sys, g(1:n), g(n + 1), orbits(i), mode, options)
             if (orbits(i)%info == CM_SUCCESS) then
                 call push(ps(i), [orbits(i)%y0, orbits(i)%period], pp, hist, nh)
             end if
         end do
     end subroutine continue_periodic_family
+
+    !> The guess g = [y, T] at p: the start (y0, t0) until a solution is known, then the
+    !! extrapolation of the last (up to three) solutions.
+    pure subroutine next_guess(p, y0, t0, pp, hist, nh, g)
+        real(dp), intent(in) :: p, y0(:), t0, pp(3), hist(:, :)
+        integer, intent(in) :: nh
+        real(dp), intent(out) :: g(:)
+        if (nh == 0) then
+            g(1:size(y0)) = y0
+            g(size(y0) + 1) = t0
+        else
+            call extrapolate(p, pp, hist, nh, g)
+        end if
+    end subroutine next_guess
 
     pure subroutine push(p, v, pp, hist, nh)
         real(dp), intent(in) :: p, v(:)
