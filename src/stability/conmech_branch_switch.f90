@@ -52,8 +52,8 @@ contains
         character(len=:), allocatable :: msg
         if (present(options)) o = options
         if (sp%kind /= SP_PD .or. .not. allocated(sp%point%y0)) then
-            br%info = CM_BAD_INPUT
-            br%message = "switch_period_doubling: not a located period-doubling point"
+            call br%fail(CM_BAD_INPUT, "switch_period_doubling: not a located period-doubling "// &
+                                       "point")
             return
         end if
         n = size(sp%point%y0)
@@ -68,8 +68,7 @@ contains
         end do
         call integrate_stm(sys, 0.0_dp, sp%point%period, y, phi, oo, info, msg)
         if (info < 0) then
-            br%info = info
-            br%message = "switch_period_doubling: "//msg
+            call br%fail(info, "switch_period_doubling: "//msg)
             return
         end if
         ! inverse iteration on M + I for the eigenvector of the multiplier -1
@@ -81,8 +80,8 @@ contains
             end do
             call dgesv(n, 1, a, n, ipiv, v, n, info)
             if (info < 0 .or. .not. (norm2(v(:, 1)) > 0.0_dp)) then
-                br%info = CM_SINGULAR
-                br%message = "switch_period_doubling: no eigenvector for the multiplier -1"
+                call br%fail(CM_SINGULAR, "switch_period_doubling: no eigenvector for the "// &
+                                          "multiplier -1")
                 return
             end if
             v(:, 1) = v(:, 1)/norm2(v(:, 1))
@@ -134,8 +133,7 @@ contains
         if (present(options)) o = options
         if (present(ratio)) ratio = huge(1.0_dp)
         if (sp%kind /= SP_BP .or. .not. allocated(sp%point%y0)) then
-            br%info = CM_BAD_INPUT
-            br%message = "switch_branch_point: not a located branch point"
+            call br%fail(CM_BAD_INPUT, "switch_branch_point: not a located branch point")
             return
         end if
         n = size(sp%point%y0)
@@ -146,28 +144,25 @@ contains
         if (o%autonomous) neq = n + 1
         if ((o%conservative .and. .not. o%in_period) .or. &
             (o%autonomous .and. o%fixed_period)) then
-            br%info = CM_BAD_INPUT
-            br%message = "switch_branch_point: for the general shooting of a family in a "// &
-                         "parameter, or of a conservative family in the period (in_period)"
+            call br%fail(CM_BAD_INPUT, "switch_branch_point: for the general shooting of a "// &
+                                       "family in a parameter, or of a conservative family in "// &
+                                       "the period (in_period)")
             return
         end if
         if (size(t_old) /= nx .or. .not. (norm2(t_old) > 0.0_dp)) then
-            br%info = CM_BAD_INPUT
-            br%message = "switch_branch_point: t_old must be a non-zero vector with one "// &
-                         "entry per unknown [y0, T, p]"
+            call br%fail(CM_BAD_INPUT, "switch_branch_point: t_old must be a non-zero vector "// &
+                                       "with one entry per unknown [y0, T, p]")
             return
         end if
         allocate (dg(neq, nx), sv(min(neq, nx)), vt(nx, nx), tn(nx), k1(nx), k2(nx))
         call shooting_jacobian(sys, set_param, sp%point, o, tfree, dg, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = "switch_branch_point: "//msg
+            call br%fail(info, "switch_branch_point: "//msg)
             return
         end if
         call svd_vt(dg, sv, vt, info)
         if (info /= CM_SUCCESS .or. size(sv) < 3) then
-            br%info = CM_SINGULAR
-            br%message = "switch_branch_point: SVD of the shooting Jacobian failed"
+            call br%fail(CM_SINGULAR, "switch_branch_point: SVD of the shooting Jacobian failed")
             return
         end if
         ! kernel of DG (neq = nx - 1 rows, or nx with in_period where the energy integral
@@ -179,9 +174,9 @@ contains
         a1 = dot_product(t_old, k1)
         a2 = dot_product(t_old, k2)
         if (.not. (hypot(a1, a2) > 0.5_dp*norm2(t_old))) then
-            br%info = CM_SINGULAR
-            br%message = "switch_branch_point: t_old is not in the kernel of the shooting "// &
-                         "Jacobian (not the tangent of this branch at this point?)"
+            call br%fail(CM_SINGULAR, "switch_branch_point: t_old is not in the kernel of the "// &
+                                      "shooting Jacobian (not the tangent of this branch at "// &
+                                      "this point?)")
             return
         end if
         tn = -a2*k1 + a1*k2

@@ -2,6 +2,8 @@
 !! points and the branch itself (see conmech_continuation).
 module conmech_branch_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
+    use conmech_code_names, only: code_name
     use conmech_status
     implicit none
     private
@@ -89,9 +91,7 @@ module conmech_branch_types
     end type special_point
 
     !> A branch: its points and special points, the status and a message.
-    type :: branch
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: branch
         integer :: direction = 1              !! the side the branch was continued to
         integer :: npoints = 0
         type(cont_point), allocatable :: points(:)
@@ -105,18 +105,9 @@ contains
     pure function special_name(kind) result(s)
         integer, intent(in) :: kind
         character(len=:), allocatable :: s
-        select case (kind)
-        case (SP_FOLD)
-            s = "fold"
-        case (SP_BP)
-            s = "branch point"
-        case (SP_PD)
-            s = "period doubling"
-        case (SP_NS)
-            s = "Neimark-Sacker"
-        case default
-            s = "unknown"
-        end select
+        s = code_name(kind, [SP_FOLD, SP_BP, SP_PD, SP_NS], &
+                      [character(len=15) :: "fold", "branch point", "period doubling", &
+                       "Neimark-Sacker"], "unknown")
     end function special_name
 
 end module conmech_branch_types

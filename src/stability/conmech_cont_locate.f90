@@ -23,6 +23,7 @@
 !! neutral saddle) is not reported.
 module conmech_cont_locate
     use conmech_kinds, only: dp
+    use conmech_illinois, only: illinois_bracket
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_orbit_types, only: set_parameter_proc
@@ -119,36 +120,36 @@ contains
         type(cont_point), intent(in) :: p0, p1
         type(special_point), intent(out) :: sp
         real(dp), intent(out) :: xs(:)
-        real(dp) :: sa, sb, fa, fb, sc, fc, x(size(x0)), t(size(x0)), xh(size(x0))
+        real(dp) :: sc, fc, x(size(x0)), t(size(x0)), xh(size(x0))
         real(dp) :: xa(size(x0)), xb(size(x0)), da(size(x0)), db(size(x0)), pscale, res
-        integer :: iter, side, it, info
+        integer :: iter, it, info
+        type(illinois_bracket) :: br
+        logical :: moved
         type(cont_point) :: trial, qa, qb
         type(cconstraint) :: con
         character(len=:), allocatable :: msg, why
         character(len=40) :: buf
-        sa = 0.0_dp
-        sb = ds
+        br%a = 0.0_dp
+        br%b = ds
         qa = p0
         qb = p1
         xa = x0
         xb = x1
         da = t0/cp_rdot(pb, t0, t0)
         db = t1/cp_rdot(pb, t0, t1)
-        fa = qa%psi(kind)
-        fb = qb%psi(kind)
-        side = 0
+        br%fa = qa%psi(kind)
+        br%fb = qb%psi(kind)
         con%kind = CON_LINEAR
         con%a = t0
         if (pb%o%discretisation /= 1) call zero_unreduced(con%a)
         why = "the iteration limit"
         sp%reason = SPR_LIMIT
         do iter = 1, 60
-            sc = (sa*fb - sb*fa)/(fb - fa)
-            if (.not. (sc > min(sa, sb) .and. sc < max(sa, sb))) sc = 0.5_dp*(sa + sb)
-            if (sa < sb) then
-                xh = hermite(sa, xa, da, sb, xb, db, sc)
+            sc = br%trial()
+            if (br%a < br%b) then
+                xh = hermite(br%a, xa, da, br%b, xb, db, sc)
             else
-                xh = hermite(sb, xb, db, sa, xa, da, sc)
+                xh = hermite(br%b, xb, db, br%a, xa, da, sc)
             end if
             x = xh
             con%b = dot_product(con%a, x0) + sc
@@ -171,10 +172,10 @@ contains
                 if (info == CM_SINGULAR) then
                     ! no unique tangent at the branch point: this branch's is the limit of
                     ! its tangents, the derivative of the interpolant
-                    if (sa < sb) then
-                        t = hermite_slope(sa, xa, da, sb, xb, db, sc)
+                    if (br%a < br%b) then
+                        t = hermite_slope(br%a, xa, da, br%b, xb, db, sc)
                     else
-                        t = hermite_slope(sb, xb, db, sa, xa, da, sc)
+                        t = hermite_slope(br%b, xb, db, br%a, xa, da, sc)
                     end if
                     t = t/cp_rnorm(pb, t)
                     call cp_make_point(sys, set_param, pb, x, t, it, sc, trial, info, &
@@ -188,7 +189,7 @@ contains
                 sp%reason = SPR_CORRECTOR
                 exit
             end if
-            if (cp_rnorm(pb, x - xh) > 0.01_dp*abs(sb - sa) .and. &
+            if (cp_rnorm(pb, x - xh) > 0.01_dp*abs(br%b - br%a) .and. &
                 cp_rnorm(pb, x - xh) > 1.0e3_dp*pb%o%tol*max(1.0_dp, maxval(abs(x)))) then
                 write (buf, '(es10.3)') sc
                 sp%reason = SPR_LEFT_BRANCH
@@ -197,7 +198,7 @@ contains
                 exit
             end if
             fc = trial%psi(kind)
-            if (fc == 0.0_dp .or. abs(sb - sa) <= pb%o%locate_tol) then
+            if (fc == 0.0_dp .or. abs(br%b - br%a) <= pb%o%locate_tol) then
                 sp%point = trial
                 sp%located = .true.
                 sp%reason = SPR_LOCATED
@@ -206,19 +207,12 @@ contains
                 xs = x
                 return
             end if
-            if (fc*fb < 0.0_dp) then
-                sa = sb
-                fa = fb
+            call br%update(sc, fc, moved)
+            if (moved) then
                 qa = qb
                 xa = xb
                 da = db
-                side = 0
-            else
-                if (side == 1) fa = 0.5_dp*fa
-                side = 1
             end if
-            sb = sc
-            fb = fc
             qb = trial
             xb = x
             db = t/cp_rdot(pb, t0, t)

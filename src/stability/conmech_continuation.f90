@@ -100,8 +100,7 @@ contains
         if (present(options)) pb%o = options
         call cp_setup(pb, y0, period, p0, free, targets, free_time, period_factor, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = msg
+            call br%fail(info, msg)
             return
         end if
         if (pb%o%autonomous .and. .not. present(tangent0)) then
@@ -122,8 +121,7 @@ contains
         if (.not. pb%o%in_period) call set_param(sys, p0)
         call cp_pack_start(sys, pb, y0, period, p0, x, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = "continuation: "//msg
+            call br%fail(info, "continuation: "//msg)
             return
         end if
         ! the first point: Newton at fixed p (a given tangent0 starts at a bifurcation
@@ -138,8 +136,7 @@ contains
         end if
         call first_point(sys, set_param, pb, x, con, it, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = "continuation: the start is not a periodic orbit: "//msg
+            call br%fail(info, "continuation: the start is not a periodic orbit: "//msg)
             return
         end if
         if (pb%o%autonomous .and. .not. present(tangent0)) then
@@ -147,10 +144,10 @@ contains
             call cp_unpack(pb, x, f, tend, per, p)
             call sys%rhs(0.0_dp, f, fx)
             if (norm2(fx)*per <= 1.0e-10_dp*max(1.0_dp, maxval(abs(f)))) then
-                br%info = CM_BAD_INPUT
-                br%message = "continuation: the start converged to an equilibrium (a "// &
-                             "periodic solution of any period): start from the orbit's "// &
-                             "own period, e.g. found by symmetric_orbit with the time free"
+                call br%fail(CM_BAD_INPUT, "continuation: the start converged to an "// &
+                                           "equilibrium (a periodic solution of any period): "// &
+                                           "start from the orbit's own period, e.g. found by "// &
+                                           "symmetric_orbit with the time free")
                 return
             end if
         end if
@@ -162,18 +159,17 @@ contains
         if (present(tangent0)) then
             call start_tangent(pb, tangent0, t, info)
             if (info /= CM_SUCCESS) then
-                br%info = CM_BAD_INPUT
-                br%message = "continuation: tangent0 must have one entry per unknown "// &
-                             "[y0, T, p] of single shooting (T only if free)"
+                call br%fail(CM_BAD_INPUT, "continuation: tangent0 must have one entry per "// &
+                                           "unknown [y0, T, p] of single shooting (T only if "// &
+                                           "free)")
                 return
             end if
         end if
         call cp_make_point(sys, set_param, pb, x, t, it, 0.0_dp, br%points(1), info, &
                            keep_t=present(tangent0))
         if (info /= CM_SUCCESS) then
-            br%info = CM_SINGULAR
-            br%message = "continuation: degenerate start (no unique tangent: the orbit is "// &
-                         "not isolated, or already at a fold)"
+            call br%fail(CM_SINGULAR, "continuation: degenerate start (no unique tangent: the "// &
+                                      "orbit is not isolated, or already at a fold)")
             return
         end if
         if (dir == 0 .and. .not. present(tangent0)) then
@@ -201,10 +197,9 @@ contains
                 ds = 0.5_dp*ds
                 if (ds < pb%o%ds_min) then
                     write (buf, '(es23.15)') br%points(br%npoints)%p
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "continuation stopped at p = "//trim(adjustl(buf))// &
-                                 ": the corrector did not converge with ds >= ds_min ("// &
-                                 msg//")"
+                    call br%fail(CM_NO_CONVERGENCE, "continuation stopped at p = "// &
+                                                    trim(adjustl(buf))//": the corrector did "// &
+                                                    "not converge with ds >= ds_min ("//msg//")")
                     exit
                 end if
                 cycle
@@ -221,11 +216,11 @@ contains
                     write (buf, '(es23.15)') pt%p
                     write (b2, '(i0,a,i0,a,es9.2)') pb%bvp%k, " intervals of degree ", &
                         pb%bvp%m, "; closure ", clos
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "continuation stopped at p = "//trim(adjustl(buf))// &
-                                 ": the collocation mesh ("//trim(b2)//") does not "// &
-                                 "resolve the orbit there (use more intervals or a higher "// &
-                                 "degree)"
+                    call br%fail(CM_NO_CONVERGENCE, "continuation stopped at p = "// &
+                                                    trim(adjustl(buf))//": the collocation "// &
+                                                    "mesh ("//trim(b2)//") does not resolve "// &
+                                                    "the orbit there (use more intervals or "// &
+                                                    "a higher degree)")
                     exit
                 end if
             end if

@@ -3,6 +3,8 @@
 !! branch itself.
 module conmech_eq_branch_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
+    use conmech_code_names, only: code_name
     use conmech_status
     implicit none
     private
@@ -72,9 +74,7 @@ module conmech_eq_branch_types
     end type eq_special
 
     !> A branch of equilibria: its points and special points, the status and a message.
-    type :: eq_branch
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: eq_branch
         integer :: npoints = 0
         type(eq_point), allocatable :: points(:)
         integer :: nspecial = 0
@@ -87,14 +87,7 @@ contains
     pure function eq_special_name(kind) result(s)
         integer, intent(in) :: kind
         character(len=:), allocatable :: s
-        select case (kind)
-        case (EQ_FOLD)
-            s = "fold"
-        case (EQ_HOPF)
-            s = "Hopf"
-        case default
-            s = "unknown"
-        end select
+        s = code_name(kind, [EQ_FOLD, EQ_HOPF], [character(len=4) :: "fold", "Hopf"], "unknown")
     end function eq_special_name
 
 end module conmech_eq_branch_types

@@ -44,6 +44,7 @@
 !! with holonomic constraints is a stable equilibrium (Lagrange 1788, Dirichlet 1846).
 module conmech_equilibria
     use conmech_kinds, only: dp
+    use conmech_code_names, only: code_name
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_lapack, only: la_eig, la_sym_eig
@@ -302,20 +303,13 @@ contains
     pure function classification_name(kind) result(s)
         integer, intent(in) :: kind
         character(len=:), allocatable :: s
-        select case (kind)
-        case (EQ_ASYMPTOTICALLY_STABLE)
-            s = "asymptotically stable"
-        case (EQ_CENTRE)
-            s = "centre (linearly stable)"
-        case (EQ_UNSTABLE)
-            s = "unstable"
-        case (EQ_SECULAR)
-            s = "unstable (secular drift: a Jordan block on the imaginary axis)"
-        case (EQ_STABLE_FAMILY)
-            s = "stable (on an attracting family of equilibria, not asymptotically)"
-        case default
-            s = "degenerate (linearisation inconclusive)"
-        end select
+        s = code_name(kind, [EQ_ASYMPTOTICALLY_STABLE, EQ_CENTRE, EQ_UNSTABLE, EQ_SECULAR, &
+                             EQ_STABLE_FAMILY], &
+                      [character(len=66) :: "asymptotically stable", "centre (linearly stable)", &
+                       "unstable", &
+                       "unstable (secular drift: a Jordan block on the imaginary axis)", &
+                       "stable (on an attracting family of equilibria, not asymptotically)"], &
+                      "degenerate (linearisation inconclusive)")
     end function classification_name
 
     !> The family of equilibria through the equilibrium y with Jacobian a: for each vector k

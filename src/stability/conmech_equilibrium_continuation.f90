@@ -31,6 +31,7 @@
 module conmech_equilibrium_continuation
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
+    use conmech_illinois, only: illinois_bracket
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_lapack, only: la_eig
@@ -90,18 +91,16 @@ contains
         x(n + 1) = p0
         call correct(sys, set_param, o, x, t, .true., x, it, info, msg)
         if (info /= CM_SUCCESS) then
-            br%info = info
-            br%message = "equilibrium continuation: the start is not an equilibrium "// &
-                         "(Newton at fixed p from y0: "//msg//")"
+            call br%fail(info, "equilibrium continuation: the start is not an equilibrium "// &
+                               "(Newton at fixed p from y0: "//msg//")")
             return
         end if
         t = 0.0_dp
         t(n + 1) = real(sign(1, o%direction), dp)
         call make_point(sys, set_param, o, x, t, it, 0.0_dp, br%points(1), info)
         if (info /= CM_SUCCESS) then
-            br%info = CM_SINGULAR
-            br%message = "equilibrium continuation: degenerate start (no unique tangent: "// &
-                         "a fold or a branch point at p0)"
+            call br%fail(CM_SINGULAR, "equilibrium continuation: degenerate start (no unique "// &
+                                      "tangent: a fold or a branch point at p0)")
             return
         end if
         br%npoints = 1
@@ -118,10 +117,9 @@ contains
                 ds = 0.5_dp*ds
                 if (ds < o%ds_min) then
                     write (buf, '(es23.15)') x(n + 1)
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "equilibrium continuation stopped at p = "// &
-                                 trim(adjustl(buf))//": the corrector did not converge "// &
-                                 "with ds >= ds_min ("//msg//")"
+                    call br%fail(CM_NO_CONVERGENCE, "equilibrium continuation stopped at p = "// &
+                                                    trim(adjustl(buf))//": the corrector did "// &
+                                                    "not converge with ds >= ds_min ("//msg//")")
                     exit
                 end if
                 cycle
@@ -142,9 +140,9 @@ contains
                 br%message = "success: the branch reached the end of the p range, p = "// &
                              trim(adjustl(buf))
                 if (.not. last%located) then
-                    br%info = CM_NO_CONVERGENCE
-                    br%message = "equilibrium continuation: the end of the p range, p = "// &
-                                 trim(adjustl(buf))//", was not located"
+                    call br%fail(CM_NO_CONVERGENCE, "equilibrium continuation: the end of the "// &
+                                                    "p range, p = "//trim(adjustl(buf))// &
+                                                    ", was not located")
                 end if
                 exit
             end if
@@ -396,28 +394,28 @@ contains
         integer, intent(in) :: kind
         type(eq_point), intent(in) :: pa, pb
         type(eq_special), intent(out) :: sp
-        real(dp) :: sa, sb, fa, fb, sc, fc, x(size(x0)), t(size(x0))
-        integer :: iter, side, it, info
+        real(dp) :: sc, fc, x(size(x0)), t(size(x0))
+        integer :: iter, it, info
+        type(illinois_bracket) :: br
+        logical :: moved
         type(eq_point) :: trial
         character(len=:), allocatable :: msg
-        sa = 0.0_dp
-        sb = ds
-        fa = test_of(kind, pa, bound)
-        fb = test_of(kind, pb, bound)
+        br%a = 0.0_dp
+        br%b = ds
+        br%fa = test_of(kind, pa, bound)
+        br%fb = test_of(kind, pb, bound)
         ! the best corrected point so far (smallest |test|)
         sp%point = pa
-        sp%test = fa
-        if (abs(fb) < abs(fa)) then
+        sp%test = br%fa
+        if (abs(br%fb) < abs(br%fa)) then
             sp%point = pb
-            sp%test = fb
+            sp%test = br%fb
         end if
         sp%bracket = ds
         sp%located = .false.
         sp%reason = EQ_NOT_RESOLVED
-        side = 0
         do iter = 1, 100
-            sc = (sa*fb - sb*fa)/(fb - fa)
-            if (.not. (sc > min(sa, sb) .and. sc < max(sa, sb))) sc = 0.5_dp*(sa + sb)
+            sc = br%trial()
             x = x0 + sc*t0
             call correct(sys, set_param, o, x, t0, .false., x0 + sc*t0, it, info, msg)
             if (info == CM_SUCCESS) then
@@ -433,25 +431,16 @@ contains
                 sp%point = trial
                 sp%test = fc
             end if
-            sp%bracket = abs(sb - sa)
+            sp%bracket = abs(br%b - br%a)
             if (abs(fc) <= test_tolerance(o, kind, trial) .or. &
-                abs(sb - sa) <= o%locate_tol) then
+                abs(br%b - br%a) <= o%locate_tol) then
                 sp%point = trial
                 sp%test = fc
                 sp%located = .true.
                 sp%reason = EQ_LOCATED
                 return
             end if
-            if (fc*fb < 0.0_dp) then
-                sa = sb
-                fa = fb
-                side = 0
-            else
-                if (side == 1) fa = 0.5_dp*fa
-                side = 1
-            end if
-            sb = sc
-            fb = fc
+            call br%update(sc, fc, moved)
         end do
     end subroutine locate
 

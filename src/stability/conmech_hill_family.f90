@@ -3,6 +3,7 @@
 !! changes (S = +1 or -1), on top of `hill_variation_orbit` (conmech_hill_orbit).
 module conmech_hill_family
     use conmech_kinds, only: dp
+    use conmech_illinois, only: illinois_bracket
     use conmech_status
     use conmech_hill_orbit, only: hill_orbit, hill_orbit_options, hill_variation_orbit
     implicit none
@@ -155,51 +156,37 @@ contains
         type(hill_orbit_options), intent(in), optional :: options
         real(dp), intent(in), optional :: mtol
         type(hill_orbit_options) :: opt
-        real(dp) :: ma, mb, fa, fb, ua(2), ub(2), mc, fc, tl, w
-        integer :: it, side
+        type(illinois_bracket) :: br
+        real(dp) :: ua(2), ub(2), mc, fc, tl, w
+        integer :: it
+        logical :: moved
         if (present(options)) opt = options
         tl = 1.0e-13_dp
         if (present(mtol)) tl = mtol
-        ma = oa%m
-        mb = ob%m
-        fa = oa%stability_index - target
-        fb = ob%stability_index - target
-        if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS .or. .not. (fa*fb <= 0.0_dp) &
-            .or. oa%kappa /= ob%kappa .or. ma == mb) then
-            orb%info = CM_BAD_INPUT
-            orb%message = "hill_locate_index: need two converged orbits (same kappa) with "// &
-                          "S - target of opposite signs"
+        br%a = oa%m
+        br%b = ob%m
+        br%fa = oa%stability_index - target
+        br%fb = ob%stability_index - target
+        if (oa%info /= CM_SUCCESS .or. ob%info /= CM_SUCCESS .or. &
+            .not. (br%fa*br%fb <= 0.0_dp) .or. oa%kappa /= ob%kappa .or. br%a == br%b) then
+            call orb%fail(CM_BAD_INPUT, "hill_locate_index: need two converged orbits (same "// &
+                                        "kappa) with S - target of opposite signs")
             return
         end if
         ua = [oa%y0(1), oa%y0(4)]
         ub = [ob%y0(1), ob%y0(4)]
-        side = 0
         do it = 1, 100
-            mc = (ma*fb - mb*fa)/(fb - fa)
-            if (.not. (abs(fb - fa) > 0.0_dp)) mc = 0.5_dp*(ma + mb)
-            w = (mc - ma)/(mb - ma)
+            mc = br%trial()
+            w = (mc - br%a)/(br%b - br%a)
             call hill_variation_orbit(mc, oa%kappa, orb, opt, guess=(1.0_dp - w)*ua + w*ub)
             if (orb%info /= CM_SUCCESS) return
             fc = orb%stability_index - target
-            if (fc == 0.0_dp .or. abs(mb - ma) <= tl*max(1.0_dp, abs(mc))) return
-            if (fc*fb < 0.0_dp) then
-                ma = mb
-                fa = fb
-                ua = ub
-                mb = mc
-                fb = fc
-                ub = [orb%y0(1), orb%y0(4)]
-                side = 0
-            else
-                mb = mc
-                fb = fc
-                ub = [orb%y0(1), orb%y0(4)]
-                if (side == 1) fa = 0.5_dp*fa
-                side = 1
-            end if
+            if (fc == 0.0_dp .or. abs(br%b - br%a) <= tl*max(1.0_dp, abs(mc))) return
+            call br%update(mc, fc, moved)
+            if (moved) ua = ub
+            ub = [orb%y0(1), orb%y0(4)]
         end do
-        orb%info = CM_NO_CONVERGENCE
-        orb%message = "hill_locate_index: no convergence in 100 iterations"
+        call orb%fail(CM_NO_CONVERGENCE, "hill_locate_index: no convergence in 100 iterations")
     end subroutine hill_locate_index
 
     pure real(dp) function lagrange_weight(x, xs, np, j) result(w)

@@ -39,6 +39,7 @@
 module conmech_hill_orbit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp, pi
+    use conmech_outcome, only: outcome
     use conmech_status
     use conmech_lapack, only: la_eig
     use conmech_rk_tableaus, only: rk_tableau, dop853_tableau
@@ -65,9 +66,7 @@ module conmech_hill_orbit
     end type hill_orbit_options
 
     !> A variation orbit with its monodromy.
-    type :: hill_orbit
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: hill_orbit
         real(dp) :: m = 0.0_dp, kappa = 1.0_dp
         real(dp) :: y0(4) = 0.0_dp            !! [x0, 0, 0, v0]
         real(dp) :: period = 2.0_dp*pi
@@ -230,9 +229,8 @@ contains
                    ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1 .or. &
             opt%max_nsteps < opt%nsteps .or. .not. (opt%closure_tol > 0.0_dp) .or. &
             .not. (opt%tol > 0.0_dp)) then
-            orb%info = CM_BAD_INPUT
-            orb%message = "hill_variation_orbit: need m >= 0, kappa > 0, 1 <= nsteps <= "// &
-                          "max_nsteps, tol > 0, closure_tol > 0"
+            call orb%fail(CM_BAD_INPUT, "hill_variation_orbit: need m >= 0, kappa > 0, 1 <= "// &
+                                        "nsteps <= max_nsteps, tol > 0, closure_tol > 0")
             return
         end if
         if (present(guess)) then
@@ -241,8 +239,7 @@ contains
             call hill_orbit_guess(m, kappa, u)
         end if
         if (.not. (all(ieee_is_finite(u)) .and. u(1) > 0.0_dp)) then
-            orb%info = CM_BAD_INPUT
-            orb%message = "hill_variation_orbit: the guess needs x0 > 0"
+            call orb%fail(CM_BAD_INPUT, "hill_variation_orbit: the guess needs x0 > 0")
             return
         end if
         u0 = u
@@ -275,9 +272,9 @@ contains
             if (err <= opt%closure_tol) exit
             if (n >= opt%max_nsteps) then
                 write (buf, '(es9.2, a, i0)') err, " with nsteps = ", n
-                orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: the true closure error "// &
-                              trim(buf)//" exceeds closure_tol (raise max_nsteps)"
+                call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: the true closure "// &
+                                                 "error "//trim(buf)//" exceeds closure_tol "// &
+                                                 "(raise max_nsteps)")
                 return
             end if
             n = min(opt%max_nsteps, max(2*n, &
@@ -285,9 +282,9 @@ contains
         end do
         if (.not. (u(2) > 0.0_dp .and. zq(2) > 0.0_dp)) then
             ! Newton found another symmetric periodic solution (e.g. a retrograde one)
-            orb%info = CM_NO_CONVERGENCE
-            orb%message = "hill_variation_orbit: converged to another periodic orbit, "// &
-                          "not the direct variation orbit (a better guess is needed)"
+            call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: converged to another "// &
+                                             "periodic orbit, not the direct variation orbit "// &
+                                             "(a better guess is needed)")
             return
         end if
         orb%y0 = [u(1), 0.0_dp, 0.0_dp, u(2)]
@@ -320,8 +317,7 @@ contains
             orb%c = perigee_c_from_products(ss, tt)
         end if
         if (.not. ieee_is_finite(orb%stability_index)) then
-            orb%info = CM_NONFINITE
-            orb%message = "hill_variation_orbit: non-finite monodromy"
+            call orb%fail(CM_NONFINITE, "hill_variation_orbit: non-finite monodromy")
             return
         end if
         if (opt%eigenvalues) then
@@ -346,8 +342,7 @@ contains
         type(hill_orbit), intent(inout) :: orb
         real(dp) :: du(2), g(2), z(16), det, scale
         integer :: it
-        orb%info = CM_NO_CONVERGENCE
-        orb%message = "hill_variation_orbit: Newton did not converge"
+        call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: Newton did not converge")
         a = 0.0_dp
         zq = 0.0_dp
         ua = u
@@ -361,8 +356,8 @@ contains
             z(16) = 1.0_dp
             call hill_kernel_var(m, kappa, 0.5_dp*pi, n, z, orb%nfev)
             if (.not. all(ieee_is_finite(z))) then
-                orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: non-finite state (the guess is too far)"
+                call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: non-finite state (the "// &
+                                                 "guess is too far)")
                 return
             end if
             a(:, 1) = z(5:8)
@@ -374,8 +369,7 @@ contains
             det = a(1, 1)*a(4, 4) - a(1, 4)*a(4, 1)
             scale = max(abs(a(1, 1)*a(4, 4)), abs(a(1, 4)*a(4, 1)), tiny(1.0_dp))
             if (abs(det) <= 1.0e-13_dp*scale) then
-                orb%info = CM_SINGULAR
-                orb%message = "hill_variation_orbit: singular Newton matrix"
+                call orb%fail(CM_SINGULAR, "hill_variation_orbit: singular Newton matrix")
                 return
             end if
             du(1) = -(a(4, 4)*g(1) - a(1, 4)*g(2))/det
@@ -390,8 +384,7 @@ contains
                 return
             end if
             if (.not. (u(1) > 0.0_dp) .or. maxval(abs(du)) > 10.0_dp*scale) then
-                orb%info = CM_NO_CONVERGENCE
-                orb%message = "hill_variation_orbit: Newton diverged"
+                call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: Newton diverged")
                 return
             end if
         end do

@@ -232,36 +232,31 @@ contains
     !! (in |Re|/|lambda|), 0 if none (dgeev stores a pair as j, j + 1 with wi(j) > 0).
     pure integer function critical_pair(wr, wi) result(k)
         real(dp), intent(in) :: wr(:), wi(:)
-        real(dp) :: best, d
-        integer :: j
-        k = 0
-        best = huge(1.0_dp)
-        do j = 1, size(wr) - 1
-            if (.not. (wi(j) > 0.0_dp)) cycle
-            d = abs(wr(j))/hypot(wr(j), wi(j))
-            if (d < best) then
-                best = d
-                k = j
-            end if
-        end do
+        k = pair_argmin(wi, abs(wr)/hypot(wr, merge(wi, 1.0_dp, wi > 0.0_dp)), 0)
     end function critical_pair
 
     !> The eigenvalue with wi > 0 nearest (re, im).
     pure integer function nearest_pair(wr, wi, re, im) result(k)
         real(dp), intent(in) :: wr(:), wi(:), re, im
-        real(dp) :: best, d
+        k = pair_argmin(wi, hypot(wr - re, wi - im), 1)
+    end function nearest_pair
+
+    !> The first j < size(wi) with wi(j) > 0 and the smallest d(j) (`none` if no such j).
+    pure integer function pair_argmin(wi, d, none) result(k)
+        real(dp), intent(in) :: wi(:), d(:)
+        integer, intent(in) :: none
+        real(dp) :: best
         integer :: j
-        k = 1
+        k = none
         best = huge(1.0_dp)
-        do j = 1, size(wr) - 1
+        do j = 1, size(wi) - 1
             if (.not. (wi(j) > 0.0_dp)) cycle
-            d = hypot(wr(j) - re, wi(j) - im)
-            if (d < best) then
-                best = d
+            if (d(j) < best) then
+                best = d(j)
                 k = j
             end if
         end do
-    end function nearest_pair
+    end function pair_argmin
 
     !> dj = [J(y + h u) - J(y - h u)]/(2 h), the derivative of J along u (h = hfac
     !! eps^(1/5) s/|u|).

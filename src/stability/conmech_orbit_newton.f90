@@ -216,8 +216,7 @@ contains
         orbit%discretisation = opt%discretisation
         orbit%iterations = 0
         if (info /= CM_SUCCESS) then
-            orbit%info = info
-            orbit%message = what//": "//msg
+            call orbit%fail(info, what//": "//msg)
             return
         end if
         bvp%rtol = opt%rtol
@@ -239,8 +238,7 @@ contains
             call ms_guess(bvp, s, y0, span, x, info, msg)
         end if
         if (info /= CM_SUCCESS) then
-            orbit%info = info
-            orbit%message = what//": "//msg
+            call orbit%fail(info, what//": "//msg)
             return
         end if
         itot = 0
@@ -297,8 +295,7 @@ contains
         orbit%node_times = bvp%mesh*bvp_span(bvp, x)
         call bvp_full_factors(bvp, s, x, pf, phi, fs, fe, info, msg)
         if (info < 0) then
-            orbit%info = info
-            orbit%message = msg
+            call orbit%fail(info, msg)
             return
         end if
         call product_multipliers(phi, orbit%multipliers, fs, fe, max(opt%rtol, opt%atol))
@@ -309,8 +306,7 @@ contains
         call floquet_from_multipliers(orbit%multipliers, orbit%monodromy, orbit%period, &
                                       orbit%floquet)
         if (orbit%multipliers%info /= CM_SUCCESS) then
-            orbit%info = orbit%multipliers%info
-            orbit%message = "the periodic eigenvalue iteration failed"
+            call orbit%fail(orbit%multipliers%info, "the periodic eigenvalue iteration failed")
             return
         end if
         orbit%info = CM_SUCCESS

@@ -4,6 +4,8 @@
 !! conmech_shooting re-exports all of them.
 module conmech_orbit_types
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
+    use conmech_code_names, only: code_name
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: METHOD_DOP853
@@ -43,9 +45,7 @@ module conmech_orbit_types
     end type shooting_options
 
     !> A periodic orbit.
-    type :: periodic_orbit
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: periodic_orbit
         real(dp), allocatable :: y0(:)          !! initial state
         real(dp) :: period = 0.0_dp
         real(dp), allocatable :: monodromy(:, :)  !! the formed product of the segment STMs
@@ -86,16 +86,8 @@ contains
     pure function orbit_method_name(method) result(s)
         integer, intent(in) :: method
         character(len=:), allocatable :: s
-        select case (method)
-        case (ORBIT_SINGLE)
-            s = "single"
-        case (ORBIT_MULTIPLE)
-            s = "multiple"
-        case (ORBIT_COLLOCATION)
-            s = "collocation"
-        case default
-            s = "unknown"
-        end select
+        s = code_name(method, [ORBIT_SINGLE, ORBIT_MULTIPLE, ORBIT_COLLOCATION], &
+                      [character(len=11) :: "single", "multiple", "collocation"], "unknown")
     end function orbit_method_name
 
 end module conmech_orbit_types

@@ -33,11 +33,11 @@ module conmech_shooting
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, METHOD_DOP853
     use conmech_variational, only: integrate_stm
-    use conmech_rank, only: identity
     use conmech_floquet, only: floquet_result, floquet_from_multipliers
     use conmech_block_chain, only: lstsq_solve
     use conmech_orbit_types
     use conmech_orbit_newton, only: find_orbit_bvp
+    use conmech_shooting_newton, only: ode_opts, shooting_flow, shooting_step, shooting_check
     use conmech_periodic_multipliers, only: product_multipliers
     implicit none
     private
@@ -50,15 +50,6 @@ module conmech_shooting
     public :: symmetric_count_message, orbit_method_name, no_parameter
 
 contains
-
-    function ode_opts(o) result(oo)
-        type(shooting_options), intent(in) :: o
-        type(ode_options) :: oo
-        oo%method = o%method
-        oo%rtol = o%rtol
-        oo%atol = o%atol
-        oo%max_steps = o%max_steps
-    end function ode_opts
 
     !> General Newton shooting for a periodic orbit from the guess (y0, period).
     !! `energy` and `energy_value` are required for PO_FIXED_ENERGY (its gradient is
@@ -74,10 +65,11 @@ contains
         procedure(energy_fun), optional :: energy
         real(dp), intent(in), optional :: energy_value
         type(shooting_options) :: opt
-        integer :: md, n, neq, nun, it, rank, info, j
+        integer :: md, n, neq, nun, it, j
         real(dp), allocatable :: y(:), yt(:), phi(:, :), f0(:), ft(:), jac(:, :), r(:), dx(:)
         real(dp), allocatable :: yg(:), yp(:)
-        real(dp) :: t, h, scale
+        real(dp) :: t, h
+        logical :: ok, done
         character(len=:), allocatable :: msg
         if (present(options)) opt = options
         md = PO_FREE_PERIOD
@@ -86,21 +78,20 @@ contains
         orbit%iterations = 0
         if (n < 1 .or. .not. (period > 0.0_dp) .or. md < 1 .or. md > 3 .or. &
             .not. all(ieee_is_finite(y0))) then
-            orbit%info = CM_BAD_INPUT
-            orbit%message = "find_periodic_orbit: bad input (empty y0, period <= 0 or mode)"
+            call orbit%fail(CM_BAD_INPUT, "find_periodic_orbit: bad input (empty y0, period "// &
+                                          "<= 0 or mode)")
             return
         end if
         if (md == PO_FIXED_ENERGY .and. .not. (present(energy) .and. present(energy_value))) &
             then
-            orbit%info = CM_BAD_INPUT
-            orbit%message = "find_periodic_orbit: PO_FIXED_ENERGY needs energy and energy_value"
+            call orbit%fail(CM_BAD_INPUT, "find_periodic_orbit: PO_FIXED_ENERGY needs energy "// &
+                                          "and energy_value")
             return
         end if
         if (md /= PO_FIXED_PERIOD) then
             msg = equilibrium_message(sys, y0, period)
             if (len(msg) > 0) then
-                orbit%info = CM_BAD_INPUT
-                orbit%message = "find_periodic_orbit: "//msg
+                call orbit%fail(CM_BAD_INPUT, "find_periodic_orbit: "//msg)
                 return
             end if
         end if
@@ -118,18 +109,11 @@ contains
         call sys%rhs(0.0_dp, yg, f0)
         y = y0
         t = period
-        orbit%info = CM_NO_CONVERGENCE
-        orbit%message = "find_periodic_orbit: Newton did not converge"
+        call orbit%fail(CM_NO_CONVERGENCE, "find_periodic_orbit: Newton did not converge")
         do it = 1, opt%max_iter
             orbit%iterations = it
-            yt = y
-            phi = identity(size(phi, 1))
-            call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
-            if (info < 0) then
-                orbit%info = info
-                orbit%message = "find_periodic_orbit: integration failed: "//msg
-                return
-            end if
+            call shooting_flow(sys, y, t, opt, yt, phi, orbit, "find_periodic_orbit", ok)
+            if (.not. ok) return
             call sys%rhs(t, yt, ft)
             r(1:n) = yt - y
             r(n + 1) = dot_product(f0, y - yg)
@@ -151,32 +135,14 @@ contains
                     jac(n + 2, j) = (jac(n + 2, j) - energy(yp))/(2.0_dp*h)
                 end do
             end if
-            orbit%residual = maxval(abs(r))
-            if (.not. all(ieee_is_finite(jac)) .or. .not. all(ieee_is_finite(r))) then
-                orbit%info = CM_NO_CONVERGENCE
-                orbit%message = "find_periodic_orbit: non-finite values (a bad guess?)"
-                return
-            end if
-            call lstsq_solve(jac, -r, dx, rank, info, opt%rcond)
-            if (info /= CM_SUCCESS .or. rank < nun) then
-                orbit%info = CM_SINGULAR
-                orbit%message = "find_periodic_orbit: singular Newton matrix (the orbit is "// &
-                                "not isolated: fix the energy or the period?)"
-                return
-            end if
+            call shooting_step(jac, r, opt, nun, dx, orbit, "find_periodic_orbit", &
+                               "singular Newton matrix (the orbit is not isolated: fix the "// &
+                               "energy or the period?)", ok)
+            if (.not. ok) return
             y = y + dx(1:n)
             if (md /= PO_FIXED_PERIOD) t = t + dx(n + 1)
-            scale = max(1.0_dp, maxval(abs(y)), t)
-            if (.not. (t > 0.0_dp)) then
-                orbit%info = CM_NO_CONVERGENCE
-                orbit%message = "find_periodic_orbit: the period became non-positive"
-                return
-            end if
-            if (maxval(abs(dx)) <= opt%tol*scale .and. orbit%residual <= sqrt(opt%tol)) then
-                orbit%info = CM_SUCCESS
-                orbit%message = "success"
-                exit
-            end if
+            call shooting_check(dx, y, t, opt, orbit, "find_periodic_orbit", "the period", done)
+            if (done) exit
         end do
         if (orbit%info /= CM_SUCCESS) return
         orbit%y0 = y
@@ -201,8 +167,9 @@ contains
         real(dp), intent(in), optional :: period_factor
         type(shooting_options) :: opt
         logical :: ft_free
-        real(dp) :: pf, t, scale
-        integer :: n, nf, ntg, nun, it, info, rank, j
+        real(dp) :: pf, t
+        integer :: n, nf, ntg, nun, it, j
+        logical :: ok, done
         real(dp), allocatable :: y(:), yt(:), phi(:, :), f(:), jac(:, :), r(:), dx(:)
         character(len=:), allocatable :: msg
         if (present(options)) opt = options
@@ -218,21 +185,19 @@ contains
         if (n < 1 .or. nun < 1 .or. ntg < 1 .or. .not. (tau > 0.0_dp) .or. &
             any(free < 1) .or. any(free > n) .or. any(targets < 1) .or. any(targets > n) &
             .or. .not. all(ieee_is_finite(y0))) then
-            orbit%info = CM_BAD_INPUT
-            orbit%message = "find_symmetric_orbit: bad input (indices, tau > 0, finite y0)"
+            call orbit%fail(CM_BAD_INPUT, "find_symmetric_orbit: bad input (indices, tau > 0, "// &
+                                          "finite y0)")
             return
         end if
         msg = symmetric_count_message(nf, ft_free, ntg, opt%discretisation /= ORBIT_SINGLE)
         if (len(msg) > 0) then
-            orbit%info = CM_BAD_INPUT
-            orbit%message = "find_symmetric_orbit: "//msg
+            call orbit%fail(CM_BAD_INPUT, "find_symmetric_orbit: "//msg)
             return
         end if
         if (ft_free) then
             msg = equilibrium_message(sys, y0, pf*tau)
             if (len(msg) > 0) then
-                orbit%info = CM_BAD_INPUT
-                orbit%message = "find_symmetric_orbit: "//msg
+                call orbit%fail(CM_BAD_INPUT, "find_symmetric_orbit: "//msg)
                 return
             end if
         end if
@@ -244,18 +209,11 @@ contains
         allocate (y(n), yt(n), phi(n, n), f(n), jac(ntg, nun), r(ntg), dx(nun))
         y = y0
         t = tau
-        orbit%info = CM_NO_CONVERGENCE
-        orbit%message = "find_symmetric_orbit: Newton did not converge"
+        call orbit%fail(CM_NO_CONVERGENCE, "find_symmetric_orbit: Newton did not converge")
         do it = 1, opt%max_iter
             orbit%iterations = it
-            yt = y
-            phi = identity(size(phi, 1))
-            call integrate_stm(sys, 0.0_dp, t, yt, phi, ode_opts(opt), info, msg)
-            if (info < 0) then
-                orbit%info = info
-                orbit%message = "find_symmetric_orbit: integration failed: "//msg
-                return
-            end if
+            call shooting_flow(sys, y, t, opt, yt, phi, orbit, "find_symmetric_orbit", ok)
+            if (.not. ok) return
             r = yt(targets)
             do j = 1, nf
                 jac(:, j) = phi(targets, free(j))
@@ -264,31 +222,13 @@ contains
                 call sys%rhs(t, yt, f)
                 jac(:, nun) = f(targets)
             end if
-            orbit%residual = maxval(abs(r))
-            if (.not. all(ieee_is_finite(jac)) .or. .not. all(ieee_is_finite(r))) then
-                orbit%info = CM_NO_CONVERGENCE
-                orbit%message = "find_symmetric_orbit: non-finite values (a bad guess?)"
-                return
-            end if
-            call lstsq_solve(jac, -r, dx, rank, info, opt%rcond)
-            if (info /= CM_SUCCESS .or. rank < min(nun, ntg)) then
-                orbit%info = CM_SINGULAR
-                orbit%message = "find_symmetric_orbit: singular Newton matrix"
-                return
-            end if
+            call shooting_step(jac, r, opt, min(nun, ntg), dx, orbit, "find_symmetric_orbit", &
+                               "singular Newton matrix", ok)
+            if (.not. ok) return
             y(free) = y(free) + dx(1:nf)
             if (ft_free) t = t + dx(nun)
-            if (.not. (t > 0.0_dp)) then
-                orbit%info = CM_NO_CONVERGENCE
-                orbit%message = "find_symmetric_orbit: the time became non-positive"
-                return
-            end if
-            scale = max(1.0_dp, maxval(abs(y)), t)
-            if (maxval(abs(dx)) <= opt%tol*scale .and. orbit%residual <= sqrt(opt%tol)) then
-                orbit%info = CM_SUCCESS
-                orbit%message = "success"
-                exit
-            end if
+            call shooting_check(dx, y, t, opt, orbit, "find_symmetric_orbit", "the time", done)
+            if (done) exit
         end do
         if (orbit%info /= CM_SUCCESS) return
         orbit%y0 = y
@@ -323,8 +263,7 @@ contains
             call sys%rhs(t0, y, fs(:, l))
             call integrate_stm(sys, t0, t1, y, phi(:, :, l), ode, info, msg)
             if (info < 0) then
-                orbit%info = info
-                orbit%message = "monodromy: integration failed: "//msg
+                call orbit%fail(info, "monodromy: integration failed: "//msg)
                 return
             end if
             call sys%rhs(t1, y, fe(:, l))
@@ -337,8 +276,8 @@ contains
         call floquet_from_multipliers(orbit%multipliers, orbit%monodromy, orbit%period, &
                                       orbit%floquet)
         if (orbit%floquet%info /= CM_SUCCESS) then
-            orbit%info = orbit%floquet%info
-            orbit%message = "monodromy: the periodic eigenvalue iteration failed"
+            call orbit%fail(orbit%floquet%info, "monodromy: the periodic eigenvalue iteration "// &
+                                                "failed")
         end if
     end subroutine orbit_monodromy
 
@@ -407,12 +346,7 @@ contains
         nh = 0
         do i = 1, size(ps)
             call set_param(sys, ps(i))
-            if (nh == 0) then
-                g(1:n) = y0
-                g(n + 1) = tau
-            else
-                call extrapolate(ps(i), pp, hist, nh, g)
-            end if
+            call next_guess(ps(i), y0, tau, pp, hist, nh, g)
             call find_symmetric_orbit(sys, g(1:n), free, g(n + 1), targets, orbits(i), &
                                       options, free_time, pf)
             if (orbits(i)%info == CM_SUCCESS) then
@@ -437,18 +371,27 @@ contains
         nh = 0
         do i = 1, size(ps)
             call set_param(sys, ps(i))
-            if (nh == 0) then
-                g(1:n) = y0
-                g(n + 1) = period
-            else
-                call extrapolate(ps(i), pp, hist, nh, g)
-            end if
+            call next_guess(ps(i), y0, period, pp, hist, nh, g)
             call find_periodic_orbit(sys, g(1:n), g(n + 1), orbits(i), mode, options)
             if (orbits(i)%info == CM_SUCCESS) then
                 call push(ps(i), [orbits(i)%y0, orbits(i)%period], pp, hist, nh)
             end if
         end do
     end subroutine continue_periodic_family
+
+    !> The guess g = [y, T] at p: the start (y0, t0) until a solution is known, then the
+    !! extrapolation of the last (up to three) solutions.
+    pure subroutine next_guess(p, y0, t0, pp, hist, nh, g)
+        real(dp), intent(in) :: p, y0(:), t0, pp(3), hist(:, :)
+        integer, intent(in) :: nh
+        real(dp), intent(out) :: g(:)
+        if (nh == 0) then
+            g(1:size(y0)) = y0
+            g(size(y0) + 1) = t0
+        else
+            call extrapolate(p, pp, hist, nh, g)
+        end if
+    end subroutine next_guess
 
     pure subroutine push(p, v, pp, hist, nh)
         real(dp), intent(in) :: p, v(:)

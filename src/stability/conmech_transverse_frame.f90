@@ -7,6 +7,7 @@
 module conmech_transverse_frame
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
+    use conmech_outcome, only: outcome
     use conmech_status
     use conmech_lapack, only: dpotrf, dpotrs, la_finite
     use conmech_ode_system, only: ode_system
@@ -51,9 +52,7 @@ module conmech_transverse_frame
     end type frame_ode
 
     !> A transverse linearisation: the frame along the orbit and its monodromies.
-    type :: transverse_frame
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: transverse_frame
         integer :: n = 0                    !! state dimension N
         integer :: k = 0                    !! transverse dimension
         integer :: nc = 0                   !! invariant-manifold normals removed

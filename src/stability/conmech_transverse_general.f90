@@ -92,11 +92,11 @@ contains
         fr%nc = nc
         fr%m = model%n_inputs
         if (.not. (period > 0.0_dp .and. ieee_is_finite(period)) .or. .not. la_finite(y0)) then
-            call fail(CM_BAD_INPUT, "transverse: the period must be positive and y0 finite")
+            call fr%fail(CM_BAD_INPUT, "transverse: the period must be positive and y0 finite")
             return
         end if
         if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp .and. opt%atol > 0.0_dp)) then
-            call fail(CM_BAD_INPUT, "transverse: rtol must be in (0, 1) and atol > 0")
+            call fr%fail(CM_BAD_INPUT, "transverse: rtol must be in (0, 1) and atol > 0")
             return
         end if
         oo%method = opt%method
@@ -105,7 +105,7 @@ contains
         oo%max_steps = opt%max_steps
 
         if (opt%energy == ENERGY_REQUIRED .and. .not. model%has_energy()) then
-            call fail(CM_BAD_INPUT, "transverse: the system has no energy to reduce by")
+            call fr%fail(CM_BAD_INPUT, "transverse: the system has no energy to reduce by")
             return
         end if
         ! ---- on the invariant manifold; the orbit alone: closure, the vector field,
@@ -115,8 +115,8 @@ contains
             tol = max(1.0e-10_dp, 1.0e2_dp*opt%atol)*max(1.0_dp, maxval(abs(y0)))
             if (.not. defect <= tol) then
                 write (b1, '(es10.3)') defect
-                call fail(CM_BAD_INPUT, "transverse: y0 is not on the constraints "// &
-                          "(max |phi|, |C v| = "//trim(adjustl(b1))//")")
+                call fr%fail(CM_BAD_INPUT, "transverse: y0 is not on the constraints "// &
+                             "(max |phi|, |C v| = "//trim(adjustl(b1))//")")
                 return
             end if
         end if
@@ -125,8 +125,8 @@ contains
         k = n - 1 - nc
         if (fr%reduced) k = k - 1
         if (k < 1) then
-            call fail(CM_BAD_INPUT, "transverse: no transverse coordinate is left (N - 1 "// &
-                      "minus the invariants is < 1)")
+            call fr%fail(CM_BAD_INPUT, "transverse: no transverse coordinate is left (N - 1 "// &
+                         "minus the invariants is < 1)")
             return
         end if
         fr%k = k
@@ -158,8 +158,8 @@ contains
         allocate (work(max(1, int(wq(1)))))
         call dgesvd('A', 'N', n, p, w, n, s, u, n, vt, 1, work, size(work), lainfo)
         if (lainfo /= 0 .or. .not. (s(p) > 1.0e-8_dp*s(1))) then
-            call fail(CM_BAD_INPUT, "transverse: the vector field, the constraint normals "// &
-                      "and the energy gradient are dependent at y0 (is y0 on the constraints?)")
+            call fr%fail(CM_BAD_INPUT, "transverse: the vector field, the constraint normals "// &
+                         "and the energy gradient are dependent at y0 (is y0 on the constraints?)")
             return
         end if
         q0 = u(:, p + 1:n)
@@ -198,7 +198,7 @@ contains
         if (res%status /= CM_SUCCESS) then
             msg = "transverse: the integration along the orbit failed"
             if (allocated(res%message)) msg = msg//": "//res%message
-            call fail(res%status, msg)
+            call fr%fail(res%status, msg)
             return
         end if
         z0 = res%y(:, res%nt)
@@ -227,14 +227,14 @@ contains
         fr%frame_defect = defect
         if (info /= CM_SUCCESS .or. dsgn < 0.0_dp .or. defect > 1.0e-6_dp) then
             write (b1, '(es10.3)') defect
-            call fail(CM_NO_CONVERGENCE, "transverse: the frame did not return to the "// &
-                      "transverse space after one period (defect "//trim(b1)//")")
+            call fr%fail(CM_NO_CONVERGENCE, "transverse: the frame did not return to the "// &
+                         "transverse space after one period (defect "//trim(b1)//")")
             return
         end if
         fr%holonomy = r
         call rotation_log_init(r, fr%hlog, info, msg)
         if (info /= CM_SUCCESS) then
-            call fail(info, "transverse: "//msg)
+            call fr%fail(info, "transverse: "//msg)
             return
         end if
         o = n + ny*n + n*k
@@ -243,7 +243,7 @@ contains
         allocate (fr%mr(k), fr%mi(k))
         call la_eig(fr%monodromy, fr%mr, fr%mi, info)
         if (info /= CM_SUCCESS) then
-            call fail(info, "transverse: eigenvalues of the transverse monodromy failed")
+            call fr%fail(info, "transverse: eigenvalues of the transverse monodromy failed")
             return
         end if
         o = o + k*k
@@ -256,7 +256,7 @@ contains
             allocate (fr%fr(n), fr%fi(n))
             call la_eig(fr%full_monodromy, fr%fr, fr%fi, info)
             if (info /= CM_SUCCESS) then
-                call fail(info, "transverse: eigenvalues of the full monodromy failed")
+                call fr%fail(info, "transverse: eigenvalues of the full monodromy failed")
                 return
             end if
         end if
@@ -267,13 +267,6 @@ contains
                      trim(adjustl(b2))//")"
 
     contains
-
-        subroutine fail(code, text)
-            integer, intent(in) :: code
-            character(len=*), intent(in) :: text
-            fr%info = code
-            fr%message = text
-        end subroutine fail
 
         !> Integrate the orbit alone, sampled at 64 points: closure, f /= 0, and whether
         !! the model's energy is conserved (sets fr%reduced).
@@ -293,7 +286,7 @@ contains
                 info = CM_BAD_INPUT
                 msg = "transverse: the orbit could not be integrated over one period"
                 if (allocated(ro%message)) msg = msg//": "//ro%message
-                call fail(info, msg)
+                call fr%fail(info, msg)
                 return
             end if
             fr%closure = maxval(abs(ro%y(:, 64) - y0))
@@ -304,8 +297,8 @@ contains
                 write (c1, '(es10.3)') fr%closure
                 write (c2, '(es10.3)') tol
                 info = CM_BAD_INPUT
-                call fail(info, "transverse: the orbit is not periodic: |x(T) - x(0)| = "// &
-                          trim(adjustl(c1))//" > "//trim(adjustl(c2)))
+                call fr%fail(info, "transverse: the orbit is not periodic: |x(T) - x(0)| = "// &
+                             trim(adjustl(c1))//" > "//trim(adjustl(c2)))
                 return
             end if
             fmin = huge(1.0_dp)
@@ -326,8 +319,8 @@ contains
             end do
             if (.not. (fmin > 1.0e-10_dp*fmax .and. fmax > 0.0_dp)) then
                 info = CM_BAD_INPUT
-                call fail(info, "transverse: the vector field vanishes on the orbit (an "// &
-                          "equilibrium is not a periodic orbit)")
+                call fr%fail(info, "transverse: the vector field vanishes on the orbit (an "// &
+                             "equilibrium is not a periodic orbit)")
                 return
             end if
             fr%energy_drift = drift
@@ -337,12 +330,12 @@ contains
             if (opt%energy == ENERGY_REQUIRED .and. .not. fr%reduced) then
                 info = CM_BAD_INPUT
                 if (.not. model%has_energy()) then
-                    call fail(info, "transverse: the system has no energy to reduce by")
+                    call fr%fail(info, "transverse: the system has no energy to reduce by")
                 else
                     write (c1, '(es10.3)') drift
-                    call fail(info, "transverse: the energy is not conserved along the "// &
-                              "orbit (|grad H . f|/(|grad H| |f|) up to "// &
-                              trim(adjustl(c1))//")")
+                    call fr%fail(info, "transverse: the energy is not conserved along the "// &
+                                 "orbit (|grad H . f|/(|grad H| |f|) up to "// &
+                                 trim(adjustl(c1))//")")
                 end if
                 return
             end if

@@ -24,6 +24,7 @@
 !! L4, L5 at the apexes of the equilateral triangles.
 module conmech_cr3bp
     use conmech_kinds, only: dp
+    use conmech_rotating_frame, only: spatial_frame_product, spatial_frame_jacobian
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NO_CONVERGENCE
     use conmech_ode_system, only: ode_system
     implicit none
@@ -197,34 +198,11 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dfdy(:, :)
-        real(dp) :: acc(3), h(6)
+        real(dp) :: acc(3), h(6), jac(6, 6)
         call cr_parts(self%mu, y(1:6), acc, h)
-        dfdy = 0.0_dp
-        dfdy(1, 4) = 1.0_dp
-        dfdy(2, 5) = 1.0_dp
-        dfdy(3, 6) = 1.0_dp
-        dfdy(4, 1:3) = [h(1), h(2), h(3)]
-        dfdy(5, 1:3) = [h(2), h(4), h(5)]
-        dfdy(6, 1:3) = [h(3), h(5), h(6)]
-        dfdy(4, 5) = 2.0_dp
-        dfdy(5, 4) = -2.0_dp
+        call spatial_frame_jacobian(h, 2.0_dp, jac)
+        dfdy = jac
     end subroutine cr_jac
-
-    !> jx = J x for a 6 x k block: the velocity rows copied, H x_r + K x_v below.
-    pure subroutine cr_product(k, h, x, jx)
-        integer, intent(in) :: k
-        real(dp), intent(in) :: h(6), x(6, k)
-        real(dp), intent(out) :: jx(6, k)
-        integer :: j
-        do j = 1, k
-            jx(1, j) = x(4, j)
-            jx(2, j) = x(5, j)
-            jx(3, j) = x(6, j)
-            jx(4, j) = h(1)*x(1, j) + h(2)*x(2, j) + h(3)*x(3, j) + 2.0_dp*x(5, j)
-            jx(5, j) = h(2)*x(1, j) + h(4)*x(2, j) + h(5)*x(3, j) - 2.0_dp*x(4, j)
-            jx(6, j) = h(3)*x(1, j) + h(5)*x(2, j) + h(6)*x(3, j)
-        end do
-    end subroutine cr_product
 
     subroutine cr_jac_prod(self, t, n, k, y, x, jx)
         class(cr3bp), intent(in) :: self
@@ -234,7 +212,7 @@ contains
         real(dp), intent(out) :: jx(n, k)
         real(dp) :: acc(3), h(6)
         call cr_parts(self%mu, y(1:6), acc, h)
-        call cr_product(k, h, x, jx)
+        call spatial_frame_product(k, h, 2.0_dp, x, jx)
     end subroutine cr_jac_prod
 
     subroutine cr_rhs_jac_prod(self, t, n, k, y, dydt, x, jx)
@@ -247,7 +225,7 @@ contains
         call cr_parts(self%mu, y(1:6), acc, h)
         dydt(1:3) = y(4:6)
         dydt(4:6) = acc
-        call cr_product(k, h, x, jx)
+        call spatial_frame_product(k, h, 2.0_dp, x, jx)
     end subroutine cr_rhs_jac_prod
 
 end module conmech_cr3bp

@@ -8,7 +8,7 @@
 module conmech_hill
     use conmech_kinds, only: dp
     use conmech_ode_system, only: ode_system
-    use conmech_rotating_frame, only: rotating_frame_product
+    use conmech_rotating_frame, only: rotating_frame_product, rotating_frame_jacobian
     implicit none
     private
     public :: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f, hill_equilibrium_x
@@ -89,17 +89,10 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: y(:)
         real(dp), intent(out) :: dfdy(:, :)
-        real(dp) :: fxx, fxy, fyy
+        real(dp) :: fxx, fxy, fyy, jac(4, 4)
         call hill_hess_f(self%m, self%kappa, y(1), y(2), fxx, fxy, fyy)
-        dfdy = 0.0_dp
-        dfdy(1, 3) = 1.0_dp
-        dfdy(2, 4) = 1.0_dp
-        dfdy(3, 1) = fxx
-        dfdy(3, 2) = fxy
-        dfdy(4, 1) = fxy
-        dfdy(4, 2) = fyy
-        dfdy(3, 4) = 2.0_dp*self%m
-        dfdy(4, 3) = -2.0_dp*self%m
+        call rotating_frame_jacobian(fxx, fxy, fyy, 2.0_dp*self%m, jac)
+        dfdy = jac
     end subroutine hill_jac
 
     !> jx = J x for a 4 x k block (two rows copied, constant entries folded).

@@ -12,6 +12,7 @@ module conmech_systems_chain
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system, only: constrained_system
+    use conmech_constrained_band, only: band_dense
     implicit none
     private
     public :: pendulum_chain_xy, chain_initial_state, make_pendulum_chain, pendulum_chain_state
@@ -166,12 +167,9 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: g(:, :)
         real(dp) :: gb(size(q)/2, min(4, size(q)))
-        integer :: first(size(q)/2), i
+        integer :: first(size(q)/2)
         call ch_jac_band(self, t, q, gb, first)
-        g = 0.0_dp
-        do i = 1, size(q)/2
-            g(i, first(i):first(i) + size(gb, 2) - 1) = gb(i, :)
-        end do
+        call band_dense(gb, first, g)
     end subroutine ch_jac
 
     !> Row i: columns 2i-3 .. 2i hold [-dx_i, -dy_i, dx_i, dy_i] (row 1: [dx_1, dy_1, 0, 0]

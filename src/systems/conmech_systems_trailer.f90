@@ -13,6 +13,7 @@
 module conmech_systems_trailer
     use conmech_kinds, only: dp
     use conmech_constrained_system, only: constrained_system
+    use conmech_constrained_band, only: band_dense
     implicit none
     private
     public :: trailer_chain, trailer_chain_of, trailer_initial_state
@@ -130,12 +131,9 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: g(:, :)
         real(dp) :: gb(self%n_hol, 4)
-        integer :: first(self%n_hol), i
+        integer :: first(self%n_hol)
         call tr_jac_band(self, t, q, gb, first)
-        g = 0.0_dp
-        do i = 1, self%n_hol
-            g(i, first(i):first(i) + 3) = gb(i, :)
-        end do
+        call band_dense(gb, first, g)
     end subroutine tr_jac
     subroutine tr_gamma(self, t, q, v, gam)
         class(trailer_chain), intent(in) :: self
@@ -166,12 +164,9 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: a(:, :), b(:)
         real(dp) :: ab(self%n_nh, 2)
-        integer :: first(self%n_nh), i
+        integer :: first(self%n_nh)
         call tr_nh_band(self, t, q, ab, b, first)
-        a = 0.0_dp
-        do i = 1, self%n_nh
-            a(i, first(i):first(i) + 1) = ab(i, :)
-        end do
+        call band_dense(ab, first, a)
     end subroutine tr_nh
     !> gamma_n = -(dA/dt) v: d/dt of perp(p_i - p_{i-1}) . v_i with v fixed.
     subroutine tr_nh_gamma(self, t, q, v, gam)

@@ -1,0 +1,29 @@
+!> The status of a computed object of the stability layer (a periodic orbit, a branch of
+!! orbits or of equilibria): an info code of conmech_status and a message. The result
+!! types extend `outcome`; `fail` sets both at once where a computation stops.
+module conmech_outcome
+    use conmech_status, only: CM_BAD_INPUT
+    implicit none
+    private
+
+    public :: outcome
+
+    type :: outcome
+        integer :: info = CM_BAD_INPUT          !! CM_SUCCESS or the reason it stopped
+        character(len=:), allocatable :: message
+    contains
+        procedure :: fail => outcome_fail
+    end type outcome
+
+contains
+
+    !> info and message together (a failed or stopped computation).
+    pure subroutine outcome_fail(self, info, message)
+        class(outcome), intent(inout) :: self
+        integer, intent(in) :: info
+        character(len=*), intent(in) :: message
+        self%info = info
+        self%message = message
+    end subroutine outcome_fail
+
+end module conmech_outcome
