@@ -27,6 +27,7 @@ module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_lapack, only: dpotrf, dpotf2, dpotrs, dtrsv, la_finite
     use conmech_ode_system, only: ode_system, ode_events, ode_fd_jacobian
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
@@ -172,7 +173,6 @@ contains
         character(len=:), allocatable, intent(out), optional :: msg
         integer :: n, lainfo, i
         real(dp) :: dmin, dmax
-        character(len=16) :: buf
         n = size(mm, 1)
         info = CM_SUCCESS
         if (size(mm, 2) /= n) then
@@ -196,9 +196,8 @@ contains
         end if
         if (lainfo /= 0) then
             info = CM_SINGULAR
-            write (buf, '(i0)') lainfo
             if (present(msg)) msg = "singular mass matrix: not symmetric positive definite " &
-                                    //"(dpotrf info="//trim(buf)//")"
+                                    //"(dpotrf info="//itoa(lainfo)//")"
             return
         end if
         dmin = huge(1.0_dp)
