@@ -24,6 +24,7 @@ module conmech_gauss
     use conmech_ode_dense, only: power_basis_matrix
     use conmech_ode_stepper, only: ode_stepper, check_first_step, FORM_POWER
     use conmech_state_packer, only: state_packer
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps
     implicit none
     private
 
@@ -118,9 +119,7 @@ contains
         self%have_poly = .false.
         self%comp = self%y
         self%comp = 0.0_dp
-        self%nsteps = 0
-        if (tf /= t0) self%nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step &
-                                                   *(1.0_dp - 1.0e-12_dp)))
+        self%nsteps = grid_steps(t0, tf, opt%first_step)
         if (self%nsteps > 0) self%h = (tf - t0)/real(self%nsteps, dp)
     end subroutine gauss_setup
 
@@ -130,15 +129,8 @@ contains
         class(ode_system), intent(in) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        character(len=32) :: buf
-        info = CM_SUCCESS
         msg = "success"
-        if (self%nsteps > self%max_steps) then
-            write (buf, '(i0)') self%nsteps
-            info = CM_TOO_MANY_STEPS
-            msg = "too many steps: the run needs "//trim(buf)//" steps of first_step, " &
-                  //"more than max_steps"
-        end if
+        call check_grid_steps(self%nsteps, self%max_steps, info, msg)
     end subroutine gauss_start
 
     !> The next step of the grid (`target` is not used: the grid ends on tf).

@@ -31,6 +31,7 @@ module conmech_rk_stepper
     use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
         tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL
     use conmech_state_packer, only: state_packer
+    use conmech_fixed_grid, only: grid_steps
     use conmech_rk_tableaus, only: rk_tableau, set_dopri5_tableau, set_dop853_tableau, &
         set_verner98_tableau
     use conmech_rk_kernels, only: rk4_attempt, dopri5_attempt, dop853_attempt, &
@@ -240,8 +241,7 @@ contains
                 call hinit(self, sys)
             end if
         else
-            nsteps = max(1, ceiling(abs(self%tf - self%t)/self%first_step &
-                                    *(1.0_dp - 1.0e-12_dp)))
+            nsteps = max(1, grid_steps(self%t, self%tf, self%first_step))
             self%h = (self%tf - self%t)/real(nsteps, dp)
         end if
         self%h_fixed = self%h
