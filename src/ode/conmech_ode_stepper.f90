@@ -433,13 +433,15 @@ contains
         msg = "success"
     end subroutine step_option
 
-    !> Per-component tolerances from the options (rtol raised to 100 eps, as SciPy).
-    subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg)
+    !> Per-component tolerances from the options (rtol raised to rtol_min, default 100 eps
+    !! as SciPy; Taylor's method goes down to eps).
+    subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg, rtol_min)
         type(ode_options), intent(in) :: opt
         integer, intent(in) :: n
         real(dp), allocatable, intent(out) :: rtolv(:), atolv(:)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
+        real(dp), intent(in), optional :: rtol_min
         allocate (rtolv(n), atolv(n))
         info = CM_BAD_INPUT
         if (allocated(opt%rtol_vec)) then
@@ -468,7 +470,11 @@ contains
             msg = "bad input: atol must be non-negative"
             return
         end if
-        rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))
+        if (present(rtol_min)) then
+            rtolv = max(rtolv, rtol_min)
+        else
+            rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))
+        end if
         info = CM_SUCCESS
         msg = "success"
     end subroutine tolerance_vectors
