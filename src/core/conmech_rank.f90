@@ -101,9 +101,8 @@ contains
         real(dp), intent(out) :: basis(:, :)
         integer, intent(out) :: nnull
         integer, intent(out) :: info
-        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
-        integer :: m, n, r
-        m = size(a, 1)
+        real(dp), allocatable :: u(:, :), vt(:, :)
+        integer :: n, r
         n = size(a, 2)
         nnull = 0
         basis = 0.0_dp
@@ -111,10 +110,8 @@ contains
             info = CM_BAD_INPUT
             return
         end if
-        allocate (u(m, m), s(min(m, n)), vt(n, n))
-        call svd(a, u, s, vt, info)
+        call svd_rank(a, thresh, u, vt, r, info)
         if (info /= CM_SUCCESS) return
-        r = count(s > thresh)
         nnull = n - r
         if (nnull > 0) basis(:, 1:nnull) = transpose(vt(r + 1:n, :))
     end subroutine null_space
@@ -128,7 +125,7 @@ contains
         real(dp), intent(out) :: basis(:, :)
         integer, intent(out) :: r
         integer, intent(out) :: info
-        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
+        real(dp), allocatable :: u(:, :), vt(:, :)
         integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
@@ -138,12 +135,24 @@ contains
             info = CM_BAD_INPUT
             return
         end if
-        allocate (u(m, m), s(min(m, n)), vt(n, n))
-        call svd(a, u, s, vt, info)
-        if (info /= CM_SUCCESS) return
-        r = count(s > thresh)
+        call svd_rank(a, thresh, u, vt, r, info)
         if (r > 0) basis(:, 1:r) = u(:, 1:r)
     end subroutine range_basis
+
+    !> The full SVD of a (u: m x m, vt: n x n) and the number r of its singular values
+    !! > thresh (0 when the SVD fails).
+    subroutine svd_rank(a, thresh, u, vt, r, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: thresh
+        real(dp), allocatable, intent(out) :: u(:, :), vt(:, :)
+        integer, intent(out) :: r
+        integer, intent(out) :: info
+        real(dp) :: s(min(size(a, 1), size(a, 2)))
+        allocate (u(size(a, 1), size(a, 1)), vt(size(a, 2), size(a, 2)))
+        r = 0
+        call svd(a, u, s, vt, info)
+        if (info == CM_SUCCESS) r = count(s > thresh)
+    end subroutine svd_rank
 
     !> Minimum-norm least-squares solution x = A^+ b of A x = b (dgelsd; m x n A, one
     !! right-hand side), singular values <= rcond * sigma_max treated as zero; `rank` is
