@@ -101,11 +101,11 @@ module conmech_constrained_system
         procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: nh_matrix_band => cs_nh_matrix_band
         procedure :: energy => cs_no_energy
-        procedure :: has_energy => cs_has_no_energy
+        procedure :: has_energy => cs_not_given
         procedure :: forces_jacobian => fd_forces_jacobian
-        procedure :: has_forces_jacobian => cs_has_no_forces_jacobian
+        procedure :: has_forces_jacobian => cs_not_given
         procedure :: constraint_hessian => fd_constraint_hessian
-        procedure :: has_constraint_hessian => cs_has_no_constraint_hessian
+        procedure :: has_constraint_hessian => cs_not_given
     end type constrained_system
 
     abstract interface
@@ -195,13 +195,6 @@ module conmech_constrained_system
             real(dp), intent(in) :: q(:), v(:), lam(:)
             real(dp), intent(out) :: hl(:, :), hv(:, :)
         end subroutine fd_constraint_hessian
-        !> The defaults are finite differences.
-        module logical function cs_has_no_forces_jacobian(self)
-            class(constrained_system), intent(in) :: self
-        end function cs_has_no_forces_jacobian
-        module logical function cs_has_no_constraint_hessian(self)
-            class(constrained_system), intent(in) :: self
-        end function cs_has_no_constraint_hessian
     end interface
 
     !> The states of a position projection after a Newton step.
@@ -471,10 +464,12 @@ contains
         e = 0.0_dp
     end function cs_no_energy
 
-    logical function cs_has_no_energy(self)
+    !> The default of the has_* queries: the optional piece is not given (no energy; the
+    !! force and constraint derivatives by finite differences).
+    logical function cs_not_given(self)
         class(constrained_system), intent(in) :: self
-        cs_has_no_energy = .false.
-    end function cs_has_no_energy
+        cs_not_given = .false.
+    end function cs_not_given
 
     ! ------------------------------------------------------------------ linear algebra
 
