@@ -3,7 +3,7 @@
 program test_fixed_grid
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_TOO_MANY_STEPS
-    use conmech_fixed_grid, only: grid_steps, check_grid_steps
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps, grid_time
     use conmech_testing, only: test_suite
     implicit none
     type(test_suite) :: ts
@@ -28,6 +28,13 @@ program test_fixed_grid
         if (n /= k + 1) ok = .false.
     end do
     call ts%check(ok, "exact multiples give k steps, k + 1/2 of them round up to k + 1")
+    ! the last grid point is tf itself, where t_start + n h misses it by round-off
+    ! (3*0.1 = 0.30000000000000004 in binary floating point)
+    n = grid_steps(0.0_dp, 0.3_dp, 0.1_dp)
+    call ts%check(n == 3 .and. 3*0.1_dp /= 0.3_dp, "[0, 0.3] in steps of 0.1: 3, inexact")
+    call ts%check(grid_time(0.0_dp, 0.3_dp, 0.1_dp, n, n) == 0.3_dp, "last grid point: tf")
+    call ts%check(grid_time(0.0_dp, 0.3_dp, 0.1_dp, 2, n) == 2*0.1_dp, &
+                  "inner grid point k: t_start + k h")
     msg = "kept"
     call check_grid_steps(10, 10, info, msg)
     call ts%check(info == CM_SUCCESS .and. msg == "kept", "max_steps reached, not exceeded")

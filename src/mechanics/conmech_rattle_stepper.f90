@@ -17,11 +17,12 @@
 module conmech_rattle_stepper
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_RATTLE
     use conmech_ode_stepper, only: ode_stepper, check_first_step
     use conmech_state_packer, only: state_packer
-    use conmech_fixed_grid, only: grid_steps, check_grid_steps
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps, grid_time
     use conmech_constrained_system, only: constrained_system
     use conmech_rattle_step, only: rattle_state, rattle_work, rattle_work_init, &
         rattle_prepare, rattle_step, rattle_state_transfer
@@ -128,8 +129,7 @@ contains
             call where_failed(self%grid(cur)%t, msg)
             return
         end if
-        tk = self%t_start + k*self%hg
-        if (k == self%nsteps) tk = self%tf
+        tk = grid_time(self%t_start, self%tf, self%hg, k, self%nsteps)
         self%grid(nxt)%t = tk
         self%cur = nxt
         self%kdone = k

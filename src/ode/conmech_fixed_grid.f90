@@ -8,7 +8,7 @@ module conmech_fixed_grid
     implicit none
     private
 
-    public :: grid_steps, check_grid_steps
+    public :: grid_steps, check_grid_steps, grid_time
 
 contains
 
@@ -19,6 +19,18 @@ contains
         nsteps = 0
         if (tf /= t0) nsteps = max(1, ceiling(abs(tf - t0)/step*(1.0_dp - 1.0e-12_dp)))
     end function grid_steps
+
+    !> The time of grid point k of nsteps steps of h from t_start: tf itself at the end
+    !! (no round-off from t_start + nsteps h).
+    pure real(dp) function grid_time(t_start, tf, h, k, nsteps) result(t)
+        real(dp), intent(in) :: t_start, tf, h
+        integer, intent(in) :: k, nsteps
+        if (k == nsteps) then
+            t = tf
+        else
+            t = t_start + real(k, dp)*h
+        end if
+    end function grid_time
 
     !> CM_TOO_MANY_STEPS, with a message that gives the grid's length, when the grid has
     !! more than max_steps steps; else CM_SUCCESS and msg unchanged.

@@ -19,12 +19,13 @@ module conmech_gauss
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_GAUSS4, METHOD_GAUSS6
     use conmech_ode_dense, only: power_basis_matrix
     use conmech_ode_stepper, only: ode_stepper, check_first_step, FORM_POWER
     use conmech_state_packer, only: state_packer
-    use conmech_fixed_grid, only: grid_steps, check_grid_steps
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps, grid_time
     implicit none
     private
 
@@ -205,11 +206,7 @@ contains
         end associate
         self%have_poly = .true.
         self%dense_ready = .true.
-        if (k == self%nsteps) then
-            tnew = self%tf
-        else
-            tnew = self%t_start + real(k, dp)*h
-        end if
+        tnew = grid_time(self%t_start, self%tf, h, k, self%nsteps)
         self%kdone = k
         self%last = k == self%nsteps
         self%t_old = self%t
