@@ -1,10 +1,11 @@
 !> Numbers as text, for the messages that library routines return with their status.
 module conmech_text
     use, intrinsic :: iso_fortran_env, only: int64
+    use conmech_kinds, only: dp
     implicit none
     private
 
-    public :: itoa
+    public :: itoa, rtoa
 
     !> An integer (default kind or int64) as text, without blanks: itoa(-12) is "-12".
     interface itoa
@@ -26,5 +27,15 @@ contains
         write (buf, '(i0)') k
         text = trim(buf)
     end function itoa_int64
+
+    !> A real as text in the es14.6 format (a time in a message: " 1.250000E+00", the
+    !! leading blank of a positive value kept, trailing blanks dropped).
+    pure function rtoa(x) result(text)
+        real(dp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=14) :: buf
+        write (buf, '(es14.6)') x
+        text = trim(buf)
+    end function rtoa
 
 end module conmech_text

@@ -192,9 +192,7 @@ contains
     subroutine where_failed(t, msg)
         real(dp), intent(in) :: t
         character(len=:), allocatable, intent(inout) :: msg
-        character(len=32) :: buf
-        write (buf, '(es14.6)') t
-        msg = msg//" (RATTLE step from t ="//trim(buf)//")"
+        msg = msg//" (RATTLE step from t ="//rtoa(t)//")"
     end subroutine where_failed
 
     !> After a hook changed y: the state at t prepared again (forces, mass, G).

@@ -144,7 +144,6 @@ contains
         real(dp) :: xi, dyno, dynold, scale, h, tnew
         integer :: i, j, it, k, s
         logical :: converged
-        character(len=32) :: buf
         info = CM_SUCCESS
         s = self%s
         h = self%h
@@ -186,10 +185,9 @@ contains
                 dynold = dyno
             end do
             if (.not. converged) then
-                write (buf, '(es14.6)') self%t
                 info = CM_NO_CONVERGENCE
                 msg = "the fixed-point iteration of the Gauss stages did not converge at t =" &
-                      //trim(buf)//" (step too large, or a stiff or non-finite right-hand side)"
+                      //rtoa(self%t)//" (step too large, or a stiff or non-finite right-hand side)"
                 return
             end if
             ! collocation polynomial: u(0) = y, u(c_i) = y + z_i

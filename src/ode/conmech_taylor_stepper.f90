@@ -27,6 +27,7 @@
 module conmech_taylor_stepper
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, ode_stats, METHOD_TAYLOR
     use conmech_ode_stepper, only: ode_stepper, check_interval, tolerance_vectors, FORM_POWER
@@ -195,7 +196,6 @@ contains
         real(dp) :: h, err, d
         integer :: p, n, ic, io
         logical :: fin
-        character(len=32) :: buf
         ! msg is set on failure only (as the Runge-Kutta steppers): no allocation per step
         info = CM_SUCCESS
         p = self%order
@@ -207,14 +207,12 @@ contains
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
-                write (buf, '(es14.6)') self%t
-                msg = "more than max_steps steps, at t ="//trim(buf)
+                msg = "more than max_steps steps, at t ="//rtoa(self%t)
                 return
             end if
             if (.not. (0.1_dp*abs(h) > abs(self%t)*epsilon(1.0_dp))) then
                 info = CM_STEP_TOO_SMALL
-                write (buf, '(es14.6)') self%t
-                msg = "step size too small at t ="//trim(buf)
+                msg = "step size too small at t ="//rtoa(self%t)
                 return
             end if
             self%hit = .false.
@@ -389,7 +387,6 @@ contains
         character(len=:), allocatable, intent(out) :: msg
         integer, intent(in), optional :: kind
         type(taylor_stepper) :: stp
-        character(len=32) :: buf
         character(len=:), allocatable :: smsg
         stats = ode_stats()
         if (present(kind)) stp%kind = kind
@@ -408,8 +405,7 @@ contains
             end if
             if (.not. stp%f_finite()) then
                 info = CM_NONFINITE
-                write (buf, '(es14.6)') stp%t
-                msg = "non-finite right-hand side at t ="//trim(buf)
+                msg = "non-finite right-hand side at t ="//rtoa(stp%t)
                 exit
             end if
             if (stp%last) exit
