@@ -28,14 +28,12 @@ contains
         text = trim(buf)
     end function itoa_int64
 
-    !> A real as text in the es14.6 format (a time in a message: " 1.250000E+00", the
-    !! leading blank of a positive value kept, trailing blanks dropped).
+    !> A real as text in the es14.6 format, right-justified in its 14 characters (a time in
+    !! a message: "  1.250000E+00").
     pure function rtoa(x) result(text)
         real(dp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=14) :: buf
-        write (buf, '(es14.6)') x
-        text = trim(buf)
+        character(len=14) :: text
+        write (text, '(es14.6)') x
     end function rtoa
 
 end module conmech_text
