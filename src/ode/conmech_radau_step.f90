@@ -6,7 +6,7 @@ submodule(conmech_radau_stepper) conmech_radau_step
     use conmech_status
     use conmech_text, only: rtoa
     use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER, &
-        min_step_at, MSG_STEP_TOO_SMALL
+        min_step_at, MSG_STEP_TOO_SMALL, MSG_TOO_MANY_STEPS
     use conmech_radau_coefficients, only: NIT, THET
     use conmech_jacobian_structure, only: LU_AUTO, LU_SPARSE
     use conmech_radau_sparse, only: SPARSE_MIN_N, SPARSE_MAX_DENSITY
@@ -178,7 +178,7 @@ contains
             first_try = .false.
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
-                msg = "too many steps: max_steps reached at t ="//rtoa(self%t)
+                msg = MSG_TOO_MANY_STEPS//rtoa(self%t)
                 return
             end if
             if (self%need_jac) then

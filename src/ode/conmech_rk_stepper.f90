@@ -30,7 +30,8 @@ module conmech_rk_stepper
     use conmech_ode_options, only: ode_options, METHOD_RK4, METHOD_DOPRI5, &
         METHOD_DOP853, METHOD_VERNER98
     use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
-        tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL
+        tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL, &
+        MSG_TOO_MANY_STEPS
     use conmech_state_packer, only: state_packer
     use conmech_fixed_grid, only: grid_steps
     use conmech_rk_tableaus, only: rk_tableau, set_dopri5_tableau, set_dop853_tableau, &
@@ -346,7 +347,7 @@ contains
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
-                msg = "too many steps: max_steps reached at t ="//rtoa(self%t)
+                msg = MSG_TOO_MANY_STEPS//rtoa(self%t)
                 return
             end if
             ! the smallest step (SciPy's min_step <= 10 eps |t|: the cheap test first)
