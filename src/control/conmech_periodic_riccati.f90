@@ -89,26 +89,27 @@ module conmech_periodic_riccati
         type(dense_solution) :: sol                  !! P(t) (k*k, column-major), t in [0, T]
     end type riccati_result
 
-    !> The Hamiltonian system Z' = H(t) Z (internal).
-    type, extends(ode_system) :: hamiltonian_ode
+    !> An ODE built on a periodic LQ problem (internal): the system, R^-1 and, where the
+    !! equation has it, the state weight Q.
+    type, abstract, extends(ode_system) :: lq_ode
         class(periodic_lq), allocatable :: lq
         real(dp), allocatable :: qw(:, :), rinv(:, :)
+    end type lq_ode
+
+    !> The Hamiltonian system Z' = H(t) Z (internal).
+    type, extends(lq_ode) :: hamiltonian_ode
     contains
         procedure :: rhs => ham_rhs
     end type hamiltonian_ode
 
     !> The Riccati equation P' = -(A^T P + P A - P S P + Q) (internal).
-    type, extends(ode_system) :: riccati_ode
-        class(periodic_lq), allocatable :: lq
-        real(dp), allocatable :: qw(:, :), rinv(:, :)
+    type, extends(lq_ode) :: riccati_ode
     contains
         procedure :: rhs => ric_rhs
     end type riccati_ode
 
     !> The closed loop x' = (A - S P(t)) x with P from a dense solution (internal).
-    type, extends(ode_system) :: closed_lq_ode
-        class(periodic_lq), allocatable :: lq
-        real(dp), allocatable :: rinv(:, :)
+    type, extends(lq_ode) :: closed_lq_ode
         type(dense_solution) :: psol
     contains
         procedure :: rhs => cl_rhs
@@ -121,6 +122,18 @@ contains
         inside_unit = wr**2 + wi**2 < 1.0_dp
     end function inside_unit
 
+    !> A(t) and B(t) for an rhs; false, with dydt NaN (the integrator then stops on a
+    !! non-finite value), when the system cannot give them.
+    logical function lq_coefficients(self, t, a, b, dydt) result(ok)
+        class(lq_ode), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(out) :: a(:, :), b(:, :), dydt(:)
+        integer :: info
+        call self%lq%coefficients(t, a, b, info)
+        ok = info == CM_SUCCESS
+        if (.not. ok) dydt = ieee_value(1.0_dp, ieee_quiet_nan)
+    end function lq_coefficients
+
     subroutine ham_rhs(self, t, y, dydt)
         class(hamiltonian_ode), intent(in) :: self
         real(dp), intent(in) :: t
@@ -128,13 +141,9 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: a(self%lq%k, self%lq%k), b(self%lq%k, max(self%lq%m, 1))
         real(dp) :: z(2*self%lq%k, 2*self%lq%k), h(2*self%lq%k, 2*self%lq%k)
-        integer :: k, info
+        integer :: k
         k = self%lq%k
-        call self%lq%coefficients(t, a, b, info)
-        if (info /= CM_SUCCESS) then
-            dydt = ieee_value(1.0_dp, ieee_quiet_nan)
-            return
-        end if
+        if (.not. lq_coefficients(self, t, a, b, dydt)) return
         h(1:k, 1:k) = a
         h(1:k, k + 1:2*k) = -matmul(b, matmul(self%rinv, transpose(b)))
         h(k + 1:2*k, 1:k) = -self%qw
@@ -151,13 +160,9 @@ contains
         real(dp) :: a(self%lq%k, self%lq%k), b(self%lq%k, max(self%lq%m, 1))
         real(dp) :: p(self%lq%k, self%lq%k), pb(self%lq%k, max(self%lq%m, 1))
         real(dp) :: d(self%lq%k, self%lq%k)
-        integer :: k, info
+        integer :: k
         k = self%lq%k
-        call self%lq%coefficients(t, a, b, info)
-        if (info /= CM_SUCCESS) then
-            dydt = ieee_value(1.0_dp, ieee_quiet_nan)
-            return
-        end if
+        if (.not. lq_coefficients(self, t, a, b, dydt)) return
         p = reshape(y(1:k*k), [k, k])
         p = 0.5_dp*(p + transpose(p))
         pb = matmul(p, b)
@@ -179,13 +184,9 @@ contains
         real(dp), intent(out) :: dydt(:)
         real(dp) :: a(self%lq%k, self%lq%k), b(self%lq%k, max(self%lq%m, 1))
         real(dp) :: p(self%lq%k*self%lq%k), x(self%lq%k, self%lq%k)
-        integer :: k, info
+        integer :: k
         k = self%lq%k
-        call self%lq%coefficients(t, a, b, info)
-        if (info /= CM_SUCCESS) then
-            dydt = ieee_value(1.0_dp, ieee_quiet_nan)
-            return
-        end if
+        if (.not. lq_coefficients(self, t, a, b, dydt)) return
         call self%psol%eval(t, p)
         a = a - matmul(b, matmul(self%rinv, matmul(transpose(b), reshape(p, [k, k]))))
         x = reshape(y, [k, k])

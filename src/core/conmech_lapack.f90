@@ -14,7 +14,7 @@ module conmech_lapack
 
     public :: dgesv, dgetrf, dgetrs, dgecon, dgeev, dpotrf, dpotrs, dsysv, dsyev, dgelsd, &
         dgelsy, dlange, dpstrf, dgesvd, dgeqp3, dgees
-    public :: la_solve, la_eig, la_sym_eig, la_det, la_finite, la_status
+    public :: la_solve, la_eig, la_sym_eig, la_det, la_finite, la_status, la_input_status
 
     !> True if every entry is finite (call it before handing data to LAPACK: NaN input
     !! makes some routines report an illegal argument).
@@ -33,12 +33,6 @@ module conmech_lapack
             real(dp), intent(inout) :: a(lda, *), b(ldb, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgesv
-        subroutine dgetrf(m, n, a, lda, ipiv, info)
-            import :: dp
-            integer, intent(in) :: m, n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgetrf
         subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
             import :: dp
             character(len=1), intent(in) :: trans
@@ -71,13 +65,6 @@ module conmech_lapack
             real(dp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
             integer, intent(out) :: info
         end subroutine dgeev
-        subroutine dpotrf(uplo, n, a, lda, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: info
-        end subroutine dpotrf
         subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
             import :: dp
             character(len=1), intent(in) :: uplo
@@ -86,15 +73,6 @@ module conmech_lapack
             real(dp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine dpotrs
-        subroutine dpstrf(uplo, n, a, lda, piv, rank, tol, work, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: piv(*), rank, info
-            real(dp), intent(in) :: tol
-            real(dp), intent(out) :: work(*)
-        end subroutine dpstrf
         subroutine dsysv(uplo, n, nrhs, a, lda, ipiv, b, ldb, work, lwork, info)
             import :: dp
             character(len=1), intent(in) :: uplo
@@ -164,7 +142,43 @@ module conmech_lapack
         end subroutine dgees
     end interface
 
-    ! Unblocked Cholesky factorisations (for the small matrices of mechanical systems).
+    !> The signatures that several LAPACK routines share.
+    abstract interface
+        !> LU with partial pivoting of an m x n matrix (dgetrf; dgetf2 unblocked).
+        subroutine la_lu_factor(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine la_lu_factor
+        !> Cholesky factor in place (dpotrf; dpotf2 unblocked), or the inverse from it
+        !! (dpotri).
+        subroutine la_cholesky(uplo, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine la_cholesky
+        !> Pivoted Cholesky factor of a semidefinite matrix, with its rank (dpstrf; dpstf2
+        !! unblocked).
+        subroutine la_pivoted_cholesky(uplo, n, a, lda, piv, rank, tol, work, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: piv(*), rank, info
+            real(dp), intent(in) :: tol
+            real(dp), intent(out) :: work(*)
+        end subroutine la_pivoted_cholesky
+    end interface
+
+    ! The unblocked forms (dgetf2, dpotf2, dpstf2) make no block-size query: fast for the
+    ! small matrices of mechanical systems.
+    procedure(la_lu_factor) :: dgetrf, dgetf2
+    procedure(la_cholesky) :: dpotrf, dpotf2, dpotri
+    procedure(la_pivoted_cholesky) :: dpstrf, dpstf2
+
     interface
         subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
             import :: dp
@@ -173,37 +187,6 @@ module conmech_lapack
             real(dp), intent(in) :: a(lda, *)
             real(dp), intent(inout) :: x(*)
         end subroutine dtrsv
-        subroutine dpotf2(uplo, n, a, lda, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: info
-        end subroutine dpotf2
-        subroutine dpstf2(uplo, n, a, lda, piv, rank, tol, work, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: piv(*), rank, info
-            real(dp), intent(in) :: tol
-            real(dp), intent(out) :: work(*)
-        end subroutine dpstf2
-        !> Unblocked LU (no block-size query: fast for small constraint matrices).
-        subroutine dgetf2(m, n, a, lda, ipiv, info)
-            import :: dp
-            integer, intent(in) :: m, n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgetf2
-        !> Inverse from the Cholesky factor.
-        subroutine dpotri(uplo, n, a, lda, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(dp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: info
-        end subroutine dpotri
     end interface
 
     ! Complex LU factorisation and solve.
@@ -265,15 +248,9 @@ contains
         real(dp) :: anorm, rcond, rmin
         n = size(a, 1)
         nrhs = size(b, 2)
-        if (size(a, 2) /= n .or. size(b, 1) /= n .or. size(x, 1) /= n .or. &
-            size(x, 2) /= nrhs) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. (la_finite(a) .and. la_finite(b))) then
-            info = CM_NONFINITE
-            return
-        end if
+        info = la_input_status(size(a, 2) == n .and. size(b, 1) == n .and. size(x, 1) == n &
+                               .and. size(x, 2) == nrhs, a, b)
+        if (info /= CM_SUCCESS) return
         rmin = 1.0e3_dp*epsilon(1.0_dp)
         if (present(rcond_min)) rmin = rcond_min
         allocate (lu(n, n), ipiv(n), work(4*n), iwork(n))
@@ -306,6 +283,23 @@ contains
         end if
     end function la_status
 
+    !> The status of a wrapper's input: CM_BAD_INPUT unless `sizes_ok` (the caller's test
+    !! that the arrays' shapes agree), then CM_NONFINITE if `a` (or `b`) holds a NaN or an
+    !! Inf, else CM_SUCCESS.
+    pure integer function la_input_status(sizes_ok, a, b) result(info)
+        logical, intent(in) :: sizes_ok
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in), optional :: b(:, :)
+        info = CM_SUCCESS
+        if (.not. sizes_ok) then
+            info = CM_BAD_INPUT
+        else if (.not. la_finite(a)) then
+            info = CM_NONFINITE
+        else if (present(b)) then
+            if (.not. la_finite(b)) info = CM_NONFINITE
+        end if
+    end function la_input_status
+
     !> Eigenvalues (and optionally right eigenvectors) of a general real matrix (dgeev).
     subroutine la_eig(a, wr, wi, info, vr)
         real(dp), intent(in) :: a(:, :)
@@ -317,14 +311,8 @@ contains
         integer :: n, lwork, lainfo
         character(len=1) :: jobvr
         n = size(a, 1)
-        if (size(a, 2) /= n .or. size(wr) /= n .or. size(wi) /= n) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. la_finite(a)) then
-            info = CM_NONFINITE
-            return
-        end if
+        info = la_input_status(size(a, 2) == n .and. size(wr) == n .and. size(wi) == n, a)
+        if (info /= CM_SUCCESS) return
         jobvr = 'N'
         if (present(vr)) jobvr = 'V'
         allocate (tmp(n, n), vl(1, 1), v(n, n))
@@ -348,14 +336,8 @@ contains
         integer :: n, lwork, lainfo
         character(len=1) :: jobz
         n = size(a, 1)
-        if (size(a, 2) /= n .or. size(w) /= n) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. la_finite(a)) then
-            info = CM_NONFINITE
-            return
-        end if
+        info = la_input_status(size(a, 2) == n .and. size(w) == n, a)
+        if (info /= CM_SUCCESS) return
         jobz = 'N'
         if (present(v)) jobz = 'V'
         allocate (tmp(n, n))

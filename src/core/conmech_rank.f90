@@ -8,9 +8,8 @@
 !! decision is the whole point.
 module conmech_rank
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NO_CONVERGENCE, &
-        CM_NONFINITE
-    use conmech_lapack, only: dgesvd, dgelsd, la_finite, la_status
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NO_CONVERGENCE
+    use conmech_lapack, only: dgesvd, dgelsd, la_input_status, la_status
     implicit none
     private
 
@@ -30,15 +29,9 @@ contains
         integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
-        if (size(u, 1) /= m .or. size(u, 2) /= m .or. size(vt, 1) /= n .or. &
-            size(vt, 2) /= n .or. size(s) /= min(m, n)) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. la_finite(a)) then
-            info = CM_NONFINITE
-            return
-        end if
+        info = la_input_status(size(u, 1) == m .and. size(u, 2) == m .and. size(vt, 1) == n &
+                               .and. size(vt, 2) == n .and. size(s) == min(m, n), a)
+        if (info /= CM_SUCCESS) return
         if (m == 0 .or. n == 0) then
             info = CM_SUCCESS
             if (m > 0) u = identity(m)
@@ -57,15 +50,8 @@ contains
         integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
-        if (size(s) /= min(m, n)) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. la_finite(a)) then
-            info = CM_NONFINITE
-            return
-        end if
-        info = CM_SUCCESS
+        info = la_input_status(size(s) == min(m, n), a)
+        if (info /= CM_SUCCESS) return
         if (m == 0 .or. n == 0) return
         call run_dgesvd('N', a, s, du, dv, info)
     end subroutine singular_values
@@ -115,9 +101,8 @@ contains
         real(dp), intent(out) :: basis(:, :)
         integer, intent(out) :: nnull
         integer, intent(out) :: info
-        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
-        integer :: m, n, r
-        m = size(a, 1)
+        real(dp), allocatable :: u(:, :), vt(:, :)
+        integer :: n, r
         n = size(a, 2)
         nnull = 0
         basis = 0.0_dp
@@ -125,10 +110,8 @@ contains
             info = CM_BAD_INPUT
             return
         end if
-        allocate (u(m, m), s(min(m, n)), vt(n, n))
-        call svd(a, u, s, vt, info)
+        call svd_rank(a, thresh, u, vt, r, info)
         if (info /= CM_SUCCESS) return
-        r = count(s > thresh)
         nnull = n - r
         if (nnull > 0) basis(:, 1:nnull) = transpose(vt(r + 1:n, :))
     end subroutine null_space
@@ -142,7 +125,7 @@ contains
         real(dp), intent(out) :: basis(:, :)
         integer, intent(out) :: r
         integer, intent(out) :: info
-        real(dp), allocatable :: u(:, :), s(:), vt(:, :)
+        real(dp), allocatable :: u(:, :), vt(:, :)
         integer :: m, n
         m = size(a, 1)
         n = size(a, 2)
@@ -152,12 +135,24 @@ contains
             info = CM_BAD_INPUT
             return
         end if
-        allocate (u(m, m), s(min(m, n)), vt(n, n))
-        call svd(a, u, s, vt, info)
-        if (info /= CM_SUCCESS) return
-        r = count(s > thresh)
+        call svd_rank(a, thresh, u, vt, r, info)
         if (r > 0) basis(:, 1:r) = u(:, 1:r)
     end subroutine range_basis
+
+    !> The full SVD of a (u: m x m, vt: n x n) and the number r of its singular values
+    !! > thresh (0 when the SVD fails).
+    subroutine svd_rank(a, thresh, u, vt, r, info)
+        real(dp), intent(in) :: a(:, :)
+        real(dp), intent(in) :: thresh
+        real(dp), allocatable, intent(out) :: u(:, :), vt(:, :)
+        integer, intent(out) :: r
+        integer, intent(out) :: info
+        real(dp) :: s(min(size(a, 1), size(a, 2)))
+        allocate (u(size(a, 1), size(a, 1)), vt(size(a, 2), size(a, 2)))
+        r = 0
+        call svd(a, u, s, vt, info)
+        if (info == CM_SUCCESS) r = count(s > thresh)
+    end subroutine svd_rank
 
     !> Minimum-norm least-squares solution x = A^+ b of A x = b (dgelsd; m x n A, one
     !! right-hand side), singular values <= rcond * sigma_max treated as zero; `rank` is
@@ -177,14 +172,9 @@ contains
         n = size(a, 2)
         rank = 0
         x = 0.0_dp
-        if (size(b) /= m .or. size(x) /= n .or. m == 0 .or. n == 0) then
-            info = CM_BAD_INPUT
-            return
-        end if
-        if (.not. (la_finite(a) .and. all(abs(b) <= huge(1.0_dp)))) then
-            info = CM_NONFINITE
-            return
-        end if
+        info = la_input_status(size(b) == m .and. size(x) == n .and. m > 0 .and. n > 0, a, &
+                               reshape(b, [size(b), 1]))
+        if (info /= CM_SUCCESS) return
         allocate (tmp(m, n), rhs(max(m, n), 1), s(min(m, n)))
         tmp = a
         rhs = 0.0_dp

@@ -20,36 +20,34 @@ module conmech_status
 
     public :: status_message, status_is_success
 
+    integer, parameter :: msg_len = 65
+
+    !> The default message of each code, indexed by the code: from CM_USER_ERROR (-8)
+    !! up to CM_EVENT_STOP (1).
+    character(len=msg_len), parameter :: messages(CM_USER_ERROR:CM_EVENT_STOP) = [ &
+        character(len=msg_len) :: &
+        "a user callback reported an error", &
+        "LAPACK reported an illegal argument", &
+        "iteration did not converge", &
+        "singular matrix", &
+        "bad input", &
+        "non-finite value (NaN or Inf) in the state or the right-hand side", &
+        "step size too small: the step size underflowed", &
+        "too many steps: the maximum number of steps was reached", &
+        "success", &
+        "a termination event occurred"]
+
 contains
 
     !> Default human-readable text for a status code.
     pure function status_message(info) result(msg)
         integer, intent(in) :: info
         character(len=:), allocatable :: msg
-        select case (info)
-        case (CM_SUCCESS)
-            msg = "success"
-        case (CM_EVENT_STOP)
-            msg = "a termination event occurred"
-        case (CM_TOO_MANY_STEPS)
-            msg = "too many steps: the maximum number of steps was reached"
-        case (CM_STEP_TOO_SMALL)
-            msg = "step size too small: the step size underflowed"
-        case (CM_NONFINITE)
-            msg = "non-finite value (NaN or Inf) in the state or the right-hand side"
-        case (CM_BAD_INPUT)
-            msg = "bad input"
-        case (CM_SINGULAR)
-            msg = "singular matrix"
-        case (CM_NO_CONVERGENCE)
-            msg = "iteration did not converge"
-        case (CM_LAPACK_ERROR)
-            msg = "LAPACK reported an illegal argument"
-        case (CM_USER_ERROR)
-            msg = "a user callback reported an error"
-        case default
+        if (info < lbound(messages, 1) .or. info > ubound(messages, 1)) then
             msg = "unknown status"
-        end select
+        else
+            msg = trim(messages(info))
+        end if
     end function status_message
 
     !> True for success-like codes (CM_SUCCESS, CM_EVENT_STOP).

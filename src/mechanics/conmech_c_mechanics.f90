@@ -51,6 +51,7 @@ module conmech_c_mechanics
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_generalized, only: generalized_system
     use conmech_c_entries, only: c_mech_pointers
+    use conmech_c_system, only: c_rhs_fn   ! mass, phi, phi_jac, phi_t: f(t, q) into one array
     use conmech_constrained_system, only: constrained_system, fd_phi_jac, fd_phi_t, &
                                           fd_phi_gamma, fd_nh_gamma, fd_forces_jacobian, &
                                           fd_constraint_hessian
@@ -61,13 +62,6 @@ module conmech_c_mechanics
     public :: make_c_generalized, make_c_constrained
 
     abstract interface
-        subroutine c_mat_fn(t, q, m, p) bind(c)     ! mass, phi, phi_jac, phi_t
-            import :: c_double
-            real(c_double), value :: t
-            real(c_double), intent(in) :: q(*)
-            real(c_double), intent(out) :: m(*)
-            real(c_double), intent(in) :: p(*)
-        end subroutine c_mat_fn
         subroutine c_qv_fn(t, q, v, f, p) bind(c)   ! forces, phi_gamma, nh_gamma
             import :: c_double
             real(c_double), value :: t
@@ -115,7 +109,7 @@ module conmech_c_mechanics
     !> M(t, q) q'' = Q(t, q, q') from compiled functions.
     type, extends(generalized_system) :: c_generalized_system
         real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
-        procedure(c_mat_fn), pointer, nopass :: mass_f => null()
+        procedure(c_rhs_fn), pointer, nopass :: mass_f => null()
         procedure(c_qv_fn), pointer, nopass :: forces_f => null()
         procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
@@ -139,12 +133,12 @@ module conmech_c_mechanics
     !> A constrained system in excessive coordinates from compiled functions.
     type, extends(constrained_system) :: c_constrained_system
         real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
-        procedure(c_mat_fn), pointer, nopass :: mass_f => null()
+        procedure(c_rhs_fn), pointer, nopass :: mass_f => null()
         procedure(c_qv_fn), pointer, nopass :: forces_f => null()
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
-        procedure(c_mat_fn), pointer, nopass :: phi_f => null()
-        procedure(c_mat_fn), pointer, nopass :: phi_jac_f => null()
-        procedure(c_mat_fn), pointer, nopass :: phi_t_f => null()
+        procedure(c_rhs_fn), pointer, nopass :: phi_f => null()
+        procedure(c_rhs_fn), pointer, nopass :: phi_jac_f => null()
+        procedure(c_rhs_fn), pointer, nopass :: phi_t_f => null()
         procedure(c_qv_fn), pointer, nopass :: phi_gamma_f => null()
         procedure(c_nh_fn), pointer, nopass :: nh_f => null()
         procedure(c_qv_fn), pointer, nopass :: nh_gamma_f => null()

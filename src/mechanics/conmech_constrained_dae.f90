@@ -31,7 +31,8 @@
 !! `ggl_setup` gives the system, its initial state and the Radau stepper with its mass
 !! matrix and index vector; `dae_events` sees events of (t, [q; v]) from any DAE state
 !! whose first 2n components are [q; v] (this form and the index-3 form,
-!! conmech_constrained_index3). `dae_mass_solve` is the M^{-1} of both.
+!! conmech_constrained_index3). `dae_mass_solve` is the M^{-1} of both; `mech_dae` their
+!! common parent type and `dae_start` their common start (state and stepper mass matrix).
 module conmech_constrained_dae
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
@@ -45,15 +46,21 @@ module conmech_constrained_dae
     implicit none
     private
 
-    public :: ggl_system, dae_events, ggl_setup, dae_mass_solve
+    public :: mech_dae, ggl_system, dae_events, ggl_setup, dae_mass_solve, dae_start
+
+    !> A DAE form of a constrained system, y = [q, v, ...]: its Jacobian is always
+    !! assembled (from exact or finite-difference pieces).
+    type, abstract, extends(ode_system) :: mech_dae
+        class(constrained_system), allocatable :: mech
+    contains
+        procedure :: has_jacobian => mech_dae_has_jacobian
+    end type mech_dae
 
     !> The stabilised index-2 right-hand side of a constrained system.
-    type, extends(ode_system) :: ggl_system
-        class(constrained_system), allocatable :: mech
+    type, extends(mech_dae) :: ggl_system
     contains
         procedure :: rhs => ggl_rhs
         procedure :: jacobian => ggl_jacobian
-        procedure :: has_jacobian => ggl_has_jacobian
     end type ggl_system
 
     !> Events of (t, [q; v]) seen from a DAE state y = [q, v, ...].
@@ -190,11 +197,33 @@ contains
         end associate
     end subroutine ggl_jacobian
 
-    !> The Jacobian is always assembled (from exact or finite-difference pieces).
-    logical function ggl_has_jacobian(self)
-        class(ggl_system), intent(in) :: self
-        ggl_has_jacobian = self%mech%n >= 1
-    end function ggl_has_jacobian
+    logical function mech_dae_has_jacobian(self)
+        class(mech_dae), intent(in) :: self
+        mech_dae_has_jacobian = self%mech%n >= 1
+    end function mech_dae_has_jacobian
+
+    !> The start of a DAE form of size nd: y0 = [q, v, 0, ...] and the Radau stepper's
+    !! mass matrix diag(I, I, 0, ...) (ones on the 2n components of q and v), with its
+    !! index vector allocated (nd) for the caller to fill.
+    subroutine dae_start(q, v, nd, y0, stp)
+        real(dp), intent(in) :: q(:), v(:)
+        integer, intent(in) :: nd
+        real(dp), allocatable, intent(out) :: y0(:)
+        type(radau_stepper), intent(inout) :: stp
+        integer :: n, i
+        n = size(q)
+        allocate (y0(nd))
+        y0 = 0.0_dp
+        y0(1:n) = q
+        y0(n + 1:2*n) = v
+        if (allocated(stp%mass)) deallocate (stp%mass)
+        if (allocated(stp%dae_index)) deallocate (stp%dae_index)
+        allocate (stp%mass(nd, nd), stp%dae_index(nd))
+        stp%mass = 0.0_dp
+        do i = 1, 2*n
+            stp%mass(i, i) = 1.0_dp
+        end do
+    end subroutine dae_start
 
     !> The GGL form of sys at (t0, q, v) with the multipliers lam: the system g (its copy
     !! of sys with a constant mass factorised once), its state y0 = [q, v, lam, 0] and the
@@ -216,18 +245,8 @@ contains
         mh = sys%n_hol
         m = mh + sys%n_nh
         nd = 2*n + m + mh
-        allocate (y0(nd))
-        y0 = 0.0_dp
-        y0(1:n) = q
-        y0(n + 1:2*n) = v
+        call dae_start(q, v, nd, y0, stp)
         y0(2*n + 1:2*n + m) = lam
-        if (allocated(stp%mass)) deallocate (stp%mass)
-        if (allocated(stp%dae_index)) deallocate (stp%dae_index)
-        allocate (stp%mass(nd, nd), stp%dae_index(nd))
-        stp%mass = 0.0_dp
-        do i = 1, 2*n
-            stp%mass(i, i) = 1.0_dp
-        end do
         stp%dae_index = 1
         stp%dae_index(2*n + 1:nd) = 2
         allocate (rtol_vec(nd), atol_vec(nd))

@@ -65,12 +65,4 @@ contains
         end do
     end procedure fd_constraint_hessian
 
-    module procedure cs_has_no_forces_jacobian
-        cs_has_no_forces_jacobian = .false.
-    end procedure cs_has_no_forces_jacobian
-
-    module procedure cs_has_no_constraint_hessian
-        cs_has_no_constraint_hessian = .false.
-    end procedure cs_has_no_constraint_hessian
-
 end submodule conmech_constrained_derivatives

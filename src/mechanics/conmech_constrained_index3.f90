@@ -20,21 +20,19 @@
 !! for compiled systems that provide them, central differences otherwise.
 module conmech_constrained_index3
     use conmech_kinds, only: dp
-    use conmech_ode_system, only: ode_system
     use conmech_radau_stepper, only: radau_stepper
     use conmech_constrained_system, only: constrained_system, constraint_matrix
+    use conmech_constrained_dae, only: mech_dae, dae_start
     implicit none
     private
 
     public :: index3_system, index3_setup
 
     !> The index-3 right-hand side of a constrained system (y = [q, v, w, lambda]).
-    type, extends(ode_system) :: index3_system
-        class(constrained_system), allocatable :: mech
+    type, extends(mech_dae) :: index3_system
     contains
         procedure :: rhs => index3_rhs
         procedure :: jacobian => index3_jacobian
-        procedure :: has_jacobian => index3_has_jacobian
     end type index3_system
 
 contains
@@ -101,12 +99,6 @@ contains
         end associate
     end subroutine index3_jacobian
 
-    !> The Jacobian is always assembled (from exact or finite-difference pieces).
-    logical function index3_has_jacobian(self)
-        class(index3_system), intent(in) :: self
-        index3_has_jacobian = self%mech%n >= 1
-    end function index3_has_jacobian
-
     !> The index-3 form of sys at (q, v) with the accelerations acc and multipliers lam of
     !! the KKT system: the system g, its state y0 = [q, v, acc, lam] and the Radau stepper
     !! with the mass matrix diag(I, I, 0, 0) and RADAU5's index vector (1 for q, 2 for v
@@ -118,23 +110,14 @@ contains
         type(index3_system), intent(out) :: g
         real(dp), allocatable, intent(out) :: y0(:)
         type(radau_stepper), intent(inout) :: stp
-        integer :: n, m, mh, nd, i
+        integer :: n, m, mh, nd
         n = sys%n
         mh = sys%n_hol
         m = mh + sys%n_nh
         nd = 3*n + m
-        allocate (y0(nd))
-        y0(1:n) = q
-        y0(n + 1:2*n) = v
+        call dae_start(q, v, nd, y0, stp)
         y0(2*n + 1:3*n) = acc
         y0(3*n + 1:nd) = lam
-        if (allocated(stp%mass)) deallocate (stp%mass)
-        if (allocated(stp%dae_index)) deallocate (stp%dae_index)
-        allocate (stp%mass(nd, nd), stp%dae_index(nd))
-        stp%mass = 0.0_dp
-        do i = 1, 2*n
-            stp%mass(i, i) = 1.0_dp
-        end do
         stp%dae_index(1:n) = 1
         stp%dae_index(n + 1:2*n) = 2
         stp%dae_index(2*n + 1:3*n) = merge(3, 2, mh > 0)

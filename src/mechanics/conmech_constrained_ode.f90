@@ -12,6 +12,7 @@ module conmech_constrained_ode
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system, ode_step_hook
     use conmech_constrained_system
     use conmech_constrained_result, only: PROJ_VELOCITY, PROJ_POSITION_VELOCITY
@@ -118,7 +119,6 @@ contains
         real(dp) :: q(self%mech%n), v(self%mech%n)
         integer :: n, it
         character(len=:), allocatable :: msg
-        character(len=32) :: buf
         info = CM_SUCCESS
         n = self%mech%n
         q = y(1:n)
@@ -131,8 +131,7 @@ contains
         end if
         if (info == CM_SUCCESS) call project_velocity(self%mech, t, q, v, info, msg)
         if (info /= CM_SUCCESS) then
-            write (buf, '(es14.6)') t
-            self%message = msg//" at t ="//trim(buf)
+            self%message = msg//" at t ="//rtoa(t)
             return
         end if
         self%nproj = self%nproj + 1

@@ -55,9 +55,8 @@ contains
         real(dp) :: mm(sys%n, sys%n), x(sys%n, sys%n_hol), g(sys%n_hol, sys%n)
         real(dp) :: s(sys%n_hol, sys%n_hol), ph(sys%n_hol, 1), qk(sys%n), dq(sys%n)
         real(dp) :: rnorm
-        integer :: n, mh, lainfo, rk
+        integer :: n, mh, lainfo, rk, state
         logical :: full, ok
-        character(len=32) :: buf
         n = sys%n
         mh = sys%n_hol
         iters = 0
@@ -105,20 +104,11 @@ contains
                 q = qk
                 return
             end if
-            qk = qk - dq
-            call sys%phi(t, qk, ph(:, 1))
-            rnorm = maxval(abs(ph(:, 1)))
-            if (.not. (rnorm < huge(1.0_dp))) exit
-            if (rnorm <= tol) then
-                q = qk
-                return
-            end if
+            call position_newton_step(sys, t, tol, dq, qk, ph(:, 1), rnorm, q, state)
+            if (state == NEWTON_DIVERGED) exit
+            if (state == NEWTON_CONVERGED) return
         end do
-        iters = min(iters, max_iter)
-        info = CM_NO_CONVERGENCE
-        write (buf, '(es10.3)') rnorm
-        msg = "position projection did not converge: |phi| ="//trim(buf)// &
-              " (inconsistent constraints, or too far from the manifold)"
+        call position_not_converged(rnorm, max_iter, iters, info, msg)
     end procedure project_position
 
     !> Mass-weighted projection of v onto C(t, q) v + c0 = 0 (linear, one solve):

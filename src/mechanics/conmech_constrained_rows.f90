@@ -21,6 +21,7 @@
 module conmech_constrained_rows
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_rank, only: svd
     use conmech_constrained_system, only: constrained_system, constrained_accel, &
         project_position
@@ -134,14 +135,6 @@ contains
         sub%jac_width = 0
         sub%nh_width = 0
     end subroutine select_rows
-
-    pure function itoa(i) result(s)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: s
-        character(len=16) :: b
-        write (b, '(i0)') i
-        s = trim(b)
-    end function itoa
 
     subroutine rs_mass(self, t, q, mm)
         class(row_subset), intent(in) :: self

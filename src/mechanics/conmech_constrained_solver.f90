@@ -40,6 +40,7 @@ module conmech_constrained_solver
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_ode_system, only: ode_events
     use conmech_ode_options, only: ode_options, METHOD_RATTLE, METHOD_RADAU5
     use conmech_ode_result, only: ode_result
@@ -81,7 +82,6 @@ contains
         logical :: use_subset
         integer :: n, m, info, iters, rank0
         character(len=:), allocatable :: msg
-        character(len=32) :: buf
 
         n = sys%n
         m = sys%n_hol + sys%n_nh
@@ -92,8 +92,7 @@ contains
         if (n < 1 .or. sys%n_hol < 0 .or. sys%n_nh < 0) then
             msg = "bad input: the system needs n >= 1 coordinates, n_hol, n_nh >= 0"
         else if (size(q0) /= n .or. size(v0) /= n) then
-            write (buf, '(i0)') n
-            msg = "bad input: q0 and v0 must have n = "//trim(buf)//" elements"
+            msg = "bad input: q0 and v0 must have n = "//itoa(n)//" elements"
         else if (.not. (all(ieee_is_finite(q0)) .and. all(ieee_is_finite(v0)))) then
             msg = "bad input: q0 or v0 contains NaN or Inf"
         else if (options%projection < PROJ_NONE .or. options%projection > PROJ_BAUMGARTE) then
@@ -322,15 +321,6 @@ contains
                           "a state of size"//trim(b2)//": a larger atol lets the Newton "// &
                           "iteration converge"
         end subroutine explain_newton_failure
-
-        !> An integer as text.
-        function itoa(k) result(text)
-            integer, intent(in) :: k
-            character(len=:), allocatable :: text
-            character(len=16) :: tmp
-            write (tmp, '(i0)') k
-            text = trim(tmp)
-        end function itoa
 
         !> The method's name for messages.
         function method_label() result(label)

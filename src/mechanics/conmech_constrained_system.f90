@@ -65,8 +65,11 @@ module conmech_constrained_system
     public :: constraint_reaction
     !> Building blocks of the submodules (public: gfortran drops private module procedures
     !! that only a submodule calls): the symmetric positive semi-definite Schur solve and
-    !! the test for a kept constant-mass factor.
+    !! the test for a kept constant-mass factor; the Newton step of the position
+    !! projections and its failure.
     public :: schur_solve, has_mass_factor
+    public :: position_newton_step, position_not_converged
+    public :: NEWTON_RUNNING, NEWTON_CONVERGED, NEWTON_DIVERGED
     !> The finite-difference defaults, for extensions that choose at run time (e.g. the
     !! Python layer) whether an analytic Jacobian / acceleration term exists.
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
@@ -98,11 +101,11 @@ module conmech_constrained_system
         procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: nh_matrix_band => cs_nh_matrix_band
         procedure :: energy => cs_no_energy
-        procedure :: has_energy => cs_has_no_energy
+        procedure :: has_energy => cs_not_given
         procedure :: forces_jacobian => fd_forces_jacobian
-        procedure :: has_forces_jacobian => cs_has_no_forces_jacobian
+        procedure :: has_forces_jacobian => cs_not_given
         procedure :: constraint_hessian => fd_constraint_hessian
-        procedure :: has_constraint_hessian => cs_has_no_constraint_hessian
+        procedure :: has_constraint_hessian => cs_not_given
     end type constrained_system
 
     abstract interface
@@ -192,13 +195,34 @@ module conmech_constrained_system
             real(dp), intent(in) :: q(:), v(:), lam(:)
             real(dp), intent(out) :: hl(:, :), hv(:, :)
         end subroutine fd_constraint_hessian
-        !> The defaults are finite differences.
-        module logical function cs_has_no_forces_jacobian(self)
-            class(constrained_system), intent(in) :: self
-        end function cs_has_no_forces_jacobian
-        module logical function cs_has_no_constraint_hessian(self)
-            class(constrained_system), intent(in) :: self
-        end function cs_has_no_constraint_hessian
+    end interface
+
+    !> The states of a position projection after a Newton step.
+    integer, parameter :: NEWTON_RUNNING = 0     !! |phi| > tol: iterate on
+    integer, parameter :: NEWTON_CONVERGED = 1   !! |phi| <= tol: q holds the iterate
+    integer, parameter :: NEWTON_DIVERGED = -1   !! |phi| not finite: give up
+
+    ! The Newton iteration shared by the dense and banded position projections (submodule
+    ! conmech_position_newton).
+    interface
+        !> qk <- qk - dq, then ph = phi(t, qk) and rnorm = max |ph|; q = qk once rnorm <=
+        !! tol. state: NEWTON_RUNNING, NEWTON_CONVERGED or NEWTON_DIVERGED.
+        module subroutine position_newton_step(sys, t, tol, dq, qk, ph, rnorm, q, state)
+            class(constrained_system), intent(in) :: sys
+            real(dp), intent(in) :: t, tol
+            real(dp), intent(in) :: dq(:)
+            real(dp), intent(inout) :: qk(:), q(:)
+            real(dp), intent(out) :: ph(:), rnorm
+            integer, intent(out) :: state
+        end subroutine position_newton_step
+        !> The failure of a projection after max_iter steps, with the last |phi| (rnorm).
+        module subroutine position_not_converged(rnorm, max_iter, iters, info, msg)
+            real(dp), intent(in) :: rnorm
+            integer, intent(in) :: max_iter
+            integer, intent(inout) :: iters
+            integer, intent(out) :: info
+            character(len=:), allocatable, intent(inout) :: msg
+        end subroutine position_not_converged
     end interface
 
     ! The banded paths (submodule conmech_constrained_system_band). Each sets ok = .false.
@@ -440,10 +464,12 @@ contains
         e = 0.0_dp
     end function cs_no_energy
 
-    logical function cs_has_no_energy(self)
+    !> The default of the has_* queries: the optional piece is not given (no energy; the
+    !! force and constraint derivatives by finite differences).
+    logical function cs_not_given(self)
         class(constrained_system), intent(in) :: self
-        cs_has_no_energy = .false.
-    end function cs_has_no_energy
+        cs_not_given = .false.
+    end function cs_not_given
 
     ! ------------------------------------------------------------------ linear algebra
 

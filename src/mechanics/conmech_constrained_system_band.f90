@@ -284,8 +284,7 @@ contains
     module procedure band_project_position
         type(band_rows) :: br
         real(dp) :: r(sys%n_hol), qk(sys%n), dq(sys%n), z(sys%n), rnorm
-        integer :: kd
-        character(len=32) :: buf
+        integer :: kd, state
         iters = 0
         info = CM_SUCCESS
         ok = sys%n_hol > 0
@@ -319,21 +318,12 @@ contains
                     q = qk
                     return
                 end if
-                qk = qk - dq
-                call sys%phi(t, qk, r)
-                rnorm = maxval(abs(r))
-                if (.not. (rnorm < huge(1.0_dp))) exit
-                if (rnorm <= tol) then
-                    q = qk
-                    return
-                end if
+                call position_newton_step(sys, t, tol, dq, qk, r, rnorm, q, state)
+                if (state == NEWTON_DIVERGED) exit
+                if (state == NEWTON_CONVERGED) return
             end do
         end block
-        iters = min(iters, max_iter)
-        info = CM_NO_CONVERGENCE
-        write (buf, '(es10.3)') rnorm
-        msg = "position projection did not converge: |phi| ="//trim(buf)// &
-              " (inconsistent constraints, or too far from the manifold)"
+        call position_not_converged(rnorm, max_iter, iters, info, msg)
     end procedure band_project_position
 
     module procedure band_project_velocity

@@ -27,6 +27,7 @@ module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_lapack, only: dpotrf, dpotf2, dpotrs, dtrsv, la_finite
     use conmech_ode_system, only: ode_system, ode_events, ode_fd_jacobian
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
@@ -46,14 +47,14 @@ module conmech_generalized
         procedure(gen_mass), deferred :: mass
         procedure(gen_forces), deferred :: forces
         procedure :: energy => gen_no_energy
-        procedure :: has_energy => gen_has_no_energy
+        procedure :: has_energy => gen_not_given
         procedure :: forces_jacobian => gen_no_forces_jacobian
         procedure :: mass_forces => gen_mass_forces
-        procedure :: has_forces_jacobian => gen_has_no_forces_jacobian
+        procedure :: has_forces_jacobian => gen_not_given
         procedure :: accelerations => gen_no_accelerations
-        procedure :: has_accelerations => gen_has_no_accelerations
+        procedure :: has_accelerations => gen_not_given
         procedure :: accelerations_jacobian => gen_no_accelerations_jacobian
-        procedure :: has_accelerations_jacobian => gen_has_no_accelerations_jacobian
+        procedure :: has_accelerations_jacobian => gen_not_given
     end type generalized_system
 
     abstract interface
@@ -95,10 +96,11 @@ contains
         e = 0.0_dp
     end function gen_no_energy
 
-    logical function gen_has_no_energy(self)
+    !> The default of the has_* queries: the optional piece is not given.
+    logical function gen_not_given(self)
         class(generalized_system), intent(in) :: self
-        gen_has_no_energy = .false.
-    end function gen_has_no_energy
+        gen_not_given = .false.
+    end function gen_not_given
 
     !> Exact derivatives of the accelerations, optional: r = [dQ/dq - d(M a)/dq, dQ/dv]
     !! (ndof x 2 ndof) at the accelerations a = M^{-1} Q, so that d a/d[q, v] = M^{-1} r.
@@ -110,11 +112,6 @@ contains
         real(dp), intent(out) :: r(:, :)
         r = 0.0_dp
     end subroutine gen_no_forces_jacobian
-
-    logical function gen_has_no_forces_jacobian(self)
-        class(generalized_system), intent(in) :: self
-        gen_has_no_forces_jacobian = .false.
-    end function gen_has_no_forces_jacobian
 
     !> Accelerations a = M^{-1} Q computed directly, optional (`has_accelerations`). The
     !! default is not defined (a = 0; `generalized_accel` factorises M instead). An
@@ -128,11 +125,6 @@ contains
         a = 0.0_dp
     end subroutine gen_no_accelerations
 
-    logical function gen_has_no_accelerations(self)
-        class(generalized_system), intent(in) :: self
-        gen_has_no_accelerations = .false.
-    end function gen_has_no_accelerations
-
     !> The accelerations a and their Jacobian jac = d a/d[q, v] (ndof x 2 ndof) computed
     !! directly, optional (`has_accelerations_jacobian`). The default is not defined (zeros;
     !! the Jacobian then comes from `forces_jacobian` and a Cholesky factorisation of M).
@@ -144,11 +136,6 @@ contains
         a = 0.0_dp
         jac = 0.0_dp
     end subroutine gen_no_accelerations_jacobian
-
-    logical function gen_has_no_accelerations_jacobian(self)
-        class(generalized_system), intent(in) :: self
-        gen_has_no_accelerations_jacobian = .false.
-    end function gen_has_no_accelerations_jacobian
 
     !> mm = M(t, q) and f = Q(t, q, v) in one call (what the right-hand side needs). The
     !! default calls `mass` and `forces`; a system that computes both faster together
@@ -172,7 +159,6 @@ contains
         character(len=:), allocatable, intent(out), optional :: msg
         integer :: n, lainfo, i
         real(dp) :: dmin, dmax
-        character(len=16) :: buf
         n = size(mm, 1)
         info = CM_SUCCESS
         if (size(mm, 2) /= n) then
@@ -196,9 +182,8 @@ contains
         end if
         if (lainfo /= 0) then
             info = CM_SINGULAR
-            write (buf, '(i0)') lainfo
             if (present(msg)) msg = "singular mass matrix: not symmetric positive definite " &
-                                    //"(dpotrf info="//trim(buf)//")"
+                                    //"(dpotrf info="//itoa(lainfo)//")"
             return
         end if
         dmin = huge(1.0_dp)

@@ -17,10 +17,12 @@
 module conmech_rattle_stepper
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_RATTLE
     use conmech_ode_stepper, only: ode_stepper, check_first_step
     use conmech_state_packer, only: state_packer
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps, grid_time
     use conmech_constrained_system, only: constrained_system
     use conmech_rattle_step, only: rattle_state, rattle_work, rattle_work_init, &
         rattle_prepare, rattle_step, rattle_state_transfer
@@ -62,7 +64,6 @@ contains
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        character(len=32) :: buf
         info = CM_BAD_INPUT
         if (.not. allocated(self%mech)) then
             msg = "bad input: the RATTLE stepper has no system (set mech before init)"
@@ -78,16 +79,9 @@ contains
         if (info /= CM_SUCCESS) return
         self%ncoord = self%mech%n
         self%t_start = self%t
-        self%nsteps = 0
-        if (self%tf /= self%t) self%nsteps = max(1, ceiling(abs(self%tf - self%t) &
-                                                            /opt%first_step*(1.0_dp - 1.0e-12_dp)))
-        if (self%nsteps > opt%max_steps) then
-            write (buf, '(i0)') self%nsteps
-            info = CM_TOO_MANY_STEPS
-            msg = "too many steps: the run needs "//trim(buf)//" steps of first_step, " &
-                  //"more than max_steps"
-            return
-        end if
+        self%nsteps = grid_steps(self%t, self%tf, opt%first_step)
+        call check_grid_steps(self%nsteps, opt%max_steps, info, msg)
+        if (info /= CM_SUCCESS) return
         self%method = METHOD_RATTLE
         self%lands_on_target = .false.
         self%hg = 0.0_dp
@@ -135,8 +129,7 @@ contains
             call where_failed(self%grid(cur)%t, msg)
             return
         end if
-        tk = self%t_start + k*self%hg
-        if (k == self%nsteps) tk = self%tf
+        tk = grid_time(self%t_start, self%tf, self%hg, k, self%nsteps)
         self%grid(nxt)%t = tk
         self%cur = nxt
         self%kdone = k
@@ -199,9 +192,7 @@ contains
     subroutine where_failed(t, msg)
         real(dp), intent(in) :: t
         character(len=:), allocatable, intent(inout) :: msg
-        character(len=32) :: buf
-        write (buf, '(es14.6)') t
-        msg = msg//" (RATTLE step from t ="//trim(buf)//")"
+        msg = msg//" (RATTLE step from t ="//rtoa(t)//")"
     end subroutine where_failed
 
     !> After a hook changed y: the state at t prepared again (forces, mass, G).

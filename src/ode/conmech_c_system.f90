@@ -38,10 +38,12 @@ module conmech_c_system
     private
 
     public :: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor, set_c_taylor_fixed
-    public :: c_rhs_fn, c_jac_fn, c_jac_prod_fn, c_taylor_fn
+    public :: c_rhs_fn, c_jac_prod_fn, c_taylor_fn
 
     abstract interface
-        !> dydt = f(t, y; p), the C right-hand side.
+        !> dydt = f(t, y; p), the C right-hand side; the same signature serves every
+        !! function of (t, y) into one array: the Jacobian df/dy (n x n, column-major), and
+        !! the mass matrix and the constraints of conmech_c_mechanics.
         subroutine c_rhs_fn(t, y, dydt, p) bind(c)
             import :: c_double
             real(c_double), value :: t
@@ -49,14 +51,6 @@ module conmech_c_system
             real(c_double), intent(out) :: dydt(*)
             real(c_double), intent(in) :: p(*)
         end subroutine c_rhs_fn
-        !> dfdy = df/dy (n x n, column-major), the C Jacobian.
-        subroutine c_jac_fn(t, y, dfdy, p) bind(c)
-            import :: c_double
-            real(c_double), value :: t
-            real(c_double), intent(in) :: y(*)
-            real(c_double), intent(out) :: dfdy(*)
-            real(c_double), intent(in) :: p(*)
-        end subroutine c_jac_fn
         !> jx = J(t, y) x (n x k, column-major), the C Jacobian product.
         subroutine c_jac_prod_fn(t, y, k, x, jx, p) bind(c)
             import :: c_double, c_int
@@ -82,7 +76,7 @@ module conmech_c_system
         integer :: n = 0                                   !! state dimension
         real(dp), allocatable :: p(:)                      !! parameters (at least 1 entry)
         procedure(c_rhs_fn), pointer, nopass :: f => null()
-        procedure(c_jac_fn), pointer, nopass :: jac => null()
+        procedure(c_rhs_fn), pointer, nopass :: jac => null()
         procedure(c_jac_prod_fn), pointer, nopass :: jp => null()
         procedure(c_taylor_fn), pointer, nopass :: tj => null()    !! Taylor coefficients
         procedure(c_taylor_fn), pointer, nopass :: tjv => null()   !! ... variational

@@ -24,6 +24,7 @@ module conmech_ensemble
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     !$ use omp_lib, only: omp_get_max_threads
@@ -242,9 +243,8 @@ contains
         else if (n < 1) then
             res%message = "bad input: y0 is empty"
         else if (size(y0, 2) /= 1 .and. size(y0, 2) /= m) then
-            write (buf, '(i0)') m
             res%message = "bad input: y0 must have one column or one per member ("// &
-                          trim(buf)//")"
+                          itoa(m)//")"
         else if (eo%threads < 0) then
             res%message = "bad input: threads must be non-negative"
         else if (eo%chunk < 0) then
@@ -317,8 +317,7 @@ contains
         end do
         if (first_bad > 0) then
             res%status = res%member_status(first_bad)
-            write (buf, '(i0)') first_bad
-            res%message = "member "//trim(buf)//": "//trim(msgs(first_bad))
+            res%message = "member "//itoa(first_bad)//": "//trim(msgs(first_bad))
         else if (cancel .and. res%done < m) then
             res%status = CM_USER_ERROR
             write (buf, '(i0," of ",i0)') res%done, m

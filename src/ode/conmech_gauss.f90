@@ -19,11 +19,13 @@ module conmech_gauss
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_GAUSS4, METHOD_GAUSS6
     use conmech_ode_dense, only: power_basis_matrix
     use conmech_ode_stepper, only: ode_stepper, check_first_step, FORM_POWER
     use conmech_state_packer, only: state_packer
+    use conmech_fixed_grid, only: grid_steps, check_grid_steps, grid_time
     implicit none
     private
 
@@ -118,9 +120,7 @@ contains
         self%have_poly = .false.
         self%comp = self%y
         self%comp = 0.0_dp
-        self%nsteps = 0
-        if (tf /= t0) self%nsteps = max(1, ceiling(abs(tf - t0)/opt%first_step &
-                                                   *(1.0_dp - 1.0e-12_dp)))
+        self%nsteps = grid_steps(t0, tf, opt%first_step)
         if (self%nsteps > 0) self%h = (tf - t0)/real(self%nsteps, dp)
     end subroutine gauss_setup
 
@@ -130,15 +130,8 @@ contains
         class(ode_system), intent(in) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        character(len=32) :: buf
-        info = CM_SUCCESS
         msg = "success"
-        if (self%nsteps > self%max_steps) then
-            write (buf, '(i0)') self%nsteps
-            info = CM_TOO_MANY_STEPS
-            msg = "too many steps: the run needs "//trim(buf)//" steps of first_step, " &
-                  //"more than max_steps"
-        end if
+        call check_grid_steps(self%nsteps, self%max_steps, info, msg)
     end subroutine gauss_start
 
     !> The next step of the grid (`target` is not used: the grid ends on tf).
@@ -151,7 +144,6 @@ contains
         real(dp) :: xi, dyno, dynold, scale, h, tnew
         integer :: i, j, it, k, s
         logical :: converged
-        character(len=32) :: buf
         info = CM_SUCCESS
         s = self%s
         h = self%h
@@ -193,10 +185,9 @@ contains
                 dynold = dyno
             end do
             if (.not. converged) then
-                write (buf, '(es14.6)') self%t
                 info = CM_NO_CONVERGENCE
                 msg = "the fixed-point iteration of the Gauss stages did not converge at t =" &
-                      //trim(buf)//" (step too large, or a stiff or non-finite right-hand side)"
+                      //rtoa(self%t)//" (step too large, or a stiff or non-finite right-hand side)"
                 return
             end if
             ! collocation polynomial: u(0) = y, u(c_i) = y + z_i
@@ -213,11 +204,7 @@ contains
         end associate
         self%have_poly = .true.
         self%dense_ready = .true.
-        if (k == self%nsteps) then
-            tnew = self%tf
-        else
-            tnew = self%t_start + real(k, dp)*h
-        end if
+        tnew = grid_time(self%t_start, self%tf, h, k, self%nsteps)
         self%kdone = k
         self%last = k == self%nsteps
         self%t_old = self%t

@@ -15,6 +15,7 @@
 module conmech_ode_driver
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
     use conmech_ode_options, only: ode_options, ode_stats
     use conmech_ode_dense, only: dense_init, dense_push
@@ -50,7 +51,6 @@ contains
         integer :: n, i_eval, n_eval, hinfo
         logical :: need_dense, keep_dense, has_events, store_steps, stop_now, changed
         logical :: hit_mode
-        character(len=32) :: buf
         character(len=:), allocatable :: smsg
 
         n = size(y)
@@ -186,8 +186,7 @@ contains
             end if
             if (.not. stp%f_finite()) then
                 info = CM_NONFINITE
-                write (buf, '(es14.6)') t
-                msg = "non-finite right-hand side at t ="//trim(buf)
+                msg = "non-finite right-hand side at t ="//rtoa(t)
                 exit
             end if
             if (store_steps) call push_point(res, t, stp%y)

@@ -47,7 +47,7 @@ module conmech_ode_stepper
 
     public :: ode_stepper, check_interval, check_first_step, tolerance_vectors, check_t_eval
     public :: stepper_pack, stepper_pack_into, stepper_unpack, stepper_init, min_step_at
-    public :: MSG_STEP_TOO_SMALL
+    public :: MSG_STEP_TOO_SMALL, MSG_TOO_MANY_STEPS
     public :: FORM_HAIRER, FORM_POWER
 
     !> Fixed positions of the common part of a packed state (1-based): reals r(PACK_R_*),
@@ -66,6 +66,9 @@ module conmech_ode_stepper
     !> The failure of an adaptive step below `min_step_at` (followed by the time).
     character(len=*), parameter :: MSG_STEP_TOO_SMALL = "step size too small (the "// &
         "required step size is less than 10 spacings between numbers) at t ="
+    !> The end of an adaptive run on max_steps (followed by the time).
+    character(len=*), parameter :: MSG_TOO_MANY_STEPS = "too many steps: max_steps " &
+        //"reached at t ="
 
     !> The state every stepper has, and the contract of its procedures.
     type, abstract :: ode_stepper
@@ -433,13 +436,15 @@ contains
         msg = "success"
     end subroutine step_option
 
-    !> Per-component tolerances from the options (rtol raised to 100 eps, as SciPy).
-    subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg)
+    !> Per-component tolerances from the options (rtol raised to rtol_min, default 100 eps
+    !! as SciPy; Taylor's method goes down to eps).
+    subroutine tolerance_vectors(opt, n, rtolv, atolv, info, msg, rtol_min)
         type(ode_options), intent(in) :: opt
         integer, intent(in) :: n
         real(dp), allocatable, intent(out) :: rtolv(:), atolv(:)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
+        real(dp), intent(in), optional :: rtol_min
         allocate (rtolv(n), atolv(n))
         info = CM_BAD_INPUT
         if (allocated(opt%rtol_vec)) then
@@ -468,7 +473,11 @@ contains
             msg = "bad input: atol must be non-negative"
             return
         end if
-        rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))
+        if (present(rtol_min)) then
+            rtolv = max(rtolv, rtol_min)
+        else
+            rtolv = max(rtolv, 100.0_dp*epsilon(1.0_dp))
+        end if
         info = CM_SUCCESS
         msg = "success"
     end subroutine tolerance_vectors

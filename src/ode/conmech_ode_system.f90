@@ -43,9 +43,9 @@ module conmech_ode_system
     contains
         procedure(ode_rhs), deferred :: rhs
         procedure :: jacobian => ode_fd_jacobian
-        procedure :: has_jacobian => ode_no_jacobian
+        procedure :: has_jacobian => ode_not_given
         procedure :: rhs_jacobian => ode_rhs_jacobian
-        procedure :: has_jacobian_product => ode_no_jacobian_product
+        procedure :: has_jacobian_product => ode_not_given
         procedure :: jacobian_product => ode_jacobian_product
         procedure :: rhs_jacobian_product => ode_rhs_jacobian_product
         procedure :: taylor_size => ode_no_taylor_size
@@ -209,12 +209,6 @@ contains
         call self%jacobian_product(t, n, k, y, x, jx)
     end subroutine ode_rhs_jacobian_product
 
-    !> Default: no structure-aware product (`integrate_stm` forms J and multiplies).
-    logical function ode_no_jacobian_product(self)
-        class(ode_system), intent(in) :: self
-        ode_no_jacobian_product = .false.
-    end function ode_no_jacobian_product
-
     !> Default: no Taylor coefficients (0 columns).
     integer function ode_no_taylor_size(self, kind)
         class(ode_system), intent(in) :: self
@@ -234,10 +228,13 @@ contains
         w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
     end subroutine ode_no_taylor_jet
 
-    logical function ode_no_jacobian(self)
+    !> The default of the has_* queries: the optional piece is not given (no analytic
+    !! Jacobian: finite differences; no structure-aware product: `integrate_stm` forms J
+    !! and multiplies).
+    logical function ode_not_given(self)
         class(ode_system), intent(in) :: self
-        ode_no_jacobian = .false.
-    end function ode_no_jacobian
+        ode_not_given = .false.
+    end function ode_not_given
 
     subroutine function_rhs(self, t, y, dydt)
         class(ode_function), intent(in) :: self

@@ -4,8 +4,9 @@
 !! control modules can work on the stepper's type.
 submodule(conmech_radau_stepper) conmech_radau_step
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_stepper, only: check_first_step, tolerance_vectors, FORM_POWER, &
-        min_step_at, MSG_STEP_TOO_SMALL
+        min_step_at, MSG_STEP_TOO_SMALL, MSG_TOO_MANY_STEPS
     use conmech_radau_coefficients, only: NIT, THET
     use conmech_jacobian_structure, only: LU_AUTO, LU_SPARSE
     use conmech_radau_sparse, only: SPARSE_MIN_N, SPARSE_MAX_DENSITY
@@ -149,7 +150,6 @@ contains
         real(dp) :: quot, hmin
         integer :: lainfo
         logical :: first_try
-        character(len=32) :: buf
 
         info = CM_SUCCESS
         if (self%f_stale) call self%refresh_f(sys)
@@ -168,9 +168,8 @@ contains
                     if (self%final_step) self%h = self%tf - self%t
                     self%need_lu = .true.
                 else if (abs(self%h) < hmin .or. abs(self%h) < tiny(1.0_dp)) then
-                    write (buf, '(es14.6)') self%t
                     info = CM_STEP_TOO_SMALL
-                    msg = MSG_STEP_TOO_SMALL//trim(buf)
+                    msg = MSG_STEP_TOO_SMALL//rtoa(self%t)
                     if (self%newton_failed) msg = msg//" (the Newton iteration did not "// &
                                                   "converge)"
                     return
@@ -178,18 +177,16 @@ contains
             end if
             first_try = .false.
             if (self%nsteps >= self%max_steps) then
-                write (buf, '(es14.6)') self%t
                 info = CM_TOO_MANY_STEPS
-                msg = "too many steps: max_steps reached at t ="//trim(buf)
+                msg = MSG_TOO_MANY_STEPS//rtoa(self%t)
                 return
             end if
             if (self%need_jac) then
                 call radau_jacobian(self, sys)
                 if (.not. (all(ieee_is_finite(self%jac)) .and. &
                            all(ieee_is_finite(self%jval)))) then
-                    write (buf, '(es14.6)') self%t
                     info = CM_NONFINITE
-                    msg = "non-finite Jacobian at t ="//trim(buf)
+                    msg = "non-finite Jacobian at t ="//rtoa(self%t)
                     return
                 end if
                 self%caljac = .true.
@@ -201,10 +198,9 @@ contains
                 if (lainfo /= 0) then
                     self%nsing = self%nsing + 1
                     if (self%nsing >= 5) then
-                        write (buf, '(es14.6)') self%t
                         info = CM_SINGULAR
                         msg = "singular iteration matrix (gamma/h I - J) five times in a "// &
-                              "row at t ="//trim(buf)
+                              "row at t ="//rtoa(self%t)
                         return
                     end if
                     self%h = 0.5_dp*self%h
@@ -226,9 +222,8 @@ contains
             if (.not. self%converged) then
                 if (self%newton_failed) self%nfail = self%nfail + 1
                 if (self%nfail > 60) then
-                    write (buf, '(es14.6)') self%t
                     info = CM_STEP_TOO_SMALL
-                    msg = "step size too small at t ="//trim(buf)//" (the Newton "// &
+                    msg = "step size too small at t ="//rtoa(self%t)//" (the Newton "// &
                           "iteration did not converge in 60 step reductions)"
                     return
                 end if

@@ -128,24 +128,12 @@ contains
     subroutine dop853_kernel4(sys, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         class(ode_system), intent(in) :: sys
         integer, parameter :: n = 4
-        type(rk_tableau), intent(in) :: tb
-        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
-        real(dp), intent(inout) :: k(n, 12)
-        real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
-        real(dp) :: err5, err3, deno, sk, bs, e3, e5
-        integer :: i
         include "conmech_rk_dop853_body.inc"
     end subroutine dop853_kernel4
 
     subroutine dop853_kernel(sys, n, tb, t, h, y, k, ynew, ytmp, w3, rtol, atol, err)
         class(ode_system), intent(in) :: sys
         integer, intent(in) :: n
-        type(rk_tableau), intent(in) :: tb
-        real(dp), intent(in) :: t, h, y(n), rtol(n), atol(n)
-        real(dp), intent(inout) :: k(n, 12)
-        real(dp), intent(out) :: ynew(n), ytmp(n), w3(n), err
-        real(dp) :: err5, err3, deno, sk, bs, e3, e5
-        integer :: i
         include "conmech_rk_dop853_body.inc"
     end subroutine dop853_kernel
 

@@ -25,12 +25,15 @@ module conmech_rk_stepper
     use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, METHOD_RK4, METHOD_DOPRI5, &
         METHOD_DOP853, METHOD_VERNER98
     use conmech_ode_stepper, only: ode_stepper, stepper_init, check_first_step, &
-        tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL
+        tolerance_vectors, FORM_HAIRER, FORM_POWER, min_step_at, MSG_STEP_TOO_SMALL, &
+        MSG_TOO_MANY_STEPS
     use conmech_state_packer, only: state_packer
+    use conmech_fixed_grid, only: grid_steps
     use conmech_rk_tableaus, only: rk_tableau, set_dopri5_tableau, set_dop853_tableau, &
         set_verner98_tableau
     use conmech_rk_kernels, only: rk4_attempt, dopri5_attempt, dop853_attempt, &
@@ -240,8 +243,7 @@ contains
                 call hinit(self, sys)
             end if
         else
-            nsteps = max(1, ceiling(abs(self%tf - self%t)/self%first_step &
-                                    *(1.0_dp - 1.0e-12_dp)))
+            nsteps = max(1, grid_steps(self%t, self%tf, self%first_step))
             self%h = (self%tf - self%t)/real(nsteps, dp)
         end if
         self%h_fixed = self%h
@@ -335,7 +337,6 @@ contains
         real(dp), allocatable :: yswap(:)
         integer :: n
         logical :: defer, first_try
-        character(len=32) :: buf
         n = self%n
         info = CM_SUCCESS
         if (self%fsal_pending) then
@@ -346,8 +347,7 @@ contains
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
-                write (buf, '(es14.6)') self%t
-                msg = "too many steps: max_steps reached at t ="//trim(buf)
+                msg = MSG_TOO_MANY_STEPS//rtoa(self%t)
                 return
             end if
             ! the smallest step (SciPy's min_step <= 10 eps |t|: the cheap test first)
@@ -357,21 +357,19 @@ contains
                 if (first_try .and. .not. self%h_capped .and. self%n_nonfinite == 0) &
                     self%h = self%posneg*max(abs(self%h), hmin)
                 if (abs(self%h) < hmin .or. abs(self%h) < tiny(1.0_dp)) then
-                    write (buf, '(es14.6)') self%t
                     if (self%n_nonfinite > 0) then
                         info = CM_NONFINITE
-                        msg = "non-finite values in the right-hand side near t ="//trim(buf)
+                        msg = "non-finite values in the right-hand side near t ="//rtoa(self%t)
                     else
                         info = CM_STEP_TOO_SMALL
-                        msg = MSG_STEP_TOO_SMALL//trim(buf)
+                        msg = MSG_STEP_TOO_SMALL//rtoa(self%t)
                     end if
                     return
                 end if
             else if (.not. self%adaptive .and. (0.1_dp*abs(self%h) <= abs(self%t)* &
                                                 epsilon(1.0_dp) .or. abs(self%h) < tiny(1.0_dp))) then
-                write (buf, '(es14.6)') self%t
                 info = CM_STEP_TOO_SMALL
-                msg = "step size too small at t ="//trim(buf)
+                msg = "step size too small at t ="//rtoa(self%t)
                 return
             end if
             first_try = .false.
@@ -415,8 +413,7 @@ contains
                 ! ------------------------------------------------ rejected step
                 if (.not. self%adaptive) then
                     info = CM_NONFINITE
-                    write (buf, '(es14.6)') self%t
-                    msg = "non-finite state in a fixed step from t ="//trim(buf)
+                    msg = "non-finite state in a fixed step from t ="//rtoa(self%t)
                     return
                 end if
                 if (ieee_is_nan(err) .or. err > huge(1.0_dp)) then
@@ -424,8 +421,7 @@ contains
                     self%n_nonfinite = self%n_nonfinite + 1
                     if (self%n_nonfinite > 40) then
                         info = CM_NONFINITE
-                        write (buf, '(es14.6)') self%t
-                        msg = "non-finite values in the right-hand side near t ="//trim(buf)
+                        msg = "non-finite values in the right-hand side near t ="//rtoa(self%t)
                         return
                     end if
                     self%h = self%h*0.1_dp

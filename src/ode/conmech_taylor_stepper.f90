@@ -27,9 +27,10 @@
 module conmech_taylor_stepper
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, ode_stats, METHOD_TAYLOR
-    use conmech_ode_stepper, only: ode_stepper, check_interval, FORM_POWER
+    use conmech_ode_stepper, only: ode_stepper, check_interval, tolerance_vectors, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_taylor_events, only: taylor_events, limit_step
     use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_add_time, &
@@ -91,7 +92,8 @@ contains
         n = size(y0)
         call check_interval(t0, tf, y0, opt, info, msg, allow_inf=allow_inf)
         if (info /= CM_SUCCESS) return
-        call tolerances(self, opt, n, info, msg)
+        call tolerance_vectors(opt, n, self%rtol, self%atol, info, msg, &
+                               rtol_min=epsilon(1.0_dp))
         if (info /= CM_SUCCESS) return
         self%eps = max(minval(self%rtol), minval(self%atol))
         self%order = taylor_order(self%eps)
@@ -117,43 +119,6 @@ contains
         if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
         allocate (self%dy(n), self%ynew(n), self%e(n))
     end subroutine taylor_init
-
-    !> Per-component tolerances (non-negative; rtol at least the unit round-off).
-    subroutine tolerances(self, opt, n, info, msg)
-        class(taylor_stepper), intent(inout) :: self
-        type(ode_options), intent(in) :: opt
-        integer, intent(in) :: n
-        integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
-        if (allocated(self%rtol)) deallocate (self%rtol, self%atol)
-        allocate (self%rtol(n), self%atol(n))
-        info = CM_BAD_INPUT
-        if (allocated(opt%rtol_vec)) then
-            if (size(opt%rtol_vec) /= n) then
-                msg = "bad input: rtol must be a scalar or have the size of y0"
-                return
-            end if
-            self%rtol = opt%rtol_vec
-        else
-            self%rtol = opt%rtol
-        end if
-        if (allocated(opt%atol_vec)) then
-            if (size(opt%atol_vec) /= n) then
-                msg = "bad input: atol must be a scalar or have the size of y0"
-                return
-            end if
-            self%atol = opt%atol_vec
-        else
-            self%atol = opt%atol
-        end if
-        if (.not. (all(self%rtol >= 0.0_dp) .and. all(self%atol >= 0.0_dp))) then
-            msg = "bad input: rtol and atol must be non-negative"
-            return
-        end if
-        self%rtol = max(self%rtol, epsilon(1.0_dp))
-        info = CM_SUCCESS
-        msg = "success"
-    end subroutine tolerances
 
     !> The expansion at the initial point and the first step. A system without Taylor
     !! coefficients is CM_BAD_INPUT with a message saying so.
@@ -231,7 +196,6 @@ contains
         real(dp) :: h, err, d
         integer :: p, n, ic, io
         logical :: fin
-        character(len=32) :: buf
         ! msg is set on failure only (as the Runge-Kutta steppers): no allocation per step
         info = CM_SUCCESS
         p = self%order
@@ -243,14 +207,12 @@ contains
         do
             if (self%nsteps >= self%max_steps) then
                 info = CM_TOO_MANY_STEPS
-                write (buf, '(es14.6)') self%t
-                msg = "more than max_steps steps, at t ="//trim(buf)
+                msg = "more than max_steps steps, at t ="//rtoa(self%t)
                 return
             end if
             if (.not. (0.1_dp*abs(h) > abs(self%t)*epsilon(1.0_dp))) then
                 info = CM_STEP_TOO_SMALL
-                write (buf, '(es14.6)') self%t
-                msg = "step size too small at t ="//trim(buf)
+                msg = "step size too small at t ="//rtoa(self%t)
                 return
             end if
             self%hit = .false.
@@ -425,7 +387,6 @@ contains
         character(len=:), allocatable, intent(out) :: msg
         integer, intent(in), optional :: kind
         type(taylor_stepper) :: stp
-        character(len=32) :: buf
         character(len=:), allocatable :: smsg
         stats = ode_stats()
         if (present(kind)) stp%kind = kind
@@ -444,8 +405,7 @@ contains
             end if
             if (.not. stp%f_finite()) then
                 info = CM_NONFINITE
-                write (buf, '(es14.6)') stp%t
-                msg = "non-finite right-hand side at t ="//trim(buf)
+                msg = "non-finite right-hand side at t ="//rtoa(stp%t)
                 exit
             end if
             if (stp%last) exit
