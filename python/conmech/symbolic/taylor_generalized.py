@@ -276,11 +276,21 @@ def generalized_procedures(g, names, prefix="conmech_taylor", write_out=None, np
 
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
-    library (conmech.symbolic.taylor_library): the core only; the batch, quadruple
-    precision and variational parts are not generated for generalized systems."""
+    library (conmech.symbolic.taylor_library): the core and the variational system's
+    (``var``: conmech.symbolic.taylor_generalized_var); the batch and quadruple precision
+    parts are not generated for generalized systems, nor the variational part of trees."""
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)
     npar = max(len(d.params), 1)
+    if part == "var":
+        from .taylor_generalized_var import variational_decomposition, variational_procedures
+        if "gvar" not in dec_cache:
+            dec_cache["gvar"] = variational_decomposition(d)
+        gv, why = dec_cache["gvar"]
+        if gv is None:
+            return [], [], why
+        return variational_procedures(gv, names, npar=npar), \
+            ["taylor_var", "taylor_var_info"], None
     return core_part_lines(d, part, dec_cache, "g", generalized_decomposition,
                            "generalized systems M(q) q'' = Q",
                            lambda g: generalized_procedures(g, names, npar=npar))
