@@ -1,6 +1,7 @@
 """The variational system of a generalized system M(q) q'' = Q by Taylor's method
 (conmech.symbolic.taylor_generalized_var: the columns of Phi further right-hand sides of
-the series-Cholesky solve with M, M da = (dQ/dy - dM/dy . a) Phi).
+the series-Cholesky solve with M, M da = (dQ/dy - dM/dy . a) Phi), and its recurrences in
+quadruple precision (conmech.symbolic.taylor_generalized.generalized_quad_routine).
 
 - the generated coefficients of [y; Phi] against the core routine's (the state rows) and
   against central differences of the core routine's coefficients in the initial state
@@ -14,7 +15,10 @@ the series-Cholesky solve with M, M da = (dQ/dy - dM/dy . a) Phi).
 - the monodromy of a nonlinear normal mode of the double pendulum (found by symmetric
   shooting on the default route) through the Taylor route: the orbit's multipliers, the
   flow direction kept (Phi f(y0) = f(y0)), the DOP853 monodromy;
-- a tree has no variational part: a ValueError with the reason.
+- a tree has no variational part: a ValueError with the reason;
+- quadruple precision: the double pendulum by Taylor in real128 against Hairer's DOP853 in
+  real128 (a second method on the routine's first coefficient) to 1e-23, and the double
+  Taylor run at 1e-13 to 1e-12.
 """
 import ctypes
 
@@ -27,7 +31,7 @@ import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
 from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
 from conmech.stability import floquet, monodromy, stm, symmetric_orbit  # noqa: E402
-from conmech.symbolic import build  # noqa: E402
+from conmech.symbolic import build, taylor_quad  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
@@ -212,3 +216,17 @@ def test_a_tree_has_no_variational_part():
     assert conmech.solve_ivp(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR").success
     with pytest.raises(ValueError, match="variational"):
         stm(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR")
+
+
+def test_quadruple_precision_agrees_with_dop853_in_real128(double_pendulum):
+    y0 = ["1.2", "-0.4", "0.3", "0.1"]
+    r = taylor_quad.reference(double_pendulum, (0, 2), y0, tol=1e-28)
+    d = taylor_quad.reference_dop853(double_pendulum, (0, 2), y0, rtol=1e-25)
+    assert r.success and d.success and r.order > 30
+    from decimal import Decimal
+    diff = [abs(Decimal(u) - Decimal(v)) for u, v in zip(r.y_str, d.y_str)]
+    assert max(diff) < Decimal("1e-23"), diff
+    assert max(abs(Decimal(u)) for u in r.y_str) > Decimal(2)      # the state moved
+    s = conmech.solve_ivp(double_pendulum, (0, 2), [float(v) for v in y0], method="TAYLOR",
+                          rtol=1e-13, atol=1e-13)
+    assert np.max(np.abs(s.y[:, -1] - r.y_float)) < 1e-12

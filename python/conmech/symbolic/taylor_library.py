@@ -38,7 +38,7 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 MODULE = "conmech_symbolic_taylor_library"
 
 _FORMAT = 4     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
-                # 4: the variational part of generalized models)
+                # 4: the variational and quadruple-precision parts of generalized models)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -140,8 +140,9 @@ def taylor_source(d, part="core", _dec=None):
     ``conmech_taylor_batch``, ``qp`` ``conmech_taylor_qp``, ``var``
     ``conmech_taylor_var`` and ``_var_info``, the routines a model library with Taylor
     code holds. A generalized record M(q) q'' = Q has the core, with
-    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), and the variational
-    part (:mod:`conmech.symbolic.taylor_generalized_var`); a tree the core only. (None, [],
+    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the quadruple
+    precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
+    a tree the core only. (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
     if part not in PARTS and _lanes(part) is None:
         raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "
