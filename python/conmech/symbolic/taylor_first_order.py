@@ -41,8 +41,8 @@ def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        ", rhs=
 def core_part_lines(d, part, dec_cache, key, decompose, what, procedures):
     """(Fortran lines, entry names, reason) of one part of the Taylor library of a model whose
     recurrences run through its first-order view: the core only (the batch, quadruple
-    precision and variational parts are generated for ode systems only; a generalized
-    system's variational part: conmech.symbolic.taylor_generalized_var). decompose(d) ->
+    precision and variational parts of a generalized system are generated apart, by
+    conmech.symbolic.taylor_generalized and taylor_generalized_var). decompose(d) ->
     (*pieces, reason), pieces[0] None when the model is not supported, is kept in
     dec_cache[key] for the other parts; procedures(*pieces) writes the core; `what` names
     the kind of model in the refusal of another part."""
