@@ -305,10 +305,10 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
 
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
-    library (conmech.symbolic.taylor_library): the core, the quadruple precision one
-    (``qp``) and the variational system's (``var``: conmech.symbolic.taylor_generalized_var);
-    the batch part is not generated for generalized systems, nor the qp and var parts of
-    trees."""
+    library (conmech.symbolic.taylor_library): the core and the quadruple precision one
+    (``qp``); the batch part is not generated for generalized systems, nor the qp part of
+    trees (the variational part: conmech.symbolic.taylor_generalized_var.variational_lines).
+    """
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)
     npar = max(len(d.params), 1)
@@ -319,15 +319,6 @@ def generalized_lines(d, names, part, dec_cache):
         if g is None:
             return [], [], why
         return generalized_quad_routine(g, names, npar=npar), ["taylor_qp"], None
-    if part == "var":
-        from .taylor_generalized_var import variational_decomposition, variational_procedures
-        if "gvar" not in dec_cache:
-            dec_cache["gvar"] = variational_decomposition(d)
-        gv, why = dec_cache["gvar"]
-        if gv is None:
-            return [], [], why
-        return variational_procedures(gv, names, npar=npar), \
-            ["taylor_var", "taylor_var_info"], None
     return core_part_lines(d, part, dec_cache, "g", generalized_decomposition,
                            "generalized systems M(q) q'' = Q",
                            lambda g: generalized_procedures(g, names, npar=npar))

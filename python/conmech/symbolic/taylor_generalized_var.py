@@ -35,8 +35,9 @@ from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import first_order_procedures
 from .taylor_generalized import (WRITE_OUT_MAX, _cholesky_loop, _cholesky_out, _solve_loop,
                                  _solve_out, generalized_decomposition)
+from .taylor_tree import is_tree, tree_lines
 
-__all__ = ["variational_decomposition", "variational_procedures"]
+__all__ = ["variational_decomposition", "variational_procedures", "variational_lines"]
 
 
 class VariationalDecomposition:
@@ -280,3 +281,18 @@ def variational_procedures(g, names, prefix="conmech_taylor_var", write_out=None
     decl, body = variational_body(g, names, ind, write_out)
     return first_order_procedures(prefix, g.ncol, g.m + g.m*g.m, npar, decl, body, ind,
                                   rhs=False)
+
+
+def variational_lines(d, names, dec_cache):
+    """(Fortran lines, entry names, reason) of the variational part ("var") of a generalized
+    model's Taylor library (conmech.symbolic.taylor_library); a tree's is refused with the
+    reason (conmech.symbolic.taylor_tree)."""
+    if is_tree(d):
+        return tree_lines(d, names, "var", dec_cache)
+    if "gvar" not in dec_cache:
+        dec_cache["gvar"] = variational_decomposition(d)
+    gv, why = dec_cache["gvar"]
+    if gv is None:
+        return [], [], why
+    return variational_procedures(gv, names, npar=max(len(d.params), 1)), \
+        ["taylor_var", "taylor_var_info"], None

@@ -98,6 +98,9 @@ def _lines(d, part, dec_cache):
     from . import taylor as T
     names = _names(d)
     if d.kind == "generalized":          # through the accelerations' linear solve
+        if part == "var":
+            from .taylor_generalized_var import variational_lines
+            return variational_lines(d, names, dec_cache)
         from .taylor_generalized import generalized_lines
         return generalized_lines(d, names, part, dec_cache)
     if "f" not in dec_cache:
