@@ -32,22 +32,30 @@ def _model(fun):
     return model if getattr(model.derived, "kind", None) == "generalized" else None
 
 
-def first_order_view(fun):
+def first_order_view(fun, *parts):
     """The first-order view (an ode system of dimension 2 ndof with Taylor coefficients)
     of a generalized system made by conmech.symbolic, with fun's parameters; any other
-    system is returned as it is. ValueError with the reason when the generalized system's
-    accelerations have no Taylor recurrences (a non-smooth expression, an asymmetric mass
-    matrix)."""
+    system is returned as it is. `parts`: further parts of the Taylor library the view
+    carries ("var": the variational system's recurrences, for stm(method="TAYLOR"); "qp":
+    quadruple precision, for conmech.symbolic.taylor_quad.reference).
+    ValueError with the reason when the generalized system's accelerations (or a part
+    asked for) have no Taylor recurrences (a non-smooth expression, an asymmetric mass
+    matrix, the variational system of a tree)."""
     model = _model(fun)
     if model is None:
         return fun
     from .. import compiled
     from ..symbolic.taylor_library import lazy_taylor
-    tay = lazy_taylor(model).get()
+    tay = lazy_taylor(model).get(*parts)
     if not tay:
         raise ValueError("method TAYLOR: the generalized system M(q) q'' = Q has no Taylor "
                          f"recurrences: {getattr(model, 'taylor_reason', None) or 'unknown'}"
                          ". Use method DOP853 or VERNER98")
+    for part, what in (("var", "the variational system"), ("qp", "quadruple precision")):
+        if part in parts and part not in tay:
+            why = model.__dict__.get("_taylor_parts", {}).get(part, (None, None, None))[2]
+            raise ValueError(f"method TAYLOR: {what} of the generalized system M(q) q'' = Q "
+                             f"has no Taylor recurrences: {why or 'unknown'}")
     base = model.__dict__.get("_taylor_view")
     if base is None:
         base = compiled.ode_system(
@@ -55,6 +63,12 @@ def first_order_view(fun):
             param_names=tuple(fun.param_names), keep=model, name=fun.name,
             taylor={"jet": tay["jet"], "nw": tay["nw"]})
         model._taylor_view = base
+    new = {k: tay[k] for k in ("var", "nw_var", "qp") if k in tay and k not in base.taylor}
+    if new:
+        # the variational or quadruple-precision routine joins the view's entries (its
+        # spec is shared by every view of the model; the library stays loaded with it)
+        base.taylor.update(new)
+        compiled._taylor_spec(base.spec, base.taylor)
     return compiled.CompiledSystem(base.name, "ode", base.spec, np.array(fun.params),
                                    base.param_names, base._keep, base.taylor)
 

@@ -12,6 +12,7 @@ from .._core.native import NativeSystem
 from .._core.validate import (_callback, _check_dim, _no_jac_for_builtin, _real, _state,
                               _system_args, _tols)
 from .._core.status import raise_status
+from ..ivp.taylor_generalized import first_order_view
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
         atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
@@ -23,7 +24,9 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     central finite differences, accurate to ~1e-6 relative). With ``full_output`` a third
     item, a dict {nfev, njev}, is returned. ``method="TAYLOR"``: Taylor's method on the
     variational system's own recurrences (a system from :func:`conmech.symbolic.ode_system`:
-    the state and Phi expanded together, the step controlled on both)."""
+    the state and Phi expanded together, the step controlled on both; a generalized
+    system of :mod:`conmech.symbolic` through the accelerations' linear solve, the
+    columns of Phi further right-hand sides of the same mass matrix)."""
     y0 = _state(y0)
     _check_dim(system, y0)
     try:
@@ -42,7 +45,10 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
                              "(conmech.symbolic.ode_system), not a Python function")
         # a system of conmech.symbolic compiles the recurrences of its variational
         # system here, on first need (their entries then in its spec); without them
-        # Fortran refuses the method
+        # Fortran refuses the method. A generalized system M(q) q'' = Q runs its
+        # first-order view y = [q; v], whose variational routine expands M da = K Phi
+        # (conmech.symbolic.taylor_generalized_var)
+        system = first_order_view(system, "var")
         if hasattr(system, "taylor_parts"):
             system.taylor_parts("var")
         y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(

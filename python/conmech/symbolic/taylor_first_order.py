@@ -7,9 +7,10 @@ right-hand side as the order-1 coefficient of the same recurrences."""
 __all__ = ["core_part_lines", "first_order_procedures"]
 
 
-def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
+def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        ", rhs=True):
     """Fortran lines of the three procedures around the recurrences' declarations `decl`
-    and statements `body` (w has `nw` columns, the state `m` entries, p `npar`)."""
+    and statements `body` (w has `nw` columns, the state `m` entries, p `npar`); without
+    `rhs` the first two only (a variational system's)."""
     lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
              f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{ind}real(dp), value, intent(in) :: t",
@@ -21,6 +22,8 @@ def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
               f"{ind}integer(c_int), intent(out) :: info(4)",
               f"{ind}info = [{nw}, 0, {m}, 0]",
               f"    end subroutine {prefix}_info", ""]
+    if not rhs:
+        return lines
     lines += [f'    subroutine {prefix}_rhs(t, y, dydt, p) bind(C, name="{prefix}_rhs")',
               f"{ind}real(dp), value, intent(in) :: t",
               f"{ind}real(dp), intent(in) :: y({m})",
@@ -38,7 +41,8 @@ def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        "):
 def core_part_lines(d, part, dec_cache, key, decompose, what, procedures):
     """(Fortran lines, entry names, reason) of one part of the Taylor library of a model whose
     recurrences run through its first-order view: the core only (the batch, quadruple
-    precision and variational parts are generated for ode systems only). decompose(d) ->
+    precision and variational parts of a generalized system are generated apart, by
+    conmech.symbolic.taylor_generalized and taylor_generalized_var). decompose(d) ->
     (*pieces, reason), pieces[0] None when the model is not supported, is kept in
     dec_cache[key] for the other parts; procedures(*pieces) writes the core; `what` names
     the kind of model in the refusal of another part."""
@@ -49,5 +53,5 @@ def core_part_lines(d, part, dec_cache, key, decompose, what, procedures):
         return [], [], why
     if part != "core":
         return [], [], (f"the Taylor part {part!r} (ensembles, quadruple precision, the "
-                        f"variational system) is generated for ode systems only, not for {what}")
+                        f"variational system) is not generated for {what}")
     return procedures(*pieces), ["taylor", "taylor_info", "taylor_rhs"], None

@@ -36,7 +36,8 @@ from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import core_part_lines, first_order_procedures
 from .taylor_tree import is_tree, tree_lines
 
-__all__ = ["generalized_decomposition", "generalized_procedures", "WRITE_OUT_MAX"]
+__all__ = ["generalized_decomposition", "generalized_procedures", "generalized_quad_routine",
+           "WRITE_OUT_MAX"]
 
 #: the Cholesky factorisation and triangular solves are written out in scalars up to this
 #: many degrees of freedom (loops over a local array beyond)
@@ -101,7 +102,7 @@ def generalized_decomposition(d):
         return None, str(exc)
 
 
-def _cholesky_out(g, pp, M0, ind, fail):
+def _cholesky_out(g, pp, M0, ind, fail, kind="dp"):
     """Written-out Cholesky factorisation of M_0 (its entries as Fortran text M0(i, j)):
     the strictly lower factor in scalars cl<i>_<j>, the reciprocal diagonal in cd<i>."""
     n = g.n
@@ -112,7 +113,7 @@ def _cholesky_out(g, pp, M0, ind, fail):
         terms = [f"cl{j + 1}_{k + 1}**2" for k in range(j)]
         expr = f"{s}" + "".join(f" - {t}" for t in terms)
         lines += _wrap(f"cs = {expr}", ind)
-        lines.append(f"{ind}if (.not. cs > 0.0_dp) then")
+        lines.append(f"{ind}if (.not. cs > 0.0_{kind}) then")
         lines += [f"{ind}    {x}" for x in fail]
         lines.append(f"{ind}end if")
         lines.append(f"{ind}cd{j + 1} = {one}/sqrt(cs)")
@@ -137,15 +138,15 @@ def _solve_out(n, ind):
     return lines
 
 
-def _cholesky_loop(n, ind, fail):
+def _cholesky_loop(n, ind, fail, kind="dp"):
     """The same factorisation in loops over the local array lm (lower triangle, holding
     M_0's on entry), reciprocal diagonal in ld."""
     return [f"{ind}do jj = 1, {n}",
             f"{ind}    cs = lm(jj, jj) - sum(lm(jj, 1:jj - 1)**2)",
-            f"{ind}    if (.not. cs > 0.0_dp) then"] + \
+            f"{ind}    if (.not. cs > 0.0_{kind}) then"] + \
         [f"{ind}        {x}" for x in fail] + \
         [f"{ind}    end if",
-         f"{ind}    ld(jj) = 1.0_dp/sqrt(cs)",
+         f"{ind}    ld(jj) = 1.0_{kind}/sqrt(cs)",
          f"{ind}    do ii = jj + 1, {n}",
          f"{ind}        lm(ii, jj) = (lm(ii, jj) - sum(lm(ii, 1:jj - 1)*lm(jj, 1:jj - 1)))"
          "*ld(jj)",
@@ -162,20 +163,22 @@ def _solve_loop(n, ind):
             f"{ind}end do"]
 
 
-def generalized_body(g, names, ind="        ", write_out=None):
+def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     """(declarations, statements) of the coefficient routine (see the module docstring)
-    for a procedure that declares t, order, w(0:order, g.ncol) and p."""
+    for a procedure that declares t, order, w(0:order, g.ncol) and p (of the real kind
+    `kind`: "dp", or "qp" for quadruple precision)."""
     n = g.n
     dec = g.dec
     out = n <= WRITE_OUT_MAX if write_out is None else write_out
-    pp = _Printer(dec, names, False, "dp")
+    pp = _Printer(dec, names, False, kind)
     rc = _Recipe(pp, True, "order")
     W = pp.w
     one = pp.real(1)
-    zero = "0.0_dp"
-    decl = _decls([c for c, _ in rc.consts], "real(dp)", ind)
-    decl += _decls(rc.accs + rc.invs, "real(dp)", ind)
-    decl += [f"{ind}real(dp) :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
+    zero = f"0.0_{kind}"
+    real = f"real({kind})"
+    decl = _decls([c for c, _ in rc.consts], real, ind)
+    decl += _decls(rc.accs + rc.invs, real, ind)
+    decl += [f"{ind}{real} :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
     body = [f"{ind}if (order < 1) return"]
     for c, e in rc.consts:
         body += _wrap(f"{c} = {e}", ind)
@@ -190,21 +193,21 @@ def generalized_body(g, names, ind="        ", write_out=None):
         if g.constant(i, j):
             return pp.lin_at(g.entry(i, j), 0, True)
         return W(0, g.entry_col(i, j))
-    fail = ["w(1:order, :) = ieee_value(1.0_dp, ieee_quiet_nan)", "return"]
+    fail = [f"w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)", "return"]
     if out:
-        chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
+        chol, names_c = _cholesky_out(g, pp, M0, ind, fail, kind)
         solve = _solve_out(n, ind + "    ")
         rvec = [f"cr{i + 1}" for i in range(n)]
         gacc = [f"cg{i + 1}" for i in range(n)]
-        decl += _decls(names_c + rvec + gacc, "real(dp)", ind)
+        decl += _decls(names_c + rvec + gacc, real, ind)
     else:
-        decl += [f"{ind}real(dp) :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
+        decl += [f"{ind}{real} :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
                  f"{ind}integer :: ii, jj"]
-        chol = [f"{ind}lm = 0.0_dp"]
+        chol = [f"{ind}lm = {zero}"]
         for j in range(n):
             for i in range(j, n):
                 chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
-        chol += _cholesky_loop(n, ind, fail)
+        chol += _cholesky_loop(n, ind, fail, kind)
         solve = _solve_loop(n, ind + "    ")
         rvec = [f"cr({i + 1})" for i in range(n)]
         gacc = [f"cg({i + 1})" for i in range(n)]
@@ -220,7 +223,7 @@ def generalized_body(g, names, ind="        ", write_out=None):
     body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
     # orders 1 .. order - 1
     loop = [f"{ind}do k = 1, order - 1",
-            f"{ind}    fk = real(k, dp)",
+            f"{ind}    fk = real(k, {kind})",
             f"{ind}    rk = {one}/fk",
             f"{ind}    rk1 = {one}/(fk + {one})"]
     loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
@@ -232,7 +235,7 @@ def generalized_body(g, names, ind="        ", write_out=None):
     if plain or prods:
         loop.append(f"{ind}    do j = 1, k - 1")
         for h, lft, rgt, wt in plain:
-            wj = f"({wt}*real(j, dp) - fk)*" if wt else ""
+            wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
             loop += _wrap(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}", ind + "        ")
         for i in range(n):
             terms = [f"{W('j', g.entry_col(i, l))}*{W('k - j', g.acols[l])}"
@@ -274,13 +277,48 @@ def generalized_procedures(g, names, prefix="conmech_taylor", write_out=None, np
     return first_order_procedures(prefix, nw, m, npar, decl, body, ind)
 
 
+def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None, npar=1):
+    """The same recurrences in quadruple precision: ``cname(t, order, w, p)`` through C
+    pointers to real128 values (as conmech.symbolic.taylor.quad_routine: t, w(0:order,
+    g.ncol), p), the accelerations' factorisation and solves in real128 too."""
+    ind = "        "
+    nw = g.ncol
+    head = [f'    subroutine {cname}(tp, order, wp, pp) bind(C, name="{cname}")',
+            f"{ind}type(c_ptr), value, intent(in) :: tp, wp, pp",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(qp), pointer :: tq",
+            f"{ind}real(qp), pointer, contiguous :: wq(:, :), pq(:)",
+            f"{ind}call c_f_pointer(tp, tq)",
+            f"{ind}call c_f_pointer(wp, wq, [order + 1, {nw}])",
+            f"{ind}call c_f_pointer(pp, pq, [{npar}])",
+            f"{ind}call {cname}_body(tq, order, wq, pq)",
+            f"    end subroutine {cname}", ""]
+    inner = [f"    subroutine {cname}_body(t, order, w, p)",
+             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{ind}real(qp), intent(in) :: t",
+             f"{ind}integer(c_int), intent(in) :: order",
+             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
+             f"{ind}real(qp), intent(in) :: p({npar})"]
+    decl, body = generalized_body(g, names, ind, write_out, "qp")
+    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
+
+
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
-    library (conmech.symbolic.taylor_library): the core only; the batch, quadruple
-    precision and variational parts are not generated for generalized systems."""
+    library (conmech.symbolic.taylor_library): the core and the quadruple precision one
+    (``qp``); the batch part is not generated for generalized systems, nor the qp part of
+    trees (the variational part: conmech.symbolic.taylor_generalized_var.variational_lines).
+    """
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)
     npar = max(len(d.params), 1)
+    if part == "qp":
+        if "g" not in dec_cache:
+            dec_cache["g"] = generalized_decomposition(d)
+        g, why = dec_cache["g"]
+        if g is None:
+            return [], [], why
+        return generalized_quad_routine(g, names, npar=npar), ["taylor_qp"], None
     return core_part_lines(d, part, dec_cache, "g", generalized_decomposition,
                            "generalized systems M(q) q'' = Q",
                            lambda g: generalized_procedures(g, names, npar=npar))

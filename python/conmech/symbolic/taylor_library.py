@@ -37,7 +37,8 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 3     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees)
+_FORMAT = 4     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
+                # 4: the variational and quadruple-precision parts of generalized models)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -97,6 +98,9 @@ def _lines(d, part, dec_cache):
     from . import taylor as T
     names = _names(d)
     if d.kind == "generalized":          # through the accelerations' linear solve
+        if part == "var":
+            from .taylor_generalized_var import variational_lines
+            return variational_lines(d, names, dec_cache)
         from .taylor_generalized import generalized_lines
         return generalized_lines(d, names, part, dec_cache)
     if "f" not in dec_cache:
@@ -138,8 +142,10 @@ def taylor_source(d, part="core", _dec=None):
     `d` (see :data:`PARTS`): ``core`` holds ``conmech_taylor`` and ``_info``, ``batch``
     ``conmech_taylor_batch``, ``qp`` ``conmech_taylor_qp``, ``var``
     ``conmech_taylor_var`` and ``_var_info``, the routines a model library with Taylor
-    code holds. A generalized record M(q) q'' = Q has the core only, with
-    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`). (None, [],
+    code holds. A generalized record M(q) q'' = Q has the core, with
+    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the quadruple
+    precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
+    a tree the core only. (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
     if part not in PARTS and _lanes(part) is None:
         raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "

@@ -73,12 +73,16 @@ class QuadResult(dict):
 def _quad_inputs(system, t_span, y0, params):
     """The generated quadruple-precision routine of `system` and the inputs as pairs:
     (taylor parts, n, y0 pairs (2, n), t_span pairs (2, 2), parameter pairs (2, np))."""
-    # the quadruple-precision routine of a lazy system is compiled here, on first need
+    # the quadruple-precision routine of a lazy system is compiled here, on first need; a
+    # generalized system M(q) q'' = Q runs its first-order view y = [q; v]
+    from ..ivp.taylor_generalized import first_order_view
+    system = first_order_view(system, "qp")
     taylor = system.taylor_parts("qp") if hasattr(system, "taylor_parts") else \
         getattr(system, "taylor", None)
     if not taylor or taylor.get("qp") is None:
         raise ValueError("the system has no quadruple-precision Taylor code (a system from "
-                         "conmech.symbolic.ode_system with a smooth right-hand side)")
+                         "conmech.symbolic.ode_system with a smooth right-hand side, or a "
+                         "generalized one from lagrangian_system)")
     n = system.dimension
     if isinstance(y0, (str, bytes)) or not hasattr(y0, "__len__") and \
             not hasattr(y0, "__iter__"):
@@ -110,9 +114,10 @@ def _check_max_steps(max_steps):
 
 def reference(system, t_span, y0, tol=1e-30, params=None, max_steps=1_000_000,
               method="TAYLOR"):
-    """Integrate a system made by :func:`conmech.symbolic.ode_system` from t_span[0] to
-    t_span[1] by Taylor's method in quadruple precision (order ceil(-ln(tol)/2 + 1), 36 at
-    the default 1e-30), or with ``method="DOP853"`` by :func:`reference_dop853` with
+    """Integrate a system made by :func:`conmech.symbolic.ode_system` (or a generalized
+    system M(q) q'' = Q of :mod:`conmech.symbolic`, through its first-order view y = [q; v])
+    from t_span[0] to t_span[1] by Taylor's method in quadruple precision (order
+    ceil(-ln(tol)/2 + 1), 36 at the default 1e-30), or with ``method="DOP853"`` by :func:`reference_dop853` with
     rtol = atol = tol. y0, the times, tol and the parameters (``params``: {name: value},
     overriding the system's) may be given as decimal strings for full precision."""
     method = _method_name(method)

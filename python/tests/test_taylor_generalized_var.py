@@ -1,0 +1,232 @@
+"""The variational system of a generalized system M(q) q'' = Q by Taylor's method
+(conmech.symbolic.taylor_generalized_var: the columns of Phi further right-hand sides of
+the series-Cholesky solve with M, M da = (dQ/dy - dM/dy . a) Phi), and its recurrences in
+quadruple precision (conmech.symbolic.taylor_generalized.generalized_quad_routine).
+
+- the generated coefficients of [y; Phi] against the core routine's (the state rows) and
+  against central differences of the core routine's coefficients in the initial state
+  (the Phi rows: d y^[k] / d y0, order by order), for a system where every entry of M but
+  one varies and the forces hold velocity products, and for the double pendulum; the
+  factorisation in loops gives the written-out coefficients;
+- stm(method="TAYLOR") of the double pendulum and the cart pendulum against the DOP853
+  STM (an independent route: the Jacobian of the accelerations from its own generated
+  code), and Liouville's formula in (q, v): the flow is symplectic in (q, p), p = M(q) v,
+  so det Phi = det M(q(t0)) / det M(q(t1));
+- the monodromy of a nonlinear normal mode of the double pendulum (found by symmetric
+  shooting on the default route) through the Taylor route: the orbit's multipliers, the
+  flow direction kept (Phi f(y0) = f(y0)), the DOP853 monodromy;
+- a tree has no variational part: a ValueError with the reason;
+- quadruple precision: the double pendulum by Taylor in real128 against Hairer's DOP853 in
+  real128 (a second method on the routine's first coefficient) to 1e-23, and the double
+  Taylor run at 1e-13 to 1e-12.
+"""
+import ctypes
+
+import numpy as np
+import pytest
+
+sp = pytest.importorskip("sympy")
+
+import conmech  # noqa: E402
+from conmech import symbolic  # noqa: E402
+from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
+from conmech.stability import floquet, monodromy, stm, symmetric_orbit  # noqa: E402
+from conmech.symbolic import build, taylor_quad  # noqa: E402
+from conmech.symbolic.pipeline import model_of  # noqa: E402
+from conmech.symbolic.printer import _names  # noqa: E402
+from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
+                                                     variational_procedures)
+from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
+
+_P = ctypes.POINTER(ctypes.c_double)
+_JET = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)
+
+
+def coefficients(address, nw, params, z, order, t=0.0):
+    """The coefficients z^[0..order] (rows: the components of z) of a Taylor routine."""
+    w = np.zeros((nw, order + 1))
+    w[:len(z), 0] = z
+    p = np.ascontiguousarray(params if np.size(params) else np.zeros(1), dtype=float)
+    _JET(address)(t, order, w.ctypes.data_as(_P), p.ctypes.data_as(_P))
+    return w[:len(z)]
+
+
+def jets(system, y, order, phi=None):
+    """(core coefficients of y, variational coefficients of [y; vec(Phi)])."""
+    view = first_order_view(system, "var")
+    tay = view.taylor
+    m = len(y)
+    phi = np.eye(m) if phi is None else phi
+    addr = conmech.compiled.function_address
+    core = coefficients(addr(tay["jet"]), tay["nw"], view.params, y, order)
+    var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
+                       np.concatenate([y, phi.ravel(order="F")]), order)
+    return core, var
+
+
+@pytest.fixture(scope="module")
+def rational():
+    """M(q) = [[1 + q2^2, q1], [q1, 2]], U = (q1^2 + q2^2)/2 + q1 q2^2 / 3."""
+    t = sp.Symbol("t")
+    q1, q2 = sp.Function("q1")(t), sp.Function("q2")(t)
+    M = sp.Matrix([[1 + q2**2, q1], [q1, 2]])
+    qd = sp.Matrix([q1.diff(t), q2.diff(t)])
+    L = (qd.T*M*qd)[0]/2 - (q1**2 + q2**2)/2 - q1*q2**2/3
+    return symbolic.lagrangian_system(L, [q1, q2])
+
+
+@pytest.fixture(scope="module")
+def cart():
+    """The lecture notes' pendulum on a cart (M = m = l = 1, theta from the upright)."""
+    t = dynamicsymbols._t
+    x, th = dynamicsymbols("x theta")
+    g = sp.Symbol("g")
+    T = x.diff(t)**2 + sp.cos(th)*x.diff(t)*th.diff(t) + th.diff(t)**2/2
+    return symbolic.lagrangian_system(T - g*sp.cos(th), [x, th], params={g: 9.81})
+
+
+@pytest.fixture(scope="module")
+def double_pendulum():
+    """Unit point masses on unit rods, angles from the downward vertical."""
+    t = dynamicsymbols._t
+    a, b = dynamicsymbols("a b")
+    g = sp.Symbol("g")
+    ad, bd = a.diff(t), b.diff(t)
+    T = ad**2 + ad*bd*sp.cos(a - b) + bd**2/2
+    U = -g*(2*sp.cos(a) + sp.cos(b))
+    return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
+
+
+def mass(system, q):
+    model = model_of(system)
+    n = len(q)
+    m = model.call("mass", 0.0, np.asarray(q, dtype=float),
+                   params=np.asarray(system.params, dtype=float))
+    return np.array(m, dtype=float).reshape(n, n)
+
+
+# ------------------------------------------------------------------ coefficients
+
+@pytest.mark.parametrize("which", ["rational", "double_pendulum"])
+def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
+    """Row block of column c of Phi at order k = d y^[k] / d y0_c: central differences
+    (step h, error O(h^2) ~ 1e-10 relative at these orders) of the core routine's
+    coefficients; the state rows are the core routine's own to round-off."""
+    system = request.getfixturevalue(which)
+    y = np.array([0.5, -1/3, 0.2, 0.75]) if which == "rational" else \
+        np.array([1.2, -0.4, 0.3, 0.1])
+    order = 10
+    core, var = jets(system, y, order)
+    m = y.size
+    scale = np.max(np.abs(core), axis=0)
+    assert np.all(np.abs(var[:m] - core) <= 64*np.finfo(float).eps*scale)
+    h = 1e-5
+    for c in range(m):
+        e = np.zeros(m)
+        e[c] = h
+        fd = (jets(system, y + e, order)[0] - jets(system, y - e, order)[0])/(2*h)
+        got = var[m + c*m:m + (c + 1)*m]
+        for k in range(order + 1):
+            ref = max(np.max(np.abs(fd[:, k])), 1e-3)
+            assert np.max(np.abs(got[:, k] - fd[:, k])) <= 1e-7*ref, (c, k)
+    # Phi enters linearly: a general Phi0 gives the coefficients of the identity's times it
+    phi0 = np.arange(1.0, 1.0 + m*m).reshape(m, m)/7.0 - 1.0
+    _, var2 = jets(system, y, order, phi0)
+    K = order + 1
+    blocks = var[m:].reshape(m, m, K)          # [column, row, order] of the identity's
+    want = np.einsum("crk,cd->drk", blocks, phi0)
+    got2 = var2[m:].reshape(m, m, K)
+    assert np.allclose(got2, want, rtol=1e-12, atol=1e-12*np.max(np.abs(want)))
+
+
+def test_factorisation_in_loops_gives_the_written_out_coefficients(cart):
+    d = model_of(cart).derived
+    g, why = variational_decomposition(d)
+    assert why is None
+    lines = variational_procedures(g, _names(d), write_out=False, npar=len(d.params))
+    head = ["module conmech_tgen_var_loop_form",
+            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
+            "    implicit none", "    integer, parameter :: dp = c_double", "    public",
+            "contains", ""]
+    src = "\n".join(head + lines + ["end module conmech_tgen_var_loop_form", ""])
+    assert "do jj = 1, 2" in src
+    entries = ["taylor_var", "taylor_var_info"]
+    path, _ = build.compile_source(src, None, entries)
+    lib, addr = build.load(path, entries)
+    y = np.array([0.3, np.pi - 0.7, -0.2, 0.5])
+    z = np.concatenate([y, np.eye(4).ravel()])
+    loops = coefficients(addr["taylor_var"], g.ncol, cart.params, z, 16)
+    written = jets(cart, y, 16)[1]
+    assert np.all(np.isfinite(written))
+    assert np.allclose(loops, written, rtol=1e-13, atol=1e-13*np.max(np.abs(written)))
+
+
+# ------------------------------------------------------------------ integration
+
+def test_taylor_stm_agrees_with_dop853_and_liouville(cart, double_pendulum):
+    for system, y0, t1 in ((double_pendulum, [1.2, -0.4, 0.3, 0.1], 5.0),
+                           (cart, [0.0, np.pi - 0.7, 0.3, 0.0], 3.0)):
+        y_t, phi_t, info = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12,
+                               method="TAYLOR", full_output=True)
+        y_d, phi_d = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12)
+        assert info["nfev"] > 0
+        big = np.max(np.abs(phi_d))
+        assert big > 2.0          # a sensitive flow: the check is not of the identity
+        assert np.max(np.abs(y_t - y_d)) < 1e-9
+        assert np.max(np.abs(phi_t - phi_d)) < 1e-8*big
+        n = len(y0)//2
+        liouville = np.linalg.det(mass(system, y0[:n]))/np.linalg.det(mass(system, y_t[:n]))
+        assert abs(np.linalg.det(phi_t) - liouville) < 1e-8*big**2
+        # the state is the Taylor solve's own
+        r = conmech.solve_ivp(system, (0.0, t1), y0, method="TAYLOR", rtol=1e-12,
+                              atol=1e-12)
+        assert np.max(np.abs(r.y[:, -1] - y_t)) < 1e-9
+
+
+def test_monodromy_of_a_normal_mode(double_pendulum):
+    """The in-phase nonlinear normal mode (b/a -> sqrt(2), omega^2 -> g (2 - sqrt(2)) at
+    small amplitude): released at rest, the velocities vanish again at half the period."""
+    g = 9.81
+    a0 = 0.3
+    period = 2*np.pi/np.sqrt(g*(2 - np.sqrt(2)))
+    orb = symmetric_orbit(double_pendulum, [a0, np.sqrt(2)*a0, 0.0, 0.0], free=[1],
+                          targets=[2, 3], period=period, free_time=True)
+    y0, T = np.asarray(orb.y0), float(orb.period)
+    mt = monodromy(double_pendulum, y0, T, method="TAYLOR")
+    md = monodromy(double_pendulum, y0, T)
+    assert np.max(np.abs(mt - md)) < 1e-8*np.max(np.abs(md))
+    # the flow direction f(y0) is kept over a period
+    f = np.concatenate([y0[2:], np.linalg.solve(
+        mass(double_pendulum, y0[:2]),
+        model_of(double_pendulum).call("forces", 0.0, y0[:2], y0[2:],
+                                       params=np.asarray(double_pendulum.params)))])
+    assert np.linalg.norm(mt @ f - f) < 1e-8*np.linalg.norm(f)
+    # the multipliers of the orbit's own (default) route
+    mu_t = np.sort_complex(floquet(mt, T)["multipliers"])
+    mu_o = np.sort_complex(np.asarray(orb.multipliers))
+    assert np.max(np.abs(mu_t - mu_o)) < 1e-5
+
+
+def test_a_tree_has_no_variational_part():
+    th = dynamicsymbols("th")
+    m, l, g = sp.symbols("m l g")
+    tree = symbolic.planar_tree(
+        [symbolic.Body("link", None, "revolute", th, at=(0, 0), mass=m, com=(0, -l))],
+        {m: 1.0, l: 1.0, g: 9.81}, gravity=(0, -g))
+    assert conmech.solve_ivp(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR").success
+    with pytest.raises(ValueError, match="variational"):
+        stm(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR")
+
+
+def test_quadruple_precision_agrees_with_dop853_in_real128(double_pendulum):
+    y0 = ["1.2", "-0.4", "0.3", "0.1"]
+    r = taylor_quad.reference(double_pendulum, (0, 2), y0, tol=1e-28)
+    d = taylor_quad.reference_dop853(double_pendulum, (0, 2), y0, rtol=1e-25)
+    assert r.success and d.success and r.order > 30
+    from decimal import Decimal
+    diff = [abs(Decimal(u) - Decimal(v)) for u, v in zip(r.y_str, d.y_str)]
+    assert max(diff) < Decimal("1e-23"), diff
+    assert max(abs(Decimal(u)) for u in r.y_str) > Decimal(2)      # the state moved
+    s = conmech.solve_ivp(double_pendulum, (0, 2), [float(v) for v in y0], method="TAYLOR",
+                          rtol=1e-13, atol=1e-13)
+    assert np.max(np.abs(s.y[:, -1] - r.y_float)) < 1e-12
