@@ -572,6 +572,9 @@ SHARED = {
 """),
 }
 
+# The intermediate types that hand-written systems of the kind extend as well.
+SHARED_PUBLIC = {"constrained": ["constrained_diagonal_mass", "constrained_with_energy"]}
+
 
 def check_lines(name, lines):
     for ln in lines:
@@ -591,7 +594,8 @@ def kind_module(kind, systems, extra=()):
     out += [f"    use {m.module}, only: {m.type_name}" for m in extra]
     out += ["    implicit none", "    private", ""]
     out += wrap_statement("public :: " + ", ".join(
-        [s.model.type_name for s in systems] + [m.type_name for m in extra]), "    ")
+        SHARED_PUBLIC.get(kind, []) + [s.model.type_name for s in systems]
+        + [m.type_name for m in extra]), "    ")
     out.append("")
     shared = SHARED[kind]
     out += shared[0].splitlines() + [""]

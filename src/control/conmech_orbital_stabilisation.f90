@@ -15,6 +15,7 @@
 module conmech_orbital_stabilisation
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_outcome, only: outcome
     use conmech_lapack, only: la_sym_eig, la_eig
     use conmech_control_system, only: control_system, feedback_law, closed_loop, control_model
     use conmech_transverse_general, only: transverse_options, transverse_frame, &
@@ -28,9 +29,7 @@ module conmech_orbital_stabilisation
     public :: orbital_design_result, orbital_design
 
     !> What the design produced.
-    type :: orbital_design_result
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: orbital_design_result
         type(transverse_lq) :: lq                    !! the transverse linearisation
         type(riccati_result) :: ric                  !! P(t), closed-loop multipliers
         type(transverse_lqr_law) :: law              !! the controller
@@ -62,13 +61,13 @@ contains
         n = size(y0)
         m = plant%n_inputs
         if (m < 1 .or. ng < 8) then
-            call fail(CM_BAD_INPUT, "orbital design: need at least one input and ng >= 8")
+            call des%fail(CM_BAD_INPUT, "orbital design: need at least one input and ng >= 8")
             return
         end if
         allocate (cl%plant, source=plant)
         allocate (cl%law, source=nominal)
         if (.not. has_nominal) then
-            call fail(CM_BAD_INPUT, "orbital design: a nominal law is required (use a zero law)")
+            call des%fail(CM_BAD_INPUT, "orbital design: a nominal law is required (use a zero law)")
             return
         end if
         cl%n_inputs = m
@@ -79,7 +78,8 @@ contains
         to%full_monodromy = .true.
         call transverse_build(cl, cm, y0, period, to, des%lq%fr)
         if (des%lq%fr%info /= CM_SUCCESS) then
-            call fail(des%lq%fr%info, des%lq%fr%message)
+            des%info = des%lq%fr%info
+            des%message = des%lq%fr%message
             return
         end if
         k = des%lq%fr%k
@@ -101,7 +101,7 @@ contains
             call la_eig(mt, des%ur, des%ui, info)
             if (any(sqrt(des%ur**2 + des%ui**2) >= 1.0_dp - 1.0e-9_dp)) then
                 write (b1, '(es10.3)') maxval(sqrt(des%ur**2 + des%ui**2))
-                call fail(CM_BAD_INPUT, "orbital design: uncontrollable transverse "// &
+                call des%fail(CM_BAD_INPUT, "orbital design: uncontrollable transverse "// &
                           "linearisation: an uncontrollable multiplier of modulus "// &
                           trim(adjustl(b1))//" is not inside the unit circle (the input "// &
                           "cannot reach it)")
@@ -112,7 +112,8 @@ contains
         ! ---- the periodic Riccati equation
         call periodic_riccati(des%lq, qw, rw, ropt, des%ric)
         if (des%ric%info /= CM_SUCCESS) then
-            call fail(des%ric%info, des%ric%message)
+            des%info = des%ric%info
+            des%message = des%ric%message
             return
         end if
 
@@ -134,7 +135,7 @@ contains
             tau = period*real(i - 1, dp)/ng
             call transverse_eval(des%lq%fr, tau, x, qp, ap, bp, info, dq)
             if (info /= CM_SUCCESS) then
-                call fail(info, "orbital design: the transverse frame could not be evaluated")
+                call des%fail(info, "orbital design: the transverse frame could not be evaluated")
                 return
             end if
             call transverse_jacobian(cl, tau, x, f, a)
@@ -152,22 +153,13 @@ contains
             kflat = reshape(des%law%ks, [m*k, ng + 1])
             call periodic_spline(kflat, period/ng, kmf, info)
             if (info /= CM_SUCCESS) then
-                call fail(info, "orbital design: the gain's spline failed")
+                call des%fail(info, "orbital design: the gain's spline failed")
                 return
             end if
             des%law%km = reshape(kmf, [m, k, ng + 1])
         end block
         des%info = CM_SUCCESS
         des%message = des%ric%message
-
-    contains
-
-        subroutine fail(code, text)
-            integer, intent(in) :: code
-            character(len=*), intent(in) :: text
-            des%info = code
-            des%message = text
-        end subroutine fail
 
     end subroutine orbital_design
 

@@ -33,6 +33,7 @@ module conmech_periodic_riccati
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_outcome, only: outcome
     use conmech_lapack, only: dgees, dpotrf, dpotrs, la_eig, la_sym_eig, la_solve, la_finite
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, ode_integrate, &
@@ -73,9 +74,7 @@ module conmech_periodic_riccati
     end type riccati_options
 
     !> The stabilising periodic solution and its closed loop.
-    type :: riccati_result
-        integer :: info = CM_BAD_INPUT
-        character(len=:), allocatable :: message
+    type, extends(outcome) :: riccati_result
         integer :: k = 0, m = 0
         real(dp) :: period = 0.0_dp
         real(dp), allocatable :: p0(:, :)            !! P(0) = P(T)
@@ -238,25 +237,25 @@ contains
         res%period = lq%period
         if (k < 1 .or. m < 1 .or. .not. (lq%period > 0.0_dp) .or. size(qw, 1) /= k .or. &
             size(qw, 2) /= k .or. size(rw, 1) /= m .or. size(rw, 2) /= m) then
-            call fail(CM_BAD_INPUT, "riccati: need k, m >= 1, a positive period, Q k x k "// &
+            call res%fail(CM_BAD_INPUT, "riccati: need k, m >= 1, a positive period, Q k x k "// &
                       "and R m x m")
             return
         end if
         if (.not. (la_finite(qw) .and. la_finite(rw))) then
-            call fail(CM_BAD_INPUT, "riccati: Q and R must be finite")
+            call res%fail(CM_BAD_INPUT, "riccati: Q and R must be finite")
             return
         end if
         allocate (rc(m, m), ev(max(k, m)))
         rc = rw
         call dpotrf('U', m, rc, m, lainfo)
         if (lainfo /= 0 .or. maxval(abs(rw - transpose(rw))) > 1.0e-12_dp*maxval(abs(rw))) then
-            call fail(CM_BAD_INPUT, "riccati: R must be symmetric positive definite")
+            call res%fail(CM_BAD_INPUT, "riccati: R must be symmetric positive definite")
             return
         end if
         call la_sym_eig(0.5_dp*(qw + transpose(qw)), ev(1:k), info)
         if (info /= CM_SUCCESS .or. ev(1) < -1.0e-12_dp*max(abs(ev(k)), 1.0_dp) .or. &
             maxval(abs(qw - transpose(qw))) > 1.0e-12_dp*max(maxval(abs(qw)), 1.0_dp)) then
-            call fail(CM_BAD_INPUT, "riccati: Q must be symmetric positive semi-definite")
+            call res%fail(CM_BAD_INPUT, "riccati: Q must be symmetric positive semi-definite")
             return
         end if
         allocate (res%rinv(m, m))
@@ -282,7 +281,7 @@ contains
         z = reshape(psi, [4*k*k])
         call ode_integrate(hs, 0.0_dp, lq%period, z, oo, info, message=msg)
         if (info < 0) then
-            call fail(info, "riccati: the Hamiltonian system could not be integrated: "//msg)
+            call res%fail(info, "riccati: the Hamiltonian system could not be integrated: "//msg)
             return
         end if
         psi = reshape(z, [2*k, 2*k])
@@ -299,7 +298,7 @@ contains
         dist = minval(abs(sqrt(wr**2 + wi**2) - 1.0_dp))
         if (dist < opt%unit_circle_tol .and. maxval(wr**2 + wi**2) < 1.0e16_dp) then
             write (b1, '(es10.3)') dist
-            call fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: the "// &
+            call res%fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: the "// &
                       "Hamiltonian monodromy has multipliers on the unit circle "// &
                       "(min ||mu| - 1| = "//trim(adjustl(b1))//"): the system is not "// &
                       "stabilisable, or not detectable through Q")
@@ -316,7 +315,7 @@ contains
                 p = 0.5_dp*(p + transpose(p))
             else if (maxval(wr**2 + wi**2) < 1.0e16_dp) then
                 ! a well-conditioned monodromy whose stable subspace is not a graph over x
-                call fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: "// &
+                call res%fail(CM_NO_CONVERGENCE, "riccati: no stabilising periodic solution: "// &
                           "the stable subspace of the Hamiltonian monodromy is not a graph "// &
                           "(X singular): the system is not stabilisable")
                 return
@@ -341,7 +340,7 @@ contains
             if (rr%status /= CM_SUCCESS) then
                 msg = "riccati: the backward integration failed"
                 if (allocated(rr%message)) msg = msg//": "//rr%message
-                call fail(rr%status, msg)
+                call res%fail(rr%status, msg)
                 return
             end if
             pnew = reshape(rr%y(1:k*k, rr%nt), [k, k])
@@ -375,7 +374,7 @@ contains
         res%periodicity = change
         if (.not. change <= opt%periodic_tol) then
             write (b1, '(es10.3)') change
-            call fail(CM_NO_CONVERGENCE, "riccati: the backward passes did not return "// &
+            call res%fail(CM_NO_CONVERGENCE, "riccati: the backward passes did not return "// &
                       "to P(0) (relative change "//trim(adjustl(b1))//"): no stabilising "// &
                       "periodic solution")
             return
@@ -403,7 +402,7 @@ contains
         end do
         if (.not. res%min_eig > 0.0_dp) then
             write (b1, '(es10.3)') res%min_eig
-            call fail(CM_NO_CONVERGENCE, "riccati: the periodic solution is not positive "// &
+            call res%fail(CM_NO_CONVERGENCE, "riccati: the periodic solution is not positive "// &
                       "definite (smallest eigenvalue "//trim(adjustl(b1))//")")
             return
         end if
@@ -422,35 +421,26 @@ contains
         z = reshape(xt, [k*k])
         call ode_integrate(cs, 0.0_dp, lq%period, z, oo, info, message=msg)
         if (info < 0) then
-            call fail(info, "riccati: the closed loop could not be integrated: "//msg)
+            call res%fail(info, "riccati: the closed loop could not be integrated: "//msg)
             return
         end if
         res%cl_monodromy = reshape(z, [k, k])
         call la_eig(res%cl_monodromy, res%cmr, res%cmi, info)
         if (info /= CM_SUCCESS) then
-            call fail(info, "riccati: eigenvalues of the closed-loop monodromy failed")
+            call res%fail(info, "riccati: eigenvalues of the closed-loop monodromy failed")
             return
         end if
         dist = maxval(sqrt(res%cmr**2 + res%cmi**2))
         write (b1, '(es10.3)') dist
         write (b2, '(es10.3)') res%periodicity
         if (.not. dist < 1.0_dp) then
-            call fail(CM_NO_CONVERGENCE, "riccati: the closed loop is not stable (largest "// &
+            call res%fail(CM_NO_CONVERGENCE, "riccati: the closed loop is not stable (largest "// &
                       "multiplier modulus "//trim(adjustl(b1))//")")
             return
         end if
         res%info = CM_SUCCESS
         res%message = "success (largest closed-loop multiplier "//trim(adjustl(b1))// &
                       ", periodicity "//trim(adjustl(b2))//")"
-
-    contains
-
-        subroutine fail(code, text)
-            integer, intent(in) :: code
-            character(len=*), intent(in) :: text
-            res%info = code
-            res%message = text
-        end subroutine fail
 
     end subroutine periodic_riccati
 

@@ -161,22 +161,15 @@ contains
         end if
     end function take
 
+    ! In place with room (every step of the Python steppers) an item goes straight to its
+    ! entry; otherwise take() checks the mode and the room and grows the counts first.
+
     subroutine item_real(p, x)
         class(state_packer), intent(inout) :: p
         real(dp), intent(inout) :: x
-        ! in place with room (every step of the Python steppers): straight to the entry
-        if (p%inplace .and. p%info == CM_SUCCESS .and. p%mode /= PACK_COUNT) then
-            if (p%nr < size(p%rx)) then
-                p%nr = p%nr + 1
-                if (p%mode == PACK_READ) then
-                    x = p%rx(p%nr)
-                else
-                    p%rx(p%nr) = x
-                end if
-                return
-            end if
+        if (.not. in_place_room(p, .true.)) then
+            if (.not. take(p, 1, 0, 0)) return
         end if
-        if (.not. take(p, 1, 0, 0)) return
         p%nr = p%nr + 1
         if (p%inplace) then
             if (p%mode == PACK_READ) then
@@ -194,18 +187,9 @@ contains
     subroutine item_int(p, k)
         class(state_packer), intent(inout) :: p
         integer, intent(inout) :: k
-        if (p%inplace .and. p%info == CM_SUCCESS .and. p%mode /= PACK_COUNT) then
-            if (p%ni < size(p%ivx)) then
-                p%ni = p%ni + 1
-                if (p%mode == PACK_READ) then
-                    k = p%ivx(p%ni)
-                else
-                    p%ivx(p%ni) = k
-                end if
-                return
-            end if
+        if (.not. in_place_room(p, .false.)) then
+            if (.not. take(p, 0, 1, 0)) return
         end if
-        if (.not. take(p, 0, 1, 0)) return
         p%ni = p%ni + 1
         if (p%inplace) then
             if (p%mode == PACK_READ) then
@@ -219,6 +203,20 @@ contains
             p%iv(p%ni) = k
         end if
     end subroutine item_int
+
+    !> Packing in place, without error, with room in the in-place array for one more real
+    !! (`real_item`) or integer entry.
+    pure logical function in_place_room(p, real_item)
+        class(state_packer), intent(in) :: p
+        logical, intent(in) :: real_item
+        in_place_room = .false.
+        if (.not. (p%inplace .and. p%info == CM_SUCCESS .and. p%mode /= PACK_COUNT)) return
+        if (real_item) then
+            in_place_room = p%nr < size(p%rx)
+        else
+            in_place_room = p%ni < size(p%ivx)
+        end if
+    end function in_place_room
 
     subroutine item_logical(p, l)
         class(state_packer), intent(inout) :: p

@@ -19,12 +19,11 @@ module conmech_collocation
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
-    use conmech_ode_solver, only: ode_options, ode_integrate
     use conmech_lapack, only: dgetrf, dgetrs
     use conmech_orbit_types, only: set_parameter_proc
     use conmech_orbit_bvp, only: orbit_bvp, bvp_z, bvp_begin
     use conmech_block_chain, only: chain_factor
-    use conmech_multiple_shooting, only: bvp_ode_options
+    use conmech_multiple_shooting, only: guess_states
     implicit none
     private
 
@@ -186,34 +185,32 @@ contains
         real(dp), intent(inout) :: x(:)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        type(ode_options) :: oo
-        real(dp) :: y(bvp%n), t, tn
-        integer :: j, i, n, o
+        real(dp) :: times(1 + bvp%k*(bvp%m + 1)), ys(bvp%n, 1 + bvp%k*(bvp%m + 1))
+        integer :: j, i, n, o, c
         n = bvp%n
-        oo = bvp_ode_options(bvp)
-        y = y0
-        t = 0.0_dp
-        x(1:n) = y
-        info = CM_SUCCESS
-        msg = "success"
+        ! per interval its m stages, then its end node
+        times(1) = 0.0_dp
         do j = 1, bvp%k
             do i = 1, bvp%m + 1
+                c = 1 + (j - 1)*(bvp%m + 1) + i
                 if (i <= bvp%m) then
-                    tn = (bvp%mesh(j) + bvp%tab%c(i)*(bvp%mesh(j + 1) - bvp%mesh(j)))*span
+                    times(c) = (bvp%mesh(j) + bvp%tab%c(i)*(bvp%mesh(j + 1) - bvp%mesh(j)))*span
                 else
-                    tn = bvp%mesh(j + 1)*span
+                    times(c) = bvp%mesh(j + 1)*span
                 end if
-                call ode_integrate(sys, t, tn, y, oo, info, message=msg)
-                if (info < 0) then
-                    msg = "integrating the initial guess: "//msg
-                    return
-                end if
-                t = tn
+            end do
+        end do
+        call guess_states(bvp, sys, y0, times, ys, info, msg)
+        if (info < 0) return
+        x(1:n) = y0
+        do j = 1, bvp%k
+            do i = 1, bvp%m + 1
+                c = 1 + (j - 1)*(bvp%m + 1) + i
                 if (i <= bvp%m) then
                     o = n*(bvp%k + 1) + ((j - 1)*bvp%m + (i - 1))*n
-                    x(o + 1:o + n) = y
+                    x(o + 1:o + n) = ys(:, c)
                 else
-                    x(j*n + 1:(j + 1)*n) = y
+                    x(j*n + 1:(j + 1)*n) = ys(:, c)
                 end if
             end do
         end do

@@ -11,6 +11,7 @@ module conmech_cont_setup
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
+    use conmech_text, only: itoa
     use conmech_ode_system, only: ode_system
     use conmech_orbit_types, only: set_parameter_proc, ORBIT_SINGLE, ORBIT_COLLOCATION
     use conmech_orbit_bvp
@@ -132,7 +133,7 @@ contains
                     " free components"
                 if (pb%tfree) b1 = trim(b1)//" + the time"
                 msg = "continuation: "//trim(b1)//") for "// &
-                      trim(adjustl(itoa(ntg)))//" targets: symmetric shooting needs as "// &
+                      itoa(ntg)//" targets: symmetric shooting needs as "// &
                       "many unknowns (free components, and the time if free) as targets "// &
                       "(the parameter is the one extra unknown of the branch)"
                 return
@@ -183,12 +184,6 @@ contains
         info = CM_SUCCESS
         msg = "success"
     end subroutine cp_setup
-
-    pure function itoa(k) result(s)
-        integer, intent(in) :: k
-        character(len=16) :: s
-        write (s, '(i0)') k
-    end function itoa
 
     !> X of the start (y0, period, p0); multiple shooting and collocation integrate y0
     !! over the period for the other nodes (info from that integration).

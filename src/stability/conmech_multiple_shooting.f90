@@ -22,7 +22,7 @@ module conmech_multiple_shooting
     implicit none
     private
 
-    public :: ms_evaluate, ms_guess, segment_closure, bvp_ode_options
+    public :: ms_evaluate, ms_guess, guess_states, segment_closure, bvp_ode_options
 
 contains
 
@@ -128,25 +128,40 @@ contains
         real(dp), intent(inout) :: x(:)
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
+        real(dp) :: ys(bvp%n, bvp%k + 1)
+        call guess_states(bvp, sys, y0, bvp%mesh(1:bvp%k + 1)*span, ys, info, msg)
+        if (info < 0) return
+        x(1:(bvp%k + 1)*bvp%n) = reshape(ys, [(bvp%k + 1)*bvp%n])
+    end subroutine ms_guess
+
+    !> The orbit integrated from y0 at times(1) through the increasing times: ys(:, i) is
+    !! its state at times(i) (ys(:, 1) = y0), one integration from each time to the next
+    !! (the initial guess of a discretisation). info and msg of the last integration, or
+    !! of the one that failed (info < 0).
+    subroutine guess_states(bvp, sys, y0, times, ys, info, msg)
+        type(orbit_bvp), intent(in) :: bvp
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: y0(:), times(:)
+        real(dp), intent(out) :: ys(:, :)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
         type(ode_options) :: oo
         real(dp) :: y(bvp%n)
-        integer :: j, n
-        n = bvp%n
+        integer :: i
         oo = bvp_ode_options(bvp)
         y = y0
-        x(1:n) = y
+        ys(:, 1) = y
         info = CM_SUCCESS
         msg = "success"
-        do j = 1, bvp%k
-            call ode_integrate(sys, bvp%mesh(j)*span, bvp%mesh(j + 1)*span, y, oo, info, &
-                               message=msg)
+        do i = 2, size(times)
+            call ode_integrate(sys, times(i - 1), times(i), y, oo, info, message=msg)
             if (info < 0) then
                 msg = "integrating the initial guess: "//msg
                 return
             end if
-            x(j*n + 1:(j + 1)*n) = y
+            ys(:, i) = y
         end do
-    end subroutine ms_guess
+    end subroutine guess_states
 
     !> The closure of the nodes by independent integrations (the state alone, not the
     !! variational equations): max over j of |y(t_(j+1); z_j) - z_(j+1)|.

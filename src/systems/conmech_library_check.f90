@@ -21,6 +21,7 @@
 module conmech_library_check
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_text, only: itoa
     implicit none
     private
 
@@ -121,14 +122,6 @@ contains
         end do
         name_is = buf(off + len(name)) == 0_int8
     end function name_is
-
-    function itoa(k) result(s)
-        integer(int64), intent(in) :: k
-        character(len=:), allocatable :: s
-        character(len=24) :: b
-        write (b, '(i0)') k
-        s = trim(b)
-    end function itoa
 
     !> Check the shared library `path` before dlopen (see the module documentation);
     !! `symbols` (blank-padded names) must be defined in its dynamic symbol table.

@@ -12,6 +12,7 @@ module conmech_systems_chain
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_constrained_system, only: constrained_system
+    use conmech_systems_constrained, only: constrained_with_energy
     use conmech_constrained_band, only: band_dense
     implicit none
     private
@@ -20,12 +21,11 @@ module conmech_systems_chain
     !> N links; set n = 2N, n_hol = N, diagonal_mass, jac_width = min(4, n) (or use
     !! conmech_systems_mech::make_constrained("pendulum_chain_xy", [N, m, l, g]), which
     !! calls make_pendulum_chain).
-    type, extends(constrained_system) :: pendulum_chain_xy
+    type, extends(constrained_with_energy) :: pendulum_chain_xy
         real(dp) :: m = 1.0_dp
         real(dp) :: l = 1.0_dp
         real(dp) :: g = 9.81_dp
     contains
-        procedure :: mass => ch_mass
         procedure :: mass_diagonal => ch_mass_diagonal
         procedure :: forces => ch_forces
         procedure :: phi => ch_phi
@@ -33,7 +33,6 @@ module conmech_systems_chain
         procedure :: phi_jac_band => ch_jac_band
         procedure :: phi_gamma => ch_gamma
         procedure :: energy => ch_energy
-        procedure :: has_energy => ch_has_energy
     end type pendulum_chain_xy
 
 contains
@@ -109,18 +108,6 @@ contains
         end do
         v0 = 0.0_dp
     end subroutine chain_initial_state
-
-    subroutine ch_mass(self, t, q, mm)
-        class(pendulum_chain_xy), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: mm(:, :)
-        integer :: i
-        mm = 0.0_dp
-        do i = 1, size(q)
-            mm(i, i) = self%m
-        end do
-    end subroutine ch_mass
 
     subroutine ch_mass_diagonal(self, t, q, d)
         class(pendulum_chain_xy), intent(in) :: self
@@ -211,10 +198,5 @@ contains
         real(dp) :: e
         e = 0.5_dp*self%m*sum(v**2) + self%m*self%g*sum(q(2::2))
     end function ch_energy
-
-    logical function ch_has_energy(self)
-        class(pendulum_chain_xy), intent(in) :: self
-        ch_has_energy = .true.
-    end function ch_has_energy
 
 end module conmech_systems_chain

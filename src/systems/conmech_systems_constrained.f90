@@ -10,8 +10,9 @@ module conmech_systems_constrained
     implicit none
     private
 
-    public :: pendulum_xy, rod_two_masses, double_pendulum_xy, atwood_xy, pendulum_moving_xy, &
-        & yoyo, skate, rolling_disk, rolling_ball
+    public :: constrained_diagonal_mass, constrained_with_energy, pendulum_xy, &
+        & rod_two_masses, double_pendulum_xy, atwood_xy, pendulum_moving_xy, yoyo, skate, &
+        & rolling_disk, rolling_ball
 
     !> A constrained system whose mass is diagonal, given by `mass_diagonal` (which every
     !! extension overrides: the default `mass_diagonal` calls `mass`).

@@ -12,7 +12,7 @@
 !! Set n = 2N, n_hol = n_nh = N - 1 and the flags, or use `trailer_chain_of(N)`.
 module conmech_systems_trailer
     use conmech_kinds, only: dp
-    use conmech_constrained_system, only: constrained_system
+    use conmech_systems_constrained, only: constrained_diagonal_mass
     use conmech_constrained_band, only: band_dense
     implicit none
     private
@@ -22,13 +22,12 @@ module conmech_systems_trailer
     !! consecutive points (N - 1 holonomic rows, windows of width 4) and a knife edge at
     !! each point i >= 2 along its link, perp(p_i - p_{i-1}) . v_i = 0 (N - 1 Pfaffian
     !! rows, windows of width 2): an N-trailer. Rows of G and A interleave along the chain.
-    type, extends(constrained_system) :: trailer_chain
+    type, extends(constrained_diagonal_mass) :: trailer_chain
         real(dp) :: m = 1.0_dp       !! mass of each point
         real(dp) :: l = 1.0_dp       !! length of each rod
         real(dp) :: f = 1.0_dp       !! magnitude of the force on the first point
         real(dp) :: w = 1.0_dp       !! its angular rate: direction (cos w t, sin w t)
     contains
-        procedure :: mass => tr_mass
         procedure :: mass_diagonal => tr_mass_diagonal
         procedure :: forces => tr_forces
         procedure :: phi => tr_phi
@@ -73,17 +72,6 @@ contains
         end do
     end subroutine trailer_initial_state
 
-    subroutine tr_mass(self, t, q, mm)
-        class(trailer_chain), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:)
-        real(dp), intent(out) :: mm(:, :)
-        integer :: i
-        mm = 0.0_dp
-        do i = 1, size(q)
-            mm(i, i) = self%m
-        end do
-    end subroutine tr_mass
     subroutine tr_mass_diagonal(self, t, q, d)
         class(trailer_chain), intent(in) :: self
         real(dp), intent(in) :: t

@@ -1,6 +1,6 @@
-!> The status of a computed object of the stability layer (a periodic orbit, a branch of
-!! orbits or of equilibria): an info code of conmech_status and a message. The result
-!! types extend `outcome`; `fail` sets both at once where a computation stops.
+!> The status of a computed object (a periodic orbit, a branch of orbits or of equilibria,
+!! a Riccati solution, a controller design): an info code of conmech_status and a message.
+!! The result types extend `outcome`; `fail` sets both at once where a computation stops.
 module conmech_outcome
     use conmech_status, only: CM_BAD_INPUT
     implicit none
