@@ -108,7 +108,9 @@ def timed(fn, repeat):
     return best, out
 
 
-def heyoka_runner(pr, tol):
+def heyoka_runner(pr, tol, split=False):
+    """run() -> (final state, steps, order); split: (call, read), call() the reset and
+    the propagation alone (what is timed), read(r) -> what run() returns."""
     syms = {str(s): hy.make_vars(str(s)) for s in pr["y"]}
     pars = {str(k): float(v) for k, v in pr["p"].items()}
 
@@ -119,12 +121,17 @@ def heyoka_runner(pr, tol):
     dyn = [(syms[str(s)], conv(f)) for s, f in zip(pr["y"], pr["f"])]
     ta = hy.taylor_adaptive(dyn, list(map(float, pr["y0"])), tol=tol)
 
-    def run():
+    def call():
         ta.time = 0.0
         ta.state[:] = pr["y0"]
-        r = ta.propagate_until(pr["T"])
+        return ta.propagate_until(pr["T"])
+
+    def read(r):
         return ta.state.copy(), r[3], ta.order
-    return run
+
+    def run():
+        return read(call())
+    return (call, read) if split else run
 
 
 def work_precision(name, pr, repeat, tols):

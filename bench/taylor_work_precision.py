@@ -11,8 +11,9 @@ period). Below tol ~1e-13 on Kepler e = 0.9 every code is at the round-off floor
 double-precision state (a few 1e-12, scattered by an order of magnitude with the
 roundings: python/tests/test_taylor_precision.py), so single errors there compare luck. Times are
 the minimum over interleaved rounds in one process (each round times every method at every
-tolerance once, so a burst of load hits all of them alike). Orders and steps are printed
-beside the times.
+tolerance once, so a burst of load hits all of them alike), each round's figure the
+fastest of --calls consecutive calls, and a call is timed alone (the result is read
+apart). Orders and steps are printed beside the times.
 
 Ratios at equal accuracy: for each Taylor point (error E, time T) the other method's time at
 error E is interpolated linearly in log(time) against log(error) between the two of its
@@ -20,7 +21,8 @@ tolerances whose errors bracket E (walking from loose to tight tolerances); when
 never reach E (or never rise to E), the ratio is not given ("-": out of its range) rather
 than extrapolated.
 
-    python bench/taylor_work_precision.py [--rounds 7] [--problems kepler arenstorf]
+    python bench/taylor_work_precision.py [--rounds 7] [--calls 5]
+                                          [--problems kepler arenstorf]
                                           [--out bench/results/taylor_work_precision.md]
 """
 import argparse
@@ -44,46 +46,51 @@ DOP853_MIN_TOL = 1e-14      # below, DOP853 is at its round-off floor (and slow)
 
 
 def runners(pr, sys_, tol):
-    """{method: run}; run() -> (final state, steps, order or nfev)."""
+    """{method: (call, read)}: call() the solve alone (what is timed), read(r) -> (final
+    state, steps, order or nfev)."""
     out = {}
 
     def conmech_run(m):
-        def run():
-            r = conmech.solve_ivp(sys_, (0, pr["T"]), pr["y0"], method=m, rtol=tol,
-                                  atol=tol)
+        def call():
+            return conmech.solve_ivp(sys_, (0, pr["T"]), pr["y0"], method=m, rtol=tol,
+                                     atol=tol)
+
+        def read(r):
             assert r.success, r.message
             return r.y[:, -1], r.naccept, (taylor_order(tol) if m == "TAYLOR" else r.nfev)
-        return run
+        return call, read
     out["TAYLOR"] = conmech_run("TAYLOR")
     if tol >= DOP853_MIN_TOL:
         out["DOP853"] = conmech_run("DOP853")
     if hy is not None:
-        h = heyoka_runner(pr, tol)
-
-        def hrun():
-            y, nsteps, order = h()
-            return y, nsteps, order
-        out["heyoka"] = hrun
+        out["heyoka"] = heyoka_runner(pr, tol, split=True)
     return out
 
 
-def measure(name, rounds):
+def measure(name, rounds, calls):
+    """Errors, steps and times of every method at every tolerance: the time of a solve
+    call alone (its result read apart), the minimum over `calls` consecutive calls in each
+    of `rounds` interleaved rounds."""
     pr = problems()[name]
     sys_ = symbolic.ode_system(pr["f"], pr["y"], params=pr["p"])
     ref = reference(sys_, pr)
     runs = {tol: runners(pr, sys_, tol) for tol in TOLS}
     rows = {tol: {} for tol in TOLS}
     for tol, rs in runs.items():             # first calls: compilation, set-up
-        for m, run in rs.items():
-            y, steps, extra = run()
+        for m, (call, read) in rs.items():
+            y, steps, extra = read(call())
             rows[tol][m] = dict(err=float(np.max(np.abs(y - ref))), steps=steps, extra=extra,
                                 time=math.inf)
+    clock = time.perf_counter
     for _ in range(rounds):
         for tol, rs in runs.items():
-            for m, run in rs.items():
-                a = time.perf_counter()
-                run()
-                rows[tol][m]["time"] = min(rows[tol][m]["time"], time.perf_counter() - a)
+            for m, (call, _) in rs.items():
+                best = rows[tol][m]["time"]
+                for _ in range(calls):
+                    a = clock()
+                    call()
+                    best = min(best, clock() - a)
+                rows[tol][m]["time"] = best
     return rows
 
 
@@ -129,21 +136,24 @@ def table(name, rows):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--calls", type=int, default=5, help="consecutive calls timed per round")
     ap.add_argument("--problems", nargs="*", default=["kepler", "arenstorf"])
     ap.add_argument("--out", default=os.path.join(RESULTS, "taylor_work_precision.md"))
     args = ap.parse_args()
     if hy is None:
         print("heyoka is not installed: only conmech's methods are timed")
     load0 = os.getloadavg()
-    allrows = {name: measure(name, args.rounds) for name in args.problems}
+    allrows = {name: measure(name, args.rounds, args.calls) for name in args.problems}
     load1 = os.getloadavg()
     lines = ["# Work-precision: conmech TAYLOR vs heyoka vs conmech DOP853", "",
-             f"`python bench/taylor_work_precision.py --rounds {args.rounds}`; heyoka "
+             f"`python bench/taylor_work_precision.py --rounds {args.rounds} --calls "
+             f"{args.calls}`; heyoka "
              f"{getattr(hy, '__version__', 'not installed')}; one period, rtol = atol = tol; "
              "error = max-norm at the end against a quadruple-precision Taylor reference from the "
              "exact values of the doubles the runs start from; "
-             f"time = min over {args.rounds} interleaved rounds (us, through Python: "
-             "solve_ivp / propagate_until). "
+             f"time = min over {args.rounds} interleaved rounds of {args.calls} consecutive "
+             "calls each (us, through Python: the solve_ivp / propagate_until call alone, "
+             "its result read apart). "
              f"Load average (1 min) {load0[0]:.1f} at the start, {load1[0]:.1f} at the end "
              "(2 cores shared): wall-clock figures are provisional.", ""]
     for name, rows in allrows.items():

@@ -26,7 +26,9 @@ Every recurrence splits into a *history* sum over the coefficients of orders 1..
 known when order k starts) and a few *current* terms in the order-k coefficients of the
 operands. The generated code computes the history sums of all operations in ONE loop over
 j (independent accumulators: the multiply-adds pipeline instead of waiting on one chain),
-then the current terms in dependency order, then y^[k+1]. Two sums are cheaper than their
+the two terms holding an order k - 1 coefficient last (taylor_lanes.history_terms: the
+rest of the sum is ready before order k - 1 ends), then the current terms in dependency
+order, then y^[k+1]. Two sums are cheaper than their
 textbook form: a square's (and a square root's) sum is symmetric, sum_{j=1..k-1} a[j]
 a[k-j] = 2 sum_{j<k/2} a[j] a[k-j] + a[k/2]^2 (k even), half the products in a second
 loop over j < k/2; a power's two sums (of a[j] c[k-j] and of j a[j] c[k-j]) are one sum
@@ -53,12 +55,12 @@ from .taylor_decompose import (_JWEIGHT, Decomposition,  # noqa: F401 (public na
 from .isa import scalar_isa_flags as _scalar_isa_flags
 from .taylor_lanes import (_SYM, _current_statements, _history_sum,  # noqa: F401
                            _history_sum_pair, _pair_derivatives, _pair_history,
-                           _pair_outputs, _sum_seq)
+                           _pair_outputs, _sum_seq, history_loops)
 
 __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
            "variational_exprs", "TAYLOR_VERSION"]
 
-TAYLOR_VERSION = "2"
+TAYLOR_VERSION = "3"
 
 #: flags added to the model libraries' for the written-out routine (isa.scalar_isa_flags):
 #: -fopenmp-simd for its paired history sums (two-lane loops marked ``!$omp simd``, which
@@ -396,14 +398,8 @@ def body_lines(dec, names, kind="dp", batch=0, given=False, ind="        ", fixe
         loop += [f"{ind}    {h} = {zero}" for h in rc.accs]
         plain = [x for x in rc.hist if x[3] is not _SYM]
         sym = [x for x in rc.hist if x[3] is _SYM]
-        if plain:
-            loop.append(f"{ind}    do j = 1, k - 1")
-            for h, lft, rgt, wt in plain:
-                wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
-                loop += _wrap(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}",
-                              ind + "        ")
-            loop.append(f"{ind}    end do")
-        loop += square_sums(sym, W, pp, ind)
+        loop += history_loops(plain, sym, W, kind, pp.real(2), ind,
+                              lambda st, i: [x for s in st for x in _wrap(s, i)])
         for f in rc.cur:
             loop += _wrap(f(E), ind + "    ")
         if not given:

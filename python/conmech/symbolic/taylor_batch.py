@@ -37,7 +37,7 @@ from .._core.lanes import LANES     # the lane counts a batch library can be bui
 from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (public names)
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 7
+VERSION = 8
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_routine",
            "run_routine", "LANES"]
@@ -97,24 +97,7 @@ def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
     body += [f"{ind}    {h} = {zero}" for h in rc.accs]
     plain = [x for x in rc.hist if x[3] is not T._SYM]
     sym = [x for x in rc.hist if x[3] is T._SYM]
-    if plain:
-        body.append(f"{ind}    do j = 1, k - 1")
-        stm = []
-        for h, lft, rgt, wt in plain:
-            wj = f"({wt}*real(j, {kind}) - fk)*" if wt else ""
-            stm.append(f"{h} = {h} + {wj}{W('j', lft)}*{W('k - j', rgt)}")
-        body += loop(stm, ind + "        ")
-        body.append(f"{ind}    end do")
-    if sym:       # squares: the pairs j < k - j once, doubled, and the middle term
-        body.append(f"{ind}    do j = 1, (k - 1)/2")
-        body += loop([f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}"
-                      for h, lft, _, _ in sym], ind + "        ")
-        body.append(f"{ind}    end do")
-        body += [f"{ind}    {h} = {pp.real(2)}*{h}" for h, _, _, _ in sym]
-        body.append(f"{ind}    if (mod(k, 2) == 0) then")
-        body += loop([f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}"
-                      for h, lft, _, _ in sym], ind + "        ")
-        body.append(f"{ind}    end if")
+    body += T.history_loops(plain, sym, W, kind, pp.real(2), ind, loop)
     cur = [f(E) for f in rc.cur]
     cur += [f"{W('k + 1', i + 1)} = rk1*({pp.lin_at(o, 'k', False)})"
             for i, o in enumerate(dec.outputs)]

@@ -2,7 +2,8 @@
 statements (:func:`conmech.symbolic.taylor.fixed_order_source`).
 
 A history sum of order k is written out with literal indices, the terms in the loop
-version's order (so the same bits). Sums of the same form are paired, as a compiler's SLP
+version's order (so the same bits): the oldest coefficients first, the two terms that
+hold an order k - 1 coefficient last (:func:`history_terms`). Sums of the same form are paired, as a compiler's SLP
 vectorizer pairs isomorphic operations: the two sums become the two lanes of one statement
 in a loop over the lanes ``ln = 1, 2`` marked ``!$omp simd`` (gfortran vectorizes it when
 compiled with -fopenmp-simd; its own vectorizer leaves such code scalar), the paired
@@ -20,10 +21,59 @@ import sympy as sp
 _SYM = "sym"
 
 
+def history_terms(k):
+    """The order of the terms j = 1 .. k - 1 of a history sum of order k (term j: a[j]
+    b[k-j]): j = 2 .. k - 2, then k - 1, then 1. Only the two end terms hold an order
+    k - 1 coefficient, the last one computed (a[k-1], b[k-1]; b is the operation's own
+    column when it has one, computed after its operand a): the sum of the older terms is
+    ready before order k - 1 ends, and the chain from order k - 1 to order k is two
+    multiply-adds long rather than k - 1 (the sums are latency-bound)."""
+    return list(range(2, k - 1)) + [k - 1]*(k >= 3) + [1]*(k >= 2)
+
+
+def symmetric_terms(k):
+    """The order of the terms j = 1 .. (k - 1)/2 of a square's halved history sum: down to
+    j = 1, whose a[k-1] is the newest coefficient."""
+    return list(range((k - 1)//2, 0, -1))
+
+
+def history_loops(plain, sym, W, kind, two, ind, emit):
+    """The lines of the loop version's history sums of order k (a variable; fk its real),
+    the terms in the order of :func:`history_terms` and :func:`symmetric_terms`: plain,
+    sym the recipes (h, left, right, weight) of the plain and symmetric sums; W(j,
+    column) spells a coefficient, two the literal 2; emit(statements, indent) the lines of
+    statements."""
+    lines = []
+
+    def terms(j, kj):
+        return [f"{h} = {h} + " + (f"({wt}*real({j}, {kind}) - fk)*" if wt else "") +
+                f"{W(j, lft)}*{W(kj, rgt)}" for h, lft, rgt, wt in plain]
+    if plain:
+        lines.append(f"{ind}    do j = 2, k - 2")
+        lines += emit(terms("j", "k - j"), ind + "        ")
+        lines += [f"{ind}    end do", f"{ind}    if (k >= 3) then"]
+        lines += emit(terms("k - 1", "1"), ind + "        ")
+        lines += [f"{ind}    end if", f"{ind}    if (k >= 2) then"]
+        lines += emit(terms("1", "k - 1"), ind + "        ")
+        lines.append(f"{ind}    end if")
+    if sym:
+        lines.append(f"{ind}    do j = (k - 1)/2, 1, -1")
+        lines += emit([f"{h} = {h} + {W('j', lft)}*{W('k - j', lft)}"
+                       for h, lft, _, _ in sym], ind + "        ")
+        lines.append(f"{ind}    end do")
+        lines += [f"{ind}    {h} = {two}*{h}" for h, _, _, _ in sym]
+        lines.append(f"{ind}    if (mod(k, 2) == 0) then")
+        lines += emit([f"{h} = {h} + {W('k/2', lft)}*{W('k/2', lft)}"
+                       for h, lft, _, _ in sym], ind + "        ")
+        lines.append(f"{ind}    end if")
+    return lines
+
+
 def _sum_seq(terms, zero):
     """The terms summed left to right: the order of the loop version's history sums
-    (h = 0; h = h + term_j, j = 1 .. k - 1), so the written-out routine and the loop give
-    the same coefficients to the last bit (compiled without -ffast-math)."""
+    (h = 0; h = h + term_j, j in the order of history_terms), so the written-out routine
+    and the loop give the same coefficients to the last bit (compiled without
+    -ffast-math)."""
     return " + ".join(terms) if terms else zero
 
 
@@ -34,14 +84,15 @@ def _history_sum(pp, k, lft, rgt, wt, W=None):
     W = pp.w if W is None else W
     zero = f"0.0_{pp.kind}"
     if wt is _SYM:
-        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in range(1, (k - 1)//2 + 1)]
+        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in symmetric_terms(k)]
         out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
         if k % 2 == 0:
             mid = f"{W(k//2, lft)}*{W(k//2, lft)}"
             out = f"{out} + {mid}" if out else mid
         return out or zero
     weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
-    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)], zero)
+    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in history_terms(k)],
+                    zero)
 
 
 def _pair_history(hist, dec):

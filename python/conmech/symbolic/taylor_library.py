@@ -30,6 +30,7 @@ from . import taylor_batch as _taylor_batch
 from .build import (FFLAGS, _read_json, _write_atomic, cache_dir, compile_source,
                     load)
 from .codegen import _names, check_source, private_procedures
+from .taylor import TAYLOR_VERSION
 
 __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batch_entries",
            "MODULE", "PARTS"]
@@ -245,6 +246,8 @@ def _source_path(key, part):
     if lanes is not None:       # the batch source depends on the lanes (the machine's)
         fixed = _fixed_order(part)
         part = f"batch{lanes}{'' if fixed is None else f'o{fixed}'}-v{_taylor_batch.VERSION}"
+    else:                       # the scalar source depends on the emitter's version
+        part = f"{part}-v{TAYLOR_VERSION}"
     return os.path.join(cache_dir(), f"conmech_{key}.taylor-{part}.json")
 
 
