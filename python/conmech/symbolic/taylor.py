@@ -499,13 +499,10 @@ def c_routine(dec, names, cname, batch=0, given=False, fixed=None, paired=True):
     return head + decl + body + [f"    end subroutine {cname}", ""]
 
 
-def quad_routine(dec, names, cname):
-    """Quadruple precision ``cname(t, order, w, p)`` through C pointers to real128 values
-    (C has no standard 128-bit type): t, w(0:order, nw), p."""
-    ind = "        "
-    nw = dec.ncol
-    npar = max(len(dec.params), 1)
-    head = [f'    subroutine {cname}(tp, order, wp, pp) bind(C, name="{cname}")',
+def quad_entry(cname, nw, npar, ind="        "):
+    """``cname(t, order, w, p)`` through C pointers to real128 values (C has no standard
+    128-bit type), calling ``cname_body`` on t, w(0:order, nw), p."""
+    return [f'    subroutine {cname}(tp, order, wp, pp) bind(C, name="{cname}")',
             f"{ind}type(c_ptr), value, intent(in) :: tp, wp, pp",
             f"{ind}integer(c_int), value, intent(in) :: order",
             f"{ind}real(qp), pointer :: tq",
@@ -515,6 +512,12 @@ def quad_routine(dec, names, cname):
             f"{ind}call c_f_pointer(pp, pq, [{npar}])",
             f"{ind}call {cname}_body(tq, order, wq, pq)",
             f"    end subroutine {cname}", ""]
+
+
+def quad_routine(dec, names, cname):
+    """The recurrences in quadruple precision, entry :func:`quad_entry`."""
+    ind, nw, npar = "        ", dec.ncol, max(len(dec.params), 1)
+    head = quad_entry(cname, nw, npar)
     inner = [f"    subroutine {cname}_body(t, order, w, p)",
              f"{ind}real(qp), intent(in) :: t",
              f"{ind}integer(c_int), intent(in) :: order",

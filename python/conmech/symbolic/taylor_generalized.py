@@ -31,7 +31,7 @@ expansion), the first-order right-hand side of the stepper's view of the system.
 """
 import sympy as sp
 
-from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
+from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, quad_entry, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import core_part_lines, first_order_procedures
 from .taylor_tree import is_tree, tree_lines
@@ -44,7 +44,23 @@ __all__ = ["generalized_decomposition", "generalized_procedures", "generalized_q
 WRITE_OUT_MAX = 8
 
 
-class GeneralizedDecomposition:
+class MassEntries:
+    """The entries of a symmetric mass matrix held as output columns of a decomposition
+    (``dec``; ``mass`` {(i, j): output index} for i <= j): shared by the accelerations'
+    and the variational system's decompositions."""
+
+    def entry(self, i, j):
+        """The affine form (_Lin) of M_ij (symmetric: the upper triangle's)."""
+        return self.dec.outputs[self.mass[(min(i, j), max(i, j))]]
+
+    def entry_col(self, i, j):
+        return self.dec.out_cols[self.mass[(min(i, j), max(i, j))]]
+
+    def constant(self, i, j):
+        return not self.entry(i, j).terms
+
+
+class GeneralizedDecomposition(MassEntries):
     """The decomposition of the entries of M (upper triangle, by columns) and Q in the
     state [q; v] (attributes: ``dec``, the :class:`Decomposition` with the entries as
     output columns; ``n`` degrees of freedom; ``mass`` {(i, j): output index} for i <= j
@@ -69,15 +85,6 @@ class GeneralizedDecomposition:
         self.acols = list(range(base + 1, base + n + 1))
         self.ncol = base + n
 
-    def entry(self, i, j):
-        """The affine form (_Lin) of M_ij (symmetric: the upper triangle's)."""
-        return self.dec.outputs[self.mass[(min(i, j), max(i, j))]]
-
-    def entry_col(self, i, j):
-        return self.dec.out_cols[self.mass[(min(i, j), max(i, j))]]
-
-    def constant(self, i, j):
-        return not self.entry(i, j).terms
 
 
 def generalized_decomposition(d):
@@ -283,16 +290,7 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
     g.ncol), p), the accelerations' factorisation and solves in real128 too."""
     ind = "        "
     nw = g.ncol
-    head = [f'    subroutine {cname}(tp, order, wp, pp) bind(C, name="{cname}")',
-            f"{ind}type(c_ptr), value, intent(in) :: tp, wp, pp",
-            f"{ind}integer(c_int), value, intent(in) :: order",
-            f"{ind}real(qp), pointer :: tq",
-            f"{ind}real(qp), pointer, contiguous :: wq(:, :), pq(:)",
-            f"{ind}call c_f_pointer(tp, tq)",
-            f"{ind}call c_f_pointer(wp, wq, [order + 1, {nw}])",
-            f"{ind}call c_f_pointer(pp, pq, [{npar}])",
-            f"{ind}call {cname}_body(tq, order, wq, pq)",
-            f"    end subroutine {cname}", ""]
+    head = quad_entry(cname, nw, npar)
     inner = [f"    subroutine {cname}_body(t, order, w, p)",
              f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{ind}real(qp), intent(in) :: t",

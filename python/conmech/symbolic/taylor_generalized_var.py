@@ -33,14 +33,14 @@ import sympy as sp
 from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import first_order_procedures
-from .taylor_generalized import (WRITE_OUT_MAX, _cholesky_loop, _cholesky_out, _solve_loop,
-                                 _solve_out, generalized_decomposition)
+from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, _cholesky_loop, _cholesky_out,
+                                 _solve_loop, _solve_out, generalized_decomposition)
 from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["variational_decomposition", "variational_procedures", "variational_lines"]
 
 
-class VariationalDecomposition:
+class VariationalDecomposition(MassEntries):
     """The decomposition of M (upper triangle), Q and R = K Phi of a generalized record in
     the state [q; v; vec(Phi); a] (attributes: ``dec``; ``n`` degrees of freedom; ``m`` =
     2n the size of y; ``mass`` {(i, j): output index}, i <= j; ``forces`` and ``rhs``
@@ -105,15 +105,6 @@ class VariationalDecomposition:
         base = dec.ncol
         self.dcols = [[base + 1 + c*n + i for i in range(n)] for c in range(m)]
         self.ncol = base + m*n
-
-    def entry(self, i, j):
-        return self.dec.outputs[self.mass[(min(i, j), max(i, j))]]
-
-    def entry_col(self, i, j):
-        return self.dec.out_cols[self.mass[(min(i, j), max(i, j))]]
-
-    def constant(self, i, j):
-        return not self.entry(i, j).terms
 
 
 def variational_decomposition(d):
