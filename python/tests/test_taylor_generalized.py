@@ -20,7 +20,6 @@ method step by step from Python (conmech.Stepper(method="TAYLOR")).
   bit, and the dense output of each step from its Taylor polynomial;
 - ensemble.solve(method="TAYLOR") of a generalized system: each member its own run.
 """
-import ctypes
 from fractions import Fraction
 
 import numpy as np
@@ -37,18 +36,7 @@ from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized import (generalized_decomposition,  # noqa: E402
                                                  generalized_procedures)
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
-
-_P = ctypes.POINTER(ctypes.c_double)
-_JET = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)
-
-
-def coefficients(address, nw, params, y, order, t=0.0):
-    """The coefficients y^[0..order] (rows: the components of y) of a Taylor routine."""
-    w = np.zeros((nw, order + 1))
-    w[:len(y), 0] = y
-    p = np.ascontiguousarray(params if np.size(params) else np.zeros(1), dtype=float)
-    _JET(address)(t, order, w.ctypes.data_as(_P), p.ctypes.data_as(_P))
-    return w[:len(y)]
+from taylor_jets import coefficients  # noqa: E402
 
 
 def jet(system, y, order, t=0.0):

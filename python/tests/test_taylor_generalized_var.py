@@ -20,8 +20,6 @@ quadruple precision (conmech.symbolic.taylor_generalized.generalized_quad_routin
   real128 (a second method on the routine's first coefficient) to 1e-23, and the double
   Taylor run at 1e-13 to 1e-12.
 """
-import ctypes
-
 import numpy as np
 import pytest
 
@@ -37,18 +35,8 @@ from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
                                                      variational_procedures)
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
+from taylor_jets import coefficients  # noqa: E402
 
-_P = ctypes.POINTER(ctypes.c_double)
-_JET = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)
-
-
-def coefficients(address, nw, params, z, order, t=0.0):
-    """The coefficients z^[0..order] (rows: the components of z) of a Taylor routine."""
-    w = np.zeros((nw, order + 1))
-    w[:len(z), 0] = z
-    p = np.ascontiguousarray(params if np.size(params) else np.zeros(1), dtype=float)
-    _JET(address)(t, order, w.ctypes.data_as(_P), p.ctypes.data_as(_P))
-    return w[:len(z)]
 
 
 def jets(system, y, order, phi=None):
