@@ -36,6 +36,7 @@ from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized import (generalized_decomposition,  # noqa: E402
                                                  generalized_procedures)
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
+import taylor_jets  # noqa: E402
 from taylor_jets import coefficients  # noqa: E402
 
 
@@ -48,24 +49,12 @@ def jet(system, y, order, t=0.0):
 
 @pytest.fixture(scope="module")
 def cart():
-    """The lecture notes' pendulum on a cart (M = m = l = 1, theta from the upright)."""
-    t = dynamicsymbols._t
-    x, th = dynamicsymbols("x theta")
-    g = sp.Symbol("g")
-    T = x.diff(t)**2 + sp.cos(th)*x.diff(t)*th.diff(t) + th.diff(t)**2/2
-    return symbolic.lagrangian_system(T - g*sp.cos(th), [x, th], params={g: 9.81})
+    return taylor_jets.cart_pendulum()
 
 
 @pytest.fixture(scope="module")
 def double_pendulum():
-    """Unit point masses on unit rods, angles from the downward vertical."""
-    t = dynamicsymbols._t
-    a, b = dynamicsymbols("a b")
-    g = sp.Symbol("g")
-    ad, bd = a.diff(t), b.diff(t)
-    T = ad**2 + ad*bd*sp.cos(a - b) + bd**2/2
-    U = -g*(2*sp.cos(a) + sp.cos(b))
-    return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
+    return taylor_jets.double_pendulum()
 
 
 # ------------------------------------------------------------------ coefficients
