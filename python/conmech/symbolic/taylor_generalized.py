@@ -170,6 +170,33 @@ def _solve_loop(n, ind):
             f"{ind}end do"]
 
 
+def order_zero(g, pp, rc, s0, ind, kind="dp"):
+    """The parts every coefficient routine through M's factorisation starts with:
+    (declarations, the order-0 statements `s0` of the operations and of the entries of M
+    that vary, those entries' index pairs, M0(i, j) the Fortran value of M_ij at order 0,
+    the statements that fail the expansion when M_0 is not positive definite)."""
+    W = pp.w
+    real = f"real({kind})"
+    decl = _decls([c for c, _ in rc.consts], real, ind)
+    decl += _decls(rc.accs + rc.invs, real, ind)
+    decl += [f"{ind}{real} :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
+    body = [f"{ind}if (order < 1) return"]
+    for c, e in rc.consts:
+        body += _wrap(f"{c} = {e}", ind)
+    for x in s0:
+        body += _wrap(x, ind)
+    varying = [(i, j) for (i, j) in g.mass if not g.constant(i, j)]
+    for (i, j) in varying:
+        body += _wrap(f"{W(0, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 0, True)}", ind)
+
+    def M0(i, j):
+        if g.constant(i, j):
+            return pp.lin_at(g.entry(i, j), 0, True)
+        return W(0, g.entry_col(i, j))
+    fail = [f"w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)", "return"]
+    return decl, body, varying, M0, fail
+
+
 def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     """(declarations, statements) of the coefficient routine (see the module docstring)
     for a procedure that declares t, order, w(0:order, g.ncol) and p (of the real kind
@@ -183,24 +210,8 @@ def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     one = pp.real(1)
     zero = f"0.0_{kind}"
     real = f"real({kind})"
-    decl = _decls([c for c, _ in rc.consts], real, ind)
-    decl += _decls(rc.accs + rc.invs, real, ind)
-    decl += [f"{ind}{real} :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
-    body = [f"{ind}if (order < 1) return"]
-    for c, e in rc.consts:
-        body += _wrap(f"{c} = {e}", ind)
     # order 0: the operations, the entries of M and Q, the factorisation, a_0
-    for x in rc.s0:
-        body += _wrap(x, ind)
-    varying = [(i, j) for (i, j) in g.mass if not g.constant(i, j)]
-    for (i, j) in varying:
-        body += _wrap(f"{W(0, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 0, True)}", ind)
-
-    def M0(i, j):
-        if g.constant(i, j):
-            return pp.lin_at(g.entry(i, j), 0, True)
-        return W(0, g.entry_col(i, j))
-    fail = [f"w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)", "return"]
+    decl, body, varying, M0, fail = order_zero(g, pp, rc, rc.s0, ind, kind)
     if out:
         chol, names_c = _cholesky_out(g, pp, M0, ind, fail, kind)
         solve = _solve_out(n, ind + "    ")

@@ -34,7 +34,7 @@ from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import first_order_procedures
 from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, _cholesky_loop, _cholesky_out,
-                                 _solve_loop, _solve_out, generalized_decomposition)
+                                 _solve_loop, _solve_out, generalized_decomposition, order_zero)
 from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["variational_decomposition", "variational_procedures", "variational_lines"]
@@ -140,23 +140,7 @@ def variational_body(g, names, ind="        ", write_out=None):
     W = pp.w
     one = pp.real(1)
     zero = "0.0_dp"
-    decl = _decls([c for c, _ in rc.consts], "real(dp)", ind)
-    decl += _decls(rc.accs + rc.invs, "real(dp)", ind)
-    decl += [f"{ind}real(dp) :: fk, rk, rk1, cs", f"{ind}integer :: k, j"]
-    body = [f"{ind}if (order < 1) return"]
-    for c, e in rc.consts:
-        body += _wrap(f"{c} = {e}", ind)
-    for x in rc.s0[:ns0]:
-        body += _wrap(x, ind)
-    varying = [(i, j) for (i, j) in g.mass if not g.constant(i, j)]
-    for (i, j) in varying:
-        body += _wrap(f"{W(0, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 0, True)}", ind)
-
-    def M0(i, j):
-        if g.constant(i, j):
-            return pp.lin_at(g.entry(i, j), 0, True)
-        return W(0, g.entry_col(i, j))
-    fail = ["w(1:order, :) = ieee_value(1.0_dp, ieee_quiet_nan)", "return"]
+    decl, body, varying, M0, fail = order_zero(g, pp, rc, rc.s0[:ns0], ind)
     if out:
         chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
         solve = _solve_out(n, ind + "    ")
