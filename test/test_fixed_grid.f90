@@ -41,5 +41,6 @@ program test_fixed_grid
     call check_grid_steps(11, 10, info, msg)
     call ts%check(info == CM_TOO_MANY_STEPS .and. index(msg, "needs 11 steps") > 0, &
                   "one step over max_steps: CM_TOO_MANY_STEPS naming the grid's length")
+    deallocate (msg)
     call ts%finish()
 end program test_fixed_grid
