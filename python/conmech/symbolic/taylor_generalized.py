@@ -59,6 +59,18 @@ class MassEntries:
     def constant(self, i, j):
         return not self.entry(i, j).terms
 
+    def mass_and_forces(self, M, Q, n):
+        """The outputs M's upper triangle (by columns), then Q: sets ``mass`` and
+        ``forces`` and returns the list of the entries."""
+        self.mass = {}
+        entries = []
+        for j in range(n):
+            for i in range(j + 1):
+                self.mass[(i, j)] = len(entries)
+                entries.append(M[i, j])
+        self.forces = list(range(len(entries), len(entries) + n))
+        return entries + [Q[i] for i in range(n)]
+
 
 class GeneralizedDecomposition(MassEntries):
     """The decomposition of the entries of M (upper triangle, by columns) and Q in the
@@ -71,20 +83,12 @@ class GeneralizedDecomposition(MassEntries):
         n = d.n
         M, Q = d.M, d.Q
         self.n = n
-        self.mass = {}
-        entries = []
-        for j in range(n):
-            for i in range(j + 1):
-                self.mass[(i, j)] = len(entries)
-                entries.append(M[i, j])
-        self.forces = list(range(len(entries), len(entries) + n))
-        entries += [Q[i] for i in range(n)]
+        entries = self.mass_and_forces(M, Q, n)
         state = list(d.coords) + list(d.speeds)
         self.dec = decompose(entries, state, d.t, d.params, given=True)
         base = self.dec.ncol
         self.acols = list(range(base + 1, base + n + 1))
         self.ncol = base + n
-
 
 
 def generalized_decomposition(d):

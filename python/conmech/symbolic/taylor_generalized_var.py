@@ -76,14 +76,7 @@ class VariationalDecomposition(MassEntries):
         R = [sum(K[i][lc]*phi[c*m + lc] for lc in range(m)) for c in range(m)
              for i in range(n)]
         self.n, self.m = n, m
-        self.mass = {}
-        entries = []
-        for j in range(n):
-            for i in range(j + 1):
-                self.mass[(i, j)] = len(entries)
-                entries.append(M[i, j])
-        self.forces = list(range(len(entries), len(entries) + n))
-        entries += [Q[i] for i in range(n)]
+        entries = self.mass_and_forces(M, Q, n)
         self.rhs = list(range(len(entries), len(entries) + len(R)))
         entries += R
         state = y + phi + acc
