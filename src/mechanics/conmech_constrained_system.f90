@@ -53,6 +53,7 @@
 !!   constrained equations): central differences (submodule conmech_constrained_derivatives).
 module conmech_constrained_system
     use conmech_kinds, only: dp
+    use conmech_central_step, only: central_step
     use conmech_status
     use conmech_lapack, only: dpotrs, la_finite
     use conmech_schur, only: schur_solve
@@ -367,7 +368,7 @@ contains
         integer :: j
         qp = q
         do j = 1, size(q)
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(q(j)), 1.0_dp)
+            h = central_step(q(j))
             qp(j) = q(j) + h
             call self%phi(t, qp, cp)
             qp(j) = q(j) - h
@@ -388,7 +389,7 @@ contains
             pt = 0.0_dp
             return
         end if
-        h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(t), 1.0_dp)
+        h = central_step(t)
         call self%phi(t + h, q, cp)
         call self%phi(t - h, q, cm)
         pt = (cp - cm)/(2.0_dp*h)
