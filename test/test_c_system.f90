@@ -86,7 +86,7 @@ program test_c_system
     call make_c_generalized(2, fp, [1.3_dp, 0.7_dp, 0.9_dp, 9.81_dp], cg, info, msg)
     call ts%check(info == CM_SUCCESS .and. cg%has_forces_jacobian(), "make_c_generalized")
     allocate (wc%mech, source=cg)
-    cg%fjac_f => null()
+    cg%core%fjac_f => null()
     allocate (wf%mech, source=cg)
     y = [0.1_dp, 2.5_dp, 0.3_dp, -0.4_dp]
     call wc%jacobian(0.0_dp, y, ja)

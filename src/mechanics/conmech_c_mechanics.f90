@@ -58,7 +58,7 @@ module conmech_c_mechanics
     implicit none
     private
 
-    public :: c_generalized_system, c_constrained_system, c_mech_pointers
+    public :: c_generalized_system, c_constrained_system, c_mech_pointers, c_mech_core
     public :: make_c_generalized, make_c_constrained
 
     abstract interface
@@ -106,13 +106,23 @@ module conmech_c_mechanics
         end subroutine c_nh_fn
     end interface
 
-    !> M(t, q) q'' = Q(t, q, q') from compiled functions.
-    type, extends(generalized_system) :: c_generalized_system
+    !> The compiled functions that both kinds of system have: M(t, q), Q(t, q, q'), the
+    !! Jacobian of the force balance and the energy (the last two optional), with the
+    !! parameters passed to each.
+    type :: c_mech_core
         real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
         procedure(c_rhs_fn), pointer, nopass :: mass_f => null()
         procedure(c_qv_fn), pointer, nopass :: forces_f => null()
         procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
         procedure(c_energy_fn), pointer, nopass :: energy_f => null()
+    contains
+        procedure :: connect => core_connect
+        procedure :: energy => core_energy
+    end type c_mech_core
+
+    !> M(t, q) q'' = Q(t, q, q') from compiled functions.
+    type, extends(generalized_system) :: c_generalized_system
+        type(c_mech_core) :: core
         procedure(c_mf_fn), pointer, nopass :: mf_f => null()
         procedure(c_qv_fn), pointer, nopass :: accel_f => null()
         procedure(c_mf_fn), pointer, nopass :: accel_jac_f => null()
@@ -132,17 +142,13 @@ module conmech_c_mechanics
 
     !> A constrained system in excessive coordinates from compiled functions.
     type, extends(constrained_system) :: c_constrained_system
-        real(dp), allocatable :: p(:)   !! parameters (at least 1 entry)
-        procedure(c_rhs_fn), pointer, nopass :: mass_f => null()
-        procedure(c_qv_fn), pointer, nopass :: forces_f => null()
-        procedure(c_energy_fn), pointer, nopass :: energy_f => null()
+        type(c_mech_core) :: core
         procedure(c_rhs_fn), pointer, nopass :: phi_f => null()
         procedure(c_rhs_fn), pointer, nopass :: phi_jac_f => null()
         procedure(c_rhs_fn), pointer, nopass :: phi_t_f => null()
         procedure(c_qv_fn), pointer, nopass :: phi_gamma_f => null()
         procedure(c_nh_fn), pointer, nopass :: nh_f => null()
         procedure(c_qv_fn), pointer, nopass :: nh_gamma_f => null()
-        procedure(c_fjac_fn), pointer, nopass :: fjac_f => null()
         procedure(c_hess_fn), pointer, nopass :: hess_f => null()
     contains
         procedure :: forces_jacobian => cc_forces_jacobian
@@ -163,14 +169,39 @@ module conmech_c_mechanics
 
 contains
 
-    !> Copy the parameters (at least one entry, f2py/C never see an empty array).
-    subroutine set_params(dst, params)
-        real(dp), allocatable, intent(out) :: dst(:)
+    !> Take the required mass and forces functions, the optional forces_jac and energy, and
+    !! a copy of the parameters (at least one entry, f2py/C never see an empty array).
+    subroutine core_connect(self, fp, params, info, msg)
+        class(c_mech_core), intent(inout) :: self
+        type(c_mech_pointers), intent(in) :: fp
         real(dp), intent(in) :: params(:)
-        allocate (dst(max(size(params), 1)))
-        dst = 0.0_dp
-        dst(1:size(params)) = params
-    end subroutine set_params
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        info = CM_BAD_INPUT
+        if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then
+            msg = "bad input: the mass and forces function pointers must not be null"
+            return
+        end if
+        call c_f_procpointer(fp%mass, self%mass_f)
+        call c_f_procpointer(fp%forces, self%forces_f)
+        if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, self%fjac_f)
+        if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, self%energy_f)
+        allocate (self%p(max(size(params), 1)))
+        self%p = 0.0_dp
+        self%p(1:size(params)) = params
+        info = CM_SUCCESS
+        msg = "success"
+    end subroutine core_connect
+
+    !> The energy, 0 without an energy function.
+    function core_energy(self, t, q, v) result(e)
+        class(c_mech_core), intent(in) :: self
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: q(:), v(:)
+        real(dp) :: e
+        e = 0.0_dp
+        if (associated(self%energy_f)) e = self%energy_f(t, q, v, self%p)
+    end function core_energy
 
     !> Build a compiled generalized system with `ndof` coordinates. Required: mass, forces.
     subroutine make_c_generalized(ndof, fp, params, sys, info, msg)
@@ -185,21 +216,12 @@ contains
             msg = "bad input: the number of coordinates of a compiled system must be positive"
             return
         end if
-        if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then
-            msg = "bad input: the mass and forces function pointers must not be null"
-            return
-        end if
+        call sys%core%connect(fp, params, info, msg)
+        if (info /= CM_SUCCESS) return
         sys%ndof = ndof
-        call c_f_procpointer(fp%mass, sys%mass_f)
-        call c_f_procpointer(fp%forces, sys%forces_f)
-        if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
-        if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
         if (c_associated(fp%mass_forces)) call c_f_procpointer(fp%mass_forces, sys%mf_f)
         if (c_associated(fp%accel)) call c_f_procpointer(fp%accel, sys%accel_f)
         if (c_associated(fp%accel_jac)) call c_f_procpointer(fp%accel_jac, sys%accel_jac_f)
-        call set_params(sys%p, params)
-        info = CM_SUCCESS
-        msg = "success"
     end subroutine make_c_generalized
 
     !> Build a compiled constrained system: n coordinates, n_hol holonomic and n_nh
@@ -222,10 +244,9 @@ contains
                   //"n_hol, n_nh >= 0 constraints"
             return
         end if
-        if (.not. (c_associated(fp%mass) .and. c_associated(fp%forces))) then
-            msg = "bad input: the mass and forces function pointers must not be null"
-            return
-        end if
+        call sys%core%connect(fp, params, info, msg)
+        if (info /= CM_SUCCESS) return
+        info = CM_BAD_INPUT
         if (n_hol > 0 .and. .not. c_associated(fp%phi)) then
             msg = "bad input: holonomic constraints need the phi function"
             return
@@ -238,21 +259,15 @@ contains
         sys%n_hol = n_hol
         sys%n_nh = n_nh
         sys%rheonomic = rheonomic
-        call c_f_procpointer(fp%mass, sys%mass_f)
-        call c_f_procpointer(fp%forces, sys%forces_f)
-        if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, sys%energy_f)
         if (c_associated(fp%phi)) call c_f_procpointer(fp%phi, sys%phi_f)
         if (c_associated(fp%phi_jac)) call c_f_procpointer(fp%phi_jac, sys%phi_jac_f)
         if (c_associated(fp%phi_t)) call c_f_procpointer(fp%phi_t, sys%phi_t_f)
         if (c_associated(fp%phi_gamma)) call c_f_procpointer(fp%phi_gamma, sys%phi_gamma_f)
         if (c_associated(fp%nh_matrix)) call c_f_procpointer(fp%nh_matrix, sys%nh_f)
         if (c_associated(fp%nh_gamma)) call c_f_procpointer(fp%nh_gamma, sys%nh_gamma_f)
-        if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, sys%fjac_f)
         if (c_associated(fp%constraint_hessian)) &
             call c_f_procpointer(fp%constraint_hessian, sys%hess_f)
-        call set_params(sys%p, params)
         info = CM_SUCCESS
-        msg = "success"
     end subroutine make_c_constrained
 
     ! ------------------------------------------------------------ generalized system
@@ -262,7 +277,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: mm(:, :)
-        call self%mass_f(t, q, mm, self%p)
+        call self%core%mass_f(t, q, mm, self%core%p)
     end subroutine cg_mass
 
     subroutine cg_mass_forces(self, t, q, v, mm, f)
@@ -271,10 +286,10 @@ contains
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: mm(:, :), f(:)
         if (associated(self%mf_f)) then
-            call self%mf_f(t, q, v, mm, f, self%p)
+            call self%mf_f(t, q, v, mm, f, self%core%p)
         else
-            call self%mass_f(t, q, mm, self%p)
-            call self%forces_f(t, q, v, f, self%p)
+            call self%core%mass_f(t, q, mm, self%core%p)
+            call self%core%forces_f(t, q, v, f, self%core%p)
         end if
     end subroutine cg_mass_forces
 
@@ -283,7 +298,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: a(:)
-        call self%accel_f(t, q, v, a, self%p)
+        call self%accel_f(t, q, v, a, self%core%p)
     end subroutine cg_accelerations
 
     logical function cg_has_accelerations(self)
@@ -296,7 +311,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: a(:), jac(:, :)
-        call self%accel_jac_f(t, q, v, a, jac, self%p)
+        call self%accel_jac_f(t, q, v, a, jac, self%core%p)
     end subroutine cg_accelerations_jacobian
 
     logical function cg_has_accelerations_jacobian(self)
@@ -309,7 +324,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: f(:)
-        call self%forces_f(t, q, v, f, self%p)
+        call self%core%forces_f(t, q, v, f, self%core%p)
     end subroutine cg_forces
 
     function cg_energy(self, t, q, v) result(e)
@@ -317,13 +332,12 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp) :: e
-        e = 0.0_dp
-        if (associated(self%energy_f)) e = self%energy_f(t, q, v, self%p)
+        e = self%core%energy(t, q, v)
     end function cg_energy
 
     logical function cg_has_energy(self)
         class(c_generalized_system), intent(in) :: self
-        cg_has_energy = associated(self%energy_f)
+        cg_has_energy = associated(self%core%energy_f)
     end function cg_has_energy
 
     subroutine cg_forces_jacobian(self, t, q, v, a, r)
@@ -331,12 +345,12 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:), a(:)
         real(dp), intent(out) :: r(:, :)
-        call self%fjac_f(t, q, v, a, r, self%p)
+        call self%core%fjac_f(t, q, v, a, r, self%core%p)
     end subroutine cg_forces_jacobian
 
     logical function cg_has_forces_jacobian(self)
         class(c_generalized_system), intent(in) :: self
-        cg_has_forces_jacobian = associated(self%fjac_f)
+        cg_has_forces_jacobian = associated(self%core%fjac_f)
     end function cg_has_forces_jacobian
 
     ! ------------------------------------------------------------ constrained system
@@ -346,7 +360,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: mm(:, :)
-        call self%mass_f(t, q, mm, self%p)
+        call self%core%mass_f(t, q, mm, self%core%p)
     end subroutine cc_mass
 
     subroutine cc_forces(self, t, q, v, f)
@@ -354,7 +368,7 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: f(:)
-        call self%forces_f(t, q, v, f, self%p)
+        call self%core%forces_f(t, q, v, f, self%core%p)
     end subroutine cc_forces
 
     function cc_energy(self, t, q, v) result(e)
@@ -362,13 +376,12 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:)
         real(dp) :: e
-        e = 0.0_dp
-        if (associated(self%energy_f)) e = self%energy_f(t, q, v, self%p)
+        e = self%core%energy(t, q, v)
     end function cc_energy
 
     logical function cc_has_energy(self)
         class(c_constrained_system), intent(in) :: self
-        cc_has_energy = associated(self%energy_f)
+        cc_has_energy = associated(self%core%energy_f)
     end function cc_has_energy
 
     subroutine cc_phi(self, t, q, c)
@@ -377,7 +390,7 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: c(:)
         if (associated(self%phi_f)) then
-            call self%phi_f(t, q, c, self%p)
+            call self%phi_f(t, q, c, self%core%p)
         else
             c = 0.0_dp
         end if
@@ -389,7 +402,7 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: g(:, :)
         if (associated(self%phi_jac_f)) then
-            call self%phi_jac_f(t, q, g, self%p)
+            call self%phi_jac_f(t, q, g, self%core%p)
         else
             call fd_phi_jac(self, t, q, g)
         end if
@@ -401,7 +414,7 @@ contains
         real(dp), intent(in) :: q(:)
         real(dp), intent(out) :: pt(:)
         if (associated(self%phi_t_f)) then
-            call self%phi_t_f(t, q, pt, self%p)
+            call self%phi_t_f(t, q, pt, self%core%p)
         else
             call fd_phi_t(self, t, q, pt)
         end if
@@ -413,7 +426,7 @@ contains
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: gam(:)
         if (associated(self%phi_gamma_f)) then
-            call self%phi_gamma_f(t, q, v, gam, self%p)
+            call self%phi_gamma_f(t, q, v, gam, self%core%p)
         else
             call fd_phi_gamma(self, t, q, v, gam)
         end if
@@ -426,7 +439,7 @@ contains
         real(dp), intent(out) :: a(:, :)
         real(dp), intent(out) :: b(:)
         if (associated(self%nh_f)) then
-            call self%nh_f(t, q, a, b, self%p)
+            call self%nh_f(t, q, a, b, self%core%p)
         else
             a = 0.0_dp
             b = 0.0_dp
@@ -439,7 +452,7 @@ contains
         real(dp), intent(in) :: q(:), v(:)
         real(dp), intent(out) :: gam(:)
         if (associated(self%nh_gamma_f)) then
-            call self%nh_gamma_f(t, q, v, gam, self%p)
+            call self%nh_gamma_f(t, q, v, gam, self%core%p)
         else
             call fd_nh_gamma(self, t, q, v, gam)
         end if
@@ -450,8 +463,8 @@ contains
         real(dp), intent(in) :: t
         real(dp), intent(in) :: q(:), v(:), a(:)
         real(dp), intent(out) :: r(:, :)
-        if (associated(self%fjac_f)) then
-            call self%fjac_f(t, q, v, a, r, self%p)
+        if (associated(self%core%fjac_f)) then
+            call self%core%fjac_f(t, q, v, a, r, self%core%p)
         else
             call fd_forces_jacobian(self, t, q, v, a, r)
         end if
@@ -459,7 +472,7 @@ contains
 
     logical function cc_has_forces_jacobian(self)
         class(c_constrained_system), intent(in) :: self
-        cc_has_forces_jacobian = associated(self%fjac_f)
+        cc_has_forces_jacobian = associated(self%core%fjac_f)
     end function cc_has_forces_jacobian
 
     subroutine cc_constraint_hessian(self, t, q, v, lam, hl, hv)
@@ -468,7 +481,7 @@ contains
         real(dp), intent(in) :: q(:), v(:), lam(:)
         real(dp), intent(out) :: hl(:, :), hv(:, :)
         if (associated(self%hess_f) .and. self%n_hol + self%n_nh > 0) then
-            call self%hess_f(t, q, v, lam, hl, hv, self%p)
+            call self%hess_f(t, q, v, lam, hl, hv, self%core%p)
         else
             call fd_constraint_hessian(self, t, q, v, lam, hl, hv)
         end if

@@ -23,7 +23,7 @@ contains
         qp = q
         vp = v
         do j = 1, n
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(q(j)), 1.0_dp)
+            h = central_step(q(j))
             qp(j) = q(j) + h
             call self%forces(t, qp, v, fp)
             call self%mass(t, qp, mp)
@@ -34,7 +34,7 @@ contains
             r(:, j) = (fp - fm - matmul(mp - mm, a))/(2.0_dp*h)
         end do
         do j = 1, n
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(v(j)), 1.0_dp)
+            h = central_step(v(j))
             vp(j) = v(j) + h
             call self%forces(t, q, vp, fp)
             vp(j) = v(j) - h

@@ -53,6 +53,8 @@
 !!   constrained equations): central differences (submodule conmech_constrained_derivatives).
 module conmech_constrained_system
     use conmech_kinds, only: dp
+    use conmech_mechanical_system, only: mechanical_system
+    use conmech_central_step, only: central_step
     use conmech_status
     use conmech_lapack, only: dpotrs, la_finite
     use conmech_schur, only: schur_solve
@@ -75,7 +77,7 @@ module conmech_constrained_system
     public :: fd_phi_jac, fd_phi_t, fd_phi_gamma, fd_nh_gamma
     public :: fd_forces_jacobian, fd_constraint_hessian
 
-    type, abstract :: constrained_system
+    type, abstract, extends(mechanical_system) :: constrained_system
         integer :: n = 0             !! number of (excessive) coordinates
         integer :: n_hol = 0         !! number of holonomic constraints phi(t, q) = 0
         integer :: n_nh = 0          !! number of non-holonomic constraints A q' + b = 0
@@ -89,8 +91,6 @@ module conmech_constrained_system
         !! prepare_mass for a constant mass whose inverse is banded
         real(dp), allocatable :: mass_inv_band(:, :)
     contains
-        procedure(cs_mass), deferred :: mass
-        procedure(cs_forces), deferred :: forces
         procedure :: phi => cs_no_phi
         procedure :: phi_jac => fd_phi_jac
         procedure :: phi_t => fd_phi_t
@@ -100,32 +100,11 @@ module conmech_constrained_system
         procedure :: mass_diagonal => cs_mass_diagonal
         procedure :: phi_jac_band => cs_phi_jac_band
         procedure :: nh_matrix_band => cs_nh_matrix_band
-        procedure :: energy => cs_no_energy
-        procedure :: has_energy => cs_not_given
         procedure :: forces_jacobian => fd_forces_jacobian
         procedure :: has_forces_jacobian => cs_not_given
         procedure :: constraint_hessian => fd_constraint_hessian
         procedure :: has_constraint_hessian => cs_not_given
     end type constrained_system
-
-    abstract interface
-        !> mm = M(t, q) (n x n, symmetric positive definite).
-        subroutine cs_mass(self, t, q, mm)
-            import :: constrained_system, dp
-            class(constrained_system), intent(in) :: self
-            real(dp), intent(in) :: t
-            real(dp), intent(in) :: q(:)
-            real(dp), intent(out) :: mm(:, :)
-        end subroutine cs_mass
-        !> f = Q(t, q, v) (applied forces, velocity terms included).
-        subroutine cs_forces(self, t, q, v, f)
-            import :: constrained_system, dp
-            class(constrained_system), intent(in) :: self
-            real(dp), intent(in) :: t
-            real(dp), intent(in) :: q(:), v(:)
-            real(dp), intent(out) :: f(:)
-        end subroutine cs_forces
-    end interface
 
     ! Reactions, residuals and projections (submodule conmech_constrained_projection).
     interface
@@ -367,7 +346,7 @@ contains
         integer :: j
         qp = q
         do j = 1, size(q)
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(q(j)), 1.0_dp)
+            h = central_step(q(j))
             qp(j) = q(j) + h
             call self%phi(t, qp, cp)
             qp(j) = q(j) - h
@@ -388,7 +367,7 @@ contains
             pt = 0.0_dp
             return
         end if
-        h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(t), 1.0_dp)
+        h = central_step(t)
         call self%phi(t + h, q, cp)
         call self%phi(t - h, q, cm)
         pt = (cp - cm)/(2.0_dp*h)
@@ -456,16 +435,8 @@ contains
         gam = -w/(12.0_dp*s)
     end subroutine fd_nh_gamma
 
-    function cs_no_energy(self, t, q, v) result(e)
-        class(constrained_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp) :: e
-        e = 0.0_dp
-    end function cs_no_energy
-
-    !> The default of the has_* queries: the optional piece is not given (no energy; the
-    !! force and constraint derivatives by finite differences).
+    !> The default of the has_* queries: the optional piece is not given (the force and
+    !! constraint derivatives by finite differences).
     logical function cs_not_given(self)
         class(constrained_system), intent(in) :: self
         cs_not_given = .false.

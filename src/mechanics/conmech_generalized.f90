@@ -26,6 +26,7 @@
 module conmech_generalized
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use conmech_kinds, only: dp
+    use conmech_mechanical_system, only: mechanical_system
     use conmech_status
     use conmech_text, only: itoa
     use conmech_lapack, only: dpotrf, dpotf2, dpotrs, dtrsv, la_finite
@@ -41,13 +42,9 @@ module conmech_generalized
     integer, parameter :: SMALL_NDOF = 32
 
     !> A system M(t, q) q'' = Q(t, q, q') with `ndof` generalized coordinates.
-    type, abstract :: generalized_system
+    type, abstract, extends(mechanical_system) :: generalized_system
         integer :: ndof = 0   !! number of generalized coordinates
     contains
-        procedure(gen_mass), deferred :: mass
-        procedure(gen_forces), deferred :: forces
-        procedure :: energy => gen_no_energy
-        procedure :: has_energy => gen_not_given
         procedure :: forces_jacobian => gen_no_forces_jacobian
         procedure :: mass_forces => gen_mass_forces
         procedure :: has_forces_jacobian => gen_not_given
@@ -56,25 +53,6 @@ module conmech_generalized
         procedure :: accelerations_jacobian => gen_no_accelerations_jacobian
         procedure :: has_accelerations_jacobian => gen_not_given
     end type generalized_system
-
-    abstract interface
-        !> mm = M(t, q), symmetric positive definite (ndof x ndof).
-        subroutine gen_mass(self, t, q, mm)
-            import :: generalized_system, dp
-            class(generalized_system), intent(in) :: self
-            real(dp), intent(in) :: t
-            real(dp), intent(in) :: q(:)
-            real(dp), intent(out) :: mm(:, :)
-        end subroutine gen_mass
-        !> f = Q(t, q, v): generalized forces including the velocity terms.
-        subroutine gen_forces(self, t, q, v, f)
-            import :: generalized_system, dp
-            class(generalized_system), intent(in) :: self
-            real(dp), intent(in) :: t
-            real(dp), intent(in) :: q(:), v(:)
-            real(dp), intent(out) :: f(:)
-        end subroutine gen_forces
-    end interface
 
     !> First-order form y = [q, v], y' = [v, M^{-1} Q] of a generalized system.
     type, extends(ode_system) :: generalized_ode
@@ -86,15 +64,6 @@ module conmech_generalized
     end type generalized_ode
 
 contains
-
-    !> Default energy: not defined (returns 0; `has_energy` is false).
-    function gen_no_energy(self, t, q, v) result(e)
-        class(generalized_system), intent(in) :: self
-        real(dp), intent(in) :: t
-        real(dp), intent(in) :: q(:), v(:)
-        real(dp) :: e
-        e = 0.0_dp
-    end function gen_no_energy
 
     !> The default of the has_* queries: the optional piece is not given.
     logical function gen_not_given(self)

@@ -33,6 +33,7 @@
 module conmech_ode_system
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
+    use conmech_central_step, only: central_step
     implicit none
     private
 
@@ -158,7 +159,7 @@ contains
         integer :: j
         yp = y
         do j = 1, size(y)
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(y(j)), 1.0_dp)
+            h = central_step(y(j))
             yp(j) = y(j) + h
             call self%rhs(t, yp, fp)
             yp(j) = y(j) - h

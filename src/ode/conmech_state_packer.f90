@@ -62,6 +62,12 @@ module conmech_state_packer
         procedure :: reading => packer_reading
     end type state_packer
 
+    !> An allocatable target of a read given the shape named in the call (reallocated
+    !! only when its shape differs).
+    interface fit
+        module procedure fit_reals, fit_ints, fit_real_matrix, fit_complex_matrix
+    end interface fit
+
 contains
 
     !> A packer that counts a state of column length n (p%nr, p%ni, p%nw afterwards):
@@ -234,10 +240,7 @@ contains
         if (.not. take(p, 0, 0, 1)) return
         p%nw = p%nw + 1
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a) /= p%n) deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(p%n))
+            call fit(a, p%n)
             if (p%inplace) then
                 a = p%wx(:, p%nw)
             else
@@ -259,11 +262,7 @@ contains
         k = hi - lo + 1
         if (.not. take(p, 0, 0, k)) return
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a, 1) /= p%n .or. size(a, 2) /= k .or. lbound(a, 2) /= lo) &
-                    deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(p%n, lo:hi))
+            call fit(a, p%n, lo, hi)
             if (p%inplace) then
                 a(:, lo:hi) = p%wx(:, p%nw + 1:p%nw + k)
             else
@@ -284,10 +283,7 @@ contains
         integer, intent(in) :: m
         if (.not. take(p, 0, m, 0)) return
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a) /= m) deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(m))
+            call fit(a, m)
             if (p%inplace) then
                 a = p%ivx(p%ni + 1:p%ni + m)
             else
@@ -308,10 +304,7 @@ contains
         integer, intent(in) :: m
         if (.not. take(p, 0, 0, 2*m)) return
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a, 1) /= p%n .or. size(a, 2) /= m) deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(p%n, m))
+            call fit(a, p%n, m)
             if (p%inplace) then
                 a = cmplx(p%wx(:, p%nw + 1:p%nw + m), p%wx(:, p%nw + m + 1:p%nw + 2*m), &
                           kind=dp)
@@ -336,10 +329,7 @@ contains
         integer, intent(in) :: m
         if (.not. take(p, m, 0, 0)) return
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a) /= m) deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(m))
+            call fit(a, m)
             if (p%inplace) then
                 a = p%rx(p%nr + 1:p%nr + m)
             else
@@ -360,10 +350,7 @@ contains
         integer, intent(in) :: m1, m2
         if (.not. take(p, m1*m2, 0, 0)) return
         if (p%mode == PACK_READ) then
-            if (allocated(a)) then
-                if (size(a, 1) /= m1 .or. size(a, 2) /= m2) deallocate (a)
-            end if
-            if (.not. allocated(a)) allocate (a(m1, m2))
+            call fit(a, m1, 1, m2)
             if (p%inplace) then
                 a = reshape(p%rx(p%nr + 1:p%nr + m1*m2), [m1, m2])
             else
@@ -376,5 +363,43 @@ contains
         end if
         p%nr = p%nr + m1*m2
     end subroutine pack_real_matrix
+
+    subroutine fit_reals(a, m)
+        real(dp), allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: m
+        if (allocated(a)) then
+            if (size(a) /= m) deallocate (a)
+        end if
+        if (.not. allocated(a)) allocate (a(m))
+    end subroutine fit_reals
+
+    subroutine fit_ints(a, m)
+        integer, allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: m
+        if (allocated(a)) then
+            if (size(a) /= m) deallocate (a)
+        end if
+        if (.not. allocated(a)) allocate (a(m))
+    end subroutine fit_ints
+
+    !> Shape (m, lo:hi).
+    subroutine fit_real_matrix(a, m, lo, hi)
+        real(dp), allocatable, intent(inout) :: a(:, :)
+        integer, intent(in) :: m, lo, hi
+        if (allocated(a)) then
+            if (size(a, 1) /= m .or. size(a, 2) /= hi - lo + 1 .or. lbound(a, 2) /= lo) &
+                deallocate (a)
+        end if
+        if (.not. allocated(a)) allocate (a(m, lo:hi))
+    end subroutine fit_real_matrix
+
+    subroutine fit_complex_matrix(a, m1, m2)
+        complex(dp), allocatable, intent(inout) :: a(:, :)
+        integer, intent(in) :: m1, m2
+        if (allocated(a)) then
+            if (size(a, 1) /= m1 .or. size(a, 2) /= m2) deallocate (a)
+        end if
+        if (.not. allocated(a)) allocate (a(m1, m2))
+    end subroutine fit_complex_matrix
 
 end module conmech_state_packer

@@ -2,7 +2,7 @@
 !! points and the branch itself (see conmech_continuation).
 module conmech_branch_types
     use conmech_kinds, only: dp
-    use conmech_outcome, only: outcome
+    use conmech_branch_outcome, only: branch_outcome
     use conmech_code_names, only: code_name
     use conmech_status
     implicit none
@@ -91,11 +91,9 @@ module conmech_branch_types
     end type special_point
 
     !> A branch: its points and special points, the status and a message.
-    type, extends(outcome) :: branch
+    type, extends(branch_outcome) :: branch
         integer :: direction = 1              !! the side the branch was continued to
-        integer :: npoints = 0
         type(cont_point), allocatable :: points(:)
-        integer :: nspecial = 0
         type(special_point), allocatable :: special(:)
     end type branch
 

@@ -7,6 +7,7 @@
 module conmech_cont_problem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
+    use conmech_central_step, only: central_step
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, ode_integrate
@@ -174,7 +175,7 @@ contains
         do j = 1, pb%nx
             if (j > ny .and. j /= pb%nx) cycle
             if (j == pb%nx .and. pb%o%in_period) cycle
-            h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(x(j)), 1.0_dp)
+            h = central_step(x(j))
             xp = x
             xp(j) = x(j) + h
             call cp_unpack(pb, xp, y, tend, per, p)

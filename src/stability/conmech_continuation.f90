@@ -196,10 +196,7 @@ contains
             if (info /= CM_SUCCESS) then
                 ds = 0.5_dp*ds
                 if (ds < pb%o%ds_min) then
-                    write (buf, '(es23.15)') br%points(br%npoints)%p
-                    call br%fail(CM_NO_CONVERGENCE, "continuation stopped at p = "// &
-                                                    trim(adjustl(buf))//": the corrector did "// &
-                                                    "not converge with ds >= ds_min ("//msg//")")
+                    call br%corrector_stalled("continuation", br%points(br%npoints)%p, msg)
                     exit
                 end if
                 cycle

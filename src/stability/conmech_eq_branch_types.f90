@@ -3,7 +3,7 @@
 !! branch itself.
 module conmech_eq_branch_types
     use conmech_kinds, only: dp
-    use conmech_outcome, only: outcome
+    use conmech_branch_outcome, only: branch_outcome
     use conmech_code_names, only: code_name
     use conmech_status
     implicit none
@@ -74,10 +74,8 @@ module conmech_eq_branch_types
     end type eq_special
 
     !> A branch of equilibria: its points and special points, the status and a message.
-    type, extends(outcome) :: eq_branch
-        integer :: npoints = 0
+    type, extends(branch_outcome) :: eq_branch
         type(eq_point), allocatable :: points(:)
-        integer :: nspecial = 0
         type(eq_special), allocatable :: special(:)
     end type eq_branch
 

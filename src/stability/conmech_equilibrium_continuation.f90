@@ -116,10 +116,7 @@ contains
             if (info /= CM_SUCCESS) then
                 ds = 0.5_dp*ds
                 if (ds < o%ds_min) then
-                    write (buf, '(es23.15)') x(n + 1)
-                    call br%fail(CM_NO_CONVERGENCE, "equilibrium continuation stopped at p = "// &
-                                                    trim(adjustl(buf))//": the corrector did "// &
-                                                    "not converge with ds >= ds_min ("//msg//")")
+                    call br%corrector_stalled("equilibrium continuation", x(n + 1), msg)
                     exit
                 end if
                 cycle

@@ -23,6 +23,7 @@
 module conmech_orbit_bvp
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
+    use conmech_central_step, only: central_step
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_orbit_types, only: ORBIT_MULTIPLE, ORBIT_COLLOCATION, energy_fun
@@ -260,7 +261,7 @@ contains
                 r = r + 1
                 bvp%bres(r) = energy(z1) - bvp%energy_value
                 do j = 1, n
-                    h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(z1(j)), 1.0_dp)
+                    h = central_step(z1(j))
                     yp = z1
                     yp(j) = z1(j) + h
                     bvp%bz1(r, j) = energy(yp)

@@ -101,8 +101,8 @@ contains
         type is (generalized_ode)
             select type (mech => inner%mech)
             type is (c_generalized_system)
-                if (ip <= size(mech%p)) then
-                    mech%p(ip) = p
+                if (ip <= size(mech%core%p)) then
+                    mech%core%p(ip) = p
                     ok = .true.
                 end if
             end select

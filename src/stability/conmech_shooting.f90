@@ -29,6 +29,7 @@
 module conmech_shooting
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
+    use conmech_central_step, only: central_step
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_ode_solver, only: ode_options, METHOD_DOP853
@@ -127,7 +128,7 @@ contains
             if (md == PO_FIXED_ENERGY) then
                 r(n + 2) = energy(y) - energy_value
                 do j = 1, n
-                    h = epsilon(1.0_dp)**(1.0_dp/3.0_dp)*max(abs(y(j)), 1.0_dp)
+                    h = central_step(y(j))
                     yp = y
                     yp(j) = y(j) + h
                     jac(n + 2, j) = energy(yp)
