@@ -110,17 +110,21 @@ def test_packed_arguments_of_inconsistent_sizes_refused():
     from conmech._core.status import BAD_INPUT
     k = conmech.systems.kepler(1.0)
     tol = np.full(4, 1e-8)
-    fun, params, spec, ipar, rpar, n, name = native_path.prepare(
+    fun, params, spec, ipack, rpar, n, name = native_path.prepare(
         k, BY_NAME["DOP853"].code, tol, tol, 0.0, 1e300, 1000)
     y0 = np.array(KEPLER_Y0)
-    for r, out in ((rpar[:-2], np.empty(50)), (rpar, np.empty(2*n + 1))):
+    long_name = ipack.copy()
+    long_name[6] = ipack.size           # a name longer than the pack holds
+    for i, r, out in ((ipack, rpar[:-2], np.empty(50)), (ipack, rpar, np.empty(2*n + 1)),
+                      (ipack[:6], rpar, np.empty(50)), (ipack[:-1], rpar, np.empty(50)),
+                      (long_name, rpar, np.empty(50))):
         iout = np.zeros(40, dtype=np.int64)
-        _conmech.flat_solve_packed(name, params, spec, ipar, r, 0.0, 1.0, y0, out, iout)
+        _conmech.flat_solve_packed(i, params, spec, r, 0.0, 1.0, y0, out, iout)
         assert iout[6] == BAD_INPUT and iout[0] == 0
         assert "inconsistent sizes" in native_path.message_text(iout[8:])
     iout = np.zeros(40, dtype=np.int64)
     out = np.empty(2*(n + 1))          # room for two points: the run's are kept for take
-    _conmech.flat_solve_packed(name, params, spec, ipar, rpar, 0.0, 1.0, y0, out, iout)
+    _conmech.flat_solve_packed(ipack, params, spec, rpar, 0.0, 1.0, y0, out, iout)
     nt = -int(iout[0])
     assert iout[6] == 0 and nt > 2 and iout[7] != 0
     # a take that does not match the kept points copies nothing (and frees them)

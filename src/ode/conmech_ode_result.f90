@@ -10,6 +10,9 @@ module conmech_ode_result
 
     public :: ode_result, push_point, push_event, shrink_result
 
+    !> numbers (times and states) the outputs' second growth makes room for (8 kB)
+    integer, parameter :: ROOM = 1024
+
     !> Result of `ode_solve`.
     type :: ode_result
         integer :: status = CM_BAD_INPUT
@@ -28,11 +31,19 @@ module conmech_ode_result
 
 contains
 
-    !> Append the point (t, y) to the outputs.
+    !> Append the point (t, y) to the outputs: room for 16 points first (the end points
+    !! of a run), then at once for ROOM numbers (times and states), so that a run of a
+    !! small system stores its steps without growing again (each growth allocates and
+    !! copies both arrays), then twice the room each time.
     subroutine push_point(res, t, y)
         type(ode_result), intent(inout) :: res
         real(dp), intent(in) :: t, y(:)
-        if (res%nt >= size(res%t)) call resize(res%t, res%y, res%nt, max(16, 2*size(res%t)))
+        integer :: cap
+        if (res%nt >= size(res%t)) then
+            cap = 16
+            if (size(res%t) > 0) cap = max(2*size(res%t), ROOM/(size(y) + 1))
+            call resize(res%t, res%y, res%nt, cap)
+        end if
         res%nt = res%nt + 1
         res%t(res%nt) = t
         res%y(:, res%nt) = y

@@ -1,23 +1,26 @@
 !> solve_ivp's common cases (a built-in or compiled system, or a Python right-hand side
 !! without a Jacobian; no events, no dense output) through the flat layer at the smallest
-!! fixed cost. f2py's cost per call grows with the
-!! number of arguments, with every output array it creates (zero-filled) and above all
-!! with a call-back argument (the Python function is inspected on every call), so these
-!! routines have none of them but the right-hand side itself: the arguments that do not change between calls with the
-!! same method and tolerances come packed in two arrays the caller prepares once
-!! (ipar, rpar), the outputs go into arrays the caller passes (out, iout), and a run with
-!! more points than `out` holds leaves them in Fortran memory for flat_solve_take.
+!! fixed cost. f2py's cost per call grows with the number of arguments, with every output
+!! array it creates (zero-filled) and above all with a call-back argument (the Python
+!! function is inspected on every call), so these routines have none of them but the
+!! right-hand side itself: the arguments that do not change between calls with the same
+!! method and tolerances come packed in two arrays the caller prepares once (ipack and
+!! rpar, or ipar and rpar for a Python right-hand side), the outputs go into
+!! arrays the caller passes (out, iout), and a run with more points than `out` holds
+!! leaves them in Fortran memory for flat_solve_take.
 !!
 !! The layout of the points in out (nt points, n components): out(1:nt) the times, then
 !! the states by component, out(nt*i + 1 : nt*(i + 1)) = y(i, 1:nt): the caller reads
 !! y as a C-ordered (n, nt) array without a copy.
 
-!> Integrate y' = f(t, y) of the built-in (or compiled) system `name` (parameters
-!! params(1:np), function table spec(1:nspec), nspec = 0 for a built-in) from y0 over
-!! [t0, tf]. ipar = [np, nspec, method, max_steps, neval, with_t_eval] (method as
-!! flat_solve, METHOD_RK45_SCIPY included; with_t_eval /= 0: the points are t_eval's);
-!! rpar = [first_step, max_step, rtol(1:n), atol(1:n), t_eval(1:max(neval, 1))]
-!! (neval = 0: a point at every step, one unused number last).
+!> Integrate y' = f(t, y) of the built-in (or compiled) system named in ipack
+!! (parameters params(1:np), function table spec(1:nspec), nspec = 0 for a built-in;
+!! both read at every call, as the system holds them) from y0 over [t0, tf].
+!! ipack = [np, nspec, method, max_steps, neval, with_t_eval, lname, the name's lname
+!! characters (codes)] (method as flat_solve, METHOD_RK45_SCIPY included; with_t_eval
+!! /= 0: the points are t_eval's; the name packed with the numbers: one f2py conversion
+!! less than a string argument); rpar = [first_step, max_step, rtol(1:n), atol(1:n),
+!! t_eval(1:max(neval, 1))] (neval = 0: a point at every step, one unused number last).
 !! On return iout(1:8) = [nt, nfev, njev, nlu, naccept, nreject, info, handle] and
 !! iout(9:40) the message, its 256 characters as bytes (f2py's character output costs a
 !! loop over every character on every call; this is read only when needed). nt > 0 points
@@ -26,30 +29,44 @@
 !! solve_ivp returns them: a zero-length span without t_eval gives (t0, y0) twice (SciPy's
 !! solver makes one empty step), a run that stored no point gives (t0, y0). info is the
 !! run's status (0 end reached, < 0 failure, CM_BAD_INPUT refused) with its message.
-subroutine flat_solve_packed(name, lp, params, ls, spec, ipar, lr, rpar, t0, tf, n, y0, &
+subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, n, y0, &
                              nout, out, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
     use conmech_kinds, only: dp
+    use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_flat_spec, only: spec_system_of_size
-    use conmech_flat_packed_support, only: packed_sizes_ok, run_packed
+    use conmech_flat_packed_support, only: packed_sizes_ok, run_packed, put_message
     implicit none
-    character(len=*), intent(in) :: name
-    integer(c_int), intent(in) :: lp, ls, lr, n, nout
+    integer(c_int), intent(in) :: li, lp, ls, lr, n, nout
+    integer(c_int64_t), intent(in) :: ipack(li)
     real(c_double), intent(in) :: params(lp)
     integer(c_int64_t), intent(in) :: spec(ls)
-    integer(c_int), intent(in) :: ipar(6)
     real(c_double), intent(in) :: rpar(lr)
     real(c_double), intent(in) :: t0, tf
     real(c_double), intent(in) :: y0(n)
     real(c_double), intent(inout) :: out(nout)
     integer(c_int64_t), intent(inout) :: iout(40)
+    integer, parameter :: HEAD = 7
     class(ode_system), allocatable :: sys
-    character(len=:), allocatable :: msg
-    integer :: info
+    character(len=:), allocatable :: msg, name
+    integer(c_int) :: ipar(6), lname
+    integer :: info, i
 
     iout = 0
+    lname = -1
+    if (li >= HEAD) lname = int(max(-1_c_int64_t, min(ipack(HEAD), int(li, c_int64_t))), c_int)
+    if (lname < 0 .or. li - HEAD < lname) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: packed arguments of inconsistent sizes", iout)
+        return
+    end if
+    ipar = int(ipack(1:6), c_int)
     if (.not. packed_sizes_ok(ipar, lp, ls, lr, n, nout, iout)) return
+    allocate (character(len=lname) :: name)
+    do i = 1, lname
+        name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
+    end do
     call spec_system_of_size(name, real(params(1:ipar(1)), dp), ipar(2), spec, n, "", sys, &
                              info, msg)
     call run_packed(sys, info, msg, ipar, rpar, t0, tf, n, y0, out, iout)

@@ -27,19 +27,22 @@ _TEMPLATE = dict(t=None, y=None, sol=None, t_events=None, y_events=None, nfev=0,
 
 def prepare(fun, code, rtol, atol, h0, hmax, max_steps, t_ev=None):
     """The packed fixed arguments of flat_solve_packed for the system ``fun`` (checked
-    arguments): (fun, params, spec, ipar, rpar, n, name as bytes), where params and spec
-    are the arrays they were packed for (a system given new ones is packed again),
-    ipar = [np, nspec, method, max_steps, neval, with t_eval], rpar = [first_step,
-    max_step, rtol, atol, t_eval or one unused number]."""
+    arguments): (fun, params, spec, ipack, rpar, n, name as bytes), where params and spec
+    are the arrays they were packed for (a system given new ones is packed again; they
+    are passed as they are, so that values changed in place are read),
+    ipack = [np, nspec, method, max_steps, neval, with t_eval, len(name), the name's
+    bytes], rpar = [first_step, max_step, rtol, atol, t_eval or one unused number]."""
     params, spec = fun.params, fun.spec
     n = fun.dimension
+    name = fun.name.encode("ascii", "replace")
     neval = 0 if t_ev is None else t_ev.size
-    ipar = np.array([params.size, spec.size if spec is not _NO_SPEC else 0, code,
-                     max_steps, neval, t_ev is not None], dtype=np.intc)
+    ipack = np.concatenate([[params.size, spec.size if spec is not _NO_SPEC else 0, code,
+                             max_steps, neval, t_ev is not None, len(name)],
+                            np.frombuffer(name, dtype=np.uint8)]).astype(_INT64)
     rpar = np.concatenate([[h0, hmax], np.broadcast_to(rtol, (n,)),
                            np.broadcast_to(atol, (n,)), t_ev if neval else _PAD])
-    ipar.flags.writeable = rpar.flags.writeable = False
-    return fun, params, spec, ipar, rpar, n, fun.name.encode("ascii", "replace")
+    ipack.flags.writeable = rpar.flags.writeable = False
+    return fun, params, spec, ipack, rpar, n, name
 
 
 def run(prep, t0, tf, y0, cap=0):
@@ -47,13 +50,13 @@ def run(prep, t0, tf, y0, cap=0):
     (:func:`prepare`) from ``y0`` (n finite numbers: an array, list or tuple) over
     [t0, tf]; room for ``cap`` points in one call (0: _OUT_DOUBLES numbers; 2 for a
     zero-length span)."""
-    fun, params, spec, ipar, rpar, n, name = prep
+    fun, params, spec, ipack, rpar, n, name = prep
     if not cap:
         cap = 2 if tf == t0 else max(_OUT_DOUBLES // (n + 1), 2)
     out = np.empty(cap*(n + 1))
     iout = np.empty(40, dtype=_INT64)       # 8 numbers, then the message's 256 bytes
-    _conmech.flat_solve_packed(name, params if params.size else _PAD, spec, ipar, rpar, t0,
-                               tf, y0, out, iout)
+    _conmech.flat_solve_packed(ipack, params if params.size else _PAD, spec, rpar, t0, tf,
+                               y0, out, iout)
     return _result(out, iout, n)
 
 
@@ -79,12 +82,16 @@ def _take(out, iout, n, guard=None):
 
 def _result(out, iout, n, guard=None):
     """The OdeResult of a packed call's outputs (:func:`_take`)."""
-    out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
-    if nt*(n + 1) != out.size:
-        out = out[:nt*(n + 1)].copy()       # the result does not hold on to the room
+    nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
+    if nt < 0 or guard is not None or info == BAD_INPUT:
+        out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
+    m = nt*(n + 1)
+    # the points as an (n + 1, nt) array: its first row the times, the others y (views
+    # of one array the size of the points: the result does not hold on to the room)
+    points = (out if m == out.size else out[:m].copy()).reshape(n + 1, nt)
     res = OdeResult(_TEMPLATE)
-    res["t"] = out[:nt]
-    res["y"] = out[nt:].reshape(n, nt)
+    res["t"] = points[0]
+    res["y"] = points[1:]
     if nfev:
         res["nfev"] = nfev
     if njev or nlu:
