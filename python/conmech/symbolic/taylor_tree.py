@@ -28,7 +28,10 @@ stepper reports as a non-finite right-hand side
 The library has the routines of a generalized system's Taylor library (its first-order
 view runs on them): ``conmech_taylor(t, order, w, p)`` and ``_info`` with the work-array
 convention of an ode system's (the state [q; v] in the columns 1..2n), and
-``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; a] from the order-1 expansion).
+``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; a] from the order-1 expansion); its
+quadruple-precision part the same recurrences in real128 (``conmech_taylor_qp``, the entry
+of :mod:`conmech.symbolic.taylor_quad`), and its variational part the chain differentiated
+forward (:mod:`conmech.symbolic.taylor_tree_var`).
 """
 import math
 
