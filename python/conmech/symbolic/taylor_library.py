@@ -102,6 +102,9 @@ def _lines(d, part, dec_cache):
     if d.kind == "generalized":          # through the accelerations' linear solve
         from .taylor_tree import is_tree, tree_lines
         if is_tree(d):                   # through the articulated-body chain
+            if part == "var":
+                from .taylor_tree_var import tree_variational_lines
+                return tree_variational_lines(d, names, dec_cache)
             return tree_lines(d, names, part, dec_cache)
         if part == "var":
             from .taylor_generalized_var import variational_lines

@@ -148,12 +148,12 @@ def tree_quad_routine(dec, pivots, names, cname="conmech_taylor_qp"):
 
 def tree_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a tree model's Taylor library
-    (:mod:`conmech.symbolic.taylor_library`): the core, the quadruple precision part
-    (``qp``) and the variational one (``var``: :mod:`conmech.symbolic.taylor_tree_var`);
-    the batch part is not generated for trees."""
+    (:mod:`conmech.symbolic.taylor_library`): the core and the quadruple precision part
+    (``qp``); the variational part is :mod:`conmech.symbolic.taylor_tree_var`'s
+    (``tree_variational_lines``), and the batch part is not generated for trees."""
     if part == "var":
-        from .taylor_tree_var import tree_variational_lines
-        return tree_variational_lines(d, names, dec_cache)
+        raise ValueError("the variational part of a tree: "
+                         "conmech.symbolic.taylor_tree_var.tree_variational_lines")
     if part == "qp":
         if "tree" not in dec_cache:
             dec_cache["tree"] = tree_decomposition(d)
