@@ -15,7 +15,6 @@ quadruple precision (conmech.symbolic.taylor_generalized.generalized_quad_routin
 - the monodromy of a nonlinear normal mode of the double pendulum (found by symmetric
   shooting on the default route) through the Taylor route: the orbit's multipliers, the
   flow direction kept (Phi f(y0) = f(y0)), the DOP853 monodromy;
-- a tree has no variational part: a ValueError with the reason;
 - quadruple precision: the double pendulum by Taylor in real128 against Hairer's DOP853 in
   real128 (a second method on the routine's first coefficient) to 1e-23, and the double
   Taylor run at 1e-13 to 1e-12.
@@ -34,7 +33,6 @@ from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
                                                      variational_procedures)
-from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
 from taylor_jets import coefficients  # noqa: E402
 
@@ -182,17 +180,6 @@ def test_monodromy_of_a_normal_mode(double_pendulum):
     mu_t = np.sort_complex(floquet(mt, T)["multipliers"])
     mu_o = np.sort_complex(np.asarray(orb.multipliers))
     assert np.max(np.abs(mu_t - mu_o)) < 1e-5
-
-
-def test_a_tree_has_no_variational_part():
-    th = dynamicsymbols("th")
-    m, l, g = sp.symbols("m l g")
-    tree = symbolic.planar_tree(
-        [symbolic.Body("link", None, "revolute", th, at=(0, 0), mass=m, com=(0, -l))],
-        {m: 1.0, l: 1.0, g: 9.81}, gravity=(0, -g))
-    assert conmech.solve_ivp(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR").success
-    with pytest.raises(ValueError, match="variational"):
-        stm(tree, (0.0, 1.0), [0.3, 0.0], method="TAYLOR")
 
 
 def test_quadruple_precision_agrees_with_dop853_in_real128(double_pendulum):

@@ -38,8 +38,9 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 4     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
-                # 4: the variational and quadruple-precision parts of generalized models)
+_FORMAT = 5     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
+                # 4: the variational and quadruple-precision parts of generalized models,
+                # 5: those of trees)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -99,6 +100,12 @@ def _lines(d, part, dec_cache):
     from . import taylor as T
     names = _names(d)
     if d.kind == "generalized":          # through the accelerations' linear solve
+        from .taylor_tree import is_tree, tree_lines
+        if is_tree(d):                   # through the articulated-body chain
+            if part == "var":
+                from .taylor_tree_var import tree_variational_lines
+                return tree_variational_lines(d, names, dec_cache)
+            return tree_lines(d, names, part, dec_cache)
         if part == "var":
             from .taylor_generalized_var import variational_lines
             return variational_lines(d, names, dec_cache)
@@ -146,7 +153,8 @@ def taylor_source(d, part="core", _dec=None):
     code holds. A generalized record M(q) q'' = Q has the core, with
     ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the quadruple
     precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
-    a tree the core only. (None, [],
+    a tree the same three through its articulated-body chain
+    (:mod:`conmech.symbolic.taylor_tree`, :mod:`conmech.symbolic.taylor_tree_var`). (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
     if part not in PARTS and _lanes(part) is None:
         raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "

@@ -28,20 +28,23 @@ stepper reports as a non-finite right-hand side
 The library has the routines of a generalized system's Taylor library (its first-order
 view runs on them): ``conmech_taylor(t, order, w, p)`` and ``_info`` with the work-array
 convention of an ode system's (the state [q; v] in the columns 1..2n), and
-``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; a] from the order-1 expansion).
+``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; a] from the order-1 expansion); its
+quadruple-precision part the same recurrences in real128 (``conmech_taylor_qp``, the entry
+of :mod:`conmech.symbolic.taylor_quad`), and its variational part the chain differentiated
+forward (:mod:`conmech.symbolic.taylor_tree_var`).
 """
 import math
 
 import sympy as sp
 
 from .spatial_aba import _spatial_aba
-from .taylor import _Printer, _wrap, body_lines
+from .taylor import _Printer, _wrap, body_lines, quad_entry
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import core_part_lines, first_order_procedures
 from .tree_aba import _aba
 
-__all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_procedures", "tree_lines",
-           "pivot_values"]
+__all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_body", "tree_procedures",
+           "tree_quad_routine", "tree_lines", "pivot_values"]
 
 
 def is_tree(d):
@@ -90,19 +93,15 @@ def tree_decomposition(d):
     return dec, pivots, None
 
 
-def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
-    """Fortran lines of ``prefix(t, order, w, p)`` (bind(C): the recurrences of the
-    chain, with the pivots checked at order 0), ``prefix_info(info)`` ([columns of w, 0,
-    2n, 0]) and ``prefix_rhs(t, y, dydt, p)``."""
-    ind = "        "
-    nw = dec.ncol
-    m = dec.n
-    npar = max(len(dec.params), 1)
-    decl, body = body_lines(dec, names, "dp", 0, False, ind)
+def tree_body(dec, pivots, names, kind="dp", ind="        "):
+    """(declarations, statements) of the recurrences of the chain (`kind` "dp" or "qp"),
+    with the pivots checked at order 0, for a procedure that declares t, order, w(0:order,
+    dec.ncol) and p and uses ieee_value and ieee_quiet_nan."""
+    decl, body = body_lines(dec, names, kind, 0, False, ind)
     # the pivot checks: after the order-0 statements, before the loop over the orders
     # (order 0 evaluates the chain in full: the accelerations, as the tree's right-hand
     # side does, and then nothing of order >= 1 is kept from a non-positive pivot)
-    pp = _Printer(dec, names, False, "dp")
+    pp = _Printer(dec, names, False, kind)
     start = f"{ind}do k = 1, order - 1"
     at = body.index(start) if start in body else len(body)
     checks = []
@@ -110,20 +109,58 @@ def tree_procedures(dec, pivots, names, prefix="conmech_taylor"):
         if not lin.terms:
             continue          # a constant pivot: checked positive when the tree was built
         checks += _wrap(f"pivot = {pp.lin_at(lin, 0, True)}", ind)
-        checks += [f"{ind}if (.not. (pivot > 0.0_dp)) then",
-                   f"{ind}    w(1:order, :) = ieee_value(1.0_dp, ieee_quiet_nan)",
+        checks += [f"{ind}if (.not. (pivot > 0.0_{kind})) then",
+                   f"{ind}    w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)",
                    f"{ind}    return",
                    f"{ind}end if"]
     body = body[:at] + checks + body[at:]
     if checks:
-        decl = decl + [f"{ind}real(dp) :: pivot"]
-    return first_order_procedures(prefix, nw, m, npar, decl, body, ind)
+        decl = decl + [f"{ind}real({kind}) :: pivot"]
+    return decl, body
+
+
+def tree_procedures(dec, pivots, names, prefix="conmech_taylor", rhs=True):
+    """Fortran lines of ``prefix(t, order, w, p)`` (bind(C): the recurrences of the
+    chain, with the pivots checked at order 0), ``prefix_info(info)`` ([columns of w, 0,
+    size of the state, 0]) and, with `rhs`, ``prefix_rhs(t, y, dydt, p)``."""
+    ind = "        "
+    decl, body = tree_body(dec, pivots, names, "dp", ind)
+    return first_order_procedures(prefix, dec.ncol, dec.n, max(len(dec.params), 1), decl,
+                                  body, ind, rhs=rhs)
+
+
+def tree_quad_routine(dec, pivots, names, cname="conmech_taylor_qp"):
+    """The same recurrences in quadruple precision: ``cname(t, order, w, p)`` through C
+    pointers to real128 values (:func:`conmech.symbolic.taylor.quad_entry`: t, w(0:order,
+    dec.ncol), p), the pivots checked in real128."""
+    ind = "        "
+    nw = dec.ncol
+    head = quad_entry(cname, nw, max(len(dec.params), 1))
+    inner = [f"    subroutine {cname}_body(t, order, w, p)",
+             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
+             f"{ind}real(qp), intent(in) :: t",
+             f"{ind}integer(c_int), intent(in) :: order",
+             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
+             f"{ind}real(qp), intent(in) :: p({max(len(dec.params), 1)})"]
+    decl, body = tree_body(dec, pivots, names, "qp", ind)
+    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
 
 
 def tree_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a tree model's Taylor library
-    (:mod:`conmech.symbolic.taylor_library`): the core only (the batch, quadruple
-    precision and variational parts are generated for ode systems only)."""
+    (:mod:`conmech.symbolic.taylor_library`): the core and the quadruple precision part
+    (``qp``); the variational part is :mod:`conmech.symbolic.taylor_tree_var`'s
+    (``tree_variational_lines``), and the batch part is not generated for trees."""
+    if part == "var":
+        raise ValueError("the variational part of a tree: "
+                         "conmech.symbolic.taylor_tree_var.tree_variational_lines")
+    if part == "qp":
+        if "tree" not in dec_cache:
+            dec_cache["tree"] = tree_decomposition(d)
+        dec, pivots, why = dec_cache["tree"]
+        if dec is None:
+            return [], [], why
+        return tree_quad_routine(dec, pivots, names), ["taylor_qp"], None
     return core_part_lines(d, part, dec_cache, "tree", tree_decomposition,
                            "trees (their first-order view runs the core)",
                            lambda dec, pivots: tree_procedures(dec, pivots, names))

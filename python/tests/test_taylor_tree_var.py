@@ -1,0 +1,259 @@
+"""The variational system of a symbolic tree by Taylor's method (conmech.symbolic.taylor_tree_var:
+forward-mode differentiation of the articulated-body chain, the tangents further
+definitions of the chain) and its recurrences in quadruple precision
+(conmech.symbolic.taylor_tree.tree_quad_routine).
+
+- the generated coefficients of [y; Phi] against the core routine's (the state rows) and
+  against central differences of the core routine's coefficients in the initial state
+  (the Phi rows: d y^[k] / d y0, order by order), for the double pendulum tree, an arm
+  on a slide (a prismatic joint, a spring, dampers, a torque in t) and two joints of the
+  shipped spatial arm (URDF); a general Phi0 gives the identity's
+  coefficients times Phi0;
+- stm(method="TAYLOR") of the double pendulum tree (two motions) against the DOP853 STM (an
+  independent route: the Jacobian of the accelerations from the tree's own generated
+  code), and Liouville's formula in (q, v): the flow is symplectic in (q, p), p = M(q) v,
+  so det Phi = det M(q(t0)) / det M(q(t1)); Phi(t1) f(y0) = f(y1) along the solution;
+- the double pendulum tree and the double pendulum built from its Lagrangian (the mass
+  matrix route, conmech.symbolic.taylor_generalized_var) give the same STM;
+- the monodromy of a nonlinear normal mode of the double pendulum tree (found by symmetric
+  shooting on the default route) through the Taylor route: the orbit's multipliers, the
+  flow direction kept, the DOP853 monodromy;
+- quadruple precision: the double and triple pendulum trees by Taylor in real128 against
+  Hairer's DOP853 in real128 (a second method on the routine's first coefficient) to
+  1e-24, and a double Taylor run's error measured against it;
+- a tree with a non-smooth force has no variational part: a ValueError with the reason.
+"""
+from decimal import Decimal
+
+import numpy as np
+import pytest
+
+sp = pytest.importorskip("sympy")
+
+import conmech  # noqa: E402
+from conmech import symbolic  # noqa: E402
+from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
+from conmech.stability import floquet, monodromy, stm, symmetric_orbit  # noqa: E402
+from conmech.symbolic import planar_tree, taylor_quad  # noqa: E402
+from conmech.symbolic.pipeline import model_of  # noqa: E402
+import symbolic_seeds as seeds  # noqa: E402
+import taylor_jets  # noqa: E402
+from taylor_jets import coefficients  # noqa: E402
+from test_taylor_tree import chain  # noqa: E402
+from conmech.symbolic.urdf import data_path  # noqa: E402
+from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
+
+
+@pytest.fixture(scope="session", autouse=True)
+def symbolic_cache(tmp_path_factory):
+    """The test session's one compile cache (symbolic_seeds.use_test_cache)."""
+    return seeds.use_test_cache(tmp_path_factory.getbasetemp())
+
+
+def pendulum_tree(N, unit=False):
+    """N point masses on rods, pinned at the origin, absolute angles from the downward
+    vertical (unit: unit masses and rods, the double pendulum of taylor_jets)."""
+    bodies, params, g = chain(N)
+    if unit:
+        params = {s: (9.81 if s == g else 1.0) for s in params}
+    return planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute")
+
+
+@pytest.fixture(scope="module")
+def double_tree():
+    return pendulum_tree(2, unit=True)
+
+
+@pytest.fixture(scope="module")
+def triple_tree():
+    return pendulum_tree(3)
+
+
+def jets(system, y, order, phi=None, t0=0.0):
+    """(core coefficients of y, variational coefficients of [y; vec(Phi)])."""
+    view = first_order_view(system, "var")
+    tay = view.taylor
+    m = len(y)
+    phi = np.eye(m) if phi is None else phi
+    addr = conmech.compiled.function_address
+    core = coefficients(addr(tay["jet"]), tay["nw"], view.params, y, order, t0)
+    var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
+                       np.concatenate([y, phi.ravel(order="F")]), order, t0)
+    return core, var
+
+
+def mass(system, q):
+    n = len(q)
+    m = model_of(system).call("mass", 0.0, np.asarray(q, dtype=float),
+                              params=np.asarray(system.params, dtype=float))
+    return np.array(m, dtype=float).reshape(n, n)
+
+
+def rhs(system, y):
+    """f(y) = [v; a] of the first-order view (its core routine's first coefficient)."""
+    return jets(system, np.asarray(y, dtype=float), 1)[0][:, 1]
+
+
+# ------------------------------------------------------------------ coefficients
+
+def cart_arm():
+    """An arm on a horizontal prismatic slide (spring, damper), with an offset and an
+    inertia, driven by a torque that depends on t and damped: the joints, forces in q, v
+    and t of the branched tree of test_taylor_tree on two bodies."""
+    t = dynamicsymbols._t
+    x, a = dynamicsymbols("x a")
+    m0, m1, I1, k, c, l1, tau0, w, g = sp.symbols("m0 m1 I1 k c l1 tau0 w g")
+    bodies = [symbolic.Body("cart", None, "prismatic", x, axis=(1, 0), mass=m0),
+              symbolic.Body("arm", "cart", "revolute", a, at=(0.1, 0.2), mass=m1,
+                            com=(l1/2, -0.05), inertia=I1)]
+    params = {m0: 2.0, m1: 1.0, I1: 0.08, k: 3.0, c: 0.3, l1: 1.0, tau0: 0.5, w: 1.7,
+              g: 9.81}
+    forces = {"cart": -k*x - c*x.diff(t), a: tau0*sp.sin(w*t) - c*a.diff(t)}
+    return planar_tree(bodies, params, gravity=(0, -g), forces=forces)
+
+
+def two_joint_arm():
+    """The first two joints of the shipped seven-joint arm (URDF text: the links and
+    joints beyond link2 dropped)."""
+    import xml.etree.ElementTree as ET
+    root = ET.parse(data_path("arm7.urdf")).getroot()
+    keep = {"base", "link1", "link2"}
+    for el in list(root):
+        if el.tag == "link" and el.get("name") not in keep or \
+                el.tag == "joint" and el.find("child").get("link") not in keep:
+            root.remove(el)
+    return symbolic.from_urdf(ET.tostring(root, encoding="unicode"))
+
+
+@pytest.mark.parametrize("which", ["double_tree", "cart_arm", "spatial"])
+def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
+    """Row block of column c of Phi at order k = d y^[k] / d y0_c: central differences
+    (step h, error O(h^2) ~ 1e-10 relative at these orders) of the core routine's
+    coefficients; the state rows are the core routine's own to round-off."""
+    if which == "spatial":
+        system = two_joint_arm()
+        y = np.array([0.2, -0.4, -0.5, 0.3])
+    elif which == "cart_arm":
+        system = cart_arm()
+        y = np.array([0.3, -0.4, 0.5, -0.7])
+    else:
+        system = request.getfixturevalue(which)
+        y = np.array([1.2, -0.4, 0.3, 0.1])
+    order, t0 = 8, 0.7
+    core, var = jets(system, y, order, t0=t0)
+    m = y.size
+    scale = np.max(np.abs(core), axis=0)
+    assert np.all(np.abs(var[:m] - core) <= 64*np.finfo(float).eps*scale)
+    h = 1e-5
+    for c in range(m):
+        e = np.zeros(m)
+        e[c] = h
+        fd = (jets(system, y + e, order, t0=t0)[0] - jets(system, y - e, order, t0=t0)[0])/(2*h)
+        got = var[m + c*m:m + (c + 1)*m]
+        for k in range(order + 1):
+            ref = max(np.max(np.abs(fd[:, k])), 1e-3)
+            assert np.max(np.abs(got[:, k] - fd[:, k])) <= 1e-7*ref, (c, k)
+    # Phi enters linearly: a general Phi0 gives the coefficients of the identity's times it
+    phi0 = np.arange(1.0, 1.0 + m*m).reshape(m, m)/7.0 - 1.0
+    _, var2 = jets(system, y, order, phi0, t0=t0)
+    K = order + 1
+    blocks = var[m:].reshape(m, m, K)          # [column, row, order] of the identity's
+    want = np.einsum("crk,cd->drk", blocks, phi0)
+    got2 = var2[m:].reshape(m, m, K)
+    assert np.allclose(got2, want, rtol=1e-12, atol=1e-12*np.max(np.abs(want)))
+
+
+# ------------------------------------------------------------------ integration
+
+def test_taylor_stm_agrees_with_dop853_liouville_and_the_flow(double_tree):
+    for system, y0, t1 in ((double_tree, [1.2, -0.4, 0.3, 0.1], 5.0),
+                           (double_tree, [0.3, 2.5, -1.0, 0.4], 4.0)):
+        y_t, phi_t, info = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12,
+                               method="TAYLOR", full_output=True)
+        y_d, phi_d = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12)
+        assert info["nfev"] > 0
+        big = np.max(np.abs(phi_d))
+        assert big > 2.0          # a sensitive flow: the check is not of the identity
+        assert np.max(np.abs(y_t - y_d)) < 1e-9
+        assert np.max(np.abs(phi_t - phi_d)) < 1e-8*big
+        n = len(y0)//2
+        liouville = np.linalg.det(mass(system, y0[:n]))/np.linalg.det(mass(system, y_t[:n]))
+        assert abs(np.linalg.det(phi_t) - liouville) < 1e-8*big**(2*n)
+        # the flow's direction is carried along: Phi f(y0) = f(y1)
+        f0, f1 = rhs(system, y0), rhs(system, y_t)
+        assert np.linalg.norm(phi_t @ f0 - f1) < 1e-8*big*np.linalg.norm(f0)
+        # the state is the Taylor solve's own
+        r = conmech.solve_ivp(system, (0.0, t1), y0, method="TAYLOR", rtol=1e-12,
+                              atol=1e-12)
+        assert np.max(np.abs(r.y[:, -1] - y_t)) < 1e-9
+
+
+def test_tree_and_lagrangian_give_the_same_stm(double_tree):
+    """The double pendulum as a tree (the articulated-body chain differentiated forward)
+    and from its Lagrangian (M da = K Phi solved order by order): one STM."""
+    lag = taylor_jets.double_pendulum()
+    y0 = [1.2, -0.4, 0.3, 0.1]
+    y_tree, phi_tree = stm(double_tree, (0.0, 5.0), y0, method="TAYLOR")
+    y_lag, phi_lag = stm(lag, (0.0, 5.0), y0, method="TAYLOR")
+    big = np.max(np.abs(phi_lag))
+    assert big > 2.0
+    assert np.max(np.abs(y_tree - y_lag)) < 1e-9
+    assert np.max(np.abs(phi_tree - phi_lag)) < 1e-8*big
+    # and their coefficients at a point, order by order, to round-off
+    y = np.array(y0)
+    _, var_tree = jets(double_tree, y, 12)
+    _, var_lag = jets(lag, y, 12)
+    scale = np.max(np.abs(var_lag), axis=0)
+    assert np.all(np.abs(var_tree - var_lag) <= 1e-13*scale)
+
+
+def test_monodromy_of_a_normal_mode(double_tree):
+    """The in-phase nonlinear normal mode (b/a -> sqrt(2), omega^2 -> g (2 - sqrt(2)) at
+    small amplitude): released at rest, the velocities vanish again at half the period."""
+    g = 9.81
+    a0 = 0.3
+    period = 2*np.pi/np.sqrt(g*(2 - np.sqrt(2)))
+    orb = symmetric_orbit(double_tree, [a0, np.sqrt(2)*a0, 0.0, 0.0], free=[1],
+                          targets=[2, 3], period=period, free_time=True)
+    y0, T = np.asarray(orb.y0), float(orb.period)
+    mt = monodromy(double_tree, y0, T, method="TAYLOR")
+    md = monodromy(double_tree, y0, T)
+    assert np.max(np.abs(mt - md)) < 1e-8*np.max(np.abs(md))
+    # the flow direction f(y0) is kept over a period
+    f = rhs(double_tree, y0)
+    assert np.linalg.norm(mt @ f - f) < 1e-8*np.linalg.norm(f)
+    # the multipliers of the orbit's own (default) route: a pair at 1 and a pair on the
+    # unit circle (a stable conservative orbit)
+    mu_t = np.sort_complex(floquet(mt, T)["multipliers"])
+    mu_o = np.sort_complex(np.asarray(orb.multipliers))
+    assert np.max(np.abs(mu_t - mu_o)) < 1e-5
+    assert np.max(np.abs(np.abs(mu_t) - 1)) < 1e-6
+
+
+def test_a_non_smooth_tree_has_no_variational_part():
+    bodies, params, g = chain(2)
+    th = [b.q for b in bodies]
+    tree = planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute",
+                       forces=[-sp.Abs(th[0]), 0])
+    with pytest.raises(ValueError, match="smooth"):
+        stm(tree, (0.0, 1.0), [0.3, 0.2, 0.0, 0.1], method="TAYLOR")
+
+
+# ------------------------------------------------------------------ quadruple precision
+
+@pytest.mark.parametrize("which", ["double_tree", "triple_tree"])
+def test_quadruple_precision_agrees_with_dop853_in_real128(which, request):
+    system = request.getfixturevalue(which)
+    y0 = ["1.2", "-0.4", "0.3", "0.1"] if which == "double_tree" else \
+        ["1.2", "0.4", "-0.5", "0", "0.3", "-0.2"]
+    r = taylor_quad.reference(system, (0, 2), y0, tol=1e-30)
+    d = taylor_quad.reference_dop853(system, (0, 2), y0, rtol=1e-27)
+    assert r.success and d.success and r.order > 30
+    diff = [abs(Decimal(u) - Decimal(v)) for u, v in zip(r.y_str, d.y_str)]
+    assert max(diff) < Decimal("1e-24"), diff
+    assert max(abs(Decimal(u)) for u in r.y_str) > Decimal(1)      # the state moved
+    # a double Taylor run's error, measured against the reference: at the tolerance's level
+    s = conmech.solve_ivp(system, (0, 2), [float(v) for v in y0], method="TAYLOR",
+                          rtol=1e-13, atol=1e-13)
+    err = np.max(np.abs(s.y[:, -1] - r.y_float))
+    assert 0 < err < 1e-12
