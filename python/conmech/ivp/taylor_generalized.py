@@ -40,7 +40,7 @@ def first_order_view(fun, *parts):
     quadruple precision, for conmech.symbolic.taylor_quad.reference).
     ValueError with the reason when the generalized system's accelerations (or a part
     asked for) have no Taylor recurrences (a non-smooth expression, an asymmetric mass
-    matrix, the variational system of a tree)."""
+    matrix)."""
     model = _model(fun)
     if model is None:
         return fun

@@ -26,7 +26,8 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     variational system's own recurrences (a system from :func:`conmech.symbolic.ode_system`:
     the state and Phi expanded together, the step controlled on both; a generalized
     system of :mod:`conmech.symbolic` through the accelerations' linear solve, the
-    columns of Phi further right-hand sides of the same mass matrix)."""
+    columns of Phi further right-hand sides of the same mass matrix; a tree of
+    :mod:`conmech.symbolic` through its articulated-body chain differentiated forward)."""
     y0 = _state(y0)
     _check_dim(system, y0)
     try:

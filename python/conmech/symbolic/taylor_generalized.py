@@ -319,8 +319,8 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
     library (conmech.symbolic.taylor_library): the core and the quadruple precision one
-    (``qp``); the batch part is not generated for generalized systems, nor the qp part of
-    trees (the variational part: conmech.symbolic.taylor_generalized_var.variational_lines).
+    (``qp``), a tree's through its articulated-body chain; the batch part is not generated
+    for generalized systems or trees (the variational part: conmech.symbolic.taylor_generalized_var.variational_lines).
     """
     if is_tree(d):              # a tree: through its articulated-body code
         return tree_lines(d, names, part, dec_cache)

@@ -253,8 +253,8 @@ def variational_procedures(g, names, prefix="conmech_taylor_var", write_out=None
 
 def variational_lines(d, names, dec_cache):
     """(Fortran lines, entry names, reason) of the variational part ("var") of a generalized
-    model's Taylor library (conmech.symbolic.taylor_library); a tree's is refused with the
-    reason (conmech.symbolic.taylor_tree)."""
+    model's Taylor library (conmech.symbolic.taylor_library); a tree's is its chain's
+    (conmech.symbolic.taylor_tree_var)."""
     if is_tree(d):
         return tree_lines(d, names, "var", dec_cache)
     if "gvar" not in dec_cache:
