@@ -33,7 +33,7 @@ sp = pytest.importorskip("sympy")
 import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
 from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
-from conmech.stability import floquet, monodromy, stm, symmetric_orbit  # noqa: E402
+from conmech.stability import stm  # noqa: E402
 from conmech.symbolic import planar_tree, taylor_quad  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
@@ -208,25 +208,11 @@ def test_tree_and_lagrangian_give_the_same_stm(double_tree):
 
 
 def test_monodromy_of_a_normal_mode(double_tree):
-    """The in-phase nonlinear normal mode (b/a -> sqrt(2), omega^2 -> g (2 - sqrt(2)) at
-    small amplitude): released at rest, the velocities vanish again at half the period."""
-    g = 9.81
-    a0 = 0.3
-    period = 2*np.pi/np.sqrt(g*(2 - np.sqrt(2)))
-    orb = symmetric_orbit(double_tree, [a0, np.sqrt(2)*a0, 0.0, 0.0], free=[1],
-                          targets=[2, 3], period=period, free_time=True)
-    y0, T = np.asarray(orb.y0), float(orb.period)
-    mt = monodromy(double_tree, y0, T, method="TAYLOR")
-    md = monodromy(double_tree, y0, T)
-    assert np.max(np.abs(mt - md)) < 1e-8*np.max(np.abs(md))
-    # the flow direction f(y0) is kept over a period
-    f = rhs(double_tree, y0)
-    assert np.linalg.norm(mt @ f - f) < 1e-8*np.linalg.norm(f)
-    # the multipliers of the orbit's own (default) route: a pair at 1 and a pair on the
-    # unit circle (a stable conservative orbit)
-    mu_t = np.sort_complex(floquet(mt, T)["multipliers"])
-    mu_o = np.sort_complex(np.asarray(orb.multipliers))
-    assert np.max(np.abs(mu_t - mu_o)) < 1e-5
+    """The in-phase normal mode's Taylor monodromy (taylor_jets): the default route's, the
+    flow direction kept, the orbit's multipliers; a stable conservative orbit has them all
+    on the unit circle (a pair at 1, a pair of modulus 1)."""
+    mu_t = taylor_jets.check_normal_mode_monodromy(double_tree,
+                                                   lambda y0: rhs(double_tree, y0))
     assert np.max(np.abs(np.abs(mu_t) - 1)) < 1e-6
 
 
