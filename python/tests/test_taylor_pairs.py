@@ -20,6 +20,7 @@ from conmech import symbolic  # noqa: E402
 from conmech.symbolic import build  # noqa: E402
 from conmech.symbolic import taylor as T  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
+from conmech.symbolic.taylor_recipe import Recipe  # noqa: E402
 
 _P = ctypes.POINTER(ctypes.c_double)
 x, y, u, v, mu = sp.symbols("x y u v mu")
@@ -50,7 +51,7 @@ def pairing(f, params=()):
     dec = T.decompose(f, [x, y, u, v], sp.Symbol("t"), list(params))
     pp = T._Printer(dec, {p: f"p({i + 1})" for i, p in enumerate(params)}, False, "dp")
     pp.scalars = set()
-    rc = T._Recipe(pp, False, 15)
+    rc = Recipe(pp, False, 15)
     pairs, lanes = T._pair_history(rc.hist, dec)
     kind = {c: op.kind for op in dec.ops for c in op.out}
     return dec, rc.hist, pairs, lanes, kind

@@ -35,6 +35,7 @@ import re
 
 from .._core.lanes import LANES     # the lane counts a batch library can be built with
 from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (public names)
+from .taylor_recipe import Recipe
 
 #: the version of the generated batch code (a change regenerates the kept sources)
 VERSION = 8
@@ -57,7 +58,7 @@ def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
     kind = "dp"
     pp = T._Printer(dec, names, False, kind)
     pp.w = lambda k, c: f"w(l, {k}, {c})"
-    rc = T._Recipe(pp, False, "order")
+    rc = Recipe(pp, False, "order")
     W = pp.w
 
     def lane(x):          # the accumulators, reciprocals and t are per lane

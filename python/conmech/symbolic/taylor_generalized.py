@@ -31,8 +31,9 @@ expansion), the first-order right-hand side of the stepper's view of the system.
 """
 import sympy as sp
 
-from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, quad_entry, square_sums
+from .taylor import _SYM, _decls, _Printer, _wrap, quad_entry, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
+from .taylor_recipe import Recipe
 from .taylor_first_order import core_part_lines, first_order_procedures
 from .taylor_tree import is_tree, tree_lines
 
@@ -209,7 +210,7 @@ def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     dec = g.dec
     out = n <= WRITE_OUT_MAX if write_out is None else write_out
     pp = _Printer(dec, names, False, kind)
-    rc = _Recipe(pp, True, "order")
+    rc = Recipe(pp, True, "order")
     W = pp.w
     one = pp.real(1)
     zero = f"0.0_{kind}"

@@ -30,8 +30,9 @@ import copy
 
 import sympy as sp
 
-from .taylor import _SYM, _decls, _Printer, _Recipe, _wrap, square_sums
+from .taylor import _SYM, _decls, _Printer, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
+from .taylor_recipe import Recipe
 from .taylor_first_order import first_order_procedures
 from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, _cholesky_loop, _cholesky_out,
                                  _solve_loop, _solve_out, generalized_decomposition, order_zero)
@@ -117,7 +118,7 @@ def _prefix_counts(g, names):
     the accelerations: a prefix of the recipe of all of them."""
     dec = copy.copy(g.dec)
     dec.ops = g.dec.ops[:g.nsplit]
-    rc = _Recipe(_Printer(dec, names, False, "dp"), True, "order")
+    rc = Recipe(_Printer(dec, names, False, "dp"), True, "order")
     return len(rc.s0), len(rc.cur)
 
 
@@ -128,7 +129,7 @@ def variational_body(g, names, ind="        ", write_out=None):
     dec = g.dec
     out = n <= WRITE_OUT_MAX if write_out is None else write_out
     pp = _Printer(dec, names, False, "dp")
-    rc = _Recipe(pp, True, "order")
+    rc = Recipe(pp, True, "order")
     ns0, ncur = _prefix_counts(g, names)
     W = pp.w
     one = pp.real(1)
