@@ -23,6 +23,7 @@ definitions of the chain) and its recurrences in quadruple precision
   1e-24, and a double Taylor run's error measured against it;
 - a tree with a non-smooth force has no variational part: a ValueError with the reason.
 """
+import copy
 from decimal import Decimal
 
 import numpy as np
@@ -36,6 +37,7 @@ from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
 from conmech.stability import stm  # noqa: E402
 from conmech.symbolic import planar_tree, taylor_quad  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
+from conmech.symbolic.taylor_library import TREE_VAR_OPT, _part_flags  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
 import taylor_jets  # noqa: E402
 from taylor_jets import coefficients  # noqa: E402
@@ -186,6 +188,20 @@ def test_taylor_stm_agrees_with_dop853_liouville_and_the_flow(double_tree):
         r = conmech.solve_ivp(system, (0.0, t1), y0, method="TAYLOR", rtol=1e-12,
                               atol=1e-12)
         assert np.max(np.abs(r.y[:, -1] - y_t)) < 1e-9
+
+
+def test_a_trees_variational_routine_is_compiled_at_its_own_optimisation(double_tree):
+    """A tree's variational library is built with TREE_VAR_OPT in place of -O3 (its
+    compile time), a Lagrangian system's and the tree's other parts with the defaults,
+    and flags given to the model are kept as given."""
+    tree_model = model_of(double_tree)
+    flags = _part_flags(tree_model, "var")
+    assert TREE_VAR_OPT in flags and "-O3" not in flags
+    assert _part_flags(tree_model, "core") is None
+    assert _part_flags(model_of(taylor_jets.double_pendulum()), "var") is None
+    given = copy.copy(tree_model)
+    given.flags = ["-O2", "-fPIC", "-shared"]
+    assert _part_flags(given, "var") == given.flags
 
 
 def test_tree_and_lagrangian_give_the_same_stm(double_tree):

@@ -57,6 +57,26 @@ PARTS = ("core", "batch", "qp", "var")
 BATCH_WIDTH = _taylor_batch.machine_lanes()
 
 
+#: the optimisation of a tree's variational routine: its forward-differentiated chain is
+#: ~8x the core's operations in one loop body, which gfortran's -O3 takes 3-4x longer to
+#: compile than -O1 (double pendulum 25 s against 8 s, triple 132 s against 34 s) for no
+#: faster code (an expansion of the triple pendulum's to order 15: 226-442 us at -O3,
+#: 234-361 us at -O1, alternated runs; the same coefficients)
+TREE_VAR_OPT = "-O1"
+
+
+def _part_flags(model, part):
+    """The compiler flags of one part's library: the model's (None: build's defaults),
+    with a tree's variational routine at TREE_VAR_OPT unless the model was given flags."""
+    flags = getattr(model, "flags", None)
+    if flags is None and part == "var" and getattr(model.derived, "kind", None) == \
+            "generalized":
+        from .taylor_tree import is_tree
+        if is_tree(model.derived):
+            return [TREE_VAR_OPT if f == "-O3" else f for f in FFLAGS]
+    return flags
+
+
 def batch_part(lanes=None):
     """The part name of a batch library with `lanes` lanes (None: the machine's width,
     the part "batch"); a ValueError for a lane count not in taylor_batch.LANES."""
@@ -228,7 +248,7 @@ def taylor_library(model, part="core"):
         if src is None:
             state = (None, None, why)
         else:
-            flags = getattr(model, "flags", None)
+            flags = _part_flags(model, part)
             lanes = _lanes(part)
             if lanes is not None:   # the batch code for the machine's vector instructions
                 flags = list(FFLAGS if flags is None else flags) + \
