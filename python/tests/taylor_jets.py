@@ -1,13 +1,17 @@
 """Shared by the Taylor tests of generalized systems and trees: calling a compiled Taylor
-routine ``name(t, order, w, p)`` directly, the two generalized systems both test, and the
-monodromy check of the double pendulum's in-phase normal mode."""
+routine ``name(t, order, w, p)`` directly, the core and variational coefficients of a
+system's first-order view and the check of Phi's rows against central differences, the two
+generalized systems both test, and the monodromy check of the double pendulum's in-phase
+normal mode."""
 import ctypes
 
 import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
+import conmech
 from conmech import symbolic
+from conmech.ivp.taylor_generalized import first_order_view
 from conmech.stability import floquet, monodromy, symmetric_orbit
 
 _P = ctypes.POINTER(ctypes.c_double)
@@ -22,6 +26,47 @@ def coefficients(address, nw, params, y, order, t=0.0):
     p = np.ascontiguousarray(params if np.size(params) else np.zeros(1), dtype=float)
     _JET(address)(t, order, w.ctypes.data_as(_P), p.ctypes.data_as(_P))
     return w[:len(y)]
+
+
+def jets(system, y, order, phi=None, t0=0.0):
+    """(core coefficients of y, variational coefficients of [y; vec(Phi)]) at t0 of a
+    generalized system or tree with Phi(t0) = phi (default the identity)."""
+    view = first_order_view(system, "var")
+    tay = view.taylor
+    m = len(y)
+    phi = np.eye(m) if phi is None else phi
+    addr = conmech.compiled.function_address
+    core = coefficients(addr(tay["jet"]), tay["nw"], view.params, y, order, t0)
+    var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
+                       np.concatenate([y, phi.ravel(order="F")]), order, t0)
+    return core, var
+
+
+def check_phi_rows(system, y, order, t0=0.0):
+    """Row block of column c of Phi at order k = d y^[k] / d y0_c: central differences
+    (step h, error O(h^2) ~ 1e-10 relative at these orders) of the core routine's
+    coefficients; the state rows are the core routine's own to round-off; Phi enters
+    linearly (a general Phi0 gives the identity's coefficients times Phi0)."""
+    core, var = jets(system, y, order, t0=t0)
+    m = y.size
+    scale = np.max(np.abs(core), axis=0)
+    assert np.all(np.abs(var[:m] - core) <= 64*np.finfo(float).eps*scale)
+    h = 1e-5
+    for c in range(m):
+        e = np.zeros(m)
+        e[c] = h
+        fd = (jets(system, y + e, order, t0=t0)[0] - jets(system, y - e, order, t0=t0)[0])/(2*h)
+        got = var[m + c*m:m + (c + 1)*m]
+        for k in range(order + 1):
+            ref = max(np.max(np.abs(fd[:, k])), 1e-3)
+            assert np.max(np.abs(got[:, k] - fd[:, k])) <= 1e-7*ref, (c, k)
+    phi0 = np.arange(1.0, 1.0 + m*m).reshape(m, m)/7.0 - 1.0
+    _, var2 = jets(system, y, order, phi0, t0=t0)
+    K = order + 1
+    blocks = var[m:].reshape(m, m, K)          # [column, row, order] of the identity's
+    want = np.einsum("crk,cd->drk", blocks, phi0)
+    got2 = var2[m:].reshape(m, m, K)
+    assert np.allclose(got2, want, rtol=1e-12, atol=1e-12*np.max(np.abs(want)))
 
 
 def cart_pendulum():

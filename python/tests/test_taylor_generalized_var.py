@@ -26,7 +26,6 @@ sp = pytest.importorskip("sympy")
 
 import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
-from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
 from conmech.stability import stm  # noqa: E402
 from conmech.symbolic import build, taylor_quad  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
@@ -34,21 +33,8 @@ from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
                                                      variational_procedures)
 import taylor_jets  # noqa: E402
-from taylor_jets import coefficients  # noqa: E402
+from taylor_jets import check_phi_rows, coefficients, jets  # noqa: E402
 
-
-
-def jets(system, y, order, phi=None):
-    """(core coefficients of y, variational coefficients of [y; vec(Phi)])."""
-    view = first_order_view(system, "var")
-    tay = view.taylor
-    m = len(y)
-    phi = np.eye(m) if phi is None else phi
-    addr = conmech.compiled.function_address
-    core = coefficients(addr(tay["jet"]), tay["nw"], view.params, y, order)
-    var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
-                       np.concatenate([y, phi.ravel(order="F")]), order)
-    return core, var
 
 
 @pytest.fixture(scope="module")
@@ -86,32 +72,11 @@ def mass(system, q):
 def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
     """Row block of column c of Phi at order k = d y^[k] / d y0_c: central differences
     (step h, error O(h^2) ~ 1e-10 relative at these orders) of the core routine's
-    coefficients; the state rows are the core routine's own to round-off."""
+    coefficients, the state rows and Phi's linearity (taylor_jets.check_phi_rows)."""
     system = request.getfixturevalue(which)
     y = np.array([0.5, -1/3, 0.2, 0.75]) if which == "rational" else \
         np.array([1.2, -0.4, 0.3, 0.1])
-    order = 10
-    core, var = jets(system, y, order)
-    m = y.size
-    scale = np.max(np.abs(core), axis=0)
-    assert np.all(np.abs(var[:m] - core) <= 64*np.finfo(float).eps*scale)
-    h = 1e-5
-    for c in range(m):
-        e = np.zeros(m)
-        e[c] = h
-        fd = (jets(system, y + e, order)[0] - jets(system, y - e, order)[0])/(2*h)
-        got = var[m + c*m:m + (c + 1)*m]
-        for k in range(order + 1):
-            ref = max(np.max(np.abs(fd[:, k])), 1e-3)
-            assert np.max(np.abs(got[:, k] - fd[:, k])) <= 1e-7*ref, (c, k)
-    # Phi enters linearly: a general Phi0 gives the coefficients of the identity's times it
-    phi0 = np.arange(1.0, 1.0 + m*m).reshape(m, m)/7.0 - 1.0
-    _, var2 = jets(system, y, order, phi0)
-    K = order + 1
-    blocks = var[m:].reshape(m, m, K)          # [column, row, order] of the identity's
-    want = np.einsum("crk,cd->drk", blocks, phi0)
-    got2 = var2[m:].reshape(m, m, K)
-    assert np.allclose(got2, want, rtol=1e-12, atol=1e-12*np.max(np.abs(want)))
+    check_phi_rows(system, y, 10)
 
 
 def test_factorisation_in_loops_gives_the_written_out_coefficients(cart):

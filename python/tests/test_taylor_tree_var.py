@@ -33,14 +33,13 @@ sp = pytest.importorskip("sympy")
 
 import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
-from conmech.ivp.taylor_generalized import first_order_view  # noqa: E402
 from conmech.stability import stm  # noqa: E402
 from conmech.symbolic import planar_tree, taylor_quad  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.taylor_library import TREE_VAR_OPT, _part_flags  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
 import taylor_jets  # noqa: E402
-from taylor_jets import coefficients  # noqa: E402
+from taylor_jets import check_phi_rows, jets  # noqa: E402
 from test_taylor_tree import chain  # noqa: E402
 from conmech.symbolic.urdf import data_path  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
@@ -69,19 +68,6 @@ def double_tree():
 @pytest.fixture(scope="module")
 def triple_tree():
     return pendulum_tree(3)
-
-
-def jets(system, y, order, phi=None, t0=0.0):
-    """(core coefficients of y, variational coefficients of [y; vec(Phi)])."""
-    view = first_order_view(system, "var")
-    tay = view.taylor
-    m = len(y)
-    phi = np.eye(m) if phi is None else phi
-    addr = conmech.compiled.function_address
-    core = coefficients(addr(tay["jet"]), tay["nw"], view.params, y, order, t0)
-    var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
-                       np.concatenate([y, phi.ravel(order="F")]), order, t0)
-    return core, var
 
 
 def mass(system, q):
@@ -131,7 +117,7 @@ def two_joint_arm():
 def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
     """Row block of column c of Phi at order k = d y^[k] / d y0_c: central differences
     (step h, error O(h^2) ~ 1e-10 relative at these orders) of the core routine's
-    coefficients; the state rows are the core routine's own to round-off."""
+    coefficients, the state rows and Phi's linearity (taylor_jets.check_phi_rows)."""
     if which == "spatial":
         system = two_joint_arm()
         y = np.array([0.2, -0.4, -0.5, 0.3])
@@ -141,28 +127,7 @@ def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
     else:
         system = request.getfixturevalue(which)
         y = np.array([1.2, -0.4, 0.3, 0.1])
-    order, t0 = 8, 0.7
-    core, var = jets(system, y, order, t0=t0)
-    m = y.size
-    scale = np.max(np.abs(core), axis=0)
-    assert np.all(np.abs(var[:m] - core) <= 64*np.finfo(float).eps*scale)
-    h = 1e-5
-    for c in range(m):
-        e = np.zeros(m)
-        e[c] = h
-        fd = (jets(system, y + e, order, t0=t0)[0] - jets(system, y - e, order, t0=t0)[0])/(2*h)
-        got = var[m + c*m:m + (c + 1)*m]
-        for k in range(order + 1):
-            ref = max(np.max(np.abs(fd[:, k])), 1e-3)
-            assert np.max(np.abs(got[:, k] - fd[:, k])) <= 1e-7*ref, (c, k)
-    # Phi enters linearly: a general Phi0 gives the coefficients of the identity's times it
-    phi0 = np.arange(1.0, 1.0 + m*m).reshape(m, m)/7.0 - 1.0
-    _, var2 = jets(system, y, order, phi0, t0=t0)
-    K = order + 1
-    blocks = var[m:].reshape(m, m, K)          # [column, row, order] of the identity's
-    want = np.einsum("crk,cd->drk", blocks, phi0)
-    got2 = var2[m:].reshape(m, m, K)
-    assert np.allclose(got2, want, rtol=1e-12, atol=1e-12*np.max(np.abs(want)))
+    check_phi_rows(system, y, 8, t0=0.7)
 
 
 # ------------------------------------------------------------------ integration
