@@ -12,7 +12,8 @@ from sympy.physics.mechanics import dynamicsymbols
 import conmech
 from conmech import symbolic
 from conmech.ivp.taylor_generalized import first_order_view
-from conmech.stability import floquet, monodromy, symmetric_orbit
+from conmech.symbolic.pipeline import model_of
+from conmech.stability import floquet, monodromy, stm, symmetric_orbit
 
 _P = ctypes.POINTER(ctypes.c_double)
 _JET = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)
@@ -40,6 +41,41 @@ def jets(system, y, order, phi=None, t0=0.0):
     var = coefficients(addr(tay["var"]), tay["nw_var"], view.params,
                        np.concatenate([y, phi.ravel(order="F")]), order, t0)
     return core, var
+
+
+def mass(system, q):
+    """M(q) of a generalized system or tree, from its model's compiled mass routine."""
+    n = len(q)
+    m = model_of(system).call("mass", 0.0, np.asarray(q, dtype=float),
+                              params=np.asarray(system.params, dtype=float))
+    return np.array(m, dtype=float).reshape(n, n)
+
+
+def rhs(system, y):
+    """f(y) = [v; a] of the first-order view (its core routine's first coefficient)."""
+    return jets(system, np.asarray(y, dtype=float), 1)[0][:, 1]
+
+
+def check_stm(system, y0, t1):
+    """The Taylor STM over [0, t1] against the DOP853 STM on a sensitive flow; Liouville's
+    det Phi = det M(q0)/det M(q1) (unit determinant in (q, p), mapped to (q, v)); the flow
+    direction carried along, Phi f(y0) = f(y1) (an autonomous system); the state the Taylor
+    solve's own."""
+    y_t, phi_t, info = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12, method="TAYLOR",
+                           full_output=True)
+    y_d, phi_d = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12)
+    assert info["nfev"] > 0
+    big = np.max(np.abs(phi_d))
+    assert big > 2.0          # a sensitive flow: the check is not of the identity
+    assert np.max(np.abs(y_t - y_d)) < 1e-9
+    assert np.max(np.abs(phi_t - phi_d)) < 1e-8*big
+    n = len(y0)//2
+    liouville = np.linalg.det(mass(system, y0[:n]))/np.linalg.det(mass(system, y_t[:n]))
+    assert abs(np.linalg.det(phi_t) - liouville) < 1e-8*big**2
+    f0, f1 = rhs(system, y0), rhs(system, y_t)
+    assert np.linalg.norm(phi_t @ f0 - f1) < 1e-8*big*np.linalg.norm(f0)
+    r = conmech.solve_ivp(system, (0.0, t1), y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
+    assert np.max(np.abs(r.y[:, -1] - y_t)) < 1e-9
 
 
 def check_phi_rows(system, y, order, t0=0.0):
@@ -89,12 +125,12 @@ def double_pendulum():
     return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
 
 
-def check_normal_mode_monodromy(system, flow):
+def check_normal_mode_monodromy(system):
     """The Taylor monodromy of the double pendulum `system`'s in-phase nonlinear normal
     mode (b/a -> sqrt(2), omega^2 -> g (2 - sqrt(2)) at small amplitude; released at rest,
     its velocities vanish again at half the period) against the default route's, the
-    flow direction ``flow(y0)`` kept over a period and the multipliers those of the orbit's
-    own route; returns the Taylor route's multipliers."""
+    flow direction f(y0) kept over a period and the multipliers those of the orbit's own
+    route; returns the Taylor route's multipliers."""
     g = 9.81
     a0 = 0.3
     period = 2*np.pi/np.sqrt(g*(2 - np.sqrt(2)))
@@ -104,7 +140,7 @@ def check_normal_mode_monodromy(system, flow):
     mt = monodromy(system, y0, T, method="TAYLOR")
     md = monodromy(system, y0, T)
     assert np.max(np.abs(mt - md)) < 1e-8*np.max(np.abs(md))
-    f = flow(y0)
+    f = rhs(system, y0)
     assert np.linalg.norm(mt @ f - f) < 1e-8*np.linalg.norm(f)
     mu_t = np.sort_complex(floquet(mt, T)["multipliers"])
     mu_o = np.sort_complex(np.asarray(orb.multipliers))

@@ -39,7 +39,7 @@ from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.taylor_library import TREE_VAR_OPT, _part_flags  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
 import taylor_jets  # noqa: E402
-from taylor_jets import check_phi_rows, jets  # noqa: E402
+from taylor_jets import check_phi_rows, check_stm, jets  # noqa: E402
 from test_taylor_tree import chain  # noqa: E402
 from conmech.symbolic.urdf import data_path  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
@@ -68,18 +68,6 @@ def double_tree():
 @pytest.fixture(scope="module")
 def triple_tree():
     return pendulum_tree(3)
-
-
-def mass(system, q):
-    n = len(q)
-    m = model_of(system).call("mass", 0.0, np.asarray(q, dtype=float),
-                              params=np.asarray(system.params, dtype=float))
-    return np.array(m, dtype=float).reshape(n, n)
-
-
-def rhs(system, y):
-    """f(y) = [v; a] of the first-order view (its core routine's first coefficient)."""
-    return jets(system, np.asarray(y, dtype=float), 1)[0][:, 1]
 
 
 # ------------------------------------------------------------------ coefficients
@@ -133,26 +121,8 @@ def test_phi_rows_are_the_derivatives_of_the_state_coefficients(which, request):
 # ------------------------------------------------------------------ integration
 
 def test_taylor_stm_agrees_with_dop853_liouville_and_the_flow(double_tree):
-    for system, y0, t1 in ((double_tree, [1.2, -0.4, 0.3, 0.1], 5.0),
-                           (double_tree, [0.3, 2.5, -1.0, 0.4], 4.0)):
-        y_t, phi_t, info = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12,
-                               method="TAYLOR", full_output=True)
-        y_d, phi_d = stm(system, (0.0, t1), y0, rtol=1e-12, atol=1e-12)
-        assert info["nfev"] > 0
-        big = np.max(np.abs(phi_d))
-        assert big > 2.0          # a sensitive flow: the check is not of the identity
-        assert np.max(np.abs(y_t - y_d)) < 1e-9
-        assert np.max(np.abs(phi_t - phi_d)) < 1e-8*big
-        n = len(y0)//2
-        liouville = np.linalg.det(mass(system, y0[:n]))/np.linalg.det(mass(system, y_t[:n]))
-        assert abs(np.linalg.det(phi_t) - liouville) < 1e-8*big**(2*n)
-        # the flow's direction is carried along: Phi f(y0) = f(y1)
-        f0, f1 = rhs(system, y0), rhs(system, y_t)
-        assert np.linalg.norm(phi_t @ f0 - f1) < 1e-8*big*np.linalg.norm(f0)
-        # the state is the Taylor solve's own
-        r = conmech.solve_ivp(system, (0.0, t1), y0, method="TAYLOR", rtol=1e-12,
-                              atol=1e-12)
-        assert np.max(np.abs(r.y[:, -1] - y_t)) < 1e-9
+    check_stm(double_tree, [1.2, -0.4, 0.3, 0.1], 5.0)
+    check_stm(double_tree, [0.3, 2.5, -1.0, 0.4], 4.0)
 
 
 def test_a_trees_variational_routine_is_compiled_at_its_own_optimisation(double_tree):
@@ -192,8 +162,7 @@ def test_monodromy_of_a_normal_mode(double_tree):
     """The in-phase normal mode's Taylor monodromy (taylor_jets): the default route's, the
     flow direction kept, the orbit's multipliers; a stable conservative orbit has them all
     on the unit circle (a pair at 1, a pair of modulus 1)."""
-    mu_t = taylor_jets.check_normal_mode_monodromy(double_tree,
-                                                   lambda y0: rhs(double_tree, y0))
+    mu_t = taylor_jets.check_normal_mode_monodromy(double_tree)
     assert np.max(np.abs(np.abs(mu_t) - 1)) < 1e-6
 
 
