@@ -4,6 +4,7 @@ system's first-order view and the check of Phi's rows against central difference
 generalized systems both test, and the monodromy check of the double pendulum's in-phase
 normal mode."""
 import ctypes
+from decimal import Decimal
 
 import numpy as np
 import sympy as sp
@@ -11,6 +12,7 @@ from sympy.physics.mechanics import dynamicsymbols
 
 import conmech
 from conmech import symbolic
+from conmech.symbolic import taylor_quad
 from conmech.ivp.taylor_generalized import first_order_view
 from conmech.symbolic.pipeline import model_of
 from conmech.stability import floquet, monodromy, stm, symmetric_orbit
@@ -146,3 +148,20 @@ def check_normal_mode_monodromy(system):
     mu_o = np.sort_complex(np.asarray(orb.multipliers))
     assert np.max(np.abs(mu_t - mu_o)) < 1e-5
     return mu_t
+
+
+def check_quadruple_reference(system, y0, tol, dop_rtol, agree, moved=1):
+    """The quadruple-precision Taylor reference over [0, 2] from the decimal strings y0
+    (to `tol`) against quadruple-precision DOP853 (to `dop_rtol`): they agree to `agree`,
+    the state moved beyond `moved`, and a double Taylor run at 1e-13 is off by a positive
+    error below 1e-12 against it."""
+    r = taylor_quad.reference(system, (0, 2), y0, tol=tol)
+    d = taylor_quad.reference_dop853(system, (0, 2), y0, rtol=dop_rtol)
+    assert r.success and d.success and r.order > 30
+    diff = [abs(Decimal(u) - Decimal(v)) for u, v in zip(r.y_str, d.y_str)]
+    assert max(diff) < Decimal(agree), diff
+    assert max(abs(Decimal(u)) for u in r.y_str) > Decimal(moved)
+    s = conmech.solve_ivp(system, (0, 2), [float(v) for v in y0], method="TAYLOR",
+                          rtol=1e-13, atol=1e-13)
+    err = np.max(np.abs(s.y[:, -1] - r.y_float))
+    assert 0 < err < 1e-12

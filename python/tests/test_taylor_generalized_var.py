@@ -24,9 +24,8 @@ import pytest
 
 sp = pytest.importorskip("sympy")
 
-import conmech  # noqa: E402
 from conmech import symbolic  # noqa: E402
-from conmech.symbolic import build, taylor_quad  # noqa: E402
+from conmech.symbolic import build  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
@@ -106,14 +105,5 @@ def test_monodromy_of_a_normal_mode(double_pendulum):
 
 
 def test_quadruple_precision_agrees_with_dop853_in_real128(double_pendulum):
-    y0 = ["1.2", "-0.4", "0.3", "0.1"]
-    r = taylor_quad.reference(double_pendulum, (0, 2), y0, tol=1e-28)
-    d = taylor_quad.reference_dop853(double_pendulum, (0, 2), y0, rtol=1e-25)
-    assert r.success and d.success and r.order > 30
-    from decimal import Decimal
-    diff = [abs(Decimal(u) - Decimal(v)) for u, v in zip(r.y_str, d.y_str)]
-    assert max(diff) < Decimal("1e-23"), diff
-    assert max(abs(Decimal(u)) for u in r.y_str) > Decimal(2)      # the state moved
-    s = conmech.solve_ivp(double_pendulum, (0, 2), [float(v) for v in y0], method="TAYLOR",
-                          rtol=1e-13, atol=1e-13)
-    assert np.max(np.abs(s.y[:, -1] - r.y_float)) < 1e-12
+    taylor_jets.check_quadruple_reference(double_pendulum, ["1.2", "-0.4", "0.3", "0.1"],
+                                          1e-28, 1e-25, "1e-23", moved=2)
