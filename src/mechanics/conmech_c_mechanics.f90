@@ -51,7 +51,8 @@ module conmech_c_mechanics
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_generalized, only: generalized_system
     use conmech_c_entries, only: c_mech_pointers
-    use conmech_c_system, only: c_rhs_fn   ! mass, phi, phi_jac, phi_t: f(t, q) into one array
+    use conmech_c_system, only: c_rhs_fn, &  ! mass, phi, phi_jac, phi_t: f(t, q) into one array
+                                c_parameters
     use conmech_constrained_system, only: constrained_system, fd_phi_jac, fd_phi_t, &
                                           fd_phi_gamma, fd_nh_gamma, fd_forces_jacobian, &
                                           fd_constraint_hessian
@@ -186,9 +187,7 @@ contains
         call c_f_procpointer(fp%forces, self%forces_f)
         if (c_associated(fp%forces_jac)) call c_f_procpointer(fp%forces_jac, self%fjac_f)
         if (c_associated(fp%energy)) call c_f_procpointer(fp%energy, self%energy_f)
-        allocate (self%p(max(size(params), 1)))
-        self%p = 0.0_dp
-        self%p(1:size(params)) = params
+        self%p = c_parameters(params)
         info = CM_SUCCESS
         msg = "success"
     end subroutine core_connect

@@ -38,6 +38,7 @@ module conmech_c_system
     private
 
     public :: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor, set_c_taylor_fixed
+    public :: c_parameters
     public :: c_rhs_fn, c_jac_prod_fn, c_taylor_fn
 
     abstract interface
@@ -120,12 +121,20 @@ contains
         sys%n = n
         call c_f_procpointer(rhs, sys%f)
         if (c_associated(jac)) call c_f_procpointer(jac, sys%jac)
-        allocate (sys%p(max(size(params), 1)))
-        sys%p = 0.0_dp
-        sys%p(1:size(params)) = params
+        sys%p = c_parameters(params)
         info = CM_SUCCESS
         msg = "success"
     end subroutine make_c_ode
+
+    !> The parameter array a compiled function is handed: a copy of `params`, one unused
+    !! zero when there are none (a C function gets a valid address either way).
+    pure function c_parameters(params) result(p)
+        real(dp), intent(in) :: params(:)
+        real(dp), allocatable :: p(:)
+        allocate (p(max(size(params), 1)))
+        p = 0.0_dp
+        p(1:size(params)) = params
+    end function c_parameters
 
     !> Give a `c_ode_system` the C Jacobian product `jac_prod` (c_null_funptr removes it).
     subroutine set_c_jac_prod(sys, jac_prod)
