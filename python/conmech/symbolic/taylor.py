@@ -367,17 +367,26 @@ def quad_entry(cname, nw, npar, ind="        "):
             f"    end subroutine {cname}", ""]
 
 
+def quad_procedure(cname, nw, npar, decl, body, ieee=False, ind="        "):
+    """Fortran lines of ``cname`` (:func:`quad_entry`) and of the real128 routine
+    ``cname_body(t, order, w(0:order, nw), p(npar))`` it calls, of declarations `decl` and
+    statements `body` (`ieee`: they use ieee_value and ieee_quiet_nan)."""
+    inner = [f"    subroutine {cname}_body(t, order, w, p)"]
+    if ieee:
+        inner.append(f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, "
+                     "ieee_quiet_nan")
+    inner += [f"{ind}real(qp), intent(in) :: t",
+              f"{ind}integer(c_int), intent(in) :: order",
+              f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
+              f"{ind}real(qp), intent(in) :: p({npar})"]
+    return quad_entry(cname, nw, npar, ind) + inner + decl + body + \
+        [f"    end subroutine {cname}_body", ""]
+
+
 def quad_routine(dec, names, cname):
     """The recurrences in quadruple precision, entry :func:`quad_entry`."""
-    ind, nw, npar = "        ", dec.ncol, max(len(dec.params), 1)
-    head = quad_entry(cname, nw, npar)
-    inner = [f"    subroutine {cname}_body(t, order, w, p)",
-             f"{ind}real(qp), intent(in) :: t",
-             f"{ind}integer(c_int), intent(in) :: order",
-             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
-             f"{ind}real(qp), intent(in) :: p({npar})"]
-    decl, body = body_lines(dec, names, "qp", 0, False, ind)
-    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
+    decl, body = body_lines(dec, names, "qp", 0, False)
+    return quad_procedure(cname, dec.ncol, max(len(dec.params), 1), decl, body)
 
 
 def taylor_procedures(dec, names, prefix="conmech_taylor", batch_width=4, quad=True):

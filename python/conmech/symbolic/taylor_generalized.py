@@ -31,11 +31,10 @@ expansion), the first-order right-hand side of the stepper's view of the system.
 """
 import sympy as sp
 
-from .taylor import _SYM, _decls, _Printer, _wrap, quad_entry, square_sums
+from .taylor import _SYM, _decls, _Printer, _wrap, quad_procedure, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_recipe import Recipe
 from .taylor_first_order import core_part_lines, first_order_procedures
-from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["generalized_decomposition", "generalized_procedures", "generalized_quad_routine",
            "WRITE_OUT_MAX"]
@@ -304,27 +303,17 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
     """The same recurrences in quadruple precision: ``cname(t, order, w, p)`` through C
     pointers to real128 values (as conmech.symbolic.taylor.quad_routine: t, w(0:order,
     g.ncol), p), the accelerations' factorisation and solves in real128 too."""
-    ind = "        "
-    nw = g.ncol
-    head = quad_entry(cname, nw, npar)
-    inner = [f"    subroutine {cname}_body(t, order, w, p)",
-             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
-             f"{ind}real(qp), intent(in) :: t",
-             f"{ind}integer(c_int), intent(in) :: order",
-             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
-             f"{ind}real(qp), intent(in) :: p({npar})"]
-    decl, body = generalized_body(g, names, ind, write_out, "qp")
-    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
+    decl, body = generalized_body(g, names, "        ", write_out, "qp")
+    return quad_procedure(cname, g.ncol, npar, decl, body, ieee=True)
 
 
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
     library (conmech.symbolic.taylor_library): the core and the quadruple precision one
-    (``qp``), a tree's through its articulated-body chain; the batch part is not generated
-    for generalized systems or trees (the variational part: conmech.symbolic.taylor_generalized_var.variational_lines).
+    (``qp``); the batch part is not generated for generalized systems (the variational
+    part: conmech.symbolic.taylor_generalized_var.variational_lines; a tree's parts:
+    conmech.symbolic.taylor_tree).
     """
-    if is_tree(d):              # a tree: through its articulated-body code
-        return tree_lines(d, names, part, dec_cache)
     npar = max(len(d.params), 1)
     if part == "qp":
         if "g" not in dec_cache:

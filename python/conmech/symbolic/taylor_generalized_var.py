@@ -36,7 +36,6 @@ from .taylor_recipe import Recipe
 from .taylor_first_order import first_order_procedures
 from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, _cholesky_loop, _cholesky_out,
                                  _solve_loop, _solve_out, generalized_decomposition, order_zero)
-from .taylor_tree import is_tree, tree_lines
 
 __all__ = ["variational_decomposition", "variational_procedures", "variational_lines"]
 
@@ -255,9 +254,7 @@ def variational_procedures(g, names, prefix="conmech_taylor_var", write_out=None
 def variational_lines(d, names, dec_cache):
     """(Fortran lines, entry names, reason) of the variational part ("var") of a generalized
     model's Taylor library (conmech.symbolic.taylor_library); a tree's is its chain's
-    (conmech.symbolic.taylor_tree_var)."""
-    if is_tree(d):
-        return tree_lines(d, names, "var", dec_cache)
+    (conmech.symbolic.taylor_tree_var.tree_variational_lines)."""
     if "gvar" not in dec_cache:
         dec_cache["gvar"] = variational_decomposition(d)
     gv, why = dec_cache["gvar"]

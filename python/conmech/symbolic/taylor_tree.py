@@ -38,13 +38,13 @@ import math
 import sympy as sp
 
 from .spatial_aba import _spatial_aba
-from .taylor import _Printer, _wrap, body_lines, quad_entry
+from .taylor import _Printer, _wrap, body_lines, quad_procedure
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_first_order import core_part_lines, first_order_procedures
 from .tree_aba import _aba
 
-__all__ = ["is_tree", "tree_chain", "tree_decomposition", "tree_body", "tree_procedures",
-           "tree_quad_routine", "tree_lines", "pivot_values"]
+__all__ = ["is_tree", "tree_chain", "tree_decomposition", "kept_tree_decomposition",
+           "tree_body", "tree_procedures", "tree_quad_routine", "tree_lines", "pivot_values"]
 
 
 def is_tree(d):
@@ -133,17 +133,16 @@ def tree_quad_routine(dec, pivots, names, cname="conmech_taylor_qp"):
     """The same recurrences in quadruple precision: ``cname(t, order, w, p)`` through C
     pointers to real128 values (:func:`conmech.symbolic.taylor.quad_entry`: t, w(0:order,
     dec.ncol), p), the pivots checked in real128."""
-    ind = "        "
-    nw = dec.ncol
-    head = quad_entry(cname, nw, max(len(dec.params), 1))
-    inner = [f"    subroutine {cname}_body(t, order, w, p)",
-             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
-             f"{ind}real(qp), intent(in) :: t",
-             f"{ind}integer(c_int), intent(in) :: order",
-             f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
-             f"{ind}real(qp), intent(in) :: p({max(len(dec.params), 1)})"]
-    decl, body = tree_body(dec, pivots, names, "qp", ind)
-    return head + inner + decl + body + [f"    end subroutine {cname}_body", ""]
+    decl, body = tree_body(dec, pivots, names, "qp")
+    return quad_procedure(cname, dec.ncol, max(len(dec.params), 1), decl, body, ieee=True)
+
+
+def kept_tree_decomposition(d, dec_cache):
+    """:func:`tree_decomposition` of `d`, kept in `dec_cache` (one library build's) under
+    "tree", the key core_part_lines keeps it under."""
+    if "tree" not in dec_cache:
+        dec_cache["tree"] = tree_decomposition(d)
+    return dec_cache["tree"]
 
 
 def tree_lines(d, names, part, dec_cache):
@@ -155,9 +154,7 @@ def tree_lines(d, names, part, dec_cache):
         raise ValueError("the variational part of a tree: "
                          "conmech.symbolic.taylor_tree_var.tree_variational_lines")
     if part == "qp":
-        if "tree" not in dec_cache:
-            dec_cache["tree"] = tree_decomposition(d)
-        dec, pivots, why = dec_cache["tree"]
+        dec, pivots, why = kept_tree_decomposition(d, dec_cache)
         if dec is None:
             return [], [], why
         return tree_quad_routine(dec, pivots, names), ["taylor_qp"], None

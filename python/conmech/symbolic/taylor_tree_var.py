@@ -28,7 +28,7 @@ by columns) and the pivots checked at order 0 as the core routine checks them, a
 import sympy as sp
 
 from .taylor_decompose import TaylorUnsupported, decompose
-from .taylor_tree import tree_chain, tree_decomposition, tree_procedures
+from .taylor_tree import kept_tree_decomposition, tree_chain, tree_procedures
 
 __all__ = ["tangent_chain", "tree_variational_decomposition", "tree_variational_lines"]
 
@@ -127,10 +127,9 @@ def tree_variational_decomposition(d):
 def tree_variational_lines(d, names, dec_cache):
     """(Fortran lines, entry names, reason) of the variational part ("var") of a tree
     model's Taylor library (conmech.symbolic.taylor_library)."""
-    if "tree" not in dec_cache:          # the tree's own reason first (shared with the core)
-        dec_cache["tree"] = tree_decomposition(d)
-    if dec_cache["tree"][0] is None:
-        return [], [], dec_cache["tree"][2]
+    tree, _, why = kept_tree_decomposition(d, dec_cache)    # the tree's own reason first
+    if tree is None:
+        return [], [], why
     if "tree_var" not in dec_cache:
         dec_cache["tree_var"] = tree_variational_decomposition(d)
     dec, pivots, why = dec_cache["tree_var"]
