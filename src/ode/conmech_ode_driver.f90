@@ -129,7 +129,16 @@ contains
             end if
             h_next = stp%h_done
             t = stp%t
-            if (need_dense) call stp%dense(sys)
+            ! the continuous extension where something reads it: events and the dense
+            ! solution on every step, t_eval only on a step that holds its next point
+            ! (DOP853's and Verner's extra stages cost evaluations, as in SciPy)
+            if (need_dense) then
+                if (has_events .or. keep_dense) then
+                    call stp%dense(sys)
+                else if (i_eval <= n_eval) then
+                    if ((t_eval(i_eval) - stp%t)*stp%posneg < 0.0_dp) call stp%dense(sys)
+                end if
+            end if
 
             stop_now = .false.
             t_stop = stp%t
