@@ -1,6 +1,8 @@
 """Work-precision of conmech's Taylor method (solve_ivp, method="TAYLOR", on a system made
 by conmech.symbolic) against heyoka's taylor_adaptive (PyPI, in this benchmark only) and
-conmech's own DOP853 on the same compiled system: Kepler e = 0.9 and Arenstorf's orbit, one
+conmech's own DOP853 on the same compiled system, and conmech.Propagator (method TAYLOR, the
+final state alone, as heyoka's propagate_until returns it; solve_ivp returns every step's
+point): Kepler e = 0.9 and Arenstorf's orbit, one
 period each, rtol = atol = tol over 1e-8 .. 1e-16.
 
 Errors are measured at the end of the period against a quadruple-precision Taylor reference
@@ -60,6 +62,18 @@ def runners(pr, sys_, tol):
             return r.y[:, -1], r.naccept, (taylor_order(tol) if m == "TAYLOR" else r.nfev)
         return call, read
     out["TAYLOR"] = conmech_run("TAYLOR")
+    # the final state alone, as heyoka's propagate_until gives it: conmech.Propagator
+    prop = conmech.Propagator(sys_, pr["y0"], method="TAYLOR", rtol=tol, atol=tol)
+    y0 = np.array(pr["y0"], dtype=float)
+
+    def prop_call():
+        prop.t, prop.y = 0.0, y0
+        return prop.propagate_until(pr["T"])
+
+    def prop_read(o):
+        assert o.success, o.message
+        return prop.y, o.naccept, taylor_order(tol)
+    out["propagate"] = (prop_call, prop_read)
     if tol >= DOP853_MIN_TOL:
         out["DOP853"] = conmech_run("DOP853")
     if hy is not None:
@@ -113,8 +127,10 @@ def table(name, rows):
     lines = [f"### {name}", "",
              "| tol | TAYLOR us / error / order, steps | heyoka us / error / order, steps | "
              "DOP853 us / error / nfev | TAYLOR / heyoka (equal error) | TAYLOR / heyoka "
-             "(same tol) | TAYLOR / DOP853 (equal error) | TAYLOR / DOP853 (same tol) |",
-             "|---|---|---|---|---|---|---|---|"]
+             "(same tol) | TAYLOR / DOP853 (equal error) | TAYLOR / DOP853 (same tol) | "
+             "Propagator us | Propagator / heyoka (equal error) | Propagator / heyoka "
+             "(same tol) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for tol in TOLS:
         r = rows[tol]
         t = r["TAYLOR"]
@@ -129,6 +145,11 @@ def table(name, rows):
             te = at_equal_error(curves[m], t["err"]) if curves[m] else None
             cells.append(f"{t['time']/te:.2f}" if te else "-")
             cells.append(f"{t['time']/other['time']:.2f}" if other else "-")
+        p = r["propagate"]
+        cells.append(f"{p['time']*1e6:.1f}")
+        te = at_equal_error(curves["heyoka"], p["err"]) if curves["heyoka"] else None
+        cells.append(f"{p['time']/te:.2f}" if te else "-")
+        cells.append(f"{p['time']/h['time']:.2f}" if h else "-")
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 

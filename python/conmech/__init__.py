@@ -16,6 +16,7 @@ import sys
 from .ivp import ensemble
 from .ivp.dense import ConstantDenseOutput
 from .ivp.solve import DenseOutput, OdeResult, OdeSolution, solve_ivp
+from .ivp.propagator import Propagation, Propagator
 from .ivp.stepper import (DOP853, DOPRI5, RK4, RK45, VERNER98, Gauss4, Gauss6,  # noqa: F401
                           Radau, Stepper)
 from .mechanics import compiled, constrained, degrees_of_freedom, systems
@@ -33,5 +34,5 @@ del _name, _module
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution", "ConstantDenseOutput", "systems", "hill", "stability",
            "constrained", "compiled"]
 __all__ += ["ensemble", "DOP853", "DOPRI5", "RK4", "RK45", "VERNER98"]
-__all__ += ["Radau", "Gauss4", "Gauss6", "Stepper"]
+__all__ += ["Radau", "Gauss4", "Gauss6", "Stepper", "Propagator", "Propagation"]
 __version__ = "0.1.0"

@@ -1,0 +1,140 @@
+"""conmech.Propagator: a state carried from one time to the next.
+
+Properties checked: one propagation gives the bits of solve_ivp's last point over the same
+span (the same Fortran run, its only output point the end); a chain of propagations and a
+propagation back to the start agree with the exact solution within the tolerances; a
+failure leaves the state as it was and says why; bad input is refused with solve_ivp's
+messages; a Python right-hand side takes solve_ivp's route with the same answer."""
+import math
+
+import numpy as np
+import pytest
+
+import conmech
+from conmech import systems
+
+ARENSTORF_T = 17.0652165601579625588917206249
+ARENSTORF_Y0 = [0.994, 0.0, 0.0, -2.00158510637908252240537862224]
+
+
+@pytest.mark.parametrize("method", ["DOP853", "RK45", "VERNER98", "Radau"])
+def test_one_propagation_is_solve_ivps_last_point(method):
+    sys_ = systems.arenstorf()
+    p = conmech.Propagator(sys_, ARENSTORF_Y0, method=method, rtol=1e-10, atol=1e-10)
+    out = p.propagate_until(ARENSTORF_T)
+    r = conmech.solve_ivp(sys_, (0.0, ARENSTORF_T), ARENSTORF_Y0, method=method,
+                          rtol=1e-10, atol=1e-10)
+    assert out.success and out.status == 0 and r.success
+    assert p.t == ARENSTORF_T
+    np.testing.assert_array_equal(p.y, r.y[:, -1])
+    # the same steps: the run stores no point but its end, it takes no other step
+    assert (out.naccept, out.nreject) == (r.naccept, r.nreject)
+    assert out.nfev == r.nfev
+
+
+def test_taylor_on_a_symbolic_system_is_solve_ivps_last_point():
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    x, y, u, v = sp.symbols("x y u v")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    kep = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+    e = 0.9
+    y0 = [1 - e, 0.0, 0.0, math.sqrt((1 + e)/(1 - e))]
+    p = conmech.Propagator(kep, y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
+    out = p.propagate_until(2*math.pi)
+    r = conmech.solve_ivp(kep, (0.0, 2*math.pi), y0, method="TAYLOR", rtol=1e-12,
+                          atol=1e-12)
+    assert out.success
+    np.testing.assert_array_equal(p.y, r.y[:, -1])
+    assert out.nfev == r.nfev
+    # the orbit closes after one period (Kepler's exact solution)
+    assert np.max(np.abs(p.y - y0)) < 1e-9
+
+
+def test_a_chain_of_propagations_follows_the_exact_solution():
+    omega = 2.0
+    p = conmech.Propagator(systems.harmonic(omega), [1.0, 0.0], method="DOP853",
+                           rtol=1e-12, atol=1e-12)
+    for t in np.linspace(0.1, 10.0, 25):
+        assert p.propagate_until(t).success
+        assert p.t == t
+        exact = [math.cos(omega*t), -omega*math.sin(omega*t)]
+        np.testing.assert_allclose(p.y, exact, atol=1e-9)
+    # and back to the start, backwards in time
+    assert p.propagate_until(0.0).success
+    np.testing.assert_allclose(p.y, [1.0, 0.0], atol=1e-9)
+    y_before = p.y
+    assert p.propagate_for(0.5).success and p.t == 0.5
+    assert p.y is not y_before
+    np.testing.assert_allclose(y_before, [1.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(p.y, [math.cos(1.0), -omega*math.sin(1.0)], atol=1e-9)
+
+
+def test_the_arrays_returned_are_not_overwritten():
+    p = conmech.Propagator(systems.harmonic(), [1.0, 0.0], method="DOP853", rtol=1e-10,
+                           atol=1e-10)
+    p.propagate_until(1.0)
+    y1 = p.y
+    kept = y1.copy()
+    p.propagate_until(2.0)
+    np.testing.assert_array_equal(y1, kept)
+    assert not np.array_equal(p.y, kept)
+
+
+def test_a_failure_keeps_the_state_and_says_why():
+    p = conmech.Propagator(systems.arenstorf(), ARENSTORF_Y0, method="DOP853", rtol=1e-10,
+                           atol=1e-10, max_steps=5)
+    out = p.propagate_until(ARENSTORF_T)
+    assert not out.success and out.status < 0
+    assert "max_steps" in out.message
+    assert p.t == 0.0
+    np.testing.assert_array_equal(p.y, ARENSTORF_Y0)
+
+
+def test_a_zero_length_propagation_does_nothing():
+    p = conmech.Propagator(systems.harmonic(), [1.0, 0.5], t0=3.0)
+    out = p.propagate_until(3.0)
+    assert out.success and out.nfev == 0 and p.t == 3.0
+    np.testing.assert_array_equal(p.y, [1.0, 0.5])
+
+
+def test_a_python_right_hand_side_takes_solve_ivps_route():
+    def f(t, y):
+        return [y[1], -y[0]]
+    p = conmech.Propagator(f, [1.0, 0.0], method="DOP853", rtol=1e-11, atol=1e-11)
+    assert p.propagate_until(math.pi).success
+    r = conmech.solve_ivp(f, (0.0, math.pi), [1.0, 0.0], method="DOP853", rtol=1e-11,
+                          atol=1e-11)
+    np.testing.assert_array_equal(p.y, r.y[:, -1])
+    np.testing.assert_allclose(p.y, [-1.0, 0.0], atol=1e-9)
+
+
+def test_new_parameters_are_packed_again():
+    sys_ = systems.harmonic(1.0)
+    p = conmech.Propagator(sys_, [1.0, 0.0], method="DOP853", rtol=1e-11, atol=1e-11)
+    sys_.params = np.array([3.0])
+    assert p.propagate_until(1.0).success
+    np.testing.assert_allclose(p.y[0], math.cos(3.0), atol=1e-9)
+
+
+@pytest.mark.parametrize("kwargs, err, text", [
+    (dict(y0=[1.0]), ValueError, "y0"),
+    (dict(y0=[1.0, math.nan]), ValueError, "finite"),
+    (dict(method="NOPE"), ValueError, "method"),
+    (dict(rtol=-1.0), ValueError, "rtol"),
+    (dict(t0=math.inf), ValueError, "t0"),
+    (dict(max_steps=0), ValueError, "max_steps"),
+])
+def test_bad_input_is_refused_with_a_message(kwargs, err, text):
+    args = dict(fun=systems.harmonic(), y0=[1.0, 0.0])
+    args.update(kwargs)
+    with pytest.raises(err, match=text):
+        conmech.Propagator(**args)
+
+
+@pytest.mark.parametrize("t", [math.nan, math.inf, "1.0", None])
+def test_a_bad_time_is_refused(t):
+    p = conmech.Propagator(systems.harmonic(), [1.0, 0.0])
+    with pytest.raises((TypeError, ValueError), match="t"):
+        p.propagate_until(t)
+    assert p.t == 0.0
