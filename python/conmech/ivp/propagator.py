@@ -12,9 +12,10 @@ time to the next and returns the state there alone (the run's only output point 
 requested time, so no step's point is stored).
 
 A system compiled or built in (``conmech.systems``, ``conmech.compiled``,
-``conmech.symbolic``) takes that one-call route; a Python function, a complex state or a
-constrained system runs :func:`conmech.solve_ivp` with ``t_eval=[t]`` (the same result,
-with solve_ivp's cost per call).
+``conmech.symbolic``) takes that one-call route; a Python function or a complex state runs
+:func:`conmech.solve_ivp` with ``t_eval=[t]`` (the same result, with solve_ivp's cost per
+call). Constrained systems are refused, as by solve_ivp (:mod:`conmech.constrained`
+integrates them).
 """
 import math
 import warnings
