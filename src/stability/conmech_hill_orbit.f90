@@ -44,6 +44,7 @@ module conmech_hill_orbit
     use conmech_lapack, only: la_eig
     use conmech_rk_tableaus, only: rk_tableau, dop853_tableau
     use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: tolerance_options
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate, ode_solve, ode_result
     use conmech_hill, only: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f
     use conmech_hill_kernel, only: hill_kernel_var, hill_kernel_state, hill_var_rhs
@@ -497,14 +498,12 @@ contains
         end if
         ts%m = orb%m
         ts%kappa = orb%kappa
-        opt%rtol = 1.0e-13_dp
-        if (present(rtol)) opt%rtol = rtol
+        opt = tolerance_options(1.0e-13_dp, rtol)
         if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
             res%info = CM_BAD_INPUT
             res%message = "hill_transverse: rtol must be in (0, 1)"
             return
         end if
-        opt%atol = opt%rtol
         z = [orb%y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, orb%period, z, opt, res%info, message=msg)
         res%message = msg
@@ -535,9 +534,7 @@ contains
         end if
         hp%m = orb%m
         hp%kappa = orb%kappa
-        opt%rtol = 1.0e-12_dp
-        if (present(rtol)) opt%rtol = rtol
-        opt%atol = opt%rtol
+        opt = tolerance_options(1.0e-12_dp, rtol)
         call ode_solve(hp, [0.0_dp, max(orb%period, maxval(t))], orb%y0, opt, r, t_eval=t)
         info = r%status
         if (info < 0) return
