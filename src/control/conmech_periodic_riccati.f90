@@ -338,9 +338,8 @@ contains
             end do
             call ode_solve(rs, [lq%period, 0.0_dp], z0, oo, rr)
             if (rr%status /= CM_SUCCESS) then
-                msg = "riccati: the backward integration failed"
-                if (allocated(rr%message)) msg = msg//": "//rr%message
-                call res%fail(rr%status, msg)
+                call res%fail_with_cause(rr%status, "riccati: the backward integration failed", &
+                                         rr%message)
                 return
             end if
             pnew = reshape(rr%y(1:k*k, rr%nt), [k, k])

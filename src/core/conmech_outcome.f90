@@ -13,6 +13,7 @@ module conmech_outcome
         character(len=:), allocatable :: message
     contains
         procedure :: fail => outcome_fail
+        procedure :: fail_with_cause => outcome_fail_with_cause
     end type outcome
 
 contains
@@ -25,5 +26,19 @@ contains
         self%info = info
         self%message = message
     end subroutine outcome_fail
+
+    !> `fail` with the message of the step that failed appended (": cause") when it left
+    !! one (an unallocated cause: the message alone).
+    pure subroutine outcome_fail_with_cause(self, info, message, cause)
+        class(outcome), intent(inout) :: self
+        integer, intent(in) :: info
+        character(len=*), intent(in) :: message
+        character(len=:), allocatable, intent(in) :: cause
+        if (allocated(cause)) then
+            call self%fail(info, message//": "//cause)
+        else
+            call self%fail(info, message)
+        end if
+    end subroutine outcome_fail_with_cause
 
 end module conmech_outcome

@@ -21,7 +21,7 @@ module conmech_constrained_band
     private
 
     public :: band_width_of, band_schur, band_gmul, band_gtmul, band_factor, band_solve
-    public :: band_dense, band_schur_minv, band_minv_mul, band_order
+    public :: band_dense, band_windows, band_schur_minv, band_minv_mul, band_order
 
     interface
         subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
@@ -229,5 +229,37 @@ contains
             g(i, first(i):first(i) + w - 1) = gb(i, :)
         end do
     end subroutine band_dense
+
+    !> The row windows of a dense g (m x n), the inverse of `band_dense`: gb(i, :) =
+    !! g(i, first(i) + 0:w-1) (w = size(gb, 2)), each window holding every nonzero of its
+    !! row and starting at its first nonzero where it fits (else at n - w + 1). When some
+    !! row's nonzeros span more than w columns, or w > n, first = 0 (no band structure).
+    pure subroutine band_windows(g, gb, first)
+        real(dp), intent(in) :: g(:, :)
+        real(dp), intent(out) :: gb(:, :)
+        integer, intent(out) :: first(:)
+        integer :: i, j0, j1, n, w
+        n = size(g, 2)
+        w = size(gb, 2)
+        gb = 0.0_dp
+        first = 0
+        if (w > n) return
+        do i = 1, size(g, 1)
+            j0 = 1
+            do while (j0 < n .and. g(i, j0) == 0.0_dp)
+                j0 = j0 + 1
+            end do
+            j1 = n
+            do while (j1 > j0 .and. g(i, j1) == 0.0_dp)
+                j1 = j1 - 1
+            end do
+            if (j1 - j0 + 1 > w) then
+                first = 0
+                return
+            end if
+            first(i) = min(j0, n - w + 1)
+            gb(i, :) = g(i, first(i):first(i) + w - 1)
+        end do
+    end subroutine band_windows
 
 end module conmech_constrained_band

@@ -59,6 +59,7 @@ module conmech_constrained_system
     use conmech_lapack, only: dpotrs, la_finite
     use conmech_schur, only: schur_solve
     use conmech_generalized, only: mass_cholesky
+    use conmech_constrained_band, only: band_windows
     implicit none
     private
 
@@ -306,25 +307,8 @@ contains
         real(dp), intent(out) :: gb(:, :)
         integer, intent(out) :: first(:)
         real(dp) :: g(self%n_hol, self%n)
-        integer :: i, j0, j1, w
-        w = size(gb, 2)
         call self%phi_jac(t, q, g)
-        do i = 1, self%n_hol
-            j0 = 1
-            do while (j0 < self%n .and. g(i, j0) == 0.0_dp)
-                j0 = j0 + 1
-            end do
-            j1 = self%n
-            do while (j1 > j0 .and. g(i, j1) == 0.0_dp)
-                j1 = j1 - 1
-            end do
-            if (j1 - j0 + 1 > w .or. w > self%n) then
-                first = 0
-                return
-            end if
-            first(i) = min(j0, self%n - w + 1)
-            gb(i, :) = g(i, first(i):first(i) + w - 1)
-        end do
+        call band_windows(g, gb, first)
     end subroutine cs_phi_jac_band
 
     !> The default has no holonomic constraints.

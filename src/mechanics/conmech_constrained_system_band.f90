@@ -9,7 +9,7 @@
 submodule(conmech_constrained_system) conmech_constrained_system_band
     use conmech_lapack, only: dpotrs
     use conmech_constrained_band, only: band_width_of, band_schur, band_schur_minv, &
-        band_gmul, band_gtmul, band_factor, band_solve, band_minv_mul, band_order
+        band_gmul, band_gtmul, band_factor, band_solve, band_minv_mul, band_order, band_windows
     implicit none
 
     !> The constraint rows at (t, q) as windows ordered by their first column, and the
@@ -47,28 +47,8 @@ contains
 
     module procedure cs_nh_matrix_band
         real(dp) :: a(self%n_nh, self%n)
-        integer :: i, j0, j1, w
-        w = size(ab, 2)
         call self%nh_matrix(t, q, a, b)
-        ab = 0.0_dp
-        first = 0
-        if (w > self%n) return
-        do i = 1, self%n_nh
-            j0 = 1
-            do while (j0 < self%n .and. a(i, j0) == 0.0_dp)
-                j0 = j0 + 1
-            end do
-            j1 = self%n
-            do while (j1 > j0 .and. a(i, j1) == 0.0_dp)
-                j1 = j1 - 1
-            end do
-            if (j1 - j0 + 1 > w) then
-                first = 0
-                return
-            end if
-            first(i) = min(j0, self%n - w + 1)
-            ab(i, :) = a(i, first(i):first(i) + w - 1)
-        end do
+        call band_windows(a, ab, first)
     end procedure cs_nh_matrix_band
 
     module procedure keep_mass_inverse

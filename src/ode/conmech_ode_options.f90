@@ -16,7 +16,7 @@ module conmech_ode_options
     integer, parameter, public :: METHOD_RATTLE = 8  !! constrained systems only (constrained_solve)
     integer, parameter, public :: METHOD_TAYLOR = 9  !! Taylor's method (conmech_taylor_stepper)
 
-    public :: ode_options, ode_stats
+    public :: ode_options, ode_stats, tolerance_options
 
     !> Options of the integrators. Zero means "use the method's default" for
     !! first_step, safety, fac_min, fac_max; beta < 0 means the default.
@@ -48,5 +48,18 @@ module conmech_ode_options
         integer :: njev = 0       !! Jacobian evaluations (implicit methods)
         integer :: nlu = 0        !! LU decompositions (implicit methods)
     end type ode_stats
+
+contains
+
+    !> Options at rtol = atol = `rtol` when present, else `default` (all else at the
+    !! defaults of ode_options).
+    pure function tolerance_options(default, rtol) result(opt)
+        real(dp), intent(in) :: default
+        real(dp), intent(in), optional :: rtol
+        type(ode_options) :: opt
+        opt%rtol = default
+        if (present(rtol)) opt%rtol = rtol
+        opt%atol = opt%rtol
+    end function tolerance_options
 
 end module conmech_ode_options

@@ -17,6 +17,7 @@ module conmech_floquet
     use conmech_kinds, only: dp, pi
     use conmech_status
     use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: tolerance_options
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate
     use conmech_variational, only: integrate_stm
     use conmech_lapack, only: la_eig
@@ -291,9 +292,7 @@ contains
             res%message = "hill_solve: the period must be positive"
             return
         end if
-        opt%rtol = 1.0e-12_dp
-        if (present(rtol)) opt%rtol = rtol
-        opt%atol = opt%rtol
+        opt = tolerance_options(1.0e-12_dp, rtol)
         y = 0.0_dp
         phi = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2])
         ! the state y = 0 is a solution: the STM alone is integrated (y stays 0)

@@ -15,7 +15,7 @@ module conmech_hill_kernel
     use conmech_kinds, only: dp
     implicit none
     private
-    public :: hill_kernel_var, hill_kernel_state
+    public :: hill_kernel_var, hill_kernel_state, hill_var_rhs
 
     real(dp), parameter :: a2_1 = 5.26001519587677318785587544488e-2_dp
     real(dp), parameter :: a3_1 = 1.97250569845378994544595329183e-2_dp
@@ -78,10 +78,12 @@ module conmech_hill_kernel
 
 contains
 
-    !> dz for z = [x, y, x', y', c1(4), c3(4), c4(4)] (c: columns of the STM).
-    pure subroutine var_rhs16(m, kappa, z, dz)
-        real(dp), intent(in) :: m, kappa, z(16)
-        real(dp), intent(out) :: dz(16)
+    !> dz for z = [x, y, x', y', c1(4), ..., cj(4)], nz = 4 + 4 j >= 8 (c: columns of the
+    !! STM; conmech_hill_orbit integrates all four, the kernel three).
+    pure subroutine hill_var_rhs(m, kappa, nz, z, dz)
+        integer, intent(in) :: nz
+        real(dp), intent(in) :: m, kappa, z(nz)
+        real(dp), intent(out) :: dz(nz)
         real(dp) :: x, y, ir, ir3, k3, fxx, fxy, fyy, tm, m3
         integer :: o
         x = z(1)
@@ -98,13 +100,13 @@ contains
         fxx = k3*x*x - ir3 + m3
         fxy = k3*x*y
         fyy = k3*y*y - ir3
-        do o = 4, 12, 4
+        do o = 4, nz - 4, 4
             dz(o + 1) = z(o + 3)
             dz(o + 2) = z(o + 4)
             dz(o + 3) = fxx*z(o + 1) + fxy*z(o + 2) + tm*z(o + 4)
             dz(o + 4) = fxy*z(o + 1) + fyy*z(o + 2) - tm*z(o + 3)
         end do
-    end subroutine var_rhs16
+    end subroutine hill_var_rhs
 
     !> ds for the state s = [x, y, x', y'].
     pure subroutine state_rhs(m, kappa, s, ds)
@@ -132,7 +134,7 @@ contains
         pure subroutine rhs_of(s, ds)
             real(dp), intent(in) :: s(nz)
             real(dp), intent(out) :: ds(nz)
-            call var_rhs16(m, kappa, s, ds)
+            call hill_var_rhs(m, kappa, nz, s, ds)
         end subroutine rhs_of
     end subroutine hill_kernel_var
 

@@ -44,9 +44,10 @@ module conmech_hill_orbit
     use conmech_lapack, only: la_eig
     use conmech_rk_tableaus, only: rk_tableau, dop853_tableau
     use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: tolerance_options
     use conmech_ode_solver, only: ode_options, ode_stats, ode_integrate, ode_solve, ode_result
     use conmech_hill, only: hill_problem, hill_jacobi, hill_grad_f, hill_hess_f
-    use conmech_hill_kernel, only: hill_kernel_var, hill_kernel_state
+    use conmech_hill_kernel, only: hill_kernel_var, hill_kernel_state, hill_var_rhs
     implicit none
     private
 
@@ -122,36 +123,6 @@ contains
         end if
     end function hill_perigee_c
 
-    !> z' for z = [x, y, x', y', vec(Phi)] (Phi 4 x 4 by columns).
-    pure subroutine var_rhs(m, kappa, z, dz)
-        real(dp), intent(in) :: m, kappa, z(20)
-        real(dp), intent(out) :: dz(20)
-        real(dp) :: x, y, r2, ir, ir3, ir5, fxx, fxy, fyy, tm, k3
-        integer :: j, o
-        x = z(1)
-        y = z(2)
-        r2 = x*x + y*y
-        ir = 1.0_dp/sqrt(r2)
-        ir3 = ir*ir*ir
-        ir5 = ir3*ir*ir
-        tm = 2.0_dp*m
-        dz(1) = z(3)
-        dz(2) = z(4)
-        dz(3) = tm*z(4) - kappa*x*ir3 + 3.0_dp*m*m*x
-        dz(4) = -tm*z(3) - kappa*y*ir3
-        k3 = 3.0_dp*kappa*ir5
-        fxx = k3*x*x - kappa*ir3 + 3.0_dp*m*m
-        fxy = k3*x*y
-        fyy = k3*y*y - kappa*ir3
-        do j = 1, 4
-            o = 4*j
-            dz(o + 1) = z(o + 3)
-            dz(o + 2) = z(o + 4)
-            dz(o + 3) = fxx*z(o + 1) + fxy*z(o + 2) + tm*z(o + 4)
-            dz(o + 4) = fxy*z(o + 1) + fyy*z(o + 2) - tm*z(o + 3)
-        end do
-    end subroutine var_rhs
-
     !> Fixed-step DOP853 (8th-order solution) for the state and its STM over [0, t1].
     pure subroutine integrate_var(tab, m, kappa, t1, nsteps, z, nfev)
         type(rk_tableau), intent(in) :: tab
@@ -163,13 +134,13 @@ contains
         integer :: istep, i, j
         h = t1/nsteps
         do istep = 1, nsteps
-            call var_rhs(m, kappa, z, k(:, 1))
+            call hill_var_rhs(m, kappa, 20, z, k(:, 1))
             do i = 2, 12
                 zt = z
                 do j = 1, i - 1
                     if (tab%a(i, j) /= 0.0_dp) zt = zt + (h*tab%a(i, j))*k(:, j)
                 end do
-                call var_rhs(m, kappa, zt, k(:, i))
+                call hill_var_rhs(m, kappa, 20, zt, k(:, i))
             end do
             do j = 1, 12
                 if (tab%b(j) /= 0.0_dp) z = z + (h*tab%b(j))*k(:, j)
@@ -178,16 +149,19 @@ contains
         nfev = nfev + 12*nsteps
     end subroutine integrate_var
 
-    pure subroutine start_state(u, z)
+    !> z = [x0, 0, 0, v0, e(cols(1)), ..., e(cols(j))] for u = (x0, v0): the symmetric
+    !! start with the columns of the identity STM that are integrated along.
+    pure subroutine start_state(u, cols, z)
         real(dp), intent(in) :: u(2)
-        real(dp), intent(out) :: z(20)
+        integer, intent(in) :: cols(:)
+        real(dp), intent(out) :: z(:)
+        integer :: j
         z = 0.0_dp
         z(1) = u(1)
         z(4) = u(2)
-        z(5) = 1.0_dp
-        z(10) = 1.0_dp
-        z(15) = 1.0_dp
-        z(20) = 1.0_dp
+        do j = 1, size(cols)
+            z(4*j + cols(j)) = 1.0_dp
+        end do
     end subroutine start_state
 
     !> The variation orbit for (m, kappa) with its monodromy, multipliers and c.
@@ -299,7 +273,7 @@ contains
             block
                 real(dp) :: z(20)
                 tab = dop853_tableau()
-                call start_state(u, z)
+                call start_state(u, [1, 2, 3, 4], z)
                 call integrate_var(tab, m, kappa, 2.0_dp*pi, 4*n, z, orb%nfev)
                 orb%monodromy = reshape(z(5:20), [4, 4])
             end block
@@ -348,12 +322,7 @@ contains
         ua = u
         do it = 1, opt%max_iter
             orb%iterations = orb%iterations + 1
-            z = 0.0_dp
-            z(1) = u(1)
-            z(4) = u(2)
-            z(5) = 1.0_dp
-            z(11) = 1.0_dp
-            z(16) = 1.0_dp
+            call start_state(u, [1, 3, 4], z)
             call hill_kernel_var(m, kappa, 0.5_dp*pi, n, z, orb%nfev)
             if (.not. all(ieee_is_finite(z))) then
                 call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: non-finite state (the "// &
@@ -529,14 +498,12 @@ contains
         end if
         ts%m = orb%m
         ts%kappa = orb%kappa
-        opt%rtol = 1.0e-13_dp
-        if (present(rtol)) opt%rtol = rtol
+        opt = tolerance_options(1.0e-13_dp, rtol)
         if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
             res%info = CM_BAD_INPUT
             res%message = "hill_transverse: rtol must be in (0, 1)"
             return
         end if
-        opt%atol = opt%rtol
         z = [orb%y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, orb%period, z, opt, res%info, message=msg)
         res%message = msg
@@ -567,9 +534,7 @@ contains
         end if
         hp%m = orb%m
         hp%kappa = orb%kappa
-        opt%rtol = 1.0e-12_dp
-        if (present(rtol)) opt%rtol = rtol
-        opt%atol = opt%rtol
+        opt = tolerance_options(1.0e-12_dp, rtol)
         call ode_solve(hp, [0.0_dp, max(orb%period, maxval(t))], orb%y0, opt, r, t_eval=t)
         info = r%status
         if (info < 0) return

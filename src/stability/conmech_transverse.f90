@@ -24,6 +24,7 @@ module conmech_transverse
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system
+    use conmech_ode_options, only: tolerance_options
     use conmech_ode_solver, only: ode_options, ode_integrate, METHOD_DOP853
     use conmech_floquet, only: multipliers_2x2
     implicit none
@@ -158,16 +159,14 @@ contains
             res%message = "transverse_monodromy: need period > 0, finite y0, |q'| > 0"
             return
         end if
+        opt = tolerance_options(1.0e-12_dp, rtol)
         opt%method = METHOD_DOP853
-        opt%rtol = 1.0e-12_dp
-        if (present(rtol)) opt%rtol = rtol
         if (.not. (opt%rtol > 0.0_dp .and. opt%rtol < 1.0_dp)) then
             res%info = CM_BAD_INPUT
             res%message = "transverse_monodromy: rtol must be in (0, 1)"
             return
         end if
         allocate (ts%base, source=sys)
-        opt%atol = opt%rtol
         z = [y0, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp]
         call ode_integrate(ts, 0.0_dp, period, z, opt, res%info, message=msg)
         res%message = msg

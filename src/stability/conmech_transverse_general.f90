@@ -196,9 +196,8 @@ contains
         call ode_solve(fr%ode, [0.0_dp, period], z0, oo, res)
         fr%nfev = res%stats%nfev
         if (res%status /= CM_SUCCESS) then
-            msg = "transverse: the integration along the orbit failed"
-            if (allocated(res%message)) msg = msg//": "//res%message
-            call fr%fail(res%status, msg)
+            call fr%fail_with_cause(res%status, "transverse: the integration along the orbit "// &
+                                    "failed", res%message)
             return
         end if
         z0 = res%y(:, res%nt)
@@ -240,12 +239,8 @@ contains
         o = n + ny*n + n*k
         mred = reshape(z0(o + 1:o + k*k), [k, k])
         fr%monodromy = matmul(r, mred)
-        allocate (fr%mr(k), fr%mi(k))
-        call la_eig(fr%monodromy, fr%mr, fr%mi, info)
-        if (info /= CM_SUCCESS) then
-            call fr%fail(info, "transverse: eigenvalues of the transverse monodromy failed")
-            return
-        end if
+        call monodromy_eig(fr%monodromy, fr%mr, fr%mi, "transverse")
+        if (info /= CM_SUCCESS) return
         o = o + k*k
         if (fr%m > 0) then
             fr%gramian = matmul(r, matmul(reshape(z0(o + 1:o + k*k), [k, k]), transpose(r)))
@@ -253,12 +248,8 @@ contains
         end if
         if (fr%ode%full) then
             fr%full_monodromy = reshape(z0(o + 1:o + n*n), [n, n])
-            allocate (fr%fr(n), fr%fi(n))
-            call la_eig(fr%full_monodromy, fr%fr, fr%fi, info)
-            if (info /= CM_SUCCESS) then
-                call fr%fail(info, "transverse: eigenvalues of the full monodromy failed")
-                return
-            end if
+            call monodromy_eig(fr%full_monodromy, fr%fr, fr%fi, "full")
+            if (info /= CM_SUCCESS) return
         end if
         write (b1, '(es10.3)') fr%closure
         write (b2, '(es10.3)') fr%frame_defect
@@ -284,9 +275,8 @@ contains
             call ode_solve(sys, [0.0_dp, period], y0, o1, ro, t_eval=ts)
             if (ro%status /= CM_SUCCESS .or. ro%nt /= 64) then
                 info = CM_BAD_INPUT
-                msg = "transverse: the orbit could not be integrated over one period"
-                if (allocated(ro%message)) msg = msg//": "//ro%message
-                call fr%fail(info, msg)
+                call fr%fail_with_cause(info, "transverse: the orbit could not be integrated "// &
+                                        "over one period", ro%message)
                 return
             end if
             fr%closure = maxval(abs(ro%y(:, 64) - y0))
@@ -341,6 +331,18 @@ contains
             end if
             info = CM_SUCCESS
         end subroutine check_orbit
+
+        !> The eigenvalues (wr, wi) of a monodromy matrix a (info; on failure fr fails,
+        !! naming `which` monodromy).
+        subroutine monodromy_eig(a, wr, wi, which)
+            real(dp), intent(in) :: a(:, :)
+            real(dp), allocatable, intent(out) :: wr(:), wi(:)
+            character(len=*), intent(in) :: which
+            allocate (wr(size(a, 1)), wi(size(a, 1)))
+            call la_eig(a, wr, wi, info)
+            if (info /= CM_SUCCESS) call fr%fail(info, "transverse: eigenvalues of the "// &
+                                                 which//" monodromy failed")
+        end subroutine monodromy_eig
 
     end subroutine transverse_build
 
