@@ -18,7 +18,7 @@ import numpy as np
 
 from .._core.model import model_of
 
-__all__ = ["first_order_view", "name_the_mass_matrix"]
+__all__ = ["first_order_view", "name_the_mass_matrix", "batch_entries", "mass_note"]
 
 
 def _model(fun):
@@ -73,19 +73,35 @@ def first_order_view(fun, *parts):
                                    base.param_names, base._keep, base.taylor)
 
 
-def name_the_mass_matrix(fun, res):
-    """`res` (a failed run of fun's first-order view) with its message completed by the
-    state of the mass matrix at the last accepted point: not positive definite there, or
-    its condition number."""
+def batch_entries(fun, lanes=None):
+    """The entries (``batch``, ``width``, ``batch_run``) of the batch library of a
+    generalized system made by conmech.symbolic (its first-order view's coefficients in
+    `lanes` SIMD lanes, None: the machine's width, and the propagator,
+    :mod:`conmech.symbolic.taylor_generalized_batch`), compiled on first need; None when it
+    has none (any other system, a tree, more than taylor_generalized.WRITE_OUT_MAX degrees
+    of freedom: the ensemble then runs member by member)."""
     model = _model(fun)
-    if model is None or res.success or res.status != -1 or not res.t.size:
-        return res
+    if model is None:
+        return None
+    from ..symbolic.taylor_library import batch_entries as library_batch
+    tay = library_batch(model, lanes)
+    return tay if tay and tay.get("batch_run") is not None else None
+
+
+def mass_note(fun, t, y):
+    """" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted point,
+    t = ..., ...)": the state of fun's mass matrix at (t, y), y = [q; v] (not finite, not
+    positive definite, or its extreme eigenvalues), and for a tree its first pivot that is
+    not positive; "" for any other system or when M cannot be evaluated."""
+    model = _model(fun)
+    if model is None:
+        return ""
     n = model.derived.n
-    t, q = float(res.t[-1]), np.array(res.y[:n, -1], dtype=float)
+    y = np.array(y, dtype=float)
     try:
-        m = model.call("mass", t, q, params=np.asarray(fun.params, dtype=float))
+        m = model.call("mass", float(t), y[:n], params=np.asarray(fun.params, dtype=float))
     except (KeyError, ValueError, TypeError, AttributeError):
-        return res
+        return ""
     m = np.array(m, dtype=float).reshape(n, n)
     if not np.all(np.isfinite(m)):
         note = "is not finite"
@@ -95,23 +111,34 @@ def name_the_mass_matrix(fun, res):
             note = f"has smallest eigenvalue {ev[0]:.3g} and largest {ev[-1]:.3g}"
         else:
             note = "is not positive definite (singular or indefinite)"
-    res.message = (f"{res.message} (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at "
-                   f"the last accepted point, t = {t:.6g}, {note}{_pivots(model, res, fun)})")
+    return (f" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted "
+            f"point, t = {float(t):.6g}, {note}{_pivots(model, float(t), y, fun)})")
+
+
+def name_the_mass_matrix(fun, res):
+    """`res` (a failed run of fun's first-order view) with its message completed by the
+    state of the mass matrix at the last accepted point: not positive definite there, or
+    its condition number."""
+    model = _model(fun)
+    if model is None or res.success or res.status != -1 or not res.t.size:
+        return res
+    note = mass_note(fun, res.t[-1], res.y[:, -1])
+    if note:
+        res.message = f"{res.message}{note}"
     return res
 
 
-def _pivots(model, res, fun):
+def _pivots(model, t, y, fun):
     """For a tree: "; the articulated inertia of the joint of body 'b' is x, not
     positive ..." for the first pivot of its articulated-body algorithm that is not
-    positive at the last accepted point (empty if none is)."""
+    positive at (t, y), the last accepted point (empty if none is)."""
     from ..symbolic.taylor_tree import is_tree, pivot_values
     d = model.derived
     if not is_tree(d):
         return ""
     n = d.n
-    y = np.array(res.y[:, -1], dtype=float)
     try:
-        vals = pivot_values(d, float(res.t[-1]), y[:n], y[n:2*n],
+        vals = pivot_values(d, t, y[:n], y[n:2*n],
                             np.asarray(fun.params, dtype=float))
     except (ValueError, TypeError, AttributeError):
         return ""
