@@ -6,14 +6,18 @@ system whose Taylor coefficients come from the recurrences of M and Q and the li
 solve order by order (:mod:`conmech.symbolic.taylor_generalized`), or for a tree from the
 recurrences of its articulated-body code, definition by definition
 (:mod:`conmech.symbolic.taylor_tree`); compiled on first need and cached like an ode
-model's Taylor library.
+model's Taylor library. An ensemble (``ensemble.solve(method="TAYLOR")``) of the view runs
+its members in SIMD lanes through the batch routine of
+:mod:`conmech.symbolic.taylor_generalized_batch` (:func:`batch_entries`; member by member
+for a tree or more than 8 degrees of freedom).
 
 :func:`first_order_view` gives the view (the same parameters; the model behind it, so that
 the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
 run's message what the mass matrix is at the last accepted point (a singular or indefinite
 M makes the coefficients non-finite, which the stepper reports as a non-finite right-hand
 side or a step size too small), and for a tree which joint's articulated inertia (the
-pivot of its articulated-body algorithm) is not positive there."""
+pivot of its articulated-body algorithm) is not positive there; :func:`mass_note` is that
+text for a given point (an ensemble's failed member)."""
 import numpy as np
 
 from .._core.model import model_of

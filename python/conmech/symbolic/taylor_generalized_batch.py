@@ -155,7 +155,32 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
     decls = _decls(consts, "real(dp)", ind)
     decls += _decls([f"{x}(nl)" for x in lane], "real(dp)", ind)
     decls += [f"{ind}real(dp) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
-    return head + decls + out + [f"    end subroutine {cname}", ""]
+    return head + decls + _lanes_outside(out) + [f"    end subroutine {cname}", ""]
+
+
+def _lanes_outside(lines):
+    """The loops over the terms j of the history sums whose only statement is a loop over
+    the lanes, turned inside out: the lanes' loop outside, vectorised as a whole by the
+    compiler, each lane's accumulators held in a vector register over the terms rather than
+    loaded and stored at every term (each lane adds the same terms in the same order)."""
+    out, i = [], 0
+    while i < len(lines):
+        x = lines[i]
+        s = x.lstrip()
+        at = x[:len(x) - len(s)]
+        if s.startswith("do j = ") and i + 2 < len(lines) and \
+                lines[i + 1] == f"{at}    !$omp simd" and \
+                lines[i + 2] == f"{at}    do l = 1, nl":
+            end = lines.index(f"{at}    end do", i + 3)
+            if lines[end + 1] == f"{at}end do":
+                out += [f"{at}!$omp simd", f"{at}do l = 1, nl", f"{at}    {s}"]
+                out += lines[i + 3:end]
+                out += [f"{at}    end do", f"{at}end do"]
+                i = end + 2
+                continue
+        out.append(x)
+        i += 1
+    return out
 
 
 def batch_lines(d, names, lanes, fixed, dec_cache, codes):
