@@ -164,3 +164,24 @@ def test_more_degrees_of_freedom_than_written_out_run_member_by_member():
     assert ens.success
     r = conmech.solve_ivp(system, (0, 1.0), y0s[1], method="TAYLOR", rtol=1e-10, atol=1e-10)
     assert np.array_equal(ens.y_final[1], r.y[:, -1])
+
+
+def test_shared_parameters_given_to_the_call_are_used(systems):
+    """params given to the call for every member (one row or scalars) are the members'
+    parameters on the lanes route too, for a generalized system and an ode system."""
+    system, y0s, tf = systems[2]
+    ens = ensemble.solve(system, (0, 1.0), y0s[:3], params={"k": 25.0, "A": 0.5},
+                         method="TAYLOR", rtol=TOL, atol=TOL)
+    other = system.with_params(k=25.0, A=0.5)
+    for i in range(3):
+        r = conmech.solve_ivp(other, (0, 1.0), y0s[i], method="TAYLOR", rtol=TOL, atol=TOL)
+        assert np.array_equal(ens.y_final[i], r.y[:, -1])
+    x, v, c = sp.symbols("x v c_gbatch")
+    osc = symbolic.ode_system([v, -c*sp.sin(x)], [x, v], params={c: 1.0})
+    y0 = np.array([[1.0, 0.0], [0.5, 0.2]])
+    ens = ensemble.solve(osc, (0, 2.0), y0, params=[4.0], method="TAYLOR", rtol=TOL,
+                         atol=TOL)
+    for i in range(2):
+        r = conmech.solve_ivp(osc.with_params(c_gbatch=4.0), (0, 2.0), y0[i],
+                              method="TAYLOR", rtol=TOL, atol=TOL)
+        assert np.array_equal(ens.y_final[i], r.y[:, -1])

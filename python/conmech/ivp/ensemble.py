@@ -250,16 +250,19 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps,
 
 
 def _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps,
-                        nthreads, generalized=None):
+                        nthreads, generalized=None, params=None):
     """The members in SIMD lanes (the generated propagator, lanes refilled as members end)
     or in batches of the coefficient routine's width (a system given a batch routine
     only), chunks of members in OpenMP threads; each member's steps are those of its
     solve_ivp run, bit for bit. `generalized`: the system M(q) q'' = Q whose first-order
     view `system` is (the message of a failed member then says what its mass matrix is
-    where it stopped)."""
+    where it stopped). `params`: the members' shared parameters (None: the system's)."""
     n = system.dimension
     y0m = np.broadcast_to(y0a, (m, n)) if y0a.shape[0] == 1 else y0a
-    p = system.params if system.params.size else _PAD
+    if params is not None and system.params.size:
+        p = np.ascontiguousarray(params, dtype=float)
+    else:
+        p = system.params if system.params.size else _PAD
     if taylor.get("batch_run") is not None:
         (y_final, t_final, codes, nfev, naccept, nreject, info,
          message) = _conmech.flat_taylor_batch_run(
@@ -287,7 +290,8 @@ def _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax, ma
                    f"{first}: {status_message(int(codes[first]))}")
         if generalized is not None:
             from .taylor_generalized import mass_note
-            message += mass_note(generalized, t_final[first], y_final[:, first])
+            message += mass_note(generalized, t_final[first], y_final[:, first],
+                                 p if system.params.size else None)
     return EnsembleResult(
         t=None, y=None, t_final=t_final, y_final=np.ascontiguousarray(y_final.T),
         status=status, member_success=status >= 0, codes=codes, nfev=nfev.astype(int),
@@ -483,7 +487,7 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
                            generalized)
     if taylor is not None:
         return _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax,
-                                   int(max_steps), nthreads, generalized)
+                                   int(max_steps), nthreads, generalized, ptab[:, 0])
     name, _, _, nspec, spec = system._flat_args()
     (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,
      info, message) = _conmech.flat_ensemble_builtin(

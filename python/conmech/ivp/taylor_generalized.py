@@ -92,18 +92,20 @@ def batch_entries(fun, lanes=None):
     return tay if tay and tay.get("batch_run") is not None else None
 
 
-def mass_note(fun, t, y):
+def mass_note(fun, t, y, params=None):
     """" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted point,
     t = ..., ...)": the state of fun's mass matrix at (t, y), y = [q; v] (not finite, not
-    positive definite, or its extreme eigenvalues), and for a tree its first pivot that is
-    not positive; "" for any other system or when M cannot be evaluated."""
+    positive definite, or its extreme eigenvalues), with fun's parameters or `params`,
+    and for a tree its first pivot that is not positive; "" for any other system or when
+    M cannot be evaluated."""
     model = _model(fun)
     if model is None:
         return ""
     n = model.derived.n
     y = np.array(y, dtype=float)
+    p = np.asarray(fun.params if params is None else params, dtype=float)
     try:
-        m = model.call("mass", float(t), y[:n], params=np.asarray(fun.params, dtype=float))
+        m = model.call("mass", float(t), y[:n], params=p)
     except (KeyError, ValueError, TypeError, AttributeError):
         return ""
     m = np.array(m, dtype=float).reshape(n, n)
@@ -116,7 +118,7 @@ def mass_note(fun, t, y):
         else:
             note = "is not positive definite (singular or indefinite)"
     return (f" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted "
-            f"point, t = {float(t):.6g}, {note}{_pivots(model, float(t), y, fun)})")
+            f"point, t = {float(t):.6g}, {note}{_pivots(model, float(t), y, p)})")
 
 
 def name_the_mass_matrix(fun, res):
@@ -132,7 +134,7 @@ def name_the_mass_matrix(fun, res):
     return res
 
 
-def _pivots(model, t, y, fun):
+def _pivots(model, t, y, p):
     """For a tree: "; the articulated inertia of the joint of body 'b' is x, not
     positive ..." for the first pivot of its articulated-body algorithm that is not
     positive at (t, y), the last accepted point (empty if none is)."""
@@ -142,8 +144,7 @@ def _pivots(model, t, y, fun):
         return ""
     n = d.n
     try:
-        vals = pivot_values(d, t, y[:n], y[n:2*n],
-                            np.asarray(fun.params, dtype=float))
+        vals = pivot_values(d, t, y[:n], y[n:2*n], p)
     except (ValueError, TypeError, AttributeError):
         return ""
     # the first in the chain's order (leaves first): the pivots of its ancestors are then

@@ -9,8 +9,9 @@ The coefficient routine ``conmech_taylor_batch(t, order, w, p)`` (t(lanes), w(la
 the triangular solves written out in scalars) with every per-lane value a vector of the
 lanes: the accumulators of the history sums, the reciprocals, the Cholesky factor of M_0
 (cd<i>, cl<i>_<j>), the right-hand sides of the solves (cr<i>) and the history sums of
-M a (cg<i>), each statement in a ``!$omp simd`` loop over the lanes, innermost; the loops
-over the orders k and the terms j stay outside, common to the lanes. Each lane runs the
+M a (cg<i>), each statement in a ``!$omp simd`` loop over the lanes; the loop over the
+orders k stays outside, common to the lanes, and the loops over the terms j of the history
+sums run inside the lanes' loop (:func:`_lanes_outside`). Each lane runs the
 scalar statement's operations in its order, so each member gets the scalar routine's
 coefficients to the last bit, and the propagator (the same for ode systems and the view
 of a generalized one) takes the steps of the member's own solve_ivp(method="TAYLOR") run.
