@@ -8,8 +8,8 @@ recurrences of its articulated-body code, definition by definition
 (:mod:`conmech.symbolic.taylor_tree`); compiled on first need and cached like an ode
 model's Taylor library. An ensemble (``ensemble.solve(method="TAYLOR")``) of the view runs
 its members in SIMD lanes through the batch routine of
-:mod:`conmech.symbolic.taylor_generalized_batch` (:func:`batch_entries`; member by member
-for a tree or more than 8 degrees of freedom).
+:mod:`conmech.symbolic.taylor_generalized_batch`, or of :mod:`conmech.symbolic.taylor_tree_batch`
+for a tree (:func:`batch_entries`; member by member for more than 8 degrees of freedom).
 
 :func:`first_order_view` gives the view (the same parameters; the model behind it, so that
 the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
@@ -81,9 +81,10 @@ def batch_entries(fun, lanes=None):
     """The entries (``batch``, ``width``, ``batch_run``) of the batch library of a
     generalized system made by conmech.symbolic (its first-order view's coefficients in
     `lanes` SIMD lanes, None: the machine's width, and the propagator,
-    :mod:`conmech.symbolic.taylor_generalized_batch`), compiled on first need; None when it
-    has none (any other system, a tree, more than taylor_generalized.WRITE_OUT_MAX degrees
-    of freedom: the ensemble then runs member by member)."""
+    :mod:`conmech.symbolic.taylor_generalized_batch`, for a tree
+    :mod:`conmech.symbolic.taylor_tree_batch`), compiled on first need; None when it has
+    none (any other system, more than taylor_generalized.WRITE_OUT_MAX degrees of freedom:
+    the ensemble then runs member by member)."""
     model = _model(fun)
     if model is None:
         return None

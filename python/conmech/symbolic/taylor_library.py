@@ -40,7 +40,7 @@ MODULE = "conmech_symbolic_taylor_library"
 
 _FORMAT = 6     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
                 # 4: the variational and quadruple-precision parts of generalized models,
-                # 5: those of trees, 6: the batch part of generalized models)
+                # 5: those of trees, 6: the batch part of generalized models and trees)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -125,6 +125,12 @@ def _lines(d, part, dec_cache):
             if part == "var":
                 from .taylor_tree_var import tree_variational_lines
                 return tree_variational_lines(d, names, dec_cache)
+            if _lanes(part) is not None:     # the ode systems' lanes, the pivots per lane
+                from .._core import status as S
+                from .taylor_tree_batch import tree_batch_lines
+                return tree_batch_lines(d, names, _lanes(part), _fixed_order(part),
+                                        dec_cache, (S.SUCCESS, S.TOO_MANY_STEPS,
+                                                    S.STEP_TOO_SMALL, S.NONFINITE))
             return tree_lines(d, names, part, dec_cache)
         if part == "var":
             from .taylor_generalized_var import variational_lines
@@ -181,8 +187,8 @@ def taylor_source(d, part="core", _dec=None):
     for its first-order view (:mod:`conmech.symbolic.taylor_generalized_batch`, the loop
     version, up to taylor_generalized.WRITE_OUT_MAX degrees of freedom), the quadruple
     precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
-    a tree the core, quadruple precision and variational parts through its
-    articulated-body chain (:mod:`conmech.symbolic.taylor_tree`,
+    a tree the same four through its articulated-body chain
+    (:mod:`conmech.symbolic.taylor_tree`, :mod:`conmech.symbolic.taylor_tree_batch`,
     :mod:`conmech.symbolic.taylor_tree_var`). (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
     if part not in PARTS and _lanes(part) is None:
@@ -339,9 +345,10 @@ def batch_entries(model, lanes, order=None):
     once per model, lanes and order, under a lock; None when f has no Taylor recurrences
     (or, for the machine's lanes in the loop version, which is the lazy part "batch" of
     the model's systems: ask the system). A generalized model M(q) q'' = Q has the loop
-    version only, for any lanes (:mod:`conmech.symbolic.taylor_generalized_batch`): its
-    entries, or None with the reason in ``model._taylor_parts[part]`` (a tree, more than
-    taylor_generalized.WRITE_OUT_MAX degrees of freedom, no recurrences)."""
+    version only, for any lanes (:mod:`conmech.symbolic.taylor_generalized_batch`, a tree's
+    :mod:`conmech.symbolic.taylor_tree_batch`): its entries, or None with the reason in
+    ``model._taylor_parts[part]`` (more than taylor_generalized.WRITE_OUT_MAX degrees of
+    freedom, no recurrences)."""
     part = batch_part(lanes)
     if getattr(model.derived, "kind", None) == "generalized":
         with _BATCH_LOCK:
