@@ -272,7 +272,8 @@ def test_stepper_refuses_a_system_without_taylor_code():
 
 def test_ensemble_members_are_their_own_runs(cart):
     """ensemble.solve(method="TAYLOR") of a generalized system runs its first-order view
-    member by member: each member is its solve_ivp run, bit for bit."""
+    in SIMD lanes (test_taylor_generalized_batch.py): each member is its solve_ivp run,
+    bit for bit."""
     from conmech import ensemble
     y0s = np.array([[0.0, np.pi - 0.7, 0.3, 0.0], [0.1, 2.0, -0.2, 0.4]])
     ens = ensemble.solve(cart, (0, 3.0), y0s, method="TAYLOR", rtol=1e-11, atol=1e-11)

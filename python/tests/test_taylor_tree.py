@@ -17,7 +17,8 @@ definition by definition into elementary operations with Taylor recurrences).
 - the error at the end of a run falls with the tolerance (the order and step from the
   tolerance, as for ode systems): about in proportion, and below 100 times the tolerance;
 - Stepper(method="TAYLOR") runs the steps of solve_ivp(method="TAYLOR"), bit for bit, and
-  ensemble.solve(method="TAYLOR") the runs of solve_ivp member by member;
+  ensemble.solve(method="TAYLOR") each member's solve_ivp run (in SIMD lanes:
+  test_taylor_tree_batch.py);
 - a joint whose articulated inertia is not positive at run time (a zero mass at a leaf):
   a failed run whose message names the body; a tree with a non-smooth force is refused
   with the reason.

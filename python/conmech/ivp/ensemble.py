@@ -201,14 +201,18 @@ def _member_params(system, params):
     return np.asfortranarray(table.T), table.shape[0]
 
 
-def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
+def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps,
+                  generalized=None):
     """The Taylor entries of the batch route of an ensemble, or None: method TAYLOR, a
     system with a batch routine, shared parameters, final states only (no t_eval, events,
     first_step or progress). A system of conmech.symbolic gets its batch library here, on
     first need: the coefficient routine and the propagator over SIMD lanes
     (conmech.symbolic.taylor_batch) with `lanes` lanes (None: the machine's vector
     width), the recurrences written out for the order of the tolerance eps when they are
-    small enough."""
+    small enough. `generalized`: the generalized system M(q) q'' = Q whose first-order
+    view `system` is (its batch library: conmech.symbolic.taylor_generalized_batch, the
+    loop version, or for a tree conmech.symbolic.taylor_tree_batch; none for more than
+    WRITE_OUT_MAX degrees of freedom: member by member)."""
     if not (isinstance(method, str) and method.upper() == "TAYLOR"):
         return None
     batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
@@ -217,6 +221,10 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
         # recurrences here, on first need (their entries then in its spec)
         getattr(system, "taylor", None)
         return None
+    if generalized is not None:
+        from .taylor_generalized import batch_entries
+        extra = batch_entries(generalized, lanes)
+        return dict(system.taylor, **extra) if extra else None
     taylor = None
     if hasattr(system, "taylor_parts"):
         # a system of conmech.symbolic compiles its Taylor recurrences here, on first
@@ -242,14 +250,19 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps):
 
 
 def _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax, max_steps,
-                        nthreads):
+                        nthreads, generalized=None, params=None):
     """The members in SIMD lanes (the generated propagator, lanes refilled as members end)
     or in batches of the coefficient routine's width (a system given a batch routine
     only), chunks of members in OpenMP threads; each member's steps are those of its
-    solve_ivp run, bit for bit."""
+    solve_ivp run, bit for bit. `generalized`: the system M(q) q'' = Q whose first-order
+    view `system` is (the message of a failed member then says what its mass matrix is
+    where it stopped). `params`: the members' shared parameters (None: the system's)."""
     n = system.dimension
     y0m = np.broadcast_to(y0a, (m, n)) if y0a.shape[0] == 1 else y0a
-    p = system.params if system.params.size else _PAD
+    if params is not None and system.params.size:
+        p = np.ascontiguousarray(params, dtype=float)
+    else:
+        p = system.params if system.params.size else _PAD
     if taylor.get("batch_run") is not None:
         (y_final, t_final, codes, nfev, naccept, nreject, info,
          message) = _conmech.flat_taylor_batch_run(
@@ -275,6 +288,10 @@ def _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax, ma
         from .._core.status import status_message
         message = (f"{int((codes < 0).sum())} of {m} members failed; the first, member "
                    f"{first}: {status_message(int(codes[first]))}")
+        if generalized is not None:
+            from .taylor_generalized import mass_note
+            message += mass_note(generalized, t_final[first], y_final[:, first],
+                                 p if system.params.size else None)
     return EnsembleResult(
         t=None, y=None, t_final=t_final, y_final=np.ascontiguousarray(y_final.T),
         status=status, member_success=status >= 0, codes=codes, nfev=nfev.astype(int),
@@ -331,7 +348,11 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         t_eval, events, first_step, progress or per-member params): members integrated
         together in this many SIMD lanes (1, 2, 4, 8 or 16; None: the machine's vector
         width for doubles, 4 with AVX2, 8 with AVX-512), each a library compiled once per
-        model. The results do not depend on it. Only with method="TAYLOR".
+        model. The results do not depend on it. Only with method="TAYLOR". An ode system,
+        a generalized system M(q) q'' = Q of up to 8 degrees of freedom
+        (conmech.symbolic.taylor_generalized_batch) and a tree
+        (conmech.symbolic.taylor_tree_batch) take this route; a generalized system of
+        more degrees of freedom runs member by member.
 
     Returns
     -------
@@ -352,10 +373,12 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
     code = _METHOD_CODES.get(method.upper(), 0)
     if code == 0:
         raise ValueError(f"method must be one of {', '.join(_METHODS)}, got {method!r}")
+    generalized = None
     if method.upper() == "TAYLOR" and getattr(system, "kind", None) == "generalized":
-        # M(q) q'' = Q made by conmech.symbolic: its first-order view (no batch routine:
-        # member by member)
+        # M(q) q'' = Q made by conmech.symbolic: its first-order view, with the batch
+        # routine of its lanes when it has one
         from .taylor_generalized import first_order_view
+        generalized = system
         system = first_order_view(system)
 
     # ---------------------------------------------------------------- t_span, y0, params
@@ -461,10 +484,11 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
 
     nt = t_ev.size
     eps = max(float(np.min(rtol_v)), 2.220446049250313e-16, float(np.min(atol_v)))
-    taylor = _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps)
+    taylor = _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps,
+                           generalized)
     if taylor is not None:
         return _solve_taylor_batch(system, taylor, t0, tf, y0a, m, rtol_v, atol_v, hmax,
-                                   int(max_steps), nthreads)
+                                   int(max_steps), nthreads, generalized, ptab[:, 0])
     name, _, _, nspec, spec = system._flat_args()
     (y_eval, t_final, y_final, codes, nfev, naccept, nreject, nev, ev_t, ev_y, ev_id, done,
      info, message) = _conmech.flat_ensemble_builtin(

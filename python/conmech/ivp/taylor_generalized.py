@@ -6,19 +6,23 @@ system whose Taylor coefficients come from the recurrences of M and Q and the li
 solve order by order (:mod:`conmech.symbolic.taylor_generalized`), or for a tree from the
 recurrences of its articulated-body code, definition by definition
 (:mod:`conmech.symbolic.taylor_tree`); compiled on first need and cached like an ode
-model's Taylor library.
+model's Taylor library. An ensemble (``ensemble.solve(method="TAYLOR")``) of the view runs
+its members in SIMD lanes through the batch routine of
+:mod:`conmech.symbolic.taylor_generalized_batch`, or of :mod:`conmech.symbolic.taylor_tree_batch`
+for a tree (:func:`batch_entries`; member by member for more than 8 degrees of freedom).
 
 :func:`first_order_view` gives the view (the same parameters; the model behind it, so that
 the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
 run's message what the mass matrix is at the last accepted point (a singular or indefinite
 M makes the coefficients non-finite, which the stepper reports as a non-finite right-hand
 side or a step size too small), and for a tree which joint's articulated inertia (the
-pivot of its articulated-body algorithm) is not positive there."""
+pivot of its articulated-body algorithm) is not positive there; :func:`mass_note` is that
+text for a given point (an ensemble's failed member)."""
 import numpy as np
 
 from .._core.model import model_of
 
-__all__ = ["first_order_view", "name_the_mass_matrix"]
+__all__ = ["first_order_view", "name_the_mass_matrix", "batch_entries", "mass_note"]
 
 
 def _model(fun):
@@ -73,19 +77,38 @@ def first_order_view(fun, *parts):
                                    base.param_names, base._keep, base.taylor)
 
 
-def name_the_mass_matrix(fun, res):
-    """`res` (a failed run of fun's first-order view) with its message completed by the
-    state of the mass matrix at the last accepted point: not positive definite there, or
-    its condition number."""
+def batch_entries(fun, lanes=None):
+    """The entries (``batch``, ``width``, ``batch_run``) of the batch library of a
+    generalized system made by conmech.symbolic (its first-order view's coefficients in
+    `lanes` SIMD lanes, None: the machine's width, and the propagator,
+    :mod:`conmech.symbolic.taylor_generalized_batch`, for a tree
+    :mod:`conmech.symbolic.taylor_tree_batch`), compiled on first need; None when it has
+    none (any other system, more than taylor_generalized.WRITE_OUT_MAX degrees of freedom:
+    the ensemble then runs member by member)."""
     model = _model(fun)
-    if model is None or res.success or res.status != -1 or not res.t.size:
-        return res
+    if model is None:
+        return None
+    from ..symbolic.taylor_library import batch_entries as library_batch
+    tay = library_batch(model, lanes)
+    return tay if tay and tay.get("batch_run") is not None else None
+
+
+def mass_note(fun, t, y, params=None):
+    """" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted point,
+    t = ..., ...)": the state of fun's mass matrix at (t, y), y = [q; v] (not finite, not
+    positive definite, or its extreme eigenvalues), with fun's parameters or `params`,
+    and for a tree its first pivot that is not positive; "" for any other system or when
+    M cannot be evaluated."""
+    model = _model(fun)
+    if model is None:
+        return ""
     n = model.derived.n
-    t, q = float(res.t[-1]), np.array(res.y[:n, -1], dtype=float)
+    y = np.array(y, dtype=float)
+    p = np.asarray(fun.params if params is None else params, dtype=float)
     try:
-        m = model.call("mass", t, q, params=np.asarray(fun.params, dtype=float))
+        m = model.call("mass", float(t), y[:n], params=p)
     except (KeyError, ValueError, TypeError, AttributeError):
-        return res
+        return ""
     m = np.array(m, dtype=float).reshape(n, n)
     if not np.all(np.isfinite(m)):
         note = "is not finite"
@@ -95,24 +118,34 @@ def name_the_mass_matrix(fun, res):
             note = f"has smallest eigenvalue {ev[0]:.3g} and largest {ev[-1]:.3g}"
         else:
             note = "is not positive definite (singular or indefinite)"
-    res.message = (f"{res.message} (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at "
-                   f"the last accepted point, t = {t:.6g}, {note}{_pivots(model, res, fun)})")
+    return (f" (method TAYLOR on M(q) q'' = Q: the mass matrix M(q) at the last accepted "
+            f"point, t = {float(t):.6g}, {note}{_pivots(model, float(t), y, p)})")
+
+
+def name_the_mass_matrix(fun, res):
+    """`res` (a failed run of fun's first-order view) with its message completed by the
+    state of the mass matrix at the last accepted point: not positive definite there, or
+    its condition number."""
+    model = _model(fun)
+    if model is None or res.success or res.status != -1 or not res.t.size:
+        return res
+    note = mass_note(fun, res.t[-1], res.y[:, -1])
+    if note:
+        res.message = f"{res.message}{note}"
     return res
 
 
-def _pivots(model, res, fun):
+def _pivots(model, t, y, p):
     """For a tree: "; the articulated inertia of the joint of body 'b' is x, not
     positive ..." for the first pivot of its articulated-body algorithm that is not
-    positive at the last accepted point (empty if none is)."""
+    positive at (t, y), the last accepted point (empty if none is)."""
     from ..symbolic.taylor_tree import is_tree, pivot_values
     d = model.derived
     if not is_tree(d):
         return ""
     n = d.n
-    y = np.array(res.y[:, -1], dtype=float)
     try:
-        vals = pivot_values(d, float(res.t[-1]), y[:n], y[n:2*n],
-                            np.asarray(fun.params, dtype=float))
+        vals = pivot_values(d, t, y[:n], y[n:2*n], p)
     except (ValueError, TypeError, AttributeError):
         return ""
     # the first in the chain's order (leaves first): the pivots of its ancestors are then

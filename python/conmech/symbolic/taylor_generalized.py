@@ -27,7 +27,9 @@ The routine has the signature and the work-array convention of an ode system's
 ``conmech_taylor(t, order, w, p)`` (w(0:order, nw), the state in the columns 1..2n), so the
 Taylor stepper, the dense output and the step control run on it unchanged; the library
 also exports ``conmech_taylor_rhs(t, y, dydt, p)`` (f = [v; M^-1 Q] from the order-1
-expansion), the first-order right-hand side of the stepper's view of the system.
+expansion), the first-order right-hand side of the stepper's view of the system. The same
+statements with a vector of SIMD lanes for every per-member value are the batch routine of
+ensembles (:mod:`conmech.symbolic.taylor_generalized_batch`).
 """
 import sympy as sp
 
@@ -310,9 +312,9 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
 def generalized_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a generalized model's Taylor
     library (conmech.symbolic.taylor_library): the core and the quadruple precision one
-    (``qp``); the batch part is not generated for generalized systems (the variational
-    part: conmech.symbolic.taylor_generalized_var.variational_lines; a tree's parts:
-    conmech.symbolic.taylor_tree).
+    (``qp``) (the batch part: conmech.symbolic.taylor_generalized_batch.batch_lines; the
+    variational part: conmech.symbolic.taylor_generalized_var.variational_lines; a tree's
+    parts: conmech.symbolic.taylor_tree).
     """
     npar = max(len(d.params), 1)
     if part == "qp":

@@ -38,9 +38,9 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 5     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
+_FORMAT = 6     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
                 # 4: the variational and quadruple-precision parts of generalized models,
-                # 5: those of trees)
+                # 5: those of trees, 6: the batch part of generalized models and trees)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -125,10 +125,22 @@ def _lines(d, part, dec_cache):
             if part == "var":
                 from .taylor_tree_var import tree_variational_lines
                 return tree_variational_lines(d, names, dec_cache)
+            if _lanes(part) is not None:     # the ode systems' lanes, the pivots per lane
+                from .._core import status as S
+                from .taylor_tree_batch import tree_batch_lines
+                return tree_batch_lines(d, names, _lanes(part), _fixed_order(part),
+                                        dec_cache, (S.SUCCESS, S.TOO_MANY_STEPS,
+                                                    S.STEP_TOO_SMALL, S.NONFINITE))
             return tree_lines(d, names, part, dec_cache)
         if part == "var":
             from .taylor_generalized_var import variational_lines
             return variational_lines(d, names, dec_cache)
+        if _lanes(part) is not None:     # the lanes through the written-out factorisation
+            from .._core import status as S
+            from .taylor_generalized_batch import batch_lines
+            return batch_lines(d, names, _lanes(part), _fixed_order(part), dec_cache,
+                               (S.SUCCESS, S.TOO_MANY_STEPS, S.STEP_TOO_SMALL,
+                                S.NONFINITE))
         from .taylor_generalized import generalized_lines
         return generalized_lines(d, names, part, dec_cache)
     if "f" not in dec_cache:
@@ -171,10 +183,13 @@ def taylor_source(d, part="core", _dec=None):
     ``conmech_taylor_batch``, ``qp`` ``conmech_taylor_qp``, ``var``
     ``conmech_taylor_var`` and ``_var_info``, the routines a model library with Taylor
     code holds. A generalized record M(q) q'' = Q has the core, with
-    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the quadruple
+    ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the batch part
+    for its first-order view (:mod:`conmech.symbolic.taylor_generalized_batch`, the loop
+    version, up to taylor_generalized.WRITE_OUT_MAX degrees of freedom), the quadruple
     precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
-    a tree the same three through its articulated-body chain
-    (:mod:`conmech.symbolic.taylor_tree`, :mod:`conmech.symbolic.taylor_tree_var`). (None, [],
+    a tree the same four through its articulated-body chain
+    (:mod:`conmech.symbolic.taylor_tree`, :mod:`conmech.symbolic.taylor_tree_batch`,
+    :mod:`conmech.symbolic.taylor_tree_var`). (None, [],
     reason) when f has no Taylor recurrences (a non-smooth expression)."""
     if part not in PARTS and _lanes(part) is None:
         raise ValueError(f"part must be one of {', '.join(PARTS)} or batchK (K lanes), "
@@ -329,8 +344,15 @@ def batch_entries(model, lanes, order=None):
     `order` when given and small enough (FIXED_MAX_TERMS), else the loop version. Built
     once per model, lanes and order, under a lock; None when f has no Taylor recurrences
     (or, for the machine's lanes in the loop version, which is the lazy part "batch" of
-    the model's systems: ask the system)."""
+    the model's systems: ask the system). A generalized model M(q) q'' = Q has the loop
+    version only, for any lanes (:mod:`conmech.symbolic.taylor_generalized_batch`, a tree's
+    :mod:`conmech.symbolic.taylor_tree_batch`): its entries, or None with the reason in
+    ``model._taylor_parts[part]`` (more than taylor_generalized.WRITE_OUT_MAX degrees of
+    freedom, no recurrences)."""
     part = batch_part(lanes)
+    if getattr(model.derived, "kind", None) == "generalized":
+        with _BATCH_LOCK:
+            return taylor_library(model, part)
     if order is not None:
         dec = _decomposition(model)
         if dec is not None:

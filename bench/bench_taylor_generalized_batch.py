@@ -1,0 +1,115 @@
+"""Taylor ensembles of a generalized system M(q) q'' = Q in SIMD lanes: conmech.ensemble.solve
+(method="TAYLOR") on the double pendulum from its Lagrangian (symbolic.lagrangian_system),
+the batch route (conmech.symbolic.taylor_generalized_batch: the coefficients of the
+first-order view for several members at once, the written-out Cholesky factorisation of M
+per lane, the ode systems' lane propagator) against the member-by-member route (the scalar
+Taylor stepper on the first-order view, one member after another: the same call with the
+parameter g given per member, which the batch route does not take), in one run.
+
+Problem: m double pendulums (unit masses and rods, g = 9.81), initial angles uniform in
+[-1, 1] and angular velocities in [-0.5, 0.5] (seeded), integrated over [0, T] at rtol =
+atol = tol. ``--system chain3``: a planar tree of 3 point masses on rods instead
+(symbolic.planar_tree, its articulated-body chain: conmech.symbolic.taylor_tree_batch). Both routes give each member the steps and the final state of its own
+solve_ivp(method="TAYLOR") run, bit for bit (checked here). Best of `--repeat` rounds, the
+routes interleaved within a round; the machine's load (uptime) before and after.
+
+    python bench/bench_taylor_generalized_batch.py [--m 2000] [--T 10] [--tol 1e-12]
+        [--threads 1 2] [--repeat 3] [--system double_pendulum|chain3]
+"""
+import argparse
+import os
+import time
+
+import numpy as np
+import sympy as sp
+from sympy.physics.mechanics import dynamicsymbols
+
+from conmech import ensemble, symbolic
+
+
+def double_pendulum():
+    t = dynamicsymbols._t
+    a, b = dynamicsymbols("a b")
+    g = sp.Symbol("g")
+    ad, bd = a.diff(t), b.diff(t)
+    T = ad**2 + ad*bd*sp.cos(a - b) + bd**2/2
+    U = -g*(2*sp.cos(a) + sp.cos(b))
+    return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
+
+
+def chain3():
+    """3 point masses on rods pinned at the origin, absolute angles (a planar tree)."""
+    th = dynamicsymbols("th1:4")
+    m, ell = sp.symbols("m1:4"), sp.symbols("l1:4")
+    g = sp.Symbol("g")
+    bodies = [symbolic.Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute",
+                            th[i], at=(0, 0) if i == 0 else (0, -ell[i - 1]), mass=m[i],
+                            com=(0, -ell[i])) for i in range(3)]
+    params = {**{s: 0.8 + 0.15*i for i, s in enumerate(m)},
+              **{s: 1.1 - 0.05*i for i, s in enumerate(ell)}, g: 9.81}
+    return symbolic.planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute")
+
+
+def load():
+    return os.getloadavg()[0]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--m", type=int, default=2000)
+    ap.add_argument("--T", type=float, default=10.0)
+    ap.add_argument("--tol", type=float, default=1e-12)
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--lanes", type=int, nargs="+", default=[None])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--system", choices=["double_pendulum", "chain3"],
+                    default="double_pendulum")
+    args = ap.parse_args()
+    system = double_pendulum() if args.system == "double_pendulum" else chain3()
+    nq = 2 if args.system == "double_pendulum" else 3
+    rng = np.random.default_rng(7)
+    m = args.m
+    y0 = np.column_stack([rng.uniform(-1.0, 1.0, (m, nq)),
+                          rng.uniform(-0.5, 0.5, (m, nq))])
+    span = (0.0, args.T)
+    kw = dict(method="TAYLOR", rtol=args.tol, atol=args.tol)
+    per_member_g = {"g": np.full(m, 9.81)}      # the same value: the member route
+    # build both routes' libraries before the timed runs
+    ensemble.solve(system, span, y0[:8], **kw)
+    for lanes in args.lanes:
+        ensemble.solve(system, span, y0[:8], lanes=lanes, **kw)
+    ensemble.solve(system, span, y0[:8], params={"g": np.full(8, 9.81)}, **kw)
+    print(f"{args.system}, {m} members over [0, {args.T:g}] at tol {args.tol:g}; "
+          f"load before {load():.2f}")
+    for threads in args.threads:
+        best = {}
+        out = {}
+        for _ in range(args.repeat):
+            for lanes in args.lanes:
+                key = f"batch (lanes {lanes or 'machine'})"
+                t0 = time.perf_counter()
+                out[key] = ensemble.solve(system, span, y0, lanes=lanes, threads=threads,
+                                          **kw)
+                best[key] = min(best.get(key, np.inf), time.perf_counter() - t0)
+            key = "member by member"
+            t0 = time.perf_counter()
+            out[key] = ensemble.solve(system, span, y0, params=per_member_g,
+                                      threads=threads, **kw)
+            best[key] = min(best.get(key, np.inf), time.perf_counter() - t0)
+        ref = out["member by member"]
+        assert ref.success
+        for key, r in out.items():
+            same = np.array_equal(r.y_final, ref.y_final) and \
+                np.array_equal(r.nfev, ref.nfev)
+            print(f"  threads {threads}  {key:24s} {m/best[key]:10,.0f} members/s  "
+                  f"({best[key]:.3f} s; median steps {int(np.median(r.naccept))}; "
+                  f"bits as member by member: {same})")
+        base = m/best["member by member"]
+        for key in out:
+            if key != "member by member":
+                print(f"  threads {threads}  {key}: {m/best[key]/base:.2f}x member by member")
+    print(f"load after {load():.2f}")
+
+
+if __name__ == "__main__":
+    main()
