@@ -149,7 +149,8 @@ def tree_lines(d, names, part, dec_cache):
     """(Fortran lines, entry names, reason) of one part of a tree model's Taylor library
     (:mod:`conmech.symbolic.taylor_library`): the core and the quadruple precision part
     (``qp``); the variational part is :mod:`conmech.symbolic.taylor_tree_var`'s
-    (``tree_variational_lines``), and the batch part is not generated for trees."""
+    (``tree_variational_lines``), the batch part
+    :mod:`conmech.symbolic.taylor_tree_batch`'s (``tree_batch_lines``)."""
     if part == "var":
         raise ValueError("the variational part of a tree: "
                          "conmech.symbolic.taylor_tree_var.tree_variational_lines")
