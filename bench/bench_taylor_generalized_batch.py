@@ -18,6 +18,7 @@ routes interleaved within a round; the machine's load (uptime) before and after.
 """
 import argparse
 import os
+import sys
 import time
 
 import numpy as np
@@ -26,15 +27,9 @@ from sympy.physics.mechanics import dynamicsymbols
 
 from conmech import ensemble, symbolic
 
-
-def double_pendulum():
-    t = dynamicsymbols._t
-    a, b = dynamicsymbols("a b")
-    g = sp.Symbol("g")
-    ad, bd = a.diff(t), b.diff(t)
-    T = ad**2 + ad*bd*sp.cos(a - b) + bd**2/2
-    U = -g*(2*sp.cos(a) + sp.cos(b))
-    return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python",
+                                "tests"))
+from taylor_jets import double_pendulum  # noqa: E402  (the tests' double pendulum)
 
 
 def chain3():

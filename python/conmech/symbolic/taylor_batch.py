@@ -40,10 +40,22 @@ from .taylor_recipe import Recipe
 #: the version of the generated batch code (a change regenerates the kept sources)
 VERSION = 8
 
-__all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_routine",
+__all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_head",
+           "coefficient_routine",
            "run_routine", "LANES"]
 
 _LANE_NAMES = re.compile(r"\b(h\d+|iv\d+|t)\b(?!\()")
+
+
+def coefficient_head(cname, lanes, nw, npar, ind):
+    """The first lines of a batch coefficient routine ``cname(t, order, w, p)`` (bind(C)):
+    `lanes` members, t(nl), w(nl, 0:order, nw), p(npar); `ind` the body's indentation."""
+    return [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
+            f"{ind}integer, parameter :: nl = {lanes}",
+            f"{ind}real(dp), intent(in) :: t(nl)",
+            f"{ind}integer(c_int), value, intent(in) :: order",
+            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
+            f"{ind}real(dp), intent(in) :: p({npar})"]
 
 
 def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
@@ -73,12 +85,7 @@ def coefficient_routine(dec, names, lanes, cname="conmech_taylor_batch"):
     zero = f"0.0_{kind}"
     nw = dec.ncol
     npar = max(len(dec.params), 1)
-    head = [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
-            f"{ind}integer, parameter :: nl = {lanes}",
-            f"{ind}real(dp), intent(in) :: t(nl)",
-            f"{ind}integer(c_int), value, intent(in) :: order",
-            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
-            f"{ind}real(dp), intent(in) :: p({npar})"]
+    head = coefficient_head(cname, lanes, nw, npar, ind)
     decl = T._decls([c for c, _ in rc.consts], f"real({kind})", ind)
     decl += T._decls([f"{x}(nl)" for x in rc.accs + rc.invs], f"real({kind})", ind)
     decl += [f"{ind}real({kind}) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]

@@ -30,7 +30,7 @@ import re
 
 from .taylor import _decls, _wrap
 from .taylor_generalized import WRITE_OUT_MAX, generalized_decomposition, generalized_body
-from .taylor_batch import machine_lanes, run_routine
+from .taylor_batch import coefficient_head, machine_lanes, run_routine
 
 __all__ = ["batch_lines", "coefficient_routine"]
 
@@ -147,12 +147,7 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
         assignment(at, s)
     flush()
     nw = g.ncol
-    head = [f'    subroutine {cname}(t, order, w, p) bind(C, name="{cname}")',
-            f"{ind}integer, parameter :: nl = {lanes}",
-            f"{ind}real(dp), intent(in) :: t(nl)",
-            f"{ind}integer(c_int), value, intent(in) :: order",
-            f"{ind}real(dp), intent(inout) :: w(nl, 0:order, {nw})",
-            f"{ind}real(dp), intent(in) :: p({npar})"]
+    head = coefficient_head(cname, lanes, nw, npar, ind)
     decls = _decls(consts, "real(dp)", ind)
     decls += _decls([f"{x}(nl)" for x in lane], "real(dp)", ind)
     decls += [f"{ind}real(dp) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
