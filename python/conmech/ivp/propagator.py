@@ -125,8 +125,9 @@ class Propagator:
         return (run_fun,) + prep[1:4] + (rpar,) + prep[5:]
 
     def propagate_until(self, t):
-        """Integrate from ``self.t`` to ``t`` (either direction); a :data:`Propagation`.
-        On success ``self.t`` and ``self.y`` are the new time and state; on a failure
+        """Integrate from ``self.t`` to ``t`` (either direction). Returns a
+        ``conmech.Propagation`` named tuple (success, status, message, nfev, naccept,
+        nreject: the run's evaluations and steps). On success ``self.t`` and ``self.y`` are the new time and state; on a failure
         (too many steps, a step size below round-off, a non-finite right-hand side)
         they stay as they were and the result's message says what stopped the run."""
         if not (type(t) is float or type(t) is int):
