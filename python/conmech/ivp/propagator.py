@@ -29,9 +29,11 @@ from .._core.checks import initial_state, positive_finite, real_scalar, step_con
     step_limit
 from .._core.native import NativeSystem
 from .._core.status import BAD_INPUT
-from .methods import BY_NAME, RK45_SCIPY
+from .methods import BY_NAME
 from .native_path import _PAD, prepare
+from .result import _MESSAGES
 from .solve import solve_ivp
+from .solve_fast import fast_method_code
 from .taylor import with_fixed_order
 from .taylor_generalized import first_order_view
 
@@ -101,13 +103,11 @@ class Propagator:
         """The packed arguments of the one-call route (native_path.prepare with one
         output time, its last number in rpar), or None where solve_ivp takes another
         route for this system and method."""
-        upper = method.upper()
-        info = BY_NAME.get(upper)
-        if info is None or info.fixed_step or info.constrained_only:
+        code = fast_method_code(method)     # 0: a method the one-call route does not take
+        if not code:
             return None
-        code = RK45_SCIPY if upper == "RK45" else info.code
         run_fun = fun
-        if info is BY_NAME.get("TAYLOR"):
+        if code == BY_NAME["TAYLOR"].code:
             if getattr(fun, "taylor", None):
                 run_fun = with_fixed_order(fun, rtol, atol)
             elif getattr(fun, "kind", None) == "generalized":
@@ -127,17 +127,17 @@ class Propagator:
     def propagate_until(self, t):
         """Integrate from ``self.t`` to ``t`` (either direction). Returns a
         ``conmech.Propagation`` named tuple (success, status, message, nfev, naccept,
-        nreject: the run's evaluations and steps). On success ``self.t`` and ``self.y`` are the new time and state; on a failure
-        (too many steps, a step size below round-off, a non-finite right-hand side)
-        they stay as they were and the result's message says what stopped the run."""
+        nreject: the run's evaluations and steps). On success ``self.t`` and ``self.y``
+        are the new time and state; on a failure (too many steps, a step size below
+        round-off, a non-finite right-hand side) they stay as they were and the result's
+        message says what stopped the run."""
         if not (type(t) is float or type(t) is int):
             t = real_scalar(t, "t")
         t = float(t)
         if not math.isfinite(t):
             raise ValueError(f"t must be finite, got {t}")
         if t == self.t:
-            return Propagation(True, 0, "The solver successfully reached the end of the "
-                               "integration interval.", 0, 0, 0)
+            return Propagation(True, 0, _MESSAGES[0], 0, 0, 0)
         packed = self._packed
         if packed is not None and packed[1] is packed[0].params and \
                 packed[2] is packed[0].spec:
@@ -170,8 +170,7 @@ class Propagator:
             raise ValueError(message_text(iout[8:]))
         if info >= 0 and nt == 1:
             self.t, self.y = t, out[1:n + 1]
-            return Propagation(True, 0, "The solver successfully reached the end of the "
-                               "integration interval.", nfev, naccept, nreject)
+            return Propagation(True, 0, _MESSAGES[0], nfev, naccept, nreject)
         return Propagation(False, min(info, -1), message_text(iout[8:]), nfev, naccept,
                            nreject)
 
