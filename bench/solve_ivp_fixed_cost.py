@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Wall clock of solve_ivp's fixed cost, in one process: the symbolic Kepler system (zero
-span and one period at 1e-12, DOP853 and TAYLOR), the built-in Kepler system over a short
-span, and a Python right-hand side against SciPy's solve_ivp (zero span and (0, 0.1),
+span and one period at 1e-12, DOP853 and TAYLOR; one period with t_eval = [T] and with
+max_steps, through the fast entry and through the full checks, which np.float64 tolerances
+take), the built-in Kepler system over a short span, and a Python right-hand side against SciPy's solve_ivp (zero span and (0, 0.1),
 DOP853 and RK45). Each figure is the minimum over 7 batches (us per call); run it on a
 quiet machine and give `uptime` beside the figures.
 
@@ -10,6 +11,7 @@ quiet machine and give `uptime` beside the figures.
 import math
 import time
 
+import numpy as np
 import scipy.integrate as si
 import sympy as sp
 
@@ -46,6 +48,16 @@ def main():
                                                 rtol=1e-12, atol=1e-12), 200)
         print(f"{m} symbolic Kepler zero span {zero:.1f} us, one period at 1e-12 "
               f"{period:.1f} us")
+        T = 2*math.pi
+        for label, opts in [("t_eval=[T]", dict(t_eval=[T])),
+                            ("max_steps=10**6", dict(max_steps=10**6))]:
+            fast = tmin(lambda: conmech.solve_ivp(kep, (0, T), y0, method=m, rtol=1e-12,
+                                                  atol=1e-12, **opts), 200)
+            full = tmin(lambda: conmech.solve_ivp(kep, (0, T), y0, method=m,
+                                                  rtol=np.float64(1e-12),
+                                                  atol=np.float64(1e-12), **opts), 200)
+            print(f"{m} symbolic Kepler one period, {label}: {fast:.1f} us "
+                  f"(full checks {full:.1f} us)")
     bk = conmech.systems.kepler()
     short = tmin(lambda: conmech.solve_ivp(bk, (0, 0.01), [0.5, 0, 0, 3**0.5],
                                            method="DOP853"))

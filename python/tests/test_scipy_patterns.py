@@ -190,6 +190,42 @@ def test_tests_events_with_t_eval_and_no_events_found():
     assert b.y_events[0].shape == a.y_events[0].shape == (0,)
 
 
+def test_terminal_count_with_t_eval_before_the_events():
+    # the run restarts after the first of two terminal occurrences with no t_eval point
+    # left: t holds t_eval's points only (no step of the later part), as SciPy's
+    def cross(t, y):
+        return y[0]
+    cross.terminal = 2
+    a, b = both(lambda t, y: [y[1], -y[0]], [0, 10], [1.0, 0.0], events=cross,
+                t_eval=[0.1, 0.5], rtol=1e-10, atol=1e-10)
+    assert a.status == b.status == 1
+    np.testing.assert_array_equal(b.t, a.t)
+    np.testing.assert_allclose(b.y, a.y, rtol=1e-8)
+    np.testing.assert_allclose(b.t_events[0], a.t_events[0], rtol=1e-9)
+
+
+@pytest.mark.parametrize("kw", [dict(), dict(method="DOP853"), dict(dense_output=True),
+                                dict(events=lambda t, y: y[0] - 0.5), dict(t_span=(1, 1)),
+                                dict(y0=[1.0 + 1.0j])])
+def test_empty_t_eval_gives_empty_lists(kw):
+    # t_eval=[]: the span is integrated (events, dense output, counts) and t, y are the
+    # empty lists SciPy returns, for a Python right-hand side and a compiled system
+    args = dict(t_span=(0, 2), y0=[1.0])
+    args.update(kw)
+    t_span, y0 = args.pop("t_span"), args.pop("y0")
+    a, b = both(exponential_decay, t_span, y0, t_eval=[], **args)
+    assert a.t == b.t == [] and a.y == b.y == []
+    assert a.status == b.status == 0
+    if "events" in kw:
+        np.testing.assert_allclose(b.t_events[0], a.t_events[0], rtol=1e-3)
+    if "dense_output" in kw:
+        np.testing.assert_allclose(b.sol(1.0), a.sol(1.0), rtol=1e-3)
+    sys = conmech.systems.harmonic()
+    for opts in [dict(rtol=1e-6), dict(rtol=np.float64(1e-6)), dict(dense_output=True)]:
+        r = conmech.solve_ivp(sys, t_span, [1.0, 0.0], t_eval=[], **opts)
+        assert r.t == [] and r.y == [] and r.success
+
+
 def test_tests_ode_solution_attributes():
     a, b = both(exponential_decay, [0, 10], [2, 4, 8], dense_output=True)
     sa, sb = a.sol, b.sol

@@ -144,3 +144,88 @@ def test_prepared_call_reads_the_systems_parameters(counted):
     _same(r2, ref[2.0])
     _same(r3, ref[1.0])
     assert not np.array_equal(r1.y, r2.y)
+
+
+_TEV = [0.25, 1.0, 1.5, 2.75]
+
+
+@pytest.mark.parametrize("span, opts", [
+    ((0.0, 3.0), dict(t_eval=_TEV)),
+    ((0.0, 3.0), dict(t_eval=tuple(_TEV))),
+    ((0.0, 3.0), dict(t_eval=np.array(_TEV))),
+    ((0.0, 3.0), dict(t_eval=np.linspace(0.0, 3.0, 101))),     # the array checks
+    ((0.0, 3.0), dict(t_eval=[0, 1, 3])),                       # ints, both ends
+    ((0.0, 3.0), dict(t_eval=[])),                              # no point: SciPy's lists
+    ((3.0, 0.5), dict(t_eval=[2.5, 1.0, 0.5])),                 # backwards
+    ((3.0, 0.0), dict(t_eval=np.linspace(3.0, 0.0, 40))),
+    ((0.0, 3.0), dict(first_step=1e-3)),
+    ((0.0, 3.0), dict(first_step=3)),                           # the whole span
+    ((0.0, 3.0), dict(max_step=0.05)),
+    ((0.0, 3.0), dict(max_step=1)),
+    ((0.0, 3.0), dict(max_steps=5)),                            # stops: status -1
+    ((0.0, 3.0), dict(max_steps=10**6, max_step=0.5, first_step=0.01, t_eval=_TEV)),
+])
+@pytest.mark.parametrize("method", ["DOP853", "RK45", "Radau"])
+def test_fast_options_equal_full_path(counted, span, opts, method):
+    # t_eval, first_step, max_step and max_steps of plain kinds take the fast entry and
+    # give the full path's result bit for bit (np.float64 tolerances: the full checks)
+    kep = conmech.systems.kepler()
+    fast = conmech.solve_ivp(kep, span, Y0, method=method, rtol=1e-9, atol=1e-10, **opts)
+    assert len(counted) == 1
+    full = conmech.solve_ivp(kep, span, Y0, method=method, rtol=np.float64(1e-9),
+                             atol=np.float64(1e-10), **opts)
+    assert len(counted) == 1
+    _same(fast, full)
+    if "t_eval" in opts:
+        assert list(fast.t) == [float(t) for t in opts["t_eval"]]
+    if opts.get("max_steps") == 5:
+        assert fast.status == -1 and not fast.success and "max_steps" in fast.message
+    else:
+        assert fast.success
+
+
+def test_fast_t_eval_taylor_symbolic(counted):
+    # method TAYLOR on a symbolic system with output times: its polynomial at each time
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    x, y, u, v = sp.symbols("x y u v")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    kep = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+    t_eval = np.linspace(0.0, 2*np.pi, 7)
+    fast = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method="TAYLOR", t_eval=t_eval,
+                             rtol=1e-12, atol=1e-12)
+    full = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method="TAYLOR", t_eval=t_eval,
+                             rtol=np.float64(1e-12), atol=np.float64(1e-12))
+    assert len(counted) == 1
+    _same(fast, full)
+    ref = conmech.solve_ivp(conmech.systems.kepler(), (0.0, 2*np.pi), Y0, method="DOP853",
+                            t_eval=t_eval, rtol=1e-13, atol=1e-13)
+    assert np.max(np.abs(fast.y - ref.y)) < 1e-9
+
+
+@pytest.mark.parametrize("kw, exc, text", [
+    (dict(t_eval=[0.5, 2.0]), ValueError, "not within t_span"),
+    (dict(t_eval=[-0.5, 0.5]), ValueError, "not within t_span"),
+    (dict(t_eval=[0.5, 0.25]), ValueError, "not properly sorted"),
+    (dict(t_eval=[0.5, 0.5]), ValueError, "not properly sorted"),
+    (dict(t_eval=[0.5, math.nan]), ValueError, "NaN or Inf"),
+    (dict(t_eval=np.linspace(0.0, 2.0, 50)), ValueError, "not within t_span"),
+    (dict(t_eval=np.linspace(1.0, 0.0, 50)), ValueError, "not properly sorted"),
+    (dict(t_eval=np.zeros((2, 2))), ValueError, "1-dimensional"),
+    (dict(t_eval=["a"]), TypeError, "t_eval must be an array of real numbers"),
+    (dict(first_step=2.0), ValueError, "first_step exceeds the length of t_span"),
+    (dict(first_step=-0.1), ValueError, "first_step must be a positive"),
+    (dict(first_step=math.nan), ValueError, "first_step must be a positive"),
+    (dict(max_step=0.0), ValueError, "max_step must be a positive"),
+    (dict(max_step=math.nan), ValueError, "max_step must be a positive"),
+    (dict(max_steps=0), ValueError, "max_steps must be positive"),
+    (dict(max_steps=2**31), ValueError, "max_steps must be positive"),
+    (dict(max_steps=1.5), TypeError, "max_steps must be None or an integer"),
+    (dict(max_steps=True), TypeError, "max_steps must be None or an integer"),
+])
+def test_bad_options_keep_their_messages(counted, kw, exc, text):
+    kep = conmech.systems.kepler()
+    with pytest.raises(exc) as info:
+        conmech.solve_ivp(kep, (0.0, 1.0), Y0, method="DOP853", rtol=1e-6, atol=1e-8, **kw)
+    assert text in str(info.value)
+    assert not counted

@@ -45,6 +45,20 @@ def prepare(fun, code, rtol, atol, h0, hmax, max_steps, t_ev=None):
     return fun, params, spec, ipack, rpar, n, name
 
 
+def with_options(prep, h0, hmax, max_steps, t_ev=None):
+    """The packed arguments ``prep`` (:func:`prepare`, packed without step options or
+    output times) with the first step h0 (0.0: the method's choice), the largest step
+    hmax, the step limit and the output times t_ev (a sequence of floats, or None: every
+    step): copies of its two packs, the rest shared."""
+    fun, params, spec, ipack, rpar, n, name = prep
+    ipack = ipack.copy()
+    ipack[3] = max_steps
+    ipack[4] = 0 if t_ev is None else len(t_ev)
+    ipack[5] = t_ev is not None
+    rpar = np.concatenate([[h0, hmax], rpar[2:2 + 2*n], t_ev if ipack[4] else _PAD])
+    return fun, params, spec, ipack, rpar, n, name
+
+
 def run(prep, t0, tf, y0, cap=0):
     """The OdeResult of one run of flat_solve_packed with the packed arguments ``prep``
     (:func:`prepare`) from ``y0`` (n finite numbers: an array, list or tuple) over
@@ -122,8 +136,10 @@ def solve_callable(rhs, guard, n, t0, tf, y0, t_ev, with_t_eval, code, rtol, ato
     iout = np.zeros(40, dtype=_INT64)
     _conmech.flat_solve_rhs_packed(rhs, ipar, rpar, t0, tf, y0, out, iout)
     res = _result(out, iout, n, guard)
-    if with_t_eval and res.t.size == 0:
-        res.t, res.y = [], []   # SciPy's lists when no point of t_eval was reached
+    if with_t_eval and (res.t.size == 0 or not neval):
+        # SciPy's lists when no point of t_eval was reached, or t_eval is empty (the
+        # flat call's neval = 0 stores every step)
+        res.t, res.y = [], []
     return res
 
 
@@ -136,6 +152,6 @@ def solve_native(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax,
     prep = prepare(fun, code, rtol, atol, h0, hmax, max_steps,
                    t_ev if with_t_eval else None)
     res = run(prep, t0, tf, y0, max(t_ev.size, 2) if with_t_eval else 0)
-    if with_t_eval and res.t.size == 0:
-        res.t, res.y = [], []   # SciPy's lists when no point of t_eval was reached
+    if with_t_eval and (res.t.size == 0 or not t_ev.size):
+        res.t, res.y = [], []   # as solve_callable's
     return res

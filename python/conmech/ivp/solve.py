@@ -182,13 +182,12 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         or an event function reaches the caller unchanged.
     """
     if (type(rtol) is float and type(atol) is float and type(method) is str and args is None
-            and t_eval is None and events is None and dense_output is False
-            and vectorized is False and jac is None and not options and first_step is None
-            and max_steps is None and type(max_step) is float and max_step == math.inf
-            and isinstance(fun, NativeSystem)):
-        # the most frequent call, with plain inputs: checked with the cheapest tests of the
-        # same rules (None: an input of another kind or a bad one, checked below)
-        res = _fast_solve(fun, t_span, y0, method, rtol, atol, _TAYLOR, with_fixed_order)
+            and events is None and dense_output is False and vectorized is False
+            and jac is None and not options and isinstance(fun, NativeSystem)):
+        # the most frequent calls, with plain inputs: checked with the cheapest tests of
+        # the same rules (None: an input of another kind or a bad one, checked below)
+        res = _fast_solve(fun, t_span, y0, method, rtol, atol, _TAYLOR, with_fixed_order,
+                          t_eval, first_step, max_step, max_steps)
         if res is not None:
             return res
     # ---------------------------------------------------------------- fun and args
@@ -360,6 +359,10 @@ def _solve(problem, common, h0, jac, pattern):
         ev_term = np.array([int(r > 0) for r in remaining], dtype=np.intc) if ne else _PADI
         out = run.call(t_cur, tf, y_cur, t_ev_cur, h0 if first_seg else 0.0, ev_dir,
                        ev_term, ev_res, common)
+        if with_t_eval and not t_ev_cur.size:
+            # no output time in this segment (the flat call's neval = 0 stores every
+            # step): no point
+            out["t"], out["y"] = out["t"][:0], out["y"][:, :0]
         stop_at_start = isinstance(run.guard.error, _StopAtStart)
         if stop_at_start:
             run.guard.error = None

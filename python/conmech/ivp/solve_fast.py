@@ -1,19 +1,21 @@
-"""The fast entry of :func:`conmech.solve_ivp` for its most frequent call: a built-in or
+"""The fast entry of :func:`conmech.solve_ivp` for its most frequent calls: a built-in or
 compiled system, a method named by a string, float tolerances, a span and a state of
-plain floats, and none of the options that call back into Python (events, t_eval, dense
-output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
+plain floats, optionally ``t_eval`` (a list, tuple or float array of times), ``first_step``,
+``max_step`` and ``max_steps``, and none of the options that call back into Python (events,
+dense output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
 same rules (type tests on Python scalars and lists, no NumPy conversion to find a type)
 and goes to the one-call native path with arguments packed once per system, method and
-tolerances; any input outside these kinds, or one that breaks a rule, returns None and
-the full checks of solve_ivp run, with their messages. The result is the one the full
-path gives (the same Fortran call with the same arrays)."""
+tolerances (the step options and the output times are written into a copy of them); any
+input outside these kinds, or one that breaks a rule, returns None and the full checks of
+solve_ivp run, with their messages. The result is the one the full path gives (the same
+Fortran call with the same numbers)."""
 import math
 
 import numpy as np
 
 from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR, _warn_rtol
 from .methods import BY_NAME, RK45_SCIPY
-from .native_path import prepare, run as run_native
+from .native_path import prepare, run as run_native, with_options
 
 __all__ = ["fast_solve", "fast_method_code"]
 
@@ -74,15 +76,17 @@ def _state(y0, n):
     return None
 
 
-def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
-    """The result of solve_ivp(fun, t_span, y0, method, rtol=rtol, atol=atol) for a
-    NativeSystem ``fun``, float ``rtol``/``atol`` and a string ``method``, when every
-    input is of a plain kind and valid; None otherwise (the caller runs the full checks).
+def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
+               t_eval=None, first_step=None, max_step=math.inf, max_steps=None):
+    """The result of solve_ivp(fun, t_span, y0, method, t_eval, rtol=rtol, atol=atol,
+    first_step=first_step, max_step=max_step, max_steps=max_steps) for a NativeSystem
+    ``fun``, float ``rtol``/``atol`` and a string ``method``, when every input is of a
+    plain kind and valid; None otherwise (the caller runs the full checks).
     ``taylor_system(fun, rtol, atol)`` gives the system method TAYLOR runs (its
     recurrences written out for the tolerances' order), ``taylor_code`` that method's
     code. The packed arguments of the flat call are kept per system, method and
-    tolerances (the last _KEEP), so that a repeated call checks only the span and the
-    state."""
+    tolerances (the last _KEEP), so that a repeated call checks only the span, the state
+    and the options it gives."""
     if type(t_span) is tuple or type(t_span) is list:
         if len(t_span) != 2:
             return None
@@ -109,9 +113,77 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system):
         _PREPARED[key] = prep
     elif _state(y0, prep[6]) is None:
         return None
+    if t_eval is None and first_step is None and max_steps is None and max_step == math.inf:
+        if rtol < RTOL_FLOOR:
+            _warn_rtol(4)       # SciPy's warning, at the user's call (Fortran raises rtol)
+        return run_native(prep[1:], t0, tf, y0)
+    steps = _step_options(t0, tf, first_step, max_step, max_steps)
+    if steps is None:
+        return None
+    if t_eval is not None:
+        t_eval = _time_points(t_eval, t0, tf)
+        if t_eval is None:
+            return None
     if rtol < RTOL_FLOOR:
-        _warn_rtol(4)           # SciPy's warning, at the user's call (Fortran raises rtol)
-    return run_native(prep[1:], t0, tf, y0)
+        _warn_rtol(4)
+    packed = with_options(prep[1:], *steps, t_eval)
+    res = run_native(packed, t0, tf, y0, max(len(t_eval), 2) if t_eval is not None else 0)
+    if t_eval is not None and (res.t.size == 0 or not len(t_eval)):
+        res.t, res.y = [], []   # as native_path.solve_native's
+    return res
+
+
+def _step_options(t0, tf, first_step, max_step, max_steps):
+    """(first step or 0.0, largest step, step limit) when first_step (None or a positive
+    finite number at most the span's length), max_step (a positive number, inf allowed)
+    and max_steps (None or an int in [1, 2**31 - 1]) are plain and valid; else None."""
+    if first_step is None:
+        h0 = 0.0
+    elif type(first_step) is float or type(first_step) is int:
+        h0 = float(first_step)
+        if not (0.0 < h0 < math.inf and (h0 <= abs(tf - t0) or tf == t0)):
+            return None
+    else:
+        return None
+    if not ((type(max_step) is float or type(max_step) is int) and max_step > 0):
+        return None     # NaN fails the comparison
+    if max_steps is None:
+        limit = NO_STEP_LIMIT
+    elif type(max_steps) is int and 1 <= max_steps <= NO_STEP_LIMIT:
+        limit = max_steps
+    else:
+        return None
+    return h0, min(float(max_step), _HUGE), limit
+
+
+def _time_points(t_eval, t0, tf):
+    """t_eval itself when it is a list or tuple of floats (or ints), or a 1-D float64
+    array, of times inside [t0, tf] strictly monotonic in the direction of integration;
+    else None."""
+    if type(t_eval) is list or type(t_eval) is tuple:
+        for v in t_eval:
+            if not (type(v) is float or type(v) is int):
+                return None
+        values = t_eval
+    elif type(t_eval) is np.ndarray and t_eval.dtype == np.float64 and t_eval.ndim == 1:
+        if t_eval.size > 32:
+            lo, hi = min(t0, tf), max(t0, tf)
+            d = np.diff(t_eval)
+            ok = bool(t_eval.min() >= lo and t_eval.max() <= hi and
+                      ((d > 0).all() if tf >= t0 else (d < 0).all()))
+            return t_eval if ok else None       # NaN fails min/max's comparisons
+        values = t_eval.tolist()
+    else:
+        return None
+    lo, hi = min(t0, tf), max(t0, tf)
+    last = None
+    for v in values:
+        if not lo <= v <= hi:                   # NaN and Inf fail it too
+            return None
+        if last is not None and not (v > last if tf >= t0 else v < last):
+            return None
+        last = v
+    return t_eval
 
 
 def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
