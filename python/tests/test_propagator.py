@@ -138,3 +138,22 @@ def test_a_bad_time_is_refused(t):
     with pytest.raises((TypeError, ValueError), match="t"):
         p.propagate_until(t)
     assert p.t == 0.0
+
+
+def test_small_rtol_warns_once_at_construction():
+    # solve_ivp's warning about an rtol below 100 eps, given once when the Propagator is
+    # made; the propagations (and a repacking after new parameters) give none, without
+    # touching the global warning filters
+    import warnings
+    k = conmech.systems.kepler(1.0)
+    with pytest.warns(UserWarning, match="rtol") as record:
+        p = conmech.Propagator(k, [0.5, 0.0, 0.0, 3.0 ** 0.5], method="DOP853", rtol=1e-20,
+                               atol=1e-12)
+    assert len(record) == 1
+    filters = list(warnings.filters)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert p.propagate_until(1.0).success
+        k.params = np.array([2.0])          # new parameters: packed again
+        assert p.propagate_until(2.0).success
+    assert warnings.filters == filters

@@ -54,17 +54,18 @@ def step_limit(max_steps):
     return int(max_steps)
 
 
-def tolerance(value, name, n, stacklevel=3):
+def tolerance(value, name, n, stacklevel=3, warn=True):
     """A tolerance as a contiguous float array of shape (n,), checked (non-negative,
     finite; a scalar or one value per component). ``rtol`` below 100 eps is raised to it
-    with SciPy's UserWarning (``stacklevel``: the user's call)."""
+    with SciPy's UserWarning (``stacklevel``: the user's call; ``warn=False``: a caller
+    that gave the warning already, without touching the global warning filters)."""
     if type(value) is float or type(value) is int:   # fast path for the common case
         v = float(value)
         if not v >= 0:
             raise ValueError(f"{name} must be non-negative")
         if v == math.inf:
             raise ValueError(f"{name} must be finite")
-        if name == "rtol" and v < RTOL_FLOOR:
+        if warn and name == "rtol" and v < RTOL_FLOOR:
             _warn_rtol(stacklevel + 1)
         arr = np.empty(n)
         arr.fill(v)           # (np.full costs three times as much on small arrays)
@@ -86,7 +87,7 @@ def tolerance(value, name, n, stacklevel=3):
         raise ValueError(f"{name} must be non-negative")
     if not np.isfinite(arr).all():
         raise ValueError(f"{name} must be finite")
-    if name == "rtol" and (arr < RTOL_FLOOR).any():
+    if warn and name == "rtol" and (arr < RTOL_FLOOR).any():
         _warn_rtol(stacklevel + 1)
     return np.ascontiguousarray(arr)
 

@@ -18,15 +18,14 @@ call). Constrained systems are refused, as by solve_ivp (:mod:`conmech.constrain
 integrates them).
 """
 import math
-import warnings
 from collections import namedtuple
 
 import numpy as np
 
 from .. import _conmech
 from .._core.callback import message_text
-from .._core.checks import initial_state, positive_finite, real_scalar, step_controls, \
-    step_limit
+from .._core.checks import initial_state, positive_finite, real_scalar, step_limit, \
+    tolerance
 from .._core.native import NativeSystem
 from .._core.status import BAD_INPUT
 from .methods import BY_NAME
@@ -114,9 +113,9 @@ class Propagator:
                 run_fun = first_order_view(fun)
         if not isinstance(run_fun, NativeSystem):
             return None
-        with warnings.catch_warnings():     # solve_ivp's warnings were given in __init__
-            warnings.simplefilter("ignore")
-            rtol_v, atol_v, _ = step_controls(rtol, atol, n, None, 0.0, 0.0)
+        # checked, and warned about, by solve_ivp in __init__
+        rtol_v = tolerance(rtol, "rtol", n, warn=False)
+        atol_v = tolerance(atol, "atol", n, warn=False)
         hmax = min(positive_finite(max_step, "max_step", allow_inf=True),
                    float(np.finfo(float).max))
         prep = prepare(run_fun, code, rtol_v, atol_v, 0.0, hmax,
