@@ -24,8 +24,16 @@ the scalar stepper would), the other lanes unaffected (the scalar routine's earl
 has no per-lane equivalent in vector code; the lanes are independent, so none is needed).
 
 For more than :data:`conmech.symbolic.taylor_generalized.WRITE_OUT_MAX` degrees of
-freedom the scalar routine factorises M_0 in loops over a local array; that form has no
-batch routine here (an ensemble of such a system runs member by member)."""
+freedom the scalar routine factorises M_0 and solves in loops over local arrays (lm, the
+lower triangle of M_0 overwritten by its factor; ld, the reciprocal pivots; cr, the
+right-hand sides; cg, the history sums of M a); the batch routine runs that loop form
+with the lanes as the arrays' first index (lm(l, i, j), ...), each array statement of
+the scalar loops (the sum intrinsic over a row section included) in a lanes' loop inside
+the same loops over the rows and columns, so each lane again performs the scalar
+routine's operations in its order and gets its coefficients to the last bit. No size is
+refused; a generalized system without batch recurrences is one without scalar ones (a
+non-smooth expression, an asymmetric M), and one order written out (``fixed``) is not
+generated (the loop version serves every order)."""
 import re
 
 from .taylor import _decls, _wrap
@@ -77,19 +85,27 @@ def _declared(decl):
 
 def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
     """Fortran lines of the bind(C) routine ``cname(t, order, w, p)`` of `lanes` members of
-    the generalized system of the decomposition `g` (see the module docstring); a
-    ValueError for more than WRITE_OUT_MAX degrees of freedom."""
-    if g.n > WRITE_OUT_MAX:
-        raise ValueError(f"more than {WRITE_OUT_MAX} degrees of freedom")
+    the generalized system of the decomposition `g` (see the module docstring): the
+    scalars of the written-out factorisation up to WRITE_OUT_MAX degrees of freedom, the
+    loop form's arrays with a lanes' index beyond."""
     ind = "        "
-    decl, body = generalized_body(g, names, ind, True)
+    loops = g.n > WRITE_OUT_MAX
+    decl, body = generalized_body(g, names, ind, not loops)
+    # the loop form's local arrays (lm, ld, cr, cg) with the lanes as their first index
+    arrays = [] if not loops else ["lm", "ld", "cr", "cg"]
+    if loops:
+        decl = [x for x in decl if not x.lstrip().startswith(("real(dp) :: lm(",
+                                                              "integer :: ii, jj"))]
     reals = _declared(decl)
     lane = [x for x in reals if not _INVARIANT.match(x)]
     consts = [x for x in reals if x.startswith("tc")]
     per_lane = re.compile(r"\b(" + "|".join(map(re.escape, lane + ["t"])) + r")\b(?!\()")
 
+    per_lane_array = re.compile(r"\b(" + "|".join(["w"] + arrays) + r")\(")
+
     def in_lanes(s):
-        return per_lane.sub(lambda mm: f"{mm.group(1)}(l)", re.sub(r"\bw\(", "w(l, ", s))
+        return per_lane.sub(lambda mm: f"{mm.group(1)}(l)",
+                            per_lane_array.sub(lambda mm: f"{mm.group(1)}(l, ", s))
     out, group, gind = [], [], None
 
     def flush():
@@ -106,14 +122,19 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
         if m is None:
             raise ValueError(f"unexpected statement in the generalized Taylor body: {s}")
         lhs = m.group(1)
-        if lhs == "w" or lhs in lane:
+        if s == "lm = 0.0_dp":
+            # the factor's array cleared for every lane at once
+            flush()
+            out.append(at + s)
+            return
+        if lhs == "w" or lhs in lane or lhs in arrays:
             if group and at != gind:
                 flush()
             gind = at
             group.append(in_lanes(s))
         else:
             rhs = s.split("=", 1)[1]
-            if "w(" in rhs or per_lane.search(rhs):
+            if per_lane_array.search(rhs) or per_lane.search(rhs):
                 raise ValueError(f"a lane-invariant value depends on a lane: {s}")
             flush()
             out.append(at + s)
@@ -136,7 +157,7 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
         cond = _one_line_if(s)
         if cond:
             # if (a condition on the order) statement: the condition common to the lanes
-            if "w(" in cond or per_lane.search(cond):
+            if per_lane_array.search(cond) or per_lane.search(cond):
                 raise ValueError(f"a condition depends on a lane: {s}")
             flush()
             out.append(f"{at}{cond} then")
@@ -150,6 +171,10 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
     head = coefficient_head(cname, lanes, nw, npar, ind)
     decls = _decls(consts, "real(dp)", ind)
     decls += _decls([f"{x}(nl)" for x in lane], "real(dp)", ind)
+    if loops:
+        n = g.n
+        decls += [f"{ind}real(dp) :: lm(nl, {n}, {n}), ld(nl, {n}), cr(nl, {n}), "
+                  f"cg(nl, {n})", f"{ind}integer :: ii, jj"]
     decls += [f"{ind}real(dp) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
     if lanes <= machine_lanes():
         out = _lanes_outside(out)
@@ -190,8 +215,7 @@ def batch_lines(d, names, lanes, fixed, dec_cache, codes):
     Taylor library with `lanes` lanes: the coefficient routine and the propagator
     ``conmech_taylor_batch_run`` (:func:`conmech.symbolic.taylor_batch.run_routine` for
     the 2n states of the first-order view); codes: the propagator's status codes. No
-    routine written out for one order (`fixed`): refused with the reason, as is a system
-    of more than WRITE_OUT_MAX degrees of freedom."""
+    routine written out for one order (`fixed`): refused with the reason."""
     if "g" not in dec_cache:
         dec_cache["g"] = generalized_decomposition(d)
     g, why = dec_cache["g"]
@@ -201,11 +225,6 @@ def batch_lines(d, names, lanes, fixed, dec_cache, codes):
         return [], [], ("the batch recurrences of a generalized system M(q) q'' = Q are "
                         "not written out for one order (the loop version serves every "
                         "order)")
-    if g.n > WRITE_OUT_MAX:
-        return [], [], (f"the batch recurrences of a generalized system M(q) q'' = Q are "
-                        f"generated for up to {WRITE_OUT_MAX} degrees of freedom (the "
-                        f"factorisation of M written out in scalars), this one has {g.n}: "
-                        "its ensembles run member by member")
     npar = max(len(d.params), 1)
     return coefficient_routine(g, names, lanes, npar=npar) + \
         run_routine(2*g.n, g.ncol, npar, lanes, codes), \
