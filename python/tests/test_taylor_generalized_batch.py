@@ -16,10 +16,12 @@ factorisation and triangular solves per lane, the propagator of the ode systems'
 - beyond WRITE_OUT_MAX degrees of freedom (M's factorisation in loops over per-lane
   arrays): nine pendulums on a cart (10 degrees of freedom, an arrow-shaped M whose
   Cholesky factor fills in) take the lanes route, each member its own solve_ivp(method=
-  "TAYLOR") run bit for bit (and the member-by-member route's), 1 and 4 lanes the same
-  bits, DOP853 to ~1e-9; a member with a singular M among 9 degrees of freedom fails
-  alone.
+  "TAYLOR") run bit for bit (and the member-by-member route's; its wide lanes' loops
+  split into loops of at most WIDE_REFS references), 1 and 4 lanes the same bits, DOP853
+  to ~1e-9; a member with a singular M among 9 degrees of freedom fails alone.
 """
+import re
+
 import numpy as np
 import pytest
 
@@ -29,6 +31,7 @@ import conmech  # noqa: E402
 from conmech import ensemble, symbolic  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.taylor_generalized import WRITE_OUT_MAX  # noqa: E402
+from conmech.symbolic.taylor_generalized_batch import WIDE_REFS  # noqa: E402
 from conmech.symbolic.taylor_library import taylor_source  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
@@ -156,6 +159,21 @@ def test_a_mass_matrix_singular_along_the_way_fails_its_member_only():
         assert abs(ens.y_final[i, 0] - np.sqrt(q0**2 + 2*q0*v0)) < 1e-9
 
 
+def _lane_loop_refs(src):
+    """The references to per-lane values, w(l, ...) and x(l), of each lanes' loop."""
+    refs, cur = [], None
+    for x in src.splitlines():
+        s = x.strip()
+        if s == "do l = 1, nl":
+            cur = 0
+        elif cur is not None and s == "end do":
+            refs.append(cur)
+            cur = None
+        elif cur is not None:
+            cur += len(re.findall(r"\(l[,)]", x))
+    return refs
+
+
 @pytest.fixture(scope="module")
 def metronomes():
     """Nine pendulums on a cart on a spring (10 degrees of freedom), 6 members."""
@@ -170,6 +188,8 @@ def test_beyond_written_out_the_lanes_route_gives_each_member_its_own_run(metron
     assert model_of(system).derived.n == 10 > WRITE_OUT_MAX
     src, _, why = taylor_source(model_of(system).derived, "batch4")
     assert why is None and "do jj = 1, 10" in src and "lm(nl, 10, 10)" in src
+    # its wide lanes' loops split (one of 271 references here) to WIDE_REFS at most
+    assert max(_lane_loop_refs(src)) <= WIDE_REFS
     ens = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL)
     assert ens.success and _batch_built(system)
     by_member = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL,

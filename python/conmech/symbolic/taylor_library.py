@@ -136,7 +136,7 @@ def _lines(d, part, dec_cache):
         if part == "var":
             from .taylor_generalized_var import variational_lines
             return variational_lines(d, names, dec_cache)
-        if _lanes(part) is not None:     # the lanes through the written-out factorisation
+        if _lanes(part) is not None:     # the lanes through the factorisation per lane
             from .._core import status as S
             from .taylor_generalized_batch import batch_lines
             return batch_lines(d, names, _lanes(part), _fixed_order(part), dec_cache,
