@@ -35,9 +35,9 @@ system's lanes' loops (the history sums, an order's recurrences: thousands of ar
 references, which gcc's dependence analysis gives up on, leaving the loop scalar) are
 split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`; the
 10-link pendulum chain: 2.35x the member-by-member route's CPU time per member, against
-0.79x unsplit). No size is refused; a generalized system without batch recurrences is one without scalar ones (a
-non-smooth expression, an asymmetric M), and one order written out (``fixed``) is not
-generated (the loop version serves every order)."""
+0.79x unsplit). No size is refused; a generalized system without batch recurrences is
+one without scalar ones (a non-smooth expression, an asymmetric M), and one order
+written out (``fixed``) is not generated (the loop version serves every order)."""
 import re
 
 from .taylor import _decls, _wrap
