@@ -33,9 +33,9 @@ the same loops over the rows and columns, so each lane again performs the scalar
 routine's operations in its order and gets its coefficients to the last bit. Such a
 system's lanes' loops (the history sums, an order's recurrences: thousands of array
 references, which gcc's dependence analysis gives up on, leaving the loop scalar) are
-split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`; the
-10-link pendulum chain: 2.35x the member-by-member route's CPU time per member, against
-0.79x unsplit). No size is refused; a generalized system without batch recurrences is
+split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`; a
+10-link pendulum chain's ensemble then runs 2.35x as fast as member by member in CPU
+time, 0.79x unsplit). No size is refused; a generalized system without batch recurrences is
 one without scalar ones (a non-smooth expression, an asymmetric M), and one order
 written out (``fixed``) is not generated (the loop version serves every order)."""
 import re
@@ -180,15 +180,16 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
         decls += [f"{ind}real(dp) :: lm(nl, {n}, {n}), ld(nl, {n}), cr(nl, {n}), "
                   f"cg(nl, {n})", f"{ind}integer :: ii, jj"]
     decls += [f"{ind}real(dp) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
-    if g.n > WRITE_OUT_MAX:
+    if loops:
         out = _split_wide(out)
     elif lanes <= machine_lanes():
         out = _lanes_outside(out)
     return head + decls + out + [f"    end subroutine {cname}", ""]
 
 
-#: array references per lanes' loop at most (gcc's dependence analysis gives up on a loop of
-#: more than 1000, its loop-max-datarefs-for-datadeps, and leaves it scalar)
+#: array references per lanes' loop at most, beyond WRITE_OUT_MAX degrees of freedom (gcc's
+#: dependence analysis gives up on a loop of more than 1000, its parameter
+#: loop-max-datarefs-for-datadeps, and leaves it scalar)
 WIDE_REFS = 200
 _REF = re.compile(r"\(l[,)]")
 
