@@ -9,12 +9,19 @@ parameter g given per member, which the batch route does not take), in one run.
 Problem: m double pendulums (unit masses and rods, g = 9.81), initial angles uniform in
 [-1, 1] and angular velocities in [-0.5, 0.5] (seeded), integrated over [0, T] at rtol =
 atol = tol. ``--system chain3``: a planar tree of 3 point masses on rods instead
-(symbolic.planar_tree, its articulated-body chain: conmech.symbolic.taylor_tree_batch). Both routes give each member the steps and the final state of its own
+(symbolic.planar_tree, its articulated-body chain: conmech.symbolic.taylor_tree_batch).
+``--system chain10``: a planar chain of 10 unit point masses on unit rods from its
+Lagrangian (the tests' pendulum_chain: beyond taylor_generalized.WRITE_OUT_MAX degrees of
+freedom, M's factorisation in loops over per-lane arrays), initial angles in [-0.3, 0.3]
+and rates in [-0.2, 0.2]; ``--system metronomes10``: the tests' nine pendulums on a cart
+(10 degrees of freedom), the same ranges. The time of the first build of each library
+(sympy to loaded library, compile included; nothing when it is cached) is printed. Both
+routes give each member the steps and the final state of its own
 solve_ivp(method="TAYLOR") run, bit for bit (checked here). Best of `--repeat` rounds, the
 routes interleaved within a round; the machine's load (uptime) before and after.
 
     python bench/bench_taylor_generalized_batch.py [--m 2000] [--T 10] [--tol 1e-12]
-        [--threads 1 2] [--repeat 3] [--system double_pendulum|chain3]
+        [--threads 1 2] [--repeat 3] [--system double_pendulum|chain3|chain10|metronomes10]
 """
 import argparse
 import os
@@ -29,7 +36,7 @@ from conmech import ensemble, symbolic
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python",
                                 "tests"))
-from taylor_jets import double_pendulum  # noqa: E402  (the tests' double pendulum)
+from taylor_jets import double_pendulum, metronomes_on_a_cart, pendulum_chain  # noqa: E402
 
 
 def chain3():
@@ -57,23 +64,31 @@ def main():
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--lanes", type=int, nargs="+", default=[None])
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--system", choices=["double_pendulum", "chain3"],
-                    default="double_pendulum")
+    ap.add_argument("--system", choices=["double_pendulum", "chain3", "chain10",
+                                         "metronomes10"], default="double_pendulum")
     args = ap.parse_args()
-    system = double_pendulum() if args.system == "double_pendulum" else chain3()
-    nq = 2 if args.system == "double_pendulum" else 3
+    system, nq = {"double_pendulum": (double_pendulum, 2), "chain3": (chain3, 3),
+                  "chain10": (lambda: pendulum_chain(10), 10),
+                  "metronomes10": (lambda: metronomes_on_a_cart(9), 10)}[args.system]
+    system = system()
     rng = np.random.default_rng(7)
     m = args.m
-    y0 = np.column_stack([rng.uniform(-1.0, 1.0, (m, nq)),
-                          rng.uniform(-0.5, 0.5, (m, nq))])
+    wide = nq > 3
+    y0 = np.column_stack([rng.uniform(-0.3 if wide else -1.0, 0.3 if wide else 1.0, (m, nq)),
+                          rng.uniform(-0.2 if wide else -0.5, 0.2 if wide else 0.5, (m, nq))])
     span = (0.0, args.T)
     kw = dict(method="TAYLOR", rtol=args.tol, atol=args.tol)
     per_member_g = {"g": np.full(m, 9.81)}      # the same value: the member route
-    # build both routes' libraries before the timed runs
-    ensemble.solve(system, span, y0[:8], **kw)
-    for lanes in args.lanes:
-        ensemble.solve(system, span, y0[:8], lanes=lanes, **kw)
+    # build both routes' libraries before the timed runs (the member route's core first)
+    t0 = time.perf_counter()
     ensemble.solve(system, span, y0[:8], params={"g": np.full(8, 9.81)}, **kw)
+    print(f"first member-by-member call (core library built if not cached): "
+          f"{time.perf_counter() - t0:.1f} s")
+    for lanes in args.lanes:
+        t0 = time.perf_counter()
+        ensemble.solve(system, span, y0[:8], lanes=lanes, **kw)
+        print(f"first batch call, lanes {lanes or 'machine'} (batch library built if not "
+              f"cached): {time.perf_counter() - t0:.1f} s")
     print(f"{args.system}, {m} members over [0, {args.T:g}] at tol {args.tol:g}; "
           f"load before {load():.2f}")
     for threads in args.threads:

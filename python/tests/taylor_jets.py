@@ -127,6 +127,37 @@ def double_pendulum():
     return symbolic.lagrangian_system(T - U, [a, b], params={g: 9.81})
 
 
+def pendulum_chain(n):
+    """A planar chain of n unit point masses on unit rods from a fixed pivot, absolute
+    angles from the downward vertical: M_ab = (n - max(a, b)) cos(q_a - q_b) (0-based),
+    the potential -g sum_i (n - i) cos(q_i)."""
+    t = dynamicsymbols._t
+    q = dynamicsymbols(" ".join(f"c{i}" for i in range(n)))
+    g = sp.Symbol("g")
+    qd = [x.diff(t) for x in q]
+    T = sum((n - max(a, b))*sp.cos(q[a] - q[b])*qd[a]*qd[b] if a != b else (n - a)*qd[a]**2
+            for a in range(n) for b in range(n))/2
+    U = -g*sum((n - i)*sp.cos(q[i]) for i in range(n))
+    return symbolic.lagrangian_system(T - U, q, params={g: 9.81})
+
+
+def metronomes_on_a_cart(n):
+    """n pendulums (unit masses, lengths 1 + i/10) hanging from a cart (mass 2, on a
+    spring of stiffness 5) that moves on a line: n + 1 degrees of freedom [x, th_1..th_n],
+    M(q) the arrow matrix with M_00 = 2 + n, M_0i = l_i cos(th_i), M_ii = l_i**2 (its
+    Cholesky factor is full: every column after the first fills in)."""
+    t = dynamicsymbols._t
+    x = dynamicsymbols("x")
+    th = dynamicsymbols(" ".join(f"th{i}" for i in range(n)))
+    g = sp.Symbol("g")
+    ell = [1 + sp.Rational(i, 10) for i in range(n)]
+    xd = x.diff(t)
+    T = (2 + n)*xd**2/2 + sum(ell[i]*sp.cos(th[i])*xd*th[i].diff(t) +
+                              ell[i]**2*th[i].diff(t)**2/2 for i in range(n))
+    U = 5*x**2/2 - g*sum(ell[i]*sp.cos(th[i]) for i in range(n))
+    return symbolic.lagrangian_system(T - U, [x] + list(th), params={g: 9.81})
+
+
 def check_normal_mode_monodromy(system):
     """The Taylor monodromy of the double pendulum `system`'s in-phase nonlinear normal
     mode (b/a -> sqrt(2), omega^2 -> g (2 - sqrt(2)) at small amplitude; released at rest,

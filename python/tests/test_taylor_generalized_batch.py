@@ -13,9 +13,15 @@ factorisation and triangular solves per lane, the propagator of the ode systems'
 - 2, 4 and 8 lanes give the same bits;
 - a member whose mass matrix is singular at its initial state fails on its own, with a
   message that names it and its mass matrix, the other members unaffected;
-- a system of more degrees of freedom than WRITE_OUT_MAX has no batch part (the reason
-  said), and a tree none either: their ensembles run member by member.
+- beyond WRITE_OUT_MAX degrees of freedom (M's factorisation in loops over per-lane
+  arrays): nine pendulums on a cart (10 degrees of freedom, an arrow-shaped M whose
+  Cholesky factor fills in) take the lanes route, each member its own solve_ivp(method=
+  "TAYLOR") run bit for bit (and the member-by-member route's; its wide lanes' loops
+  split into loops of at most WIDE_REFS references), 1 and 4 lanes the same bits, DOP853
+  to ~1e-9; a member with a singular M among 9 degrees of freedom fails alone.
 """
+import re
+
 import numpy as np
 import pytest
 
@@ -25,9 +31,11 @@ import conmech  # noqa: E402
 from conmech import ensemble, symbolic  # noqa: E402
 from conmech.symbolic.pipeline import model_of  # noqa: E402
 from conmech.symbolic.taylor_generalized import WRITE_OUT_MAX  # noqa: E402
+from conmech.symbolic.taylor_generalized_batch import WIDE_REFS  # noqa: E402
 from conmech.symbolic.taylor_library import taylor_source  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
+from taylor_jets import metronomes_on_a_cart  # noqa: E402
 
 TOL = 1e-12
 
@@ -151,19 +159,93 @@ def test_a_mass_matrix_singular_along_the_way_fails_its_member_only():
         assert abs(ens.y_final[i, 0] - np.sqrt(q0**2 + 2*q0*v0)) < 1e-9
 
 
-def test_more_degrees_of_freedom_than_written_out_run_member_by_member():
+def _lane_loop_refs(src):
+    """The references to per-lane values, w(l, ...) and x(l), of each lanes' loop."""
+    refs, cur = [], None
+    for x in src.splitlines():
+        s = x.strip()
+        if s == "do l = 1, nl":
+            cur = 0
+        elif cur is not None and s == "end do":
+            refs.append(cur)
+            cur = None
+        elif cur is not None:
+            cur += len(re.findall(r"\(l[,)]", x))
+    return refs
+
+
+@pytest.fixture(scope="module")
+def metronomes():
+    """Nine pendulums on a cart on a spring (10 degrees of freedom), 6 members."""
+    system = metronomes_on_a_cart(9)
+    rng = np.random.default_rng(11)
+    y0s = np.column_stack([rng.uniform(-0.3, 0.3, (6, 10)), rng.uniform(-0.4, 0.4, (6, 10))])
+    return system, y0s, 2.0
+
+
+def test_beyond_written_out_the_lanes_route_gives_each_member_its_own_run(metronomes):
+    system, y0s, tf = metronomes
+    assert model_of(system).derived.n == 10 > WRITE_OUT_MAX
+    src, _, why = taylor_source(model_of(system).derived, "batch4")
+    assert why is None and "do jj = 1, 10" in src and "lm(nl, 10, 10)" in src
+    # its wide lanes' loops split (one of 271 references here) to WIDE_REFS at most
+    assert max(_lane_loop_refs(src)) <= WIDE_REFS
+    ens = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL)
+    assert ens.success and _batch_built(system)
+    by_member = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL,
+                               progress=lambda done, total: None)
+    assert np.array_equal(ens.y_final, by_member.y_final)
+    assert np.array_equal(ens.nfev, by_member.nfev)
+    for i, y0 in enumerate(y0s):
+        r = conmech.solve_ivp(system, (0, tf), y0, method="TAYLOR", rtol=TOL, atol=TOL)
+        assert r.success and ens.t_final[i] == tf
+        assert np.array_equal(ens.y_final[i], r.y[:, -1])
+        assert (ens.nfev[i], ens.naccept[i], ens.nreject[i]) == \
+            (r.nfev, r.naccept, r.nreject)
+        d = conmech.solve_ivp(system, (0, tf), y0, method="DOP853", rtol=1e-13, atol=1e-13)
+        scale = max(1.0, np.max(np.abs(d.y[:, -1])))
+        assert np.max(np.abs(ens.y_final[i] - d.y[:, -1])) < 1e-9*scale
+        # a genuine motion: every pendulum and the cart move
+        assert np.min(np.abs(ens.y_final[i] - y0)) > 1e-6
+
+
+def test_beyond_written_out_one_and_four_lanes_give_the_same_bits(metronomes):
+    system, y0s, tf = metronomes
+    runs = [ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL,
+                           lanes=k) for k in (1, 4)]
+    assert np.array_equal(runs[0].y_final, runs[1].y_final)
+    assert np.array_equal(runs[0].nfev, runs[1].nfev)
+    paths = model_of(system).taylor_paths
+    # two libraries (4 lanes: "batch" when that is the machine's width)
+    assert paths.get("batch1") is not None
+    assert paths.get("batch4", paths.get("batch")) not in (None, paths["batch1"])
+
+
+def test_beyond_written_out_a_singular_mass_matrix_fails_its_member_only():
+    """Eight oscillators with M_ii = 1 + x_i^2/4 and a ninth coordinate z with M = z^2
+    (singular at z = 0): the member starting at z = 0 fails on its own, the others are
+    their solve_ivp runs."""
     n = WRITE_OUT_MAX + 1
     t = dynamicsymbols._t
     qs = dynamicsymbols(" ".join(f"x{i}" for i in range(n)))
-    L = sum((1 + qs[i]**2/4)*qs[i].diff(t)**2/2 - qs[i]**2/2 for i in range(n))
+    L = sum((1 + qs[i]**2/4)*qs[i].diff(t)**2/2 - qs[i]**2/2 for i in range(n - 1))
+    z = qs[-1]
+    L += z**2*z.diff(t)**2/2 + z**2/2
     system = symbolic.lagrangian_system(L, qs, jacobian=False)
-    src, _, why = taylor_source(model_of(system).derived, "batch4")
-    assert src is None and f"up to {WRITE_OUT_MAX} degrees of freedom" in why
-    y0s = members(n, 3, 5)
-    ens = ensemble.solve(system, (0, 1.0), y0s, method="TAYLOR", rtol=1e-10, atol=1e-10)
-    assert ens.success
-    r = conmech.solve_ivp(system, (0, 1.0), y0s[1], method="TAYLOR", rtol=1e-10, atol=1e-10)
-    assert np.array_equal(ens.y_final[1], r.y[:, -1])
+    y0s = members(n, 4, 5)
+    y0s[:, n - 1] = [1.0, 0.9, 0.0, 1.2]
+    y0s[:, 2*n - 1] = [0.3, -0.2, 1.0, 0.1]
+    ens = ensemble.solve(system, (0, 1.0), y0s, method="TAYLOR", rtol=1e-10, atol=1e-10,
+                         lanes=2)
+    assert _batch_built(system)
+    assert not ens.success and list(ens.status) == [0, 0, -1, 0]
+    assert "1 of 4 members failed; the first, member 2: non-finite" in ens.message
+    assert "mass matrix" in ens.message and "not positive definite" in ens.message
+    assert np.all(np.isfinite(ens.y_final)) and ens.t_final[2] == 0.0
+    for i in (0, 1, 3):
+        r = conmech.solve_ivp(system, (0, 1.0), y0s[i], method="TAYLOR", rtol=1e-10,
+                              atol=1e-10)
+        assert np.array_equal(ens.y_final[i], r.y[:, -1]) and ens.naccept[i] == r.naccept
 
 
 def test_shared_parameters_given_to_the_call_are_used(systems):

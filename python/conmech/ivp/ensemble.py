@@ -211,8 +211,8 @@ def _taylor_batch(system, method, nt, ne, mp, first_step, progress, lanes, eps,
     width), the recurrences written out for the order of the tolerance eps when they are
     small enough. `generalized`: the generalized system M(q) q'' = Q whose first-order
     view `system` is (its batch library: conmech.symbolic.taylor_generalized_batch, the
-    loop version, or for a tree conmech.symbolic.taylor_tree_batch; none for more than
-    WRITE_OUT_MAX degrees of freedom: member by member)."""
+    loop version, or for a tree conmech.symbolic.taylor_tree_batch, for any number of
+    degrees of freedom)."""
     if not (isinstance(method, str) and method.upper() == "TAYLOR"):
         return None
     batch = nt == 0 and ne == 0 and mp <= 1 and first_step is None and progress is None
@@ -349,10 +349,10 @@ def solve(system: Any, t_span: Sequence[float], y0: ArrayLike,
         together in this many SIMD lanes (1, 2, 4, 8 or 16; None: the machine's vector
         width for doubles, 4 with AVX2, 8 with AVX-512), each a library compiled once per
         model. The results do not depend on it. Only with method="TAYLOR". An ode system,
-        a generalized system M(q) q'' = Q of up to 8 degrees of freedom
-        (conmech.symbolic.taylor_generalized_batch) and a tree
-        (conmech.symbolic.taylor_tree_batch) take this route; a generalized system of
-        more degrees of freedom runs member by member.
+        a generalized system M(q) q'' = Q of any number of degrees of freedom
+        (conmech.symbolic.taylor_generalized_batch: M's factorisation written out in
+        scalars up to 8, in loops over per-lane arrays beyond) and a tree
+        (conmech.symbolic.taylor_tree_batch) take this route.
 
     Returns
     -------

@@ -9,7 +9,8 @@ recurrences of its articulated-body code, definition by definition
 model's Taylor library. An ensemble (``ensemble.solve(method="TAYLOR")``) of the view runs
 its members in SIMD lanes through the batch routine of
 :mod:`conmech.symbolic.taylor_generalized_batch`, or of :mod:`conmech.symbolic.taylor_tree_batch`
-for a tree (:func:`batch_entries`; member by member for more than 8 degrees of freedom).
+for a tree (:func:`batch_entries`; for any number of degrees of freedom: written out in
+scalars up to 8, the loop form's arrays per lane beyond).
 
 :func:`first_order_view` gives the view (the same parameters; the model behind it, so that
 the Taylor paths of ode systems apply to it); :func:`name_the_mass_matrix` adds to a failed
@@ -83,8 +84,8 @@ def batch_entries(fun, lanes=None):
     `lanes` SIMD lanes, None: the machine's width, and the propagator,
     :mod:`conmech.symbolic.taylor_generalized_batch`, for a tree
     :mod:`conmech.symbolic.taylor_tree_batch`), compiled on first need; None when it has
-    none (any other system, more than taylor_generalized.WRITE_OUT_MAX degrees of freedom:
-    the ensemble then runs member by member)."""
+    none (any other system, or no batch recurrences: the ensemble then runs member by
+    member)."""
     model = _model(fun)
     if model is None:
         return None

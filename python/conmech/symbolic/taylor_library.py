@@ -38,9 +38,10 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 6     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
+_FORMAT = 7     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
                 # 4: the variational and quadruple-precision parts of generalized models,
-                # 5: those of trees, 6: the batch part of generalized models and trees)
+                # 5: those of trees, 6: the batch part of generalized models and trees,
+                # 7: that of generalized models beyond WRITE_OUT_MAX degrees of freedom)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
@@ -135,7 +136,7 @@ def _lines(d, part, dec_cache):
         if part == "var":
             from .taylor_generalized_var import variational_lines
             return variational_lines(d, names, dec_cache)
-        if _lanes(part) is not None:     # the lanes through the written-out factorisation
+        if _lanes(part) is not None:     # the lanes through the factorisation per lane
             from .._core import status as S
             from .taylor_generalized_batch import batch_lines
             return batch_lines(d, names, _lanes(part), _fixed_order(part), dec_cache,
@@ -185,7 +186,7 @@ def taylor_source(d, part="core", _dec=None):
     code holds. A generalized record M(q) q'' = Q has the core, with
     ``conmech_taylor_rhs`` (:mod:`conmech.symbolic.taylor_generalized`), the batch part
     for its first-order view (:mod:`conmech.symbolic.taylor_generalized_batch`, the loop
-    version, up to taylor_generalized.WRITE_OUT_MAX degrees of freedom), the quadruple
+    version, for any number of degrees of freedom), the quadruple
     precision part and the variational part (:mod:`conmech.symbolic.taylor_generalized_var`);
     a tree the same four through its articulated-body chain
     (:mod:`conmech.symbolic.taylor_tree`, :mod:`conmech.symbolic.taylor_tree_batch`,
@@ -347,8 +348,7 @@ def batch_entries(model, lanes, order=None):
     the model's systems: ask the system). A generalized model M(q) q'' = Q has the loop
     version only, for any lanes (:mod:`conmech.symbolic.taylor_generalized_batch`, a tree's
     :mod:`conmech.symbolic.taylor_tree_batch`): its entries, or None with the reason in
-    ``model._taylor_parts[part]`` (more than taylor_generalized.WRITE_OUT_MAX degrees of
-    freedom, no recurrences)."""
+    ``model._taylor_parts[part]`` (no recurrences)."""
     part = batch_part(lanes)
     if getattr(model.derived, "kind", None) == "generalized":
         with _BATCH_LOCK:
