@@ -33,6 +33,10 @@ module conmech_ode_options
         real(dp) :: fac_min = 0.0_dp               !! smallest step ratio hnew/h
         real(dp) :: fac_max = 0.0_dp               !! largest step ratio hnew/h
         real(dp) :: beta = -1.0_dp                 !! Lund stabilisation exponent
+        !> explicit Runge-Kutta methods: a step ending within stretch*h before its target
+        !! (tf, an output point) is stretched onto it; < 0 means Hairer's 0.01, 0 is SciPy's
+        !! rule (a step is only cut where it would pass the target)
+        real(dp) :: stretch = -1.0_dp
         logical :: dense_output = .false.          !! keep a dense_solution in the result
         logical :: save_steps = .true.             !! without t_eval: store every step
         logical :: hit_t_eval = .false.            !! shorten steps to land on t_eval points

@@ -52,6 +52,9 @@ module conmech_rk_stepper
         real(dp) :: hmax = 0.0_dp         !! largest |h|
         real(dp) :: h_fixed = 0.0_dp      !! RK4's step
         real(dp) :: safe = 0.9_dp, facc1 = 5.0_dp, facc2 = 0.1_dp, beta = 0.0_dp
+        !> a step that would end within (stretch - 1) h before its target is stretched onto
+        !! it (Hairer's 1.01; 1: SciPy's rule, a step is only cut where it passes the target)
+        real(dp) :: stretch = 1.01_dp
         real(dp) :: expo1 = 0.2_dp, facold = 1.0e-4_dp
         real(dp) :: first_step = 0.0_dp   !! 0: Hairer's heuristic
         integer :: nsteps = 0             !! attempted steps
@@ -114,6 +117,8 @@ contains
         self%n_nonfinite = 0
         self%reject = .false.
         self%fsal_pending = .false.
+        self%stretch = 1.01_dp
+        if (opt%stretch >= 0.0_dp) self%stretch = 1.0_dp + opt%stretch
         if (self%adaptive) then
             if (opt%beta >= 0.0_dp) self%beta = opt%beta
             if (opt%method == METHOD_DOPRI5) then
@@ -204,6 +209,7 @@ contains
         call p%item(facc2)
         call p%item(beta)
         call p%item(self%expo1)
+        call p%item(self%stretch)
         call p%item(self%facold)
         call p%item(self%first_step)
         call p%item(self%nsteps)
@@ -325,7 +331,8 @@ contains
 
     !> Attempt steps until one is accepted, then advance to its end. `target` is the point
     !! a step lands on if it reaches it (tf, or the next output point; Hairer's rule:
-    !! a step is stretched by up to 1 % to reach it). info: CM_SUCCESS after an accepted
+    !! a step is stretched by up to 1 % to reach it, `stretch`; SciPy's RK45 only cuts a
+    !! step that would pass it). info: CM_SUCCESS after an accepted
     !! step, else the failure (too many steps, step too small, non-finite values).
     subroutine rk_step_impl(self, sys, target, info, msg)
         class(rk_stepper), intent(inout) :: self
@@ -376,7 +383,7 @@ contains
             self%hit = .false.
             h_unclipped = self%h
             if (self%adaptive) then
-                if ((self%t + 1.01_dp*self%h - target)*self%posneg > 0.0_dp) then
+                if ((self%t + self%stretch*self%h - target)*self%posneg > 0.0_dp) then
                     self%h = target - self%t
                     self%hit = .true.
                 end if

@@ -376,6 +376,10 @@ def _solve(problem, common, h0, jac, pattern):
             raise ValueError(message)
         if stop_at_start:
             # SciPy: a terminal event zero at t0, moving in its direction, stops there
+            if not builtin:
+                # the evaluations up to the first step (the Fortran run went on with the
+                # guard's NaN, whose attempts it counted too)
+                nfev = run.guard.count("fun")
             segs.append(dict(t=np.array([t0, t0]) if not with_t_eval else
                              t_ev[t_ev == t0], y=None, ev=run.start_events, dense=None))
             status = 1
@@ -393,11 +397,15 @@ def _solve(problem, common, h0, jac, pattern):
         t_stop = out["ev"][-1][1] if out["ev"] else tf
         fired = set()
         stop = False
-        for i, te, _ in out["ev"]:
+        for k, (i, te, _) in enumerate(out["ev"]):
             if remaining[i] > 0:
                 remaining[i] -= 1
                 if remaining[i] == 0:
+                    # SciPy's handle_events: no event after the one that ends the run is
+                    # reported, not even one at the same time (ordered by index there)
+                    del out["ev"][k + 1:]
                     stop = True
+                    break
             if te == t_stop:
                 fired.add(i)
         if stop or t_stop == tf:

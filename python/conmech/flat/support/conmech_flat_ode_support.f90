@@ -148,6 +148,7 @@ contains
         if (method == METHOD_RK45_SCIPY) then
             opt%method = METHOD_DOPRI5
             opt%beta = 0.0_dp
+            opt%stretch = 0.0_dp
         end if
         call new_stepper(opt%method, stp, sinfo, msg)
         if (sinfo == CM_SUCCESS) call set_jacobian_structure(stp, n, jac_const, nnz, sp_ptr, &

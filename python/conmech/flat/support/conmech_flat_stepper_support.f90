@@ -102,6 +102,7 @@ contains
             nfev0 = 0
             if (method == METHOD_RK45_SCIPY) then
                 opt%beta = 0.0_dp
+                opt%stretch = 0.0_dp
                 if (action == ACTION_START .and. .not. first_step > 0.0_c_double .and. &
                     t_bound /= t0 .and. all(y0 == y0) .and. all(abs(y0) <= huge(1.0_dp))) then
                     call scipy_first_step(sys, [t0, t_bound], y0, &
