@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Wall clock of solve_ivp's fixed cost, in one process: the symbolic Kepler system (zero
 span and one period at 1e-12, DOP853 and TAYLOR; one period with t_eval = [T] and with
-max_steps, through the fast entry and through the full checks, which np.float64 tolerances
+max_steps, through the fast entry and through the full checks, which 0-d array tolerances
 take), the built-in Kepler system over a short span, and a Python right-hand side against SciPy's solve_ivp (zero span and (0, 0.1),
 DOP853 and RK45). Each figure is the minimum over 7 batches (us per call); run it on a
 quiet machine and give `uptime` beside the figures.
@@ -54,8 +54,8 @@ def main():
             fast = tmin(lambda: conmech.solve_ivp(kep, (0, T), y0, method=m, rtol=1e-12,
                                                   atol=1e-12, **opts), 200)
             full = tmin(lambda: conmech.solve_ivp(kep, (0, T), y0, method=m,
-                                                  rtol=np.float64(1e-12),
-                                                  atol=np.float64(1e-12), **opts), 200)
+                                                  rtol=np.array(1e-12),
+                                                  atol=np.array(1e-12), **opts), 200)
             print(f"{m} symbolic Kepler one period, {label}: {fast:.1f} us "
                   f"(full checks {full:.1f} us)")
     bk = conmech.systems.kepler()

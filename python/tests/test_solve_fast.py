@@ -41,9 +41,9 @@ def test_fast_equals_full_path(counted, method, y0):
     kep = conmech.systems.kepler()
     fast = conmech.solve_ivp(kep, (0.0, 3.0), y0, method=method, rtol=1e-9, atol=1e-10)
     assert len(counted) == 1
-    # np.float64 tolerances are not a fast-path kind: the full checks run
-    full = conmech.solve_ivp(kep, (0.0, 3.0), y0, method=method, rtol=np.float64(1e-9),
-                             atol=np.float64(1e-10))
+    # 0-d array tolerances are not a fast-path kind: the full checks run
+    full = conmech.solve_ivp(kep, (0.0, 3.0), y0, method=method, rtol=np.array(1e-9),
+                             atol=np.array(1e-10))
     assert len(counted) == 1
     assert fast.success and fast.t.size > 3
     _same(fast, full)
@@ -106,7 +106,7 @@ def test_small_rtol_warns_as_scipy(counted):
     assert r.success and len(counted) == 1
     with pytest.warns(UserWarning, match="rtol") as full_w:
         full = conmech.solve_ivp(kep, (0.0, 0.5), Y0, method="DOP853",
-                                 rtol=np.float64(1e-20))
+                                 rtol=np.array(1e-20))
     assert len(counted) == 1
     assert [w.filename for w in fast_w] == [w.filename for w in full_w] == [__file__]
     assert [str(w.message) for w in fast_w] == [str(w.message) for w in full_w]
@@ -122,7 +122,7 @@ def test_fast_symbolic_with_params(counted, method):
     kep = symbolic.ode_system([u, v, -mu*x/r3, -mu*y/r3], [x, y, u, v], params={mu: 1.0})
     fast = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method=method, rtol=1e-12, atol=1e-12)
     full = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method=method,
-                             rtol=np.float64(1e-12), atol=np.float64(1e-12))
+                             rtol=np.array(1e-12), atol=np.array(1e-12))
     assert len(counted) == 1
     _same(fast, full)
     assert np.max(np.abs(fast.y[:, -1] - Y0)) < 1e-9      # one period closes the orbit
@@ -168,12 +168,12 @@ _TEV = [0.25, 1.0, 1.5, 2.75]
 @pytest.mark.parametrize("method", ["DOP853", "RK45", "Radau"])
 def test_fast_options_equal_full_path(counted, span, opts, method):
     # t_eval, first_step, max_step and max_steps of plain kinds take the fast entry and
-    # give the full path's result bit for bit (np.float64 tolerances: the full checks)
+    # give the full path's result bit for bit (0-d array tolerances: the full checks)
     kep = conmech.systems.kepler()
     fast = conmech.solve_ivp(kep, span, Y0, method=method, rtol=1e-9, atol=1e-10, **opts)
     assert len(counted) == 1
-    full = conmech.solve_ivp(kep, span, Y0, method=method, rtol=np.float64(1e-9),
-                             atol=np.float64(1e-10), **opts)
+    full = conmech.solve_ivp(kep, span, Y0, method=method, rtol=np.array(1e-9),
+                             atol=np.array(1e-10), **opts)
     assert len(counted) == 1
     _same(fast, full)
     if "t_eval" in opts:
@@ -195,7 +195,7 @@ def test_fast_t_eval_taylor_symbolic(counted):
     fast = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method="TAYLOR", t_eval=t_eval,
                              rtol=1e-12, atol=1e-12)
     full = conmech.solve_ivp(kep, (0.0, 2*np.pi), Y0, method="TAYLOR", t_eval=t_eval,
-                             rtol=np.float64(1e-12), atol=np.float64(1e-12))
+                             rtol=np.array(1e-12), atol=np.array(1e-12))
     assert len(counted) == 1
     _same(fast, full)
     ref = conmech.solve_ivp(conmech.systems.kepler(), (0.0, 2*np.pi), Y0, method="DOP853",
@@ -229,3 +229,16 @@ def test_bad_options_keep_their_messages(counted, kw, exc, text):
         conmech.solve_ivp(kep, (0.0, 1.0), Y0, method="DOP853", rtol=1e-6, atol=1e-8, **kw)
     assert text in str(info.value)
     assert not counted
+
+
+def test_numpy_double_tolerances_take_the_fast_entry(counted):
+    # tolerances from NumPy (np.logspace's values in a work-precision loop) are plain
+    # doubles: the fast entry, with the result of the same Python floats
+    kep = conmech.systems.kepler()
+    for tol in np.logspace(-6, -10, 3):
+        assert type(tol) is np.float64
+        a = conmech.solve_ivp(kep, (0.0, 2.0), Y0, method="DOP853", rtol=tol, atol=tol)
+        b = conmech.solve_ivp(kep, (0.0, 2.0), Y0, method="DOP853", rtol=float(tol),
+                              atol=float(tol))
+        _same(a, b)
+    assert len(counted) == 6

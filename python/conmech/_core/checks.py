@@ -59,7 +59,8 @@ def tolerance(value, name, n, stacklevel=3, warn=True):
     finite; a scalar or one value per component). ``rtol`` below 100 eps is raised to it
     with SciPy's UserWarning (``stacklevel``: the user's call; ``warn=False``: a caller
     that gave the warning already, without touching the global warning filters)."""
-    if type(value) is float or type(value) is int:   # fast path for the common case
+    if type(value) is float or type(value) is int or type(value) is np.float64:
+        # the common cases: a Python number, or a NumPy double (np.logspace's values)
         v = float(value)
         if not v >= 0:
             raise ValueError(f"{name} must be non-negative")

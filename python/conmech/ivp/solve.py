@@ -181,7 +181,9 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         On bad input; the message names the argument. An exception raised inside ``fun``
         or an event function reaches the caller unchanged.
     """
-    if (type(rtol) is float and type(atol) is float and type(method) is str and args is None
+    if ((type(rtol) is float or type(rtol) is np.float64) and
+            (type(atol) is float or type(atol) is np.float64) and type(method) is str
+            and args is None
             and events is None and dense_output is False and vectorized is False
             and jac is None and not options and isinstance(fun, NativeSystem)):
         # the most frequent calls, with plain inputs: checked with the cheapest tests of

@@ -33,8 +33,8 @@ def with_fixed_order(fun, rtol, atol):
     ode system made by conmech.symbolic; else `fun` itself. The library is compiled once
     per model and order (cached on disk) and kept with the model; the system is kept per
     `fun` object and order (the last 64), so a repeated call is two dictionary look-ups."""
-    r = float(rtol) if type(rtol) is float else float(np.min(rtol))
-    a = float(atol) if type(atol) is float else float(np.min(atol))
+    r = float(rtol) if isinstance(rtol, float) else float(np.min(rtol))
+    a = float(atol) if isinstance(atol, float) else float(np.min(atol))
     eps = max(r, 2.220446049250313e-16, a)       # the stepper's: rtol >= the round-off
     order = _ORDERS.get(eps)
     if order is None:
