@@ -83,24 +83,32 @@ def _batch_built(system):
     return any(k.startswith("batch") and v[1] is not None for k, v in parts.items())
 
 
+def _lanes_members_checked(system, y0s, tf, dop_tol, agree):
+    """The lanes route's ensemble of `system`: built as a batch, each member bit-identical
+    to the member-by-member route and to its own solve_ivp TAYLOR run (state and counts),
+    and within `agree` (relative) of DOP853 at `dop_tol`. Returns the ensemble."""
+    ens = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL)
+    assert ens.success and _batch_built(system)
+    by_member = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL,
+                               progress=lambda done, total: None)
+    assert np.array_equal(ens.y_final, by_member.y_final)
+    assert np.array_equal(ens.nfev, by_member.nfev)
+    for i, y0 in enumerate(y0s):
+        r = conmech.solve_ivp(system, (0, tf), y0, method="TAYLOR", rtol=TOL, atol=TOL)
+        assert r.success and ens.t_final[i] == tf
+        assert np.array_equal(ens.y_final[i], r.y[:, -1])
+        assert (ens.nfev[i], ens.naccept[i], ens.nreject[i]) == \
+            (r.nfev, r.naccept, r.nreject)
+        d = conmech.solve_ivp(system, (0, tf), y0, method="DOP853", rtol=dop_tol,
+                              atol=dop_tol)
+        scale = max(1.0, np.max(np.abs(d.y[:, -1])))
+        assert np.max(np.abs(ens.y_final[i] - d.y[:, -1])) < agree*scale, system.name
+    return ens
+
+
 def test_members_are_their_own_taylor_runs_and_agree_with_dop853(systems):
     for system, y0s, tf in systems:
-        ens = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL)
-        assert ens.success and _batch_built(system)
-        by_member = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL,
-                                   atol=TOL, progress=lambda done, total: None)
-        assert np.array_equal(ens.y_final, by_member.y_final)
-        assert np.array_equal(ens.nfev, by_member.nfev)
-        for i, y0 in enumerate(y0s):
-            r = conmech.solve_ivp(system, (0, tf), y0, method="TAYLOR", rtol=TOL, atol=TOL)
-            assert r.success and ens.t_final[i] == tf
-            assert np.array_equal(ens.y_final[i], r.y[:, -1])
-            assert (ens.nfev[i], ens.naccept[i], ens.nreject[i]) == \
-                (r.nfev, r.naccept, r.nreject)
-            d = conmech.solve_ivp(system, (0, tf), y0, method="DOP853", rtol=3e-14,
-                                  atol=3e-14)
-            scale = max(1.0, np.max(np.abs(d.y[:, -1])))
-            assert np.max(np.abs(ens.y_final[i] - d.y[:, -1])) < 1e-11*scale, system.name
+        _lanes_members_checked(system, y0s, tf, 3e-14, 1e-11)
 
 
 def test_lanes_give_the_same_bits(systems):
@@ -190,21 +198,8 @@ def test_beyond_written_out_the_lanes_route_gives_each_member_its_own_run(metron
     assert why is None and "do jj = 1, 10" in src and "lm(nl, 10, 10)" in src
     # its wide lanes' loops split (one of 271 references here) to WIDE_REFS at most
     assert max(_lane_loop_refs(src)) <= WIDE_REFS
-    ens = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL)
-    assert ens.success and _batch_built(system)
-    by_member = ensemble.solve(system, (0, tf), y0s, method="TAYLOR", rtol=TOL, atol=TOL,
-                               progress=lambda done, total: None)
-    assert np.array_equal(ens.y_final, by_member.y_final)
-    assert np.array_equal(ens.nfev, by_member.nfev)
+    ens = _lanes_members_checked(system, y0s, tf, 1e-13, 1e-9)
     for i, y0 in enumerate(y0s):
-        r = conmech.solve_ivp(system, (0, tf), y0, method="TAYLOR", rtol=TOL, atol=TOL)
-        assert r.success and ens.t_final[i] == tf
-        assert np.array_equal(ens.y_final[i], r.y[:, -1])
-        assert (ens.nfev[i], ens.naccept[i], ens.nreject[i]) == \
-            (r.nfev, r.naccept, r.nreject)
-        d = conmech.solve_ivp(system, (0, tf), y0, method="DOP853", rtol=1e-13, atol=1e-13)
-        scale = max(1.0, np.max(np.abs(d.y[:, -1])))
-        assert np.max(np.abs(ens.y_final[i] - d.y[:, -1])) < 1e-9*scale
         # a genuine motion: every pendulum and the cart move
         assert np.min(np.abs(ens.y_final[i] - y0)) > 1e-6
 
