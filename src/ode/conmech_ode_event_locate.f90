@@ -14,7 +14,8 @@ module conmech_ode_event_locate
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NONFINITE
+    use conmech_text, only: itoa, rtoa
     use conmech_ode_system, only: ode_events, ode_step_hook
     use conmech_ode_result, only: ode_result, push_event
     use conmech_ode_stepper, only: ode_stepper
@@ -84,6 +85,16 @@ contains
         nfound = 0
         ! the end first: the first call after t0 is always g at the first step's end
         call events%eval(stp%t, stp%y, g_new)
+        ! a NaN has no sign: no crossing can be told, so the run stops here (and a Python
+        ! event function that raised, whose value is NaN from then on, ends the run at once)
+        do i = 1, ne
+            if (g_new(i) /= g_new(i)) then
+                info = CM_NONFINITE
+                msg = "event function "//itoa(i)//" of "//itoa(ne)//" is NaN at t ="// &
+                      rtoa(stp%t)
+                return
+            end if
+        end do
         m = sample_count(stp, events)
         if (m > 1) then
             call sampled_crossings(stp, events, m, g_old, g_new, ev_times, ev_ids, nfound, &

@@ -125,7 +125,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         optional attribute ``resolution`` (a time) also samples the event on each step's
         continuous extension at points at most that far apart, and locates every sign
         change between them: crossings more than ``resolution`` apart are all found
-        (without changing the steps; cost: event evaluations).
+        (without changing the steps; cost: event evaluations). An event value that is
+        NaN stops the run (status -1, the message names the event and the time).
     vectorized : bool
         As SciPy's explicit methods: ``fun`` is called with y of shape (n, 1) and its
         result flattened.
