@@ -33,9 +33,9 @@ the same loops over the rows and columns, so each lane again performs the scalar
 routine's operations in its order and gets its coefficients to the last bit. Such a
 system's lanes' loops (the history sums, an order's recurrences: thousands of array
 references, which gcc's dependence analysis gives up on, leaving the loop scalar) are
-split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`; a
-10-link pendulum chain's ensemble then runs 2.35x as fast as member by member in CPU
-time, 0.79x unsplit). No size is refused; a generalized system without batch recurrences is
+split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`;
+unsplit, a 10-link pendulum chain's ensemble ran slower in lanes than member by member:
+``python bench/bench_taylor_generalized_batch.py --system chain10``). No size is refused; a generalized system without batch recurrences is
 one without scalar ones (a non-smooth expression, an asymmetric M), and one order
 written out (``fixed``) is not generated (the loop version serves every order)."""
 import re
