@@ -35,9 +35,10 @@ system's lanes' loops (the history sums, an order's recurrences: thousands of ar
 references, which gcc's dependence analysis gives up on, leaving the loop scalar) are
 split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`;
 unsplit, a 10-link pendulum chain's ensemble ran slower in lanes than member by member:
-``python bench/bench_taylor_generalized_batch.py --system chain10``). No size is refused; a generalized system without batch recurrences is
-one without scalar ones (a non-smooth expression, an asymmetric M), and one order
-written out (``fixed``) is not generated (the loop version serves every order)."""
+``python bench/bench_taylor_generalized_batch.py --system chain10``). No size is
+refused; a generalized system without batch recurrences is one without scalar ones (a
+non-smooth expression, an asymmetric M), and one order written out (``fixed``) is not
+generated (the loop version serves every order)."""
 import re
 
 from .taylor import _decls, _wrap
@@ -240,7 +241,8 @@ def _split_wide(lines):
                     st, k = _joined(body, k)
                     stmts.append(st)
                 for ch in _chunks(stmts):
-                    out += [x, lines[i + 1]] + [y for st in ch for y in st] + [f"{at}end do"]
+                    out += [x, lines[i + 1]] + [y for st in ch for y in st]
+                    out.append(f"{at}end do")
                 i = end + 1
                 continue
         out.append(x)
