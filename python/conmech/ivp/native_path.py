@@ -135,10 +135,14 @@ def solve_callable(rhs, guard, n, t0, tf, y0, t_ev, with_t_eval, code, rtol, ato
     out = np.empty(cap*(n + 1))
     iout = np.zeros(40, dtype=_INT64)
     _conmech.flat_solve_rhs_packed(rhs, ipar, rpar, t0, tf, y0, out, iout)
-    res = _result(out, iout, n, guard)
+    return scipy_points(_result(out, iout, n, guard), with_t_eval, neval)
+
+
+def scipy_points(res, with_t_eval, neval):
+    """res with SciPy's empty lists as t and y when a run with t_eval (neval times)
+    reached none of them, or t_eval is empty (the flat call's neval = 0 stores every
+    step)."""
     if with_t_eval and (res.t.size == 0 or not neval):
-        # SciPy's lists when no point of t_eval was reached, or t_eval is empty (the
-        # flat call's neval = 0 stores every step)
         res.t, res.y = [], []
     return res
 
@@ -152,6 +156,4 @@ def solve_native(fun, t0, tf, y0, t_ev, with_t_eval, code, rtol, atol, h0, hmax,
     prep = prepare(fun, code, rtol, atol, h0, hmax, max_steps,
                    t_ev if with_t_eval else None)
     res = run(prep, t0, tf, y0, max(t_ev.size, 2) if with_t_eval else 0)
-    if with_t_eval and (res.t.size == 0 or not t_ev.size):
-        res.t, res.y = [], []   # as solve_callable's
-    return res
+    return scipy_points(res, with_t_eval, t_ev.size)

@@ -15,7 +15,7 @@ import numpy as np
 
 from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR, _warn_rtol
 from .methods import BY_NAME, RK45_SCIPY
-from .native_path import prepare, run as run_native, with_options
+from .native_path import prepare, run as run_native, scipy_points, with_options
 
 __all__ = ["fast_solve", "fast_method_code"]
 
@@ -128,9 +128,7 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
         _warn_rtol(4)
     packed = with_options(prep[1:], *steps, t_eval)
     res = run_native(packed, t0, tf, y0, max(len(t_eval), 2) if t_eval is not None else 0)
-    if t_eval is not None and (res.t.size == 0 or not len(t_eval)):
-        res.t, res.y = [], []   # as native_path.solve_native's
-    return res
+    return scipy_points(res, t_eval is not None, len(t_eval) if t_eval is not None else 0)
 
 
 def _step_options(t0, tf, first_step, max_step, max_steps):
