@@ -1,7 +1,8 @@
 !> Event location on the last step of any stepper: sign changes of the event functions
 !! (with each event's direction), each root found by Brent's method on the step's
 !! continuous extension (`eval_unit`, to near machine precision in t), reported in the
-!! order of time (ties in the order of the events) up to the one that ends the run: a
+!! order of time (ties in the order the roots were found: by event index for the events
+!! without a resolution, as SciPy's) up to the one that ends the run: a
 !! terminal event at the occurrence that brings its remaining count to zero (SciPy's
 !! handle_events: nothing after it is reported, not even an event at the same time).
 !!
