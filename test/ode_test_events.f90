@@ -12,8 +12,10 @@ module ode_test_events
         procedure :: eval => radial_eval
     end type radial_events
 
-    !> sin(50 y_1) + 0.9: with y_1 = t, 32 zeros on [0, 2], the closest 0.018 apart.
+    !> sin(50 y_1) + level: with y_1 = t and the default level 0.9, 32 zeros on [0, 2], the
+    !! closest 0.018 apart; with level 0, zero at t = 0 and every pi/50.
     type, extends(ode_events) :: sine_event
+        real(dp) :: level = 0.9_dp
     contains
         procedure :: eval => sine_eval
     end type sine_event
@@ -40,7 +42,7 @@ contains
         class(sine_event), intent(in) :: self
         real(dp), intent(in) :: t, y(:)
         real(dp), intent(out) :: g(:)
-        g(1) = sin(50.0_dp*y(1)) + 0.9_dp
+        g(1) = sin(50.0_dp*y(1)) + self%level
     end subroutine sine_eval
 
     subroutine circle_after_step(self, t, y, changed, info)

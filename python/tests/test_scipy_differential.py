@@ -8,16 +8,11 @@ initial step and controller), so the structure of the two results must be the sa
 status, message, sol present or not) and the values must agree to round-off: the step
 times, the states, the event times (to 1e-8 relative) and the dense output.
 
-Documented differences: nfev is SciPy's + 1 without first_step (SciPy's initial-step
-heuristic is counted once more), and conmech's extra keys (naccept, nreject).
+This holds for terminal counts above one too (terminal=2: the run goes on with SciPy's
+steps after the first occurrence) and for events exactly zero at t0 (SciPy's rule).
 
-A known difference, not a deliberate one: an event with a terminal count above one
-(terminal=2) ends a segment at each occurrence before the last and the run restarts there
-with a new initial step, where SciPy carries on with its steps. Up to that first
-occurrence everything is compared as above; after it only the structure that does not
-depend on the steps (types, dtypes, numbers of rows, status, message), since the steps,
-and with them the crossings that SciPy's rule (a sign change between step ends) misses,
-differ."""
+Documented differences: nfev is SciPy's + 1 without first_step (SciPy's initial-step
+heuristic is counted once more), and conmech's extra keys (naccept, nreject)."""
 import math
 import os
 import warnings
@@ -146,31 +141,10 @@ def same_array_structure(a, b, what):
         assert len(a) == len(b), (what, a, b)
 
 
-def restart_time(a, events, t0, tf):
-    """The first occurrence, in SciPy's result a, of an event with a terminal count above
-    one (where conmech restarts the run), or None."""
-    if events is None or isinstance(a, type):
-        return None
-    evs = [events] if callable(events) else events
-    sgn = math.copysign(1.0, tf - t0)
-    times = [a.t_events[k][0] for k, e in enumerate(evs)
-             if getattr(e, "terminal", False) not in (False, True, 0, 1)
-             and a.t_events[k].size]
-    return min(times, key=lambda t: t * sgn) if times else None
-
-
-def before(t, t_r, sgn, margin, inclusive=False):
-    """The mask of the times t before t_r in the direction sgn (inclusive: up to t_r;
-    margin: the round-off of the two runs' t_r)."""
-    d = (np.asarray(t, dtype=float) - t_r) * sgn
-    return d <= margin if inclusive else d < -margin
-
-
-def compare(a, b, n, scale, t0, tf, t_r=None, with_t_eval=False, nfev_extra=None, vtol=1e-8,
+def compare(a, b, n, scale, t0, tf, with_t_eval=False, nfev_extra=None, vtol=1e-8,
             ttol=1e-6, same_grid=True):
     """SciPy's result a and conmech's b: the structure exactly, the values to the
-    round-off of the same steps; t_r (see restart_time): after it, the structure that does
-    not depend on the steps only. nfev_extra: conmech's nfev - SciPy's, when pinned.
+    round-off of the same steps. nfev_extra: conmech's nfev - SciPy's, when pinned.
     Not same_grid (other steps): without t_eval, t and y at the ends only."""
     if isinstance(a, type) or isinstance(b, type):
         assert a is b, (a, b)          # both raise the same kind of exception
@@ -180,8 +154,7 @@ def compare(a, b, n, scale, t0, tf, t_r=None, with_t_eval=False, nfev_extra=None
     assert b.message == a.message
     span = abs(tf - t0)
     sgn = math.copysign(1.0, tf - t0)
-    margin = min(vtol, 1e-4) * span     # the two runs' t_r differ by about this
-    if (t_r is None and same_grid) or with_t_eval:
+    if same_grid or with_t_eval:
         same_array_structure(a.t, b.t, "t")
         same_array_structure(a.y, b.y, "y")
     else:
@@ -191,29 +164,22 @@ def compare(a, b, n, scale, t0, tf, t_r=None, with_t_eval=False, nfev_extra=None
                       np.asarray(b.y))
     if not same_grid and not with_t_eval:
         assert b.t.size >= 2 and b.y.shape == (n, b.t.size)
-        ends = [0, -1] if t_r is None else [0]
+        ends = [0, -1]
         ta, ya, tb, yb = ta[ends], ya[:, ends], tb[ends], yb[:, ends]
-    elif t_r is not None:
-        ka, kb = before(ta, t_r, sgn, margin), before(tb, t_r, sgn, margin)
-        ta, ya, tb, yb = ta[ka], ya[..., ka], tb[kb], yb[..., kb]
-        assert ta.shape == tb.shape
     # the step sizes agree to the round-off of the error estimates, which the controller
     # amplifies (up to ~1e-7 of the span at rtol 1e-10); y at those times agrees to that
     # shift times its rate of change
     np.testing.assert_allclose(tb, ta, rtol=0, atol=ttol * span)
     shift = np.max(np.abs(tb - ta), initial=0.0)
     np.testing.assert_allclose(yb, ya, rtol=vtol, atol=vtol * scale + 10 * shift * scale)
-    if nfev_extra is not None and t_r is None:
+    if nfev_extra is not None:
         assert b.nfev == a.nfev + nfev_extra, (a.nfev, b.nfev)
     assert (a.sol is None) == (b.sol is None)
     if a.sol is not None:
         assert callable(b.sol)
         ends_a, ends_b = (a.sol.t_min, a.sol.t_max), (b.sol.t_min, b.sol.t_max)
         t_end = a.sol.t_max if sgn > 0 else a.sol.t_min
-        if t_r is None:
-            np.testing.assert_allclose(ends_b, ends_a, rtol=0, atol=vtol * span)
-        else:
-            t_end = t_r
+        np.testing.assert_allclose(ends_b, ends_a, rtol=0, atol=vtol * span)
         tt = t0 + np.linspace(0.0, 1.0, 8)[:-1] * (t_end - t0)
         sa, sb = a.sol(tt), b.sol(tt)
         assert sa.shape == sb.shape
@@ -227,13 +193,6 @@ def compare(a, b, n, scale, t0, tf, t_r=None, with_t_eval=False, nfev_extra=None
     assert len(b.t_events) == len(a.t_events) == len(b.y_events) == len(a.y_events)
     for k, (tea, teb, yea, yeb) in enumerate(zip(a.t_events, b.t_events, a.y_events,
                                                  b.y_events)):
-        if t_r is not None:
-            assert type(teb) is np.ndarray and teb.ndim == 1 and teb.dtype == tea.dtype
-            assert type(yeb) is np.ndarray and (yeb.shape == (0,) if not teb.size else
-                                                yeb.shape == (teb.size, n))
-            ka = before(tea, t_r, sgn, margin, True)
-            kb = before(teb, t_r, sgn, margin, True)
-            tea, teb, yea, yeb = tea[ka], teb[kb], yea[ka], yeb[kb]
         same_array_structure(tea, teb, f"t_events[{k}]")
         same_array_structure(yea, yeb, f"y_events[{k}]")
         np.testing.assert_allclose(teb, tea, rtol=vtol, atol=vtol * span)
@@ -277,8 +236,7 @@ def test_rk45_python_rhs_agrees_with_scipy(problem, t0, length, backwards, t_eva
                  (param,) if use_args else None, t0, tf, y0, single_event)
     a = run(scipy_integrate.solve_ivp, fun, (t0, tf), y0, **kw)
     b = run(conmech.solve_ivp, fun, (t0, tf), y0, **kw)
-    compare(a, b, len(y0), max(map(abs, y0)) * 10, t0, tf,
-            restart_time(a, kw["events"], t0, tf), kw["t_eval"] is not None,
+    compare(a, b, len(y0), max(map(abs, y0)) * 10, t0, tf, kw["t_eval"] is not None,
             nfev_extra=1 if first_step is None else 0)
 
 
@@ -307,14 +265,13 @@ def test_compiled_system_agrees_with_scipy(system, method, t0, length, backwards
                  single_event)
     a = run(scipy_integrate.solve_ivp, rhs, (t0, tf), y0, method=method, **kw)
     b = run(conmech.solve_ivp, make(), (t0, tf), y0, method=method, **kw)
-    t_r = restart_time(a, kw["events"], t0, tf)
     scale, with_t_eval = max(map(abs, y0)) * 10, kw["t_eval"] is not None
     if method == "RK45":
-        compare(a, b, len(y0), scale, t0, tf, t_r, with_t_eval)
+        compare(a, b, len(y0), scale, t0, tf, with_t_eval)
     else:
         # DOP853: Hairer's initial step (documented), so other steps: the t grid of a run
         # without t_eval is not SciPy's; the values agree to the solution's accuracy
-        compare(a, b, len(y0), scale, t0, tf, t_r, with_t_eval,
+        compare(a, b, len(y0), scale, t0, tf, with_t_eval,
                 vtol=max(100 * kw["rtol"], 1e-7), same_grid=False)
     if isinstance(b, type) or kw["events"] is not None or dense:
         return
@@ -374,8 +331,8 @@ def test_no_event_reported_after_the_terminating_one_at_the_same_time():
 
 def test_terminal_event_at_t0_counts_the_first_step_only():
     """A terminal event zero at t0 that the first step moves in its direction stops the
-    run at t0 (SciPy's rule) after that one step: nfev is SciPy's + 1, not the count of
-    a run that went on to tf with the stopped callbacks' NaN."""
+    run at t0 (SciPy's rule) after that one step: nfev is SciPy's + 1 (its initial-step
+    heuristic), the first step's evaluations and no more."""
     def at_start(t, y):
         return t
     at_start.terminal = True
@@ -384,3 +341,21 @@ def test_terminal_event_at_t0_counts_the_first_step_only():
     assert b.status == a.status == 1 and list(b.t) == list(a.t) == [0.0, 0.0]
     np.testing.assert_array_equal(b.t_events[0], [0.0])
     assert b.nfev == a.nfev + 1
+
+
+def test_terminal_count_takes_scipys_steps_after_each_occurrence():
+    """terminal=3 on an event that crosses zero every 0.5: the run goes on with SciPy's
+    steps past the first two occurrences (no restart, no new initial step), so t, y, the
+    events, the dense output and nfev are SciPy's (compare's criteria), forwards and
+    backwards."""
+    def wave(t, y):
+        return math.sin(2 * math.pi * t) + 0.3
+    wave.terminal = 3
+    for tf in (5.0, -5.0):
+        for dense in (False, True):
+            kw = dict(events=wave, dense_output=dense, rtol=1e-6, atol=1e-9)
+            a = scipy_integrate.solve_ivp(oscillator, (0.0, tf), [1.0, 0.5], **kw)
+            b = conmech.solve_ivp(oscillator, (0.0, tf), [1.0, 0.5], **kw)
+            assert b.status == a.status == 1 and b.t_events[0].size == 3
+            assert b.t.size == a.t.size > 4 and b.naccept == a.t.size - 1
+            compare(a, b, 2, 10.0, 0.0, tf, nfev_extra=1)

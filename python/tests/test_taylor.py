@@ -194,13 +194,19 @@ def test_compiled_events_find_every_root(kepler):
 
 
 def test_event_of_a_state_variable(kepler):
-    """Crossings of y = 0 (the apsides) of Kepler e = 0.9: half periods."""
+    """Crossings of y = 0 (the apsides) of Kepler e = 0.9: half periods, and t0, where y
+    is exactly zero (SciPy's rule, applied to compiled events as to a Python one)."""
     x, y = sp.symbols("x y")
     e = 0.9
     y0 = [1 - e, 0.0, 0.0, np.sqrt((1 + e)/(1 - e))]
-    r = conmech.solve_ivp(kepler, (0, 3*np.pi + 0.1), y0, method="TAYLOR", rtol=1e-12,
-                          atol=1e-12, events=[symbolic.event(kepler, y)])
-    assert np.allclose(r.t_events[0], [np.pi, 2*np.pi, 3*np.pi], rtol=0, atol=1e-9)
+    kw = dict(method="TAYLOR", rtol=1e-12, atol=1e-12)
+    r = conmech.solve_ivp(kepler, (0, 3*np.pi + 0.1), y0, events=[symbolic.event(kepler, y)],
+                          **kw)
+    assert r.t_events[0][0] == 0.0 and np.array_equal(r.y_events[0][0], y0)
+    assert np.allclose(r.t_events[0], [0.0, np.pi, 2*np.pi, 3*np.pi], rtol=0, atol=1e-9)
+    p = conmech.solve_ivp(kepler, (0, 3*np.pi + 0.1), y0, events=[lambda t, s: s[1]], **kw)
+    assert p.t_events[0].size == 4
+    np.testing.assert_allclose(r.t_events[0], p.t_events[0], rtol=0, atol=1e-9)
 
 
 def test_variational_taylor_agrees_with_dop853(arenstorf):

@@ -259,6 +259,8 @@ contains
                 gev%n = n
                 if (allocated(events%direction)) gev%direction = events%direction
                 if (allocated(events%terminal)) gev%terminal = events%terminal
+                if (allocated(events%count)) gev%count = events%count
+                gev%zero_at_t0 = events%zero_at_t0
                 if (options%dae_index == 3) then
                     call ode_solve(g3, t_span, y0, opt, ores, t_eval=t_eval, events=gev, &
                                    stepper=rstp)

@@ -4,8 +4,11 @@
 !!   or the points of t_eval, from the stepper's continuous extension (or, in hit mode,
 !!   options%hit_t_eval, at step ends that land on them);
 !! - events located on the continuous extension (conmech_ode_event_locate), in time order,
-!!   a terminal one ending the run at its state (status CM_EVENT_STOP); an event with a
-!!   `resolution` is also sampled inside each step, so that no two crossings cancel;
+!!   a terminal one ending the run at its state at its `count`-th occurrence (status
+!!   CM_EVENT_STOP; the occurrences left are the run's, the events stay intent(in)); an
+!!   event with a `resolution` is also sampled inside each step, so that no two crossings
+!!   cancel; with `zero_at_t0`, an event zero at t0 is tested on the first step by SciPy's
+!!   rule (a stop there ends the run at t0 with y0, after that one step);
 !! - the step hook (`ode_step_hook`: after every accepted step, and at every event state),
 !!   which may change y (a projection onto a manifold), count or stop the run;
 !! - the dense solution (options%dense_output): the steps' polynomials, segment by segment;
@@ -21,7 +24,7 @@ module conmech_ode_driver
     use conmech_ode_dense, only: dense_init, dense_push
     use conmech_ode_result, only: ode_result, push_point, shrink_result
     use conmech_ode_stepper, only: ode_stepper, check_t_eval
-    use conmech_ode_event_locate, only: find_events, check_events
+    use conmech_ode_event_locate, only: find_events, check_events, event_counts
     implicit none
     private
     public :: ode_drive
@@ -47,6 +50,8 @@ contains
         class(ode_step_hook), intent(inout), optional :: hook
 
         real(dp), allocatable :: g_old(:), ytmp(:), y_stop(:)
+        integer, allocatable :: ev_left(:)
+        logical, allocatable :: at_start(:)
         real(dp) :: t, t_stop, target, h_next
         integer :: n, i_eval, n_eval, hinfo
         logical :: need_dense, keep_dense, has_events, store_steps, stop_now, changed
@@ -109,6 +114,9 @@ contains
         if (has_events) then
             allocate (g_old(events%n_events()), y_stop(n))
             call events%eval(t0, y, g_old)
+            ev_left = event_counts(events)
+            ! the events SciPy's rule tests at t0 (on the first step only)
+            at_start = events%zero_at_t0 .and. g_old == 0.0_dp
         end if
         if (n_eval > 0) allocate (ytmp(n))
         ! without dense output, a hook that may change y gets f evaluated once, after it
@@ -143,8 +151,9 @@ contains
             stop_now = .false.
             t_stop = stp%t
             if (has_events) then
-                call find_events(stp, events, g_old, stop_now, t_stop, y_stop, info, msg, &
-                                 res, hook)
+                call find_events(stp, events, g_old, at_start, ev_left, stop_now, t_stop, &
+                                 y_stop, info, msg, res, hook)
+                at_start = .false.
                 if (info /= CM_SUCCESS) exit
             end if
 

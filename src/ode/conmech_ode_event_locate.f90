@@ -1,7 +1,13 @@
 !> Event location on the last step of any stepper: sign changes of the event functions
 !! (with each event's direction), each root found by Brent's method on the step's
 !! continuous extension (`eval_unit`, to near machine precision in t), reported in the
-!! order of time up to the first terminal one.
+!! order of time (ties in the order the roots were found: by event index for the events
+!! without a resolution, as SciPy's) up to the one that ends the run: a
+!! terminal event at the occurrence that brings its remaining count to zero (SciPy's
+!! handle_events: nothing after it is reported, not even an event at the same time).
+!!
+!! With `zero_at_t0`, an event exactly zero at t0 is a root at t0 of the first step when
+!! the step's end moves it in its direction (SciPy's find_active_events with g_old = 0).
 !!
 !! By default an event is compared at the step's two ends only (SciPy's rule): one sign
 !! change per step and event, so two crossings inside one step cancel and are missed. An
@@ -22,7 +28,7 @@ module conmech_ode_event_locate
     use conmech_brent, only: brent_state, brent_init, brent_step, brent_take
     implicit none
     private
-    public :: find_events, check_events
+    public :: find_events, check_events, event_counts
 
     !> the largest count of sub-intervals of one step (half the int64 range)
     integer(int64), parameter :: M_MAX = ishft(huge(1_int64), -1)
@@ -30,7 +36,8 @@ module conmech_ode_event_locate
 contains
 
     !> Check the event settings: terminal and direction allocated with one entry per
-    !! event, resolution (if allocated) as many entries, each >= 0 and not NaN.
+    !! event, resolution (if allocated) as many entries, each >= 0 and not NaN, count (if
+    !! allocated) as many entries, each >= 1.
     subroutine check_events(events, info, msg)
         class(ode_events), intent(in) :: events
         integer, intent(out) :: info
@@ -42,6 +49,8 @@ contains
             msg = "bad input: events%terminal and events%direction differ in size"
         else if (.not. resolution_ok()) then
             msg = "bad input: events%resolution must have one entry per event, each >= 0"
+        else if (.not. count_ok()) then
+            msg = "bad input: events%count must have one entry per event, each >= 1"
         else
             info = CM_SUCCESS
             msg = "success"
@@ -55,18 +64,40 @@ contains
             resolution_ok = .not. (any(ieee_is_nan(events%resolution)) .or. &
                                    any(events%resolution < 0.0_dp))
         end function resolution_ok
+        logical function count_ok()
+            count_ok = .true.
+            if (.not. allocated(events%count)) return
+            count_ok = size(events%count) == size(events%direction)
+            if (count_ok) count_ok = all(events%count >= 1)
+        end function count_ok
     end subroutine check_events
 
+    !> The occurrences left before each event ends the run, at the start of a run (checked
+    !! settings): its count for a terminal event (1 if unallocated), 0 for the others
+    !! (never ending it). The run decrements them in `find_events`.
+    pure function event_counts(events) result(left)
+        class(ode_events), intent(in) :: events
+        integer :: left(size(events%direction))
+        left = 0
+        where (events%terminal) left = 1
+        if (allocated(events%count)) where (events%terminal) left = events%count
+    end function event_counts
+
     !> Locate the zero crossings of the event functions in the accepted step of stp
-    !! (g_old: the functions at its start, updated to its end). Each event state is passed
-    !! to hook%at_event (if present) and stored in res (if present). At a terminal event:
-    !! stop_now, its time t_stop and state y_stop; later events of the step are dropped.
-    !! info /= CM_SUCCESS (with msg) when the extension or the hook fails.
-    subroutine find_events(stp, events, g_old, stop_now, t_stop, y_stop, info, msg, res, &
-                           hook)
+    !! (g_old: the functions at its start, updated to its end; at_start: the events that
+    !! are roots at the step's start if its end moves them in their direction, SciPy's rule
+    !! at t0). Each event state is passed to hook%at_event (if present) and stored in res
+    !! (if present); left (see `event_counts`) counts the occurrences down. At the one that
+    !! brings an entry to zero: stop_now, its time t_stop and state y_stop; later events of
+    !! the step are dropped. info /= CM_SUCCESS (with msg) when the extension or the hook
+    !! fails.
+    subroutine find_events(stp, events, g_old, at_start, left, stop_now, t_stop, y_stop, &
+                           info, msg, res, hook)
         class(ode_stepper), intent(inout) :: stp
         class(ode_events), intent(in) :: events
         real(dp), intent(inout) :: g_old(:)
+        logical, intent(in) :: at_start(:)
+        integer, intent(inout) :: left(:)
         logical, intent(inout) :: stop_now
         real(dp), intent(inout) :: t_stop
         real(dp), intent(inout) :: y_stop(:)
@@ -74,7 +105,7 @@ contains
         character(len=:), allocatable, intent(inout) :: msg
         type(ode_result), intent(inout), optional :: res
         class(ode_step_hook), intent(inout), optional :: hook
-        real(dp) :: g_new(size(g_old)), ye(stp%n), posneg, te, tmin
+        real(dp) :: g_new(size(g_old)), ye(stp%n), posneg, te
         real(dp), allocatable :: ev_times(:)
         integer, allocatable :: ev_ids(:), order(:)
         integer :: ne, ie, iev, i, j, nfound
@@ -94,6 +125,13 @@ contains
                       rtoa(stp%t)
                 return
             end if
+        end do
+        ! SciPy's find_active_events with g_old = 0: rising if g_new >= 0, falling if
+        ! g_new <= 0; the root is the step's start
+        do i = 1, ne
+            if (.not. at_start(i)) cycle
+            if (.not. leaves_zero(g_new(i), events%direction(i))) cycle
+            call add_root(ev_times, ev_ids, nfound, stp%t_old, i)
         end do
         m = sample_count(stp, events)
         if (m > 1) then
@@ -128,14 +166,14 @@ contains
                 j = j - 1
             end do
         end do
-        tmin = stp%t
         do j = 1, nfound
             i = order(j)
             te = ev_times(i)
             ie = ev_ids(i)
-            if (stop_now .and. (te - tmin)*posneg > 0.0_dp) exit
             if (te == stp%t) then
                 ye = stp%y
+            else if (te == stp%t_old) then
+                ye = stp%y_old
             else
                 call stp%eval(te, ye, info, msg)
                 if (info /= CM_SUCCESS) return
@@ -150,11 +188,14 @@ contains
                 info = CM_SUCCESS
             end if
             if (present(res)) call push_event(res, te, ye, ie)
-            if (events%terminal(ie) .and. .not. stop_now) then
-                stop_now = .true.
-                tmin = te
-                t_stop = te
-                y_stop = ye
+            if (left(ie) > 0) then
+                left(ie) = left(ie) - 1
+                if (left(ie) == 0) then
+                    stop_now = .true.
+                    t_stop = te
+                    y_stop = ye
+                    exit
+                end if
             end if
         end do
     end subroutine find_events
@@ -167,6 +208,13 @@ contains
         crossing = (ga < 0.0_dp .and. gb >= 0.0_dp .and. dir >= 0) .or. &
                    (ga > 0.0_dp .and. gb <= 0.0_dp .and. dir <= 0)
     end function crossing
+
+    !> An event zero at a step's start that its end gb moves in its direction dir.
+    pure logical function leaves_zero(gb, dir)
+        real(dp), intent(in) :: gb
+        integer, intent(in) :: dir
+        leaves_zero = (gb >= 0.0_dp .and. dir >= 0) .or. (gb <= 0.0_dp .and. dir <= 0)
+    end function leaves_zero
 
     !> Whether event i is sampled inside the steps (a positive resolution).
     pure logical function resolved(events, i)

@@ -48,7 +48,8 @@ contains
     !! the end points only); with `t_eval` (sorted in the direction of integration and
     !! inside t_span) it holds the solution there, from the dense output. Events are
     !! located on the dense output to near machine precision; a terminal event ends the
-    !! integration there (status CM_EVENT_STOP) and is the last output point. `stepper`:
+    !! integration at its `count`-th occurrence (status CM_EVENT_STOP), which is the last
+    !! output point. `stepper`:
     !! a caller's own stepper (any extension of `ode_stepper`) instead of the one of
     !! options%method.
     subroutine ode_solve(sys, t_span, y0, options, res, t_eval, events, hook, stepper)

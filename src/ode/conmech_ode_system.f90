@@ -26,10 +26,15 @@
 !!
 !! Events are an extension of `ode_events`: `eval` fills g(1:n_events) at (t, y); the
 !! components `direction` (+1 rising only, -1 falling only, 0 both) and `terminal` say which
-!! zero crossings count and which stop the integration. The optional `resolution` sets, per
+!! zero crossings count and which stop the integration; the optional `count` makes a terminal
+!! event stop the run at its count-th occurrence (every occurrence is reported). The
+!! optional `resolution` sets, per
 !! event, the largest spacing in t at which the event is sampled on each step's continuous
 !! extension (0 or unallocated: only at the step's ends, SciPy's rule, which misses two
-!! crossings inside one step).
+!! crossings inside one step). `zero_at_t0` (off by default) adds SciPy's rule at the start:
+!! an event exactly zero at t0 is reported there when the first step moves it in its
+!! direction; off, an event that starts on its surface (a Poincare section through the
+!! initial state) is first seen where it crosses again.
 module conmech_ode_system
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_kinds, only: dp
@@ -91,6 +96,13 @@ module conmech_ode_system
     type, abstract :: ode_events
         integer, allocatable :: direction(:)   !! +1 rising, -1 falling, 0 both
         logical, allocatable :: terminal(:)    !! stop the integration at this event
+        !> the occurrence of a terminal event that stops the integration (unallocated: the
+        !! first; ignored for a non-terminal event)
+        integer, allocatable :: count(:)
+        !> SciPy's rule at t0: an event exactly zero at t0 is reported at t0 (with y0, and
+        !! counted) if its value at the end of the first step is >= 0 for a rising event,
+        !! <= 0 for a falling one (either for both directions)
+        logical :: zero_at_t0 = .false.
         !> largest spacing in t of the samples of the event on each step's continuous
         !! extension, so that crossings farther apart than it are told apart (0 or
         !! unallocated: the step's ends only, SciPy's rule)

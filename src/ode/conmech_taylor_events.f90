@@ -40,9 +40,6 @@ module conmech_taylor_events
         integer :: degree = 24      !! D, the degree of the events' series
         real(dp), allocatable :: p(:)   !! parameters
         integer :: nsplit = 0       !! steps shortened to separate two roots (statistics)
-        !> events taken as zero at t = t_zero (a run continued from one of their roots)
-        logical, allocatable :: zero_at(:)
-        real(dp) :: t_zero = 0.0_dp
     contains
         procedure :: eval => events_eval
     end type taylor_events
@@ -60,9 +57,6 @@ contains
         w(0, 1:self%n) = y(1:self%n)
         call self%series(t, 0, w, self%p)
         g(1:self%ne) = w(0, self%n + 1:self%n + self%ne)
-        if (allocated(self%zero_at) .and. t == self%t_zero) then
-            where (self%zero_at) g(1:self%ne) = 0.0_dp
-        end if
     end subroutine events_eval
 
     !> Shorten the step h (signed) from (t, polynomial c(0:p, 1:n)) so that no event has

@@ -77,9 +77,11 @@ end subroutine flat_system_dimension
 !! differences).
 !! Tolerances are per component; first_step = 0: automatic; dense /= 0: dense output;
 !! neval = 0: output at every accepted step; ne = 0: no events (`events` is not called).
-!! ev_dir: +1 rising, -1 falling, 0 both; ev_term /= 0: terminal; ev_res: each event's
-!! resolution (largest spacing of its samples inside a step; 0: the step's ends only, SciPy's
-!! rule). jac_const /= 0: the Jacobian is constant (read once, njev 0); nnz >= 0: the
+!! ev_dir: +1 rising, -1 falling, 0 both; ev_term > 0: terminal, the run stops at that
+!! occurrence (0: not terminal); an event exactly zero at t0 follows SciPy's rule (reported
+!! at t0 when the first step moves it in its direction); ev_res: each event's resolution
+!! (largest spacing of its samples inside a step; 0: the step's ends only, SciPy's rule).
+!! jac_const /= 0: the Jacobian is constant (read once, njev 0); nnz >= 0: the
 !! sparsity pattern of df/dy by columns, sp_ptr(n + 1) and rows sp_idx(1:nnz) (1-based), for
 !! differences by groups of columns (methods that use a Jacobian; nnz = -1: none).
 !! dense_form: form of the dense coefficients handed to `store` (1 Hairer's, 2 power basis,
@@ -118,5 +120,5 @@ subroutine flat_solve(name, np, params, nspec, spec, fun, jfun, source, events, 
     if (info /= CM_SUCCESS) return
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, jac_const, nnz, sp_ptr, &
-                   sp_idx, events, store, counts, dense_form, info, message)
+                   sp_idx, events, store, counts, dense_form, info, message, zero_at_t0=.true.)
 end subroutine flat_solve

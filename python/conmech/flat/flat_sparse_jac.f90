@@ -32,7 +32,7 @@ subroutine flat_solve_sparse_jac(fun, jvals, events, store, n, t_span, y0, metho
     if (info /= CM_SUCCESS) return
     call run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, max_steps, &
                    dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, 0, nnz, sp_ptr, &
-                   sp_idx, events, store, counts, dense_form, info, message)
+                   sp_idx, events, store, counts, dense_form, info, message, zero_at_t0=.true.)
 end subroutine flat_solve_sparse_jac
 
 !> One stepper action (flat_stepper_callback's) with a sparse Jacobian: jvals and the

@@ -4,13 +4,13 @@
 !! with compiled events: evaddr is the address of the events' series routine
 !! (conmech.symbolic.taylor.event_source) with evnw work columns, evdeg the degree of the
 !! series used to isolate their roots; ne events with directions ev_dir (+1 rising, -1
-!! falling, 0 both) and terminal flags ev_term; ev_zero /= 0: the event is taken as zero
-!! at t0 (a run continued from its root). Other arguments and `store` as in
-!! flat_solve; counts = [nfev, njev, nlu, naccept, nreject, steps shortened to
-!! separate two roots of an event].
+!! falling, 0 both) and terminal counts ev_term (> 0: the run stops at that occurrence,
+!! 0: not terminal); an event exactly zero at t0 follows SciPy's rule, as in flat_solve.
+!! Other arguments and `store` as in flat_solve; counts = [nfev, njev, nlu, naccept,
+!! nreject, steps shortened to separate two roots of an event].
 subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0, rtol, &
                              atol, first_step, max_step, max_steps, dense, neval, t_eval, &
-                             evaddr, evnw, evdeg, ne, ev_dir, ev_term, ev_zero, counts, &
+                             evaddr, evnw, evdeg, ne, ev_dir, ev_term, counts, &
                              dense_form, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
     use conmech_kinds, only: dp
@@ -34,7 +34,7 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
     real(c_double), intent(in) :: t_eval(max(neval, 1))
     integer(8), intent(in) :: evaddr
     integer(c_int), intent(in) :: evnw, evdeg, ne
-    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1)), ev_zero(max(ne, 1))
+    integer(c_int), intent(in) :: ev_dir(max(ne, 1)), ev_term(max(ne, 1))
     integer(c_int), intent(out) :: counts(6), dense_form, info
     character(len=256), intent(out) :: message
 !f2py external store
@@ -65,7 +65,7 @@ subroutine flat_solve_taylor(name, np, params, nspec, spec, store, n, t_span, y0
     end if
     call run_taylor_solve(sys, n, t_span, y0, rtol, atol, first_step, max_step, max_steps, &
                           dense, neval, t_eval, int(evaddr, c_int64_t), evnw, evdeg, &
-                          real(params(1:max(np, 1)), dp), ne, ev_dir, ev_term, ev_zero, store, &
+                          real(params(1:max(np, 1)), dp), ne, ev_dir, ev_term, store, &
                           counts, dense_form, info, message)
 end subroutine flat_solve_taylor
 

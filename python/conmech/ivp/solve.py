@@ -31,7 +31,7 @@ from .complex_form import complex_result as _complex_result, real_form as _real_
 from .empty import solve_empty as _solve_empty
 from .solve_fast import fast_solve as _fast_solve
 from .result import OdeResult
-from .assemble import assemble as _assemble, drop_first_point as _drop_first_point
+from .assemble import assemble as _assemble
 from .._core.status import BAD_INPUT
 
 __all__ = ["solve_ivp", "OdeResult", "DenseOutput", "OdeSolution"]
@@ -50,10 +50,6 @@ _PAD, _PADI, _EMPTY = np.zeros(1), np.zeros(1, dtype=np.intc), np.zeros(0)
 _PAD.flags.writeable = _PADI.flags.writeable = _EMPTY.flags.writeable = False
 _COMPLEX_REFUSED = ("`y0` is complex, but the chosen solver does not support integration "
                     "in a complex domain.")
-
-
-class _StopAtStart(Exception):
-    """Internal: a terminal event zero at t0 stops the run there (SciPy's rule)."""
 
 
 _OPTION_NAMES = ("jac", "jac_sparsity", "lband", "uband", "min_step")
@@ -338,94 +334,37 @@ def _check_jac_value(jac, n):
 
 
 def _solve(problem, common, h0, jac, pattern):
-    """solve_ivp on a real, non-empty problem (checked), in segments: a terminal event
-    whose count is not reached yet ends a segment and the next one starts at the event
-    (its function is taken as zero there, so it is not found again at once)."""
+    """solve_ivp on a real, non-empty problem (checked): one Fortran call, which counts the
+    occurrences of the terminal events (ev_term: each event's count, 0 not terminal) and
+    applies SciPy's rule to an event exactly zero at t0."""
     fun, builtin, args = problem["fun"], problem["builtin"], problem["args"]
     t0, tf, y0, t_ev = problem["t0"], problem["tf"], problem["y0"], problem["t_ev"]
     with_t_eval, settings = problem["with_t_eval"], problem["settings"]
     n = y0.size
     ne = len(settings)
     run = _Run(fun, builtin, args, n, settings, problem["vectorized"], t0, jac, pattern, y0)
-    remaining = [s[1] for s in settings]       # occurrences left before termination
     if ne:
         ev_dir = np.array([s[2] for s in settings], dtype=np.intc)
+        ev_term = np.array([s[1] for s in settings], dtype=np.intc)
         ev_res = np.array([s[3] for s in settings], dtype=float)
     else:
-        ev_dir, ev_res = _PADI, _PAD
-
-    t_cur, y_cur, t_ev_cur, first_seg = t0, y0, t_ev, True
-    segs = []
-    nfev = naccept = nreject = 0
-    status, message, form = 0, "", 0
-    while True:
-        ev_term = np.array([int(r > 0) for r in remaining], dtype=np.intc) if ne else _PADI
-        out = run.call(t_cur, tf, y_cur, t_ev_cur, h0 if first_seg else 0.0, ev_dir,
-                       ev_term, ev_res, common)
-        if with_t_eval and not t_ev_cur.size:
-            # no output time in this segment (the flat call's neval = 0 stores every
-            # step): no point
-            out["t"], out["y"] = out["t"][:0], out["y"][:, :0]
-        stop_at_start = isinstance(run.guard.error, _StopAtStart)
-        if stop_at_start:
-            run.guard.error = None
-        run.guard.check()
-        nfev += out["nfev"]
-        naccept += out["naccept"]
-        nreject += out["nreject"]
-        form = out["form"] or form
-        info, message = out["info"], out["message"]
-        if info == BAD_INPUT and not stop_at_start:
-            raise ValueError(message)
-        if stop_at_start:
-            # SciPy: a terminal event zero at t0, moving in its direction, stops there
-            if not builtin:
-                # the evaluations up to the first step (the Fortran run went on with the
-                # guard's NaN, whose attempts it counted too)
-                nfev = run.guard.count("fun")
-            segs.append(dict(t=np.array([t0, t0]) if not with_t_eval else
-                             t_ev[t_ev == t0], y=None, ev=run.start_events, dense=None))
-            status = 1
-            break
-        if not first_seg:
-            out = _drop_first_point(out, with_t_eval)
-        segs.append(out)
-        if first_seg and run.start_events:
-            out["ev"] = run.start_events + out["ev"]
-        first_seg = False
-        if info != 1 or not ne:
-            status = info if info >= 0 else -1
-            break
-        # a terminal event: count the occurrences of this segment
-        t_stop = out["ev"][-1][1] if out["ev"] else tf
-        fired = set()
-        stop = False
-        for k, (i, te, _) in enumerate(out["ev"]):
-            if remaining[i] > 0:
-                remaining[i] -= 1
-                if remaining[i] == 0:
-                    # SciPy's handle_events: no event after the one that ends the run is
-                    # reported, not even one at the same time (ordered by index there)
-                    del out["ev"][k + 1:]
-                    stop = True
-                    break
-            if te == t_stop:
-                fired.add(i)
-        if stop or t_stop == tf:
-            status = 1
-            break
-        t_cur, y_cur = t_stop, out["ev"][-1][2].copy()
-        if with_t_eval:
-            t_ev_cur = t_ev_cur[(t_ev_cur - t_stop)*math.copysign(1.0, tf - t0) > 0]
-        run.zero_at_start = fired
-
-    return _assemble(segs, run, n, ne, t0, tf, y0, with_t_eval, problem["dense"], form,
-                     status, message, nfev, naccept, nreject)
+        ev_dir, ev_term, ev_res = _PADI, _PADI, _PAD
+    out = run.call(t0, tf, y0, t_ev, h0, ev_dir, ev_term, ev_res, common)
+    if with_t_eval and not t_ev.size:
+        # t_eval=[]: no output time (the flat call's neval = 0 stores every step)
+        out["t"], out["y"] = out["t"][:0], out["y"][:, :0]
+    run.guard.check()
+    info, message = out["info"], out["message"]
+    if info == BAD_INPUT:
+        raise ValueError(message)
+    return _assemble(out, run, n, ne, t0, tf, y0, with_t_eval, problem["dense"],
+                     out["form"], info if info >= 0 else -1, message, out["nfev"],
+                     out["naccept"], out["nreject"])
 
 
 class _Run:
-    """The callbacks of one solve_ivp call (one Guard for fun and the events) and the
-    Fortran call of one segment."""
+    """The callbacks of one solve_ivp call (one Guard for fun and the events) and its
+    Fortran call."""
 
     def __init__(self, fun, builtin, args, n, settings, vectorized, t0, jac=None,
                  pattern=None, y0=None):
@@ -434,10 +373,6 @@ class _Run:
         self.njev = self.nlu = 0
         self.fun, self.builtin, self.args, self.n = fun, builtin, args, n
         self.settings = settings
-        self.t0 = t0
-        self.zero_at_start = set()      # events taken as zero at a segment's start
-        self.start_events = []          # SciPy's events at t0: (i, t0, y0)
-        self.first_segment = True
         self.rhs = None
         self.failure = []
         if builtin and jac is not None:
@@ -457,17 +392,13 @@ class _Run:
                 user = fun
             self.rhs = self.guard.wrap(user, 2, (n,), "fun", extra=args)
 
-    def events_callback(self, y_start):
-        """The events callback of a segment: g of every event, checked (one scalar each);
-        SciPy's rule for an event exactly zero at t0 (first segment), and zero at a
-        continuation's start for the events that ended the previous segment."""
+    def events_callback(self):
+        """The events callback: g of every event, checked (one scalar each); NaN from the
+        first exception on (kept by the guard, which the caller re-raises)."""
         settings, args, guard = self.settings, self.args, self.guard
         ne = len(settings)
         funs = [s[0] for s in settings]
         nan_g = np.full(ne, np.nan)
-        state = {"calls": 0, "zero": []}
-        first = self.first_segment
-        zero_at_start = set(self.zero_at_start)
 
         def events_cb(t, y):
             if guard.error is not None:
@@ -480,33 +411,11 @@ class _Run:
                     if r is None:
                         raise ValueError(f"events[{i}] returned None; expected a number")
                     g[i] = as_result(r, (), f"events[{i}]")
-                k = state["calls"]
-                state["calls"] = k + 1
-                if k == 0:
-                    for i in zero_at_start:
-                        g[i] = 0.0
-                    if first:
-                        state["zero"] = [i for i in range(ne) if g[i] == 0.0
-                                         and i not in zero_at_start]
-                elif k == 1 and state["zero"]:
-                    self._scipy_start_rule(state["zero"], g, y_start)
                 return g
             except BaseException as exc:   # noqa: B036 (kept, re-raised by check())
                 guard.fail(exc)
                 return nan_g
         return events_cb
-
-    def _scipy_start_rule(self, zero, g_new, y_start):
-        # SciPy's find_active_events with g = 0 at t0: up if g_new >= 0, down if <= 0;
-        # the root is t0 itself. (The driver evaluates the events at the end of the first
-        # step before any sample inside it: this is g_new.)
-        for i in zero:
-            d = self.settings[i][2]
-            up, down = g_new[i] >= 0, g_new[i] <= 0
-            if (d > 0 and up) or (d < 0 and down) or (d == 0 and (up or down)):
-                self.start_events.append((i, self.t0, y_start.copy()))
-                if self.settings[i][1] == 1:
-                    raise _StopAtStart()
 
     def call(self, t_a, tf, y_a, t_ev, h0, ev_dir, ev_term, ev_res, common):
         ne = len(self.settings)
@@ -523,7 +432,7 @@ class _Run:
                 res["dense"] = (ts.copy(), hs.copy(), coef.reshape(n, -1, ts.size).copy())
 
         if ne:
-            events_cb = self.events_callback(y_a)
+            events_cb = self.events_callback()
         else:
             def events_cb(t, y):  # never called when ne = 0
                 return _PAD
@@ -536,8 +445,7 @@ class _Run:
             kw_taylor = {k: v for k, v in kw.items()
                          if k not in ("ev_res", "nnz", "sp_ptr", "sp_idx")}
             counts, form, info, message = run_compiled_events(
-                self.fun, [st[0] for st in self.settings], store, kw_taylor,
-                self.zero_at_start)
+                self.fun, [st[0] for st in self.settings], store, kw_taylor)
         elif self.builtin:
             counts, form, info, message = _conmech.flat_solve(
                 *self.fun._system_args(), events_cb, store, jac_const=0, **kw)
@@ -553,7 +461,6 @@ class _Run:
         nfev, njev, nlu, naccept, nreject = counts.tolist()
         self.njev += njev
         self.nlu += nlu
-        self.first_segment = False
         res.setdefault("t", np.array([t_a]))
         res.setdefault("y", y_a[:, None].copy())
         res.setdefault("ev", [])

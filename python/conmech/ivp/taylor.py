@@ -119,16 +119,14 @@ def _library(fun, evs):
     return cache[key]
 
 
-def run_compiled_events(fun, evs, store, kw, zero_at_start):
-    """One segment of solve_ivp with compiled events: the flat call, returning (counts,
-    form, info, message) like flat_solve (counts of 5)."""
+def run_compiled_events(fun, evs, store, kw):
+    """solve_ivp with compiled events: the flat call, returning (counts, form, info,
+    message) like flat_solve (counts of 5)."""
     from ..symbolic.taylor_events import DEGREE
     lib = _library(fun, evs)
-    ne = len(evs)
-    zero = np.array([int(i in zero_at_start) for i in range(ne)], dtype=np.intc)
     name, np_, p, nspec, spec = fun._flat_args()
     args = {k: v for k, v in kw.items() if k != "method"}
     counts, form, info, message = _conmech.flat_solve_taylor(
         name, np_, p, nspec, spec, store, evaddr=lib["address"], evnw=lib["nw"],
-        evdeg=DEGREE, ev_zero=zero, **args)
+        evdeg=DEGREE, **args)
     return counts[:5], form, info, message

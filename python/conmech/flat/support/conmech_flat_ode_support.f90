@@ -89,26 +89,30 @@ contains
     !! Tolerances are per component; first_step 0 means automatic; ne = 0: no events;
     !! neval = 0: output at every step. `events` is not called when ne = 0. The arrays
     !! t_eval, ev_dir, ev_term, ev_res have at least one element (f2py cannot pass empty
-    !! ones). ev_res: each event's resolution (0: SciPy's rule, the step's ends only).
-    !! jac_const, nnz, sp_ptr, sp_idx: `set_jacobian_structure`.
+    !! ones). ev_term: an event's terminal count (> 0: the run stops at that occurrence;
+    !! 0: not terminal). ev_res: each event's resolution (0: SciPy's rule, the step's ends
+    !! only). jac_const, nnz, sp_ptr, sp_idx: `set_jacobian_structure`. zero_at_t0
+    !! (default .false.): SciPy's rule for an event zero at t0 (ode_events%zero_at_t0).
     !! dense_form: the polynomial form of the dense coefficients (dense_solution%form of
     !! conmech_ode_solver: 1 Hairer's, 2 power basis; 0 without dense output).
     subroutine run_solve(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                          max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
                          jac_const, nnz, sp_ptr, sp_idx, events, store, counts, dense_form, &
-                         info, message)
+                         info, message, zero_at_t0)
         class(ode_system), intent(in) :: sys
         include "../flat_solve_args.inc"
         integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
         external :: events, store
         integer(c_int), intent(out) :: counts(5), dense_form, info
         character(len=*), intent(out) :: message
+        logical, intent(in), optional :: zero_at_t0
         type(ode_result) :: res
 
         dense_form = 0
         call solve_into(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                         max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
-                        jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events)
+                        jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events, &
+                        zero_at_t0)
         if (.not. allocated(res%t)) return          ! refused before any integration
         call store_result(res, n, dense /= 0, store, dense_form)
     end subroutine run_solve
@@ -119,7 +123,8 @@ contains
     !! were refused before the run). `events` may be absent when ne = 0.
     subroutine solve_into(sys, n, t_span, y0, method, rtol, atol, first_step, max_step, &
                           max_steps, dense, neval, t_eval, ne, ev_dir, ev_term, ev_res, &
-                          jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events)
+                          jac_const, nnz, sp_ptr, sp_idx, res, counts, info, message, events, &
+                          zero_at_t0)
         class(ode_system), intent(in) :: sys
         include "../flat_solve_args.inc"
         integer(c_int), intent(in) :: jac_const, nnz, sp_ptr(:), sp_idx(:)
@@ -128,6 +133,7 @@ contains
         character(len=*), intent(out) :: message
         external :: events
         optional :: events
+        logical, intent(in), optional :: zero_at_t0
 
         type(ode_options) :: opt
         type(callback_events), allocatable :: ev
@@ -168,8 +174,10 @@ contains
             ev%n = n
             ev%ne = ne
             ev%direction = ev_dir(1:ne)
-            ev%terminal = ev_term(1:ne) /= 0
+            ev%terminal = ev_term(1:ne) > 0
+            ev%count = max(ev_term(1:ne), 1)
             ev%resolution = ev_res(1:ne)
+            if (present(zero_at_t0)) ev%zero_at_t0 = zero_at_t0
         end if
         if (neval > 0) te = t_eval(1:neval)
         ! the optional arguments once: an unallocated actual argument is an absent one

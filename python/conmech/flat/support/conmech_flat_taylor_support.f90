@@ -20,12 +20,12 @@ module conmech_flat_taylor_support
 contains
 
     !> ode_solve with METHOD_TAYLOR and the compiled events at address evaddr (series
-    !! routine with evnw work columns; ne events with directions ev_dir and terminal flags
-    !! ev_term; those with ev_zero /= 0 are taken as zero at t0, a run continued from their
-    !! root); counts = [nfev, njev, nlu, naccept, nreject, steps shortened by events].
+    !! routine with evnw work columns; ne events with directions ev_dir and terminal counts
+    !! ev_term, SciPy's rule for an event zero at t0); counts = [nfev, njev, nlu, naccept,
+    !! nreject, steps shortened by events].
     subroutine run_taylor_solve(sys, n, t_span, y0, rtol, atol, first_step, max_step, &
                                 max_steps, dense, neval, t_eval, evaddr, evnw, evdeg, &
-                                params, ne, ev_dir, ev_term, ev_zero, store, counts, &
+                                params, ne, ev_dir, ev_term, store, counts, &
                                 dense_form, info, message)
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: n
@@ -36,7 +36,7 @@ contains
         integer(c_int64_t), intent(in) :: evaddr
         integer(c_int), intent(in) :: evnw, evdeg, ne
         real(c_double), intent(in) :: params(:)
-        integer(c_int), intent(in) :: ev_dir(:), ev_term(:), ev_zero(:)
+        integer(c_int), intent(in) :: ev_dir(:), ev_term(:)
         external :: store
         integer(c_int), intent(out) :: counts(6), dense_form, info
         character(len=*), intent(out) :: message
@@ -64,9 +64,9 @@ contains
         ev%degree = evdeg
         ev%p = params
         ev%direction = ev_dir(1:ne)
-        ev%terminal = ev_term(1:ne) /= 0
-        ev%zero_at = ev_zero(1:ne) /= 0
-        ev%t_zero = t_span(1)
+        ev%terminal = ev_term(1:ne) > 0
+        ev%count = max(ev_term(1:ne), 1)
+        ev%zero_at_t0 = .true.
         stp%ev => ev
         if (neval > 0) then
             call ode_solve(sys, t_span, y0, opt, res, t_eval=t_eval(1:neval), events=ev, &
