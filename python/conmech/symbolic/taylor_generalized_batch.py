@@ -37,8 +37,9 @@ In either form a large system's lanes' loops (order 0, the history sums, an orde
 recurrences: thousands of array references, which gcc's dependence analysis gives up on,
 leaving the loop scalar) are split into consecutive loops of at most WIDE_REFS references
 (:func:`_split_wide`; unsplit, a 10-link pendulum chain's ensemble ran slower in lanes
-than member by member, an 8-link chain's 0.85x-1.13x: ``python
-bench/bench_taylor_generalized_batch.py --system chain10``, ``--system chain8``). No size is
+than member by member, an 8-link chain's at 0.87x-1.02x against 2.3x-2.8x split, one
+thread: ``python bench/bench_taylor_generalized_batch.py --system chain10``, ``--system
+chain8``). No size is
 refused; a generalized system without batch recurrences is one without scalar ones (a
 non-smooth expression, an asymmetric M), and one order written out (``fixed``) is not
 generated (the loop version serves every order)."""
@@ -264,10 +265,10 @@ def _lanes_outside(lines):
     8 lanes on AVX2: 1,226,678 instructions per member inside out against 1,041,875,
     callgrind; 4 lanes: 1,073,734 against 1,279,308). Only a loop of at most WIDE_REFS
     per-lane references: a longer one keeps more accumulators than the registers hold
-    (the 8-link chain's 228, 1008 references: gcc vectorises the lanes' loop outside, and
-    one expansion to order 20 with 8 lanes on AVX-512 took 18.9 us per member against
-    15.5 us with the lanes' loops inside, split; a group of 16 accumulators outside is
-    not vectorised at all, "control flow in loop")."""
+    (the 8-link chain's 228, 1008 references: gcc vectorises that lanes' loop outside
+    with the accumulators spilled to memory, an expansion with 8 lanes on AVX-512 about
+    a fifth slower than with the lanes' loops inside, split; groups of 16 accumulators
+    outside are not vectorised at all, "control flow in loop")."""
     out, i = [], 0
     while i < len(lines):
         x = lines[i]
