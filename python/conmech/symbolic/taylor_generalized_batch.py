@@ -37,7 +37,7 @@ In either form a large system's lanes' loops (order 0, the history sums, an orde
 recurrences: thousands of array references, which gcc's dependence analysis gives up on,
 leaving the loop scalar) are split into consecutive loops of at most WIDE_REFS references
 (:func:`_split_wide`; unsplit, a 10-link pendulum chain's ensemble ran slower in lanes
-than member by member, an 8-link chain's at 0.87x-1.02x against 2.3x-2.8x split, one
+than member by member, an 8-link chain's at 0.87x-1.02x against 2.3x-2.9x split, one
 thread: ``python bench/bench_taylor_generalized_batch.py --system chain10``, ``--system
 chain8``). No size is
 refused; a generalized system without batch recurrences is one without scalar ones (a
