@@ -13,15 +13,18 @@ atol = tol. ``--system chain3``: a planar tree of 3 point masses on rods instead
 ``--system chain10``: a planar chain of 10 unit point masses on unit rods from its
 Lagrangian (the tests' pendulum_chain: beyond taylor_generalized.WRITE_OUT_MAX degrees of
 freedom, M's factorisation in loops over per-lane arrays), initial angles in [-0.3, 0.3]
-and rates in [-0.2, 0.2]; ``--system metronomes10``: the tests' nine pendulums on a cart
-(10 degrees of freedom), the same ranges. The time of the first build of each library
-(sympy to loaded library, compile included; nothing when it is cached) is printed. Both
+and rates in [-0.2, 0.2]; ``--system chain8``: the same chain of 8 links (the
+written-out factorisation per lane, at its largest size); ``--system metronomes10``: the
+tests' nine pendulums on a cart (10 degrees of freedom), the same ranges. The time of the
+first build of each library (sympy to loaded library, compile included; nothing when it is
+cached) is printed. Both
 routes give each member the steps and the final state of its own
 solve_ivp(method="TAYLOR") run, bit for bit (checked here). Best of `--repeat` rounds, the
 routes interleaved within a round; the machine's load (uptime) before and after.
 
     python bench/bench_taylor_generalized_batch.py [--m 2000] [--T 10] [--tol 1e-12]
-        [--threads 1 2] [--repeat 3] [--system double_pendulum|chain3|chain10|metronomes10]
+        [--threads 1 2] [--repeat 3]
+        [--system double_pendulum|chain3|chain8|chain10|metronomes10]
 """
 import argparse
 import os
@@ -64,10 +67,11 @@ def main():
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--lanes", type=int, nargs="+", default=[None])
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--system", choices=["double_pendulum", "chain3", "chain10",
+    ap.add_argument("--system", choices=["double_pendulum", "chain3", "chain8", "chain10",
                                          "metronomes10"], default="double_pendulum")
     args = ap.parse_args()
     system, nq = {"double_pendulum": (double_pendulum, 2), "chain3": (chain3, 3),
+                  "chain8": (lambda: pendulum_chain(8), 8),
                   "chain10": (lambda: pendulum_chain(10), 10),
                   "metronomes10": (lambda: metronomes_on_a_cart(9), 10)}[args.system]
     system = system()

@@ -13,6 +13,9 @@ factorisation and triangular solves per lane, the propagator of the ode systems'
 - 2, 4 and 8 lanes give the same bits;
 - a member whose mass matrix is singular at its initial state fails on its own, with a
   message that names it and its mass matrix, the other members unaffected;
+- at WRITE_OUT_MAX degrees of freedom (an 8-link pendulum chain, written out): its lanes'
+  loops of thousands of references split to at most WIDE_REFS each, each member its own
+  solve_ivp(method="TAYLOR") run bit for bit, 4 and 8 lanes the same bits;
 - beyond WRITE_OUT_MAX degrees of freedom (M's factorisation in loops over per-lane
   arrays): nine pendulums on a cart (10 degrees of freedom, an arrow-shaped M whose
   Cholesky factor fills in) take the lanes route, each member its own solve_ivp(method=
@@ -35,7 +38,7 @@ from conmech.symbolic.taylor_generalized_batch import WIDE_REFS  # noqa: E402
 from conmech.symbolic.taylor_library import taylor_source  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
-from taylor_jets import metronomes_on_a_cart  # noqa: E402
+from taylor_jets import metronomes_on_a_cart, pendulum_chain  # noqa: E402
 
 TOL = 1e-12
 
@@ -180,6 +183,28 @@ def _lane_loop_refs(src):
         elif cur is not None:
             cur += len(re.findall(r"\(l[,)]", x))
     return refs
+
+
+def test_written_out_at_its_largest_splits_wide_loops_and_gives_each_member_its_own_run():
+    """An 8-link pendulum chain (M full, written out): the order-0, history-sum and
+    recurrence loops over the lanes (851, 1008 and 1990 references unsplit) split to at
+    most WIDE_REFS references, for 4 and 8 lanes; each member its own solve_ivp run."""
+    system = pendulum_chain(WRITE_OUT_MAX)
+    d = model_of(system).derived
+    assert d.n == WRITE_OUT_MAX
+    for part in ("batch4", "batch8"):
+        src, _, why = taylor_source(d, part)
+        assert why is None and "lm(" not in src and "cl8_7(nl)" in src
+        assert max(_lane_loop_refs(src)) <= WIDE_REFS
+    rng = np.random.default_rng(13)
+    y0s = np.column_stack([rng.uniform(-0.3, 0.3, (5, 8)), rng.uniform(-0.2, 0.2, (5, 8))])
+    ens = _lanes_members_checked(system, y0s, 1.0, 1e-13, 1e-9)
+    assert np.min(np.abs(ens.y_final - y0s)) > 1e-6
+    runs = [ensemble.solve(system, (0, 1.0), y0s, method="TAYLOR", rtol=TOL, atol=TOL,
+                           lanes=k) for k in (4, 8)]
+    assert np.array_equal(runs[0].y_final, runs[1].y_final)
+    assert np.array_equal(runs[0].nfev, runs[1].nfev)
+    assert np.array_equal(runs[0].y_final, ens.y_final)
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,8 @@ lanes: the accumulators of the history sums, the reciprocals, the Cholesky facto
 (cd<i>, cl<i>_<j>), the right-hand sides of the solves (cr<i>) and the history sums of
 M a (cg<i>), each statement in a ``!$omp simd`` loop over the lanes; the loop over the
 orders k stays outside, common to the lanes, and the loops over the terms j of the history
-sums run inside the lanes' loop (:func:`_lanes_outside`). Each lane runs the
+sums run inside the lanes' loop (:func:`_lanes_outside`) when they are short (at most
+WIDE_REFS per-lane references). Each lane runs the
 scalar statement's operations in its order, so each member gets the scalar routine's
 coefficients to the last bit, and the propagator (the same for ode systems and the view
 of a generalized one) takes the steps of the member's own solve_ivp(method="TAYLOR") run.
@@ -30,12 +31,15 @@ right-hand sides; cg, the history sums of M a); the batch routine runs that loop
 with the lanes as the arrays' first index (lm(l, i, j), ...), each array statement of
 the scalar loops (the sum intrinsic over a row section included) in a lanes' loop inside
 the same loops over the rows and columns, so each lane again performs the scalar
-routine's operations in its order and gets its coefficients to the last bit. Such a
-system's lanes' loops (the history sums, an order's recurrences: thousands of array
-references, which gcc's dependence analysis gives up on, leaving the loop scalar) are
-split into consecutive loops of at most WIDE_REFS references (:func:`_split_wide`;
-unsplit, a 10-link pendulum chain's ensemble ran slower in lanes than member by member:
-``python bench/bench_taylor_generalized_batch.py --system chain10``). No size is
+routine's operations in its order and gets its coefficients to the last bit.
+
+In either form a large system's lanes' loops (order 0, the history sums, an order's
+recurrences: thousands of array references, which gcc's dependence analysis gives up on,
+leaving the loop scalar) are split into consecutive loops of at most WIDE_REFS references
+(:func:`_split_wide`; unsplit, a 10-link pendulum chain's ensemble ran slower in lanes
+than member by member, an 8-link chain's at 0.87x-1.02x against 2.3x-2.9x split, one
+thread: ``python bench/bench_taylor_generalized_batch.py --system chain10``, ``--system
+chain8``). No size is
 refused; a generalized system without batch recurrences is one without scalar ones (a
 non-smooth expression, an asymmetric M), and one order written out (``fixed``) is not
 generated (the loop version serves every order)."""
@@ -181,16 +185,15 @@ def coefficient_routine(g, names, lanes, cname="conmech_taylor_batch", npar=1):
         decls += [f"{ind}real(dp) :: lm(nl, {n}, {n}), ld(nl, {n}), cr(nl, {n}), "
                   f"cg(nl, {n})", f"{ind}integer :: ii, jj"]
     decls += [f"{ind}real(dp) :: fk, rk, rk1", f"{ind}integer :: k, j, l"]
-    if loops:
-        out = _split_wide(out)
-    elif lanes <= machine_lanes():
+    if not loops and lanes <= machine_lanes():
         out = _lanes_outside(out)
+    out = _split_wide(out)
     return head + decls + out + [f"    end subroutine {cname}", ""]
 
 
-#: array references per lanes' loop at most, beyond WRITE_OUT_MAX degrees of freedom (gcc's
-#: dependence analysis gives up on a loop of more than 1000, its parameter
-#: loop-max-datarefs-for-datadeps, and leaves it scalar)
+#: per-lane array references per lanes' loop at most (gcc's dependence analysis gives up on
+#: a loop of more than 1000, its parameter loop-max-datarefs-for-datadeps, and leaves it
+#: scalar), and per history sums' loop turned inside out
 WIDE_REFS = 200
 _REF = re.compile(r"\(l[,)]")
 
@@ -221,12 +224,14 @@ def _chunks(stmts):
 
 def _split_wide(lines):
     """The lanes' loops of more than WIDE_REFS references split into consecutive lanes'
-    loops: beyond WRITE_OUT_MAX degrees of freedom the loops of the history sums and of
-    an order's recurrences reach thousands of references, which the compiler leaves
-    scalar. Each lane runs the same statements in the same order (a lane's values live in
-    its own elements), so its bits are those of the unsplit loop. Such a system's loops
-    over the terms j keep the lanes' loops inside (:func:`_lanes_outside` not applied: a
-    lanes' loop outside a loop over the terms of many accumulators is not vectorised)."""
+    loops: a large system's loops of order 0, of the history sums and of an order's
+    recurrences reach thousands of references, which the compiler leaves scalar (an
+    8-link pendulum chain written out: 851, 1008 and 1990). Each lane runs the same
+    statements in the same order (a lane's values live in its own elements), so its bits
+    are those of the unsplit loop. The loops over the terms j of such a system keep the
+    lanes' loops inside (:func:`_lanes_outside` not applied to them: a lanes' loop
+    outside a loop over the terms of many accumulators is not vectorised, or holds them
+    in memory rather than registers)."""
     out, i = [], 0
     while i < len(lines):
         x = lines[i]
@@ -258,7 +263,12 @@ def _lanes_outside(lines):
     For lanes that fill one vector register at most: more lanes than the machine's vector
     width take two registers per accumulator, too many to hold (the double pendulum with
     8 lanes on AVX2: 1,226,678 instructions per member inside out against 1,041,875,
-    callgrind; 4 lanes: 1,073,734 against 1,279,308)."""
+    callgrind; 4 lanes: 1,073,734 against 1,279,308). Only a loop of at most WIDE_REFS
+    per-lane references: a longer one keeps more accumulators than the registers hold
+    (the 8-link chain's 228, 1008 references: gcc vectorises that lanes' loop outside
+    with the accumulators spilled to memory, an expansion with 8 lanes on AVX-512 about
+    a fifth slower than with the lanes' loops inside, split; groups of 16 accumulators
+    outside are not vectorised at all, "control flow in loop")."""
     out, i = [], 0
     while i < len(lines):
         x = lines[i]
@@ -268,7 +278,8 @@ def _lanes_outside(lines):
                 lines[i + 1] == f"{at}    !$omp simd" and \
                 lines[i + 2] == f"{at}    do l = 1, nl":
             end = lines.index(f"{at}    end do", i + 3)
-            if lines[end + 1] == f"{at}end do":
+            refs = sum(len(_REF.findall(y)) for y in lines[i + 3:end])
+            if lines[end + 1] == f"{at}end do" and refs <= WIDE_REFS:
                 out += [f"{at}!$omp simd", f"{at}do l = 1, nl", f"{at}    {s}"]
                 out += lines[i + 3:end]
                 out += [f"{at}    end do", f"{at}end do"]

@@ -38,10 +38,11 @@ __all__ = ["taylor_source", "taylor_library", "lazy_taylor", "batch_part", "batc
 #: the Fortran module of the Taylor library
 MODULE = "conmech_symbolic_taylor_library"
 
-_FORMAT = 7     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
+_FORMAT = 8     # of the kept source (conmech_KEY.taylor.json; 2: generalized models, 3: trees,
                 # 4: the variational and quadruple-precision parts of generalized models,
                 # 5: those of trees, 6: the batch part of generalized models and trees,
-                # 7: that of generalized models beyond WRITE_OUT_MAX degrees of freedom)
+                # 7: that of generalized models beyond WRITE_OUT_MAX degrees of freedom,
+                # 8: the wide lanes' loops of the written-out generalized batch split)
 
 # guards the creation of a model's LazyTaylor (one per model); the build itself runs
 # under the LazyTaylor's own lock
