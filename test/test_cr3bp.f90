@@ -113,10 +113,17 @@ contains
         call system_energy(sys, 0.0_dp, [0.3_dp, -0.7_dp], e, info, msg)
         call ts%check_close(e, 0.5_dp*(0.49_dp + 4.0_dp*0.09_dp), 1.0e-15_dp, &
                             "energy of the harmonic oscillator")
+        call ts%check(system_has_energy(sys), "the harmonic oscillator has an energy")
         call make_system("double_pendulum", [real(dp) ::], sys, info, msg)
         call system_energy(sys, 0.0_dp, [0.1_dp, 0.2_dp, 0.0_dp, 0.0_dp], e, info, msg)
         call ts%check_close(e, -9.81_dp*(2.0_dp*cos(0.1_dp) + cos(0.2_dp)), 1.0e-13_dp, &
                             "energy of the double pendulum at rest = U")
+        call ts%check(system_has_energy(sys), "the double pendulum has an energy")
+        call system_energy(sys, 0.0_dp, [0.1_dp, 0.2_dp, 0.0_dp], e, info, msg)
+        call ts%check(info == CM_BAD_INPUT .and. index(msg, "even") > 0, &
+                      "double pendulum: an odd state size is bad input with a message")
+        call system_energy(sys, 0.0_dp, [real(dp) ::], e, info, msg)
+        call ts%check(info == CM_BAD_INPUT, "double pendulum: an empty state is bad input")
         call make_system("vanderpol", [1.0_dp], sys, info, msg)
         call ts%check(.not. system_has_energy(sys), "Van der Pol has no energy")
         call system_energy(sys, 0.0_dp, [0.1_dp, 0.2_dp], e, info, msg)

@@ -679,38 +679,52 @@ def params_module(models):
         "in the documented order and their defaults (missing trailing parameters keep their "
         "defaults; more than the system has is an error in every registry: `make_system`, "
         "`make_generalized`, `make_constrained`, and so in the programs and the Python "
-        "package).")
+        "package). One table (`param_table`) holds the names and defaults of every system; "
+        "the count, the names and the completed vector are read from it.")
     out += ["module conmech_systems_params", "    use conmech_kinds, only: dp",
             "    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT", "    implicit none",
             "    private",
             "    public :: builtin_param_count, builtin_param_names, builtin_params, "
-            "check_param_count", "", "contains", "",
+            "check_param_count", "",
+            "    !> The parameters of one built-in system.",
+            "    type :: param_entry",
+            "        logical :: known = .false.                  !! the name is a built-in",
+            '        character(len=:), allocatable :: names      !! in order ("" if unknown)',
+            "        real(dp), allocatable :: defaults(:)        !! one per parameter",
+            "    end type param_entry", "", "contains", "",
+            "    !> The table entry of the built-in `name` (not `known` if the name is unknown).",
+            "    pure function param_table(name) result(e)",
+            f"{IND}character(len=*), intent(in) :: name",
+            f"{IND}type(param_entry) :: e", f"{IND}e%known = .true.",
+            f"{IND}select case (trim(name))"]
+    out += grouped_cases([(m.name, ["e%names = " + fstring(", ".join(p.name for p in m.params))]
+                          + wrap_statement("e%defaults = [" + ", ".join(
+                              lit(p.default) for p in m.params) + "]", ""))
+                          for m in allm])
+    out += [f"{IND}case default", f"{IND}    e%known = .false.", f'{IND}    e%names = ""',
+            f"{IND}    allocate (e%defaults(0))", f"{IND}end select",
+            "    end function param_table", "",
             "    !> Number of parameters of a built-in system (-1 if the name is unknown).",
             "    pure integer function builtin_param_count(name) result(np)",
-            f"{IND}character(len=*), intent(in) :: name", f"{IND}select case (trim(name))"]
-    out += grouped_cases([(m.name, [f"np = {len(m.params)}"]) for m in
-                          sorted(allm, key=lambda m: len(m.params))])
-    out += [f"{IND}case default", f"{IND}    np = -1", f"{IND}end select",
+            f"{IND}character(len=*), intent(in) :: name",
+            f"{IND}type(param_entry) :: e", f"{IND}e = param_table(name)",
+            f"{IND}np = merge(size(e%defaults), -1, e%known)",
             "    end function builtin_param_count", "",
             '    !> The parameters of a built-in system, named in order ("" if unknown).',
             "    pure function builtin_param_names(name) result(s)",
             f"{IND}character(len=*), intent(in) :: name",
-            f"{IND}character(len=:), allocatable :: s", f"{IND}select case (trim(name))"]
-    out += grouped_cases([(m.name, ["s = " + fstring(", ".join(p.name for p in m.params))])
-                          for m in allm])
-    out += [f"{IND}case default", f'{IND}    s = ""', f"{IND}end select",
+            f"{IND}character(len=:), allocatable :: s", f"{IND}type(param_entry) :: e",
+            f"{IND}e = param_table(name)", f"{IND}s = e%names",
             "    end function builtin_param_names", "",
             "    !> The whole parameter vector of the built-in `name`: the given leading values "
             "and", "    !! the defaults of the others (`params` itself if the name is unknown).",
             "    pure function builtin_params(name, params) result(p)",
             f"{IND}character(len=*), intent(in) :: name",
             f"{IND}real(dp), intent(in) :: params(:)",
-            f"{IND}real(dp), allocatable :: p(:)", f"{IND}integer :: k",
-            f"{IND}select case (trim(name))"]
-    out += grouped_cases([(m.name, wrap_statement(
-        "p = [" + ", ".join(lit(p.default) for p in m.params) + "]", "")) for m in allm])
-    out += [f"{IND}case default", f"{IND}    p = params", f"{IND}    return",
-            f"{IND}end select", f"{IND}k = min(size(params), size(p))",
+            f"{IND}real(dp), allocatable :: p(:)", f"{IND}type(param_entry) :: e",
+            f"{IND}integer :: k", f"{IND}e = param_table(name)",
+            f"{IND}if (.not. e%known) then", f"{IND}    p = params", f"{IND}    return",
+            f"{IND}end if", f"{IND}p = e%defaults", f"{IND}k = min(size(params), size(p))",
             f"{IND}p(1:k) = params(1:k)", "    end function builtin_params", "",
             "    !> info = CM_BAD_INPUT with a message naming the system and its parameters "
             "when more", "    !! parameters are given than the built-in `name` has (unknown "

@@ -445,26 +445,13 @@ contains
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
         real(dp), intent(in), optional :: rtol_min
+        logical :: ok
         allocate (rtolv(n), atolv(n))
         info = CM_BAD_INPUT
-        if (allocated(opt%rtol_vec)) then
-            if (size(opt%rtol_vec) /= n) then
-                msg = "bad input: rtol must be a scalar or have the size of y0"
-                return
-            end if
-            rtolv = opt%rtol_vec
-        else
-            rtolv = opt%rtol
-        end if
-        if (allocated(opt%atol_vec)) then
-            if (size(opt%atol_vec) /= n) then
-                msg = "bad input: atol must be a scalar or have the size of y0"
-                return
-            end if
-            atolv = opt%atol_vec
-        else
-            atolv = opt%atol
-        end if
+        call per_component(opt%rtol, opt%rtol_vec, "rtol", rtolv, ok)
+        if (.not. ok) return
+        call per_component(opt%atol, opt%atol_vec, "atol", atolv, ok)
+        if (.not. ok) return
         if (.not. all(rtolv >= 0.0_dp)) then
             msg = "bad input: rtol must be non-negative"
             return
@@ -480,6 +467,25 @@ contains
         end if
         info = CM_SUCCESS
         msg = "success"
+    contains
+        !> v = the options' vector `name`_vec where given (it must have the size of y0),
+        !! else the scalar tolerance in every component; not ok (and the message) otherwise.
+        subroutine per_component(scalar, vec, name, v, ok)
+            real(dp), intent(in) :: scalar
+            real(dp), allocatable, intent(in) :: vec(:)
+            character(len=*), intent(in) :: name
+            real(dp), intent(inout) :: v(:)
+            logical, intent(out) :: ok
+            ok = .true.
+            if (.not. allocated(vec)) then
+                v = scalar
+            else if (size(vec) /= n) then
+                ok = .false.
+                msg = "bad input: "//name//" must be a scalar or have the size of y0"
+            else
+                v = vec
+            end if
+        end subroutine per_component
     end subroutine tolerance_vectors
 
     !> The smallest step of the adaptive methods at t in the direction posneg: 10 times the

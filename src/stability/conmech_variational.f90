@@ -268,23 +268,8 @@ contains
         vs%n = n
         opt = options
         if (only .or. allocated(options%atol_vec) .or. allocated(options%rtol_vec)) then
-            allocate (opt%atol_vec(nz), opt%rtol_vec(nz))
-            opt%atol_vec = options%atol
-            opt%rtol_vec = options%rtol
-            if (allocated(options%atol_vec)) then
-                if (size(options%atol_vec) == n) then
-                    opt%atol_vec(1:n) = options%atol_vec
-                else if (size(options%atol_vec) == nz) then
-                    opt%atol_vec = options%atol_vec
-                end if
-            end if
-            if (allocated(options%rtol_vec)) then
-                if (size(options%rtol_vec) == n) then
-                    opt%rtol_vec(1:n) = options%rtol_vec
-                else if (size(options%rtol_vec) == nz) then
-                    opt%rtol_vec = options%rtol_vec
-                end if
-            end if
+            opt%atol_vec = z_tolerance(options%atol, options%atol_vec, n, nz)
+            opt%rtol_vec = z_tolerance(options%rtol, options%rtol_vec, n, nz)
             if (only) then
                 scl = sqrt(real(n, dp)/real(nz, dp))
                 opt%atol_vec(1:n) = opt%atol_vec(1:n)*scl
@@ -311,5 +296,21 @@ contains
         phi = reshape(z(n + 1:), [n, n])
         if (present(message)) message = msg
     end subroutine integrate_stm
+
+    !> A tolerance of z = [y; vec(Phi)] per component: the scalar one, overridden by the
+    !! options' vector where it is given for the state (size n) or for all of z (size nz).
+    pure function z_tolerance(scalar, vec, n, nz) result(w)
+        real(dp), intent(in) :: scalar
+        real(dp), allocatable, intent(in) :: vec(:)
+        integer, intent(in) :: n, nz
+        real(dp) :: w(nz)
+        w = scalar
+        if (.not. allocated(vec)) return
+        if (size(vec) == n) then
+            w(1:n) = vec
+        else if (size(vec) == nz) then
+            w = vec
+        end if
+    end function z_tolerance
 
 end module conmech_variational

@@ -123,6 +123,18 @@ contains
         name_is = buf(off + len(name)) == 0_int8
     end function name_is
 
+    !> "" if the `bytes` bytes from offset `first` lie in a file of sz bytes, else the
+    !! message that the file is truncated where `what` (e.g. "segment 2 ends").
+    pure function extent_message(what, first, bytes, sz) result(msg)
+        character(len=*), intent(in) :: what
+        integer(int64), intent(in) :: first, bytes, sz
+        character(len=:), allocatable :: msg
+        msg = ""
+        if (first < 0 .or. bytes < 0 .or. first + bytes > sz) &
+            msg = "truncated: "//what//" at byte "//itoa(first + bytes)//", the file has "// &
+                  itoa(sz)
+    end function extent_message
+
     !> Check the shared library `path` before dlopen (see the module documentation);
     !! `symbols` (blank-padded names) must be defined in its dynamic symbol table.
     !! info = CM_BAD_INPUT and a message naming the file and the problem otherwise.
@@ -186,22 +198,16 @@ contains
             msg = "no program headers"
             return
         end if
-        if (phoff < 0 .or. phoff + phnum*PHDR > sz) then
-            msg = "truncated: the program headers end at byte "// &
-                  itoa(phoff + phnum*PHDR)//", the file has "//itoa(sz)
-            return
-        end if
+        msg = extent_message("the program headers end", phoff, phnum*PHDR, sz)
+        if (len(msg) > 0) return
         do k = 0, phnum - 1
             off = phoff + k*PHDR
             ptype = le(buf, off, 4)
             poff = le(buf, off + 8, 8)
             pfsz = le(buf, off + 32, 8)
             pmsz = le(buf, off + 40, 8)
-            if (poff < 0 .or. pfsz < 0 .or. poff + pfsz > sz) then
-                msg = "truncated: segment "//itoa(k)//" ends at byte "// &
-                      itoa(poff + pfsz)//", the file has "//itoa(sz)
-                return
-            end if
+            msg = extent_message("segment "//itoa(k)//" ends", poff, pfsz, sz)
+            if (len(msg) > 0) return
             if (ptype == PT_LOAD .and. pfsz > pmsz) then
                 msg = "segment "//itoa(k)//" is larger in the file than in memory"
                 return
@@ -211,11 +217,8 @@ contains
             msg = "no section headers (its symbols cannot be checked)"
             return
         end if
-        if (shoff < 0 .or. shoff + shnum*SHDR > sz) then
-            msg = "truncated: the section headers end at byte "// &
-                  itoa(shoff + shnum*SHDR)//", the file has "//itoa(sz)
-            return
-        end if
+        msg = extent_message("the section headers end", shoff, shnum*SHDR, sz)
+        if (len(msg) > 0) return
         allocate (found(size(symbols)))
         found = .false.
         do k = 0, shnum - 1
@@ -223,11 +226,9 @@ contains
             stype = le(buf, off + 4, 4)
             soff = le(buf, off + 24, 8)
             ssize = le(buf, off + 32, 8)
-            if (stype /= SHT_NOBITS .and. (soff < 0 .or. ssize < 0 .or. soff + ssize > sz)) then
-                msg = "truncated: section "//itoa(k)//" ends at byte "// &
-                      itoa(soff + ssize)//", the file has "//itoa(sz)
-                return
-            end if
+            if (stype == SHT_NOBITS) cycle   ! no bytes in the file
+            msg = extent_message("section "//itoa(k)//" ends", soff, ssize, sz)
+            if (len(msg) > 0) return
         end do
         do k = 0, shnum - 1
             off = shoff + k*SHDR

@@ -24,31 +24,18 @@ module conmech_system_energy
     private
     public :: system_energy, system_has_energy
 
+    integer, parameter :: NO_ENERGY = 0    !! `energy_of`: the system has no energy
+    integer, parameter :: EVEN_SIZE = -1   !! `energy_of`: y = [q, q'] of any even size
+
 contains
 
     !> Whether `sys` has an energy that `system_energy` evaluates.
     logical function system_has_energy(sys) result(has)
         class(ode_system), intent(in) :: sys
-        select type (sys)
-        type is (harmonic_oscillator)
-            has = .true.
-        type is (pendulum_theta)
-            has = .true.
-        type is (kepler_2d)
-            has = .true.
-        type is (arenstorf)
-            has = .true.
-        type is (hill_problem)
-            has = .true.
-        type is (hill_spatial)
-            has = .true.
-        type is (cr3bp)
-            has = .true.
-        class is (generalized_ode)
-            has = sys%mech%has_energy()
-        class default
-            has = .false.
-        end select
+        real(dp) :: e, y(0)
+        integer :: need
+        e = energy_of(sys, 0.0_dp, y, need)
+        has = need /= NO_ENERGY
     end function system_has_energy
 
     !> e = the energy of `sys` at (t, y) (see the module notes); info CM_BAD_INPUT if the
@@ -60,52 +47,62 @@ contains
         real(dp), intent(out) :: e
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
+        integer :: need
+        e = energy_of(sys, t, y, need)
+        info = CM_BAD_INPUT
+        if (need == NO_ENERGY) then
+            msg = "bad input: the system defines no energy (first integral)"
+        else if (need == EVEN_SIZE .and. (mod(size(y), 2) /= 0 .or. size(y) == 0)) then
+            msg = "bad input: a system in generalized coordinates has y = [q, q'] "// &
+                  "(an even, positive size)"
+        else if (need /= EVEN_SIZE .and. size(y) /= need) then
+            msg = "bad input: y has the wrong size for the system"
+        else
+            info = CM_SUCCESS
+            msg = "success"
+        end if
+    end subroutine system_energy
+
+    !> The one table of the energies: the energy of `sys` at (t, y), or 0 when y does not
+    !! have the size it takes; `need` is that size (EVEN_SIZE: any even size, y = [q, q']
+    !! in generalized coordinates; NO_ENERGY: the system has none).
+    function energy_of(sys, t, y, need) result(e)
+        class(ode_system), intent(in) :: sys
+        real(dp), intent(in) :: t
+        real(dp), intent(in) :: y(:)
+        integer, intent(out) :: need
+        real(dp) :: e
         integer :: nd
         e = 0.0_dp
-        info = CM_BAD_INPUT
-        msg = "bad input: the system defines no energy (first integral)"
+        need = NO_ENERGY
         select type (sys)
         type is (harmonic_oscillator)
-            if (.not. size_ok(2)) return
-            e = 0.5_dp*(y(2)**2 + sys%omega**2*y(1)**2)
+            if (fits(2)) e = 0.5_dp*(y(2)**2 + sys%omega**2*y(1)**2)
         type is (pendulum_theta)
-            if (.not. size_ok(2)) return
-            e = sys%energy(y)
+            if (fits(2)) e = sys%energy(y)
         type is (kepler_2d)
-            if (.not. size_ok(4)) return
-            e = sys%energy(y)
+            if (fits(4)) e = sys%energy(y)
         type is (arenstorf)
-            if (.not. size_ok(4)) return
-            e = cr3bp_jacobi(sys%mu, [y(1), y(2), 0.0_dp, y(3), y(4), 0.0_dp])
+            if (fits(4)) e = cr3bp_jacobi(sys%mu, [y(1), y(2), 0.0_dp, y(3), y(4), 0.0_dp])
         type is (hill_problem)
-            if (.not. size_ok(4)) return
-            e = sys%jacobi(y)
+            if (fits(4)) e = sys%jacobi(y)
         type is (hill_spatial)
-            if (.not. size_ok(6)) return
-            e = sys%jacobi(y)
+            if (fits(6)) e = sys%jacobi(y)
         type is (cr3bp)
-            if (.not. size_ok(6)) return
-            e = sys%jacobi(y)
+            if (fits(6)) e = sys%jacobi(y)
         class is (generalized_ode)
             if (.not. sys%mech%has_energy()) return
-            if (mod(size(y), 2) /= 0) then
-                msg = "bad input: a system in generalized coordinates has y = [q, q'] "// &
-                      "(an even size)"
-                return
-            end if
+            need = EVEN_SIZE
             nd = size(y)/2
-            e = sys%mech%energy(t, y(1:nd), y(nd + 1:))
-        class default
-            return
+            if (size(y) > 0 .and. 2*nd == size(y)) e = sys%mech%energy(t, y(1:nd), y(nd + 1:))
         end select
-        info = CM_SUCCESS
-        msg = "success"
     contains
-        logical function size_ok(n)
+        !> The energy takes n components (recorded in `need`): does y have them?
+        logical function fits(n)
             integer, intent(in) :: n
-            size_ok = size(y) == n
-            if (.not. size_ok) msg = "bad input: y has the wrong size for the system"
-        end function size_ok
-    end subroutine system_energy
+            need = n
+            fits = size(y) == n
+        end function fits
+    end function energy_of
 
 end module conmech_system_energy
