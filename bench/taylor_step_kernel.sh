@@ -6,7 +6,8 @@
 # taylor_check_jet, taylor_next_rho; K: the same operations in one routine with n = 4 and
 # p = 15 as constants (bench/taylor_callgrind/step_kernel_kepler.f90, compiled with the
 # flags of the written-out recurrences, conmech.symbolic.taylor.FIXED_EXTRA_FLAGS); J: the
-# recurrences alone, as many expansions as a period has steps. Prints the steps and the
+# recurrences alone, as many expansions as a period has steps (D: each expansion about the
+# state the previous one moved, a serial chain). Prints the steps and the
 # final state's bits of G and K (they must agree), callgrind instructions per period, and
 # the time per period: ROUNDS interleaved rounds of 20000 periods each, min and median.
 # Usage (repository root; fpm, valgrind, PYTHON with conmech installed):
@@ -46,7 +47,7 @@ ir() { valgrind --tool=callgrind --callgrind-out-file="$tmp/o.$1.$2" "$tmp/drive
        grep -E '^(summary|totals):' "$tmp/o.$1.$2" | head -1 | awk '{print $2}'; }
 for m in G K J; do echo "$m instructions/period: $(( ($(ir $m 11) - $(ir $m 1))/10 ))"; done
 for r in $(seq 1 "$ROUNDS"); do
-    for m in G K J; do "$tmp/drive" $m 20000 | awk -v m=$m '{print m, $(NF-1)}'; done
+    for m in G K J D; do "$tmp/drive" $m 20000 | awk -v m=$m '{print m, $(NF-1)}'; done
 done | sort -k1,1 -k2,2n | awk '{v[$1] = v[$1] " " $2; c[$1]++; a[$1, c[$1]] = $2}
     END {for (m in c) printf "%s us/period: min %s median %s (all:%s)\n", m, a[m, 1],
          a[m, int((c[m] + 1)/2)], v[m]}'

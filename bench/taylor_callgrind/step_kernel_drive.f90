@@ -3,9 +3,10 @@
 !! (conmech_taylor_core, the recurrences through a procedure pointer as c_ode_system calls
 !! them: G) or with the kernel written out for the model (step_kernel_kepler.f90, also
 !! through a pointer: K); J: the recurrences alone, 73 expansions (the steps of a period)
-!! per repetition. Prints the steps, the rejected steps, the final state's bits, its
+!! per repetition, all about the same state; D: the same, each about the state the previous
+!! one gives (a serial chain). Prints the steps, the rejected steps, the final state's bits, its
 !! closure error and the time per period (us).
-!!   step_kernel_drive G|K|J REPS
+!!   step_kernel_drive G|K|J|D REPS
 program drive
     use, intrinsic :: iso_c_binding
     use, intrinsic :: iso_fortran_env, only: int64
@@ -64,6 +65,21 @@ program drive
         end do
         call system_clock(c1)
         print '(a, 1x, f8.3, a)', "J 73 expansions", real(c1 - c0, dp)/real(cr, dp)/reps*1e6, " us"
+        stop
+    end if
+    if (mode(1:1) == "D") then
+        ! each expansion about the state the previous one moved (a short Euler step): the
+        ! recurrences as a serial chain, as in the integration
+        do r = 1, reps
+            jets(0, 1:n, 1) = y0
+            do i = 1, 73
+                call jf(t, p, jets(:, :, 1), par)
+                jets(0, 1:n, 1) = jets(0, 1:n, 1) + 1.0e-9_dp*jets(1, 1:n, 1)
+            end do
+        end do
+        call system_clock(c1)
+        print '(a, 1x, es10.3, 1x, f8.3, a)', "D", jets(0, 1, 1), &
+            real(c1 - c0, dp)/real(cr, dp)/reps*1e6, " us"
         stop
     end if
     do r = 1, reps
