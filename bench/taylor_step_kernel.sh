@@ -6,8 +6,8 @@
 # taylor_check_jet, taylor_next_rho; K: the same operations in one routine with n = 4 and
 # p = 15 as constants (bench/taylor_callgrind/step_kernel_kepler.f90, compiled with the
 # flags of the written-out recurrences, conmech.symbolic.taylor.FIXED_EXTRA_FLAGS); J: the
-# recurrences alone, as many expansions as a period has steps (D: each expansion about the
-# state the previous one moved, a serial chain). Prints the steps and the
+# recurrences alone, as many expansions as a period has steps (D: each expansion waiting for
+# the last coefficients of the previous one, a serial chain). Prints the steps and the
 # final state's bits of G and K (they must agree), callgrind instructions per period, and
 # the time per period: ROUNDS interleaved rounds of 20000 periods each, min and median.
 # Usage (repository root; fpm, valgrind, PYTHON with conmech installed):
