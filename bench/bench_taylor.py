@@ -63,6 +63,20 @@ def problems():
     out["pcr3bp"] = dict(f=fa, y=[x, y, u, v], p={mu: 0.01215058560962404},
                          ps={"mu": "0.01215058560962404"},
                          y0=[0.8233851820, 0, 0, 0.1263841015], y0s=None, T=10.0, Ts="10")
+    # spatial circular restricted three-body problem, Earth-Moon: a northern L1 halo orbit
+    # (z amplitude 0.058; conmech.cr3bp.halo_family from the halo bifurcation of the planar
+    # Lyapunov family, member 30 of ds = 0.01), over one period
+    z, w = sp.symbols("z w")
+    r1 = ((x + mu)**2 + y**2 + z**2)**sp.Rational(3, 2)
+    r2 = ((x - mup)**2 + y**2 + z**2)**sp.Rational(3, 2)
+    fh = [u, v, w, x + 2*v - mup*(x + mu)/r1 - mu*(x - mup)/r2,
+          y - 2*u - mup*y/r1 - mu*y/r2, -mup*z/r1 - mu*z/r2]
+    out["halo"] = dict(f=fh, y=[x, y, z, u, v, w], p={mu: 0.012150585609624},
+                       ps={"mu": "0.012150585609624"},
+                       y0=[0.8242000712223545, -4.6539672307516955e-11, 0.058201226424566974,
+                           -3.8330613927905326e-11, 0.16882862193947631,
+                           6.410654827666035e-11],
+                       y0s=None, T=2.763288917273153, Ts=None)
     # double pendulum (unit masses and lengths, g = 1), angles a, b and their rates
     a, b, p, q = sp.symbols("a b p q")
     dd = a - b

@@ -2,8 +2,10 @@
 by conmech.symbolic) against heyoka's taylor_adaptive (PyPI, in this benchmark only) and
 conmech's own DOP853 on the same compiled system, and conmech.Propagator (method TAYLOR, the
 final state alone, as heyoka's propagate_until returns it; solve_ivp returns every step's
-point): Kepler e = 0.9 and Arenstorf's orbit, one
-period each, rtol = atol = tol over 1e-8 .. 1e-16.
+point): Kepler e = 0.9 and Arenstorf's orbit by default; with --problems also the planar
+restricted three-body problem (pcr3bp), an Earth-Moon L1 halo orbit of the spatial one
+(halo) and the double pendulum (pendulum) of bench_taylor.problems; one period (pcr3bp and
+the pendulum: t = 10) each, rtol = atol = tol over 1e-8 .. 1e-16.
 
 Errors are measured at the end of the period against a quadruple-precision Taylor reference
 (conmech.symbolic.taylor_quad, tol 1e-30; it closes Arenstorf's orbit to 1e-25) started
@@ -168,7 +170,7 @@ def main():
     load1 = os.getloadavg()
     lines = ["# Work-precision: conmech TAYLOR vs heyoka vs conmech DOP853", "",
              f"`python bench/taylor_work_precision.py --rounds {args.rounds} --calls "
-             f"{args.calls}`; heyoka "
+             f"{args.calls} --problems {' '.join(args.problems)}`; heyoka "
              f"{getattr(hy, '__version__', 'not installed')}; one period, rtol = atol = tol; "
              "error = max-norm at the end against a quadruple-precision Taylor reference from the "
              "exact values of the doubles the runs start from; "
