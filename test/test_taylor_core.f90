@@ -17,7 +17,7 @@ program test_taylor_core
     integer, parameter :: p = 15, nmax = 7
     real(dp) :: c(0:p, nmax), w(0:p, nmax), rtol(nmax), atol(nmax), e1(nmax), e2(nmax)
     real(dp) :: ynew(nmax), dy1(nmax), dy2(nmax), f1(nmax), u(3), h, rho1, rho2, eps, decay
-    real(dp) :: err1, err2
+    real(dp) :: err1, err2, yj(nmax)
     integer :: trial, n, nb, k, i, nbad_rho, nbad_eval, nsep
     logical :: fin
 
@@ -67,7 +67,7 @@ program test_taylor_core
         w = 0.0_dp
         call random_number(f1)
         w(1, 1:n) = f1(1:n)
-        call taylor_eval_jet(n, p, c(:, 1:n), h, w(:, 1:n), dy2)
+        call taylor_eval_jet(n, p, c(:, 1:n), h, w(:, 1:n), yj, dy2)
         err1 = taylor_check(n, p, h, ynew, dy1, f1(1:n), e1)
         call taylor_check_jet(n, p, h, w(:, 1:n), dy2, e1, err2, fin)
         if (.not. (all(same(ynew(1:n), w(0, 1:n))) .and. all(same(dy1(1:n), dy2(1:n))) .and. &

@@ -37,7 +37,7 @@ program drive
     character(len=8) :: mode, a
     integer :: reps, r, ic, io, nst, nrej, i
     integer(c_int) :: fi
-    real(dp) :: jets(0:p, nw, 2), rtol(n), atol(n), e(n), dy(n), y0(n), y(n), par(1)
+    real(dp) :: ynew(n), jets(0:p, nw, 2), rtol(n), atol(n), e(n), dy(n), y0(n), y(n), par(1)
     real(dp) :: t, tlo, h, tf, eps, decay, rho, err, ecc, hmax
     logical :: hit, fin
     integer(int64) :: c0, c1, cr
@@ -104,7 +104,8 @@ program drive
                 end if
                 nst = nst + 1
                 if (mode(1:1) == "G") then
-                    call taylor_eval_jet(n, p, jets(:, :, ic), h, jets(:, :, io), dy)
+                    call taylor_eval_jet(n, p, jets(:, :, ic), h, jets(:, :, io), ynew, &
+                                         dy)
                     call jf(t + h, p, jets(:, :, io), par)
                     call taylor_check_jet(n, p, h, jets(:, :, io), dy, e, err, fin)
                 else

@@ -146,70 +146,21 @@ contains
         end if
     end subroutine taylor_eval_step
 
-    !> taylor_eval_step with the new state written into w(0, 1:n) (the zeroth coefficients
-    !! of the expansion about the step's end, which the system then completes) and the
-    !! derivative into dy: the same Horner chains, component by component, in the same
-    !! interleaved groups (one pass, no intermediate copy of the state).
-    pure subroutine taylor_eval_jet(n, p, c, h, w, dy)
+    !> taylor_eval_step with the new state also written into w(0, 1:n) (the zeroth
+    !! coefficients of the expansion about the step's end, which the system then
+    !! completes): the same Horner chains. The chains' results go to the contiguous ynew
+    !! and dy first (stored contiguously, the compiler pairs the chains into packed
+    !! operations; a strided store into w keeps them scalar), then into w.
+    pure subroutine taylor_eval_jet(n, p, c, h, w, ynew, dy)
         integer, intent(in) :: n, p
         real(dp), intent(in) :: c(0:p, n), h
         real(dp), intent(inout) :: w(0:p, n)
-        real(dp), intent(out) :: dy(n)
-        real(dp) :: y1, y2, y3, y4, d1, d2, d3, d4
-        integer :: i, k
-        i = 1
-        do while (i + 3 <= n)
-            y1 = c(p, i)
-            y2 = c(p, i + 1)
-            y3 = c(p, i + 2)
-            y4 = c(p, i + 3)
-            d1 = 0.0_dp
-            d2 = 0.0_dp
-            d3 = 0.0_dp
-            d4 = 0.0_dp
-            do k = p - 1, 0, -1
-                d1 = y1 + h*d1
-                d2 = y2 + h*d2
-                d3 = y3 + h*d3
-                d4 = y4 + h*d4
-                y1 = c(k, i) + h*y1
-                y2 = c(k, i + 1) + h*y2
-                y3 = c(k, i + 2) + h*y3
-                y4 = c(k, i + 3) + h*y4
-            end do
-            w(0, i) = y1
-            w(0, i + 1) = y2
-            w(0, i + 2) = y3
-            w(0, i + 3) = y4
-            dy(i:i + 3) = [d1, d2, d3, d4]
-            i = i + 4
+        real(dp), intent(out) :: ynew(n), dy(n)
+        integer :: i
+        call taylor_eval_step(n, p, c, h, ynew, dy)
+        do i = 1, n
+            w(0, i) = ynew(i)
         end do
-        do while (i + 1 <= n)
-            y1 = c(p, i)
-            y2 = c(p, i + 1)
-            d1 = 0.0_dp
-            d2 = 0.0_dp
-            do k = p - 1, 0, -1
-                d1 = y1 + h*d1
-                d2 = y2 + h*d2
-                y1 = c(k, i) + h*y1
-                y2 = c(k, i + 1) + h*y2
-            end do
-            w(0, i) = y1
-            w(0, i + 1) = y2
-            dy(i:i + 1) = [d1, d2]
-            i = i + 2
-        end do
-        if (i == n) then
-            y1 = c(p, i)
-            d1 = 0.0_dp
-            do k = p - 1, 0, -1
-                d1 = y1 + h*d1
-                y1 = c(k, i) + h*y1
-            end do
-            w(0, i) = y1
-            dy(i) = d1
-        end if
     end subroutine taylor_eval_jet
 
     !> taylor_check (err) on the expansion about the step's end, w(0, :) = P(h) and

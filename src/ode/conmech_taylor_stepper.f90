@@ -56,7 +56,7 @@ module conmech_taylor_stepper
         real(dp) :: err = 0.0_dp          !! safety-check ratio of the last accepted step
         integer :: nsteps = 0, max_steps = 100000
         logical :: finite = .false.       !! f at the current point finite
-        real(dp), allocatable :: rtol(:), atol(:), dy(:), e(:)
+        real(dp), allocatable :: rtol(:), atol(:), dy(:), ynew(:), e(:)
         !> (0:p, nw, 2): the expansion at (t, y) is jets(:, :, ic), the one at (t_old,
         !! y_old) (the last step's polynomial, and the next step's work array) the other;
         !! an accepted step swaps them by flipping ic (no copy)
@@ -116,8 +116,8 @@ contains
         self%nw = 0
         self%finite = .false.
         if (allocated(self%jets)) deallocate (self%jets)
-        if (allocated(self%dy)) deallocate (self%dy, self%e)
-        allocate (self%dy(n), self%e(n))
+        if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+        allocate (self%dy(n), self%ynew(n), self%e(n))
     end subroutine taylor_init
 
     !> The expansion at the initial point and the first step. A system without Taylor
@@ -226,7 +226,8 @@ contains
                 if (h /= d) self%hit = .false.
             end if
             self%nsteps = self%nsteps + 1
-            call taylor_eval_jet(n, p, self%jets(:, :, ic), h, self%jets(:, :, io), self%dy)
+            call taylor_eval_jet(n, p, self%jets(:, :, ic), h, self%jets(:, :, io), self%ynew, &
+                                 self%dy)
             call sys%taylor_jet(self%kind, self%t + h, p, self%nw, self%jets(:, :, io))
             self%st%nfev = self%st%nfev + 1
             call taylor_check_jet(n, p, h, self%jets(:, :, io), self%dy, self%e, err, fin)
@@ -365,9 +366,10 @@ contains
             if (allocated(a)) self%jets(:, 1:self%n, 1) = transpose(a)
             if (allocated(b)) self%jets(:, 1:self%n, 2) = transpose(b)
             self%finite = all(abs(self%jets(1, 1:self%n, 1)) <= huge(1.0_dp))
-            if (allocated(self%dy)) deallocate (self%dy, self%e)
-            allocate (self%dy(self%n), self%e(self%n))
+            if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
+            allocate (self%dy(self%n), self%ynew(self%n), self%e(self%n))
             self%dy = 0.0_dp
+            self%ynew = 0.0_dp
             call taylor_scales(self%n, self%nblock, self%y, self%rtol, self%atol, self%e)
         end if
     end subroutine taylor_transfer
