@@ -11,18 +11,12 @@ program drive
     use, intrinsic :: iso_c_binding
     use, intrinsic :: iso_fortran_env, only: int64
     use conmech_taylor_core
+    use conmech_c_system, only: c_taylor_fn
     use conmech_symbolic_taylor_fixed, only: conmech_taylor_fixed
     use kepler_kernel, only: kepler_step
     implicit none
     integer, parameter :: dp = c_double, n = 4, p = 15, nw = 10
     abstract interface
-        subroutine jet_fn(t, order, w, par) bind(c)
-            import :: c_double, c_int
-            real(c_double), value :: t
-            integer(c_int), value :: order
-            real(c_double), intent(inout) :: w(*)
-            real(c_double), intent(in) :: par(*)
-        end subroutine jet_fn
         subroutine kern_fn(t, h, c, w, rtol, atol, eps, decay, e, dy, err, fin, rho, par) bind(c)
             import :: c_double, c_int
             real(c_double), value :: t, h, eps, decay
@@ -32,7 +26,7 @@ program drive
             integer(c_int), intent(out) :: fin
         end subroutine kern_fn
     end interface
-    procedure(jet_fn), pointer :: jf
+    procedure(c_taylor_fn), pointer :: jf
     procedure(kern_fn), pointer :: kf
     character(len=8) :: mode, a
     integer :: reps, r, ic, io, nst, nrej, i
