@@ -96,6 +96,12 @@ class Propagator:
         if builtin and isinstance(method, str):
             self._packed = self._pack(fun, method, rtol, atol, max_step, max_steps,
                                       y.size)
+        # the flat call's outputs, kept from call to call (room for two points of the
+        # packed system's n: the flat routine asks it; 8 numbers, then the message's 256
+        # bytes)
+        n = self._packed[5] if self._packed is not None else y.size
+        self._out = np.empty(2*(n + 1))
+        self._iout = np.empty(40, dtype=np.int64)
 
     @staticmethod
     def _pack(fun, method, rtol, atol, max_step, max_steps, n):
@@ -160,15 +166,14 @@ class Propagator:
     def _native(self, packed, t):
         fun, params, spec, ipack, rpar, n, _ = packed
         rpar[-1] = t
-        out = np.empty(2*(n + 1))       # the flat call asks room for two points
-        iout = np.empty(40, dtype=np.int64)
+        out, iout = self._out, self._iout
         _conmech.flat_solve_packed(ipack, params if params.size else _PAD, spec, rpar,
                                    self.t, t, self.y, out, iout)
         nt, nfev, _, _, naccept, nreject, info, _ = iout[:8].tolist()
         if info == BAD_INPUT:
             raise ValueError(message_text(iout[8:]))
         if info >= 0 and nt == 1:
-            self.t, self.y = t, out[1:n + 1]
+            self.t, self.y = t, out[1:n + 1].copy()
             return Propagation(True, 0, _MESSAGES[0], nfev, naccept, nreject)
         return Propagation(False, min(info, -1), message_text(iout[8:]), nfev, naccept,
                            nreject)
