@@ -96,12 +96,13 @@ class Propagator:
         if builtin and isinstance(method, str):
             self._packed = self._pack(fun, method, rtol, atol, max_step, max_steps,
                                       y.size)
-        # the flat call's outputs, kept from call to call (room for two points of the
-        # packed system's n: the flat routine asks it; 8 numbers, then the message's 256
-        # bytes)
-        n = self._packed[5] if self._packed is not None else y.size
-        self._out = np.empty(2*(n + 1))
-        self._iout = np.empty(40, dtype=np.int64)
+        if self._packed is not None:
+            # the one-call route's outputs, kept from call to call (room for two points of
+            # the packed system's n: the flat routine asks it; 8 numbers, then the
+            # message's 256 bytes)
+            n = self._packed[5]
+            self._out = np.empty(2*(n + 1))
+            self._iout = np.empty(40, dtype=np.int64)
 
     @staticmethod
     def _pack(fun, method, rtol, atol, max_step, max_steps, n):
