@@ -25,7 +25,7 @@ contains
         real(dp), intent(inout) :: w(0:p, nw), e(n)
         real(dp), intent(out) :: dy(n), err, rho
         integer(c_int), intent(out) :: fin
-        real(dp) :: y(n), d(n), cc, dd, z, y1, s1, s2, l, a1, a2, en(n)
+        real(dp) :: y(n), d(n), cc, dd, z, y1, s1, s2, l, a1, a2
         integer :: i, k, e1, e2
         do i = 1, n
             y(i) = c(p, i)
