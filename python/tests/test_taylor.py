@@ -146,7 +146,9 @@ def test_one_period_kepler_and_dense_output(kepler):
     y0 = [1 - e, 0.0, 0.0, np.sqrt((1 + e)/(1 - e))]
     r = conmech.solve_ivp(kepler, (0, 2*np.pi), y0, method="TAYLOR", rtol=1e-12, atol=1e-12,
                           dense_output=True)
-    assert r.success and 60 < r.naccept < 90      # heyoka takes 73 steps here
+    # order 18 (Jorba and Zou's 15 raised by 3) and its longer steps: 54 steps, where
+    # Jorba and Zou's order and step (heyoka's) take 73
+    assert r.success and 45 < r.naccept < 65
     assert np.max(np.abs(r.y[:, -1] - kepler_exact(y0, 2*np.pi))) < 2e-10
     for tt in (0.3, 2.0, 3.14159, 6.2):
         assert np.max(np.abs(r.sol(tt) - kepler_exact(y0, tt))) < 2e-10

@@ -19,7 +19,7 @@ module conmech_taylor_batch
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
-    use conmech_taylor_core, only: taylor_order, taylor_next_rho, taylor_eval_step, &
+    use conmech_taylor_core, only: taylor_order, taylor_decay, taylor_next_rho, taylor_eval_step, &
         taylor_check, taylor_add_time, taylor_shrink, TAYLOR_CHECK_MAX
     implicit none
     private
@@ -123,7 +123,7 @@ contains
         rt = max(rtol, epsilon(1.0_dp))
         eps = max(minval(rt), minval(atol))
         ord = taylor_order(eps)
-        decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
+        decay = taylor_decay(eps)
         posneg = sign(1.0_dp, tf - t0)
         hm = min(abs(hmax), abs(tf - t0))
         allocate (w(width, 0:ord, nw), cur(0:ord, n, width))

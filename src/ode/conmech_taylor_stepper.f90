@@ -3,14 +3,17 @@
 !!
 !! Each step expands the solution about the current point to order p,
 !! y(t + s) = sum_k y^[k] s^k, and evaluates the polynomial at s = h. Order and step follow
-!! Jorba and Zou (2005), as heyoka does:
+!! Jorba and Zou (2005), as heyoka does, with the order raised and the step lengthened to
+!! match (conmech_taylor_core's taylor_order and taylor_decay):
 !!
-!! - p = ceil(-ln(eps)/2 + 1) for the tolerance eps = max(rtol, atol) (the smallest
-!!   components of vector tolerances), at least 2 (order 15 at 1e-12, 20 at 1e-16);
+!! - p = p0 + max(3, p0/5), p0 = ceil(-ln(eps)/2 + 1) (at least 2) for the tolerance
+!!   eps = max(rtol, atol) (the smallest components of vector tolerances): order 18 at
+!!   1e-12, 24 at 1e-16;
 !! - rho = min over k = p - 1, p of (1/N_k)^(1/k), N_k = max_i |y_i^[k]| eps/E_i with
 !!   E_i = max(atol_i, rtol_i ||y||_inf) (the radius of convergence seen by the last two
 !!   coefficients; rtol = atol = eps gives Jorba and Zou's mixed absolute/relative norm);
-!!   h = rho exp(-2) exp(-0.7/(p - 1)): the terms of order p - 1 and p stay below E_i.
+!!   h = rho exp(-lambda0 (p0 + 1)/(p + 1)), lambda0 = 2 + 0.7/(p0 - 1): the first
+!!   neglected term is as small as at Jorba and Zou's order and step, h = rho exp(-lambda0).
 !!
 !! Safety check of the step: the coefficients at the step's end are computed at once (the
 !! next step needs them), so f(t + h, y(t + h)) = y^[1] there is known for free; it is
@@ -33,7 +36,7 @@ module conmech_taylor_stepper
     use conmech_ode_stepper, only: ode_stepper, check_interval, tolerance_vectors, FORM_POWER
     use conmech_state_packer, only: state_packer
     use conmech_taylor_events, only: taylor_events, limit_step
-    use conmech_taylor_core, only: taylor_order, taylor_scales, taylor_add_time, &
+    use conmech_taylor_core, only: taylor_order, taylor_decay, taylor_scales, taylor_add_time, &
         taylor_shrink, TAYLOR_CHECK_MAX, taylor_eval_jet, taylor_check_jet, taylor_next_rho
     implicit none
     private
@@ -52,7 +55,7 @@ module conmech_taylor_stepper
         real(dp) :: hmax = huge(1.0_dp)
         real(dp) :: first_step = 0.0_dp
         real(dp) :: eps = 0.0_dp          !! tolerance that set the order
-        real(dp) :: decay = 0.0_dp        !! exp(-2 - 0.7/(p - 1)), Jorba and Zou's factor
+        real(dp) :: decay = 0.0_dp        !! h/rho (taylor_decay)
         real(dp) :: err = 0.0_dp          !! safety-check ratio of the last accepted step
         integer :: nsteps = 0, max_steps = 100000
         logical :: finite = .false.       !! f at the current point finite
@@ -97,7 +100,7 @@ contains
         if (info /= CM_SUCCESS) return
         self%eps = max(minval(self%rtol), minval(self%atol))
         self%order = taylor_order(self%eps)
-        self%decay = exp(-2.0_dp - 0.7_dp/real(self%order - 1, dp))
+        self%decay = taylor_decay(self%eps)
         call self%setup_base(METHOD_TAYLOR, t0, tf, y0, self%order, FORM_POWER)
         self%nblock = n
         if (self%kind == 1) self%nblock = nint((sqrt(4.0_dp*n + 1.0_dp) - 1.0_dp)/2.0_dp)

@@ -22,9 +22,11 @@ FIXED_MAX_TERMS = 40000
 
 
 def taylor_order(eps):
-    """Jorba and Zou's order ceil(-ln(eps)/2 + 1), at least 2 (conmech_taylor_core's
-    taylor_order, the same arithmetic)."""
-    return max(2, math.ceil(-0.5*math.log(max(eps, 2.2250738585072014e-308)) + 1.0))
+    """The order for the tolerance eps: Jorba and Zou's p0 = ceil(-ln(eps)/2 + 1) (at
+    least 2) raised by max(3, p0 // 5) (conmech_taylor_core's taylor_order, the same
+    arithmetic)."""
+    p0 = max(2, math.ceil(-0.5*math.log(max(eps, 2.2250738585072014e-308)) + 1.0))
+    return p0 + max(3, p0//5)
 
 
 def with_fixed_order(fun, rtol, atol):

@@ -216,7 +216,7 @@ _RUN = """\
         integer, parameter :: nl = {lanes}, nw = {nw}
         real(dp), allocatable :: wb(:)
         real(dp) :: rt({n}), atol({n}), t0, tf, eps, decay, hm
-        integer :: ord
+        integer :: ord, ord0
         t0 = span(1)
         tf = span(2)
         atol = tol(:, 2)
@@ -227,8 +227,9 @@ _RUN = """\
         ! the scalar stepper's order, step bound and decay factor (conmech_taylor_core)
         rt = max(tol(:, 1), epsilon(1.0_dp))
         eps = max(minval(rt), minval(atol))
-        ord = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
-        decay = exp(-2.0_dp - 0.7_dp/real(ord - 1, dp))
+        ord0 = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
+        ord = ord0 + max(3, ord0/5)
+        decay = exp(-(2.0_dp + 0.7_dp/real(ord0 - 1, dp))*real(ord0 + 1, dp)/real(ord + 1, dp))
         hm = min(abs(hmax), abs(tf - t0))
         ! two expansions per lane (see the stepping routine), nl*(ord + 1)*nw values each
         allocate (wb(nl*(ord + 1)*nw*2))
