@@ -1,9 +1,13 @@
 !> Taylor's method in quadruple precision (real128, gfortran's IEEE binary128: 113-bit
 !! significand, unit round-off 9.6e-35) for reference solutions: the generated routine
 !! conmech_taylor_qp expands the solution in real128 (C pointers to real128 values), and
-!! the step follows Jorba and Zou as in double precision (order ceil(-ln(tol)/2 + 1): 36 at
-!! 1e-30; rho from the last two coefficients; the step's safety check from the next
-!! expansion; the time summed in double length).
+!! the step follows Jorba and Zou (order ceil(-ln(tol)/2 + 1): 36 at 1e-30; rho from the
+!! last two coefficients; the step's safety check from the next expansion; the time summed
+!! in double length). The double-precision stepper raises that order (taylor_order of
+!! conmech_taylor_core), because its step is bound by the latency of a chain of fast
+!! operations; real128 arithmetic is done in software, each operation costs far more than
+!! a pipeline's latency, and the work counted in products, which Jorba and Zou's order
+!! minimises, is what a step costs.
 module conmech_taylor_quad
     use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_loc
     use, intrinsic :: iso_fortran_env, only: qp => real128
