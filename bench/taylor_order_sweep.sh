@@ -19,16 +19,19 @@ git ls-files -z | tar --null -T - -cf - | (mkdir -p "$work/repo" && tar -C "$wor
 cd "$work/repo"
 core=src/ode/conmech_taylor_core.f90
 cp bench/callgrind_taylor.sh "$work/callgrind_taylor.sh"
-grep -q 'taylor_order = p0 + max(3, p0/5)' "$core" || { echo "taylor_order's rule not found"; exit 1; }
+grep -q 'taylor_order = p0 + max(3, p0/5)' "$core" ||
+    { echo "taylor_order's rule not found in $core"; exit 1; }
 for d in $DELTAS; do
     sed -i "s|taylor_order = p0 + .*|taylor_order = p0 + $d|" "$core"
     # the fixed-order source for p0 + d (the installed package's taylor_order is the library's)
     jz="max(2, __import__('math').ceil(-0.5*__import__('math').log(float(sys.argv[1])) + 1)) + $d"
     cp "$work/callgrind_taylor.sh" bench/callgrind_taylor.sh
     sed -i "s|taylor_order(float(sys.argv\[1\]))|$jz|" bench/callgrind_taylor.sh
-    sed -i "s|from conmech.ivp.taylor import taylor_order; print(taylor_order(\$TOL))|import math; print(max(2, math.ceil(-0.5*math.log(\$TOL) + 1)) + $d)|" \
+    order="import math; print(max(2, math.ceil(-0.5*math.log(\$TOL) + 1)) + $d)"
+    sed -i "s|from conmech.ivp.taylor import taylor_order; print(taylor_order(\$TOL))|$order|" \
         bench/callgrind_taylor.sh
     echo "== order p0 + $d"
     mkdir -p "$work/cg$d"
-    CALLGRIND_TMP="$work/cg$d" PYTHON="$PY" bash bench/callgrind_taylor.sh "$TOL" | grep -E "^(taylor|fixed) "
+    CALLGRIND_TMP="$work/cg$d" PYTHON="$PY" bash bench/callgrind_taylor.sh "$TOL" |
+        grep -E "^(taylor|fixed) "
 done

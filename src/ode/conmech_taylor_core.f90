@@ -36,7 +36,7 @@ contains
     !! step counted as p^2 products; but a step of a small system is a chain of dependent
     !! operations whose length grows like p, with a fixed part (Horner, the check, the step
     !! size) beside it, so a higher order with longer steps (taylor_decay) takes less time:
-    !! on Kepler's problem at 1e-12, 55 steps of order 18 against 74 of order 15, 11% fewer
+    !! on Kepler's problem at 1e-12, 54 steps of order 18 against 73 of order 15, 11% fewer
     !! instructions, a smaller error (bench/results/taylor_order.md).
     pure integer function taylor_order(eps)
         real(dp), intent(in) :: eps
