@@ -38,14 +38,17 @@ module conmech_taylor_batch
         end subroutine taylor_batch_fn
         !> The generated propagator over SIMD lanes (conmech.symbolic.taylor_batch): the
         !! members y(n, m) from span(1) to span(2) in place, each as the scalar stepper
-        !! integrates it; tol(n, 2) = [rtol, atol]; per member st (status), te (where it
-        !! stopped), cnt(:, j) = [expansions, accepted, rejected].
-        subroutine taylor_batch_run_fn(m, y, span, tol, hmax, mxs, p, te, st, cnt) bind(c)
+        !! integrates it; tol(n, 2) = [rtol, atol]; order and decay: taylor_order and
+        !! taylor_decay of the tolerances (the rule lives here, not in generated code);
+        !! per member st (status), te (where it stopped), cnt(:, j) = [expansions,
+        !! accepted, rejected].
+        subroutine taylor_batch_run_fn(m, y, span, tol, hmax, mxs, order, decay, p, te, st, &
+                                       cnt) bind(c)
             import :: c_double, c_int
-            integer(c_int), value :: m, mxs
+            integer(c_int), value :: m, mxs, order
             real(c_double), intent(inout) :: y(*)
             real(c_double), intent(in) :: span(2), tol(*), p(*)
-            real(c_double), value :: hmax
+            real(c_double), value :: hmax, decay
             real(c_double), intent(out) :: te(*)
             integer(c_int), intent(out) :: st(*), cnt(*)
         end subroutine taylor_batch_run_fn
@@ -68,8 +71,8 @@ contains
         real(dp), intent(out) :: tend(m)
         integer(c_int), intent(out) :: info(m), nexp(m), nacc(m), nrej(m)
         integer(c_int), allocatable :: cnt(:, :)
-        real(dp) :: tol(n, 2)
-        integer :: nthr, chunk, nc, b, j0, nm
+        real(dp) :: tol(n, 2), eps, decay
+        integer :: nthr, chunk, nc, b, j0, nm, ord
         nthr = 1
         !$ nthr = omp_get_max_threads()
         if (threads > 0) nthr = threads
@@ -79,6 +82,10 @@ contains
         nc = (m + chunk - 1)/chunk
         tol(:, 1) = rtol
         tol(:, 2) = atol
+        ! the scalar stepper's order and step factor (taylor_propagate's tolerance eps)
+        eps = max(minval(max(rtol, epsilon(1.0_dp))), minval(atol))
+        ord = taylor_order(eps)
+        decay = taylor_decay(eps)
         allocate (cnt(3, m))
         !$omp parallel do num_threads(nthr) schedule(dynamic, 1) default(shared) &
         !$omp private(b, j0, nm)
@@ -86,8 +93,8 @@ contains
             j0 = (b - 1)*chunk + 1
             nm = min(chunk, m - j0 + 1)
             call run(int(nm, c_int), y(:, j0:j0 + nm - 1), [t0, tf], tol, hmax, &
-                     int(max_steps, c_int), p, tend(j0:j0 + nm - 1), info(j0:j0 + nm - 1), &
-                     cnt(:, j0:j0 + nm - 1))
+                     int(max_steps, c_int), int(ord, c_int), decay, p, tend(j0:j0 + nm - 1), &
+                     info(j0:j0 + nm - 1), cnt(:, j0:j0 + nm - 1))
         end do
         !$omp end parallel do
         nexp = cnt(1, :)

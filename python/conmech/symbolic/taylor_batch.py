@@ -38,7 +38,7 @@ from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (publi
 from .taylor_recipe import Recipe
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 9
+VERSION = 10
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_head",
            "coefficient_routine",
@@ -201,36 +201,34 @@ _CALL_FIXED = """\
         end if"""
 
 _RUN = """\
-    !> Integrate the members y(:, 1:m) from span(1) to span(2) in place, {lanes} lanes at a
+    !> Integrate the members y(:, 1:m) from ts(1) to ts(2) in place, {lanes} lanes at a
     !! time (a lane takes the next member as soon as its own has ended), each member
     !! exactly as the scalar Taylor stepper integrates it alone; tol(:, 1) = rtol, tol(:, 2)
-    !! = atol, steps of at most hmax, at most mxs attempted. st(j): the status of member j,
+    !! = atol, steps of at most hx, at most mxs attempted; ord and decay: the scalar
+    !! stepper's order and step factor for these tolerances (conmech_taylor_core's
+    !! taylor_order and taylor_decay, given by the caller). st(j): the status of member j,
     !! te(j) where it stopped, cnt(:, j) its expansions (nfev), accepted, rejected steps.
-    subroutine conmech_taylor_batch_run(m, y, span, tol, hmax, mxs, p, te, st, cnt) bind(C, name="conmech_taylor_batch_run")
-        integer(c_int), value, intent(in) :: m, mxs
+    subroutine conmech_taylor_batch_run(m, y, ts, tol, hx, mxs, ord, decay, p, te, st, cnt) bind(C, name="conmech_taylor_batch_run")
+        integer(c_int), value, intent(in) :: m, mxs, ord
         real(dp), intent(inout) :: y({n}, m)
-        real(dp), intent(in) :: span(2), tol({n}, 2), p({npar})
-        real(dp), value, intent(in) :: hmax
+        real(dp), intent(in) :: ts(2), tol({n}, 2), p({npar})
+        real(dp), value, intent(in) :: hx, decay
         real(dp), intent(out) :: te(m)
         integer(c_int), intent(out) :: st(m), cnt(3, m)
         integer, parameter :: nl = {lanes}, nw = {nw}
         real(dp), allocatable :: wb(:)
-        real(dp) :: rt({n}), atol({n}), t0, tf, eps, decay, hm
-        integer :: ord, ord0
-        t0 = span(1)
-        tf = span(2)
+        real(dp) :: rt({n}), atol({n}), t0, tf, eps, hm
+        t0 = ts(1)
+        tf = ts(2)
         atol = tol(:, 2)
         st = {ok}
         cnt = 0
         te = t0
         if (m < 1 .or. tf == t0) return
-        ! the scalar stepper's order, step bound and decay factor (conmech_taylor_core)
+        ! the scalar stepper's tolerance and step bound (conmech_taylor_core)
         rt = max(tol(:, 1), epsilon(1.0_dp))
         eps = max(minval(rt), minval(atol))
-        ord0 = max(2, ceiling(-0.5_dp*log(max(eps, tiny(1.0_dp))) + 1.0_dp))
-        ord = ord0 + max(3, ord0/5)
-        decay = exp(-(2.0_dp + 0.7_dp/real(ord0 - 1, dp))*real(ord0 + 1, dp)/real(ord + 1, dp))
-        hm = min(abs(hmax), abs(tf - t0))
+        hm = min(abs(hx), abs(tf - t0))
         ! two expansions per lane (see the stepping routine), nl*(ord + 1)*nw values each
         allocate (wb(nl*(ord + 1)*nw*2))
 {call}
