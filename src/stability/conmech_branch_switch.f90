@@ -60,6 +60,7 @@ contains
         allocate (y(n), phi(n, n), a(n, n), v(n, 1), ipiv(n), t0(n + 2))
         oo%rtol = o%rtol
         oo%atol = o%atol
+        oo%method = o%integrator
         call set_param(sys, sp%point%p)
         y = sp%point%y0
         phi = 0.0_dp
@@ -206,6 +207,7 @@ contains
         nx = size(dg, 2)
         oo%rtol = o%rtol
         oo%atol = o%atol
+        oo%method = o%integrator
         h = o%fd_step*max(1.0_dp, abs(pt%p))
         if (.not. o%in_period) then
             call set_param(sys, pt%p + h)

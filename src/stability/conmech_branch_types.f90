@@ -5,6 +5,7 @@ module conmech_branch_types
     use conmech_branch_outcome, only: branch_outcome
     use conmech_code_names, only: code_name
     use conmech_status
+    use conmech_ode_solver, only: METHOD_DOP853
     implicit none
     private
 
@@ -43,7 +44,8 @@ module conmech_branch_types
         integer :: max_iter = 12              !! corrector iterations
         real(dp) :: tol = 1.0e-10_dp          !! corrector: |dX| <= tol max(1, |X|)
         real(dp) :: res_tol = 1.0e-8_dp       !! and max |G| <= res_tol
-        real(dp) :: rtol = 1.0e-11_dp         !! integrator (DOP853) tolerances
+        integer :: integrator = METHOD_DOP853 !! of the orbits and their STMs (or TAYLOR)
+        real(dp) :: rtol = 1.0e-11_dp         !! its tolerances
         real(dp) :: atol = 1.0e-11_dp
         real(dp) :: rcond = 1.0e-12_dp        !! rank threshold of the Newton matrices
         real(dp) :: fd_step = 1.0e-5_dp       !! relative step of the parameter derivative

@@ -46,6 +46,7 @@ contains
                                              pb%phi(n, n))
         oo%rtol = pb%o%rtol
         oo%atol = pb%o%atol
+        oo%method = pb%o%integrator
         call cp_unpack(pb, x, y0, tend, per, p)
         h = pb%o%fd_step*max(1.0_dp, abs(p))
         if (.not. (tend > 0.0_dp)) then
@@ -317,6 +318,7 @@ contains
             if (pb%sym) then
                 oo%rtol = pb%o%rtol
                 oo%atol = pb%o%atol
+                oo%method = pb%o%integrator
                 phi(:, :, 1) = 0.0_dp
                 do j = 1, pb%n
                     phi(j, j, 1) = 1.0_dp
@@ -380,6 +382,7 @@ contains
         end if
         oo%rtol = pb%o%rtol
         oo%atol = pb%o%atol
+        oo%method = pb%o%integrator
         y1 = y
         call ode_integrate(sys, 0.0_dp, per, y1, oo, info, message=msg)
         if (info < 0) return

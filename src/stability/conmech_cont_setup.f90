@@ -178,6 +178,7 @@ contains
             pb%bvp%autonomous = pb%o%autonomous
             pb%bvp%rtol = pb%o%rtol
             pb%bvp%atol = pb%o%atol
+            pb%bvp%integrator = pb%o%integrator
             pb%bvp%fd_step = pb%o%fd_step
             pb%nx = pb%bvp%nx
         end if

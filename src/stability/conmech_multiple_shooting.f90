@@ -33,6 +33,7 @@ contains
         oo%rtol = bvp%rtol
         oo%atol = bvp%atol
         oo%max_steps = bvp%max_steps
+        oo%method = bvp%integrator
     end function bvp_ode_options
 
     !> Residuals, chain blocks and their factorisation at X.

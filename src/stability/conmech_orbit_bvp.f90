@@ -26,6 +26,7 @@ module conmech_orbit_bvp
     use conmech_central_step, only: central_step
     use conmech_status
     use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: METHOD_DOP853
     use conmech_orbit_types, only: ORBIT_MULTIPLE, ORBIT_COLLOCATION, energy_fun
     use conmech_block_chain, only: block_chain, chain_factor, chain_solve
     use conmech_collocation_tableau, only: gauss_tableau, gauss_collocation
@@ -51,6 +52,7 @@ module conmech_orbit_bvp
         real(dp) :: fd_step = 1.0e-5_dp   !! relative step of the parameter derivative
         real(dp) :: rtol = 1.0e-12_dp, atol = 1.0e-12_dp  !! integrator tolerances
         integer :: max_steps = 100000
+        integer :: integrator = METHOD_DOP853   !! of the segments and their STMs
         integer, allocatable :: free(:), targets(:)
         real(dp), allocatable :: ybase(:)        !! symmetric: the fixed components' values
         real(dp), allocatable :: mesh(:)         !! K + 1 nodes in [0, 1]

@@ -222,6 +222,7 @@ contains
         bvp%rtol = opt%rtol
         bvp%atol = opt%atol
         bvp%max_steps = opt%max_steps
+        bvp%integrator = opt%method
         if (.not. sym .and. md == PO_FIXED_ENERGY) then
             bvp%energy_row = .true.
             bvp%energy_value = energy_value

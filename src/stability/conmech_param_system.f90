@@ -28,6 +28,8 @@ module conmech_param_system
         procedure :: has_jacobian_product => bp_has_jac_prod
         procedure :: jacobian_product => bp_jac_prod
         procedure :: rhs_jacobian_product => bp_rhs_jac_prod
+        procedure :: taylor_size => bp_taylor_size
+        procedure :: taylor_jet => bp_taylor_jet
     end type builtin_param_system
 
 contains
@@ -166,6 +168,22 @@ contains
         real(dp), intent(out) :: dydt(n), jx(n, k)
         call self%inner%rhs_jacobian_product(t, n, k, y, dydt, x, jx)
     end subroutine bp_rhs_jac_prod
+
+    !> The wrapped system's Taylor work size (0: it has no Taylor code of that kind).
+    integer function bp_taylor_size(self, kind)
+        class(builtin_param_system), intent(in) :: self
+        integer, intent(in) :: kind
+        bp_taylor_size = self%inner%taylor_size(kind)
+    end function bp_taylor_size
+
+    !> The wrapped system's Taylor coefficients (its parameters as last set).
+    subroutine bp_taylor_jet(self, kind, t, order, nw, w)
+        class(builtin_param_system), intent(in) :: self
+        integer, intent(in) :: kind, order, nw
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: w(0:order, nw)
+        call self%inner%taylor_jet(kind, t, order, nw, w)
+    end subroutine bp_taylor_jet
 
     !> set_param of a builtin_param_system or an extension of it (other systems are left
     !! unchanged).

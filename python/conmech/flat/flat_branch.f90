@@ -19,7 +19,7 @@ subroutine flat_branch(name, np, params, nspec, spec, ip, fun, jfun, source, p0,
     use conmech_flat_system, only: flat_param_system
     use conmech_support_cont, only: run_continuation, callback_energy
     implicit none
-    integer(c_int), intent(in) :: n, iopt(16), nfree, ntg, mp
+    integer(c_int), intent(in) :: n, iopt(17), nfree, ntg, mp
     real(c_double), intent(in) :: y0(n), period, ropt(15)
     integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), ntang
     real(c_double), intent(inout) :: tang(max(ntang, 1))  ! in: old tangent; out: SV ratio

@@ -18,7 +18,7 @@ subroutine flat_po(name, np, params, nspec, spec, fun, jfun, source, n, y0, peri
     integer(c_int), intent(in) :: n, kind, mode, nfree, ntg, free_time
     integer(c_int), intent(in) :: max_iter, nk
     real(c_double), intent(in) :: y0(n), period, period_factor, rtol, atol
-    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), iopt(5)
+    integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), iopt(6)
     real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n), merr(n)
     real(c_double), intent(out) :: accuracy, nodes(n, nk), node_times(nk), residual
     integer(c_int), intent(out) :: deflated, nnodes, iterations, info

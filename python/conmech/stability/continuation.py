@@ -13,6 +13,7 @@ from .._core.callback import Guard, as_result
 from .._core.native import _NO_SPEC, _PAD, NativeSystem, _unused_callback
 from .._core.validate import _check_dim, _count, _msg, _real, _state
 from .orbits import _METHODS, stable_tolerance
+from .variational import stm_integrator
 from .._core.result import Record, StatusRecord
 from .._core.status import raise_status
 
@@ -152,7 +153,8 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
                  res_tol=1e-8, max_iter=12, locate=True, locate_tol=1e-11, energy=None,
                  in_period=False, period_range=(-np.inf, np.inf),
                  energy_range=(-np.inf, np.inf), method="single", segments=8, degree=4,
-                 intervals=40, jac=None, _switch=0, _tangent=None) -> Branch:
+                 intervals=40, jac=None, integrator="DOP853", _switch=0,
+                 _tangent=None) -> Branch:
     """Pseudo-arclength continuation of the periodic orbit through ``y0`` (period guess
     ``period``) in a parameter, with its special points located (see conmech_continuation).
 
@@ -171,6 +173,10 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     (``intervals`` intervals of ``degree`` Gauss points): the same equations discretised
     as a boundary-value problem and solved by a structured Newton; the step ``ds``
     measures the same unknowns (first node, period, parameter) for all three.
+
+    ``integrator``: "DOP853" (the default) or "TAYLOR", the integrator of the orbits and
+    their state transition matrices: Taylor's method on the variational system's own
+    recurrences, for a system compiled by :mod:`conmech.symbolic` (ValueError otherwise).
 
     ``jac``: the exact Jacobian df/dy of a callable, ``jac(t, y, p)`` (``jac(t, y)`` with
     ``in_period``), for the state transition matrices instead of differences.
@@ -200,6 +206,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
         raise ValueError("rtol must be < 1")
     if not isinstance(method, str) or method not in _METHODS:
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
+    shooting_system, code = stm_integrator(system, integrator)
     segments = _count(segments, "segments", 1, 100000)
     degree = _count(degree, "degree", 1, 8)
     intervals = _count(intervals, "intervals", 2, 100000)
@@ -247,7 +254,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
     iopt = np.array([max_points, dirn, max_iter, bool(autonomous),
                      bool(fixed_period), bool(conservative), bool(locate), sym,
                      bool(free_time), int(_switch), bool(in_period), _METHODS[method],
-                     segments, degree, intervals, bool(has_range_e)], dtype=np.int32)
+                     segments, degree, intervals, bool(has_range_e), code], dtype=np.int32)
     tang = np.zeros(1) if _tangent is None else np.array(_tangent, dtype=float).ravel()
     g = Guard()
     nan = float("nan")
@@ -283,7 +290,7 @@ def continuation(system: Any, y0: ArrayLike, period: float, param: str | int | N
             if p0 is not None:
                 params[ip] = float(p0)
             pname = (system.param_names or tuple(f"p{i}" for i in range(params.size)))[ip]
-        name, _, _, nspec, spec = system._flat_args()
+        name, _, _, nspec, spec = shooting_system._flat_args()
         sargs = (name, npar, params, nspec, spec, ip + 1, _unused_callback,
                  _unused_callback, 0, 0.0)
     else:

@@ -237,9 +237,10 @@ def lyapunov_family(system: Any, q_eq: ArrayLike, mode: int = 0, *, amplitude: f
         csys = system
         if system.params.size == 0 and isinstance(system, CompiledSystem):
             # continuation() needs a parameter slot even when it continues in the period
-            # (it never sets it): a compiled system without parameters gets an unused one
+            # (it never sets it): a compiled system without parameters gets an unused one,
+            # its Taylor entries shared (integrator="TAYLOR")
             csys = CompiledSystem(system.name, system.kind, system.spec, np.zeros(1),
-                                  ("unused",), system._keep)
+                                  ("unused",), system._keep, system._taylor)
         br = continuation(csys, ya, ta, in_period=True, conservative=True,
                           direction=1 if tb > ta else -1, rtol=rtol, atol=rtol,
                           energy=lambda y, p: efun(y), **options)

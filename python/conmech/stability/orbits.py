@@ -16,6 +16,7 @@ from .._core.validate import (_callback, _check_dim, _count, _no_jac_for_builtin
                               _state, _system_args, _tols)
 from .._core.result import Record
 from .._core.status import raise_status
+from .variational import stm_integrator
 
 class PeriodicOrbit(Record):
     """Result of the orbit solvers: y0, period, monodromy (the formed product of the
@@ -45,14 +46,15 @@ class PeriodicOrbit(Record):
 _METHODS = {"single": 1, "multiple": 2, "collocation": 3}
 
 
-def _method_options(method, segments, degree, intervals, adapt):
+def _method_options(method, segments, degree, intervals, adapt, integrator):
     if not isinstance(method, str) or method not in _METHODS:
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
     segments = _count(segments, "segments", 1, 100000)
     degree = _count(degree, "degree", 1, 8)
     intervals = _count(intervals, "intervals", 2, 100000)
     adapt = _count(adapt, "adapt", 0, 20)
-    iopt = np.array([_METHODS[method], segments, degree, intervals, adapt], dtype=np.int32)
+    iopt = np.array([_METHODS[method], segments, degree, intervals, adapt, integrator],
+                    dtype=np.int32)
     nk = {1: 1, 2: segments + 1, 3: intervals + 1}[_METHODS[method]]
     return iopt, nk
 
@@ -68,15 +70,16 @@ def stable_tolerance(err, mu):
 
 def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_factor, rtol,
            atol, max_iter, jac=None, method="single", segments=8, degree=4, intervals=40,
-           adapt=2):
+           adapt=2, integrator="DOP853"):
     y0 = _state(y0)
     _check_dim(system, y0)
     period = _real(period, "period", 0.0, low_open=True)
     period_factor = _real(period_factor, "period_factor", 0.0, low_open=True)
     rtol, atol = _tols(rtol, atol)
     max_iter = _count(max_iter, "max_iter", 1, 10000)
-    iopt, nk = _method_options(method, segments, degree, intervals, adapt)
     _no_jac_for_builtin(system, jac)
+    shooting_system, code = stm_integrator(system, integrator)
+    iopt, nk = _method_options(method, segments, degree, intervals, adapt, code)
     try:
         fr = np.asarray(free).ravel()
         tg = np.asarray(targets).ravel()
@@ -106,7 +109,7 @@ def _orbit(system, y0, period, kind, mode, free, targets, free_time, period_fact
     args = (y0, period, kind, mode, nfree, fr, ntg, tg, int(bool(free_time)),
             period_factor, rtol, atol, max_iter, iopt, nk)
     njev = 0
-    g, sargs = _system_args(system, y0.size, y0, 0.0, jac)
+    g, sargs = _system_args(shooting_system, y0.size, y0, 0.0, jac)
     out = _conmech.flat_po(*sargs, *args)
     if g is not None:
         g.check()
@@ -184,13 +187,20 @@ _METHOD_DOC = """
     does not resolve the orbit raises RuntimeError saying so). The multipliers come from
     the segments' (or intervals') transfer matrices by the periodic QR algorithm, the flow
     direction deflated: for a Hamiltonian system mu_min mu_max = 1 and the trivial pair
-    hold to the integration error even when |mu_max| is 1e9."""
+    hold to the integration error even when |mu_max| is 1e9.
+
+    ``integrator``: "DOP853" (the default) or "TAYLOR", the integrator of the shooting
+    segments and their state transition matrices (single and multiple shooting, and the
+    monodromy of a collocation orbit): Taylor's method on the variational system's own
+    recurrences, for a system compiled by :mod:`conmech.symbolic` (ValueError otherwise).
+    The orbit's residual is checked by DOP853 either way."""
 
 
 def periodic_orbit(system: Any, y0: ArrayLike, period: float, fixed_period: bool = False,
                    rtol: float = 1e-12, atol: float = 1e-12, max_iter=30,
                    jac=None, *, method: str = "single", segments: int = 8, degree: int = 4,
-                   intervals: int = 40, adapt: int = 2) -> PeriodicOrbit:
+                   intervals: int = 40, adapt: int = 2,
+                   integrator: str = "DOP853") -> PeriodicOrbit:
     """Newton's method for a periodic orbit from the guess (y0, period), with the phase
     condition f(y0_guess) . (y0 - y0_guess) = 0. The period is an unknown unless
     ``fixed_period``. Raises ValueError for a start at an equilibrium, RuntimeError when the
@@ -199,14 +209,16 @@ def periodic_orbit(system: Any, y0: ArrayLike, period: float, fixed_period: bool
     exact Jacobian of a Python system.
     """
     return _orbit(system, y0, period, 1, 2 if fixed_period else 1, [], [], False, 1.0,
-                  rtol, atol, max_iter, jac, method, segments, degree, intervals, adapt)
+                  rtol, atol, max_iter, jac, method, segments, degree, intervals, adapt,
+                  integrator)
 
 
 def symmetric_orbit(system: Any, y0: ArrayLike, free: Sequence[int], targets: Sequence[int],
                     period: float, period_factor: float = 2.0, free_time: bool = False,
                     rtol=1e-12, atol=1e-12, max_iter=30, jac=None, *,
                     method: str = "single", segments: int = 8, degree: int = 4,
-                    intervals: int = 40, adapt: int = 2) -> PeriodicOrbit:
+                    intervals: int = 40, adapt: int = 2,
+                    integrator: str = "DOP853") -> PeriodicOrbit:
     """Symmetric shooting: y0 on the symmetry line (its fixed components as given), the
     components ``free`` (0-based) unknown, the components ``targets`` of the state at
     tau = period/period_factor must vanish (2: half period, 4: quarter period for two
@@ -218,7 +230,8 @@ def symmetric_orbit(system: Any, y0: ArrayLike, free: Sequence[int], targets: Se
     the full period (the rest of it integrated from the end of the shooting span).
     """
     return _orbit(system, y0, period, 2, 1, free, targets, free_time, period_factor, rtol,
-                  atol, max_iter, jac, method, segments, degree, intervals, adapt)
+                  atol, max_iter, jac, method, segments, degree, intervals, adapt,
+                  integrator)
 
 
 periodic_orbit.__doc__ += _METHOD_DOC

@@ -12,7 +12,36 @@ from .._core.native import NativeSystem
 from .._core.validate import (_callback, _check_dim, _no_jac_for_builtin, _real, _state,
                               _system_args, _tols)
 from .._core.status import raise_status
+from ..ivp.methods import BY_NAME
 from ..ivp.taylor_generalized import first_order_view
+
+_TAYLOR = BY_NAME["TAYLOR"].code
+#: the integrators of a state with its STM: name -> method code
+STM_INTEGRATORS = {"DOP853": BY_NAME["DOP853"].code, "TAYLOR": _TAYLOR}
+
+
+def stm_integrator(system, name, what="integrator"):
+    """(the system to integrate, the method code) for the state and its STM by the
+    integrator ``name`` ("DOP853" or "TAYLOR", any case; ``what`` names the argument in
+    the messages). TAYLOR runs Taylor's method on the variational system's own
+    recurrences: ``system`` must be compiled by conmech.symbolic; its variational
+    recurrences are compiled here on first need (their entries then in its spec;
+    without them Fortran refuses the method), and a generalized system M(q) q'' = Q
+    runs its first-order view y = [q; v], whose variational routine expands
+    M da = K Phi (conmech.symbolic.taylor_generalized_var)."""
+    code = STM_INTEGRATORS.get(name.upper()) if isinstance(name, str) else None
+    if code is None:
+        raise ValueError(f"{what} must be 'DOP853' or 'TAYLOR', got {name!r}")
+    if code != _TAYLOR:
+        return system, code
+    if not isinstance(system, NativeSystem):
+        raise ValueError(f"{what} 'TAYLOR' needs a compiled system with Taylor code "
+                         "(conmech.symbolic.ode_system), not a Python function")
+    system = first_order_view(system, "var")
+    if hasattr(system, "taylor_parts"):
+        system.taylor_parts("var")
+    return system, code
+
 
 def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12,
         atol: float = 1e-12, jac: Callable[..., ArrayLike] | None = None,
@@ -38,20 +67,8 @@ def stm(system: Any, t_span: Sequence[float], y0: ArrayLike, rtol: float = 1e-12
     rtol, atol = _tols(rtol, atol)
     _no_jac_for_builtin(system, jac)
     njev = 0
-    if not isinstance(method, str) or method.upper() not in ("DOP853", "TAYLOR"):
-        raise ValueError(f"method must be 'DOP853' or 'TAYLOR', got {method!r}")
-    if method.upper() == "TAYLOR":
-        if not isinstance(system, NativeSystem):
-            raise ValueError("method 'TAYLOR' needs a compiled system with Taylor code "
-                             "(conmech.symbolic.ode_system), not a Python function")
-        # a system of conmech.symbolic compiles the recurrences of its variational
-        # system here, on first need (their entries then in its spec); without them
-        # Fortran refuses the method. A generalized system M(q) q'' = Q runs its
-        # first-order view y = [q; v], whose variational routine expands M da = K Phi
-        # (conmech.symbolic.taylor_generalized_var)
-        system = first_order_view(system, "var")
-        if hasattr(system, "taylor_parts"):
-            system.taylor_parts("var")
+    system, code = stm_integrator(system, method, "method")
+    if code == _TAYLOR:
         y1, phi, nfev, _, info, message = _conmech.flat_stm_taylor(
             *system._flat_args(), y0, t0, t1, rtol, atol)
     else:

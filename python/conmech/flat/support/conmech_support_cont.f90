@@ -14,13 +14,14 @@ module conmech_support_cont
     use conmech_continuation, only: cont_options, branch, special_point, continue_orbits, &
                                     SP_PD, SP_BP, branch_energy
     use conmech_branch_switch, only: switch_period_doubling, switch_branch_point
+    use conmech_support_orbits, only: stm_integrator_ok
     implicit none
     private
     public :: set_param_any, run_continuation, callback_energy
     public :: MAX_SPECIAL, NROPT, NIOPT
 
     integer, parameter :: MAX_SPECIAL = 64
-    integer, parameter :: NROPT = 15, NIOPT = 16
+    integer, parameter :: NROPT = 15, NIOPT = 17
 
 contains
 
@@ -40,7 +41,8 @@ contains
     !! tol, res_tol, rtol, atol, locate_tol, period_factor, period_min, period_max,
     !! energy_min, energy_max]; iopt = [max_points, direction, max_iter, autonomous,
     !! fixed_period, conservative, locate, symmetric, free_time, switch, in_period,
-    !! discretisation, segments, degree, intervals, has_energy]: switch = 1 starts the
+    !! discretisation, segments, degree, intervals, has_energy, integrator (METHOD_DOP853
+    !! or METHOD_TAYLOR)]: switch = 1 starts the
     !! doubled-period branch at the period-doubling point (p0, y0, period), switch = 2 the
     !! second branch at the branch point (p0, y0, period) whose old tangent is
     !! tang(1:ntang) (unknowns [y0, T, p]; its singular-value ratio is returned in
@@ -88,6 +90,10 @@ contains
         sp_kind = 0; sp_index = 0; sp_p = 0.0_dp; sp_per = 0.0_dp; sp_y = 0.0_dp
         sp_mr = 0.0_dp; sp_mi = 0.0_dp; sp_s = 0.0_dp; sp_located = 0; sp_test = 0.0_dp
         sp_closure = 0.0_dp; sp_bracket = 0.0_dp
+        if (.not. stm_integrator_ok(iopt(17), message)) then
+            info = CM_BAD_INPUT
+            return
+        end if
         o%ds = ropt(1)
         o%ds_min = ropt(2)
         o%ds_max = ropt(3)
@@ -116,6 +122,7 @@ contains
         o%intervals = iopt(15)
         sym = iopt(8) /= 0
         has_en = iopt(16) /= 0
+        o%integrator = iopt(17)
         call set_param_any(sys, p0)
         if (iopt(10) == 2) then
             sp%kind = SP_BP

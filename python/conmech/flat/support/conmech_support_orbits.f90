@@ -7,18 +7,20 @@ module conmech_support_orbits
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
+    use conmech_ode_solver, only: METHOD_DOP853
+    use conmech_ode_options, only: METHOD_TAYLOR
     use conmech_shooting, only: shooting_options, periodic_orbit, find_periodic_orbit, &
                                 find_symmetric_orbit
     implicit none
     private
-    public :: run_periodic_orbit
+    public :: run_periodic_orbit, stm_integrator_ok
 
 contains
 
     !> kind 1: general shooting (mode 1 free period, 2 fixed period), kind 2: symmetric
     !! (free_idx, targets one-based; tau = period/period_factor, free_time /= 0).
     !! iopt = [discretisation (1 single, 2 multiple, 3 collocation), segments, degree,
-    !! intervals, adapt]; nk >= the number of nodes (segments or intervals + 1).
+    !! intervals, adapt, integrator (a method code: METHOD_DOP853 or METHOD_TAYLOR)]; nk >= the number of nodes (segments or intervals + 1).
     !! Outputs: the orbit, the formed monodromy, multipliers (mr, mi) with error estimates
     !! merr and the set's accuracy, deflated (1: mr(1) is the deflated flow multiplier),
     !! the nnodes nodes and their times.
@@ -30,7 +32,7 @@ contains
         class(ode_system), intent(in) :: sys
         integer(c_int), intent(in) :: n, kind, mode, nfree, ntg, free_time, max_iter, nk
         real(c_double), intent(in) :: y0(n), period, period_factor, rtol, atol
-        integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), iopt(5)
+        integer(c_int), intent(in) :: free_idx(max(nfree, 1)), targets(max(ntg, 1)), iopt(6)
         real(c_double), intent(out) :: y0_out(n), period_out, mono(n, n), mr(n), mi(n)
         real(c_double), intent(out) :: merr(n), accuracy, nodes(n, nk), node_times(nk)
         real(c_double), intent(out) :: residual
@@ -46,6 +48,7 @@ contains
         so%degree = iopt(3)
         so%intervals = iopt(4)
         so%adapt = iopt(5)
+        so%method = iopt(6)
         y0_out = 0.0_c_double
         period_out = 0.0_c_double
         mono = 0.0_c_double
@@ -62,6 +65,10 @@ contains
         if (iopt(1) < 1 .or. iopt(1) > 3) then
             info = CM_BAD_INPUT
             message = "unknown discretisation"
+            return
+        end if
+        if (.not. stm_integrator_ok(iopt(6), message)) then
+            info = CM_BAD_INPUT
             return
         end if
         if (kind == 1) then
@@ -99,4 +106,14 @@ contains
         end if
     end subroutine run_periodic_orbit
 
+    !> Whether `code` names an integrator the orbit solvers offer for the state and its
+    !! STM: DOP853, or Taylor's method on the variational system's own recurrences (a
+    !! compiled system of conmech.symbolic); else false with the message.
+    logical function stm_integrator_ok(code, message) result(ok)
+        integer(c_int), intent(in) :: code
+        character(len=*), intent(inout) :: message
+        ok = code == METHOD_DOP853 .or. code == METHOD_TAYLOR
+        if (.not. ok) message = "bad input: the integrator of the orbit and its STM must "// &
+                                "be DOP853 or TAYLOR"
+    end function stm_integrator_ok
 end module conmech_support_orbits
