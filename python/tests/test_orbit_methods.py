@@ -6,6 +6,7 @@ import ctypes
 import os
 import shutil
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -86,6 +87,18 @@ def test_symmetric_orbits_by_every_method(method):
     np.testing.assert_allclose(o.y0, ref.y0, atol=1e-9)
     assert o.stability_index == pytest.approx(ref.stability_index, rel=1e-8)
     assert o.node_times[-1] == pytest.approx(o.period/2, abs=1e-12)
+
+
+def test_tight_tolerance_orbit_warns_about_nothing_the_user_did_not_call():
+    """At rtol below SciPy's floor the orbit's independent closure check runs at the floor
+    (the integrator's own value), silently: the same orbit as at the floor itself."""
+    ref = hf.lyapunov_orbit(0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        o = stability.symmetric_orbit(hf.system(), ref.y0, [3], [1, 2], ref.period,
+                                      free_time=True, rtol=1e-15, atol=1e-15)
+    assert o.period == pytest.approx(ref.period, abs=1e-9)
+    assert o.residual < 1e-10
 
 
 @pytest.fixture(scope="module")

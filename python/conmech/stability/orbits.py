@@ -14,6 +14,7 @@ from ..ivp.solve import solve_ivp
 from .._core.native import NativeSystem
 from .._core.validate import (_callback, _check_dim, _count, _no_jac_for_builtin, _real,
                               _state, _system_args, _tols)
+from .._core.checks import RTOL_FLOOR
 from .._core.result import Record
 from .._core.status import raise_status
 from .variational import stm_integrator
@@ -159,7 +160,9 @@ def _true_orbit_residual(system, y0, period, kind, targets, period_factor, rtol,
         spans = list(zip(node_times[:-1], node_times[1:]))
     res = 0.0
     for j, (y, span) in enumerate(zip(starts, spans)):
-        r = solve_ivp(system, span, y, method="DOP853", rtol=rtol, atol=atol,
+        # rtol at SciPy's floor at least: the value the integrator runs with anyway, and
+        # no warning about a solve_ivp call the user did not make
+        r = solve_ivp(system, span, y, method="DOP853", rtol=max(rtol, RTOL_FLOOR), atol=atol,
                       max_steps=10**6)
         if not r.success:
             raise RuntimeError(f"the orbit found could not be checked: {r.message}")
