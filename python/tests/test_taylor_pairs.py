@@ -2,8 +2,10 @@
 of the same form share one 2-wide vector, as the two lanes of a pair of columns.
 
 - the pairing finds the grouping an SLP vectorizer would (Kepler: the two squares and the
-  two products x P, y P; Arenstorf: the two distances' squares, powers and products, y^2
-  alone), every pair of one kind and weight, no column in two lanes;
+  two products x P, y P; Arenstorf: the two distances' squares and powers, the products
+  (x + mu) P1 and (x - 1 + mu) P2; y^2 and y (c - m1 P1 - mu P2), whose common factor y
+  the decomposition takes out, alone), every pair of one kind and weight, no column in
+  two lanes;
 - the paired written-out routine gives the coefficients of the unpaired one (and of the
   loop routine) to the last bit, for powers, products, squares and sine/cosine pairs
   (each lane runs the scalar sum's operations in the same order).
@@ -97,11 +99,12 @@ def test_arenstorf_pairs_the_two_distances():
     dec, hist, pairs, lanes, kind = pairing(arenstorf_f(), [mu])
     _check_pairs(hist, pairs, lanes)
     kinds = sorted(_kind_of(dec, hist[i]) for i, _ in pairs)
-    assert kinds == ["mul", "mul", "pow", "sq"]
+    assert kinds == ["mul", "pow", "sq"]
     for i, j in pairs:
         assert _kind_of(dec, hist[i]) == _kind_of(dec, hist[j])
     unpaired = [k for k in range(len(hist)) if all(k not in pr for pr in pairs)]
-    assert [_kind_of(dec, hist[k]) for k in unpaired] == ["sq"]      # y^2
+    # y^2, and y times the sum of the two powers' terms (one product for y's equation)
+    assert [_kind_of(dec, hist[k]) for k in unpaired] == ["sq", "mul"]
 
 
 def _fixed_jet(source, nw, order, y0, params):

@@ -62,7 +62,7 @@ from .taylor_recipe import Recipe
 __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
            "variational_exprs", "TAYLOR_VERSION"]
 
-TAYLOR_VERSION = "3"
+TAYLOR_VERSION = "4"
 
 #: flags added to the model libraries' for the written-out routine (isa.scalar_isa_flags):
 #: -fopenmp-simd for its paired history sums (two-lane loops marked ``!$omp simd``, which

@@ -38,7 +38,7 @@ from .isa import isa_flags, machine_lanes, scalar_isa_flags  # noqa: F401 (publi
 from .taylor_recipe import Recipe
 
 #: the version of the generated batch code (a change regenerates the kept sources)
-VERSION = 10
+VERSION = 11
 
 __all__ = ["machine_lanes", "isa_flags", "scalar_isa_flags", "coefficient_head",
            "coefficient_routine",

@@ -216,8 +216,17 @@ class Decomposition:
         if e.is_Add:
             const, var = e.as_independent(*self._var, as_Add=True)
             out = _Lin(self._const(const) if const != 0 else 0)
-            for term in sp.Add.make_args(var):
-                c, v = term.as_independent(*self._var, as_Add=False)
+            terms = [term.as_independent(*self._var, as_Add=False)
+                     for term in sp.Add.make_args(var)]
+            groups, terms = self._common_factors(terms)
+            for f, part in groups:
+                # f (sum c rest): one product for the group
+                s = _Lin()
+                for c, rest in part:
+                    s = s.plus(self._build(rest).scaled(self._const(c) if c != 1 else 1))
+                out = out.plus(_Lin.col(self._op("mul", sorted([self._col(f),
+                                                                self._mat(s)]))[0]))
+            for c, v in terms:
                 out = out.plus(self._build(v).scaled(self._const(c) if c != 1 else 1))
             return out
         if e.is_Mul:
@@ -230,6 +239,40 @@ class Decomposition:
         if isinstance(e, sp.Function) and e.func in _SMOOTH_FUNCS:
             return _Lin.col(self._function(_SMOOTH_FUNCS[e.func], e.args[0]))
         raise TaylorUnsupported(f"cannot expand {type(e).__name__} ({e}) in Taylor series")
+
+    def _common_factors(self, terms):
+        """The terms (c, v) of a sum (c constant, v variable) grouped by a variable factor f
+        that two or more of them share beside other variable factors: sum c_i f r_i
+        = f sum c_i r_i takes one product where the terms take one each (a term f alone
+        joins its group for free, its r = 1). Greedy, the factor with the most such terms
+        first. Terms with a variable denominator are left as they are (their quotient
+        would become a reciprocal and a product). Returns ([(f, [(c, r), ...])], the
+        other terms)."""
+        def plain(v):
+            return all(not (x.is_Integer and x < 0) for _, x in
+                       (a.as_base_exp() for a in sp.Mul.make_args(v)))
+        groups = []
+        while True:
+            count = {}
+            for c, v in terms:
+                if v.is_Mul and plain(v):
+                    for a in sp.Mul.make_args(v):
+                        count[a] = count.get(a, 0) + 1
+            best = [a for a, k in count.items() if k >= 2]
+            if not best:
+                return groups, terms
+            f = max(best, key=lambda a: (count[a], sp.default_sort_key(a)))
+            part, others = [], []
+            for c, v in terms:
+                args = sp.Mul.make_args(v)
+                if v == f:
+                    part.append((c, sp.S.One))
+                elif v.is_Mul and plain(v) and f in args:
+                    part.append((c, sp.Mul(*[a for a in args if a != f])))
+                else:
+                    others.append((c, v))
+            groups.append((f, part))
+            terms = others
 
     def _product(self, e):
         """Column of a product of variable factors: numerator chain / denominator chain."""
