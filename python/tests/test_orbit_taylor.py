@@ -24,6 +24,7 @@ sp = pytest.importorskip("sympy")
 
 from conmech import stability, symbolic  # noqa: E402
 import taylor_jets  # noqa: E402
+from symbolic_seeds import arenstorf_ode  # noqa: E402
 
 ARENSTORF = ([0.994, 0.0, 0.0, -2.00158510637908252240537862224],
              17.0652165601579625588917206249)
@@ -33,13 +34,8 @@ HALO = ([0.8242000712223545, 0.0, 0.058201226424566974, 0.0, 0.16882862193947631
 
 @pytest.fixture(scope="module")
 def planar():
-    x, y, u, v, mu = sp.symbols("x y u v mu")
-    m1 = 1 - mu
-    d1 = ((x + mu)**2 + y**2)**sp.Rational(3, 2)
-    d2 = ((x - m1)**2 + y**2)**sp.Rational(3, 2)
-    return symbolic.ode_system(
-        [u, v, x + 2*v - m1*(x + mu)/d1 - mu*(x - m1)/d2, y - 2*u - m1*y/d1 - mu*y/d2],
-        [x, y, u, v], params={mu: 0.012277471})
+    f, state, mu = arenstorf_ode()
+    return symbolic.ode_system(f, state, params={mu: 0.012277471})
 
 
 @pytest.fixture(scope="module")
