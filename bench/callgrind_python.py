@@ -2,7 +2,8 @@
 """Instruction counts (callgrind) of conmech against SciPy through Python, for ratios that
 do not depend on the machine's load: the same problems as bench/bench_ivp.py (DOP853) and
 bench/bench_radau.py (Radau, same Python right-hand side and Jacobian, and the compiled
-system).
+system), and the routes to Hill's variation orbit of bench/hill_taylor_vs_kernel.py (the
+kernel, the STMs by DOP853 and Taylor, the orbit finders' Newton by either integrator).
 
     python bench/callgrind_python.py [--cases ...] [--k1 1] [--k2 3]
 
@@ -16,6 +17,7 @@ exactly repeatable on a shared machine, where CPU and wall times are not.
     python bench/callgrind_python.py one CASE REPS      (what valgrind runs)
 """
 import argparse
+import gc
 import os
 import re
 import subprocess
@@ -65,7 +67,33 @@ def cases():
                                              rtol=tol, atol=tol)
         return make
 
+    def hill_orbit(route):
+        # Hill's variation orbit at Hill's m (bench/hill_taylor_vs_kernel.py's routes)
+        def make():
+            import math
+            import hill_taylor_vs_kernel as hk
+            m = conmech.hill.M_HILL
+            y0 = conmech.hill.variation_orbit(m).y0
+            if route == "kernel":
+                return lambda: conmech.hill.variation_orbit(m)
+            if route == "kernel_stm":
+                sys_ = conmech.systems.hill(m=m)
+                return lambda: conmech.stability.monodromy(sys_, y0, 2*math.pi)
+            param = hk.hill_parametric(m)
+            if route == "taylor_stm":
+                return lambda: conmech.stability.monodromy(param, y0, 2*math.pi,
+                                                           method="TAYLOR")
+            return lambda: hk.quarter_orbit(param, y0, "TAYLOR" if route == "taylor_newton"
+                                            else "DOP853", 1e-12)
+        return make
+
     out = {}
+    for route, what in (("kernel", "hill.variation_orbit (orbit + monodromy, the kernel)"),
+                        ("kernel_stm", "monodromy of systems.hill, DOP853"),
+                        ("taylor_stm", "monodromy of the symbolic system, TAYLOR"),
+                        ("taylor_newton", "symmetric_orbit, quarter period, TAYLOR"),
+                        ("dop853_newton", "symmetric_orbit, quarter period, DOP853")):
+        out[f"hill_{route}"] = (f"Hill's variation orbit: {what}", hill_orbit(route))
     for kind in ("scipy", "callback", "builtin"):
         out[f"ivp_{kind}"] = (f"Kepler e = 0.5, 5 periods, DOP853 1e-10, {kind}",
                               ivp(kind, 1e-10))
@@ -76,9 +104,14 @@ def cases():
 
 def count(case, reps, tmp):
     out = os.path.join(tmp, f"cg.{case}.{reps}")
+    # the same hash seed in both processes: dict and set layouts, and so the work of
+    # the imports, cancel in the difference; one thread of BLAS and OpenMP (callgrind
+    # counts the instructions of every thread, a pool's spinning workers included)
+    env = dict(os.environ, PYTHONHASHSEED="0", OPENBLAS_NUM_THREADS="1",
+               OMP_NUM_THREADS="1")
     subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
                     sys.executable, os.path.abspath(__file__), "one", case, str(reps)],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     with open(out) as fh:
         for line in fh:
             m = re.match(r"(summary|totals): (\d+)", line)
@@ -91,6 +124,8 @@ def main():
     if len(sys.argv) > 1 and sys.argv[1] == "one":
         call = cases()[sys.argv[2]][1]()
         call()                                   # first call: lazy set-up outside the count
+        gc.collect()
+        gc.disable()            # no collection at a point that depends on the count
         for _ in range(int(sys.argv[3])):
             call()
         return 0
@@ -110,7 +145,8 @@ def main():
             per[name] = (count(name, a.k2, tmp) - count(name, a.k1, tmp)) / (a.k2 - a.k1)
             print(f"{name:16s} {per[name]:16,.0f} instructions per call   ({known[name][0]})",
                   flush=True)
-    for group, ref in (("ivp", "ivp_scipy"), ("radau", "radau_scipy")):
+    for group, ref in (("ivp", "ivp_scipy"), ("radau", "radau_scipy"),
+                       ("hill", "hill_kernel")):
         if ref in per:
             for name, v in per.items():
                 if name.startswith(group + "_") and name != ref:
