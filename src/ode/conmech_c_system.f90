@@ -38,7 +38,7 @@ module conmech_c_system
     private
 
     public :: c_ode_system, make_c_ode, set_c_jac_prod, set_c_taylor, set_c_taylor_fixed
-    public :: c_parameters
+    public :: c_parameters, set_c_parameters
     public :: c_rhs_fn, c_jac_prod_fn, c_taylor_fn
 
     abstract interface
@@ -121,7 +121,7 @@ contains
         sys%n = n
         call c_f_procpointer(rhs, sys%f)
         if (c_associated(jac)) call c_f_procpointer(jac, sys%jac)
-        sys%p = c_parameters(params)
+        call set_c_parameters(params, sys%p)
         info = CM_SUCCESS
         msg = "success"
     end subroutine make_c_ode
@@ -131,10 +131,18 @@ contains
     pure function c_parameters(params) result(p)
         real(dp), intent(in) :: params(:)
         real(dp), allocatable :: p(:)
-        allocate (p(max(size(params), 1)))
-        p = 0.0_dp
-        p(1:size(params)) = params
+        call set_c_parameters(params, p)
     end function c_parameters
+
+    !> The array of `c_parameters` allocated in place (an assignment of the function's
+    !! result to a component allocates it a second time and copies it).
+    pure subroutine set_c_parameters(params, p)
+        real(dp), intent(in) :: params(:)
+        real(dp), allocatable, intent(out) :: p(:)
+        allocate (p(max(size(params), 1)))
+        p(1) = 0.0_dp
+        p(1:size(params)) = params
+    end subroutine set_c_parameters
 
     !> Give a `c_ode_system` the C Jacobian product `jac_prod` (c_null_funptr removes it).
     subroutine set_c_jac_prod(sys, jac_prod)

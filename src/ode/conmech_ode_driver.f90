@@ -228,7 +228,7 @@ contains
             if (.not. opt%save_steps .and. n_eval == 0) then
                 if (t /= t0 .or. res%nt == 0) call push_point(res, t, y)
             end if
-            call shrink_result(res)
+            if (opt%trim_outputs) call shrink_result(res)
             if (keep_dense) res%sol%t_last = t
         end subroutine finish_outputs
 

@@ -41,6 +41,10 @@ module conmech_ode_options
         logical :: save_steps = .true.             !! without t_eval: store every step
         logical :: hit_t_eval = .false.            !! shorten steps to land on t_eval points
                                                    !! (outputs are step ends, not interpolated)
+        !> ode_solve's output arrays cut to their counts at the end (false: they may keep
+        !! room beyond res%nt and res%nev, for a caller that copies the points out anyway
+        !! and would otherwise pay for a copy of them)
+        logical :: trim_outputs = .true.
     end type ode_options
 
     !> Counters of one integration.

@@ -8,8 +8,10 @@ module conmech_ode_result
     implicit none
     private
 
-    public :: ode_result, push_point, push_event, shrink_result
+    public :: ode_result, push_point, push_event, shrink_result, start_outputs
 
+    !> points the outputs hold first (the end points of a run)
+    integer, parameter :: FIRST_ROOM = 16
     !> numbers (times and states) the outputs' second growth makes room for (8 kB)
     integer, parameter :: ROOM = 1024
 
@@ -31,16 +33,26 @@ module conmech_ode_result
 
 contains
 
-    !> Append the point (t, y) to the outputs: room for 16 points first (the end points
-    !! of a run), then at once for ROOM numbers (times and states), so that a run of a
-    !! small system stores its steps without growing again (each growth allocates and
+    !> Empty outputs for states of size n: room for FIRST_ROOM points already (the first
+    !! growth of `push_point`, without the allocation of empty arrays before it), none
+    !! for events.
+    subroutine start_outputs(res, n)
+        type(ode_result), intent(inout) :: res
+        integer, intent(in) :: n
+        allocate (res%t(FIRST_ROOM), res%y(n, FIRST_ROOM), res%ev_t(0), res%ev_y(n, 0), &
+                  res%ev_id(0))
+    end subroutine start_outputs
+
+    !> Append the point (t, y) to the outputs: room for FIRST_ROOM points first (the end
+    !! points of a run), then at once for ROOM numbers (times and states), so that a run
+    !! of a small system stores its steps without growing again (each growth allocates and
     !! copies both arrays), then twice the room each time.
     subroutine push_point(res, t, y)
         type(ode_result), intent(inout) :: res
         real(dp), intent(in) :: t, y(:)
         integer :: cap
         if (res%nt >= size(res%t)) then
-            cap = 16
+            cap = FIRST_ROOM
             if (size(res%t) > 0) cap = max(2*size(res%t), ROOM/(size(y) + 1))
             call resize(res%t, res%y, res%nt, cap)
         end if

@@ -22,7 +22,7 @@ module conmech_ode_solver
         METHOD_DOP853, METHOD_VERNER98, METHOD_RADAU5, METHOD_GAUSS4, METHOD_GAUSS6, &
         METHOD_RATTLE
     use conmech_ode_dense, only: dense_solution
-    use conmech_ode_result, only: ode_result
+    use conmech_ode_result, only: ode_result, start_outputs, shrink_result
     use conmech_ode_stepper, only: ode_stepper, stepper_pack, stepper_unpack, &
         check_first_step, check_interval, tolerance_vectors, FORM_HAIRER, FORM_POWER
     use conmech_state_packer, only: state_packer
@@ -67,8 +67,7 @@ contains
         integer :: info
         character(len=:), allocatable :: msg
 
-        allocate (res%t(0), res%y(size(y0), 0), res%ev_t(0), res%ev_y(size(y0), 0), &
-                  res%ev_id(0))
+        call start_outputs(res, size(y0))
         y = y0
         if (present(stepper)) then
             call ode_drive(stepper, sys, t_span(1), t_span(2), y, options, res%stats, &
@@ -77,11 +76,14 @@ contains
             call new_stepper(options%method, own, info, msg)
             if (info /= CM_SUCCESS) then
                 call fail(res, info, msg)
+                if (options%trim_outputs) call shrink_result(res)
                 return
             end if
             call ode_drive(own, sys, t_span(1), t_span(2), y, options, res%stats, &
                            res%status, msg, res, t_eval, events, hook)
         end if
+        ! the outputs of a run refused before its start (the driver cuts the others)
+        if (options%trim_outputs) call shrink_result(res)
         res%message = msg
         res%success = res%status >= 0
     end subroutine ode_solve

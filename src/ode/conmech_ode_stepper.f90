@@ -416,7 +416,9 @@ contains
         real(dp), intent(in) :: t0, tf
         type(ode_options), intent(in) :: opt
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        ! inout: every branch sets it, and a message of the same length (the success of
+        ! the checks before) is overwritten in place rather than freed and allocated again
+        character(len=:), allocatable, intent(inout) :: msg
         character(len=*), intent(in), optional :: fixed
         info = CM_BAD_INPUT
         if (present(fixed)) then
@@ -443,7 +445,7 @@ contains
         integer, intent(in) :: n
         real(dp), allocatable, intent(out) :: rtolv(:), atolv(:)
         integer, intent(out) :: info
-        character(len=:), allocatable, intent(out) :: msg
+        character(len=:), allocatable, intent(inout) :: msg     ! set on every path
         real(dp), intent(in), optional :: rtol_min
         logical :: ok
         allocate (rtolv(n), atolv(n))

@@ -32,10 +32,11 @@
 subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, n, y0, &
                              nout, out, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
-    use conmech_kinds, only: dp
     use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
-    use conmech_flat_spec, only: spec_system_of_size
+    use conmech_c_system, only: c_ode_system
+    use conmech_flat_spec, only: spec_system_of_size, spec_kind, spec_c_ode, check_spec_size, &
+        KIND_ODE
     use conmech_flat_packed_support, only: packed_sizes_ok, run_packed, put_message
     implicit none
     integer(c_int), intent(in) :: li, lp, ls, lr, n, nout
@@ -49,6 +50,9 @@ subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, 
     integer(c_int64_t), intent(inout) :: iout(40)
     integer, parameter :: HEAD = 7
     class(ode_system), allocatable :: sys
+    ! a compiled system (the frequent case) in a local object of its own type: no
+    ! polymorphic allocation, copy and finalization per call
+    type(c_ode_system) :: csys
     character(len=:), allocatable :: msg, name
     integer(c_int) :: ipar(6), lname
     integer :: info, i
@@ -67,8 +71,13 @@ subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, 
     do i = 1, lname
         name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
     end do
-    call spec_system_of_size(name, real(params(1:ipar(1)), dp), ipar(2), spec, n, "", sys, &
-                             info, msg)
+    if (spec_kind(ipar(2), spec) == KIND_ODE) then
+        call spec_c_ode(params(1:ipar(1)), spec, csys, info, msg)
+        call check_spec_size(name, ipar(2), spec, n, "", info, msg)
+        call run_packed(csys, info, msg, ipar, rpar, t0, tf, n, y0, out, iout)
+        return
+    end if
+    call spec_system_of_size(name, params(1:ipar(1)), ipar(2), spec, n, "", sys, info, msg)
     call run_packed(sys, info, msg, ipar, rpar, t0, tf, n, y0, out, iout)
 end subroutine flat_solve_packed
 

@@ -19,6 +19,9 @@ _PAD.flags.writeable = False
 # a run with more points hands them over by flat_solve_take
 _OUT_DOUBLES = 1024
 _INT64 = np.int64
+# module-level names for the per-call path of run (a global lookup, not an attribute)
+_empty = np.empty
+_solve_packed = _conmech.flat_solve_packed
 # the result's keys in SciPy's order with conmech's extras last, and the fields of a run
 # without events or dense output that are always the same
 _TEMPLATE = dict(t=None, y=None, sol=None, t_events=None, y_events=None, nfev=0, njev=0,
@@ -67,11 +70,26 @@ def run(prep, t0, tf, y0, cap=0):
     fun, params, spec, ipack, rpar, n, name = prep
     if not cap:
         cap = 2 if tf == t0 else max(_OUT_DOUBLES // (n + 1), 2)
-    out = np.empty(cap*(n + 1))
-    iout = np.empty(40, dtype=_INT64)       # 8 numbers, then the message's 256 bytes
-    _conmech.flat_solve_packed(ipack, params if params.size else _PAD, spec, rpar, t0, tf,
-                               y0, out, iout)
-    return _result(out, iout, n)
+    out = _empty(cap*(n + 1))
+    iout = _empty(40, _INT64)       # 8 numbers, then the message's 256 bytes
+    _solve_packed(ipack, params if params.size else _PAD, spec, rpar, t0, tf, y0, out, iout)
+    # the frequent outcome (the points fit, the run was not refused) built here: _result's
+    # steps without its call and its tests of the rare cases
+    nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
+    if nt < 0 or info:
+        return _result(out, iout, n)
+    m = nt*(n + 1)
+    points = (out if m == out.size else out[:m].copy()).reshape(n + 1, nt)
+    res = OdeResult(_TEMPLATE)
+    res["t"] = points[0]
+    res["y"] = points[1:]
+    if nfev:
+        res["nfev"] = nfev
+    if njev or nlu:
+        res["njev"], res["nlu"] = njev, nlu
+    if naccept or nreject:
+        res["naccept"], res["nreject"] = naccept, nreject
+    return res
 
 
 def _take(out, iout, n, guard=None):

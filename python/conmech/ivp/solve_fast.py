@@ -20,6 +20,8 @@ from .native_path import prepare, run as run_native, scipy_points, with_options
 __all__ = ["fast_solve", "fast_method_code"]
 
 _HUGE = float(np.finfo(float).max)
+_INF = math.inf
+_isfinite = math.isfinite      # a global lookup per call instead of an attribute's
 # method string (as given) -> code, for the methods the fast path takes: an adaptive step
 # (the fixed-step ones need first_step) on a first-order system. Bounded: only names the
 # table knows get in, in the spellings users typed.
@@ -63,7 +65,7 @@ def _state(y0, n):
         if len(y0) != n:
             return None
         for v in y0:
-            if not ((isinstance(v, float) or type(v) is int) and math.isfinite(v)):
+            if not ((isinstance(v, float) or type(v) is int) and _isfinite(v)):
                 return None
         return y0
     if type(y0) is np.ndarray and y0.dtype == np.float64 and y0.shape == (n,):
@@ -94,15 +96,18 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
         if not ((type(t0) is float or type(t0) is int) and (type(tf) is float or
                                                               type(tf) is int)):
             return None
-        t0, tf = float(t0), float(tf)
-        if not (math.isfinite(t0) and math.isfinite(tf)):
+        if type(t0) is not float or type(tf) is not float:
+            t0, tf = float(t0), float(tf)
+        if not (_isfinite(t0) and _isfinite(tf)):
             return None
     else:
         return None
     key = (id(fun), method, rtol, atol)
-    prep = _PREPARED.get(key)
-    if prep is None or prep[0] is not fun or prep[2] is not prep[1].params or \
-            prep[3] is not prep[1].spec:
+    entry = _PREPARED.get(key)
+    # entry = (fun, prep): prep the packed arguments, for the system it runs (prep[0]) with
+    # the arrays it was packed for (prep[1], prep[2])
+    if entry is None or entry[0] is not fun or entry[1][1] is not entry[1][0].params or \
+            entry[1][2] is not entry[1][0].spec:
         if _state(y0, fun.dimension) is None:
             return None
         prep = _prepare(fun, method, rtol, atol, taylor_code, taylor_system)
@@ -110,13 +115,15 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
             return None
         if len(_PREPARED) >= _KEEP:       # systems made and dropped in a loop
             _PREPARED.clear()
-        _PREPARED[key] = prep
-    elif _state(y0, prep[6]) is None:
-        return None
-    if t_eval is None and first_step is None and max_steps is None and max_step == math.inf:
+        _PREPARED[key] = (fun, prep)
+    else:
+        prep = entry[1]
+        if _state(y0, prep[5]) is None:
+            return None
+    if t_eval is None and first_step is None and max_steps is None and max_step == _INF:
         if rtol < RTOL_FLOOR:
             _warn_rtol(4)       # SciPy's warning, at the user's call (Fortran raises rtol)
-        return run_native(prep[1:], t0, tf, y0)
+        return run_native(prep, t0, tf, y0)
     steps = _step_options(t0, tf, first_step, max_step, max_steps)
     if steps is None:
         return None
@@ -126,7 +133,7 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
             return None
     if rtol < RTOL_FLOOR:
         _warn_rtol(4)
-    packed = with_options(prep[1:], *steps, t_eval)
+    packed = with_options(prep, *steps, t_eval)
     res = run_native(packed, t0, tf, y0, max(len(t_eval), 2) if t_eval is not None else 0)
     return scipy_points(res, t_eval is not None, len(t_eval) if t_eval is not None else 0)
 
@@ -185,7 +192,7 @@ def _time_points(t_eval, t0, tf):
 
 
 def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
-    """(fun, the packed arguments of native_path.prepare) for the fast path's call, or
+    """The packed arguments of native_path.prepare for the fast path's call, or
     None when the method or the tolerances are not of its kinds (the full checks run)."""
     code = fast_method_code(method)
     if not code:
@@ -199,8 +206,8 @@ def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
             run_fun = taylor_system(fun, rtol, atol)    # (cached per system and order)
         elif getattr(fun, "kind", None) == "generalized":
             return None                         # its first-order view: the full path
-    return (fun,) + prepare(run_fun, code, _tolerance(rtol, n), _tolerance(atol, n), 0.0,
-                            _HUGE, NO_STEP_LIMIT)
+    return prepare(run_fun, code, _tolerance(rtol, n), _tolerance(atol, n), 0.0, _HUGE,
+                   NO_STEP_LIMIT)
 
 
 # (id(system), method, rtol, atol) -> (system, the packed arguments); the system is kept

@@ -51,6 +51,16 @@ contains
         integer(c_int), intent(in) :: method, max_steps, dense
         real(c_double), intent(in) :: rtol(:), atol(:), first_step, max_step
         type(ode_options) :: opt
+        call set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, dense)
+    end function flat_ode_options
+
+    !> The options of `flat_ode_options` written into opt in place (no copy of the
+    !! tolerance vectors, as an assignment of the function's result makes).
+    subroutine set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, &
+                                dense)
+        type(ode_options), intent(out) :: opt
+        integer(c_int), intent(in) :: method, max_steps, dense
+        real(c_double), intent(in) :: rtol(:), atol(:), first_step, max_step
         opt%method = method
         opt%rtol_vec = rtol
         opt%atol_vec = atol
@@ -58,7 +68,7 @@ contains
         opt%max_step = max_step
         opt%max_steps = max_steps
         opt%dense_output = dense /= 0
-    end function flat_ode_options
+    end subroutine set_flat_options
 
     !> What the caller knows of df/dy, on a fresh stepper of a method that uses it (Radau):
     !! constant (jac_const /= 0: read once, never re-evaluated, not counted in njev), and
@@ -150,7 +160,9 @@ contains
             call copy_message("bad input: array sizes must be positive", message)
             return
         end if
-        opt = flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense)
+        call set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, dense)
+        ! both callers read the points up to res%nt: no final copy to cut the arrays
+        opt%trim_outputs = .false.
         if (method == METHOD_RK45_SCIPY) then
             opt%method = METHOD_DOPRI5
             opt%beta = 0.0_dp

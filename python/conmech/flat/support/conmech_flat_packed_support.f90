@@ -34,8 +34,13 @@ contains
         character(len=*), intent(in) :: text
         integer(c_int64_t), intent(inout) :: iout(40)
         character(len=256) :: message
+        integer :: i
         message = text
-        iout(9:40) = transfer(message, iout(9:40))
+        ! eight characters at a time (a transfer of the whole message into the array
+        ! section goes through an allocated temporary)
+        do i = 1, 32
+            iout(8 + i) = transfer(message(8*i - 7:8*i), 0_c_int64_t)
+        end do
     end subroutine put_message
 
     !> Integrate `sys` (made by the caller: sinfo, smsg its status) from the packed

@@ -58,7 +58,7 @@ module conmech_flat_spec
     private
     public :: KIND_BUILTIN, KIND_ODE, KIND_GENERALIZED, KIND_CONSTRAINED, SPEC_SIZE
     public :: spec_kind, spec_system, spec_generalized, spec_constrained, spec_dimension
-    public :: spec_system_of_size
+    public :: spec_system_of_size, spec_c_ode, check_spec_size
 
     integer, parameter :: KIND_BUILTIN = SPEC_KIND_BUILTIN, KIND_ODE = SPEC_KIND_ODE, &
                           KIND_GENERALIZED = SPEC_KIND_GENERALIZED, &
@@ -129,17 +129,7 @@ contains
         case (KIND_ODE)
             block
                 type(c_ode_system) :: s
-                call make_c_ode(int(spec(SLOT_N)), fptr(spec(SLOT_RHS)), fptr(spec(SLOT_JAC)), &
-                                params, s, info, msg)
-                if (size(spec) >= SLOT_JAC_PROD) call set_c_jac_prod(s, fptr(spec(SLOT_JAC_PROD)))
-                if (size(spec) >= SLOT_TAYLOR_NW_VAR) &
-                    call set_c_taylor(s, fptr(spec(SLOT_TAYLOR_JET)), int(spec(SLOT_TAYLOR_NW)), &
-                                      fptr(spec(SLOT_TAYLOR_VAR)), int(spec(SLOT_TAYLOR_NW_VAR)))
-                if (size(spec) >= SLOT_TAYLOR_ORDER_VAR) &
-                    call set_c_taylor_fixed(s, fptr(spec(SLOT_TAYLOR_JET_FIXED)), &
-                                            int(spec(SLOT_TAYLOR_ORDER)), &
-                                            fptr(spec(SLOT_TAYLOR_VAR_FIXED)), &
-                                            int(spec(SLOT_TAYLOR_ORDER_VAR)))
+                call spec_c_ode(params, spec, s, info, msg)
                 if (info == CM_SUCCESS) allocate (sys, source=s)
             end block
         case (KIND_GENERALIZED)
@@ -161,6 +151,28 @@ contains
         end select
     end subroutine spec_system
 
+    !> The compiled system of a spec of kind KIND_ODE (as `spec_system` makes it) into a
+    !! non-polymorphic object, which a caller may keep in a local variable: no allocation
+    !! of a polymorphic copy, and no finalization of it.
+    subroutine spec_c_ode(params, spec, s, info, msg)
+        real(dp), intent(in) :: params(:)
+        integer(c_int64_t), intent(in) :: spec(:)
+        type(c_ode_system), intent(out) :: s
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        call make_c_ode(int(spec(SLOT_N)), fptr(spec(SLOT_RHS)), fptr(spec(SLOT_JAC)), &
+                        params, s, info, msg)
+        if (size(spec) >= SLOT_JAC_PROD) call set_c_jac_prod(s, fptr(spec(SLOT_JAC_PROD)))
+        if (size(spec) >= SLOT_TAYLOR_NW_VAR) &
+            call set_c_taylor(s, fptr(spec(SLOT_TAYLOR_JET)), int(spec(SLOT_TAYLOR_NW)), &
+                              fptr(spec(SLOT_TAYLOR_VAR)), int(spec(SLOT_TAYLOR_NW_VAR)))
+        if (size(spec) >= SLOT_TAYLOR_ORDER_VAR) &
+            call set_c_taylor_fixed(s, fptr(spec(SLOT_TAYLOR_JET_FIXED)), &
+                                    int(spec(SLOT_TAYLOR_ORDER)), &
+                                    fptr(spec(SLOT_TAYLOR_VAR_FIXED)), &
+                                    int(spec(SLOT_TAYLOR_ORDER_VAR)))
+    end subroutine spec_c_ode
+
     !> The first-order system of `spec_system`, which must have n state variables: else
     !! CM_BAD_INPUT with `size_msg`, or (size_msg = "") a message naming the size it needs.
     subroutine spec_system_of_size(name, params, nspec, spec, n, size_msg, sys, info, msg)
@@ -172,8 +184,20 @@ contains
         class(ode_system), allocatable, intent(out) :: sys
         integer, intent(out) :: info
         character(len=:), allocatable, intent(out) :: msg
-        character(len=24) :: buf
         call spec_system(name, params, nspec, spec, sys, info, msg)
+        call check_spec_size(name, nspec, spec, n, size_msg, info, msg)
+    end subroutine spec_system_of_size
+
+    !> The size check of `spec_system_of_size` after a system was made with status info:
+    !! CM_BAD_INPUT (and the message) when it succeeded with a size other than n.
+    subroutine check_spec_size(name, nspec, spec, n, size_msg, info, msg)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: nspec, n
+        integer(c_int64_t), intent(in) :: spec(:)
+        character(len=*), intent(in) :: size_msg
+        integer, intent(inout) :: info
+        character(len=:), allocatable, intent(inout) :: msg
+        character(len=24) :: buf
         if (info /= CM_SUCCESS .or. spec_dimension(name, nspec, spec) == n) return
         info = CM_BAD_INPUT
         if (len(size_msg) > 0) then
@@ -182,7 +206,7 @@ contains
             write (buf, '(i0)') spec_dimension(name, nspec, spec)
             msg = "bad input: y0 must have size "//trim(buf)//" for the system '"//trim(name)//"'"
         end if
-    end subroutine spec_system_of_size
+    end subroutine check_spec_size
 
     !> A generalized-coordinate system: built-in `name` or compiled (spec kind 2).
     subroutine spec_generalized(name, params, nspec, spec, mech, info, msg)
