@@ -73,23 +73,12 @@ def run(prep, t0, tf, y0, cap=0):
     out = _empty(cap*(n + 1))
     iout = _empty(40, _INT64)       # 8 numbers, then the message's 256 bytes
     _solve_packed(ipack, params if params.size else _PAD, spec, rpar, t0, tf, y0, out, iout)
-    # the frequent outcome (the points fit, the run was not refused) built here: _result's
-    # steps without its call and its tests of the rare cases
+    # the frequent outcome (the points fit, the run was not refused): no tests of the
+    # rare cases
     nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
     if nt < 0 or info:
         return _result(out, iout, n)
-    m = nt*(n + 1)
-    points = (out if m == out.size else out[:m].copy()).reshape(n + 1, nt)
-    res = OdeResult(_TEMPLATE)
-    res["t"] = points[0]
-    res["y"] = points[1:]
-    if nfev:
-        res["nfev"] = nfev
-    if njev or nlu:
-        res["njev"], res["nlu"] = njev, nlu
-    if naccept or nreject:
-        res["naccept"], res["nreject"] = naccept, nreject
-    return res
+    return _points(out, n, nt, nfev, njev, nlu, naccept, nreject)
 
 
 def _take(out, iout, n, guard=None):
@@ -112,11 +101,8 @@ def _take(out, iout, n, guard=None):
     return out, nt, nfev, njev, nlu, naccept, nreject, info
 
 
-def _result(out, iout, n, guard=None):
-    """The OdeResult of a packed call's outputs (:func:`_take`)."""
-    nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
-    if nt < 0 or guard is not None or info == BAD_INPUT:
-        out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
+def _points(out, n, nt, nfev, njev, nlu, naccept, nreject):
+    """The OdeResult of a successful run's nt points in out and its counts."""
     m = nt*(n + 1)
     # the points as an (n + 1, nt) array: its first row the times, the others y (views
     # of one array the size of the points: the result does not hold on to the room)
@@ -130,6 +116,15 @@ def _result(out, iout, n, guard=None):
         res["njev"], res["nlu"] = njev, nlu
     if naccept or nreject:
         res["naccept"], res["nreject"] = naccept, nreject
+    return res
+
+
+def _result(out, iout, n, guard=None):
+    """The OdeResult of a packed call's outputs (:func:`_take`)."""
+    nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
+    if nt < 0 or guard is not None or info == BAD_INPUT:
+        out, nt, nfev, njev, nlu, naccept, nreject, info = _take(out, iout, n, guard)
+    res = _points(out, n, nt, nfev, njev, nlu, naccept, nreject)
     if info:
         if info > 0:
             res["status"], res["message"] = info, _MESSAGES.get(info) or message_text(
