@@ -27,7 +27,7 @@ subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y
     use conmech_flat_spec, only: spec_system_of_size
     use conmech_ensemble, only: ode_ensemble, ensemble_options, ensemble_result, &
         crossing_events
-    use conmech_flat_ode_support, only: copy_message, flat_ode_options
+    use conmech_flat_ode_support, only: copy_message, set_flat_options
     use conmech_flat_ensemble_support, only: builtin_members, callback_progress
     implicit none
     character(len=*), intent(in) :: name
@@ -112,7 +112,7 @@ subroutine flat_ensemble_builtin(name, np, mp, params, nspec, spec, n, m, my0, y
         return
     end if
 
-    opt = flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, 0)
+    call set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, 0)
     eo%threads = threads
     eo%chunk = chunk
     eo%terminal = terminal /= 0 .and. with_events

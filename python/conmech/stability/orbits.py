@@ -47,14 +47,14 @@ class PeriodicOrbit(Record):
 _METHODS = {"single": 1, "multiple": 2, "collocation": 3}
 
 
-def _method_options(method, segments, degree, intervals, adapt, integrator):
+def _method_options(method, segments, degree, intervals, adapt, integrator_code):
     if not isinstance(method, str) or method not in _METHODS:
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
     segments = _count(segments, "segments", 1, 100000)
     degree = _count(degree, "degree", 1, 8)
     intervals = _count(intervals, "intervals", 2, 100000)
     adapt = _count(adapt, "adapt", 0, 20)
-    iopt = np.array([_METHODS[method], segments, degree, intervals, adapt, integrator],
+    iopt = np.array([_METHODS[method], segments, degree, intervals, adapt, integrator_code],
                     dtype=np.int32)
     nk = {1: 1, 2: segments + 1, 3: intervals + 1}[_METHODS[method]]
     return iopt, nk

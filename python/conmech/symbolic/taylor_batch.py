@@ -25,7 +25,8 @@ step), so no lane waits for the slowest member of a group. Each member takes exa
 steps, and gets exactly the result, of its own :func:`conmech.solve_ivp` run with
 method="TAYLOR" (the arithmetic of :mod:`conmech_taylor_core`, operation for operation; the
 library is compiled without contraction of multiply-adds and calls glibc's scalar
-elementary functions, so vector and scalar code round alike), whatever its lane, its neighbours, the batch size or the number of threads.
+elementary functions, so vector and scalar code round alike), whatever its lane, its
+neighbours, the batch size or the number of threads.
 
 The lane count is the machine's vector width for doubles by default (:func:`machine_lanes`:
 8 with AVX-512, 4 with AVX2, else 2), and the library is compiled for that instruction set

@@ -4,7 +4,8 @@
 !! `callback_system` and `callback_events` (from conmech_flat_adapters, re-exported) adapt
 !! f2py callbacks into Python to conmech's `ode_system` and `ode_events`; `run_solve` runs
 !! `ode_solve` from plain arguments and hands the whole result to a `store` procedure,
-!! so that output sizes need not be known in advance and nothing is saved between calls (thread-safe).
+!! so that output sizes need not be known in advance and nothing is saved between calls
+!! (thread-safe).
 !!
 !! Calling conventions of the external procedures (all arguments by reference):
 !!
@@ -27,7 +28,7 @@ module conmech_flat_ode_support
     implicit none
     private
     public :: callback_system, callback_jac_system, callback_events, run_solve, copy_message
-    public :: solve_into, store_result, flat_ode_options
+    public :: solve_into, store_result, set_flat_options
     public :: scipy_first_step, set_jacobian_structure
 
     !> Method code of the flat layer for SciPy's RK45: DOPRI5 with SciPy's step control
@@ -45,17 +46,9 @@ contains
 
     !> The integration options every flat integrator routine takes from its plain arguments:
     !! the method code, the tolerances per component, the first and largest step (0: none),
-    !! the step limit and dense output (dense /= 0). SciPy's RK45 code is left to the caller.
-    function flat_ode_options(method, rtol, atol, first_step, max_step, max_steps, dense) &
-        result(opt)
-        integer(c_int), intent(in) :: method, max_steps, dense
-        real(c_double), intent(in) :: rtol(:), atol(:), first_step, max_step
-        type(ode_options) :: opt
-        call set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, dense)
-    end function flat_ode_options
-
-    !> The options of `flat_ode_options` written into opt in place (no copy of the
-    !! tolerance vectors, as an assignment of the function's result makes).
+    !! the step limit and dense output (dense /= 0), written into opt in place (no copy of
+    !! the tolerance vectors, as the assignment of a function's result makes). SciPy's RK45
+    !! code is left to the caller.
     subroutine set_flat_options(opt, method, rtol, atol, first_step, max_step, max_steps, &
                                 dense)
         type(ode_options), intent(out) :: opt

@@ -13,7 +13,7 @@ module conmech_flat_stepper_support
     use conmech_ode_stepper, only: ode_stepper, stepper_pack_into, stepper_unpack
     use conmech_ode_methods, only: new_stepper
     use conmech_flat_ode_support, only: METHOD_RK45_SCIPY, scipy_first_step, copy_message, &
-        set_jacobian_structure, flat_ode_options
+        set_jacobian_structure, set_flat_options
     use conmech_flat_spec, only: spec_system, spec_system_of_size
     implicit none
     private
@@ -98,7 +98,7 @@ contains
         msg = "success"
         select case (action)
         case (ACTION_START, ACTION_SIZES)
-            opt = flat_ode_options(code, rtol, atol, first_step, max_step, max_steps, 0)
+            call set_flat_options(opt, code, rtol, atol, first_step, max_step, max_steps, 0)
             nfev0 = 0
             if (method == METHOD_RK45_SCIPY) then
                 opt%beta = 0.0_dp

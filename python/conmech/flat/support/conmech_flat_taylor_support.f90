@@ -12,7 +12,7 @@ module conmech_flat_taylor_support
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve
     use conmech_taylor_stepper, only: taylor_stepper
     use conmech_taylor_events, only: taylor_events
-    use conmech_flat_ode_support, only: copy_message, store_result, flat_ode_options
+    use conmech_flat_ode_support, only: copy_message, store_result, set_flat_options
     implicit none
     private
     public :: run_taylor_solve
@@ -54,8 +54,8 @@ contains
             call copy_message("bad input: invalid compiled events", message)
             return
         end if
-        opt = flat_ode_options(int(METHOD_TAYLOR, c_int), rtol, atol, first_step, max_step, &
-                               max_steps, dense)
+        call set_flat_options(opt, int(METHOD_TAYLOR, c_int), rtol, atol, first_step, &
+                              max_step, max_steps, dense)
         fp = transfer(int(evaddr, c_intptr_t), c_null_funptr)
         call c_f_procpointer(fp, ev%series)
         ev%n = n

@@ -20,7 +20,8 @@ contains
     !> kind 1: general shooting (mode 1 free period, 2 fixed period), kind 2: symmetric
     !! (free_idx, targets one-based; tau = period/period_factor, free_time /= 0).
     !! iopt = [discretisation (1 single, 2 multiple, 3 collocation), segments, degree,
-    !! intervals, adapt, integrator (a method code: METHOD_DOP853 or METHOD_TAYLOR)]; nk >= the number of nodes (segments or intervals + 1).
+    !! intervals, adapt, integrator (a method code: METHOD_DOP853 or METHOD_TAYLOR)];
+    !! nk >= the number of nodes (segments or intervals + 1).
     !! Outputs: the orbit, the formed monodromy, multipliers (mr, mi) with error estimates
     !! merr and the set's accuracy, deflated (1: mr(1) is the deflated flow multiplier),
     !! the nnodes nodes and their times.
