@@ -142,14 +142,20 @@ def test_a_bad_time_is_refused(t):
 
 def test_small_rtol_warns_once_at_construction():
     # solve_ivp's warning about an rtol below 100 eps, given once when the Propagator is
-    # made; the propagations (and a repacking after new parameters) give none, without
-    # touching the global warning filters
+    # made, at the caller's line (for a number or an array); the propagations (and a
+    # repacking after new parameters) give none, without touching the global warning
+    # filters
     import warnings
     k = conmech.systems.kepler(1.0)
     with pytest.warns(UserWarning, match="rtol") as record:
         p = conmech.Propagator(k, [0.5, 0.0, 0.0, 3.0 ** 0.5], method="DOP853", rtol=1e-20,
                                atol=1e-12)
     assert len(record) == 1
+    assert record[0].filename == __file__      # at the user's call, not inside conmech
+    with pytest.warns(UserWarning, match="rtol") as record:
+        conmech.Propagator(k, [0.5, 0.0, 0.0, 3.0 ** 0.5], method="DOP853",
+                           rtol=np.full(4, 1e-20), atol=1e-12)
+    assert len(record) == 1 and record[0].filename == __file__
     filters = list(warnings.filters)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -24,8 +24,8 @@ import numpy as np
 
 from .. import _conmech
 from .._core.callback import message_text
-from .._core.checks import initial_state, positive_finite, real_scalar, step_limit, \
-    tolerance
+from .._core.checks import RTOL_FLOOR, _warn_rtol, initial_state, positive_finite, \
+    real_scalar, step_limit, tolerance
 from .._core.native import NativeSystem
 from .._core.status import BAD_INPUT
 from .methods import BY_NAME
@@ -42,6 +42,29 @@ __all__ = ["Propagator", "Propagation"]
 #: status (0, or solve_ivp's negative status of a failure), message, and the run's
 #: evaluations of the right-hand side and accepted / rejected steps
 Propagation = namedtuple("Propagation", "success status message nfev naccept nreject")
+
+
+def _raised_rtol(rtol):
+    """rtol (a non-negative finite number, or an array of them) with the values below
+    100 eps raised to that floor and SciPy's UserWarning given at the caller of the
+    caller (the user's Propagator(...)); anything else unchanged, for solve_ivp's checks
+    and messages."""
+    if type(rtol) is float or type(rtol) is int or type(rtol) is np.float64:
+        if 0 <= rtol < RTOL_FLOOR:
+            _warn_rtol(4)
+            return RTOL_FLOOR
+        return rtol
+    if isinstance(rtol, (bool, np.bool_, str, bytes)):
+        return rtol
+    try:
+        arr = np.asarray(rtol)
+    except (TypeError, ValueError):
+        return rtol
+    if arr.dtype.kind not in "iuf" or not np.isfinite(arr).all() or (arr < 0).any() or \
+            not (arr < RTOL_FLOOR).any():
+        return rtol
+    _warn_rtol(4)
+    return np.maximum(arr.astype(float), RTOL_FLOOR)
 
 
 class Propagator:
@@ -82,6 +105,9 @@ class Propagator:
         t0 = real_scalar(t0, "t0")
         if not math.isfinite(t0):
             raise ValueError(f"t0 must be finite, got {t0}")
+        # SciPy's warning about an rtol below 100 eps at the user's call, not at the
+        # validating call below (rtol raised to that floor, as the solvers do themselves)
+        rtol = _raised_rtol(rtol)
         self._options = dict(method=method, rtol=rtol, atol=atol, max_step=max_step,
                              max_steps=max_steps)
         # every rule of solve_ivp, with its messages, on a zero-length run
