@@ -6,7 +6,7 @@
 !!     q' = v                                   (index 1)
 !!     v' = w                                   (index 2)
 !!     0 = Q(t, q, v) + C^T lambda - M(t, q) w  (w: index 3)
-!!     0 = phi(t, q),  0 = A v + b              (lambda_h: index 3, lambda_n: index 2)
+!!     0 = phi(t, q),  0 = A v + b              (lambda_h: index 3, lambda_n: index 2 or 3)
 !!
 !! The DAE's mass matrix is diag(I, I, 0, 0) and no factorisation of M is needed (M w
 !! is a product). Radau IIA with RADAU5's index-aware error scaling (the error of index-2
@@ -101,9 +101,12 @@ contains
 
     !> The index-3 form of sys at (q, v) with the accelerations acc and multipliers lam of
     !! the KKT system: the system g, its state y0 = [q, v, acc, lam] and the Radau stepper
-    !! with the mass matrix diag(I, I, 0, 0) and RADAU5's index vector (1 for q, 2 for v
-    !! and the non-holonomic multipliers, 3 for w and the holonomic multipliers; w is of
-    !! index 2 when every constraint is non-holonomic).
+    !! with the mass matrix diag(I, I, 0, 0) and RADAU5's index vector: 1 for q, 2 for v,
+    !! 3 for w and the holonomic multipliers. The non-holonomic multipliers are of index 2
+    !! alone, but with holonomic constraints beside them they are solved from one coupled
+    !! system with the holonomic ones and carry their h^-2 round-off, so they are scaled as
+    !! index 3 (as index 2, the Newton increments stall on that round-off at small steps);
+    !! w is of index 2 when every constraint is non-holonomic.
     subroutine index3_setup(sys, q, v, acc, lam, g, y0, stp)
         class(constrained_system), intent(in) :: sys
         real(dp), intent(in) :: q(:), v(:), acc(:), lam(:)
@@ -122,7 +125,7 @@ contains
         stp%dae_index(n + 1:2*n) = 2
         stp%dae_index(2*n + 1:3*n) = merge(3, 2, mh > 0)
         stp%dae_index(3*n + 1:3*n + mh) = 3
-        stp%dae_index(3*n + mh + 1:nd) = 2
+        stp%dae_index(3*n + mh + 1:nd) = merge(3, 2, mh > 0)
         allocate (g%mech, source=sys)
     end subroutine index3_setup
 
