@@ -145,6 +145,57 @@ program test_taylor
                       "Taylor packed at every step = ode_solve, bit for bit")
     end block
 
+    ! a chain of runs with `resume`: the stepper continues where its last run ended (its
+    ! expansion there is the next run's start): the bits of a fresh run from that state
+    ! with one evaluation less (an autonomous system); a state elsewhere, or a run
+    ! backwards, starts again; an RK stepper always starts again
+    block
+        use conmech_ode_driver, only: ode_drive
+        use conmech_rk_stepper, only: rk_stepper
+        use conmech_ode_options, only: METHOD_DOP853
+        type(taylor_stepper) :: kept, fresh
+        type(rk_stepper) :: rk, rk_fresh
+        type(ode_stats) :: sk, sf
+        real(dp) :: yk(4), yf(4), tk(5)
+        logical :: same
+        integer :: k, infof
+        opt = ode_options()
+        opt%method = METHOD_TAYLOR
+        opt%rtol = 1.0e-12_dp
+        opt%atol = 1.0e-12_dp
+        tk = [0.0_dp, 0.9_dp, 2.5_dp, 4.0_dp, 6.0_dp]
+        yk = y0
+        same = .true.
+        do k = 1, 4
+            yf = yk
+            call ode_drive(fresh, kep, tk(k), tk(k + 1), yf, opt, sf, infof, msg)
+            call ode_drive(kept, kep, tk(k), tk(k + 1), yk, opt, sk, info, msg, resume=.true.)
+            same = same .and. info == CM_SUCCESS .and. infof == CM_SUCCESS .and. &
+                   all(yk == yf) .and. sk%naccept == sf%naccept .and. &
+                   sk%nfev == sf%nfev - merge(1, 0, k > 1)
+        end do
+        call ts%check(same, "Taylor resumed over a chain of runs = fresh runs, one "// &
+                      "evaluation less each")
+        yf = y0
+        call ode_drive(fresh, kep, 0.0_dp, 0.9_dp, yf, opt, sf, infof, msg)
+        yk = y0
+        call ode_drive(kept, kep, 0.0_dp, 0.9_dp, yk, opt, sk, info, msg, resume=.true.)
+        call ts%check(all(yk == yf) .and. sk%nfev == sf%nfev, &
+                      "a run from another state starts again")
+        yf = yk
+        call ode_drive(fresh, kep, 0.9_dp, 0.2_dp, yf, opt, sf, infof, msg)
+        call ode_drive(kept, kep, 0.9_dp, 0.2_dp, yk, opt, sk, info, msg, resume=.true.)
+        call ts%check(all(yk == yf) .and. sk%nfev == sf%nfev, "a run backwards starts again")
+        opt%method = METHOD_DOP853
+        yk = y0
+        call ode_drive(rk, kep, 0.0_dp, 0.9_dp, yk, opt, sk, info, msg, resume=.true.)
+        yf = yk
+        call ode_drive(rk_fresh, kep, 0.9_dp, 2.0_dp, yf, opt, sf, infof, msg)
+        call ode_drive(rk, kep, 0.9_dp, 2.0_dp, yk, opt, sk, info, msg, resume=.true.)
+        call ts%check(all(yk == yf) .and. sk%nfev == sf%nfev, &
+                      "DOP853 with resume starts again (it keeps a step size)")
+    end block
+
     ! no Taylor code: refused with a message
     block
         type(ode_function) :: plain

@@ -12,7 +12,9 @@
 !! - the step hook (`ode_step_hook`: after every accepted step, and at every event state),
 !!   which may change y (a projection onto a manifold), count or stop the run;
 !! - the dense solution (options%dense_output): the steps' polynomials, segment by segment;
-!! - the counters and the status, and y at the end (where the run stopped on failure).
+!! - the counters and the status, and y at the end (where the run stopped on failure);
+!! - with `resume`, a stepper that stands at (t0, y) where its last run ended continued
+!!   (`ode_stepper%resume`) instead of started again, where its method allows it.
 !! `ode_solve`, `ode_integrate` and `constrained_solve` are this loop with a stepper from
 !! the method table. Nothing per stage here: one polymorphic call per step.
 module conmech_ode_driver
@@ -35,7 +37,8 @@ contains
     !! the method options%method, or the caller's own stepper type). y: the state at the
     !! end (where the run stopped). res (optional): the outputs, events and dense solution
     !! as the module documentation says; st: the counters.
-    subroutine ode_drive(stp, sys, t0, tf, y, opt, st, info, msg, res, t_eval, events, hook)
+    subroutine ode_drive(stp, sys, t0, tf, y, opt, st, info, msg, res, t_eval, events, hook, &
+                         resume)
         class(ode_stepper), intent(inout) :: stp
         class(ode_system), intent(in) :: sys
         real(dp), intent(in) :: t0, tf
@@ -48,6 +51,9 @@ contains
         real(dp), intent(in), optional :: t_eval(:)
         class(ode_events), intent(in), optional :: events
         class(ode_step_hook), intent(inout), optional :: hook
+        !> continue stp where it stands when that is (t0, y) at the end of its last run
+        !! (the same options) and its method can (ode_stepper%resume)
+        logical, intent(in), optional :: resume
 
         real(dp), allocatable :: g_old(:), ytmp(:), y_stop(:)
         integer, allocatable :: ev_left(:)
@@ -55,7 +61,7 @@ contains
         real(dp) :: t, t_stop, target, h_next
         integer :: n, i_eval, n_eval, hinfo
         logical :: need_dense, keep_dense, has_events, store_steps, stop_now, changed
-        logical :: hit_mode
+        logical :: hit_mode, resumed
         character(len=:), allocatable :: smsg
 
         n = size(y)
@@ -74,8 +80,21 @@ contains
         end if
         ! tf may be infinite (SciPy's t_span = [t0, inf]): the run ends at a terminal
         ! event, a hook's stop, or max_steps; fixed-step methods refuse it in their setup
-        call stp%init(t0, tf, y, opt, info, msg, allow_inf=.true.)
-        if (info /= CM_SUCCESS) return
+        resumed = .false.
+        if (present(resume)) then
+            if (resume .and. tf /= t0 .and. stp%t == t0 .and. allocated(stp%y)) then
+                if (size(stp%y) == n) then
+                    if (all(stp%y == y)) call stp%resume(tf, opt, resumed)
+                end if
+            end if
+        end if
+        if (resumed) then
+            info = CM_SUCCESS
+            msg = "success"
+        else
+            call stp%init(t0, tf, y, opt, info, msg, allow_inf=.true.)
+            if (info /= CM_SUCCESS) return
+        end if
         if (present(res)) then
             if (.not. allocated(res%t)) allocate (res%t(0), res%y(n, 0))
             if (.not. allocated(res%ev_t)) allocate (res%ev_t(0), res%ev_y(n, 0), &
@@ -105,7 +124,7 @@ contains
             return
         end if
 
-        call stp%start(sys, info, msg)
+        if (.not. resumed) call stp%start(sys, info, msg)
         st = stp%st
         if (info /= CM_SUCCESS) then
             call finish_outputs()

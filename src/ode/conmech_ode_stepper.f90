@@ -134,6 +134,13 @@ module conmech_ode_stepper
         procedure :: refresh_f => stepper_refresh_f
         !> Whether f at the current point is finite (default: true, nothing kept).
         procedure :: f_finite => stepper_f_finite
+        !> Continue, towards a new end tf ahead in the same direction, a stepper that
+        !! stands where its last run reached its end, instead of `init` and `start` there
+        !! (the options are the last run's): resumed = .true. when the method then steps
+        !! as a new run from (t, y) would (it keeps nothing of earlier steps but what it
+        !! computed at t: Taylor's expansion), else .false. (the default) and the caller
+        !! starts a new run.
+        procedure :: resume => stepper_resume
         !> The common part of the state (first in every `transfer_state`).
         procedure, non_overridable :: transfer_base => stepper_transfer_base
         !> Set the common state up at (t0, y0) (for `init`): method, n, interval,
@@ -237,6 +244,14 @@ contains
         class(ode_system), intent(in) :: sys
         self%f_stale = .false.
     end subroutine stepper_refresh_f
+
+    subroutine stepper_resume(self, tf, opt, resumed)
+        class(ode_stepper), intent(inout) :: self
+        real(dp), intent(in) :: tf
+        type(ode_options), intent(in) :: opt
+        logical, intent(out) :: resumed
+        resumed = .false.
+    end subroutine stepper_resume
 
     logical function stepper_f_finite(self)
         class(ode_stepper), intent(in) :: self

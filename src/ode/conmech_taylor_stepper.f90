@@ -77,6 +77,7 @@ module conmech_taylor_stepper
         procedure :: eval_unit => taylor_eval_unit
         procedure :: refresh_f => taylor_refresh
         procedure :: f_finite => taylor_f_finite
+        procedure :: resume => taylor_resume
     end type taylor_stepper
 
 contains
@@ -122,6 +123,38 @@ contains
         if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
         allocate (self%dy(n), self%ynew(n), self%e(n))
     end subroutine taylor_init
+
+    !> Continue from the end of the last run towards tf: the expansion at (t, y) is the
+    !! one the last accepted step computed there, and a Taylor step keeps nothing else, so
+    !! the steps are those of a new run from (t, y) (for a system that depends on t, up
+    !! to the rounding of the time that expansion was made at, t_old + h_done), with one
+    !! evaluation less. Only after a run that reached its end with f finite there.
+    subroutine taylor_resume(self, tf, opt, resumed)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: tf
+        type(ode_options), intent(in) :: opt
+        logical, intent(out) :: resumed
+        resumed = .false.
+        if (.not. (self%last .and. self%finite .and. allocated(self%jets))) return
+        if (.not. (tf - self%t)*self%posneg > 0.0_dp) return
+        if (associated(self%ev)) return
+        self%tf = tf
+        self%hmax = min(abs(opt%max_step), abs(tf - self%t))
+        if (.not. self%hmax <= huge(1.0_dp)) self%hmax = huge(1.0_dp)
+        self%t_old = self%t
+        self%y_old(1:self%n) = self%y(1:self%n)
+        self%t_lo = 0.0_dp
+        self%h_done = 0.0_dp
+        self%last = .false.
+        self%hit = .false.
+        self%dense_ready = .false.
+        self%st = ode_stats()
+        self%nsteps = 0
+        self%err = 0.0_dp
+        call propose(self)
+        if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
+        resumed = .true.
+    end subroutine taylor_resume
 
     !> The expansion at the initial point and the first step. A system without Taylor
     !! coefficients is CM_BAD_INPUT with a message saying so.
