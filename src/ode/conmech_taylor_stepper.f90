@@ -37,7 +37,8 @@ module conmech_taylor_stepper
     use conmech_state_packer, only: state_packer
     use conmech_taylor_events, only: taylor_events, limit_step
     use conmech_taylor_core, only: taylor_order, taylor_decay, taylor_scales, taylor_add_time, &
-        taylor_shrink, TAYLOR_CHECK_MAX, taylor_eval_jet, taylor_check_jet, taylor_next_rho
+        taylor_shrink, TAYLOR_CHECK_MAX, taylor_eval_jet, taylor_check_jet, taylor_next_rho, &
+        taylor_eval_step
     implicit none
     private
 
@@ -309,24 +310,17 @@ contains
         self%dense_ready = .true.
     end subroutine taylor_dense
 
-    !> The last step's Taylor polynomial at tt (in [t_old, t]).
+    !> The last step's Taylor polynomial at tt (in [t_old, t]): the step's own Horner
+    !! chains, interleaved over the components (the derivative they also give goes to the
+    !! scratch dy, unused between steps).
     subroutine taylor_eval(self, tt, yout, info, msg)
         class(taylor_stepper), intent(inout) :: self
         real(dp), intent(in) :: tt
         real(dp), intent(out) :: yout(:)
         integer, intent(out), optional :: info
         character(len=:), allocatable, intent(inout), optional :: msg
-        real(dp) :: s
-        integer :: i, k
-        integer :: io
-        s = tt - self%t_old
-        io = 3 - self%ic
-        do i = 1, self%n
-            yout(i) = self%jets(self%order, i, io)
-            do k = self%order - 1, 0, -1
-                yout(i) = self%jets(k, i, io) + s*yout(i)
-            end do
-        end do
+        call taylor_eval_step(self%n, self%order, self%jets(:, 1:self%n, 3 - self%ic), &
+                              tt - self%t_old, yout, self%dy)
         if (present(info)) info = CM_SUCCESS
     end subroutine taylor_eval
 
