@@ -1,0 +1,189 @@
+!> conmech.Propagator's route for a built-in or compiled system: the system, its stepper
+!! and options made once (flat_propagation_new) and kept in Fortran memory at a handle the
+!! caller owns, a propagation per call (flat_propagation_until: three small arguments and
+!! the state), and the memory freed once (flat_propagation_free). See
+!! support/conmech_flat_propagation.f90; iout's layout is flat_solve_packed's.
+
+!> A kept propagation from the packed arguments of flat_solve_packed (ipack, params,
+!! spec, rpar; the output times in them are not read) for a state of size n. On return
+!! iout(7) = 0 and iout(8) the handle (for flat_propagation_until, and
+!! flat_propagation_free once), or iout(7) = CM_BAD_INPUT with the message in iout(9:40)
+!! and no handle (nothing to free).
+subroutine flat_propagation_new(li, ipack, lp, params, ls, spec, lr, rpar, n, iout)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_loc, c_intptr_t
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
+    use conmech_flat_packed_support, only: packed_sizes_ok, put_message
+    use conmech_flat_propagation, only: kept_propagation, propagation_make
+    implicit none
+    integer(c_int), intent(in) :: li, lp, ls, lr, n
+    integer(c_int64_t), intent(in) :: ipack(li)
+    real(c_double), intent(in) :: params(lp)
+    integer(c_int64_t), intent(in) :: spec(ls)
+    real(c_double), intent(in) :: rpar(lr)
+    integer(c_int64_t), intent(inout) :: iout(40)
+    integer, parameter :: HEAD = 7
+    type(kept_propagation), pointer :: p
+    character(len=:), allocatable :: msg, name
+    integer(c_int) :: ipar(6), lname
+    integer :: info, i
+
+    iout = 0
+    lname = -1
+    if (li >= HEAD) lname = int(max(-1_c_int64_t, min(ipack(HEAD), int(li, c_int64_t))), c_int)
+    if (lname < 0 .or. li - HEAD < lname) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: packed arguments of inconsistent sizes", iout)
+        return
+    end if
+    ipar = int(ipack(1:6), c_int)
+    if (.not. packed_sizes_ok(ipar, lp, ls, lr, n, 2*(n + 1), iout)) return
+    allocate (character(len=lname) :: name)
+    do i = 1, lname
+        name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
+    end do
+    allocate (p)
+    call propagation_make(name, params(1:ipar(1)), ipar(2), spec, ipar, rpar, n, p, info, msg)
+    if (info /= CM_SUCCESS) then
+        deallocate (p)
+        iout(7) = info
+        call put_message(msg, iout)
+        return
+    end if
+    iout(8) = transfer(c_loc(p), 0_c_intptr_t)
+end subroutine flat_propagation_new
+
+!> One propagation of y (size n) from t0 to t1 by the kept propagation at `handle`, with
+!! the parameters params (the propagation's number of them first; one unused number
+!! when it has none; the system is made again when their values changed). On return
+!! y is the state at t1 when the run reached it (iout(7) = 0), else as it was (iout(7) <
+!! 0: the run's failure; CM_BAD_INPUT: refused); iout(2:6) = [nfev, njev, nlu, naccept,
+!! nreject], the message in iout(9:40).
+subroutine flat_propagation_until(handle, lp, params, t0, t1, n, y, iout)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_ptr, c_f_pointer, &
+        c_intptr_t
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_flat_packed_support, only: put_message
+    use conmech_flat_propagation, only: kept_propagation, propagation_run
+    implicit none
+    integer(c_int64_t), intent(in) :: handle
+    integer(c_int), intent(in) :: lp, n
+    real(c_double), intent(in) :: params(lp)
+    real(c_double), intent(in) :: t0, t1
+    real(c_double), intent(inout) :: y(n)
+    integer(c_int64_t), intent(inout) :: iout(40)
+    type(kept_propagation), pointer :: p
+    type(c_ptr) :: cp
+    character(len=:), allocatable :: msg
+    integer(c_int) :: counts(5)
+    integer :: info
+
+    iout = 0
+    if (handle == 0) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: no propagation at this handle", iout)
+        return
+    end if
+    cp = transfer(int(handle, c_intptr_t), cp)
+    call c_f_pointer(cp, p)
+    if (n /= p%n .or. lp < size(p%params)) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: the state's size or the number of parameters is "// &
+                         "not the propagation's", iout)
+        return
+    end if
+    call propagation_run(p, params(1:size(p%params)), t0, t1, y, counts, info, msg)
+    iout(1) = merge(1, 0, info >= 0)
+    iout(2:6) = counts
+    iout(7) = info
+    call put_message(msg, iout)
+end subroutine flat_propagation_until
+
+!> Free the kept propagation at `handle` (made by flat_propagation_new; once per handle).
+subroutine flat_propagation_free(handle)
+    use, intrinsic :: iso_c_binding, only: c_int64_t, c_ptr, c_f_pointer, c_intptr_t
+    use conmech_flat_propagation, only: kept_propagation
+    implicit none
+    integer(c_int64_t), intent(in) :: handle
+    type(kept_propagation), pointer :: p
+    type(c_ptr) :: cp
+    if (handle == 0) return
+    cp = transfer(int(handle, c_intptr_t), cp)
+    call c_f_pointer(cp, p)
+    deallocate (p)
+end subroutine flat_propagation_free
+
+!> The states at the m times `times` (sorted from t0 towards the last, finite) by the
+!! kept propagation at `handle`, from one run from (t0, y) to the last time that evaluates
+!! its steps' continuous extension at the others (solve_ivp's t_eval): out(:, j) the state
+!! at times(j), NaN from the first time not reached; y (the state at t0 on entry) the
+!! state at the last time reached. iout(1) the number of times reached, iout(2:6) the
+!! run's counts, iout(7) its status (message in iout(9:40)), CM_BAD_INPUT for times out of
+!! order (nothing run).
+subroutine flat_propagation_grid(handle, lp, params, t0, m, times, n, y, out, iout)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_ptr, c_f_pointer, &
+        c_intptr_t
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_flat_packed_support, only: put_message
+    use conmech_flat_propagation, only: kept_propagation, propagation_grid
+    implicit none
+    integer(c_int64_t), intent(in) :: handle
+    integer(c_int), intent(in) :: lp, m, n
+    real(c_double), intent(in) :: params(lp)
+    real(c_double), intent(in) :: t0
+    real(c_double), intent(in) :: times(m)
+    real(c_double), intent(inout) :: y(n)
+    real(c_double), intent(inout) :: out(n, m)
+    integer(c_int64_t), intent(inout) :: iout(40)
+    type(kept_propagation), pointer :: p
+    type(c_ptr) :: cp
+    character(len=:), allocatable :: msg
+    integer(c_int) :: counts(5)
+    integer :: info, nt
+
+    iout = 0
+    if (handle == 0 .or. m < 1) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: no propagation at this handle, or no times", iout)
+        return
+    end if
+    cp = transfer(int(handle, c_intptr_t), cp)
+    call c_f_pointer(cp, p)
+    if (n /= p%n .or. lp < size(p%params)) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: the state's size or the number of parameters is "// &
+                         "not the propagation's", iout)
+        return
+    end if
+    if (.not. sorted_from(t0, times)) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: the times must be finite and sorted strictly from "// &
+                         "the propagator's time in one direction", iout)
+        return
+    end if
+    out = ieee_value(1.0_c_double, ieee_quiet_nan)
+    call propagation_grid(p, params(1:size(p%params)), t0, times, y, out, nt, counts, info, &
+                          msg)
+    iout(1) = nt
+    iout(2:6) = counts
+    iout(7) = info
+    call put_message(msg, iout)
+
+contains
+
+    !> times finite, the first at or after t0 and each strictly after the one before, in
+    !! the direction from t0 to the last
+    logical function sorted_from(t0, times) result(ok)
+        real(c_double), intent(in) :: t0, times(:)
+        real(c_double) :: dir, before
+        integer :: j
+        dir = sign(1.0_c_double, times(size(times)) - t0)
+        ok = (times(1) - t0)*dir >= 0.0_c_double
+        before = times(1)
+        do j = 1, size(times)
+            ok = ok .and. abs(times(j)) <= huge(1.0_c_double)
+            if (j > 1) ok = ok .and. (times(j) - before)*dir > 0.0_c_double
+            before = times(j)
+        end do
+    end function sorted_from
+end subroutine flat_propagation_grid
