@@ -10,10 +10,14 @@ a fixed part (the call, the set-up, the first expansion) and a part per step:
 fitted by least squares over the spans. Both codes run at the same tolerance (rtol = atol =
 tol, heyoka's tol), in one process, each figure the minimum over interleaved rounds of
 ``--calls`` consecutive calls (us per call). Printed: per span the steps and times, then the
-fitted fixed cost and cost per step of each code and their ratios.
+fitted fixed cost and cost per step of each code and their ratios. Then a chain: one
+period in ``--pieces`` consecutive propagations (the state at evenly spaced times, as a
+user samples an orbit), from the initial state each round; a Propagator continues its
+Taylor run from one propagation to the next (heyoka's integrator carries its state too);
+and the same times in one call of each code's propagate_grid.
 
     python bench/propagate_fixed_cost.py [--problems halo kepler] [--tol 1e-10]
-                                         [--rounds 7] [--calls 200]
+                                         [--rounds 7] [--calls 200] [--pieces 20]
 """
 import argparse
 import os
@@ -62,7 +66,7 @@ def fit(steps, times):
     return c0, c1
 
 
-def measure(name, pr, tol, rounds, ncalls):
+def measure(name, pr, tol, rounds, ncalls, pieces):
     y0 = np.array(pr["y0"], dtype=float)
     T = float(pr["T"])
     model = symbolic.ode_system(pr["f"], pr["y"], params=pr["p"] or None)
@@ -95,6 +99,34 @@ def measure(name, pr, tol, rounds, ncalls):
     print(f"fixed cost: conmech {cf:.2f} us, heyoka {hf:.2f} us ({cf/hf:.2f}x); per step: "
           f"conmech {cp:.3f} us, heyoka {hp:.3f} us ({cp/hp:.2f}x); whole period: "
           f"{rows[-1][2]/rows[-1][4]:.2f}x")
+    times = [float(T)*k/pieces for k in range(1, pieces + 1)]
+
+    def c_chain():
+        prop.t, prop.y = 0.0, y0
+        return sum(prop.propagate_until(t).naccept for t in times)
+
+    def h_chain():
+        ta.time = 0.0
+        ta.state[:] = y0
+        return sum(ta.propagate_until(t)[3] for t in times)
+    grid = np.array([0.0] + times)     # heyoka's grid begins at the current time
+
+    def c_grid():
+        prop.t, prop.y = 0.0, y0
+        return prop.propagate_grid(grid)[0].naccept
+
+    def h_grid():
+        ta.time = 0.0
+        ta.state[:] = y0
+        return ta.propagate_grid(grid)[3]
+    c_steps, h_steps = c_chain(), h_chain()
+    cg_steps, hg_steps = c_grid(), h_grid()
+    tc, th, tcg, thg = timed([c_chain, h_chain, c_grid, h_grid], rounds,
+                             max(ncalls//pieces, 5))
+    print(f"a period in {pieces} propagations: conmech {tc:.2f} us ({c_steps} steps), "
+          f"heyoka {th:.2f} us ({h_steps} steps): {tc/th:.2f}x")
+    print(f"the same {pieces} times by propagate_grid: conmech {tcg:.2f} us ({cg_steps} "
+          f"steps), heyoka {thg:.2f} us ({hg_steps} steps): {tcg/thg:.2f}x")
 
 
 def main():
@@ -103,13 +135,14 @@ def main():
     ap.add_argument("--tol", type=float, default=1e-10)
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--calls", type=int, default=200)
+    ap.add_argument("--pieces", type=int, default=20)
     args = ap.parse_args()
     if hy is None:
         sys.exit("heyoka is not installed (pip install heyoka): it is the comparison")
     prs = problems()
     print(f"load {os.getloadavg()[0]:.2f}; {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
     for name in args.problems:
-        measure(name, prs[name], args.tol, args.rounds, args.calls)
+        measure(name, prs[name], args.tol, args.rounds, args.calls, args.pieces)
     print(f"\nload {os.getloadavg()[0]:.2f}")
 
 
