@@ -11,8 +11,8 @@
 !! and no handle (nothing to free).
 subroutine flat_propagation_new(li, ipack, lp, params, ls, spec, lr, rpar, n, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_loc, c_intptr_t
-    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
-    use conmech_flat_packed_support, only: packed_sizes_ok, put_message
+    use conmech_status, only: CM_SUCCESS
+    use conmech_flat_packed_support, only: unpack_head, put_message
     use conmech_flat_propagation, only: kept_propagation, propagation_make
     implicit none
     integer(c_int), intent(in) :: li, lp, ls, lr, n
@@ -21,26 +21,12 @@ subroutine flat_propagation_new(li, ipack, lp, params, ls, spec, lr, rpar, n, io
     integer(c_int64_t), intent(in) :: spec(ls)
     real(c_double), intent(in) :: rpar(lr)
     integer(c_int64_t), intent(inout) :: iout(40)
-    integer, parameter :: HEAD = 7
     type(kept_propagation), pointer :: p
     character(len=:), allocatable :: msg, name
-    integer(c_int) :: ipar(6), lname
-    integer :: info, i
+    integer(c_int) :: ipar(6)
+    integer :: info
 
-    iout = 0
-    lname = -1
-    if (li >= HEAD) lname = int(max(-1_c_int64_t, min(ipack(HEAD), int(li, c_int64_t))), c_int)
-    if (lname < 0 .or. li - HEAD < lname) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: packed arguments of inconsistent sizes", iout)
-        return
-    end if
-    ipar = int(ipack(1:6), c_int)
-    if (.not. packed_sizes_ok(ipar, lp, ls, lr, n, 2*(n + 1), iout)) return
-    allocate (character(len=lname) :: name)
-    do i = 1, lname
-        name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
-    end do
+    if (.not. unpack_head(ipack, lp, ls, lr, n, 2*(n + 1), ipar, name, iout)) return
     allocate (p)
     call propagation_make(name, params(1:ipar(1)), ipar(2), spec, ipar, rpar, n, p, info, msg)
     if (info /= CM_SUCCESS) then
@@ -59,11 +45,9 @@ end subroutine flat_propagation_new
 !! 0: the run's failure; CM_BAD_INPUT: refused); iout(2:6) = [nfev, njev, nlu, naccept,
 !! nreject], the message in iout(9:40).
 subroutine flat_propagation_until(handle, lp, params, t0, t1, n, y, iout)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_ptr, c_f_pointer, &
-        c_intptr_t
-    use conmech_status, only: CM_BAD_INPUT
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
     use conmech_flat_packed_support, only: put_message
-    use conmech_flat_propagation, only: kept_propagation, propagation_run
+    use conmech_flat_propagation, only: kept_propagation, propagation_at, propagation_run
     implicit none
     integer(c_int64_t), intent(in) :: handle
     integer(c_int), intent(in) :: lp, n
@@ -72,25 +56,12 @@ subroutine flat_propagation_until(handle, lp, params, t0, t1, n, y, iout)
     real(c_double), intent(inout) :: y(n)
     integer(c_int64_t), intent(inout) :: iout(40)
     type(kept_propagation), pointer :: p
-    type(c_ptr) :: cp
     character(len=:), allocatable :: msg
     integer(c_int) :: counts(5)
     integer :: info
 
-    iout = 0
-    if (handle == 0) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: no propagation at this handle", iout)
-        return
-    end if
-    cp = transfer(int(handle, c_intptr_t), cp)
-    call c_f_pointer(cp, p)
-    if (n /= p%n .or. lp < size(p%params)) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: the state's size or the number of parameters is "// &
-                         "not the propagation's", iout)
-        return
-    end if
+    p => propagation_at(handle, n, lp, iout)
+    if (.not. associated(p)) return
     call propagation_run(p, params(1:size(p%params)), t0, t1, y, counts, info, msg)
     iout(1) = merge(1, 0, info >= 0)
     iout(2:6) = counts
@@ -100,16 +71,13 @@ end subroutine flat_propagation_until
 
 !> Free the kept propagation at `handle` (made by flat_propagation_new; once per handle).
 subroutine flat_propagation_free(handle)
-    use, intrinsic :: iso_c_binding, only: c_int64_t, c_ptr, c_f_pointer, c_intptr_t
-    use conmech_flat_propagation, only: kept_propagation
+    use, intrinsic :: iso_c_binding, only: c_int64_t
+    use conmech_flat_propagation, only: kept_propagation, propagation_at
     implicit none
     integer(c_int64_t), intent(in) :: handle
     type(kept_propagation), pointer :: p
-    type(c_ptr) :: cp
-    if (handle == 0) return
-    cp = transfer(int(handle, c_intptr_t), cp)
-    call c_f_pointer(cp, p)
-    deallocate (p)
+    p => propagation_at(handle)
+    if (associated(p)) deallocate (p)
 end subroutine flat_propagation_free
 
 !> The states at the m times `times` (sorted from t0 towards the last, finite) by the
@@ -120,12 +88,11 @@ end subroutine flat_propagation_free
 !! run's counts, iout(7) its status (message in iout(9:40)), CM_BAD_INPUT for times out of
 !! order (nothing run).
 subroutine flat_propagation_grid(handle, lp, params, t0, m, times, n, y, out, iout)
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_ptr, c_f_pointer, &
-        c_intptr_t
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_status, only: CM_BAD_INPUT
     use conmech_flat_packed_support, only: put_message
-    use conmech_flat_propagation, only: kept_propagation, propagation_grid
+    use conmech_flat_propagation, only: kept_propagation, propagation_at, propagation_grid
     implicit none
     integer(c_int64_t), intent(in) :: handle
     integer(c_int), intent(in) :: lp, m, n
@@ -136,26 +103,13 @@ subroutine flat_propagation_grid(handle, lp, params, t0, m, times, n, y, out, io
     real(c_double), intent(inout) :: out(n, m)
     integer(c_int64_t), intent(inout) :: iout(40)
     type(kept_propagation), pointer :: p
-    type(c_ptr) :: cp
     character(len=:), allocatable :: msg
     integer(c_int) :: counts(5)
     integer :: info, nt
 
-    iout = 0
-    if (handle == 0 .or. m < 1) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: no propagation at this handle, or no times", iout)
-        return
-    end if
-    cp = transfer(int(handle, c_intptr_t), cp)
-    call c_f_pointer(cp, p)
-    if (n /= p%n .or. lp < size(p%params)) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: the state's size or the number of parameters is "// &
-                         "not the propagation's", iout)
-        return
-    end if
-    if (.not. sorted_from(t0, times)) then
+    p => propagation_at(handle, n, lp, iout)
+    if (.not. associated(p)) return
+    if (m < 1 .or. .not. sorted_from(t0, times)) then
         iout(7) = CM_BAD_INPUT
         call put_message("bad input: the times must be finite and sorted strictly from "// &
                          "the propagator's time in one direction", iout)

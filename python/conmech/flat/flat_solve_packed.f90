@@ -32,12 +32,11 @@
 subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, n, y0, &
                              nout, out, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
-    use conmech_status, only: CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_c_system, only: c_ode_system
     use conmech_flat_spec, only: spec_system_of_size, spec_kind, spec_c_ode, check_spec_size, &
         KIND_ODE
-    use conmech_flat_packed_support, only: packed_sizes_ok, run_packed, put_message
+    use conmech_flat_packed_support, only: unpack_head, run_packed
     implicit none
     integer(c_int), intent(in) :: li, lp, ls, lr, n, nout
     integer(c_int64_t), intent(in) :: ipack(li)
@@ -48,29 +47,15 @@ subroutine flat_solve_packed(li, ipack, lp, params, ls, spec, lr, rpar, t0, tf, 
     real(c_double), intent(in) :: y0(n)
     real(c_double), intent(inout) :: out(nout)
     integer(c_int64_t), intent(inout) :: iout(40)
-    integer, parameter :: HEAD = 7
     class(ode_system), allocatable :: sys
     ! a compiled system (the frequent case) in a local object of its own type: no
     ! polymorphic allocation, copy and finalization per call
     type(c_ode_system) :: csys
     character(len=:), allocatable :: msg, name
-    integer(c_int) :: ipar(6), lname
-    integer :: info, i
+    integer(c_int) :: ipar(6)
+    integer :: info
 
-    iout = 0
-    lname = -1
-    if (li >= HEAD) lname = int(max(-1_c_int64_t, min(ipack(HEAD), int(li, c_int64_t))), c_int)
-    if (lname < 0 .or. li - HEAD < lname) then
-        iout(7) = CM_BAD_INPUT
-        call put_message("bad input: packed arguments of inconsistent sizes", iout)
-        return
-    end if
-    ipar = int(ipack(1:6), c_int)
-    if (.not. packed_sizes_ok(ipar, lp, ls, lr, n, nout, iout)) return
-    allocate (character(len=lname) :: name)
-    do i = 1, lname
-        name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
-    end do
+    if (.not. unpack_head(ipack, lp, ls, lr, n, nout, ipar, name, iout)) return
     if (spec_kind(ipar(2), spec) == KIND_ODE) then
         call spec_c_ode(params(1:ipar(1)), spec, csys, info, msg)
         call check_spec_size(name, ipar(2), spec, n, "", info, msg)

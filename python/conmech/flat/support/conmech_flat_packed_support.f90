@@ -11,7 +11,7 @@ module conmech_flat_packed_support
     use conmech_flat_ode_support, only: solve_into, copy_message
     implicit none
     private
-    public :: packed_sizes_ok, run_packed, put_message, put_points
+    public :: packed_sizes_ok, unpack_head, run_packed, put_message, put_points
 
 contains
 
@@ -28,6 +28,38 @@ contains
         iout(7) = CM_BAD_INPUT
         call put_message("bad input: packed arguments of inconsistent sizes", iout)
     end function packed_sizes_ok
+
+    !> The head of ipack (flat_solve_packed's layout: [np, nspec, method, max_steps, neval,
+    !! with_t_eval, lname, the name's lname character codes]) checked against the sizes of
+    !! the other packed arrays (packed_sizes_ok): ipar = ipack(1:6) and the system's name;
+    !! else a refusal in iout (iout cleared first either way).
+    logical function unpack_head(ipack, lp, ls, lr, n, nout, ipar, name, iout) result(ok)
+        integer(c_int64_t), intent(in) :: ipack(:)
+        integer(c_int), intent(in) :: lp, ls, lr, n, nout
+        integer(c_int), intent(out) :: ipar(6)
+        character(len=:), allocatable, intent(out) :: name
+        integer(c_int64_t), intent(inout) :: iout(40)
+        integer, parameter :: HEAD = 7
+        integer :: lname, li, i
+        iout = 0
+        ipar = 0
+        li = size(ipack)
+        lname = -1
+        if (li >= HEAD) lname = int(max(-1_c_int64_t, min(ipack(HEAD), int(li, c_int64_t))))
+        ok = lname >= 0 .and. li - HEAD >= lname
+        if (.not. ok) then
+            iout(7) = CM_BAD_INPUT
+            call put_message("bad input: packed arguments of inconsistent sizes", iout)
+            return
+        end if
+        ipar = int(ipack(1:6), c_int)
+        ok = packed_sizes_ok(ipar, lp, ls, lr, n, nout, iout)
+        if (.not. ok) return
+        allocate (character(len=lname) :: name)
+        do i = 1, lname
+            name(i:i) = achar(iand(ipack(HEAD + i), 127_c_int64_t))
+        end do
+    end function unpack_head
 
     !> The message into iout(9:40), its 256 characters as bytes.
     subroutine put_message(text, iout)

@@ -9,9 +9,10 @@
 !! The system reads its parameters at every call, as the packed route does: a call with
 !! parameter values other than the kept ones makes the system again from them.
 module conmech_flat_propagation
-    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t, c_ptr, c_f_pointer, &
+        c_intptr_t
     use conmech_kinds, only: dp
-    use conmech_status, only: CM_SUCCESS
+    use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system
     use conmech_ode_options, only: ode_options, ode_stats
     use conmech_ode_stepper, only: ode_stepper
@@ -22,9 +23,11 @@ module conmech_flat_propagation
     use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: set_flat_options, set_jacobian_structure, &
         scipy_first_step, METHOD_RK45_SCIPY
+    use conmech_flat_packed_support, only: put_message
     implicit none
     private
-    public :: kept_propagation, propagation_make, propagation_run, propagation_grid
+    public :: kept_propagation, propagation_make, propagation_at, propagation_run, &
+        propagation_grid
 
     !> What a propagation keeps from call to call.
     type :: kept_propagation
@@ -82,6 +85,30 @@ contains
         none = 0
         call set_jacobian_structure(p%stp, int(n, c_int), 0, -1, none, none, info, msg)
     end subroutine propagation_make
+
+    !> The propagation at `handle` (made by flat_propagation_new), or a null pointer with
+    !! a refusal in iout (cleared first) when there is none or (n, lp given) the state's
+    !! size is not its size or lp is below its number of parameters.
+    function propagation_at(handle, n, lp, iout) result(p)
+        integer(c_int64_t), intent(in) :: handle
+        integer(c_int), intent(in), optional :: n, lp
+        integer(c_int64_t), intent(inout), optional :: iout(40)
+        type(kept_propagation), pointer :: p
+        type(c_ptr) :: cp
+        p => null()
+        if (present(iout)) iout = 0
+        if (handle /= 0) then
+            cp = transfer(int(handle, c_intptr_t), cp)
+            call c_f_pointer(cp, p)
+            if (.not. (present(n) .and. present(lp))) return
+            if (n == p%n .and. lp >= size(p%params)) return
+        end if
+        p => null()
+        if (.not. present(iout)) return
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: no propagation at this handle, or the state's size "// &
+                         "or the number of parameters is not the propagation's", iout)
+    end function propagation_at
 
     !> One propagation of y from t0 to t1 with the parameters params (as many as the
     !! propagation was made with; y is left as it was unless the run reached t1: info >=
