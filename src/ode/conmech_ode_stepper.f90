@@ -280,8 +280,12 @@ contains
         self%st = ode_stats()
         self%y = y0
         self%y_old = y0
-        if (allocated(self%fc)) deallocate (self%fc)
-        allocate (self%fc(self%n, 0:nf))
+        ! (kept from an earlier run of the same shape)
+        if (allocated(self%fc)) then
+            if (size(self%fc, 1) /= self%n .or. lbound(self%fc, 2) /= 0 .or. &
+                ubound(self%fc, 2) /= nf) deallocate (self%fc)
+        end if
+        if (.not. allocated(self%fc)) allocate (self%fc(self%n, 0:nf))
         self%fc = 0.0_dp
     end subroutine stepper_setup_base
 

@@ -120,9 +120,12 @@ contains
         self%err = 0.0_dp
         self%nw = 0
         self%finite = .false.
-        if (allocated(self%jets)) deallocate (self%jets)
-        if (allocated(self%dy)) deallocate (self%dy, self%ynew, self%e)
-        allocate (self%dy(n), self%ynew(n), self%e(n))
+        ! the arrays of an earlier run of the same size are kept (a Propagator's runs;
+        ! `start` re-sizes the expansions when the order or the system differ)
+        if (allocated(self%dy)) then
+            if (size(self%dy) /= n) deallocate (self%dy, self%ynew, self%e)
+        end if
+        if (.not. allocated(self%dy)) allocate (self%dy(n), self%ynew(n), self%e(n))
     end subroutine taylor_init
 
     !> Continue from the end of the last run towards tf: the expansion at (t, y) is the
@@ -179,8 +182,10 @@ contains
             end if
             return
         end if
-        if (allocated(self%jets)) deallocate (self%jets)
-        allocate (self%jets(0:self%order, self%nw, 2))
+        if (allocated(self%jets)) then
+            if (any(shape(self%jets) /= [self%order + 1, self%nw, 2])) deallocate (self%jets)
+        end if
+        if (.not. allocated(self%jets)) allocate (self%jets(0:self%order, self%nw, 2))
         self%jets = 0.0_dp
         self%ic = 1
         call expand(self, sys, self%jets(:, :, 1), self%t, self%y)
@@ -381,7 +386,7 @@ contains
             allocate (a(self%n, 0:self%order), b(self%n, 0:self%order))
             a = 0.0_dp
             b = 0.0_dp
-            if (allocated(self%jets)) then
+            if (allocated(self%jets) .and. self%nw > 0) then      ! started
                 a(:, :) = transpose(self%jets(:, 1:self%n, self%ic))
                 b(:, :) = transpose(self%jets(:, 1:self%n, 3 - self%ic))
             end if
