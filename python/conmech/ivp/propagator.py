@@ -54,6 +54,8 @@ _isfinite = math.isfinite
 _F64 = np.dtype(np.float64)
 _until = _conmech.flat_propagation_until
 _empty = np.empty
+_array = np.array
+_ndarray = np.ndarray
 #: propagate_grid's rule for its times (the flat routine's message)
 _GRID_RULE = ("bad input: the times must be finite and sorted strictly from the "
               "propagator's time in one direction")
@@ -207,9 +209,26 @@ class Propagator:
         if t == self.t:
             return _NOTHING_DONE
         packed = self._packed
-        if packed is not None and packed[1] is packed[0].params and \
-                packed[2] is packed[0].spec:
-            return self._native(packed[1], t)
+        if packed is not None:
+            params = packed[1]
+            if params is packed[0].params and packed[2] is packed[0].spec:
+                # the one-call route: the run's state is a new array (self.y is left as
+                # it was)
+                y = self.y
+                y = y.copy() if type(y) is _ndarray and y.dtype is _F64 else \
+                    _array(y, float)
+                iout = self._iout
+                _until(self._handle, params if params.size else _PAD, self.t, t, y, iout)
+                nt, nfev, _, _, naccept, nreject, info, _ = iout[:8].tolist()
+                if nt == 1 and info >= 0:
+                    self.t = t
+                    self.y = y
+                    return _new_tuple(Propagation, (True, 0, _SUCCESS, nfev, naccept,
+                                                    nreject))
+                if info == BAD_INPUT:
+                    raise ValueError(message_text(iout[8:]))
+                return Propagation(False, min(info, -1), message_text(iout[8:]), nfev,
+                                   naccept, nreject)
         if packed is not None:          # the system was given new parameters: pack again
             self._repack()
             return self.propagate_until(t)
@@ -276,21 +295,6 @@ class Propagator:
     def propagate_for(self, dt):
         """:meth:`propagate_until` ``self.t + dt``."""
         return self.propagate_until(self.t + real_scalar(dt, "dt"))
-
-    def _native(self, params, t):
-        iout = self._iout
-        # the run's state, a new array (self.y is left as it was)
-        y = self.y
-        y = y.copy() if type(y) is np.ndarray and y.dtype is _F64 else np.array(y, float)
-        _until(self._handle, params if params.size else _PAD, self.t, t, y, iout)
-        nt, nfev, _, _, naccept, nreject, info, _ = iout[:8].tolist()
-        if info == BAD_INPUT:
-            raise ValueError(message_text(iout[8:]))
-        if info >= 0 and nt == 1:
-            self.t, self.y = t, y
-            return _new_tuple(Propagation, (True, 0, _SUCCESS, nfev, naccept, nreject))
-        return Propagation(False, min(info, -1), message_text(iout[8:]), nfev, naccept,
-                           nreject)
 
     def __reduce__(self):
         # a copy (copy, deepcopy, pickle) is a Propagator of its own at the same time and
