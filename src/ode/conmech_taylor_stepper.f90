@@ -112,8 +112,7 @@ contains
             return
         end if
         self%t_lo = 0.0_dp
-        self%hmax = min(abs(opt%max_step), abs(tf - t0))
-        if (.not. self%hmax <= huge(1.0_dp)) self%hmax = huge(1.0_dp)   ! Inf or NaN
+        call set_hmax(self, abs(opt%max_step), abs(tf - t0))
         self%first_step = opt%first_step
         self%max_steps = opt%max_steps
         self%nsteps = 0
@@ -143,8 +142,7 @@ contains
         if (.not. (tf - self%t)*self%posneg > 0.0_dp) return
         if (associated(self%ev)) return
         self%tf = tf
-        self%hmax = min(abs(opt%max_step), abs(tf - self%t))
-        if (.not. self%hmax <= huge(1.0_dp)) self%hmax = huge(1.0_dp)
+        call set_hmax(self, abs(opt%max_step), abs(tf - self%t))
         self%t_old = self%t
         self%y_old(1:self%n) = self%y(1:self%n)
         self%t_lo = 0.0_dp
@@ -155,8 +153,7 @@ contains
         self%st = ode_stats()
         self%nsteps = 0
         self%err = 0.0_dp
-        call propose(self)
-        if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
+        call first_proposal(self)
         resumed = .true.
     end subroutine taylor_resume
 
@@ -194,8 +191,7 @@ contains
             msg = "the right-hand side is not finite at the initial point"
             return
         end if
-        call propose(self)
-        if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
+        call first_proposal(self)
     end subroutine taylor_start
 
     !> The expansion w at (t, y) (y copied into its zeroth coefficients), and whether f there
@@ -214,6 +210,21 @@ contains
             if (.not. abs(w(1, i)) <= huge(1.0_dp)) self%finite = .false.
         end do
     end subroutine expand
+
+    !> The largest step: max_step, at most the run's span (Inf or NaN: no bound).
+    subroutine set_hmax(self, max_step, span)
+        class(taylor_stepper), intent(inout) :: self
+        real(dp), intent(in) :: max_step, span
+        self%hmax = min(max_step, span)
+        if (.not. self%hmax <= huge(1.0_dp)) self%hmax = huge(1.0_dp)
+    end subroutine set_hmax
+
+    !> A run's first step: Jorba and Zou's from the expansion at its start, or first_step.
+    subroutine first_proposal(self)
+        class(taylor_stepper), intent(inout) :: self
+        call propose(self)
+        if (self%first_step > 0.0_dp) self%h = min(self%first_step, self%hmax)*self%posneg
+    end subroutine first_proposal
 
     !> Jorba and Zou's step from the current expansion (signed, at most hmax); the scales
     !! E_i at the current point are kept for the step's safety check.
