@@ -182,8 +182,12 @@ contains
         if (allocated(self%jets)) then
             if (any(shape(self%jets) /= [self%order + 1, self%nw, 2])) deallocate (self%jets)
         end if
-        if (.not. allocated(self%jets)) allocate (self%jets(0:self%order, self%nw, 2))
-        self%jets = 0.0_dp
+        ! taylor_jet writes every coefficient it reads (the columns past the state are its
+        ! work space), so the expansions are cleared once, when made, not at every start
+        if (.not. allocated(self%jets)) then
+            allocate (self%jets(0:self%order, self%nw, 2))
+            self%jets = 0.0_dp
+        end if
         self%ic = 1
         call expand(self, sys, self%jets(:, :, 1), self%t, self%y)
         if (.not. self%f_finite()) then
