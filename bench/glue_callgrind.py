@@ -13,14 +13,15 @@ of the flat routine the call ends in (callgrind_annotate), the glue the rest.
 Cases:
   step    conmech.DOP853(kepler).step(), one accepted step (flat_stepper_step_builtin)
   solve   conmech.solve_ivp(kepler, (0, 0.01), DOP853): the fixed cost of a short solve
-          of a built-in system (flat_solve_packed)
+          of a built-in system (flat_propagation_solve: the system and stepper kept
+          with the packed arguments; flat_solve_packed in a build before it)
   hill    conmech.hill.variation_orbit(M_HILL) (flat_hill_orbit_checked)
   call    CompiledModel.call("rhs", t, y) of a symbolic ode model (the model's rhs, in
           its own library; the flat routine flat_entry_call_1 calls it)
   sym     solve_ivp(kepler from conmech.symbolic, (0, 0), DOP853): the fixed cost on a
-          compiled symbolic system (flat_solve_packed)
+          compiled symbolic system (flat_propagation_solve)
   symp    the same with a parameter (params={mu: 1.0})
-  taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_solve_packed)
+  taylor  the same system, method TAYLOR, rtol = atol = 1e-12 (flat_propagation_solve)
   py      solve_ivp(Python callable, (0, 0), DOP853) (flat_solve)
   radau   conmech.Radau(kepler).step(), rtol = atol = 1e-10 (flat_stepper_step_builtin)
   gauss6  conmech.Gauss6(kepler, first_step=1e-3).step() (flat_stepper_step_builtin)
@@ -39,9 +40,9 @@ import sys
 import tempfile
 
 # (the flat routine or model symbol whose inclusive count is the Fortran share; the
-# solve cases name the routine of an older build second, so that a build from before
-# flat_solve_packed is split the same way)
-_SOLVE = "flat_solve_packed_|flat_solve_native_"
+# solve cases name the routines of older builds after it, so that a build from before
+# flat_propagation_solve or flat_solve_packed is split the same way)
+_SOLVE = "flat_propagation_solve_|flat_solve_packed_|flat_solve_native_"
 SYMBOLS = {"step": "flat_stepper_step_builtin_", "solve": _SOLVE,
            "hill": "flat_hill_orbit_checked_", "call": "conmech_rhs",
            "sym": _SOLVE, "symp": _SOLVE, "taylor": _SOLVE, "py": "flat_solve_"}

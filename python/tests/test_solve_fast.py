@@ -14,13 +14,16 @@ Y0 = [0.5, 0.0, 0.0, 3.0 ** 0.5]
 
 @pytest.fixture
 def counted(monkeypatch):
+    """The calls of the fast entry's two one-call routes (the packed call, and the kept
+    propagation of a repeated plain call)."""
     calls = []
-    real = solve_fast.run_native
+    for name in ("run_native", "run_kept"):
+        real = getattr(solve_fast, name)
 
-    def wrapped(*a, **k):
-        calls.append(a)
-        return real(*a, **k)
-    monkeypatch.setattr(solve_fast, "run_native", wrapped)
+        def wrapped(*a, real=real, **k):
+            calls.append(a)
+            return real(*a, **k)
+        monkeypatch.setattr(solve_fast, name, wrapped)
     return calls
 
 
@@ -242,3 +245,129 @@ def test_numpy_double_tolerances_take_the_fast_entry(counted):
                               atol=float(tol))
         _same(a, b)
     assert len(counted) == 6
+
+
+@pytest.fixture
+def routes(monkeypatch):
+    """Which route each plain call took: "kept" or "packed"."""
+    taken = []
+    for name, label in (("run_native", "packed"), ("run_kept", "kept")):
+        real = getattr(solve_fast, name)
+
+        def wrapped(*a, real=real, label=label, **k):
+            taken.append(label)
+            return real(*a, **k)
+        monkeypatch.setattr(solve_fast, name, wrapped)
+    return taken
+
+
+def _packed_only(monkeypatch):
+    monkeypatch.setattr(solve_fast, "_KEPT_SIZE", 0)
+    solve_fast._PREPARED.clear()
+
+
+@pytest.mark.parametrize("method", ["RK45", "DOP853", "DOPRI5", "Radau", "VERNER98", "TAYLOR"])
+def test_kept_route_equals_packed_call(routes, monkeypatch, method):
+    # a plain call runs the system and stepper kept with its packed arguments: the
+    # points, counts and bits of the packed call, at every repetition (the stepper
+    # starts each run anew: nothing is carried over from the run before)
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    x, y, u, v = sp.symbols("x y u v")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    kep = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+    solve_fast._PREPARED.clear()
+    spans = [(0.0, 3.0), (3.0, 6.0), (0.0, 3.0), (2.0, -1.0), (1.0, 1.0)]
+    kept = [conmech.solve_ivp(kep, s, Y0, method=method, rtol=1e-9, atol=1e-10) for s in spans]
+    assert routes == ["kept"]*len(spans)
+    _packed_only(monkeypatch)
+    packed = [conmech.solve_ivp(kep, s, Y0, method=method, rtol=1e-9, atol=1e-10)
+              for s in spans]
+    assert routes[len(spans):] == ["packed"]*len(spans)
+    for a, b in zip(kept, packed):
+        _same(a, b)
+    assert kept[0].nfev > 10 and kept[0].success
+
+
+@pytest.mark.parametrize("opts", [
+    dict(t_eval=_TEV), dict(t_eval=[]), dict(t_eval=np.linspace(0.0, 3.0, 400)),
+    dict(first_step=1e-3), dict(max_step=0.05), dict(max_steps=5),
+    dict(max_steps=10**6, max_step=0.5, first_step=0.01, t_eval=_TEV)])
+@pytest.mark.parametrize("method", ["RK45", "DOP853", "Radau"])
+def test_kept_route_with_options_equals_packed_call(routes, monkeypatch, method, opts):
+    # the step options and output times of each call are set on the kept run: a call
+    # with them and the plain call after it (the options do not stay) give the packed
+    # call's results
+    kep = conmech.systems.kepler()
+    solve_fast._PREPARED.clear()
+
+    def runs():
+        return [conmech.solve_ivp(kep, (0.0, 3.0), Y0, method=method, rtol=1e-9, atol=1e-10,
+                                  **opts),
+                conmech.solve_ivp(kep, (0.0, 3.0), Y0, method=method, rtol=1e-9, atol=1e-10)]
+
+    kept = runs()
+    assert routes == ["kept", "kept"]
+    _packed_only(monkeypatch)
+    packed = runs()
+    assert routes[2:] == ["packed", "packed"]
+    for a, b in zip(kept, packed):
+        _same(a, b)
+    assert kept[1].success
+
+
+def test_kept_route_long_run_failure_and_parameters(routes, monkeypatch):
+    # more points than one call's room (handed over by flat_solve_take), a run that
+    # fails, and parameters changed in place: as the packed call
+    k = conmech.systems.kepler(1.0)
+    solve_fast._PREPARED.clear()
+
+    def runs():
+        k.params[0] = 1.0
+        out = [conmech.solve_ivp(k, (0.0, 400.0), Y0, method="DOP853", rtol=1e-10, atol=1e-10)]
+        k.params[0] = 2.0
+        out.append(conmech.solve_ivp(k, (0.0, 400.0), Y0, method="DOP853", rtol=1e-10,
+                                     atol=1e-10))
+        # a collision orbit: the right-hand side is not finite at the origin
+        out.append(conmech.solve_ivp(k, (0.0, 5.0), [0.0, 0.0, 0.0, 0.0], method="DOP853",
+                                     rtol=1e-10, atol=1e-10))
+        return out
+
+    kept = runs()
+    assert routes == ["kept"]*3
+    assert kept[0].t.size > 1000 and kept[0].success
+    assert not np.array_equal(kept[0].y, kept[1].y)
+    assert not kept[2].success and kept[2].status == -1
+    _packed_only(monkeypatch)
+    packed = runs()
+    assert routes[3:] == ["packed"]*3
+    for a, b in zip(kept, packed):
+        _same(a, b)
+
+
+def test_large_system_takes_the_packed_call(routes, monkeypatch):
+    # the kept stepper's arrays live as long as the prepared entry: kept for small
+    # systems only
+    monkeypatch.setattr(solve_fast, "_KEPT_SIZE", 3)
+    solve_fast._PREPARED.clear()
+    kep = conmech.systems.kepler()
+    a = conmech.solve_ivp(kep, (0.0, 1.0), Y0, method="DOP853")
+    monkeypatch.setattr(solve_fast, "_KEPT_SIZE", 4)
+    solve_fast._PREPARED.clear()
+    b = conmech.solve_ivp(kep, (0.0, 1.0), Y0, method="DOP853")
+    assert routes == ["packed", "kept"]
+    _same(a, b)
+
+
+def test_kept_memory_freed_with_its_entry():
+    kep = conmech.systems.kepler()
+    solve_fast._PREPARED.clear()
+    conmech.solve_ivp(kep, (0.0, 1.0), Y0, method="DOP853")
+    (entry,) = solve_fast._PREPARED.values()
+    kept = entry[2]
+    assert kept is not None and kept.handle
+    import weakref
+    gone = weakref.ref(kept)
+    del entry, kept
+    solve_fast._PREPARED.clear()
+    assert gone() is None       # its finalizer (flat_propagation_free) has run

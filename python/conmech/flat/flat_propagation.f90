@@ -141,3 +141,53 @@ contains
         end do
     end function sorted_from
 end subroutine flat_propagation_grid
+
+!> solve_ivp's run from (t0, y0) (size n) to tf by the kept propagation at `handle` (made
+!! from the packed arguments of flat_solve_packed), with this call's step options and
+!! output times: the first step h0 (0: the method's choice), the largest step hmax, the
+!! step limit max_steps, and with_t_eval /= 0: the points at t_eval(1:neval) (neval = 0:
+!! every step's, as flat_solve_packed; t_eval has one unused number then). The points,
+!! counts, status and message in out and iout exactly as flat_solve_packed gives them for
+!! the same arguments (the points kept for flat_solve_take when they do not fit), without
+!! making the system and its stepper again.
+subroutine flat_propagation_solve(handle, lp, params, t0, tf, n, y0, h0, hmax, max_steps, &
+                                  with_t_eval, neval, lt, t_eval, nout, out, iout)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
+    use conmech_status, only: CM_BAD_INPUT
+    use conmech_ode_result, only: ode_result
+    use conmech_flat_packed_support, only: put_message, put_result
+    use conmech_flat_propagation, only: kept_propagation, propagation_at, propagation_solve
+    implicit none
+    integer(c_int64_t), intent(in) :: handle
+    integer(c_int), intent(in) :: lp, n, max_steps, with_t_eval, neval, lt, nout
+    real(c_double), intent(in) :: params(lp)
+    real(c_double), intent(in) :: t0, tf, h0, hmax
+    real(c_double), intent(in) :: y0(n)
+    real(c_double), intent(in) :: t_eval(lt)
+    real(c_double), intent(inout) :: out(nout)
+    integer(c_int64_t), intent(inout) :: iout(40)
+    type(kept_propagation), pointer :: p
+    type(ode_result) :: res
+    character(len=:), allocatable :: msg
+    integer(c_int) :: counts(5)
+    integer :: info
+
+    p => propagation_at(handle, n, lp, iout)
+    if (.not. associated(p)) return
+    if (nout < 2*(n + 1) .or. neval < 0 .or. neval > lt) then
+        iout(7) = CM_BAD_INPUT
+        call put_message("bad input: packed arguments of inconsistent sizes", iout)
+        return
+    end if
+    if (neval > 0) then
+        call propagation_solve(p, params(1:size(p%params)), t0, tf, y0, h0, hmax, max_steps, &
+                               res, counts, info, msg, t_eval(1:neval))
+    else
+        call propagation_solve(p, params(1:size(p%params)), t0, tf, y0, h0, hmax, max_steps, &
+                               res, counts, info, msg)
+    end if
+    iout(2:6) = counts
+    iout(7) = info
+    call put_message(msg, iout)
+    call put_result(res, info, t0, tf, with_t_eval /= 0, n, y0, out, iout)
+end subroutine flat_propagation_solve

@@ -9,6 +9,7 @@ import numpy as np
 
 from .. import _conmech
 from .._core.callback import message_text
+from .._core.checks import NO_STEP_LIMIT
 from .._core.native import _NO_SPEC
 from .._core.status import BAD_INPUT
 from .result import _MESSAGES, OdeResult
@@ -22,6 +23,10 @@ _INT64 = np.int64
 # module-level names for the per-call path of run (a global lookup, not an attribute)
 _empty = np.empty
 _solve_packed = _conmech.flat_solve_packed
+_solve_kept = _conmech.flat_propagation_solve
+# the step options a packed call is made with (prepare's by the fast entry): the method's
+# first step, no largest step, no step limit
+_NO_OPTIONS = (0.0, float(np.finfo(float).max), NO_STEP_LIMIT)
 # the result's keys in SciPy's order with conmech's extras last, and the fields of a run
 # without events or dense output that are always the same
 _TEMPLATE = dict(t=None, y=None, sol=None, t_events=None, y_events=None, nfev=0, njev=0,
@@ -75,6 +80,30 @@ def run(prep, t0, tf, y0, cap=0):
     _solve_packed(ipack, params if params.size else _PAD, spec, rpar, t0, tf, y0, out, iout)
     # the frequent outcome (the points fit, the run was not refused): no tests of the
     # rare cases
+    nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
+    if nt < 0 or info:
+        return _result(out, iout, n)
+    return _points(out, n, nt, nfev, njev, nlu, naccept, nreject)
+
+
+def run_kept(handle, prep, t0, tf, y0, steps=None, t_ev=None, cap=0):
+    """:func:`run` of the packed arguments ``prep`` (packed without step options or output
+    times) by the kept propagation at ``handle`` made from them, with the step options
+    ``steps`` = (first step or 0.0, largest step, step limit) and the output times t_ev
+    (as :func:`with_options`; None: the packed ones, every step): the same result, without
+    making the system and its stepper in the call."""
+    params, n = prep[1], prep[5]
+    if not cap:
+        cap = 2 if tf == t0 else max(_OUT_DOUBLES // (n + 1), 2)
+    out = _empty(cap*(n + 1))
+    iout = _empty(40, _INT64)
+    h0, hmax, max_steps = steps or _NO_OPTIONS
+    if t_ev is None:
+        _solve_kept(handle, params if params.size else _PAD, t0, tf, y0, h0, hmax, max_steps,
+                    0, 0, _PAD, out, iout)
+    else:
+        _solve_kept(handle, params if params.size else _PAD, t0, tf, y0, h0, hmax, max_steps,
+                    1, len(t_ev), t_ev if len(t_ev) else _PAD, out, iout)
     nt, nfev, njev, nlu, naccept, nreject, info, _ = iout[:8].tolist()
     if nt < 0 or info:
         return _result(out, iout, n)

@@ -10,12 +10,16 @@ input outside these kinds, or one that breaks a rule, returns None and the full 
 solve_ivp run, with their messages. The result is the one the full path gives (the same
 Fortran call with the same numbers)."""
 import math
+import weakref
 
 import numpy as np
 
+from .. import _conmech
 from .._core.checks import NO_STEP_LIMIT, RTOL_FLOOR, _warn_rtol
+from .._core.status import BAD_INPUT
 from .methods import BY_NAME, RK45_SCIPY
-from .native_path import prepare, run as run_native, scipy_points, with_options
+from .native_path import _PAD, prepare, run as run_native, run_kept, scipy_points, \
+    with_options
 
 __all__ = ["fast_solve", "fast_method_code"]
 
@@ -104,8 +108,9 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
         return None
     key = (id(fun), method, rtol, atol)
     entry = _PREPARED.get(key)
-    # entry = (fun, prep): prep the packed arguments, for the system it runs (prep[0]) with
-    # the arrays it was packed for (prep[1], prep[2])
+    # entry = (fun, prep, kept): prep the packed arguments, for the system it runs
+    # (prep[0]) with the arrays it was packed for (prep[1], prep[2]); kept its _Kept run
+    # (or None)
     if entry is None or entry[0] is not fun or entry[1][1] is not entry[1][0].params or \
             entry[1][2] is not entry[1][0].spec:
         if _state(y0, fun.dimension) is None:
@@ -115,14 +120,17 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
             return None
         if len(_PREPARED) >= _KEEP:       # systems made and dropped in a loop
             _PREPARED.clear()
-        _PREPARED[key] = (fun, prep)
+        kept = _Kept.open(prep)
+        _PREPARED[key] = (fun, prep, kept)
     else:
-        prep = entry[1]
+        prep, kept = entry[1], entry[2]
         if _state(y0, prep[5]) is None:
             return None
     if t_eval is None and first_step is None and max_steps is None and max_step == _INF:
         if rtol < RTOL_FLOOR:
             _warn_rtol(4)       # SciPy's warning, at the user's call (Fortran raises rtol)
+        if kept is not None:
+            return run_kept(kept.handle, prep, t0, tf, y0)
         return run_native(prep, t0, tf, y0)
     steps = _step_options(t0, tf, first_step, max_step, max_steps)
     if steps is None:
@@ -133,8 +141,11 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
             return None
     if rtol < RTOL_FLOOR:
         _warn_rtol(4)
-    packed = with_options(prep, *steps, t_eval)
-    res = run_native(packed, t0, tf, y0, max(len(t_eval), 2) if t_eval is not None else 0)
+    cap = max(len(t_eval), 2) if t_eval is not None else 0
+    if kept is not None:
+        res = run_kept(kept.handle, prep, t0, tf, y0, steps, t_eval, cap)
+    else:
+        res = run_native(with_options(prep, *steps, t_eval), t0, tf, y0, cap)
     return scipy_points(res, t_eval is not None, len(t_eval) if t_eval is not None else 0)
 
 
@@ -210,7 +221,37 @@ def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
                    NO_STEP_LIMIT)
 
 
-# (id(system), method, rtol, atol) -> (system, the packed arguments); the system is kept
-# with them, so its id stays its own while the entry lives
+class _Kept:
+    """The system and its stepper made once in Fortran memory (a kept propagation, as
+    conmech.Propagator's) for the calls of solve_ivp with the same system, method and
+    tolerances and no step options: each call is then one run of the kept stepper
+    (flat_propagation_solve: the points, counts and bits of flat_solve_packed) without
+    making the system and the stepper again and freeing them. Kept for systems of at most
+    _KEPT_SIZE equations (the stepper's arrays, a Jacobian's n x n among them, live as
+    long as the entry); the memory is freed with the entry."""
+
+    __slots__ = ("handle", "__weakref__")
+
+    @classmethod
+    def open(cls, prep):
+        """The kept run of the packed arguments prep, or None (a large system, or one the
+        flat layer refuses: the packed route then runs and reports it)."""
+        fun, params, spec, ipack, rpar, n, _ = prep
+        if n > _KEPT_SIZE:
+            return None
+        iout = np.zeros(40, np.int64)
+        _conmech.flat_propagation_new(ipack, params if params.size else _PAD, spec, rpar, n,
+                                      iout)
+        if iout[6] == BAD_INPUT or not iout[7]:
+            return None
+        kept = cls()
+        kept.handle = int(iout[7])
+        weakref.finalize(kept, _conmech.flat_propagation_free, kept.handle)
+        return kept
+
+
+# (id(system), method, rtol, atol) -> (system, the packed arguments, their _Kept run or
+# None); the system is kept with them, so its id stays its own while the entry lives
 _PREPARED = {}
 _KEEP = 256
+_KEPT_SIZE = 64

@@ -11,7 +11,7 @@ module conmech_flat_packed_support
     use conmech_flat_ode_support, only: solve_into, copy_message
     implicit none
     private
-    public :: packed_sizes_ok, unpack_head, run_packed, put_message, put_points
+    public :: packed_sizes_ok, unpack_head, run_packed, put_message, put_points, put_result
 
 contains
 
@@ -87,7 +87,6 @@ contains
         real(c_double), intent(inout) :: out(:)
         integer(c_int64_t), intent(inout) :: iout(40)
         type(ode_result) :: res
-        type(ode_result), pointer :: kept
         character(len=256) :: message
         integer(c_int) :: none(1), counts(5), info
 
@@ -104,8 +103,24 @@ contains
         iout(2:6) = counts
         iout(7) = info
         call put_message(message, iout)
+        call put_result(res, info, t0, tf, ipar(6) /= 0, n, y0, out, iout)
+    end subroutine run_packed
+
+    !> The points of the run `res` from (t0, y0) to tf (status info; with_t_eval: its
+    !! points are the output times') into out and iout(1), or kept for flat_solve_take
+    !! (iout(1) = -their number, iout(8) the handle) when they do not fit: the start alone
+    !! for a run refused or stopped before its first step, twice for a zero-length span
+    !! without output times (SciPy's one empty step); nothing for a refusal.
+    subroutine put_result(res, info, t0, tf, with_t_eval, n, y0, out, iout)
+        type(ode_result), intent(inout) :: res
+        integer(c_int), intent(in) :: info, n
+        real(c_double), intent(in) :: t0, tf, y0(n)
+        logical, intent(in) :: with_t_eval
+        real(c_double), intent(inout) :: out(:)
+        integer(c_int64_t), intent(inout) :: iout(40)
+        type(ode_result), pointer :: kept
         if (info == CM_BAD_INPUT) return
-        if (tf == t0 .and. ipar(6) == 0) then
+        if (tf == t0 .and. .not. with_t_eval) then
             ! SciPy's solver makes one (empty) step: t = [t0, t0]
             call put_start(2)
         else if (.not. allocated(res%t)) then
@@ -137,7 +152,7 @@ contains
                 out(k*i + 1:k*(i + 1)) = y0(i)
             end do
         end subroutine put_start
-    end subroutine run_packed
+    end subroutine put_result
 
     !> The points t(1:m), y(:, 1:m) into out in the packed layout: the times, then the
     !! states by component (out(m*i + 1 : m*(i + 1)) = y(i, 1:m)).

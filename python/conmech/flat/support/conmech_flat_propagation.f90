@@ -1,6 +1,7 @@
-!> A propagation kept between calls of the flat layer (conmech.Propagator): a built-in or
-!! compiled system, its stepper and options, made once and held in Fortran memory that the
-!! caller owns through a handle (flat_propagation_new / _until / _free). Each propagation
+!> A propagation kept between calls of the flat layer (conmech.Propagator, and solve_ivp's
+!! calls of a small system with the same method and tolerances): a built-in or compiled
+!! system, its stepper and options, made once and held in Fortran memory that the caller
+!! owns through a handle (flat_propagation_new / _until / _grid / _solve / _free). Each propagation
 !! is a run of its own from the state the caller passes, by the one driver loop over the
 !! kept stepper (init, start and steps, as flat_solve_packed runs it): the same steps and
 !! the same bits as that call, without the per-call cost of making the system and the
@@ -19,7 +20,7 @@ module conmech_flat_propagation
     use conmech_ode_methods, only: new_stepper
     use conmech_ode_driver, only: ode_drive
     use conmech_ode_result, only: ode_result, start_outputs
-    use conmech_ode_solver, only: METHOD_DOPRI5
+    use conmech_ode_solver, only: METHOD_DOPRI5, ode_solve
     use conmech_flat_spec, only: spec_system_of_size
     use conmech_flat_ode_support, only: set_flat_options, set_jacobian_structure, &
         scipy_first_step, METHOD_RK45_SCIPY
@@ -27,7 +28,7 @@ module conmech_flat_propagation
     implicit none
     private
     public :: kept_propagation, propagation_make, propagation_at, propagation_run, &
-        propagation_grid
+        propagation_grid, propagation_solve
 
     !> What a propagation keeps from call to call.
     type :: kept_propagation
@@ -73,6 +74,8 @@ contains
         if (info /= CM_SUCCESS) return
         call set_flat_options(p%opt, ipar(3), rpar(3:2 + n), rpar(3 + n:2 + 2*n), rpar(1), &
                               rpar(2), ipar(4), 0)
+        ! every caller reads the points up to res%nt: no final copy to cut the arrays
+        p%opt%trim_outputs = .false.
         p%scipy_rk45 = ipar(3) == METHOD_RK45_SCIPY
         p%first_step = rpar(1)
         if (p%scipy_rk45) then
@@ -170,6 +173,38 @@ contains
             y = res%y(:, nt)
         end if
     end subroutine propagation_grid
+
+    !> One run of solve_ivp from (t0, y0) to t1 by the kept propagation, with the first
+    !! step h0 (0: the method's), the largest step hmax, the step limit max_steps and the
+    !! output times t_eval (none: every step's point) of this call: the points in res, as
+    !! solve_into gives them for the same packed arguments (a new run, never resumed: the
+    !! same bits and counts), without making the system and the stepper again.
+    subroutine propagation_solve(p, params, t0, t1, y0, h0, hmax, max_steps, res, counts, &
+                                 info, msg, t_eval)
+        type(kept_propagation), intent(inout) :: p
+        real(dp), intent(in) :: params(:)
+        real(dp), intent(in) :: t0, t1, y0(:), h0, hmax
+        integer, intent(in) :: max_steps
+        type(ode_result), intent(out) :: res
+        integer(c_int), intent(out) :: counts(5)
+        integer, intent(out) :: info
+        character(len=:), allocatable, intent(out) :: msg
+        real(dp), intent(in), optional :: t_eval(:)
+        integer(c_int) :: nfev
+        counts = 0
+        p%first_step = h0
+        p%opt%first_step = h0
+        p%opt%max_step = hmax
+        p%opt%max_steps = max_steps
+        call prepare_run(p, params, t0, t1, y0, nfev, info, msg)
+        if (info /= CM_SUCCESS) return
+        call ode_solve(p%sys, [t0, t1], y0, p%opt, res, t_eval=t_eval, stepper=p%stp)
+        p%resumable = .false.           ! a later propagation starts a run of its own
+        counts = [nfev + res%stats%nfev, res%stats%njev, res%stats%nlu, &
+                  res%stats%naccept, res%stats%nreject]
+        info = res%status
+        msg = res%message
+    end subroutine propagation_solve
 
     !> Before a run from (t0, y) to t1: the system made again if its parameters changed
     !! (the stepper then starts anew), SciPy's initial step for its RK45 (nfev its
