@@ -7,6 +7,12 @@ DOP853 and RK45). Each figure is the minimum over 7 batches (us per call); run i
 quiet machine and give `uptime` beside the figures.
 
     python bench/solve_ivp_fixed_cost.py
+    python bench/solve_ivp_fixed_cost.py --routes     # the fast entry's two routes
+
+--routes times the fast entry's kept route (a small system's system and stepper kept
+with its packed arguments, flat_propagation_solve) against its packed call
+(flat_solve_packed, which makes them at each call) on two copies of the symbolic Kepler
+system in one process, interleaved call by call (the minimum over 300 rounds, twice).
 """
 import math
 import time
@@ -17,6 +23,7 @@ import sympy as sp
 
 import conmech
 from conmech import symbolic
+from conmech.ivp import solve_fast
 
 
 def tmin(f, n=500):
@@ -69,5 +76,36 @@ def main():
             print(f"Python rhs {m} span {span}: conmech {c:.1f} us, SciPy {s:.1f} us")
 
 
+def routes():
+    """Kept route against packed call, interleaved (see the module docstring)."""
+    x, y, u, v = sp.symbols("x y u v")
+    r3 = (x**2 + y**2)**sp.Rational(3, 2)
+    e = 0.9
+    y0 = [1 - e, 0.0, 0.0, math.sqrt((1 + e)/(1 - e))]
+    T = 2*math.pi
+    kept = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+    conmech.solve_ivp(kept, (0, T), y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
+    size = solve_fast._KEPT_SIZE
+    solve_fast._KEPT_SIZE = 0           # the next system's entries: the packed call
+    packed = symbolic.ode_system([u, v, -x/r3, -y/r3], [x, y, u, v])
+    conmech.solve_ivp(packed, (0, T), y0, method="TAYLOR", rtol=1e-12, atol=1e-12)
+    solve_fast._KEPT_SIZE = size
+    for label, tf, kw in [("zero span", 0.0, {}), ("one period", T, {}),
+                          ("one period, t_eval=[T]", T, dict(t_eval=[T]))]:
+        for _ in range(2):
+            best = {}
+            for _ in range(300):
+                for route, k in (("kept", kept), ("packed", packed)):
+                    for m in ("TAYLOR", "DOP853"):
+                        a = time.perf_counter()
+                        conmech.solve_ivp(k, (0, tf), y0, method=m, rtol=1e-12, atol=1e-12,
+                                          **kw)
+                        d = time.perf_counter() - a
+                        best[route, m] = min(best.get((route, m), math.inf), d)
+            print(f"{label}: " + ", ".join(f"{r} {m} {v*1e6:.2f} us"
+                                            for (r, m), v in best.items()), flush=True)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    routes() if "--routes" in sys.argv[1:] else main()
