@@ -5,10 +5,11 @@ plain floats, optionally ``t_eval`` (a list, tuple or float array of times), ``f
 dense output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
 same rules (type tests on Python scalars and lists, no NumPy conversion to find a type)
 and goes to the one-call native path with arguments packed once per system, method and
-tolerances (the step options and the output times are written into a copy of them); any
+tolerances (the step options and the output times are written into a copy of them), or,
+for a small system, to one run of the system and stepper kept with them (_Kept); any
 input outside these kinds, or one that breaks a rule, returns None and the full checks of
 solve_ivp run, with their messages. The result is the one the full path gives (the same
-Fortran call with the same numbers)."""
+run with the same numbers)."""
 import math
 import weakref
 
@@ -224,9 +225,10 @@ def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
 class _Kept:
     """The system and its stepper made once in Fortran memory (a kept propagation, as
     conmech.Propagator's) for the calls of solve_ivp with the same system, method and
-    tolerances and no step options: each call is then one run of the kept stepper
-    (flat_propagation_solve: the points, counts and bits of flat_solve_packed) without
-    making the system and the stepper again and freeing them. Kept for systems of at most
+    tolerances: each call is then one run of the kept stepper with the call's step
+    options and output times (flat_propagation_solve: the points, counts and bits of
+    flat_solve_packed) without making the system and the stepper again and freeing them,
+    nor packing the options into copies of the packed arrays. Kept for systems of at most
     _KEPT_SIZE equations (the stepper's arrays, a Jacobian's n x n among them, live as
     long as the entry); the memory is freed with the entry."""
 
