@@ -1,11 +1,11 @@
 !> A propagation kept between calls of the flat layer (conmech.Propagator, and solve_ivp's
 !! calls of a small system with the same method and tolerances): a built-in or compiled
 !! system, its stepper and options, made once and held in Fortran memory that the caller
-!! owns through a handle (flat_propagation_new / _until / _grid / _solve / _free). Each propagation
-!! is a run of its own from the state the caller passes, by the one driver loop over the
-!! kept stepper (init, start and steps, as flat_solve_packed runs it): the same steps and
-!! the same bits as that call, without the per-call cost of making the system and the
-!! stepper, of the run's result and of the packed arguments' conversion.
+!! owns through a handle (flat_propagation_new / _until / _grid / _solve / _free). Each
+!! propagation is a run of its own from the state the caller passes, by the one driver
+!! loop over the kept stepper (init, start and steps, as flat_solve_packed runs it): the
+!! same steps and the same bits as that call, without the per-call cost of making the
+!! system and the stepper, of the run's result and of the packed arguments' conversion.
 !!
 !! The system reads its parameters at every call, as the packed route does: a call with
 !! parameter values other than the kept ones makes the system again from them.
