@@ -141,16 +141,12 @@ contains
         if (.not. (self%last .and. self%finite .and. allocated(self%jets))) return
         if (.not. (tf - self%t)*self%posneg > 0.0_dp) return
         if (associated(self%ev)) return
-        self%tf = tf
+        ! a new run's state from (t, y), as init sets it (copies of t and y: setup_base
+        ! writes both)
+        call self%setup_base(METHOD_TAYLOR, (self%t), tf, [self%y(1:self%n)], self%order, &
+                             FORM_POWER)
         call set_hmax(self, abs(opt%max_step), abs(tf - self%t))
-        self%t_old = self%t
-        self%y_old(1:self%n) = self%y(1:self%n)
         self%t_lo = 0.0_dp
-        self%h_done = 0.0_dp
-        self%last = .false.
-        self%hit = .false.
-        self%dense_ready = .false.
-        self%st = ode_stats()
         self%nsteps = 0
         self%err = 0.0_dp
         call first_proposal(self)
