@@ -330,3 +330,22 @@ def test_a_grid_of_a_python_function_and_its_failures():
         assert np.isfinite(ys[:, :2]).all() and np.isnan(ys[:, 2]).all()
         assert q.t == 0.02
         np.testing.assert_array_equal(q.y, ys[:, 1])
+
+
+@pytest.mark.parametrize("method", ["TAYLOR", "DOP853"])
+def test_new_parameter_array_is_read(method):
+    """A symbolic system given a new parameter array after the Propagator was made: the
+    next propagation runs with it (the Taylor route's written-out system shares the
+    array it had, and is made again for the new one)."""
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    x, v, k = sp.symbols("x v k")
+    system = symbolic.ode_system([v, -k*x], [x, v], params={k: 1.0})
+    p = conmech.Propagator(system, [1.0, 0.0], method=method, rtol=1e-12, atol=1e-12)
+    assert p.propagate_until(1.0).success and abs(p.y[0] - np.cos(1.0)) < 1e-10
+    system.params = np.array([4.0])
+    p.t, p.y = 0.0, np.array([1.0, 0.0])
+    assert p.propagate_until(1.0).success and abs(p.y[0] - np.cos(2.0)) < 1e-10
+    system.params[0] = 9.0
+    p.t, p.y = 0.0, np.array([1.0, 0.0])
+    assert p.propagate_until(1.0).success and abs(p.y[0] - np.cos(3.0)) < 1e-10

@@ -371,3 +371,32 @@ def test_kept_memory_freed_with_its_entry():
     del entry, kept
     solve_fast._PREPARED.clear()
     assert gone() is None       # its finalizer (flat_propagation_free) has run
+
+
+@pytest.mark.parametrize("kind, method", [("ode", "TAYLOR"), ("ode", "DOP853")])
+def test_new_parameter_array_is_read(counted, kind, method):
+    """A symbolic system given a new parameter array (or one changed in place) between
+    calls: each call runs with the parameters it has then, on the Taylor routes too (whose
+    written-out system and a generalized system's first-order view share the array)."""
+    sp = pytest.importorskip("sympy")
+    from conmech import symbolic
+    if kind == "ode":
+        x, v, k = sp.symbols("x v k")
+        system = symbolic.ode_system([v, -k*x], [x, v], params={k: 1.0})
+    else:
+        from sympy.physics.mechanics import dynamicsymbols
+        q = dynamicsymbols("q")
+        k = sp.Symbol("k")
+        system = symbolic.lagrangian_system(q.diff()**2/2 - k*q**2/2, [q], params={k: 1.0})
+
+    def end():
+        r = conmech.solve_ivp(system, (0.0, 1.0), [1.0, 0.0], method=method, rtol=1e-12,
+                              atol=1e-12)
+        assert r.success
+        return r.y[0, -1]
+    assert abs(end() - np.cos(1.0)) < 1e-10
+    system.params = np.array([4.0])
+    assert abs(end() - np.cos(2.0)) < 1e-10
+    system.params[0] = 9.0
+    assert abs(end() - np.cos(3.0)) < 1e-10
+    assert len(counted) == 3            # each call by the fast entry

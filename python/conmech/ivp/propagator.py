@@ -211,7 +211,7 @@ class Propagator:
         packed = self._packed
         if packed is not None:
             params = packed[1]
-            if params is packed[0].params and packed[2] is packed[0].spec:
+            if params is self.fun.params and packed[2] is packed[0].spec:
                 # the one-call route: the run's state is a new array (self.y is left as
                 # it was)
                 y = self.y
@@ -254,7 +254,7 @@ class Propagator:
         if ts.ndim != 1 or ts.size == 0:
             raise ValueError("times must be a non-empty one-dimensional sequence")
         packed = self._packed
-        if packed is not None and not (packed[1] is packed[0].params and
+        if packed is not None and not (packed[1] is self.fun.params and
                                        packed[2] is packed[0].spec):
             packed = self._repack()
         if packed is not None:

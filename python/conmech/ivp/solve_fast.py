@@ -110,9 +110,10 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
     key = (id(fun), method, rtol, atol)
     entry = _PREPARED.get(key)
     # entry = (fun, prep, kept): prep the packed arguments, for the system it runs
-    # (prep[0]) with the arrays it was packed for (prep[1], prep[2]); kept its _Kept run
-    # (or None)
-    if entry is None or entry[0] is not fun or entry[1][1] is not entry[1][0].params or \
+    # (prep[0]: fun, or fun with its Taylor recurrences written out, sharing fun's
+    # parameter array) with the arrays it was packed for (prep[1], prep[2]); kept its
+    # _Kept run (or None). fun given a new parameter array is packed again.
+    if entry is None or entry[0] is not fun or entry[1][1] is not fun.params or \
             entry[1][2] is not entry[1][0].spec:
         if _state(y0, fun.dimension) is None:
             return None

@@ -44,8 +44,8 @@ def with_fixed_order(fun, rtol, atol):
         if len(_ORDERS) < 256:
             _ORDERS[eps] = order
     hit = _SYSTEMS.get((id(fun), order))
-    if hit is not None and hit[0] is fun:
-        return hit[1]
+    if hit is not None and hit[0] is fun and hit[1].params is fun.params:
+        return hit[1]       # (made with fun's parameter array: not after a new one)
     if fun.taylor.get("order") == order:
         return fun
     # conmech.symbolic (sympy, an optional dependency) is imported on the Taylor paths
