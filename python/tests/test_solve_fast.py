@@ -373,7 +373,8 @@ def test_kept_memory_freed_with_its_entry():
     assert gone() is None       # its finalizer (flat_propagation_free) has run
 
 
-@pytest.mark.parametrize("kind, method", [("ode", "TAYLOR"), ("ode", "DOP853")])
+@pytest.mark.parametrize("kind, method", [("ode", "TAYLOR"), ("ode", "DOP853"),
+                                          ("generalized", "TAYLOR")])
 def test_new_parameter_array_is_read(counted, kind, method):
     """A symbolic system given a new parameter array (or one changed in place) between
     calls: each call runs with the parameters it has then, on the Taylor routes too (whose
@@ -400,3 +401,29 @@ def test_new_parameter_array_is_read(counted, kind, method):
     system.params[0] = 9.0
     assert abs(end() - np.cos(3.0)) < 1e-10
     assert len(counted) == 3            # each call by the fast entry
+
+
+def test_generalized_taylor_takes_the_fast_entry(counted):
+    """M(q) q'' = Q with method TAYLOR: the fast entry runs its first-order view, as the
+    full path does (the same result, bit for bit), with t_eval too; a failed run's message
+    names the mass matrix there as well."""
+    pytest.importorskip("sympy")
+    import taylor_jets
+    dp = taylor_jets.double_pendulum()
+    y0 = [1.2, -0.4, 0.3, 0.1]
+    for kw in ({}, dict(t_eval=[0.5, 1.0, 2.5])):
+        fast = conmech.solve_ivp(dp, (0.0, 3.0), y0, method="TAYLOR", rtol=1e-12, atol=1e-12,
+                                 **kw)
+        full = conmech.solve_ivp(dp, (0.0, 3.0), y0, method="TAYLOR",
+                                 rtol=np.array(1e-12), atol=np.array(1e-12), **kw)
+        assert fast.success
+        _same(fast, full)
+    assert len(counted) == 2
+    from sympy.physics.mechanics import dynamicsymbols
+    from conmech import symbolic
+    q = dynamicsymbols("q")
+    singular = symbolic.lagrangian_system(q**2*q.diff()**2/2, [q])
+    r = conmech.solve_ivp(singular, (0, 1), [1.0, -1.0], method="TAYLOR", rtol=1e-10,
+                          atol=1e-10)
+    assert len(counted) == 3
+    assert not r.success and "mass matrix" in r.message

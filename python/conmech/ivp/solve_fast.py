@@ -1,5 +1,6 @@
 """The fast entry of :func:`conmech.solve_ivp` for its most frequent calls: a built-in or
-compiled system, a method named by a string, float tolerances, a span and a state of
+compiled system (with method TAYLOR, a generalized symbolic system's first-order view, as
+solve_ivp runs it), a method named by a string, float tolerances, a span and a state of
 plain floats, optionally ``t_eval`` (a list, tuple or float array of times), ``first_step``,
 ``max_step`` and ``max_steps``, and none of the options that call back into Python (events,
 dense output, a Jacobian, args). Such a call is checked here with the cheapest tests of the
@@ -21,6 +22,7 @@ from .._core.status import BAD_INPUT
 from .methods import BY_NAME, RK45_SCIPY
 from .native_path import _PAD, prepare, run as run_native, run_kept, scipy_points, \
     with_options
+from .taylor_generalized import first_order_view, name_the_mass_matrix
 
 __all__ = ["fast_solve", "fast_method_code"]
 
@@ -132,8 +134,12 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
         if rtol < RTOL_FLOOR:
             _warn_rtol(4)       # SciPy's warning, at the user's call (Fortran raises rtol)
         if kept is not None:
-            return run_kept(kept.handle, prep, t0, tf, y0)
-        return run_native(prep, t0, tf, y0)
+            res = run_kept(kept.handle, prep, t0, tf, y0)
+        else:
+            res = run_native(prep, t0, tf, y0)
+        if not res["success"] and prep[0] is not fun:
+            res = name_the_mass_matrix(fun, res)    # (a generalized system's view ran)
+        return res
     steps = _step_options(t0, tf, first_step, max_step, max_steps)
     if steps is None:
         return None
@@ -148,6 +154,8 @@ def fast_solve(fun, t_span, y0, method, rtol, atol, taylor_code, taylor_system,
         res = run_kept(kept.handle, prep, t0, tf, y0, steps, t_eval, cap)
     else:
         res = run_native(with_options(prep, *steps, t_eval), t0, tf, y0, cap)
+    if not res["success"] and prep[0] is not fun:
+        res = name_the_mass_matrix(fun, res)
     return scipy_points(res, t_eval is not None, len(t_eval) if t_eval is not None else 0)
 
 
@@ -218,7 +226,13 @@ def _prepare(fun, method, rtol, atol, taylor_code, taylor_system):
         if getattr(fun, "taylor", None):        # as solve_ivp: the written-out recurrences
             run_fun = taylor_system(fun, rtol, atol)    # (cached per system and order)
         elif getattr(fun, "kind", None) == "generalized":
-            return None                         # its first-order view: the full path
+            try:                                # as solve_ivp: its first-order view
+                view = first_order_view(fun)
+            except ValueError:
+                return None                     # no recurrences: the full path says so
+            if view is fun:
+                return None
+            run_fun = taylor_system(view, rtol, atol)
     return prepare(run_fun, code, _tolerance(rtol, n), _tolerance(atol, n), 0.0, _HUGE,
                    NO_STEP_LIMIT)
 

@@ -49,6 +49,14 @@ def first_order_view(fun, *parts):
     model = _model(fun)
     if model is None:
         return fun
+    # the view of fun kept with the model (the last _VIEWS systems), while fun keeps its
+    # parameter array: a repeated call is a look-up, and the view's written-out
+    # recurrences (conmech.ivp.taylor.with_fixed_order) are found by its identity
+    views = model.__dict__.setdefault("_taylor_views", {})
+    if not parts:
+        hit = views.get(id(fun))
+        if hit is not None and hit[0] is fun and hit[1].params is fun.params:
+            return hit[1]
     from .. import compiled
     from ..symbolic.taylor_library import lazy_taylor
     tay = lazy_taylor(model).get(*parts)
@@ -74,8 +82,17 @@ def first_order_view(fun, *parts):
         # spec is shared by every view of the model; the library stays loaded with it)
         base.taylor.update(new)
         compiled._taylor_spec(base.spec, base.taylor)
-    return compiled.CompiledSystem(base.name, "ode", base.spec, np.array(fun.params),
-                                   base.param_names, base._keep, base.taylor)
+    # fun's parameter array itself: values changed in place are read, as fun's own
+    view = compiled.CompiledSystem(base.name, "ode", base.spec, fun.params, base.param_names,
+                                   base._keep, base.taylor)
+    if not parts:
+        if len(views) >= _VIEWS:
+            views.clear()
+        views[id(fun)] = (fun, view)    # fun kept alive: its id stays its own
+    return view
+
+
+_VIEWS = 16
 
 
 def batch_entries(fun, lanes=None):
