@@ -185,7 +185,7 @@ class Propagator:
             if getattr(fun, "taylor", None):
                 run_fun = with_fixed_order(fun, rtol, atol)
             elif getattr(fun, "kind", None) == "generalized":
-                run_fun = first_order_view(fun)
+                run_fun = with_fixed_order(first_order_view(fun), rtol, atol)
         if not isinstance(run_fun, NativeSystem):
             return None
         # checked, and warned about, by solve_ivp in __init__

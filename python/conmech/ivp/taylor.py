@@ -4,7 +4,9 @@
 - the recurrences written out for the run's order (no loops: the coefficients in
   registers, every multiply-add scheduled at once), compiled on first use of an order and
   cached like the model; they give the loop version's coefficients to the last bit, so a
-  run takes the same steps with either;
+  run takes the same steps with either. An ode system's (conmech.symbolic.taylor), and a
+  generalized system's first-order view's while its routine stays small
+  (conmech.symbolic.taylor_generalized_fixed; FIXED_MAX_SOURCE_GENERALIZED);
 - compiled events (made by :func:`conmech.symbolic.event`): the events of one call are
   compiled together (cached) and located by the Taylor stepper with no Python in the loop.
 """
@@ -19,6 +21,13 @@ __all__ = ["run_compiled_events", "taylor_order", "with_fixed_order"]
 #: written-out code is generated up to this many history products per expansion (beyond,
 #: the loop version runs: the source and its compile time grow as order**2)
 FIXED_MAX_TERMS = 40000
+#: a generalized system's written-out routine (a factorisation's solves and the products
+#: M_j a_{k-j} at every order besides the operations) is compiled up to this many
+#: characters of source: beyond, the loop routine was measured as fast or faster (a
+#: solve_ivp run of the double pendulum at order 24, 83 kB of source: 0.82x the loop
+#: routine's time; of a chain of three links at order 14, 101 kB: 1.01x-1.02x, at order
+#: 18 1.08x; bench/results/taylor_generalized_fixed.md)
+FIXED_MAX_SOURCE_GENERALIZED = 90000
 
 
 def taylor_order(eps):
@@ -32,7 +41,9 @@ def taylor_order(eps):
 def with_fixed_order(fun, rtol, atol):
     """`fun` with its Taylor recurrences written out for the order the tolerances give
     (rtol, atol: scalars or the per-component arrays handed to Fortran), when `fun` is an
-    ode system made by conmech.symbolic; else `fun` itself. The library is compiled once
+    ode system made by conmech.symbolic or the first-order view of a generalized one
+    (conmech.ivp.taylor_generalized.first_order_view) and such a routine is made for it;
+    else `fun` itself. The library is compiled once
     per model and order (cached on disk) and kept with the model; the system is kept per
     `fun` object and order (the last 64), so a repeated call is two dictionary look-ups."""
     r = float(rtol) if isinstance(rtol, float) else float(np.min(rtol))
@@ -70,7 +81,7 @@ def _fixed_system(fun, model, order):
     d = model.derived
     if "jet" not in fun.taylor:
         return fun
-    if getattr(d, "kind", None) != "ode":
+    if getattr(d, "kind", None) not in ("ode", "generalized"):
         return fun
     libs = model.__dict__.setdefault("_taylor_fixed_libs", {})
     if order not in libs:
@@ -82,19 +93,41 @@ def _fixed_system(fun, model, order):
 
 
 def _fixed_library(d, order):
+    """The loaded library of d's recurrences written out for `order` (an ode system's, or
+    a generalized system's through its first-order view: the view's work columns), or
+    None when there is none (the loop version then runs)."""
     import ctypes
     from ..symbolic import build    # sympy: see with_fixed_order
     from ..symbolic.taylor import (FIXED_EXTRA_FLAGS, TaylorUnsupported, fixed_order_source,
                                    ode_decompositions)
-    dec, _, _ = ode_decompositions(d, variational=False)
-    if dec is None:
-        return None
-    nhist = sum(1 for op in dec.ops for _ in range(_history_sums(op.kind)))
+    if d.kind == "generalized":
+        from ..symbolic.taylor_generalized import generalized_decomposition
+        from ..symbolic.taylor_generalized_fixed import generalized_fixed_source, \
+            mass_products
+        g, _ = generalized_decomposition(d)
+        if g is None:
+            return None
+        nhist = sum(_history_sums(op.kind) for op in g.dec.ops) + mass_products(g)
+        limit = FIXED_MAX_SOURCE_GENERALIZED
+
+        def source():
+            return generalized_fixed_source(d, order, g)
+    else:
+        dec, _, _ = ode_decompositions(d, variational=False)
+        if dec is None:
+            return None
+        nhist = sum(_history_sums(op.kind) for op in dec.ops)
+        limit = None
+
+        def source():
+            return fixed_order_source(d, order, variational=False)
     if nhist*order*(order - 1)//2 > FIXED_MAX_TERMS:
         return None
     try:
-        path, _ = build.compile_source(fixed_order_source(d, order, variational=False),
-                                       flags=build.FFLAGS + FIXED_EXTRA_FLAGS)
+        src = source()
+        if limit is not None and len(src) > limit:
+            return None
+        path, _ = build.compile_source(src, flags=build.FFLAGS + FIXED_EXTRA_FLAGS)
     except (TaylorUnsupported, build.CompileError):
         return None         # the loop version runs (same coefficients, a little slower)
     return ctypes.CDLL(path)

@@ -1,0 +1,170 @@
+"""The Taylor recurrences of a generalized system M(t, q) q'' = Q(t, q, q') written out for
+one order (``conmech_taylor_fixed``), as :func:`conmech.symbolic.taylor.fixed_order_source`
+writes out an ode system's: no loop over the orders, literal indices, the coefficients in
+scalars, so that the compiler schedules the whole expansion at once.
+
+The statements are those of the loop routine (:func:`conmech.symbolic.taylor_generalized.
+generalized_body`) order by order, with every sum in the loop's order: the history sums
+and the products M_j a_{k-j} term by term for j = 1 .. k - 1, the squares' halved sums for
+j = 1 .. (k - 1)/2, then doubled and the middle term added; the same factorisation of
+M_0 and the same triangular solves per order. Compiled without contracted multiply-adds
+(the flags of the ode systems' written-out routine), the routine gives the loop routine's
+coefficients to the last bit, so a run takes the same steps with either.
+"""
+from .taylor import _decls, _Printer, _wrap
+from .taylor_generalized import WRITE_OUT_MAX, _cholesky_loop, _cholesky_out, _solve_loop, \
+    _solve_out, generalized_decomposition, order_zero
+from .taylor_decompose import TaylorUnsupported
+from .taylor_lanes import _SYM, _sum_seq
+from .taylor_recipe import Recipe
+from .printer import _names
+
+__all__ = ["generalized_fixed_source", "mass_products"]
+
+
+def mass_products(g):
+    """The products M_il a_l of one order's history (the entries of M that vary): with the
+    operations' history sums, the measure of the written-out source's size (it grows as
+    their number times order**2 / 2)."""
+    return len(_varying_products(g))
+
+
+def _varying_products(g):
+    return [(i, l) for i in range(g.n) for l in range(g.n) if not g.constant(i, l)]
+
+
+def _history(pp, k, lft, rgt, wt):
+    """The history sum of order k of one operation (recipe terms lft, rgt, weight wt) in
+    the order of the loop routine's loops: j = 1 .. k - 1 (a square's: j = 1 ..
+    (k - 1)/2, doubled, then the middle term)."""
+    W = pp.w
+    zero = "0.0_dp"
+    if wt is _SYM:
+        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in range(1, (k - 1)//2 + 1)]
+        out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
+        if k % 2 == 0:
+            mid = f"{W(k//2, lft)}*{W(k//2, lft)}"
+            out = f"{out} + {mid}" if out else mid
+        return out or zero
+    weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
+    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)], zero)
+
+
+def generalized_fixed_body(g, names, fixed, ind="        ", write_out=None):
+    """(declarations, statements) of the coefficient routine written out for the order
+    `fixed` (the routine must be called with order = fixed; any other order returns at
+    once, w untouched), for a procedure that declares t, order, w(0:order, g.ncol) and p.
+    The state's coefficients are read from w(0, 1:2n) and written to w(1:fixed, 1:2n);
+    the operations' and the accelerations' stay in scalars."""
+    n = g.n
+    dec = g.dec
+    out = n <= WRITE_OUT_MAX if write_out is None else write_out
+    pp = _Printer(dec, names, False, "dp")
+    pp.scalars = set()
+    rc = Recipe(pp, True, fixed)
+    W = pp.w
+    one = pp.real(1)
+    decl, body, varying, M0, _ = order_zero(g, pp, rc, rc.s0, ind)
+    # a mass matrix not positive definite: NaN coefficients, as the loop routine's (the
+    # quiet NaN's bits: the flags without the standard include path leave out the
+    # intrinsic module ieee_arithmetic)
+    fail = ["w(1:order, :) = transfer(9221120237041090560_c_long_long, 1.0_dp)", "return"]
+    decl = [x for x in decl if "fk, rk, rk1" not in x and "integer :: k, j" not in x]
+    decl.append(f"{ind}real(dp) :: cs")
+    state = range(1, 2*n + 1)
+    body = [f"{ind}if (order /= {fixed}) return"] + \
+        [f"{ind}{W(0, c)} = w(0, {c})" for c in state] + body[1:]
+    if out:
+        chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
+        solve = _solve_out(n, ind)
+        rvec = [f"cr{i + 1}" for i in range(n)]
+        gacc = [f"cg{i + 1}" for i in range(n)]
+        decl += _decls(names_c + rvec + gacc, "real(dp)", ind)
+    else:
+        decl += [f"{ind}real(dp) :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
+                 f"{ind}integer :: ii, jj"]
+        chol = [f"{ind}lm = 0.0_dp"]
+        for j in range(n):
+            for i in range(j, n):
+                chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
+        chol += _cholesky_loop(n, ind, fail)
+        solve = [x[4:] for x in _solve_loop(n, ind + "    ")]
+        rvec = [f"cr({i + 1})" for i in range(n)]
+        gacc = [f"cg({i + 1})" for i in range(n)]
+    body += chol
+    for i in range(n):
+        body += _wrap(f"{rvec[i]} = {pp.lin_at(dec.outputs[g.forces[i]], 0, True)}", ind)
+    body += solve
+    jstate = [c for c in state if c in dec.jcol]
+    for i in range(n):
+        body.append(f"{ind}{W(0, g.acols[i])} = {rvec[i]}")
+        body.append(f"{ind}{W(1, i + 1)} = {W(0, n + i + 1)}")
+        body.append(f"{ind}{W(1, n + i + 1)} = {rvec[i]}")
+    body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
+    body += [f"{ind}w(1, {c}) = {W(1, c)}" for c in state]
+    prods = _varying_products(g)
+    for k in range(1, fixed):
+        E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
+        for h, lft, rgt, wt in rc.hist:
+            body += _wrap(f"{h} = {_history(pp, k, lft, rgt, wt)}", ind)
+        # sum_{j=1..k-1} M_j a_{k-j}, term by term in j as the loop adds them
+        for i in range(n):
+            terms = [f"{W(j, g.entry_col(i, l))}*{W(k - j, g.acols[l])}"
+                     for j in range(1, k) for (ii, l) in prods if ii == i]
+            body += _wrap(f"{gacc[i]} = {_sum_seq(terms, '0.0_dp')}", ind)
+        for f in rc.cur:
+            body += _wrap(f(E), ind)
+        for (i, j) in varying:
+            body += _wrap(f"{W(k, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), k, False)}",
+                          ind)
+        # r = Q_k - sum_{j=1..k} M_j a_{k-j}, then a_k = M_0^-1 r
+        for i in range(n):
+            terms = [f" - {W(k, g.entry_col(i, l))}*{W(0, g.acols[l])}"
+                     for (ii, l) in prods if ii == i]
+            q = pp.lin_at(dec.outputs[g.forces[i]], k, False)
+            body += _wrap(f"{rvec[i]} = {q} - {gacc[i]}" + "".join(terms), ind)
+        body += solve
+        rk1 = f"({one}/{pp.real(k + 1)})"
+        for i in range(n):
+            body.append(f"{ind}{W(k, g.acols[i])} = {rvec[i]}")
+            body.append(f"{ind}{W(k + 1, i + 1)} = {rk1}*{W(k, n + i + 1)}")
+            body.append(f"{ind}{W(k + 1, n + i + 1)} = {rk1}*{rvec[i]}")
+        body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
+                 for c in jstate]
+        body += [f"{ind}w({k + 1}, {c}) = {W(k + 1, c)}" for c in state]
+    scalars = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
+    decl += _decls(scalars, "real(dp)", ind)
+    return decl, body
+
+
+def generalized_fixed_source(d, order, g=None, write_out=None):
+    """Fortran source of a module with ``conmech_taylor_fixed(t, order, w, p)`` (bind(C);
+    the signature and work columns of the generalized record `d`'s ``conmech_taylor``,
+    called with order = `order` only); g: d's decomposition when already made; write_out:
+    the factorisation in scalars (True) or loops (False), by default as the loop routine
+    has it (up to WRITE_OUT_MAX degrees of freedom in scalars).
+    TaylorUnsupported when `d` has no recurrences."""
+    if g is None:
+        g, why = generalized_decomposition(d)
+        if g is None:
+            raise TaylorUnsupported(why)
+    ind = "        "
+    decl, body = generalized_fixed_body(g, _names(d), order, ind, write_out)
+    npar = max(len(d.params), 1)
+    lines = ["!> Generated by conmech.symbolic.taylor_generalized_fixed: Taylor coefficients "
+             f"of M(q) q'' = Q written out for order {order}. Do not edit.",
+             "module conmech_symbolic_taylor_fixed",
+             "    use, intrinsic :: iso_c_binding, only: c_double, c_int, c_long_long",
+             "    implicit none",
+             "    integer, parameter :: dp = c_double",
+             "    public",
+             "contains", "",
+             '    subroutine conmech_taylor_fixed(t, order, w, p) bind(C, '
+             'name="conmech_taylor_fixed")',
+             f"{ind}real(dp), value, intent(in) :: t",
+             f"{ind}integer(c_int), value, intent(in) :: order",
+             f"{ind}real(dp), intent(inout) :: w(0:order, {g.ncol})",
+             f"{ind}real(dp), intent(in) :: p({npar})"]
+    lines += decl + body + ["    end subroutine conmech_taylor_fixed", "",
+                            "end module conmech_symbolic_taylor_fixed", ""]
+    return "\n".join(lines)
