@@ -281,3 +281,18 @@ def test_ensemble_members_are_their_own_runs(cart):
         r = conmech.solve_ivp(cart, (0, 3.0), y0, method="TAYLOR", rtol=1e-11, atol=1e-11)
         assert ens.status[i] == 0 and np.array_equal(ens.y_final[i], r.y[:, -1])
         assert ens.naccept[i] == r.naccept
+
+
+def test_small_rtol_warns_once_at_the_callers_line(double_pendulum):
+    """rtol below 100 eps, as a number (the fast entry) or an array (the full path): one
+    UserWarning, pointing at the caller, as for an ode system."""
+    import warnings
+    y0 = [0.1, 0.2, 0.0, 0.0]
+    for rtol in (1e-16, np.full(4, 1e-16)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r = conmech.solve_ivp(double_pendulum, (0, 1), y0, method="TAYLOR", rtol=rtol,
+                                  atol=1e-16)
+        assert r.success
+        assert [w.filename for w in caught] == [__file__]
+        assert "rtol" in str(caught[0].message)

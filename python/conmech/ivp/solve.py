@@ -280,24 +280,22 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
         # SciPy would integrate for ever: nothing ends such a run but a failure
         raise ValueError("t_span: an infinite end needs a terminal event (or max_steps) to "
                          "end the integration")
+    generalized = None
     if builtin and code == _TAYLOR:
         if getattr(fun, "taylor", None):        # the recurrences written out for the order
             fun = with_fixed_order(fun, rtol, atol)
         elif getattr(fun, "kind", None) == "generalized":
-            # M(q) q'' = Q: its first-order view, whose recurrences solve with M order by
-            # order (other systems without Taylor code: the Fortran stepper's message)
+            # M(q) q'' = Q: its first-order view (the same state y = [q; v]), whose
+            # recurrences solve with M order by order, runs from here on (other systems
+            # without Taylor code: the Fortran stepper's message)
             view = first_order_view(fun)
             if view is not fun:
-                # the tolerances as checked here (a warning about them is given once)
-                res = solve_ivp(view, t_span, y0, method, t_eval, dense_output, events,
-                                vectorized, args, rtol=rtol_v, atol=atol_v,
-                                first_step=first_step, max_step=max_step,
-                                max_steps=max_steps, jac=jac, **options)
-                return name_the_mass_matrix(fun, res)
+                generalized, fun = fun, with_fixed_order(view, rtol_v, atol_v)
     if builtin and not settings and not dense_output and jac is None and pattern is None:
         # the common case (a compiled system, nothing called back): one Fortran call
-        return _solve_native(fun, t0, tf, y0, t_ev, t_eval is not None, code, rtol_v,
-                             atol_v, h0, hmax, int(max_steps))
+        res = _solve_native(fun, t0, tf, y0, t_ev, t_eval is not None, code, rtol_v,
+                            atol_v, h0, hmax, int(max_steps))
+        return res if generalized is None else name_the_mass_matrix(generalized, res)
     problem = dict(fun=fun, builtin=builtin, args=args, t0=t0, tf=tf, y0=y0,
                    t_ev=t_ev, with_t_eval=t_eval is not None, dense=bool(dense_output),
                    settings=settings, vectorized=bool(vectorized))
@@ -313,7 +311,8 @@ def solve_ivp(fun: Callable[..., ArrayLike] | NativeSystem, t_span: Sequence[flo
     common = dict(method=code, rtol=rtol_v, atol=atol_v, max_step=hmax,
                   max_steps=int(max_steps), dense=int(bool(dense_output)))
     if not is_complex:
-        return _solve(problem, common, h0, jac, pattern)
+        res = _solve(problem, common, h0, jac, pattern)
+        return res if generalized is None else name_the_mass_matrix(generalized, res)
     # a complex system as its real and imaginary parts: y = u + i v, [u; v]' = [Re f; Im f]
     problem.update(fun=_real_form(fun, n), y0=np.concatenate([y0.real, y0.imag]),
                    settings=[(_real_form_event(e, n), c, d, r) for e, c, d, r in settings])

@@ -145,7 +145,7 @@ def name_the_mass_matrix(fun, res):
     state of the mass matrix at the last accepted point: not positive definite there, or
     its condition number."""
     model = _model(fun)
-    if model is None or res.success or res.status != -1 or not res.t.size:
+    if model is None or res.success or res.status != -1 or not np.size(res.t):
         return res
     note = mass_note(fun, res.t[-1], res.y[:, -1])
     if note:
