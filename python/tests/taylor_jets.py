@@ -21,6 +21,15 @@ _P = ctypes.POINTER(ctypes.c_double)
 _JET = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int, _P, _P)
 
 
+def module_source(name, lines):
+    """The Fortran source of a module `name` holding the generated procedure `lines` (the
+    double kind dp and the C integer of the generated routines)."""
+    head = [f"module {name}", "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
+            "    implicit none", "    integer, parameter :: dp = c_double", "    public",
+            "contains", ""]
+    return "\n".join(head + lines + [f"end module {name}", ""])
+
+
 def coefficients(address, nw, params, y, order, t=0.0):
     """The coefficients y^[0..order] (rows: the components of y) of the Taylor routine at
     `address` whose work array has `nw` columns."""

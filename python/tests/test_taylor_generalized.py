@@ -37,7 +37,7 @@ from conmech.symbolic.taylor_generalized import (generalized_decomposition,  # n
                                                  generalized_procedures)
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
-from taylor_jets import coefficients  # noqa: E402
+from taylor_jets import coefficients, module_source  # noqa: E402
 
 
 def jet(system, y, order, t=0.0):
@@ -141,11 +141,7 @@ def test_factorisation_in_loops_gives_the_written_out_coefficients(cart):
     g, why = generalized_decomposition(d)
     assert why is None
     lines = generalized_procedures(g, _names(d), write_out=False, npar=len(d.params))
-    head = ["module conmech_tgen_loop_form",
-            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
-            "    implicit none", "    integer, parameter :: dp = c_double", "    public",
-            "contains", ""]
-    src = "\n".join(head + lines + ["end module conmech_tgen_loop_form", ""])
+    src = module_source("conmech_tgen_loop_form", lines)
     assert "do jj = 1, 2" in src
     path, _ = build.compile_source(src, None, ["taylor", "taylor_info", "taylor_rhs"])
     lib, addr = build.load(path, ["taylor", "taylor_info", "taylor_rhs"])

@@ -32,7 +32,7 @@ from conmech.symbolic.taylor_generalized import (generalized_decomposition,  # n
 from conmech.symbolic.taylor_generalized_fixed import generalized_fixed_source  # noqa: E402
 from sympy.physics.mechanics import dynamicsymbols  # noqa: E402
 import taylor_jets  # noqa: E402
-from taylor_jets import coefficients  # noqa: E402
+from taylor_jets import coefficients, module_source  # noqa: E402
 
 
 def forced_cart():
@@ -62,11 +62,7 @@ def _loop_address(system, write_out=None):
     d = model_of(system).derived
     g, _ = generalized_decomposition(d)
     lines = generalized_procedures(g, _names(d), write_out=write_out, npar=len(d.params))
-    head = ["module conmech_tgen_fixed_loops",
-            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
-            "    implicit none", "    integer, parameter :: dp = c_double", "    public",
-            "contains", ""]
-    src = "\n".join(head + lines + ["end module conmech_tgen_fixed_loops", ""])
+    src = module_source("conmech_tgen_fixed_loops", lines)
     path, _ = build.compile_source(src, None, ["taylor", "taylor_info", "taylor_rhs"])
     return build.load(path, ["taylor", "taylor_info", "taylor_rhs"])[0], \
         build.load(path, ["taylor"])[1]["taylor"]

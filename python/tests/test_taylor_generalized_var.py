@@ -31,7 +31,8 @@ from conmech.symbolic.printer import _names  # noqa: E402
 from conmech.symbolic.taylor_generalized_var import (variational_decomposition,  # noqa: E402
                                                      variational_procedures)
 import taylor_jets  # noqa: E402
-from taylor_jets import check_phi_rows, check_stm, coefficients, jets  # noqa: E402
+from taylor_jets import (check_phi_rows, check_stm, coefficients, jets,  # noqa: E402
+                         module_source)
 
 
 
@@ -74,11 +75,7 @@ def test_factorisation_in_loops_gives_the_written_out_coefficients(cart):
     g, why = variational_decomposition(d)
     assert why is None
     lines = variational_procedures(g, _names(d), write_out=False, npar=len(d.params))
-    head = ["module conmech_tgen_var_loop_form",
-            "    use, intrinsic :: iso_c_binding, only: c_double, c_int",
-            "    implicit none", "    integer, parameter :: dp = c_double", "    public",
-            "contains", ""]
-    src = "\n".join(head + lines + ["end module conmech_tgen_var_loop_form", ""])
+    src = module_source("conmech_tgen_var_loop_form", lines)
     assert "do jj = 1, 2" in src
     entries = ["taylor_var", "taylor_var_info"]
     path, _ = build.compile_source(src, None, entries)

@@ -61,6 +61,12 @@ class MassEntries:
     def constant(self, i, j):
         return not self.entry(i, j).terms
 
+    def varying_products(self):
+        """The pairs (i, l) of the products M_il a_l whose entry of M varies (has
+        coefficients beyond order 0: history terms)."""
+        return [(i, l) for i in range(self.n) for l in range(self.n)
+                if not self.constant(i, l)]
+
     def mass_and_forces(self, M, Q, n):
         """The outputs M's upper triangle (by columns), then Q: sets ``mass`` and
         ``forces`` and returns the list of the entries."""
@@ -176,6 +182,31 @@ def _solve_loop(n, ind):
             f"{ind}end do"]
 
 
+def factorisation(g, pp, M0, ind, fail, out, kind="dp"):
+    """The factorisation of M_0 and the triangular solves, written out in scalars (`out`)
+    or in loops over local arrays: (declarations, the factorisation's lines, the solves'
+    lines at the indentation ind + 4, the right-hand sides' names rvec, the history sums'
+    names gacc); M0(i, j) the Fortran value of M_ij at order 0, `fail` the statements
+    that fail the expansion."""
+    n = g.n
+    real = f"real({kind})"
+    if out:
+        chol, names_c = _cholesky_out(g, pp, M0, ind, fail, kind)
+        rvec = [f"cr{i + 1}" for i in range(n)]
+        gacc = [f"cg{i + 1}" for i in range(n)]
+        return (_decls(names_c + rvec + gacc, real, ind), chol, _solve_out(n, ind + "    "),
+                rvec, gacc)
+    decl = [f"{ind}{real} :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
+            f"{ind}integer :: ii, jj"]
+    chol = [f"{ind}lm = 0.0_{kind}"]
+    for j in range(n):
+        for i in range(j, n):
+            chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
+    chol += _cholesky_loop(n, ind, fail, kind)
+    return (decl, chol, _solve_loop(n, ind + "    "), [f"cr({i + 1})" for i in range(n)],
+            [f"cg({i + 1})" for i in range(n)])
+
+
 def order_zero(g, pp, rc, s0, ind, kind="dp"):
     """The parts every coefficient routine through M's factorisation starts with:
     (declarations, the order-0 statements `s0` of the operations and of the entries of M
@@ -215,26 +246,10 @@ def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     W = pp.w
     one = pp.real(1)
     zero = f"0.0_{kind}"
-    real = f"real({kind})"
     # order 0: the operations, the entries of M and Q, the factorisation, a_0
     decl, body, varying, M0, fail = order_zero(g, pp, rc, rc.s0, ind, kind)
-    if out:
-        chol, names_c = _cholesky_out(g, pp, M0, ind, fail, kind)
-        solve = _solve_out(n, ind + "    ")
-        rvec = [f"cr{i + 1}" for i in range(n)]
-        gacc = [f"cg{i + 1}" for i in range(n)]
-        decl += _decls(names_c + rvec + gacc, real, ind)
-    else:
-        decl += [f"{ind}{real} :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
-                 f"{ind}integer :: ii, jj"]
-        chol = [f"{ind}lm = {zero}"]
-        for j in range(n):
-            for i in range(j, n):
-                chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
-        chol += _cholesky_loop(n, ind, fail, kind)
-        solve = _solve_loop(n, ind + "    ")
-        rvec = [f"cr({i + 1})" for i in range(n)]
-        gacc = [f"cg({i + 1})" for i in range(n)]
+    fdecl, chol, solve, rvec, gacc = factorisation(g, pp, M0, ind, fail, out, kind)
+    decl += fdecl
     body += chol
     for i in range(n):
         body += _wrap(f"{rvec[i]} = {pp.lin_at(dec.outputs[g.forces[i]], 0, True)}", ind)
@@ -255,7 +270,7 @@ def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     plain = [x for x in rc.hist if x[3] is not _SYM]
     sym = [x for x in rc.hist if x[3] is _SYM]
     # the products M_il a_l: sum_{j=1..k-1} M_j a_{k-j} (the term j = k below)
-    prods = [(i, l) for i in range(n) for l in range(n) if not g.constant(i, l)]
+    prods = g.varying_products()
     if plain or prods:
         loop.append(f"{ind}    do j = 1, k - 1")
         for h, lft, rgt, wt in plain:
@@ -274,21 +289,35 @@ def generalized_body(g, names, ind="        ", write_out=None, kind="dp"):
     for (i, j) in varying:
         loop += _wrap(f"{W('k', g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), 'k', False)}",
                       ind + "    ")
-    # r = Q_k - sum_{j=1..k} M_j a_{k-j}, then a_k = M_0^-1 r
-    for i in range(n):
-        terms = [f" - {W('k', g.entry_col(i, l))}*{W(0, g.acols[l])}"
-                 for (ii, l) in prods if ii == i]
-        q = pp.lin_at(dec.outputs[g.forces[i]], "k", False)
-        loop += _wrap(f"{rvec[i]} = {q} - {gacc[i]}" + "".join(terms), ind + "    ")
-    loop += solve
-    for i in range(n):
-        loop.append(f"{ind}    {W('k', g.acols[i])} = {rvec[i]}")
-        loop.append(f"{ind}    {W('k + 1', i + 1)} = rk1*{W('k', n + i + 1)}")
-        loop.append(f"{ind}    {W('k + 1', n + i + 1)} = rk1*{rvec[i]}")
-    loop += [f"{ind}    {W('k + 1', dec.jcol[c])} = (fk + {one})*{W('k + 1', c)}"
-             for c in jstate]
+    loop += accelerations(g, pp, "k", "k + 1", "rk1", f"(fk + {one})", rvec, gacc, solve,
+                          ind + "    ")
     loop.append(f"{ind}end do")
     return decl, body + loop
+
+
+def accelerations(g, pp, k, k1, rk1, fk1, rvec, gacc, solve, ind):
+    """The statements that close order k: r = Q_k - sum_{j=1..k} M_j a_{k-j} (gacc the
+    terms j < k), a_k = M_0^-1 r (the solves' lines `solve`), then q^[k+1] = v^[k]/(k + 1),
+    v^[k+1] = a_k/(k + 1) and the state's j-weighted columns. k and k1 are the order and
+    the next one (Fortran text, or numbers in a written-out routine), rk1 and fk1 the
+    text of 1/(k + 1) and k + 1; the lines at the indentation ind."""
+    W = pp.w
+    n, dec = g.n, g.dec
+    prods = g.varying_products()
+    lines = []
+    for i in range(n):
+        terms = [f" - {W(k, g.entry_col(i, l))}*{W(0, g.acols[l])}"
+                 for (ii, l) in prods if ii == i]
+        q = pp.lin_at(dec.outputs[g.forces[i]], k, False)
+        lines += _wrap(f"{rvec[i]} = {q} - {gacc[i]}" + "".join(terms), ind)
+    lines += solve
+    for i in range(n):
+        lines.append(f"{ind}{W(k, g.acols[i])} = {rvec[i]}")
+        lines.append(f"{ind}{W(k1, i + 1)} = {rk1}*{W(k, n + i + 1)}")
+        lines.append(f"{ind}{W(k1, n + i + 1)} = {rk1}*{rvec[i]}")
+    lines += [f"{ind}{W(k1, dec.jcol[c])} = {fk1}*{W(k1, c)}"
+              for c in range(1, 2*n + 1) if c in dec.jcol]
+    return lines
 
 
 def generalized_procedures(g, names, prefix="conmech_taylor", write_out=None, npar=1):

@@ -12,10 +12,10 @@ M_0 and the same triangular solves per order. Compiled without contracted multip
 coefficients to the last bit, so a run takes the same steps with either.
 """
 from .taylor import _decls, _Printer, _wrap
-from .taylor_generalized import WRITE_OUT_MAX, _cholesky_loop, _cholesky_out, _solve_loop, \
-    _solve_out, generalized_decomposition, order_zero
+from .taylor_generalized import WRITE_OUT_MAX, accelerations, factorisation, \
+    generalized_decomposition, order_zero
 from .taylor_decompose import TaylorUnsupported
-from .taylor_lanes import _SYM, _sum_seq
+from .taylor_lanes import _history_sum, _sum_seq
 from .taylor_recipe import Recipe
 from .printer import _names
 
@@ -26,28 +26,17 @@ def mass_products(g):
     """The products M_il a_l of one order's history (the entries of M that vary): with the
     operations' history sums, the measure of the written-out source's size (it grows as
     their number times order**2 / 2)."""
-    return len(_varying_products(g))
+    return len(g.varying_products())
 
 
-def _varying_products(g):
-    return [(i, l) for i in range(g.n) for l in range(g.n) if not g.constant(i, l)]
+def _ascending(k):
+    """The terms j = 1 .. k - 1 of a plain history sum in the loop routine's order."""
+    return range(1, k)
 
 
-def _history(pp, k, lft, rgt, wt):
-    """The history sum of order k of one operation (recipe terms lft, rgt, weight wt) in
-    the order of the loop routine's loops: j = 1 .. k - 1 (a square's: j = 1 ..
-    (k - 1)/2, doubled, then the middle term)."""
-    W = pp.w
-    zero = "0.0_dp"
-    if wt is _SYM:
-        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in range(1, (k - 1)//2 + 1)]
-        out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
-        if k % 2 == 0:
-            mid = f"{W(k//2, lft)}*{W(k//2, lft)}"
-            out = f"{out} + {mid}" if out else mid
-        return out or zero
-    weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
-    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in range(1, k)], zero)
+def _ascending_half(k):
+    """The terms j = 1 .. (k - 1)/2 of a square's halved sum in the loop routine's order."""
+    return range(1, (k - 1)//2 + 1)
 
 
 def generalized_fixed_body(g, names, fixed, ind="        ", write_out=None):
@@ -74,23 +63,9 @@ def generalized_fixed_body(g, names, fixed, ind="        ", write_out=None):
     state = range(1, 2*n + 1)
     body = [f"{ind}if (order /= {fixed}) return"] + \
         [f"{ind}{W(0, c)} = w(0, {c})" for c in state] + body[1:]
-    if out:
-        chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
-        solve = _solve_out(n, ind)
-        rvec = [f"cr{i + 1}" for i in range(n)]
-        gacc = [f"cg{i + 1}" for i in range(n)]
-        decl += _decls(names_c + rvec + gacc, "real(dp)", ind)
-    else:
-        decl += [f"{ind}real(dp) :: lm({n}, {n}), ld({n}), cr({n}), cg({n})",
-                 f"{ind}integer :: ii, jj"]
-        chol = [f"{ind}lm = 0.0_dp"]
-        for j in range(n):
-            for i in range(j, n):
-                chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
-        chol += _cholesky_loop(n, ind, fail)
-        solve = [x[4:] for x in _solve_loop(n, ind + "    ")]
-        rvec = [f"cr({i + 1})" for i in range(n)]
-        gacc = [f"cg({i + 1})" for i in range(n)]
+    fdecl, chol, solve, rvec, gacc = factorisation(g, pp, M0, ind, fail, out)
+    decl += fdecl
+    solve = [x[4:] for x in solve]         # (at the body's indentation: no loop over k)
     body += chol
     for i in range(n):
         body += _wrap(f"{rvec[i]} = {pp.lin_at(dec.outputs[g.forces[i]], 0, True)}", ind)
@@ -102,11 +77,12 @@ def generalized_fixed_body(g, names, fixed, ind="        ", write_out=None):
         body.append(f"{ind}{W(1, n + i + 1)} = {rvec[i]}")
     body += [f"{ind}{W(1, dec.jcol[c])} = {W(1, c)}" for c in jstate]
     body += [f"{ind}w(1, {c}) = {W(1, c)}" for c in state]
-    prods = _varying_products(g)
+    prods = g.varying_products()
     for k in range(1, fixed):
         E = {"k": k, "fk": pp.real(k), "rk": f"({one}/{pp.real(k)})"}
         for h, lft, rgt, wt in rc.hist:
-            body += _wrap(f"{h} = {_history(pp, k, lft, rgt, wt)}", ind)
+            hs = _history_sum(pp, k, lft, rgt, wt, None, _ascending, _ascending_half)
+            body += _wrap(f"{h} = {hs}", ind)
         # sum_{j=1..k-1} M_j a_{k-j}, term by term in j as the loop adds them
         for i in range(n):
             terms = [f"{W(j, g.entry_col(i, l))}*{W(k - j, g.acols[l])}"
@@ -117,20 +93,8 @@ def generalized_fixed_body(g, names, fixed, ind="        ", write_out=None):
         for (i, j) in varying:
             body += _wrap(f"{W(k, g.entry_col(i, j))} = {pp.lin_at(g.entry(i, j), k, False)}",
                           ind)
-        # r = Q_k - sum_{j=1..k} M_j a_{k-j}, then a_k = M_0^-1 r
-        for i in range(n):
-            terms = [f" - {W(k, g.entry_col(i, l))}*{W(0, g.acols[l])}"
-                     for (ii, l) in prods if ii == i]
-            q = pp.lin_at(dec.outputs[g.forces[i]], k, False)
-            body += _wrap(f"{rvec[i]} = {q} - {gacc[i]}" + "".join(terms), ind)
-        body += solve
-        rk1 = f"({one}/{pp.real(k + 1)})"
-        for i in range(n):
-            body.append(f"{ind}{W(k, g.acols[i])} = {rvec[i]}")
-            body.append(f"{ind}{W(k + 1, i + 1)} = {rk1}*{W(k, n + i + 1)}")
-            body.append(f"{ind}{W(k + 1, n + i + 1)} = {rk1}*{rvec[i]}")
-        body += [f"{ind}{W(k + 1, dec.jcol[c])} = {pp.real(k + 1)}*{W(k + 1, c)}"
-                 for c in jstate]
+        body += accelerations(g, pp, k, k + 1, f"({one}/{pp.real(k + 1)})",
+                              pp.real(k + 1), rvec, gacc, solve, ind)
         body += [f"{ind}w({k + 1}, {c}) = {W(k + 1, c)}" for c in state]
     scalars = sorted(pp.scalars, key=lambda x: tuple(int(v) for v in x[1:].split("_")))
     decl += _decls(scalars, "real(dp)", ind)

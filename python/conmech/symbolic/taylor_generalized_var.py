@@ -34,8 +34,8 @@ from .taylor import _SYM, _decls, _Printer, _wrap, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_recipe import Recipe
 from .taylor_first_order import first_order_procedures
-from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, _cholesky_loop, _cholesky_out,
-                                 _solve_loop, _solve_out, generalized_decomposition, order_zero)
+from .taylor_generalized import (WRITE_OUT_MAX, MassEntries, factorisation,
+                                 generalized_decomposition, order_zero)
 
 __all__ = ["variational_decomposition", "variational_procedures", "variational_lines"]
 
@@ -134,25 +134,15 @@ def variational_body(g, names, ind="        ", write_out=None):
     one = pp.real(1)
     zero = "0.0_dp"
     decl, body, varying, M0, fail = order_zero(g, pp, rc, rc.s0[:ns0], ind)
+    fdecl, chol, solve, rvec, gacc = factorisation(g, pp, M0, ind, fail, out)
+    decl += fdecl
+    # the history sums of M da, one per column of Phi
     if out:
-        chol, names_c = _cholesky_out(g, pp, M0, ind, fail)
-        solve = _solve_out(n, ind + "    ")
-        rvec = [f"cr{i + 1}" for i in range(n)]
-        gacc = [f"cg{i + 1}" for i in range(n)]
         vacc = [[f"cv{c + 1}_{i + 1}" for i in range(n)] for c in range(m)]
-        decl += _decls(names_c + rvec + gacc + sum(vacc, []), "real(dp)", ind)
+        decl += _decls(sum(vacc, []), "real(dp)", ind)
     else:
-        decl += [f"{ind}real(dp) :: lm({n}, {n}), ld({n}), cr({n}), cg({n}), cv({n}, {m})",
-                 f"{ind}integer :: ii, jj"]
-        chol = [f"{ind}lm = 0.0_dp"]
-        for j in range(n):
-            for i in range(j, n):
-                chol += _wrap(f"lm({i + 1}, {j + 1}) = {M0(i, j)}", ind)
-        chol += _cholesky_loop(n, ind, fail)
-        solve = _solve_loop(n, ind + "    ")
-        rvec = [f"cr({i + 1})" for i in range(n)]
-        gacc = [f"cg({i + 1})" for i in range(n)]
         vacc = [[f"cv({i + 1}, {c + 1})" for i in range(n)] for c in range(m)]
+        decl.append(f"{ind}real(dp) :: cv({n}, {m})")
     body += chol
     solve0 = [x[4:] if x.startswith(ind + "    ") else x for x in solve]
     # the accelerations a_0, then the operations on them and the columns da_0
@@ -198,7 +188,7 @@ def variational_body(g, names, ind="        ", write_out=None):
     loop += [f"{ind}    {x} = {zero}" for x in gacc + sum(vacc, [])]
     plain = [x for x in rc.hist if x[3] is not _SYM]
     sym = [x for x in rc.hist if x[3] is _SYM]
-    prods = [(i, l) for i in range(n) for l in range(n) if not g.constant(i, l)]
+    prods = g.varying_products()
     if plain or prods:
         loop.append(f"{ind}    do j = 1, k - 1")
         for h, lft, rgt, wt in plain:

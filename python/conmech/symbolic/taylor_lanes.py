@@ -77,22 +77,23 @@ def _sum_seq(terms, zero):
     return " + ".join(terms) if terms else zero
 
 
-def _history_sum(pp, k, lft, rgt, wt, W=None):
+def _history_sum(pp, k, lft, rgt, wt, W=None, terms_of=history_terms,
+                 symmetric_of=symmetric_terms):
     """The history sum of order k written out (literal indices), the same operations in
     the same order as the loop version's (see body_lines), so the same bits. W(j, column)
-    spells a coefficient (default: the printer's)."""
+    spells a coefficient (default: the printer's); terms_of(k) and symmetric_of(k) the
+    order of the terms j of a plain sum and of a square's halved one (the loop's)."""
     W = pp.w if W is None else W
     zero = f"0.0_{pp.kind}"
     if wt is _SYM:
-        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in symmetric_terms(k)]
+        terms = [f"{W(j, lft)}*{W(k - j, lft)}" for j in symmetric_of(k)]
         out = f"{pp.real(2)}*({_sum_seq(terms, zero)})" if terms else None
         if k % 2 == 0:
             mid = f"{W(k//2, lft)}*{W(k//2, lft)}"
             out = f"{out} + {mid}" if out else mid
         return out or zero
     weight = (lambda j: f"({wt}*{pp.real(j)} - {pp.real(k)})*") if wt else (lambda j: "")
-    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in history_terms(k)],
-                    zero)
+    return _sum_seq([f"{weight(j)}{W(j, lft)}*{W(k - j, rgt)}" for j in terms_of(k)], zero)
 
 
 def _pair_history(hist, dec):
