@@ -1,20 +1,22 @@
-"""solve_ivp(method="TAYLOR") on generalized systems M(q) q'' = Q from their Lagrangians:
-the recurrences written out for the run's order (conmech.symbolic.taylor_generalized_fixed,
-what solve_ivp runs while the routine's source stays within
-conmech.ivp.taylor.FIXED_MAX_SOURCE_GENERALIZED characters) against the loop routine (the
-model library's conmech_taylor), in one process, the two routes interleaved in each round.
+"""solve_ivp(method="TAYLOR") on generalized systems M(q) q'' = Q: the recurrences written
+out for the run's order (conmech.symbolic.taylor_generalized_fixed, what solve_ivp runs
+while the routine's source stays within conmech.ivp.taylor.FIXED_MAX_SOURCE_GENERALIZED
+characters, FIXED_MAX_SOURCE_TREE for a tree) against the loop routine (the model
+library's conmech_taylor), in one process, the two routes interleaved in each round.
 
-Systems (python/tests/taylor_jets.py): the double pendulum (g = 9.81), the lecture notes'
-cart pendulum, planar chains of 3 and 4 links; initial angles spread over [-0.3, 0.3] and
-rates over [0.2, -0.2] (the cart: [0.3, pi - 0.7, -0.2, 0.5]); t in [0, 10]; rtol = atol =
-tol. Both routes take the same steps to the last bit (checked). Printed: the order, the
-written-out source's size (the routine is compiled here whatever its size, to show where
+Systems: the double pendulum (g = 9.81), the lecture notes' cart pendulum, planar chains of
+3 and 4 links from their Lagrangians (M and Q; python/tests/taylor_jets.py), and planar
+chains of 2 and 3 point masses as trees (symbolic.planar_tree: the recurrences of the
+articulated-body chain); initial angles spread over [-0.3, 0.3] and rates over [0.2, -0.2]
+(the cart: [0.3, pi - 0.7, -0.2, 0.5]); t in [0, 10]; rtol = atol = tol. Both routes
+take the same steps to the last bit (checked). Printed: the order, the written-out
+source's size (the routine is compiled here whatever its size, to show where
 the limit lies), steps, the best of --rounds rounds of --calls calls per route (us per
 call) and their ratio, and DOP853's time and evaluations at the same tolerance (down to
 1e-13: DOP853's rtol floor is 100 eps); the load average (1 min) before and after.
 
     python bench/taylor_generalized_fixed.py [--tol 1e-8 1e-12 1e-16] [--rounds 5]
-        [--calls 10] [--systems double_pendulum cart chain3 chain4]
+        [--calls 10] [--systems double_pendulum cart chain3 chain4 tree2 tree3]
 """
 import argparse
 import os
@@ -27,7 +29,9 @@ import numpy as np
 import conmech
 import conmech.ivp.taylor as ivp_taylor
 from conmech.symbolic.pipeline import model_of
-from conmech.symbolic.taylor_generalized_fixed import generalized_fixed_source
+from conmech.symbolic.taylor_generalized_fixed import generalized_fixed_source, \
+    tree_fixed_source
+from conmech.symbolic.taylor_tree import is_tree
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python",
                                 "tests"))
@@ -35,7 +39,9 @@ import taylor_jets  # noqa: E402
 
 SYSTEMS = {"double_pendulum": taylor_jets.double_pendulum, "cart": taylor_jets.cart_pendulum,
            "chain3": lambda: taylor_jets.pendulum_chain(3),
-           "chain4": lambda: taylor_jets.pendulum_chain(4)}
+           "chain4": lambda: taylor_jets.pendulum_chain(4),
+           "tree2": lambda: taylor_jets.tree_chain(2),
+           "tree3": lambda: taylor_jets.tree_chain(3)}
 
 
 def _loop_only(fun, model, order):
@@ -69,8 +75,9 @@ def main():
     ap.add_argument("--systems", nargs="+", default=list(SYSTEMS), choices=list(SYSTEMS))
     args = ap.parse_args()
     warnings.simplefilter("ignore", UserWarning)       # rtol below 100 eps at 1e-16
-    limit = ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED
-    ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED = 10**9     # every routine made, to compare
+    limits = (ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED, ivp_taylor.FIXED_MAX_SOURCE_TREE)
+    # every routine made, to compare
+    ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED = ivp_taylor.FIXED_MAX_SOURCE_TREE = 10**9
     print(f"load before: {os.getloadavg()[0]:.2f}")
     print("| system | tol | order | source kB | made by solve_ivp | steps | written out us "
           "| loop us | written out / loop | DOP853 us (nfev) | written out / DOP853 |")
@@ -83,10 +90,12 @@ def main():
         y0 = list(np.linspace(-0.3, 0.3, n)) + list(np.linspace(0.2, -0.2, n))
         if name == "cart":
             y0 = [0.3, np.pi - 0.7, -0.2, 0.5]
+        tree = is_tree(d)
         for tol in args.tol:
             order = ivp_taylor.taylor_order(max(tol, 2.220446049250313e-16))
-            size = len(generalized_fixed_source(d, order))
-            made = size <= limit
+            size = len(tree_fixed_source(d, order) if tree else
+                       generalized_fixed_source(d, order))
+            made = size <= limits[tree]
             a, b = call(systems, y0, tol, 0), call(systems, y0, tol, 1)
             assert a.success and np.array_equal(a.y, b.y) and a.nfev == b.nfev
             dop = call(systems, y0, tol, 2) if tol >= 1e-13 else None

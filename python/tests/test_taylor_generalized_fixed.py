@@ -10,7 +10,10 @@ Stepper run with method TAYLOR on its first-order view while the routine stays s
   routine's;
 - solve_ivp and the Propagator run it (the first-order view carries it for the order of
   the tolerances) and take the loop routine's steps to the last bit; a routine past the
-  source limit (three links at order 18) is not made and the loop routine runs.
+  source limit (three links at order 18) is not made and the loop routine runs;
+- a tree's (its articulated-body chain's recurrences written out as an ode system's, its
+  pivots checked at order 0): the loop routine's coefficients to the last bit, NaN for a
+  zero mass at the leaf, and made within its own source limit.
 """
 import ctypes
 
@@ -147,3 +150,45 @@ def test_a_large_routine_is_not_made():
     assert "jet_fixed" not in ivp_taylor.with_fixed_order(view, 1e-12, 1e-12).taylor
     # a low order stays below it
     assert len(generalized_fixed_source(d, 9)) <= ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED
+
+
+def test_tree_written_out_routine_gives_the_loop_coefficients():
+    """A tree's recurrences (its articulated-body chain) written out: the loop routine's
+    coefficients to the last bit, and NaN from order 1 on when a pivot is not positive (a
+    zero mass at the leaf), as the loop routine gives them."""
+    from conmech.symbolic.taylor_generalized_fixed import tree_fixed_source
+    system = taylor_jets.tree_chain(2)
+    d = model_of(system).derived
+    y = [0.3, -0.2, 0.25, -0.1]
+    for leaf in (None, 0.0):
+        view = first_order_view(system if leaf is None else system.with_params(m2=leaf))
+        nw = view.taylor["nw"]
+        loop = conmech.compiled.function_address(view.taylor["jet"])
+        for order in (8, 14):
+            src = tree_fixed_source(d, order)
+            lib = ctypes.CDLL(build.compile_source(src, flags=build.FFLAGS +
+                                                   FIXED_EXTRA_FLAGS)[0])
+            fixed = ctypes.cast(lib.conmech_taylor_fixed, ctypes.c_void_p).value
+            a = coefficients(fixed, nw, view.params, y, order, 0.2)
+            b = coefficients(loop, nw, view.params, y, order, 0.2)
+            if leaf is None:
+                assert np.all(np.isfinite(a)) and np.array_equal(a, b), order
+                assert np.max(np.abs(a[:, order])) > 0.0
+            else:
+                assert np.all(np.isnan(a[:, 1:])) and np.all(np.isnan(b[:, 1:]))
+
+
+def test_tree_routine_made_within_its_limit():
+    """Two point masses as a tree: written out at order 14 (108 kB of source), not at
+    order 24 (274 kB, past FIXED_MAX_SOURCE_TREE: the loop routine runs)."""
+    from conmech.symbolic.taylor_generalized_fixed import tree_fixed_source
+    system = taylor_jets.tree_chain(2)
+    d = model_of(system).derived
+    view = first_order_view(system)
+    assert len(tree_fixed_source(d, 14)) <= ivp_taylor.FIXED_MAX_SOURCE_TREE
+    assert "jet_fixed" in ivp_taylor.with_fixed_order(view, 1e-8, 1e-8).taylor
+    assert len(tree_fixed_source(d, 24)) > ivp_taylor.FIXED_MAX_SOURCE_TREE
+    assert "jet_fixed" not in ivp_taylor.with_fixed_order(view, 1e-16, 1e-16).taylor
+    r = conmech.solve_ivp(system, (0, 2), [0.3, -0.2, 0.25, -0.1], method="TAYLOR",
+                          rtol=1e-8, atol=1e-8)
+    assert r.success and r.nfev == r.naccept + r.nreject + 1

@@ -38,6 +38,7 @@ from conmech.symbolic import Body, planar_tree  # noqa: E402
 from conmech.symbolic.tree import derive_tree  # noqa: E402
 from conmech.symbolic.urdf import data_path  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
+import taylor_jets  # noqa: E402
 from test_taylor_generalized import coefficients  # noqa: E402
 
 t = dynamicsymbols._t
@@ -52,15 +53,7 @@ def symbolic_cache(tmp_path_factory):
 def chain(N):
     """N point masses on massless rods, pinned at the origin, angles from the downward
     vertical (absolute)."""
-    th = dynamicsymbols(f"th1:{N + 1}")
-    m, l = sp.symbols(f"m1:{N + 1}"), sp.symbols(f"l1:{N + 1}")
-    g = sp.Symbol("g")
-    bodies = [Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute", th[i],
-                   at=(0, 0) if i == 0 else (0, -l[i - 1]), mass=m[i], com=(0, -l[i]))
-              for i in range(N)]
-    params = {**{s: 0.8 + 0.15*i for i, s in enumerate(m)},
-              **{s: 1.1 - 0.05*i for i, s in enumerate(l)}, g: 9.81}
-    return bodies, params, g
+    return taylor_jets.tree_chain_bodies(N)
 
 
 def branched():

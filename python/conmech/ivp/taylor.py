@@ -5,8 +5,9 @@
   registers, every multiply-add scheduled at once), compiled on first use of an order and
   cached like the model; they give the loop version's coefficients to the last bit, so a
   run takes the same steps with either. An ode system's (conmech.symbolic.taylor), and a
-  generalized system's first-order view's while its routine stays small
-  (conmech.symbolic.taylor_generalized_fixed; FIXED_MAX_SOURCE_GENERALIZED);
+  generalized system's or a tree's first-order view's while its routine stays small
+  (conmech.symbolic.taylor_generalized_fixed; FIXED_MAX_SOURCE_GENERALIZED,
+  FIXED_MAX_SOURCE_TREE);
 - compiled events (made by :func:`conmech.symbolic.event`): the events of one call are
   compiled together (cached) and located by the Taylor stepper with no Python in the loop.
 """
@@ -28,6 +29,11 @@ FIXED_MAX_TERMS = 40000
 #: routine's time; of a chain of three links at order 14, 101 kB: 1.01x-1.02x, at order
 #: 18 1.08x; bench/results/taylor_generalized_fixed.md)
 FIXED_MAX_SOURCE_GENERALIZED = 90000
+#: the same for a tree's written-out routine (its articulated-body chain's recurrences,
+#: written out as an ode system's): two point masses as a tree at orders 14 and 18 (108
+#: and 165 kB, compiled in 2 s) run in 0.63x and 0.78x the loop routine's time, at order
+#: 24 (274 kB) 0.89x; three at order 14 (285 kB, 13 s to compile) 1.05x
+FIXED_MAX_SOURCE_TREE = 200000
 
 
 def taylor_order(eps):
@@ -100,7 +106,19 @@ def _fixed_library(d, order):
     from ..symbolic import build    # sympy: see with_fixed_order
     from ..symbolic.taylor import (FIXED_EXTRA_FLAGS, TaylorUnsupported, fixed_order_source,
                                    ode_decompositions)
-    if d.kind == "generalized":
+    from ..symbolic.taylor_tree import is_tree
+    if d.kind == "generalized" and is_tree(d):
+        from ..symbolic.taylor_tree import tree_decomposition
+        from ..symbolic.taylor_generalized_fixed import tree_fixed_source
+        dec, pivots, _ = tree_decomposition(d)
+        if dec is None:
+            return None
+        nhist = sum(_history_sums(op.kind) for op in dec.ops)
+        limit = FIXED_MAX_SOURCE_TREE
+
+        def source():
+            return tree_fixed_source(d, order, (dec, pivots))
+    elif d.kind == "generalized":
         from ..symbolic.taylor_generalized import generalized_decomposition
         from ..symbolic.taylor_generalized_fixed import generalized_fixed_source, \
             mass_products
