@@ -12,6 +12,7 @@ import conmech  # noqa: E402
 from conmech import compiled, symbolic  # noqa: E402
 from conmech.symbolic import Body, planar_tree  # noqa: E402
 import symbolic_seeds as seeds  # noqa: E402
+import taylor_jets  # noqa: E402
 
 t = dynamicsymbols._t
 
@@ -27,16 +28,11 @@ rel = seeds.rel
 
 def chain(N, absolute):
     """N point masses on massless rods, pinned at the origin (PyDy's chain: angles from the
-    downward vertical; absolute angles, or each relative to the previous link)."""
-    th = dynamicsymbols(f"th1:{N + 1}")
-    m, l = sp.symbols(f"m1:{N + 1}"), sp.symbols(f"l1:{N + 1}")
-    g = sp.Symbol("g")
-    bodies = [Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute", th[i],
-                   at=(0, 0) if i == 0 else (0, -l[i - 1]), mass=m[i], com=(0, -l[i]))
-              for i in range(N)]
-    params = {**{s: 0.8 + 0.15 * i for i, s in enumerate(m)},
-              **{s: 1.1 - 0.05 * i for i, s in enumerate(l)}, g: 9.81}
-    return bodies, params, th, (m, l, g)
+    downward vertical; absolute angles, or each relative to the previous link, as the
+    caller builds the tree): taylor_jets.tree_chain_bodies, with its symbols."""
+    bodies, params, g = taylor_jets.tree_chain_bodies(N)
+    return bodies, params, dynamicsymbols(f"th1:{N + 1}"), (
+        sp.symbols(f"m1:{N + 1}"), sp.symbols(f"l1:{N + 1}"), g)
 
 
 def accel_vs_lagrangian(model, n, rng, k=4, t0=0.37):
