@@ -11,8 +11,7 @@
 module conmech_mech_plant
     use, intrinsic :: iso_c_binding, only: c_funptr, c_null_funptr, c_associated, &
                                            c_f_procpointer, c_double
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status, only: CM_SUCCESS
     use conmech_lapack, only: dpotrs
     use conmech_generalized, only: generalized_system, mass_cholesky
@@ -81,7 +80,7 @@ contains
         dxdt(1:nd) = x(nd + 1:2*nd)
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            dxdt(nd + 1:2*nd) = ieee_value(1.0_dp, ieee_quiet_nan)
+            dxdt(nd + 1:2*nd) = nan_dp
             return
         end if
         call dpotrs('U', nd, 1, mm, nd, qf, nd, info)
@@ -102,7 +101,7 @@ contains
         bx(1:nd, :) = 0.0_dp
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            bx(nd + 1:2*nd, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+            bx(nd + 1:2*nd, :) = nan_dp
             return
         end if
         call dpotrs('U', nd, self%n_inputs, mm, nd, bq, nd, info)

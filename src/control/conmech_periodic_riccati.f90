@@ -30,8 +30,7 @@
 !! refinement that does not settle, P not positive definite, a closed loop that is not
 !! stable.
 module conmech_periodic_riccati
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status
     use conmech_outcome, only: outcome
     use conmech_lapack, only: dgees, dpotrf, dpotrs, la_eig, la_sym_eig, la_solve, la_finite
@@ -130,7 +129,7 @@ contains
         integer :: info
         call self%lq%coefficients(t, a, b, info)
         ok = info == CM_SUCCESS
-        if (.not. ok) dydt = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (.not. ok) dydt = nan_dp
     end function lq_coefficients
 
     subroutine ham_rhs(self, t, y, dydt)

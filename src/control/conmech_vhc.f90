@@ -28,8 +28,7 @@
 !! decoupling matrix D = L M^-1 B makes y'' = v = -kp y - kd y' (+ the law's extra input).
 !! D is invertible where the constraint is regular (alpha /= 0).
 module conmech_vhc
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status
     use conmech_lapack, only: la_solve, la_det, dpotrs
     use conmech_ode_system, only: ode_system
@@ -235,7 +234,7 @@ contains
         call self%plant%inputs(t, x(1:nd), z(:, 2:))
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            u = ieee_value(1.0_dp, ieee_quiet_nan)
+            u = nan_dp
             return
         end if
         call dpotrs('U', nd, 1 + self%n_inputs, mm, nd, z, nd, info)
@@ -250,7 +249,7 @@ contains
         end do
         call la_solve(lz(:, 2:), rhs, sol, info, rcond_min=1.0e-13_dp)
         if (info /= CM_SUCCESS) then
-            u = ieee_value(1.0_dp, ieee_quiet_nan)
+            u = nan_dp
             return
         end if
         u = sol(:, 1)

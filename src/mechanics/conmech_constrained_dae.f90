@@ -34,8 +34,7 @@
 !! conmech_constrained_index3). `dae_mass_solve` is the M^{-1} of both; `mech_dae` their
 !! common parent type and `dae_start` their common start (state and stepper mass matrix).
 module conmech_constrained_dae
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status, only: CM_SUCCESS
     use conmech_lapack, only: dpotrs
     use conmech_generalized, only: mass_cholesky
@@ -114,7 +113,7 @@ contains
                 ok = info == 0
             end if
         end if
-        if (.not. ok) x = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (.not. ok) x = nan_dp
     end subroutine dae_mass_solve
 
     subroutine ggl_rhs(self, t, y, dydt)

@@ -9,8 +9,7 @@
 !!   the located event states the same way (`at_event`);
 !! - `consistent_initial`: the initial state made consistent (position then velocity).
 module conmech_constrained_ode
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status
     use conmech_text, only: rtoa
     use conmech_ode_system, only: ode_system, ode_step_hook
@@ -73,7 +72,7 @@ contains
             call constrained_accel(self%mech, t, y(1:n), y(n + 1:2*n), dydt(n + 1:2*n), lam, &
                                    info)
         end if
-        if (info /= CM_SUCCESS) dydt(n + 1:2*n) = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (info /= CM_SUCCESS) dydt(n + 1:2*n) = nan_dp
     end subroutine cons_rhs
 
     !> Project y = [q, v] after an accepted step of the core integrator.

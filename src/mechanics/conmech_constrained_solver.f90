@@ -37,7 +37,6 @@
 !! A terminal event ends the run at the event state. The initial state is made consistent
 !! first (position then velocity projection; the distances moved are reported).
 module conmech_constrained_solver
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_text, only: itoa
@@ -93,7 +92,7 @@ contains
             msg = "bad input: the system needs n >= 1 coordinates, n_hol, n_nh >= 0"
         else if (size(q0) /= n .or. size(v0) /= n) then
             msg = "bad input: q0 and v0 must have n = "//itoa(n)//" elements"
-        else if (.not. (all(ieee_is_finite(q0)) .and. all(ieee_is_finite(v0)))) then
+        else if (.not. (all(abs(q0) <= huge(1.0_dp)) .and. all(abs(v0) <= huge(1.0_dp)))) then
             msg = "bad input: q0 or v0 contains NaN or Inf"
         else if (options%projection < PROJ_NONE .or. options%projection > PROJ_BAUMGARTE) then
             msg = "bad input: unknown projection"

@@ -28,10 +28,9 @@
 !!        column k holds the normalized Taylor coefficients y_k^[0..order] */
 !!     void taylor(double t, int order, double *w, const double *p);
 module conmech_c_system
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_funptr, c_associated, &
                                            c_f_procpointer
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT
     use conmech_ode_system, only: ode_system, ode_fd_jacobian, ode_jacobian_product
     implicit none
@@ -219,7 +218,7 @@ contains
         else if (kind == 1 .and. associated(self%tjv) .and. nw >= self%nw_taylor_var) then
             call self%tjv(t, int(order, c_int), w, self%p)
         else
-            w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+            w(1:, :) = nan_dp
         end if
     end subroutine c_ode_taylor_jet
 

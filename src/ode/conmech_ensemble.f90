@@ -21,8 +21,7 @@
 !!
 !! Nothing is saved between calls: every routine is thread-safe.
 module conmech_ensemble
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status
     use conmech_text, only: itoa
     use conmech_ode_system, only: ode_system, ode_events, ode_step_hook
@@ -235,7 +234,7 @@ contains
         res%k = k
         res%done = 0
         res%status = CM_BAD_INPUT
-        nan = ieee_value(1.0_dp, ieee_quiet_nan)
+        nan = nan_dp
 
         ! ---------------------------------------------------------------- validation
         if (m < 1) then
@@ -464,7 +463,7 @@ contains
             posneg = sign(1.0_dp, t_span(2) - t_span(1))
             do j = 1, min(r%nt, nt)
                 if ((t_eval(j) - t_stop)*posneg > 0.0_dp) &
-                    y_out(:, j) = ieee_value(1.0_dp, ieee_quiet_nan)
+                    y_out(:, j) = nan_dp
             end do
         end if
     end subroutine solve_member

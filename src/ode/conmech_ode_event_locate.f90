@@ -17,7 +17,6 @@
 !! The samples cost event evaluations and evaluations of the extension, no evaluation of
 !! f and no change of the steps.
 module conmech_ode_event_locate
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use, intrinsic :: iso_fortran_env, only: int64
     use conmech_kinds, only: dp
     use conmech_status, only: CM_SUCCESS, CM_BAD_INPUT, CM_NONFINITE
@@ -61,7 +60,7 @@ contains
             if (.not. allocated(events%resolution)) return
             resolution_ok = size(events%resolution) == size(events%direction)
             if (.not. resolution_ok) return
-            resolution_ok = .not. (any(ieee_is_nan(events%resolution)) .or. &
+            resolution_ok = .not. (any(events%resolution /= events%resolution) .or. &
                                    any(events%resolution < 0.0_dp))
         end function resolution_ok
         logical function count_ok()

@@ -36,8 +36,7 @@
 !! direction; off, an event that starts on its surface (a Poincare section through the
 !! initial state) is first seen where it crosses again.
 module conmech_ode_system
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_central_step, only: central_step
     implicit none
     private
@@ -238,7 +237,7 @@ contains
         integer, intent(in) :: kind, order, nw
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: w(0:order, nw)
-        w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+        w(1:, :) = nan_dp
     end subroutine ode_no_taylor_jet
 
     !> The default of the has_* queries: the optional piece is not given (no analytic

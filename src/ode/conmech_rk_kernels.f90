@@ -8,8 +8,7 @@
 !! (DOP853 blends its 5th- and 3rd-order estimators as dop853.f does). A non-finite ynew
 !! gives err = NaN (the step controller cuts the step).
 module conmech_rk_kernels
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_ode_system, only: ode_system
     use conmech_rk_tableaus, only: rk_tableau
     implicit none
@@ -45,7 +44,7 @@ contains
             ynew(i) = y(i) + h6*(k(i, 1) + 2.0_dp*(k(i, 2) + k(i, 3)) + k(i, 4))
         end do
         err = 0.0_dp
-        if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (.not. all(abs(ynew) <= huge(1.0_dp))) err = nan_dp
     end subroutine rk4_attempt
 
     !> Dormand-Prince 5(4) step: stages 2..7 (stage 7 = f(t + h, ynew), FSAL).
@@ -167,7 +166,7 @@ contains
         else
             err = abs(h)*sqrt(s/real(n, dp))
         end if
-        if (.not. all(ieee_is_finite(ynew))) err = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (.not. all(abs(ynew) <= huge(1.0_dp))) err = nan_dp
     end subroutine verner_attempt
 
     !> Stages s1..s2 of a tableau (stage s from a(s, 1:s-1), zero coefficients skipped).

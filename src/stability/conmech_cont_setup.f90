@@ -8,7 +8,6 @@
 !! pseudo-arclength equation written in them, so that a step `ds` means the same for every
 !! discretisation.
 module conmech_cont_setup
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_text, only: itoa
@@ -85,8 +84,8 @@ contains
         character(len=64) :: b1
         pb%n = size(y0)
         info = CM_BAD_INPUT
-        if (pb%n < 1 .or. .not. all(ieee_is_finite(y0)) .or. .not. (period > 0.0_dp) .or. &
-            .not. ieee_is_finite(p0) .or. pb%o%max_points < 1 .or. &
+        if (pb%n < 1 .or. .not. all(abs(y0) <= huge(1.0_dp)) .or. .not. (period > 0.0_dp) .or. &
+            .not. (abs(p0) <= huge(1.0_dp)) .or. pb%o%max_points < 1 .or. &
             .not. (pb%o%ds > 0.0_dp) .or. .not. (pb%o%ds_min > 0.0_dp)) then
             msg = "continuation: bad input (empty or non-finite y0 or p0, period <= 0, "// &
                   "max_points < 1, ds <= 0)"

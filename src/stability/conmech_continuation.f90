@@ -45,7 +45,6 @@
 !! +1; period doubling: through -1; Neimark-Sacker: a complex pair through the unit circle,
 !! not for conservative systems; test functions in conmech_multiplier_tests).
 module conmech_continuation
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_ode_system, only: ode_system

@@ -29,7 +29,6 @@
 !! iterations that run out, leave `located` false and return the best corrected equilibrium
 !! of the bracket (never an interpolated state), with its own test value and residual.
 module conmech_equilibrium_continuation
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_illinois, only: illinois_bracket
     use conmech_status
@@ -72,7 +71,8 @@ contains
         if (present(options)) o = options
         n = size(y0)
         br%info = CM_BAD_INPUT
-        if (n < 1 .or. .not. all(ieee_is_finite(y0)) .or. .not. ieee_is_finite(p0) .or. &
+        if (n < 1 .or. .not. all(abs(y0) <= huge(1.0_dp)) .or. &
+            .not. (abs(p0) <= huge(1.0_dp)) .or. &
             o%max_points < 1 .or. .not. (o%ds > 0.0_dp) .or. .not. (o%ds_min > 0.0_dp) .or. &
             .not. (o%ds_max >= o%ds_min) .or. .not. (o%tol > 0.0_dp) .or. &
             .not. (o%res_tol > 0.0_dp) .or. o%max_iter < 1) then
@@ -193,7 +193,7 @@ contains
         info = CM_NO_CONVERGENCE
         do it = 1, o%max_iter
             call evaluate(sys, set_param, o, x, f, dfx)
-            if (.not. (all(ieee_is_finite(f)) .and. all(ieee_is_finite(dfx)))) then
+            if (.not. (all(abs(f) <= huge(1.0_dp)) .and. all(abs(dfx) <= huge(1.0_dp)))) then
                 info = CM_NONFINITE
                 msg = "f or its Jacobian is not finite"
                 return

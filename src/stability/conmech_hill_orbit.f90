@@ -37,8 +37,7 @@
 !!
 !! Thread safety: no saved state (the family over m, in parallel: conmech_hill_family).
 module conmech_hill_orbit
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
-    use conmech_kinds, only: dp, pi
+    use conmech_kinds, only: dp, pi, nan_dp
     use conmech_outcome, only: outcome
     use conmech_status
     use conmech_lapack, only: la_eig
@@ -119,7 +118,7 @@ contains
         if (abs(s) <= 1.0_dp) then
             c = 1.0_dp + acos(s)/(2.0_dp*pi)
         else
-            c = ieee_value(1.0_dp, ieee_quiet_nan)
+            c = nan_dp
         end if
     end function hill_perigee_c
 
@@ -199,8 +198,8 @@ contains
         if (present(options)) opt = options
         orb%m = m
         orb%kappa = kappa
-        if (.not. (m >= 0.0_dp .and. kappa > 0.0_dp .and. ieee_is_finite(m) .and. &
-                   ieee_is_finite(kappa)) .or. opt%nsteps < 1 .or. opt%max_iter < 1 .or. &
+        if (.not. (m >= 0.0_dp .and. kappa > 0.0_dp .and. (abs(m) <= huge(1.0_dp)) .and. &
+                   (abs(kappa) <= huge(1.0_dp))) .or. opt%nsteps < 1 .or. opt%max_iter < 1 .or. &
             opt%max_nsteps < opt%nsteps .or. .not. (opt%closure_tol > 0.0_dp) .or. &
             .not. (opt%tol > 0.0_dp)) then
             call orb%fail(CM_BAD_INPUT, "hill_variation_orbit: need m >= 0, kappa > 0, 1 <= "// &
@@ -212,7 +211,7 @@ contains
         else
             call hill_orbit_guess(m, kappa, u)
         end if
-        if (.not. (all(ieee_is_finite(u)) .and. u(1) > 0.0_dp)) then
+        if (.not. (all(abs(u) <= huge(1.0_dp)) .and. u(1) > 0.0_dp)) then
             call orb%fail(CM_BAD_INPUT, "hill_variation_orbit: the guess needs x0 > 0")
             return
         end if
@@ -240,7 +239,7 @@ contains
             call hill_kernel_state(m, kappa, 0.5_dp*pi, nc, s, orb%nfev)
             r8 = (real(n, dp)/real(nc, dp))**7
             err = sqrt(s(1)**2 + s(4)**2)/abs(r8 - 1.0_dp)
-            if (.not. ieee_is_finite(err)) err = huge(1.0_dp)
+            if (.not. (abs(err) <= huge(1.0_dp))) err = huge(1.0_dp)
             orb%residual = err
             orb%nsteps = n
             if (err <= opt%closure_tol) exit
@@ -290,7 +289,7 @@ contains
             orb%stability_index = 1.0_dp - 8.0_dp*ss*tt
             orb%c = perigee_c_from_products(ss, tt)
         end if
-        if (.not. ieee_is_finite(orb%stability_index)) then
+        if (.not. (abs(orb%stability_index) <= huge(1.0_dp))) then
             call orb%fail(CM_NONFINITE, "hill_variation_orbit: non-finite monodromy")
             return
         end if
@@ -324,7 +323,7 @@ contains
             orb%iterations = orb%iterations + 1
             call start_state(u, [1, 3, 4], z)
             call hill_kernel_var(m, kappa, 0.5_dp*pi, n, z, orb%nfev)
-            if (.not. all(ieee_is_finite(z))) then
+            if (.not. all(abs(z) <= huge(1.0_dp))) then
                 call orb%fail(CM_NO_CONVERGENCE, "hill_variation_orbit: non-finite state (the "// &
                                                  "guess is too far)")
                 return
@@ -411,7 +410,7 @@ contains
         if (s >= 0.0_dp .and. t >= 0.0_dp .and. s + t > 0.0_dp) then
             c = 1.0_dp + (2.0_dp/pi)*atan2(sqrt(min(s, t)), sqrt(max(s, t)))
         else
-            c = ieee_value(1.0_dp, ieee_quiet_nan)
+            c = nan_dp
         end if
     end function perigee_c_from_products
 
@@ -425,7 +424,7 @@ contains
         real(dp) :: w(4, 4), wi(4, 4), ainv(4, 4), b(4, 4), g1(4)
         integer :: i, j
         g1 = [-1.0_dp, 1.0_dp, 1.0_dp, -1.0_dp]
-        if (.not. all(ieee_is_finite(a))) then
+        if (.not. all(abs(a) <= huge(1.0_dp))) then
             mono = 0.0_dp
             info = CM_NONFINITE
             return

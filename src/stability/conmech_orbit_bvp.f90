@@ -21,7 +21,6 @@
 !!   components `targets` of z_(K+1) vanish.
 !! A continuation adds its pseudo-arclength row on (z_1, w).
 module conmech_orbit_bvp
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_central_step, only: central_step
     use conmech_status
@@ -344,7 +343,7 @@ contains
             end do
         end if
         if (bvp%nw > 0) dx(bvp%nx - bvp%nw + 1:) = w
-        if (.not. all(ieee_is_finite(dx))) info = CM_NONFINITE
+        if (.not. all(abs(dx) <= huge(1.0_dp))) info = CM_NONFINITE
     end subroutine bvp_solve
 
 end module conmech_orbit_bvp

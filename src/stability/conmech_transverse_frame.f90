@@ -5,8 +5,7 @@
 !! section S; the Jacobian of a system without an analytic one by sixth-order central
 !! differences.
 module conmech_transverse_frame
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_outcome, only: outcome
     use conmech_status
     use conmech_lapack, only: dpotrf, dpotrs, la_finite
@@ -103,13 +102,13 @@ contains
         info = CM_SUCCESS
         if (.not. la_finite(gm)) then
             info = CM_NONFINITE
-            dq = ieee_value(1.0_dp, ieee_quiet_nan)
+            dq = nan_dp
             return
         end if
         call dpotrf('U', p, gm, p, lainfo)
         if (lainfo /= 0) then
             info = CM_SINGULAR
-            dq = ieee_value(1.0_dp, ieee_quiet_nan)
+            dq = nan_dp
             return
         end if
         wq = matmul(transpose(w), q)
@@ -175,7 +174,7 @@ contains
         call frame_derivative(self, t, y(1:n), cv(1:ny, :), q, f, a, qs, dq, dcv(1:ny, :), bx, &
                               info)
         if (info /= CM_SUCCESS) then
-            dydt = ieee_value(1.0_dp, ieee_quiet_nan)
+            dydt = nan_dp
             return
         end if
         ared = matmul(transpose(qs), matmul(a, qs) - dq)

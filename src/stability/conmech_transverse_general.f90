@@ -46,7 +46,6 @@
 !! and `transverse_hill` the coefficients of the normal deviation's equation
 !! N'' + psi N' + Phi N = 0 of a two-degree-of-freedom system.
 module conmech_transverse_general
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use conmech_kinds, only: dp
     use conmech_status
     use conmech_lapack, only: dgesvd, la_eig, la_finite, la_solve
@@ -91,7 +90,7 @@ contains
         nc = model%n_normals()
         fr%nc = nc
         fr%m = model%n_inputs
-        if (.not. (period > 0.0_dp .and. ieee_is_finite(period)) .or. .not. la_finite(y0)) then
+        if (.not. (period > 0.0_dp .and. period <= huge(1.0_dp)) .or. .not. la_finite(y0)) then
             call fr%fail(CM_BAD_INPUT, "transverse: the period must be positive and y0 finite")
             return
         end if

@@ -19,9 +19,8 @@
 !!   differences of the accelerations themselves, solutions of a linear system with
 !!   large higher derivatives, reach only ~1e-10).
 module conmech_transverse_mech
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status, only: CM_SUCCESS
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use conmech_lapack, only: la_solve
     use conmech_generalized, only: generalized_system
     use conmech_constrained_system, only: constrained_system, constrained_accel, &
@@ -110,7 +109,7 @@ contains
         m = self%mech%n_hol + self%mech%n_nh
         call constrained_accel(self%mech, t, y(1:n), y(n + 1:2*n), a, lam, info)
         if (info /= CM_SUCCESS) then
-            dfdy = ieee_value(1.0_dp, ieee_quiet_nan)
+            dfdy = nan_dp
             return
         end if
         call self%mech%mass(t, y(1:n), mm)
@@ -139,7 +138,7 @@ contains
             dfdy(j, n + j) = 1.0_dp
         end do
         if (info /= CM_SUCCESS) then
-            dfdy(n + 1:2*n, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+            dfdy(n + 1:2*n, :) = nan_dp
             return
         end if
         dfdy(n + 1:2*n, :) = dx(1:n, :)

@@ -155,8 +155,7 @@ subroutine flat_control_energy(name, np, params, nspec, spec, nd, m, bmat, baddr
                                nil, ilaw, nrl, rlaw, theta0, e0, nth, thetas, stop_at_zero, &
                                rtol, atol, es, theta_zero, found, info, message)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status, only: CM_SUCCESS, CM_EVENT_STOP, CM_BAD_INPUT
     use conmech_ode_solver, only: ode_options, ode_result, ode_solve, METHOD_DOP853
     use conmech_vhc, only: vhc_energy
@@ -176,7 +175,7 @@ subroutine flat_control_energy(name, np, params, nspec, spec, nd, m, bmat, baddr
     type(energy_zero) :: ev
     real(c_double) :: tend
     integer :: used, i
-    es = ieee_value(1.0_c_double, ieee_quiet_nan)
+    es = nan_dp
     theta_zero = 0.0_c_double
     found = 0
     call build_plant(name, real(params(1:np), dp), nspec, spec, nd, m, bmat, baddr, &

@@ -89,7 +89,7 @@ end subroutine flat_propagation_free
 !! order (nothing run).
 subroutine flat_propagation_grid(handle, lp, params, t0, m, times, n, y, out, iout)
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use conmech_kinds, only: nan_dp
     use conmech_status, only: CM_BAD_INPUT
     use conmech_flat_packed_support, only: put_message
     use conmech_flat_propagation, only: kept_propagation, propagation_at, propagation_grid
@@ -115,7 +115,7 @@ subroutine flat_propagation_grid(handle, lp, params, t0, m, times, n, y, out, io
                          "the propagator's time in one direction", iout)
         return
     end if
-    out = ieee_value(1.0_c_double, ieee_quiet_nan)
+    out = nan_dp
     call propagation_grid(p, params(1:size(p%params)), t0, times, y, out, nt, counts, info, &
                           msg)
     iout(1) = nt

@@ -6,8 +6,7 @@
 !! Callback convention: egrad(t, y, g, n), real(c_double) t, y(n), g(n); integer(c_int) n.
 module conmech_support_transverse_general
     use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use conmech_kinds, only: dp
+    use conmech_kinds, only: dp, nan_dp
     use conmech_status
     use conmech_ode_system, only: ode_system
     use conmech_generalized, only: generalized_system, generalized_ode
@@ -192,7 +191,7 @@ contains
             if (fr%reduced .and. n == 4 .and. k == 2) then
                 call transverse_hill(fr, t(i), phis(i), psis(i), info)
                 if (info /= CM_SUCCESS) then
-                    phis(i) = ieee_value(1.0_dp, ieee_quiet_nan)
+                    phis(i) = nan_dp
                     psis(i) = phis(i)
                 end if
             end if
