@@ -109,7 +109,6 @@ contains
 
     !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).
     subroutine cart_pendulum_sym_rhs(self, t, y, dydt)
-        use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         use conmech_lapack, only: dpotrs
         class(cart_pendulum_sym), intent(in) :: self
         real(dp), intent(in) :: t
@@ -129,7 +128,7 @@ contains
         a(2) = self%g*w3
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            a = ieee_value(1.0_dp, ieee_quiet_nan)
+            a = transfer(int(z'7FF8000000000000', selected_int_kind(18)), 1.0_dp)
         else
             call dpotrs('U', 2, 1, mm, 2, a, 2, info)
         end if
@@ -139,7 +138,6 @@ contains
 
     !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].
     subroutine cart_pendulum_sym_jacobian(self, t, y, dfdy)
-        use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         use conmech_lapack, only: dpotrs
         class(cart_pendulum_sym), intent(in) :: self
         real(dp), intent(in) :: t
@@ -160,7 +158,7 @@ contains
         a(2) = self%g*w3
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            dfdy = ieee_value(1.0_dp, ieee_quiet_nan)
+            dfdy = transfer(int(z'7FF8000000000000', selected_int_kind(18)), 1.0_dp)
             return
         end if
         call dpotrs('U', 2, 1, mm, 2, a, 2, info)

@@ -283,7 +283,6 @@ contains
 
     !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].
     subroutine tree_chain_sym_jacobian(self, t, y, dfdy)
-        use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         use conmech_lapack, only: dpotrs
         class(tree_chain_sym), intent(in) :: self
         real(dp), intent(in) :: t
@@ -340,7 +339,7 @@ contains
         a(3) = -self%g*w9*sin(y(3)) - y(6)*(y(4)*w18 + y(5)*w24) + w18*w26 + w20*w24 + w23 + w27
         call mass_cholesky(mm, info)
         if (info /= CM_SUCCESS) then
-            dfdy = ieee_value(1.0_dp, ieee_quiet_nan)
+            dfdy = transfer(int(z'7FF8000000000000', selected_int_kind(18)), 1.0_dp)
             return
         end if
         call dpotrs('U', 3, 1, mm, 3, a, 3, info)

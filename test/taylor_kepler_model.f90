@@ -155,7 +155,6 @@ contains
 
     !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated recurrences).
     subroutine kepler_sym_taylor_jet(self, kind, t, order, nw, w)
-        use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         class(kepler_sym), intent(in) :: self
         integer, intent(in) :: kind, order, nw
         real(dp), intent(in) :: t
@@ -165,7 +164,7 @@ contains
         else if (kind == 1 .and. nw >= 51) then
             call kepler_sym_taylor1(self, t, order, w)
         else
-            w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)
+            w(1:, :) = transfer(int(z'7FF8000000000000', selected_int_kind(18)), 1.0_dp)
         end if
     end subroutine kepler_sym_taylor_jet
 

@@ -49,7 +49,7 @@ import sympy as sp
 
 from .record import Derived
 from .taylor import emitted_taylor
-from .printer import FortranPrinter, assignments, product_lines, product_terms
+from .printer import FortranPrinter, assignments, product_lines, product_terms, quiet_nan
 from .source_text import check_source, comment_lines, comment_text
 from .tree_print import aba_lines
 
@@ -62,13 +62,15 @@ _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energ
              "rhs", "jacobian", "has_jacobian", "self", "dp", "jacobian_product",
              "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian",
              "taylor_size", "taylor_jet"}
-# names the type may not take: Fortran's intrinsic types (C424 of Fortran 2008) and what the
-# emitted code takes from conmech and the intrinsic modules (a local name would hide them)
+# names the type may not take: Fortran's intrinsic types (C424 of Fortran 2008), what the
+# emitted code takes from conmech, the intrinsic modules (and ieee_value, ieee_quiet_nan),
+# and the intrinsic functions of its quiet NaN (printer.quiet_nan): a local name would hide
+# them
 _TYPE_TAKEN = {"real", "integer", "logical", "character", "complex", "doubleprecision",
                "doublecomplex", "ode_system", "generalized_system", "constrained_system",
                "cm_success", "mass_cholesky", "dpotrs", "ieee_value", "ieee_quiet_nan",
                "ieee_arithmetic", "ieee_exceptions", "ieee_features", "iso_c_binding",
-               "iso_fortran_env"}
+               "iso_fortran_env", "transfer", "int", "selected_int_kind"}
 _IND = "        "
 # what generated code may take from conmech: the module imports exactly the ones it uses
 # (`use conmech, only:`), so that a type, a constant or a parameter of the model may share a
@@ -471,10 +473,11 @@ def _ode_products(name, pr, d):
 
 def _mass_solve(n, nrhs, rhs_name):
     """Statements: Cholesky of mm (conmech's mass_cholesky), then dpotrs on rhs_name;
-    NaN on failure."""
+    NaN on failure (from its bits: no IEEE module, whose use would save and restore the
+    floating-point environment on every call)."""
     return [f"{_IND}call mass_cholesky(mm, info)",
             f"{_IND}if (info /= CM_SUCCESS) then",
-            f"{_IND}    {rhs_name} = ieee_value(1.0_dp, ieee_quiet_nan)",
+            f"{_IND}    {rhs_name} = {quiet_nan()}",
             f"{_IND}else",
             f"{_IND}    call dpotrs('U', {n}, {nrhs}, mm, {n}, {rhs_name}, {n}, info)",
             f"{_IND}end if"]
@@ -514,7 +517,6 @@ def _gen_rhs(em, name, pry, d):
     decl, lines = em.body(pry, [("mm", d.M, True), ("a", d.Q, False)])
     return (["    !> y' = [v, a], M a = Q (Cholesky; NaN if M is not positive definite).",
              f"    subroutine {name}_rhs(self, t, y, dydt)",
-             f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{_IND}use conmech_lapack, only: dpotrs",
              f"{_IND}class({name}), intent(in) :: self",
              _decl("t"), _decl("y", [":"]), _decl("dydt", [":"], "out"),
@@ -530,7 +532,6 @@ def _gen_jac(em, name, pry, d):
     decl2, lines2 = em.body(pry, [("r", d.R, True)], prefix="u")
     lines = ["    !> Exact Jacobian: d a/d[q, v] = M^-1 R, R = [dQ/dq - d(M a)/dq, dQ/dv].",
              f"    subroutine {name}_jacobian(self, t, y, dfdy)",
-             f"{_IND}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{_IND}use conmech_lapack, only: dpotrs",
              f"{_IND}class({name}), intent(in) :: self",
              _decl("t"), _decl("y", [":"]), _decl("dfdy", [":", ":"], "out"),
@@ -539,7 +540,7 @@ def _gen_jac(em, name, pry, d):
     lines += decl1 + decl2 + lines1
     lines += [f"{_IND}call mass_cholesky(mm, info)",
               f"{_IND}if (info /= CM_SUCCESS) then",
-              f"{_IND}    dfdy = ieee_value(1.0_dp, ieee_quiet_nan)",
+              f"{_IND}    dfdy = {quiet_nan()}",
               f"{_IND}    return",
               f"{_IND}end if",
               f"{_IND}call dpotrs('U', {n}, 1, mm, {n}, a, {n}, info)"]

@@ -142,6 +142,24 @@ def prepare(expr):
     return expr.replace(is_half, lambda e: _SQRT(e.base) ** int(e.exp.p))
 
 
+#: the bits of the quiet NaN of each real kind of the generated code, as ieee_value(1.0_k,
+#: ieee_quiet_nan) gives it: (hexadecimal digits, decimal range of an integer that holds them)
+_QUIET_NAN_BITS = {"dp": ("7FF8000000000000", 18),
+                   "qp": ("7FFF8000000000000000000000000000", 38)}
+
+
+def quiet_nan(kind="dp"):
+    """Fortran text of the quiet NaN of the real kind `kind` ("dp", or "qp" for quadruple
+    precision: real128) made from its bits, with nothing to import: the generated code fills
+    the coefficients of a failed expansion with it. Not ieee_value: gfortran saves and
+    restores the whole floating-point environment (about 0.2 us) on every call of a
+    procedure whose scope uses an intrinsic IEEE module, which would tax every expansion
+    and every right-hand side. The quadruple NaN is not the double one converted: a NaN in
+    a constant conversion is an error of gfortran's range check."""
+    digits, rng = _QUIET_NAN_BITS[kind]
+    return f"transfer(int(z'{digits}', selected_int_kind({rng})), 1.0_{kind})"
+
+
 def _wrap(line, indent, width=96):
     """Split a long statement with free-form continuations (& ... &)."""
     if len(indent) + len(line) <= width:

@@ -49,7 +49,7 @@ expanded (non-smooth functions: Abs, sign, Heaviside, Min, Max, ...).
 """
 import sympy as sp
 
-from .printer import FortranPrinter, _names
+from .printer import FortranPrinter, _names, quiet_nan
 from .printer import _wrap as _wrap_line
 from .taylor_decompose import (_JWEIGHT, Decomposition,  # noqa: F401 (public names)
                                TaylorUnsupported, decompose, variational_exprs)
@@ -62,7 +62,7 @@ from .taylor_recipe import Recipe
 __all__ = ["TaylorUnsupported", "Decomposition", "decompose", "taylor_procedures",
            "variational_exprs", "TAYLOR_VERSION"]
 
-TAYLOR_VERSION = "4"
+TAYLOR_VERSION = "5"
 
 #: flags added to the model libraries' for the written-out routine (isa.scalar_isa_flags):
 #: -fopenmp-simd for its paired history sums (two-lane loops marked ``!$omp simd``, which
@@ -367,15 +367,12 @@ def quad_entry(cname, nw, npar, ind="        "):
             f"    end subroutine {cname}", ""]
 
 
-def quad_procedure(cname, nw, npar, decl, body, ieee=False, ind="        "):
+def quad_procedure(cname, nw, npar, decl, body, ind="        "):
     """Fortran lines of ``cname`` (:func:`quad_entry`) and of the real128 routine
     ``cname_body(t, order, w(0:order, nw), p(npar))`` it calls, of declarations `decl` and
-    statements `body` (`ieee`: they use ieee_value and ieee_quiet_nan)."""
-    inner = [f"    subroutine {cname}_body(t, order, w, p)"]
-    if ieee:
-        inner.append(f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, "
-                     "ieee_quiet_nan")
-    inner += [f"{ind}real(qp), intent(in) :: t",
+    statements `body`."""
+    inner = [f"    subroutine {cname}_body(t, order, w, p)",
+             f"{ind}real(qp), intent(in) :: t",
               f"{ind}integer(c_int), intent(in) :: order",
               f"{ind}real(qp), intent(inout) :: w(0:order, {nw})",
               f"{ind}real(qp), intent(in) :: p({npar})"]
@@ -462,7 +459,6 @@ def emitted_taylor(tname, d, names):
         "    !> Normalized Taylor coefficients w(0:order, 1:m) from w(0, 1:m) (generated "
         "recurrences).",
         f"    subroutine {tname}_taylor_jet(self, kind, t, order, nw, w)",
-        f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
         f"{ind}class({tname}), intent(in) :: self",
         f"{ind}integer, intent(in) :: kind, order, nw",
         f"{ind}real(dp), intent(in) :: t",
@@ -472,7 +468,7 @@ def emitted_taylor(tname, d, names):
         f"{ind}else if (kind == 1 .and. nw >= {vdec.ncol}) then",
         f"{ind}    call {tname}_taylor1(self, t, order, w)",
         f"{ind}else",
-        f"{ind}    w(1:, :) = ieee_value(1.0_dp, ieee_quiet_nan)",
+        f"{ind}    w(1:, :) = {quiet_nan()}",
         f"{ind}end if",
         f"    end subroutine {tname}_taylor_jet", ""]
     for k, dd in enumerate((dec, vdec)):

@@ -12,7 +12,6 @@ def first_order_procedures(prefix, nw, m, npar, decl, body, ind="        ", rhs=
     and statements `body` (w has `nw` columns, the state `m` entries, p `npar`); without
     `rhs` the first two only (a variational system's)."""
     lines = [f'    subroutine {prefix}(t, order, w, p) bind(C, name="{prefix}")',
-             f"{ind}use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan",
              f"{ind}real(dp), value, intent(in) :: t",
              f"{ind}integer(c_int), value, intent(in) :: order",
              f"{ind}real(dp), intent(inout) :: w(0:order, {nw})",

@@ -33,6 +33,7 @@ ensembles (:mod:`conmech.symbolic.taylor_generalized_batch`).
 """
 import sympy as sp
 
+from .printer import quiet_nan
 from .taylor import _SYM, _decls, _Printer, _wrap, quad_procedure, square_sums
 from .taylor_decompose import TaylorUnsupported, decompose
 from .taylor_recipe import Recipe
@@ -230,7 +231,7 @@ def order_zero(g, pp, rc, s0, ind, kind="dp"):
         if g.constant(i, j):
             return pp.lin_at(g.entry(i, j), 0, True)
         return W(0, g.entry_col(i, j))
-    fail = [f"w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)", "return"]
+    fail = [f"w(1:order, :) = {quiet_nan(kind)}", "return"]
     return decl, body, varying, M0, fail
 
 
@@ -335,7 +336,7 @@ def generalized_quad_routine(g, names, cname="conmech_taylor_qp", write_out=None
     pointers to real128 values (as conmech.symbolic.taylor.quad_routine: t, w(0:order,
     g.ncol), p), the accelerations' factorisation and solves in real128 too."""
     decl, body = generalized_body(g, names, "        ", write_out, "qp")
-    return quad_procedure(cname, g.ncol, npar, decl, body, ieee=True)
+    return quad_procedure(cname, g.ncol, npar, decl, body)
 
 
 def generalized_lines(d, names, part, dec_cache):

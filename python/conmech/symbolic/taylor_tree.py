@@ -37,6 +37,7 @@ import math
 
 import sympy as sp
 
+from .printer import quiet_nan
 from .spatial_aba import _spatial_aba
 from .taylor import _Printer, _wrap, body_lines, quad_procedure
 from .taylor_decompose import TaylorUnsupported, decompose
@@ -96,7 +97,7 @@ def tree_decomposition(d):
 def tree_body(dec, pivots, names, kind="dp", ind="        "):
     """(declarations, statements) of the recurrences of the chain (`kind` "dp" or "qp"),
     with the pivots checked at order 0, for a procedure that declares t, order, w(0:order,
-    dec.ncol) and p and uses ieee_value and ieee_quiet_nan."""
+    dec.ncol) and p."""
     decl, body = body_lines(dec, names, kind, 0, False, ind)
     # the pivot checks: after the order-0 statements, before the loop over the orders
     # (order 0 evaluates the chain in full: the accelerations, as the tree's right-hand
@@ -110,7 +111,7 @@ def tree_body(dec, pivots, names, kind="dp", ind="        "):
             continue          # a constant pivot: checked positive when the tree was built
         checks += _wrap(f"pivot = {pp.lin_at(lin, 0, True)}", ind)
         checks += [f"{ind}if (.not. (pivot > 0.0_{kind})) then",
-                   f"{ind}    w(1:order, :) = ieee_value(1.0_{kind}, ieee_quiet_nan)",
+                   f"{ind}    w(1:order, :) = {quiet_nan(kind)}",
                    f"{ind}    return",
                    f"{ind}end if"]
     body = body[:at] + checks + body[at:]
@@ -134,7 +135,7 @@ def tree_quad_routine(dec, pivots, names, cname="conmech_taylor_qp"):
     pointers to real128 values (:func:`conmech.symbolic.taylor.quad_entry`: t, w(0:order,
     dec.ncol), p), the pivots checked in real128."""
     decl, body = tree_body(dec, pivots, names, "qp")
-    return quad_procedure(cname, dec.ncol, max(len(dec.params), 1), decl, body, ieee=True)
+    return quad_procedure(cname, dec.ncol, max(len(dec.params), 1), decl, body)
 
 
 def kept_tree_decomposition(d, dec_cache):

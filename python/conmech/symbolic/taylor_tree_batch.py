@@ -13,6 +13,7 @@ coefficients when one is not positive; here each lane's pivots are checked after
 expansion (their order-0 values stay in w) and a lane whose pivot is not positive gets
 NaN coefficients of orders 1.. as the scalar routine gives, so the propagator reports
 that member as failed, the other lanes unaffected."""
+from .printer import quiet_nan
 from .taylor import _Printer, _wrap
 from .taylor_batch import coefficient_routine, run_routine
 from .taylor_tree import kept_tree_decomposition
@@ -36,12 +37,10 @@ def tree_coefficient_routine(dec, pivots, names, lanes, cname="conmech_taylor_ba
     tail.append(f"{ind}end do")
     end = lines.index(f"    end subroutine {cname}")
     first = lines.index(f"{ind}if (order < 1) return")
-    # a quiet NaN by its bits (the batch library is compiled without the compiler's
-    # module directory, so without ieee_arithmetic)
-    nan = [f"{ind}real(dp), parameter :: qnan = transfer(9221120237041090560_c_int64_t, "
-           "1.0_dp)"]
-    return [lines[0], f"{ind}use, intrinsic :: iso_c_binding, only: c_int64_t"] + \
-        lines[1:first] + nan + lines[first:end] + tail + lines[end:]
+    # a quiet NaN by its bits (printer.quiet_nan; the batch library is also compiled
+    # without the compiler's module directory, so without ieee_arithmetic)
+    nan = [f"{ind}real(dp), parameter :: qnan = {quiet_nan()}"]
+    return lines[:first] + nan + lines[first:end] + tail + lines[end:]
 
 
 def tree_batch_lines(d, names, lanes, fixed, dec_cache, codes):
