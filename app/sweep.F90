@@ -10,7 +10,7 @@
 !! (temporary file, fsync, rename, then the parts are deleted).
 program sweep
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use conmech_kinds, only: nan_dp
     use conmech
     use app_events, only: section_events
     use app_cli
@@ -535,7 +535,7 @@ contains
         real(dp) :: p(size(pars)), yi(n), v, tret, yend(n), nan
         integer :: info
         character(len=:), allocatable :: msg, line
-        nan = ieee_value(nan, ieee_quiet_nan)
+        nan = nan_dp
         if (count_ == 1) then
             v = vfrom
         else
