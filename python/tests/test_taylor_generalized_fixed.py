@@ -150,6 +150,12 @@ def test_a_large_routine_is_not_made():
     assert "jet_fixed" not in ivp_taylor.with_fixed_order(view, 1e-12, 1e-12).taylor
     # a low order stays below it
     assert len(generalized_fixed_source(d, 9)) <= ivp_taylor.FIXED_MAX_SOURCE_GENERALIZED
+    # the double pendulum: written out at order 18 (1e-12), not at order 24 (1e-16), where
+    # the loop routine was measured faster
+    double = taylor_jets.double_pendulum()
+    view = first_order_view(double)
+    assert "jet_fixed" in ivp_taylor.with_fixed_order(view, 1e-12, 1e-12).taylor
+    assert "jet_fixed" not in ivp_taylor.with_fixed_order(view, 1e-16, 1e-16).taylor
 
 
 def test_tree_written_out_routine_gives_the_loop_coefficients():

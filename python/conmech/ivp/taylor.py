@@ -25,14 +25,15 @@ FIXED_MAX_TERMS = 40000
 #: a generalized system's written-out routine (a factorisation's solves and the products
 #: M_j a_{k-j} at every order besides the operations) is compiled up to this many
 #: characters of source: beyond, the loop routine was measured as fast or faster (a
-#: solve_ivp run of the double pendulum at order 24, 83 kB of source: 0.82x the loop
-#: routine's time; of a chain of three links at order 14, 101 kB: 1.01x-1.02x, at order
-#: 18 1.08x; bench/results/taylor_generalized_fixed.md)
-FIXED_MAX_SOURCE_GENERALIZED = 90000
+#: solve_ivp run of the double pendulum at order 24, 83 kB of source: 1.06x-1.09x the
+#: loop routine's time; of a chain of three links at order 14, 101 kB: 1.15x-1.18x; within
+#: it, the double pendulum at order 18, 51 kB, 0.70x-0.75x, the cart pendulum at order 24,
+#: 46 kB, 0.74x-0.76x; bench/results/taylor_generalized_fixed.md)
+FIXED_MAX_SOURCE_GENERALIZED = 60000
 #: the same for a tree's written-out routine (its articulated-body chain's recurrences,
 #: written out as an ode system's): two point masses as a tree at orders 14 and 18 (108
-#: and 165 kB, compiled in 2 s) run in 0.63x and 0.78x the loop routine's time, at order
-#: 24 (274 kB) 0.89x; three at order 14 (285 kB, 13 s to compile) 1.05x
+#: and 165 kB, compiled in 2 s) run in 0.75x-0.76x and 0.86x the loop routine's time, at
+#: order 24 (274 kB) 0.95x-0.96x; three at order 14 (285 kB, 13 s to compile) 1.16x
 FIXED_MAX_SOURCE_TREE = 200000
 
 
