@@ -5,8 +5,10 @@
 !! abs(x) <= huge(x) for a finite x): no scope of the library uses the intrinsic IEEE
 !! modules, because gfortran saves and restores the whole floating-point environment
 !! (about 0.2 us) on every call of a procedure that sees their names, which an external
-!! procedure does through any module it uses that uses them: every entry of the flat
-!! layer paid it on each call.
+!! procedure does through any module it uses that uses them (every entry of the flat
+!! layer would pay it on each call). The comparison abs(x) <= huge(x) is an ordered one, so a NaN
+!! checked by it raises the invalid flag (as the Taylor stepper's checks always did); x /= x
+!! does not.
 module conmech_kinds
     use, intrinsic :: iso_fortran_env, only: real64, int32, int64
     implicit none
