@@ -12,30 +12,21 @@ tolerance, plus the step control), and the generated library's operations and bu
     python bench/bench_taylor_tree.py [--repeat 5] [--links 3 7] [--tf 10] [--amplitude 0.3]
 """
 import argparse
+import os
+import sys
 import time
 
 import numpy as np
-import sympy as sp
-from sympy.physics.mechanics import dynamicsymbols
 
 import conmech
 from conmech import symbolic
 from conmech.ivp.taylor import taylor_order
 from conmech.ivp.taylor_generalized import first_order_view
-from conmech.symbolic import Body, planar_tree
 from conmech.symbolic.taylor_tree import tree_decomposition
 
-
-def chain(N):
-    th = dynamicsymbols(f"th1:{N + 1}")
-    m, l = sp.symbols(f"m1:{N + 1}"), sp.symbols(f"l1:{N + 1}")
-    g = sp.Symbol("g")
-    bodies = [Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute", th[i],
-                   at=(0, 0) if i == 0 else (0, -l[i - 1]), mass=m[i], com=(0, -l[i]))
-              for i in range(N)]
-    params = {**{s: 0.8 + 0.15*i/N*3 for i, s in enumerate(m)},
-              **{s: 1.1 - 0.05*i/N*3 for i, s in enumerate(l)}, g: 9.81}
-    return planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python",
+                                "tests"))
+from taylor_jets import tree_chain  # noqa: E402
 
 
 def main():
@@ -49,7 +40,7 @@ def main():
     a = ap.parse_args()
     for N in a.links:
         t0 = time.perf_counter()
-        system = chain(N)
+        system = tree_chain(N, spread=3)     # masses and rods over those of 3 links
         t1 = time.perf_counter()
         first_order_view(system)          # the Taylor library: generated and compiled
         t2 = time.perf_counter()

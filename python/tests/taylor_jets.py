@@ -150,9 +150,11 @@ def pendulum_chain(n):
     return symbolic.lagrangian_system(T - U, q, params={g: 9.81})
 
 
-def tree_chain_bodies(n):
+def tree_chain_bodies(n, spread=None):
     """(bodies, parameters, g) of n point masses on rods pinned at the origin, angles from
-    the downward vertical: masses 0.8 + 0.15 i, rods 1.1 - 0.05 i."""
+    the downward vertical: masses 0.8 + 0.15 i, rods 1.1 - 0.05 i (with `spread`, the
+    increments scaled by spread/n: the masses and rods of any n span those of `spread`
+    links)."""
     from conmech.symbolic import Body
     th = dynamicsymbols(f"th1:{n + 1}")
     m, ell = sp.symbols(f"m1:{n + 1}"), sp.symbols(f"l1:{n + 1}")
@@ -160,16 +162,18 @@ def tree_chain_bodies(n):
     bodies = [Body(f"link{i}", None if i == 0 else f"link{i - 1}", "revolute", th[i],
                    at=(0, 0) if i == 0 else (0, -ell[i - 1]), mass=m[i], com=(0, -ell[i]))
               for i in range(n)]
-    params = {**{s: 0.8 + 0.15*i for i, s in enumerate(m)},
-              **{s: 1.1 - 0.05*i for i, s in enumerate(ell)}, g: 9.81}
+    def inc(c, i):
+        return c*i if spread is None else c*i/n*spread
+    params = {**{s: 0.8 + inc(0.15, i) for i, s in enumerate(m)},
+              **{s: 1.1 - inc(0.05, i) for i, s in enumerate(ell)}, g: 9.81}
     return bodies, params, g
 
 
-def tree_chain(n):
+def tree_chain(n, spread=None):
     """The chain of :func:`tree_chain_bodies` as a planar tree in absolute angles
     (symbolic.planar_tree: its articulated-body chain)."""
     from conmech.symbolic import planar_tree
-    bodies, params, g = tree_chain_bodies(n)
+    bodies, params, g = tree_chain_bodies(n, spread)
     return planar_tree(bodies, params, gravity=(0, -g), coordinates="absolute")
 
 
