@@ -80,7 +80,7 @@ fi
 stamp_file="$VENV/.conmech-build-stamp"
 stamp="$(
     {
-        find src python/conmech tools -type f \( -name '*.f90' -o -name '*.F90' -o -name '*.inc' -o -name '*.py' \) \
+        find src python/conmech tools -type f \( -name '*.f90' -o -name '*.F90' -o -name '*.inc' -o -name '*.py' -o -name '*.c' \) \
             -not -path '*/__pycache__/*' -print0 | sort -z | xargs -0 sha256sum
         sha256sum meson.build pyproject.toml
     } | sha256sum | cut -d' ' -f1

@@ -8,6 +8,7 @@ in Fortran memory for one more call (flat_solve_take) rather than calling back."
 import numpy as np
 
 from .. import _conmech
+from .._core import fastcall
 from .._core.callback import message_text
 from .._core.checks import NO_STEP_LIMIT
 from .._core.native import _NO_SPEC
@@ -23,7 +24,7 @@ _INT64 = np.int64
 # module-level names for the per-call path of run (a global lookup, not an attribute)
 _empty = np.empty
 _solve_packed = _conmech.flat_solve_packed
-_solve_kept = _conmech.flat_propagation_solve
+_solve_kept = fastcall.solve     # (flat_propagation_solve, without f2py's wrapper)
 # the step options a packed call is made with (prepare's by the fast entry): the method's
 # first step, no largest step, no step limit
 _NO_OPTIONS = (0.0, float(np.finfo(float).max), NO_STEP_LIMIT)

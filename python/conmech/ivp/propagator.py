@@ -25,6 +25,7 @@ from collections import namedtuple
 import numpy as np
 
 from .. import _conmech
+from .._core import fastcall
 from .._core.callback import message_text
 from .._core.checks import RTOL_FLOOR, _warn_rtol, initial_state, positive_finite, \
     real_scalar, step_limit, tolerance
@@ -52,7 +53,7 @@ _NOTHING_DONE = Propagation(True, 0, _SUCCESS, 0, 0, 0)
 _new_tuple = tuple.__new__
 _isfinite = math.isfinite
 _F64 = np.dtype(np.float64)
-_until = _conmech.flat_propagation_until
+_until = fastcall.until       # (flat_propagation_until, without f2py's wrapper)
 _empty = np.empty
 _array = np.array
 _ndarray = np.ndarray
@@ -144,6 +145,7 @@ class Propagator:
             self._packed = self._pack(fun, method, rtol, atol, max_step, max_steps,
                                       y.size)
         self._iout = np.empty(40, dtype=np.int64)   # 8 numbers, then the message's bytes
+        self._counts = self._iout[:8]       # (a view made once: no slice per call)
         self._handle = 0
         if self._packed is not None:
             self._open()
@@ -219,7 +221,7 @@ class Propagator:
                     _array(y, float)
                 iout = self._iout
                 _until(self._handle, params if params.size else _PAD, self.t, t, y, iout)
-                nt, nfev, _, _, naccept, nreject, info, _ = iout[:8].tolist()
+                nt, nfev, _, _, naccept, nreject, info, _ = self._counts.tolist()
                 if nt == 1 and info >= 0:
                     self.t = t
                     self.y = y
