@@ -181,15 +181,6 @@ static int read_integer(PyObject *obj, const char *name, long long lo, long long
     return 1;
 }
 
-static int check_nargs(const char *fname, Py_ssize_t nargs, Py_ssize_t expected)
-{
-    if (nargs == expected)
-        return 1;
-    PyErr_Format(PyExc_TypeError, "%s() takes %zd positional arguments (%zd given)", fname,
-                 expected, nargs);
-    return 0;
-}
-
 /* The iout argument: an int64 array of IOUT_SIZE numbers, writeable. */
 static int64_t *iout_data(PyObject *obj)
 {
@@ -203,6 +194,24 @@ static int64_t *iout_data(PyObject *obj)
     return iout;
 }
 
+/* The leading arguments of every entry: their number (`expected`, positional), the
+ * handle of the kept propagation and its parameters (read into `stack` or beyond, as
+ * read_doubles); 0 with the error set otherwise (nothing to release). */
+static int read_head(const char *fname, PyObject *const *args, Py_ssize_t nargs,
+                     Py_ssize_t expected, int64_t *handle, double *stack, doubles *params)
+{
+    long long k;
+    if (nargs != expected) {
+        PyErr_Format(PyExc_TypeError, "%s() takes %zd positional arguments (%zd given)",
+                     fname, expected, nargs);
+        return 0;
+    }
+    if (!read_integer(args[0], "handle", LLONG_MIN, LLONG_MAX, &k))
+        return 0;
+    *handle = (int64_t)k;
+    return read_doubles(args[1], stack, "params", params);
+}
+
 PyDoc_STRVAR(until_doc,
 "until(handle, params, t0, t1, y, iout)\n--\n\n"
 "flat_propagation_until(handle, params, t0, t1, y, iout) (y and iout written in place):\n"
@@ -211,18 +220,13 @@ PyDoc_STRVAR(until_doc,
 static PyObject *until(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double stack_p[STACK_DOUBLES];
-    doubles params = {NULL, NULL, NULL, 0};
-    long long k;
+    doubles params;
     int64_t handle, *iout;
     int n;
     double t0, t1, *y;
     PyObject *res = NULL;
     (void)self;
-    if (!check_nargs("until", nargs, 6) || !read_integer(args[0], "handle", LLONG_MIN,
-                                                         LLONG_MAX, &k))
-        return NULL;
-    handle = (int64_t)k;
-    if (!read_doubles(args[1], stack_p, "params", &params))
+    if (!read_head("until", args, nargs, 6, &handle, stack_p, &params))
         return NULL;
     if (!read_double(args[2], "t0", &t0) || !read_double(args[3], "t1", &t1))
         goto done;
@@ -247,20 +251,16 @@ PyDoc_STRVAR(solve_doc,
 static PyObject *solve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double stack_p[STACK_DOUBLES], stack_y[STACK_DOUBLES], stack_t[STACK_DOUBLES];
-    doubles params = {NULL, NULL, NULL, 0}, y0 = {NULL, NULL, NULL, 0},
-        te = {NULL, NULL, NULL, 0};
-    long long k, ms, wt, ne;
+    doubles params, y0 = {NULL, NULL, NULL, 0}, te = {NULL, NULL, NULL, 0};
+    long long ms, wt, ne;
     int64_t handle, *iout;
     int nout, max_steps, with_t_eval, neval;
     double t0, tf, h0, hmax, *out;
     PyObject *res = NULL;
     (void)self;
-    if (!check_nargs("solve", nargs, 13) || !read_integer(args[0], "handle", LLONG_MIN,
-                                                          LLONG_MAX, &k))
+    if (!read_head("solve", args, nargs, 13, &handle, stack_p, &params))
         return NULL;
-    handle = (int64_t)k;
-    if (!read_doubles(args[1], stack_p, "params", &params) ||
-        !read_double(args[2], "t0", &t0) || !read_double(args[3], "tf", &tf) ||
+    if (!read_double(args[2], "t0", &t0) || !read_double(args[3], "tf", &tf) ||
         !read_doubles(args[4], stack_y, "y0", &y0))
         goto done;
     if (!read_double(args[5], "h0", &h0) || !read_double(args[6], "hmax", &hmax) ||
