@@ -104,7 +104,9 @@ def test_long_state_and_times_read_from_lists():
     (0, 2**70, OverflowError, "too big"),
     (1, np.zeros(1, dtype=np.int64), TypeError, "params must be an array of float64"),
     (1, np.zeros((1, 1)), ValueError, "params must be a one-dimensional"),
-    (1, ["a"], TypeError, "params[0] must be a real number"),
+    (1, ["a"], TypeError, "params[0] must be a float or an int, got str"),
+    (1, [True], TypeError, "params[0] must be a float or an int, got bool"),
+    (1, [2**1100], OverflowError, "too large"),
     (2, "0", TypeError, "t0 must be a real number"),
     (3, None, TypeError, "t1 must be a real number"),
     (4, [0.1, 0.0, 0.0, 4.0], TypeError, "y must be a numpy array"),
@@ -179,7 +181,7 @@ def test_no_memory_kept_by_list_reads_and_refusals():
             fastcall.solve(p._handle, native_path._PAD, 0.0, 2.0, y0, 0.0, huge, 10**6, 1,
                            300, bad, out, np.zeros(40, np.int64))
         except TypeError as e:
-            right[0] += str(e) == "t_eval[299] must be a real number, got str"
+            right[0] += str(e) == "t_eval[299] must be a float or an int, got str"
 
     calls()
     tracemalloc.start()

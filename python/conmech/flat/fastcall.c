@@ -10,8 +10,8 @@
  * (converting or copying when it must) and a return value; here the arguments' kinds are
  * checked with type and flag tests only (no conversion, no copy: an argument of another
  * kind is refused with a TypeError or ValueError that names it; the callers pass arrays
- * of exactly these kinds). A read-only argument may also be a list or tuple of numbers (a
- * state, output times), read into a buffer, or a strided float64 array, copied.
+ * of exactly these kinds). A read-only argument may also be a list or tuple of floats and
+ * ints (a state, output times), read into a buffer, or a strided float64 array, copied.
  *
  * The functions are compiled into the extension module conmech._conmech and are a module
  * of their own, conmech._fastcall, with its own init function in the same shared object
@@ -98,8 +98,8 @@ static void release_doubles(doubles *d)
 }
 
 /* `obj` as read-only doubles: a one-dimensional float64 array (its data; a contiguous copy
- * of a strided or misaligned one), or a list or tuple of numbers (each converted as
- * float() does); 0 with the error set (naming `name`) otherwise. */
+ * of a strided or misaligned one), or a list or tuple of floats and ints; 0 with the error
+ * set (naming `name`) otherwise. */
 static int read_doubles(PyObject *obj, double *stack, const char *name, doubles *d)
 {
     Py_ssize_t i, m;
@@ -134,16 +134,24 @@ static int read_doubles(PyObject *obj, double *stack, const char *name, doubles 
         }
         d->data = d->heap;
     }
+    /* floats (and their subclasses, numpy's float64) and ints only: reading them runs no
+     * Python code, so the list cannot change while it is read */
     for (i = 0; i < m; i++) {
         PyObject *v = PySequence_Fast_GET_ITEM(obj, i);
-        double x = PyFloat_AsDouble(v);
-        if (x == -1.0 && PyErr_Occurred()) {
-            PyErr_Format(PyExc_TypeError, "%s[%zd] must be a real number, got %.100s", name,
-                         i, Py_TYPE(v)->tp_name);
+        if (PyFloat_Check(v)) {
+            d->data[i] = PyFloat_AS_DOUBLE(v);
+        } else if (PyLong_CheckExact(v)) {
+            d->data[i] = PyLong_AsDouble(v);
+            if (d->data[i] == -1.0 && PyErr_Occurred()) {
+                release_doubles(d);
+                return 0;
+            }
+        } else {
+            PyErr_Format(PyExc_TypeError, "%s[%zd] must be a float or an int, got %.100s",
+                         name, i, Py_TYPE(v)->tp_name);
             release_doubles(d);
             return 0;
         }
-        d->data[i] = x;
     }
     d->size = (int)m;
     return 1;
@@ -246,7 +254,7 @@ PyDoc_STRVAR(solve_doc,
 "      iout)\n--\n\n"
 "flat_propagation_solve with these arguments (out and iout written in place): a\n"
 "solve_ivp run by the kept propagation at handle. y0 and t_eval: float64 arrays, or\n"
-"lists or tuples of numbers.");
+"lists or tuples of floats and ints.");
 
 static PyObject *solve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
