@@ -54,8 +54,10 @@ def test_solve_gives_f2py_numbers():
     params = p._packed[1] if p._packed[1].size else native_path._PAD
     huge = float(np.finfo(float).max)
     n = y0.size
+    swapped = ">f8" if np.little_endian else "<f8"
     for y, t_eval in [(y0, None), (y0.tolist(), None), (tuple(y0), [0.5, 1.0, 2.0]),
-                      (y0, np.array([0.25, 3.0])), (np.repeat(y0, 2)[::2], (1.5,))]:
+                      (y0, np.array([0.25, 3.0])), (np.repeat(y0, 2)[::2], (1.5,)),
+                      (y0.astype(swapped), np.array([0.5, 2.5], dtype=swapped))]:
         outs = []
         for f in (_conmech.flat_propagation_solve, fastcall.solve):
             out = np.zeros(200*(n + 1))
@@ -112,6 +114,8 @@ def test_long_state_and_times_read_from_lists():
     (4, [0.1, 0.0, 0.0, 4.0], TypeError, "y must be a numpy array"),
     (4, np.zeros(8)[::2], ValueError, "y must be a one-dimensional contiguous array"),
     (4, np.zeros(4, dtype=np.float32), TypeError, "y must be an array of float64"),
+    (4, np.zeros(4, dtype=">f8" if np.little_endian else "<f8"), ValueError,
+     "y must be in the machine's byte order"),
     (5, np.zeros(8, dtype=np.int64), ValueError, "iout must have 40 entries"),
     (5, np.zeros(40), TypeError, "iout must be an array of int64"),
 ])

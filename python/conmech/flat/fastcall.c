@@ -11,7 +11,8 @@
  * checked with type and flag tests only (no conversion, no copy: an argument of another
  * kind is refused with a TypeError or ValueError that names it; the callers pass arrays
  * of exactly these kinds). A read-only argument may also be a list or tuple of floats and
- * ints (a state, output times), read into a buffer, or a strided float64 array, copied.
+ * ints (a state, output times), read into a buffer, or a strided or byte-swapped float64
+ * array, copied.
  *
  * The functions are compiled into the extension module conmech._conmech and are a module
  * of their own, conmech._fastcall, with its own init function in the same shared object
@@ -43,7 +44,8 @@ extern void flat_propagation_solve_(int64_t *handle, int *lp, double *params, do
 /* states and output times given as lists up to this size are read into the stack */
 #define STACK_DOUBLES 64
 
-/* The data of a one-dimensional, C-contiguous, aligned numpy array of type `type`
+/* The data of a one-dimensional, C-contiguous, aligned numpy array of type `type` in the
+ * machine's byte order
  * (writeable when `writeable`) and its size in *size (at most INT_MAX: the Fortran
  * routines take sizes as int); NULL with a TypeError or ValueError naming the argument
  * `name` otherwise. */
@@ -65,6 +67,10 @@ static void *array_data(PyObject *obj, int type, int writeable, const char *name
     if (PyArray_NDIM(a) != 1 || !PyArray_IS_C_CONTIGUOUS(a) || !PyArray_ISALIGNED(a)) {
         PyErr_Format(PyExc_ValueError, "%s must be a one-dimensional contiguous array",
                      name);
+        return NULL;
+    }
+    if (!PyArray_ISNOTSWAPPED(a)) {
+        PyErr_Format(PyExc_ValueError, "%s must be in the machine's byte order", name);
         return NULL;
     }
     if (writeable && !PyArray_ISWRITEABLE(a)) {
@@ -98,8 +104,8 @@ static void release_doubles(doubles *d)
 }
 
 /* `obj` as read-only doubles: a one-dimensional float64 array (its data; a contiguous copy
- * of a strided or misaligned one), or a list or tuple of floats and ints; 0 with the error
- * set (naming `name`) otherwise. */
+ * in the machine's byte order of a strided, misaligned or byte-swapped one), or a list or
+ * tuple of floats and ints; 0 with the error set (naming `name`) otherwise. */
 static int read_doubles(PyObject *obj, double *stack, const char *name, doubles *d)
 {
     Py_ssize_t i, m;
@@ -109,7 +115,8 @@ static int read_doubles(PyObject *obj, double *stack, const char *name, doubles 
         if (PyArray_Check(obj) && PyArray_TYPE((PyArrayObject *)obj) == NPY_DOUBLE &&
             PyArray_NDIM((PyArrayObject *)obj) == 1 &&
             !(PyArray_IS_C_CONTIGUOUS((PyArrayObject *)obj) &&
-              PyArray_ISALIGNED((PyArrayObject *)obj))) {
+              PyArray_ISALIGNED((PyArrayObject *)obj) &&
+              PyArray_ISNOTSWAPPED((PyArrayObject *)obj))) {
             d->owned = PyArray_FROMANY(obj, NPY_DOUBLE, 1, 1, NPY_ARRAY_IN_ARRAY);
             if (d->owned == NULL)
                 return 0;
