@@ -45,10 +45,9 @@ extern void flat_propagation_solve_(int64_t *handle, int *lp, double *params, do
 #define STACK_DOUBLES 64
 
 /* The data of a one-dimensional, C-contiguous, aligned numpy array of type `type` in the
- * machine's byte order
- * (writeable when `writeable`) and its size in *size (at most INT_MAX: the Fortran
- * routines take sizes as int); NULL with a TypeError or ValueError naming the argument
- * `name` otherwise. */
+ * machine's byte order (writeable when `writeable`) and its size in *size (at most
+ * INT_MAX: the Fortran routines take sizes as int); NULL with a TypeError or ValueError
+ * naming the argument `name` otherwise. */
 static void *array_data(PyObject *obj, int type, int writeable, const char *name,
                         int *size)
 {

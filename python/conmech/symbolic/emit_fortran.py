@@ -63,14 +63,13 @@ _RESERVED = {"n", "n_hol", "n_nh", "rheonomic", "ndof", "mass", "forces", "energ
              "rhs_jacobian_product", "has_jacobian_product", "rhs_jacobian",
              "taylor_size", "taylor_jet"}
 # names the type may not take: Fortran's intrinsic types (C424 of Fortran 2008), what the
-# emitted code takes from conmech, the intrinsic modules (and ieee_value, ieee_quiet_nan),
-# and the intrinsic functions of its quiet NaN (printer.quiet_nan): a local name would hide
-# them
+# emitted code takes from conmech, the intrinsic modules, and the intrinsic functions of
+# its quiet NaN (printer.quiet_nan): a local name would hide them
 _TYPE_TAKEN = {"real", "integer", "logical", "character", "complex", "doubleprecision",
                "doublecomplex", "ode_system", "generalized_system", "constrained_system",
-               "cm_success", "mass_cholesky", "dpotrs", "ieee_value", "ieee_quiet_nan",
-               "ieee_arithmetic", "ieee_exceptions", "ieee_features", "iso_c_binding",
-               "iso_fortran_env", "transfer", "int", "selected_int_kind"}
+               "cm_success", "mass_cholesky", "dpotrs", "ieee_arithmetic",
+               "ieee_exceptions", "ieee_features", "iso_c_binding", "iso_fortran_env",
+               "transfer", "int", "selected_int_kind"}
 _IND = "        "
 # what generated code may take from conmech: the module imports exactly the ones it uses
 # (`use conmech, only:`), so that a type, a constant or a parameter of the model may share a
